@@ -1,0 +1,100 @@
+//! Typed errors of the library.
+//!
+//! Every fallible function of `asperity` returns [`Result<T>`](crate::Result) with this
+//! [`Error`]. Messages are one line, name the offending value and say what is allowed, so
+//! that a command-line front end can print them as they are.
+
+use std::path::PathBuf;
+
+/// The error type of the `asperity` library.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A parameter is outside its allowed range (checked once, at construction).
+    #[error("invalid {name}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name as a user would write it (e.g. `hurst`).
+        name: &'static str,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file exists where an output should go and overwriting was not allowed.
+    #[error("{0}: output already exists (use --force to overwrite)")]
+    OutputExists(PathBuf),
+    /// A `.npy` file could not be read as the array that was expected.
+    #[error("{path}: {reason}")]
+    BadArrayFile {
+        /// The file concerned.
+        path: PathBuf,
+        /// What was wrong (dtype, shape, ...).
+        reason: String,
+    },
+    /// An input array holds NaN or infinity.
+    #[error("{what} holds a non-finite value ({value}) at index {index}")]
+    NonFinite {
+        /// What array (file name or description).
+        what: String,
+        /// Flat (row-major) index of the first bad value.
+        index: usize,
+        /// The bad value.
+        value: f64,
+    },
+    /// A computation would need more memory than the machine has available.
+    #[error("{what} needs about {needed_mib} MiB but only {available_mib} MiB are available")]
+    OutOfMemory {
+        /// What was to be allocated.
+        what: String,
+        /// Estimated need.
+        needed_mib: u64,
+        /// Memory available now.
+        available_mib: u64,
+    },
+    /// A metadata (JSON / TOML) file could not be parsed or written.
+    #[error("{path}: {reason}")]
+    Metadata {
+        /// The file concerned.
+        path: PathBuf,
+        /// The parser's message.
+        reason: String,
+    },
+}
+
+impl Error {
+    /// Shorthand for [`Error::InvalidParameter`].
+    pub fn invalid(name: &'static str, reason: impl Into<String>) -> Self {
+        Error::InvalidParameter {
+            name,
+            reason: reason.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Io`].
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// `Result` with the library's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Checks that every value is finite; the error names `what` and the first bad index.
+pub fn ensure_finite<'a>(what: &str, values: impl IntoIterator<Item = &'a f64>) -> Result<()> {
+    match values.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        Some((index, &value)) => Err(Error::NonFinite {
+            what: what.to_string(),
+            index,
+            value,
+        }),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,414 @@
+//! Fourier synthesis of rough surfaces and lines with random phases.
+//!
+//! Each Fourier mode gets the amplitude `sqrt(C(q))` of the requested spectrum and a phase
+//! drawn uniformly in `[0, 2π)`; Hermitian symmetry (`h(-q) = conj h(q)`) makes the heights
+//! real. Modes that are their own conjugate (the Nyquist rows and columns of even grids) get
+//! a random sign instead of a phase; the mean (`q = 0`) is zero. This is the paper's
+//! "inverse Fourier transform with random phases" — eq. (1) with (7)/(8) for surfaces, and
+//! eqs. (9)–(11) with `C1D = π q C2D` (28) for lines, all modes from `2π/L` to the Nyquist
+//! wavenumber. The realisation is then scaled to the requested [`Normalisation`], exactly
+//! (to rounding) for *this* realisation.
+//!
+//! # Determinism
+//! Phases come from `ChaCha8Rng::seed_from_u64(seed)`, one stream per `kx` (surfaces) or a
+//! single stream (lines), never from a thread-local or shared generator: the same seed
+//! gives bit-identical heights whatever the number of threads.
+//!
+//! # Example
+//! ```
+//! use asperity::spectrum::Psd;
+//! use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
+//! let spec = SurfaceSpec::new(64, 64, 1.0, Psd::power_law(0.8)?, Normalisation::RmsSlope(1.0))?;
+//! let surface = SurfaceGenerator::new(&spec)?.generate(42);
+//! let slope = asperity::surface::stats::rms_slope_2d(surface.heights().view(), surface.spacing());
+//! assert!((slope - 1.0).abs() < 1e-12);
+//! # Ok::<(), asperity::Error>(())
+//! ```
+
+use num_complex::Complex64;
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+use realfft::{ComplexToReal, RealFftPlanner};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+use super::{stats, validate_size, Line, Normalisation, Surface};
+use crate::fft::RealFft2;
+use crate::memory::{array_bytes, ensure_fits};
+use crate::spectrum::Psd;
+use crate::{Error, Result};
+
+/// What to generate: grid, side length, spectrum and normalisation. Validated by
+/// [`SurfaceSpec::new`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceSpec {
+    /// Grid rows (y).
+    pub rows: usize,
+    /// Grid columns (x).
+    pub cols: usize,
+    /// Side length along x.
+    pub size: f64,
+    /// Spectrum shape.
+    pub psd: Psd,
+    /// Scaling of each realisation.
+    pub normalisation: Normalisation,
+}
+
+impl SurfaceSpec {
+    /// Checks the grid (at least 2×2), the size and the normalisation.
+    pub fn new(rows: usize, cols: usize, size: f64, psd: Psd, normalisation: Normalisation) -> Result<Self> {
+        if rows < 2 || cols < 2 {
+            return Err(Error::invalid("n", format!("grid must be at least 2x2, got {rows}x{cols}")));
+        }
+        validate_size(size)?;
+        normalisation.validate()?;
+        Ok(SurfaceSpec { rows, cols, size, psd, normalisation })
+    }
+}
+
+/// Generates surfaces of one [`SurfaceSpec`], reusing its FFT plan and buffers.
+pub struct SurfaceGenerator {
+    spec: SurfaceSpec,
+    fft: RealFft2,
+    spectrum: Vec<Complex64>,
+}
+
+/// A random sign or unit phase factor for mode `(kx, ky)`.
+fn random_phase(rng: &mut ChaCha8Rng) -> Complex64 {
+    let phase = std::f64::consts::TAU * rng.random::<f64>();
+    Complex64::from_polar(1.0, phase)
+}
+
+fn random_sign(rng: &mut ChaCha8Rng) -> f64 {
+    if rng.random::<bool>() {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+impl SurfaceGenerator {
+    /// Plans the transforms; fails if the grid would not fit in memory.
+    pub fn new(spec: &SurfaceSpec) -> Result<Self> {
+        // heights (8 B) + spectrum and FFT work buffer (2 × 16 B per half-grid point).
+        let bytes = array_bytes(&[spec.rows, spec.cols], 8 + 16 + 8);
+        ensure_fits(&format!("a {}x{} surface", spec.rows, spec.cols), bytes)?;
+        let fft = RealFft2::new(spec.rows, spec.cols);
+        let spectrum = vec![Complex64::default(); fft.spectrum_len()];
+        Ok(SurfaceGenerator { spec: *spec, fft, spectrum })
+    }
+
+    /// The specification this generator draws from.
+    pub fn spec(&self) -> &SurfaceSpec {
+        &self.spec
+    }
+
+    /// One realisation for `seed`.
+    pub fn generate(&mut self, seed: u64) -> Surface {
+        let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
+        self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))
+            .expect("a validated spec has power on its grid");
+        Surface { heights, size: self.spec.size }
+    }
+
+    /// One realisation for `seed`, written into `heights` (`rows × cols`, row-major).
+    /// Fails only if the spectrum has no power on this grid (e.g. a cut-off above Nyquist).
+    pub fn try_generate(&mut self, seed: u64) -> Result<Surface> {
+        let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
+        self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))?;
+        Ok(Surface { heights, size: self.spec.size })
+    }
+
+    /// Writes a realisation into `heights` (`rows × cols`, row-major).
+    pub fn generate_into(&mut self, seed: u64, heights: &mut [f64]) -> Result<()> {
+        let SurfaceSpec { rows, cols, psd, .. } = self.spec;
+        // κ_y = ky · (L / Ly) because Ly = L·rows/cols.
+        let aspect = cols as f64 / rows as f64;
+        let nyquist_x = (cols % 2 == 0).then_some(cols / 2);
+        let nyquist_y = (rows % 2 == 0).then_some(rows / 2);
+        self.spectrum
+            .par_chunks_mut(rows)
+            .enumerate()
+            .for_each(|(kx, column)| {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                rng.set_stream(kx as u64);
+                for (ky_index, value) in column.iter_mut().enumerate() {
+                    let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+                    let kappa = (kx as f64).hypot(ky * aspect);
+                    let amplitude = psd.c2d(kappa).sqrt();
+                    *value = amplitude * random_phase(&mut rng);
+                }
+                // Columns kx = 0 and kx = Nyquist hold both ±ky: impose h(-ky) = conj h(ky).
+                if kx == 0 || Some(kx) == nyquist_x {
+                    for ky_index in rows / 2 + 1..rows {
+                        column[ky_index] = column[rows - ky_index].conj();
+                    }
+                    for self_conjugate in std::iter::once(0).chain(nyquist_y) {
+                        let v = &mut column[self_conjugate];
+                        *v = Complex64::new(v.norm() * random_sign(&mut rng), 0.0);
+                    }
+                }
+            });
+        self.fft.inverse(&mut self.spectrum, heights);
+        let view = ndarray::ArrayView2::from_shape((rows, cols), &*heights).expect("shape");
+        let realised = match self.spec.normalisation {
+            Normalisation::RmsHeight(_) => stats::rms_height(view.iter().copied()),
+            Normalisation::RmsSlope(_) => stats::rms_slope_2d(view, self.spec.size / cols as f64),
+        };
+        scale_to(heights, realised, self.spec.normalisation)
+    }
+}
+
+fn scale_to(heights: &mut [f64], realised: f64, target: Normalisation) -> Result<()> {
+    let want = match target {
+        Normalisation::RmsHeight(v) | Normalisation::RmsSlope(v) => v,
+    };
+    if !(realised.is_finite() && realised > 0.0) {
+        return Err(Error::invalid(
+            "spectrum",
+            "no power on this grid (is the cut-off above the grid's Nyquist wavenumber?)",
+        ));
+    }
+    let factor = want / realised;
+    heights.par_iter_mut().for_each(|h| *h *= factor);
+    Ok(())
+}
+
+/// What line to generate: points, length, spectrum (given as the 2D spectrum it is a
+/// cut through; the line uses `C1D = π q C2D`, eq. 28) and normalisation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LineSpec {
+    /// Number of points.
+    pub n: usize,
+    /// Length of the line.
+    pub size: f64,
+    /// The 2D spectrum shape the line represents.
+    pub psd: Psd,
+    /// Scaling of each realisation.
+    pub normalisation: Normalisation,
+}
+
+impl LineSpec {
+    /// Checks `n ≥ 2`, the size and the normalisation.
+    pub fn new(n: usize, size: f64, psd: Psd, normalisation: Normalisation) -> Result<Self> {
+        if n < 2 {
+            return Err(Error::invalid("n", format!("a line needs at least 2 points, got {n}")));
+        }
+        validate_size(size)?;
+        normalisation.validate()?;
+        Ok(LineSpec { n, size, psd, normalisation })
+    }
+}
+
+/// Generates rough lines of one [`LineSpec`], eqs. (9)–(11), reusing plan and buffers.
+pub struct LineGenerator {
+    spec: LineSpec,
+    c2r: Arc<dyn ComplexToReal<f64>>,
+    amplitudes: Vec<f64>,
+    spectrum: Vec<Complex64>,
+    scratch: Vec<Complex64>,
+}
+
+impl LineGenerator {
+    /// Plans the inverse real FFT of length `n` and tabulates the amplitudes `B(q)` (10).
+    pub fn new(spec: &LineSpec) -> Result<Self> {
+        ensure_fits(&format!("a line of {} points", spec.n), array_bytes(&[spec.n], 8 + 16 + 16))?;
+        let c2r = RealFftPlanner::<f64>::new().plan_fft_inverse(spec.n);
+        let half = spec.n / 2 + 1;
+        let amplitudes = (0..half).map(|k| spec.psd.c1d(k as f64).sqrt()).collect();
+        let scratch = vec![Complex64::default(); c2r.get_scratch_len()];
+        Ok(LineGenerator { spec: *spec, c2r, amplitudes, spectrum: vec![Complex64::default(); half], scratch })
+    }
+
+    /// The specification this generator draws from.
+    pub fn spec(&self) -> &LineSpec {
+        &self.spec
+    }
+
+    /// One realisation for `seed`.
+    pub fn generate(&mut self, seed: u64) -> Line {
+        let mut heights = ndarray::Array1::zeros(self.spec.n);
+        self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))
+            .expect("a line spectrum always has power at q = 2π/L unless cut off");
+        Line { heights, size: self.spec.size }
+    }
+
+    /// One realisation for `seed`, failing if the spectrum has no power on this grid.
+    pub fn try_generate(&mut self, seed: u64) -> Result<Line> {
+        let mut heights = ndarray::Array1::zeros(self.spec.n);
+        self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))?;
+        Ok(Line { heights, size: self.spec.size })
+    }
+
+    /// Writes a realisation into `heights` (length `n`).
+    pub fn generate_into(&mut self, seed: u64, heights: &mut [f64]) -> Result<()> {
+        let n = self.spec.n;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for (value, &amplitude) in self.spectrum.iter_mut().zip(&self.amplitudes) {
+            *value = amplitude * random_phase(&mut rng);
+        }
+        self.spectrum[0] = Complex64::default();
+        if n % 2 == 0 {
+            let v = &mut self.spectrum[n / 2];
+            *v = Complex64::new(v.norm() * random_sign(&mut rng), 0.0);
+        }
+        self.c2r
+            .process_with_scratch(&mut self.spectrum, heights, &mut self.scratch)
+            .expect("buffer sizes fixed at planning");
+        let realised = match self.spec.normalisation {
+            Normalisation::RmsHeight(_) => stats::rms_height(heights.iter().copied()),
+            Normalisation::RmsSlope(_) => stats::rms_slope_1d(heights, self.spec.size / n as f64),
+        };
+        scale_to(heights, realised, self.spec.normalisation)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::LongWavelength;
+    use crate::surface::stats::{radial_psd_2d, line_psd, rms_slope_1d, rms_slope_2d};
+    use crate::fit::power_law_fit;
+
+    fn surface_spec(rows: usize, cols: usize, hurst: f64, norm: Normalisation) -> SurfaceSpec {
+        SurfaceSpec::new(rows, cols, 1.0, Psd::power_law(hurst).unwrap(), norm).unwrap()
+    }
+
+    /// Slope of the ensemble-averaged radial PSD, fitted over κ ∈ [4, κ_max].
+    fn fitted_psd_exponent_2d(hurst: f64, realisations: u64) -> f64 {
+        let spec = surface_spec(128, 128, hurst, Normalisation::RmsHeight(1.0));
+        let mut generator = SurfaceGenerator::new(&spec).unwrap();
+        let mut mean: Vec<(f64, f64)> = Vec::new();
+        for seed in 0..realisations {
+            let psd = radial_psd_2d(&generator.generate(seed));
+            if mean.is_empty() {
+                mean = psd.iter().map(|b| (b.q, 0.0)).collect();
+            }
+            for (m, b) in mean.iter_mut().zip(&psd) {
+                m.1 += b.psd / realisations as f64;
+            }
+        }
+        let kappa_of = |q: f64| q / std::f64::consts::TAU;
+        let (q, c): (Vec<f64>, Vec<f64>) = mean.into_iter().filter(|(q, _)| kappa_of(*q) >= 4.0).unzip();
+        power_law_fit(&q, &c).unwrap().exponent
+    }
+
+    #[test]
+    fn surface_psd_follows_power_law() {
+        // Random phases give each mode exactly its target power; what remains is the radial
+        // binning of lattice points and the two self-conjugate Nyquist lines, so 0.05 on the
+        // exponent is generous for κ ≥ 4 (steep spectra are most sensitive to binning).
+        for hurst in [-0.5, 0.5, 0.8, 2.5] {
+            let exponent = fitted_psd_exponent_2d(hurst, 8);
+            let expected = -2.0 * hurst - 2.0;
+            assert!((exponent - expected).abs() < 0.05, "H = {hurst}: slope {exponent} vs {expected}");
+        }
+    }
+
+    #[test]
+    fn line_psd_follows_power_law() {
+        for hurst in [-0.5, 0.5, 0.8, 2.5] {
+            let spec = LineSpec::new(4096, 1.0, Psd::power_law(hurst).unwrap(), Normalisation::RmsHeight(1.0)).unwrap();
+            let mut generator = LineGenerator::new(&spec).unwrap();
+            let mut mean = vec![0.0; 2048];
+            let mut q = vec![0.0; 2048];
+            for seed in 0..8 {
+                for (i, b) in line_psd(&generator.generate(seed)).iter().take(2048).enumerate() {
+                    q[i] = b.q;
+                    mean[i] += b.psd / 8.0;
+                }
+            }
+            // Exactly the target power in each mode, so the fit is exact but for rounding.
+            let fit = power_law_fit(&q[..2047], &mean[..2047]).unwrap();
+            let expected = -2.0 * hurst - 1.0;
+            assert!((fit.exponent - expected).abs() < 1e-6, "H = {hurst}: {} vs {expected}", fit.exponent);
+        }
+    }
+
+    #[test]
+    fn roll_off_flat_and_cut_off_empty_below_q0() {
+        let q0 = 6.0;
+        for (long, flat) in [(LongWavelength::RollOff { q0 }, true), (LongWavelength::CutOff { q0 }, false)] {
+            let psd = Psd::new(0.8, long, None).unwrap();
+            let spec = SurfaceSpec::new(64, 64, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
+            let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3));
+            let kappa = |q: f64| q / std::f64::consts::TAU;
+            let at_q0 = bins.iter().find(|b| (kappa(b.q) - q0).abs() < 0.5).unwrap().psd;
+            for b in bins.iter().filter(|b| kappa(b.q) < q0 - 0.5) {
+                if flat {
+                    assert!((b.psd / at_q0 - 1.0).abs() < 0.25, "roll-off bin κ={} ratio {}", kappa(b.q), b.psd / at_q0);
+                } else {
+                    assert!(b.psd < 1e-20 * at_q0, "cut-off bin κ={} has power {}", kappa(b.q), b.psd);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn normalisation_is_exact() {
+        for (rows, cols) in [(64, 64), (33, 47), (40, 90)] {
+            let h = SurfaceGenerator::new(&surface_spec(rows, cols, 0.8, Normalisation::RmsHeight(2.5))).unwrap().generate(1);
+            let rms = stats::rms_height(h.heights().iter().copied());
+            assert!((rms / 2.5 - 1.0).abs() < 1e-10, "{rows}x{cols}: {rms}");
+            let s = SurfaceGenerator::new(&surface_spec(rows, cols, 0.3, Normalisation::RmsSlope(0.7))).unwrap().generate(1);
+            let slope = rms_slope_2d(s.heights().view(), s.spacing());
+            assert!((slope / 0.7 - 1.0).abs() < 1e-10, "{rows}x{cols}: {slope}");
+        }
+        let line_spec = LineSpec::new(1001, 2.0, Psd::power_law(1.0).unwrap(), Normalisation::RmsSlope(0.3)).unwrap();
+        let line = LineGenerator::new(&line_spec).unwrap().generate(5);
+        let slope = rms_slope_1d(line.heights().as_slice().unwrap(), line.spacing());
+        assert!((slope / 0.3 - 1.0).abs() < 1e-10);
+    }
+
+    #[test]
+    fn same_seed_same_bits_whatever_the_thread_count() {
+        let spec = surface_spec(96, 130, 0.8, Normalisation::RmsHeight(1.0));
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| SurfaceGenerator::new(&spec).unwrap().generate(77))
+        };
+        let reference = run(1);
+        for threads in [2, 3, 7] {
+            assert!(run(threads).heights().iter().zip(reference.heights()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+        assert_ne!(SurfaceGenerator::new(&spec).unwrap().generate(78), reference);
+    }
+
+    #[test]
+    fn every_mode_keeps_its_amplitude_on_odd_even_grids() {
+        // If Hermitian symmetry were broken, the inverse real FFT would drop part of some
+        // modes; the forward FFT of the heights would then not reproduce sqrt(C2D) · const.
+        for (rows, cols) in [(2, 2), (3, 3), (16, 16), (17, 16), (16, 17), (5, 64)] {
+            let spec = surface_spec(rows, cols, 0.5, Normalisation::RmsHeight(1.0));
+            let s = SurfaceGenerator::new(&spec).unwrap().generate(9);
+            let mean = s.heights().mean().unwrap();
+            assert!(mean.abs() < 1e-12, "{rows}x{cols}: mean {mean}");
+            let mut fft = RealFft2::new(rows, cols);
+            let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+            fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
+            let aspect = cols as f64 / rows as f64;
+            let mut ratio = None;
+            for (kx, column) in spectrum.chunks(rows).enumerate() {
+                for (ky_index, value) in column.iter().enumerate() {
+                    let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+                    let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
+                    if target == 0.0 {
+                        assert!(value.norm() < 1e-9, "{rows}x{cols}: mode ({kx},{ky}) should be empty");
+                        continue;
+                    }
+                    let r = value.norm() / target;
+                    let r0 = *ratio.get_or_insert(r);
+                    assert!((r / r0 - 1.0).abs() < 1e-9, "{rows}x{cols}: mode ({kx},{ky}) ratio {r} vs {r0}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn cut_off_beyond_nyquist_is_an_error() {
+        let psd = Psd::new(0.5, LongWavelength::CutOff { q0: 100.0 }, None).unwrap();
+        let spec = SurfaceSpec::new(16, 16, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
+        assert!(SurfaceGenerator::new(&spec).unwrap().try_generate(0).is_err());
+    }
+}

@@ -1,0 +1,156 @@
+//! Rough surfaces (2D grids) and rough lines (1D), their synthesis and their statistics.
+//!
+//! * [`generate`]: Fourier synthesis with random phases — the paper's "inverse Fourier
+//!   transform with random phases" for surfaces (eq. 1 with 7/8) and lines (eqs. 9–11, 28).
+//! * [`stats`]: rms height, rms slope, rms curvature and the radially averaged PSD.
+//!
+//! Layout: a [`Surface`] holds `rows × cols` heights, row-major, index `(row, col)` =
+//! `(y, x)`; the side along x is `size`, pixels are square with spacing `size / cols`,
+//! so the side along y is `size · rows / cols`. A [`Line`] holds `n` heights with spacing
+//! `size / n`. Heights are positive up.
+
+pub mod generate;
+pub mod stats;
+
+use ndarray::{Array1, Array2};
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+pub use generate::{LineGenerator, LineSpec, SurfaceGenerator, SurfaceSpec};
+
+/// How a generated realisation is scaled (checked by [`Normalisation::validate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", content = "value", rename_all = "snake_case")]
+pub enum Normalisation {
+    /// Scale so that the rms height (about the mean) equals the value.
+    RmsHeight(f64),
+    /// Scale so that the rms slope (finite differences, see [`stats`]) equals the value.
+    RmsSlope(f64),
+}
+
+impl Default for Normalisation {
+    /// Unit rms height.
+    fn default() -> Self {
+        Normalisation::RmsHeight(1.0)
+    }
+}
+
+impl Normalisation {
+    /// Checks that the target is positive and finite.
+    pub fn validate(&self) -> Result<()> {
+        let (name, value) = match *self {
+            Normalisation::RmsHeight(v) => ("rms-height", v),
+            Normalisation::RmsSlope(v) => ("rms-slope", v),
+        };
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(Error::invalid(name, format!("must be positive and finite, got {value}")))
+        }
+    }
+}
+
+/// Checks a physical side length.
+pub(crate) fn validate_size(size: f64) -> Result<()> {
+    if size.is_finite() && size > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid("size", format!("side length must be positive and finite, got {size}")))
+    }
+}
+
+/// A rough surface: heights on a grid of square pixels (see the module docs for layout).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    heights: Array2<f64>,
+    size: f64,
+}
+
+impl Surface {
+    /// Wraps heights with the side length along x; checks for ≥ 2×2, finite values and a
+    /// positive size.
+    pub fn new(heights: Array2<f64>, size: f64) -> Result<Self> {
+        validate_size(size)?;
+        if heights.nrows() < 2 || heights.ncols() < 2 {
+            return Err(Error::invalid("grid", format!("a surface needs at least 2x2 points, got {:?}", heights.dim())));
+        }
+        crate::ensure_finite("surface", heights.iter())?;
+        Ok(Surface { heights, size })
+    }
+
+    /// Heights, `rows × cols`.
+    pub fn heights(&self) -> &Array2<f64> {
+        &self.heights
+    }
+
+    /// Consumes the surface, returning its heights.
+    pub fn into_heights(self) -> Array2<f64> {
+        self.heights
+    }
+
+    /// Side length along x (columns).
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// Pixel spacing `size / cols`.
+    pub fn spacing(&self) -> f64 {
+        self.size / self.heights.ncols() as f64
+    }
+
+    /// `(rows, cols)`.
+    pub fn dim(&self) -> (usize, usize) {
+        self.heights.dim()
+    }
+}
+
+/// A rough line: heights at spacing `size / n`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Line {
+    heights: Array1<f64>,
+    size: f64,
+}
+
+impl Line {
+    /// Wraps heights with the line's length; checks for ≥ 2 points, finite values and a
+    /// positive size.
+    pub fn new(heights: Array1<f64>, size: f64) -> Result<Self> {
+        validate_size(size)?;
+        if heights.len() < 2 {
+            return Err(Error::invalid("grid", format!("a line needs at least 2 points, got {}", heights.len())));
+        }
+        crate::ensure_finite("line", heights.iter())?;
+        Ok(Line { heights, size })
+    }
+
+    /// Heights.
+    pub fn heights(&self) -> &Array1<f64> {
+        &self.heights
+    }
+
+    /// Consumes the line, returning its heights.
+    pub fn into_heights(self) -> Array1<f64> {
+        self.heights
+    }
+
+    /// Length of the line.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// Point spacing `size / n`.
+    pub fn spacing(&self) -> f64 {
+        self.size / self.heights.len() as f64
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.heights.len()
+    }
+
+    /// Always false: a line has at least two points.
+    pub fn is_empty(&self) -> bool {
+        self.heights.is_empty()
+    }
+}

@@ -1,0 +1,239 @@
+//! Statistics of surfaces and lines: rms height, slope and curvature; radially averaged PSD.
+//!
+//! Definitions (stated once, used everywhere, including by the normalisation of generated
+//! surfaces, so that a requested rms slope is what `stats` reports):
+//! * rms height: `sqrt(mean((h − mean h)²))`.
+//! * rms slope: from forward differences, `sqrt(mean((Δh/Δx)²) + mean((Δh/Δy)²))` over all
+//!   neighbouring pairs inside the grid (no wrap-around), so it also suits measured,
+//!   non-periodic topographies. For a line, `sqrt(mean((Δh/Δx)²))`.
+//! * rms curvature: half the rms of the five-point Laplacian over interior points (the rms
+//!   mean curvature); for a line, the rms of the three-point second difference.
+//! * PSD: the periodogram normalised so that `Σ_q C2D(q) (2π)²/A = rms²` (2D) and
+//!   `Σ_q C1D(q) 2π/L = rms²` over both signs of q (1D), averaged radially over rings of
+//!   width `2π/L` (2D). Each bin reports the mean `q` of the modes in it.
+
+use ndarray::ArrayView2;
+use num_complex::Complex64;
+use realfft::RealFftPlanner;
+use serde::Serialize;
+
+use super::{Line, Surface};
+use crate::fft::RealFft2;
+
+/// Root mean square about the mean.
+pub fn rms_height(values: impl Iterator<Item = f64> + Clone) -> f64 {
+    let (sum, count) = values.clone().fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+    let mean = sum / count as f64;
+    (values.map(|v| (v - mean).powi(2)).sum::<f64>() / count as f64).sqrt()
+}
+
+/// rms slope of a grid with pixel spacing `spacing` (forward differences, no wrap-around).
+pub fn rms_slope_2d(heights: ArrayView2<f64>, spacing: f64) -> f64 {
+    let (rows, cols) = heights.dim();
+    let mut sum_x = 0.0;
+    let mut sum_y = 0.0;
+    for r in 0..rows {
+        for c in 0..cols {
+            if c + 1 < cols {
+                sum_x += (heights[[r, c + 1]] - heights[[r, c]]).powi(2);
+            }
+            if r + 1 < rows {
+                sum_y += (heights[[r + 1, c]] - heights[[r, c]]).powi(2);
+            }
+        }
+    }
+    let mean_x = sum_x / (rows * (cols - 1)) as f64;
+    let mean_y = sum_y / ((rows - 1) * cols) as f64;
+    (mean_x + mean_y).sqrt() / spacing
+}
+
+/// rms slope of a line with point spacing `spacing`.
+pub fn rms_slope_1d(heights: &[f64], spacing: f64) -> f64 {
+    let sum: f64 = heights.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+    (sum / (heights.len() - 1) as f64).sqrt() / spacing
+}
+
+/// rms mean curvature (half the rms five-point Laplacian); `None` below 3×3.
+pub fn rms_curvature_2d(heights: ArrayView2<f64>, spacing: f64) -> Option<f64> {
+    let (rows, cols) = heights.dim();
+    if rows < 3 || cols < 3 {
+        return None;
+    }
+    let mut sum = 0.0;
+    for r in 1..rows - 1 {
+        for c in 1..cols - 1 {
+            let lap = heights[[r + 1, c]] + heights[[r - 1, c]] + heights[[r, c + 1]] + heights[[r, c - 1]]
+                - 4.0 * heights[[r, c]];
+            sum += lap * lap;
+        }
+    }
+    Some(0.5 * (sum / ((rows - 2) * (cols - 2)) as f64).sqrt() / (spacing * spacing))
+}
+
+/// rms curvature of a line (three-point second difference); `None` below 3 points.
+pub fn rms_curvature_1d(heights: &[f64], spacing: f64) -> Option<f64> {
+    if heights.len() < 3 {
+        return None;
+    }
+    let sum: f64 = heights.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum();
+    Some((sum / (heights.len() - 2) as f64).sqrt() / (spacing * spacing))
+}
+
+/// One bin of a power spectrum: mean wavenumber `q` (physical units, `2π/length`), the
+/// averaged PSD, and how many Fourier modes fell into it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PsdBin {
+    /// Mean wavenumber of the modes in the bin.
+    pub q: f64,
+    /// Averaged power spectral density.
+    pub psd: f64,
+    /// Number of modes averaged.
+    pub modes: usize,
+}
+
+/// Radially averaged 2D PSD `C2D(q)` of a surface, rings of width `2π/L` centred on
+/// integer `κ = qL/2π` from 1 up to the smaller Nyquist wavenumber.
+pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
+    let (rows, cols) = surface.dim();
+    let size = surface.size();
+    let area = size * size * rows as f64 / cols as f64;
+    let mean = surface.heights().mean().unwrap_or(0.0);
+    let centred: Vec<f64> = surface.heights().iter().map(|h| h - mean).collect();
+    let mut fft = RealFft2::new(rows, cols);
+    let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+    fft.forward(&centred, &mut spectrum);
+    let aspect = cols as f64 / rows as f64;
+    let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
+    let norm = area / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
+    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+    let half = cols / 2 + 1;
+    for (kx, column) in spectrum.chunks(rows).enumerate() {
+        // Columns 0 < kx < cols/2 stand for ±kx: weight 2 keeps the average over the ring.
+        let weight = if kx == 0 || (cols % 2 == 0 && kx == half - 1) { 1 } else { 2 };
+        for (ky_index, value) in column.iter().enumerate() {
+            let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+            let kappa = (kx as f64).hypot(ky * aspect);
+            let bin = kappa.round() as usize;
+            if bin == 0 || bin > kappa_max {
+                continue;
+            }
+            let s = &mut sums[bin];
+            s.0 += weight as f64 * kappa;
+            s.1 += weight as f64 * value.norm_sqr() * norm;
+            s.2 += weight;
+        }
+    }
+    sums.into_iter()
+        .skip(1)
+        .filter(|s| s.2 > 0)
+        .map(|(k, p, m)| PsdBin { q: std::f64::consts::TAU / size * k / m as f64, psd: p / m as f64, modes: m })
+        .collect()
+}
+
+/// 1D PSD `C1D(q)` of a line at `q = 2πk/L`, `k = 1 … n/2`.
+pub fn line_psd(line: &Line) -> Vec<PsdBin> {
+    let n = line.len();
+    let size = line.size();
+    let mean = line.heights().mean().unwrap_or(0.0);
+    let mut centred: Vec<f64> = line.heights().iter().map(|h| h - mean).collect();
+    let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let mut spectrum = r2c.make_output_vec();
+    r2c.process(&mut centred, &mut spectrum).expect("sizes from plan");
+    let norm = size / (std::f64::consts::TAU * (n as f64).powi(2));
+    spectrum
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, v)| PsdBin { q: std::f64::consts::TAU * k as f64 / size, psd: v.norm_sqr() * norm, modes: 1 })
+        .collect()
+}
+
+/// Summary statistics of a surface or line (see the module docs for definitions).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    /// rms height.
+    pub rms_height: f64,
+    /// rms slope.
+    pub rms_slope: f64,
+    /// rms curvature (`None` on grids too small for a second difference).
+    pub rms_curvature: Option<f64>,
+}
+
+/// Summary statistics of a surface.
+pub fn surface_summary(surface: &Surface) -> Summary {
+    let h = surface.heights().view();
+    Summary {
+        rms_height: rms_height(h.iter().copied()),
+        rms_slope: rms_slope_2d(h, surface.spacing()),
+        rms_curvature: rms_curvature_2d(h, surface.spacing()),
+    }
+}
+
+/// Summary statistics of a line.
+pub fn line_summary(line: &Line) -> Summary {
+    let h = line.heights().as_slice().expect("contiguous");
+    Summary {
+        rms_height: rms_height(h.iter().copied()),
+        rms_slope: rms_slope_1d(h, line.spacing()),
+        rms_curvature: rms_curvature_1d(h, line.spacing()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ndarray::Array2;
+    use std::f64::consts::TAU;
+
+    #[test]
+    fn sinusoid_statistics_match_closed_forms() {
+        // h = a sin(2π x / λ) sampled finely: rms a/√2, rms slope a(2π/λ)/√2,
+        // rms curvature (Laplacian/2 in 2D) a(2π/λ)²/(2√2).
+        let (n, a, size) = (512, 0.3, 1.0);
+        let k = TAU * 4.0 / size;
+        let dx = size / n as f64;
+        let heights = Array2::from_shape_fn((n, n), |(_, c)| a * (k * c as f64 * dx).sin());
+        let s = surface_summary(&Surface::new(heights, size).unwrap());
+        assert!((s.rms_height / (a / 2f64.sqrt()) - 1.0).abs() < 1e-12);
+        // Finite differences are off by (k dx)²/24 ≈ 1e-4, and dropping the one wrap-around
+        // pair of each row (no periodicity assumed) by up to 1/(2n) ≈ 1e-3: allow 2e-3.
+        assert!((s.rms_slope / (a * k / 2f64.sqrt()) - 1.0).abs() < 2e-3, "{}", s.rms_slope);
+        let curvature = s.rms_curvature.unwrap();
+        assert!((curvature / (a * k * k / (2.0 * 2f64.sqrt())) - 1.0).abs() < 4e-3, "{curvature}");
+    }
+
+    #[test]
+    fn psd_satisfies_parseval() {
+        let n = 64;
+        let heights = Array2::from_shape_fn((n, n + 3), |(r, c)| ((r * 31 + c * 17) % 23) as f64 / 23.0);
+        let surface = Surface::new(heights, 2.0).unwrap();
+        let (rows, cols) = surface.dim();
+        // Sum over the full spectrum = rms²: use all modes, not only the radial bins.
+        let area = 4.0 * rows as f64 / cols as f64;
+        let mean = surface.heights().mean().unwrap();
+        let centred: Vec<f64> = surface.heights().iter().map(|h| h - mean).collect();
+        let mut fft = RealFft2::new(rows, cols);
+        let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+        fft.forward(&centred, &mut spec);
+        let mut total = 0.0;
+        for (kx, col) in spec.chunks(rows).enumerate() {
+            let w = if kx == 0 || (cols % 2 == 0 && kx == cols / 2) { 1.0 } else { 2.0 };
+            total += w * col.iter().map(|v| v.norm_sqr()).sum::<f64>();
+        }
+        let c_sum = total * area / (TAU.powi(2) * ((rows * cols) as f64).powi(2));
+        let rms = rms_height(surface.heights().iter().copied());
+        assert!((c_sum * TAU.powi(2) / area / rms.powi(2) - 1.0).abs() < 1e-12);
+        assert!(!radial_psd_2d(&surface).is_empty());
+    }
+
+    #[test]
+    fn line_psd_parseval() {
+        let h: Vec<f64> = (0..101).map(|i| ((i * 37) % 11) as f64).collect();
+        let line = Line::new(ndarray::Array1::from(h), 3.0).unwrap();
+        let bins = line_psd(&line);
+        // Both signs of q: every bin but Nyquist (odd n has none) counts twice.
+        let sum: f64 = bins.iter().map(|b| 2.0 * b.psd).sum::<f64>() * TAU / 3.0;
+        let rms = rms_height(line.heights().iter().copied());
+        assert!((sum / rms.powi(2) - 1.0).abs() < 1e-12);
+    }
+}
