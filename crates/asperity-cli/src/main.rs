@@ -1,1 +1,23 @@
-fn main(){}
+//! `asperity`: the command-line front end. Parsing and error reporting only; the work is
+//! in `commands::*` and the `asperity` library.
+
+mod cli;
+mod commands;
+#[allow(dead_code)] // shared helpers, not all used by every command yet
+mod output;
+#[allow(dead_code)]
+mod plot;
+#[allow(dead_code)]
+mod progress;
+
+use clap::Parser;
+
+fn main() {
+    let cli = cli::Cli::parse();
+    if let Err(err) = commands::run(cli) {
+        // One line: the chain of causes joined, as a user reads it.
+        let chain: Vec<String> = err.chain().map(|c| c.to_string()).collect();
+        eprintln!("error: {}", chain.join(": "));
+        std::process::exit(2);
+    }
+}

@@ -144,7 +144,8 @@ impl RealFft2 {
             .zip(output.par_chunks_mut(chunk * cols))
             .zip(self.lanes.par_iter_mut())
             .for_each(|((inp, out), lane)| {
-                for (row_in, row_out) in inp.chunks_exact_mut(half).zip(out.chunks_exact_mut(cols)) {
+                for (row_in, row_out) in inp.chunks_exact_mut(half).zip(out.chunks_exact_mut(cols))
+                {
                     row_in[0].im = 0.0;
                     if cols % 2 == 0 {
                         row_in[half - 1].im = 0.0;
@@ -193,7 +194,9 @@ mod tests {
                 let mut sum = Complex64::default();
                 for r in 0..rows {
                     for c in 0..cols {
-                        let phase = -2.0 * PI * ((kx * c) as f64 / cols as f64 + (ky * r) as f64 / rows as f64);
+                        let phase = -2.0
+                            * PI
+                            * ((kx * c) as f64 / cols as f64 + (ky * r) as f64 / rows as f64);
                         sum += input[r * cols + c] * Complex64::from_polar(1.0, phase);
                     }
                 }
@@ -204,7 +207,9 @@ mod tests {
     }
 
     fn pseudo_random(n: usize) -> Vec<f64> {
-        (0..n).map(|i| ((i * 7919 + 13) % 101) as f64 / 101.0 - 0.5).collect()
+        (0..n)
+            .map(|i| ((i * 7919 + 13) % 101) as f64 / 101.0 - 0.5)
+            .collect()
     }
 
     #[test]

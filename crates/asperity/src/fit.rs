@@ -28,8 +28,9 @@ pub struct PowerLawFit {
 /// Two-sided 97.5 % quantile of Student's t with `dof` degrees of freedom.
 pub fn student_t_975(dof: usize) -> f64 {
     const TABLE: [f64; 30] = [
-        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
-        2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
     ];
     match dof {
         0 => f64::INFINITY,
@@ -38,7 +39,8 @@ pub fn student_t_975(dof: usize) -> f64 {
         _ => {
             let z: f64 = 1.959964;
             let d = dof as f64;
-            z + (z.powi(3) + z) / (4.0 * d) + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * d * d)
+            z + (z.powi(3) + z) / (4.0 * d)
+                + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * d * d)
         }
     }
 }
@@ -49,10 +51,18 @@ pub fn power_law_fit(x: &[f64], y: &[f64]) -> Result<PowerLawFit> {
         return Err(Error::invalid("fit", "x and y differ in length"));
     }
     if x.len() < 2 {
-        return Err(Error::invalid("fit", format!("need at least 2 points, got {}", x.len())));
+        return Err(Error::invalid(
+            "fit",
+            format!("need at least 2 points, got {}", x.len()),
+        ));
     }
-    if let Some(i) = (0..x.len()).find(|&i| !(x[i] > 0.0 && y[i] > 0.0 && x[i].is_finite() && y[i].is_finite())) {
-        return Err(Error::invalid("fit", format!("point {i} ({}, {}) is not positive and finite", x[i], y[i])));
+    if let Some(i) =
+        (0..x.len()).find(|&i| !(x[i] > 0.0 && y[i] > 0.0 && x[i].is_finite() && y[i].is_finite()))
+    {
+        return Err(Error::invalid(
+            "fit",
+            format!("point {i} ({}, {}) is not positive and finite", x[i], y[i]),
+        ));
     }
     let n = x.len() as f64;
     let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
@@ -68,12 +78,20 @@ pub fn power_law_fit(x: &[f64], y: &[f64]) -> Result<PowerLawFit> {
     let intercept = my - exponent * mx;
     let dof = x.len() - 2;
     let stderr = if dof > 0 {
-        let sse: f64 = lx.iter().zip(&ly).map(|(a, b)| (b - intercept - exponent * a).powi(2)).sum();
+        let sse: f64 = lx
+            .iter()
+            .zip(&ly)
+            .map(|(a, b)| (b - intercept - exponent * a).powi(2))
+            .sum();
         (sse / dof as f64 / sxx).sqrt()
     } else {
         0.0
     };
-    let half_width = if dof > 0 { student_t_975(dof) * stderr } else { 0.0 };
+    let half_width = if dof > 0 {
+        student_t_975(dof) * stderr
+    } else {
+        0.0
+    };
     Ok(PowerLawFit {
         exponent,
         prefactor: intercept.exp(),
@@ -102,7 +120,11 @@ mod tests {
     fn interval_covers_the_truth_with_noise() {
         // Deterministic multiplicative "noise" of ±5 %: the interval must contain 1.5.
         let x: Vec<f64> = (1..200).map(|i| i as f64).collect();
-        let y: Vec<f64> = x.iter().enumerate().map(|(i, v)| v.powf(1.5) * (1.0 + 0.05 * ((i * 7919) % 13) as f64 / 6.0 - 0.05)).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v.powf(1.5) * (1.0 + 0.05 * ((i * 7919) % 13) as f64 / 6.0 - 0.05))
+            .collect();
         let fit = power_law_fit(&x, &y).unwrap();
         assert!(fit.low < 1.5 && 1.5 < fit.high, "{fit:?}");
         assert!(fit.high - fit.low < 0.05);

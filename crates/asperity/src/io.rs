@@ -176,7 +176,11 @@ mod tests {
         assert_eq!(read_npy_2d(&path).unwrap(), a);
         let err = write_npy_2d(&path, false, &(a.clone() * 2.0)).unwrap_err();
         assert!(matches!(err, Error::OutputExists(_)));
-        assert_eq!(read_npy_2d(&path).unwrap(), a, "refused write kept the file");
+        assert_eq!(
+            read_npy_2d(&path).unwrap(),
+            a,
+            "refused write kept the file"
+        );
         write_npy_2d(&path, true, &(a.clone() * 2.0)).unwrap();
         assert_eq!(read_npy_2d(&path).unwrap(), a * 2.0);
         // No temporary file is left behind.

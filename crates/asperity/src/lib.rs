@@ -36,6 +36,7 @@ pub mod fft;
 pub mod fit;
 pub mod io;
 pub mod memory;
+pub mod reference;
 pub mod spectrum;
 pub mod surface;
 

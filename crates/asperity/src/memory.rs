@@ -35,8 +35,9 @@ pub fn ensure_fits(what: &str, bytes: Option<u64>) -> Result<()> {
 
 /// `count × size` in bytes, `None` on overflow.
 pub fn array_bytes(dims: &[usize], bytes_per_element: usize) -> Option<u64> {
-    dims.iter()
-        .try_fold(bytes_per_element as u64, |acc, &d| acc.checked_mul(d as u64))
+    dims.iter().try_fold(bytes_per_element as u64, |acc, &d| {
+        acc.checked_mul(d as u64)
+    })
 }
 
 #[cfg(test)]

@@ -57,13 +57,28 @@ pub struct SurfaceSpec {
 
 impl SurfaceSpec {
     /// Checks the grid (at least 2×2), the size and the normalisation.
-    pub fn new(rows: usize, cols: usize, size: f64, psd: Psd, normalisation: Normalisation) -> Result<Self> {
+    pub fn new(
+        rows: usize,
+        cols: usize,
+        size: f64,
+        psd: Psd,
+        normalisation: Normalisation,
+    ) -> Result<Self> {
         if rows < 2 || cols < 2 {
-            return Err(Error::invalid("n", format!("grid must be at least 2x2, got {rows}x{cols}")));
+            return Err(Error::invalid(
+                "n",
+                format!("grid must be at least 2x2, got {rows}x{cols}"),
+            ));
         }
         validate_size(size)?;
         normalisation.validate()?;
-        Ok(SurfaceSpec { rows, cols, size, psd, normalisation })
+        Ok(SurfaceSpec {
+            rows,
+            cols,
+            size,
+            psd,
+            normalisation,
+        })
     }
 }
 
@@ -96,7 +111,11 @@ impl SurfaceGenerator {
         ensure_fits(&format!("a {}x{} surface", spec.rows, spec.cols), bytes)?;
         let fft = RealFft2::new(spec.rows, spec.cols);
         let spectrum = vec![Complex64::default(); fft.spectrum_len()];
-        Ok(SurfaceGenerator { spec: *spec, fft, spectrum })
+        Ok(SurfaceGenerator {
+            spec: *spec,
+            fft,
+            spectrum,
+        })
     }
 
     /// The specification this generator draws from.
@@ -109,7 +128,10 @@ impl SurfaceGenerator {
         let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
         self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))
             .expect("a validated spec has power on its grid");
-        Surface { heights, size: self.spec.size }
+        Surface {
+            heights,
+            size: self.spec.size,
+        }
     }
 
     /// One realisation for `seed`, written into `heights` (`rows × cols`, row-major).
@@ -117,12 +139,17 @@ impl SurfaceGenerator {
     pub fn try_generate(&mut self, seed: u64) -> Result<Surface> {
         let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
         self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))?;
-        Ok(Surface { heights, size: self.spec.size })
+        Ok(Surface {
+            heights,
+            size: self.spec.size,
+        })
     }
 
     /// Writes a realisation into `heights` (`rows × cols`, row-major).
     pub fn generate_into(&mut self, seed: u64, heights: &mut [f64]) -> Result<()> {
-        let SurfaceSpec { rows, cols, psd, .. } = self.spec;
+        let SurfaceSpec {
+            rows, cols, psd, ..
+        } = self.spec;
         // κ_y = ky · (L / Ly) because Ly = L·rows/cols.
         let aspect = cols as f64 / rows as f64;
         let nyquist_x = (cols % 2 == 0).then_some(cols / 2);
@@ -134,7 +161,11 @@ impl SurfaceGenerator {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
                 rng.set_stream(kx as u64);
                 for (ky_index, value) in column.iter_mut().enumerate() {
-                    let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+                    let ky = if ky_index <= rows / 2 {
+                        ky_index as f64
+                    } else {
+                        ky_index as f64 - rows as f64
+                    };
                     let kappa = (kx as f64).hypot(ky * aspect);
                     let amplitude = psd.c2d(kappa).sqrt();
                     *value = amplitude * random_phase(&mut rng);
@@ -193,11 +224,19 @@ impl LineSpec {
     /// Checks `n ≥ 2`, the size and the normalisation.
     pub fn new(n: usize, size: f64, psd: Psd, normalisation: Normalisation) -> Result<Self> {
         if n < 2 {
-            return Err(Error::invalid("n", format!("a line needs at least 2 points, got {n}")));
+            return Err(Error::invalid(
+                "n",
+                format!("a line needs at least 2 points, got {n}"),
+            ));
         }
         validate_size(size)?;
         normalisation.validate()?;
-        Ok(LineSpec { n, size, psd, normalisation })
+        Ok(LineSpec {
+            n,
+            size,
+            psd,
+            normalisation,
+        })
     }
 }
 
@@ -213,12 +252,21 @@ pub struct LineGenerator {
 impl LineGenerator {
     /// Plans the inverse real FFT of length `n` and tabulates the amplitudes `B(q)` (10).
     pub fn new(spec: &LineSpec) -> Result<Self> {
-        ensure_fits(&format!("a line of {} points", spec.n), array_bytes(&[spec.n], 8 + 16 + 16))?;
+        ensure_fits(
+            &format!("a line of {} points", spec.n),
+            array_bytes(&[spec.n], 8 + 16 + 16),
+        )?;
         let c2r = RealFftPlanner::<f64>::new().plan_fft_inverse(spec.n);
         let half = spec.n / 2 + 1;
         let amplitudes = (0..half).map(|k| spec.psd.c1d(k as f64).sqrt()).collect();
         let scratch = vec![Complex64::default(); c2r.get_scratch_len()];
-        Ok(LineGenerator { spec: *spec, c2r, amplitudes, spectrum: vec![Complex64::default(); half], scratch })
+        Ok(LineGenerator {
+            spec: *spec,
+            c2r,
+            amplitudes,
+            spectrum: vec![Complex64::default(); half],
+            scratch,
+        })
     }
 
     /// The specification this generator draws from.
@@ -231,14 +279,20 @@ impl LineGenerator {
         let mut heights = ndarray::Array1::zeros(self.spec.n);
         self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))
             .expect("a line spectrum always has power at q = 2π/L unless cut off");
-        Line { heights, size: self.spec.size }
+        Line {
+            heights,
+            size: self.spec.size,
+        }
     }
 
     /// One realisation for `seed`, failing if the spectrum has no power on this grid.
     pub fn try_generate(&mut self, seed: u64) -> Result<Line> {
         let mut heights = ndarray::Array1::zeros(self.spec.n);
         self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))?;
-        Ok(Line { heights, size: self.spec.size })
+        Ok(Line {
+            heights,
+            size: self.spec.size,
+        })
     }
 
     /// Writes a realisation into `heights` (length `n`).
@@ -267,9 +321,9 @@ impl LineGenerator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectrum::LongWavelength;
-    use crate::surface::stats::{radial_psd_2d, line_psd, rms_slope_1d, rms_slope_2d};
     use crate::fit::power_law_fit;
+    use crate::spectrum::LongWavelength;
+    use crate::surface::stats::{line_psd, radial_psd_2d, rms_slope_1d, rms_slope_2d};
 
     fn surface_spec(rows: usize, cols: usize, hurst: f64, norm: Normalisation) -> SurfaceSpec {
         SurfaceSpec::new(rows, cols, 1.0, Psd::power_law(hurst).unwrap(), norm).unwrap()
@@ -290,7 +344,10 @@ mod tests {
             }
         }
         let kappa_of = |q: f64| q / std::f64::consts::TAU;
-        let (q, c): (Vec<f64>, Vec<f64>) = mean.into_iter().filter(|(q, _)| kappa_of(*q) >= 4.0).unzip();
+        let (q, c): (Vec<f64>, Vec<f64>) = mean
+            .into_iter()
+            .filter(|(q, _)| kappa_of(*q) >= 4.0)
+            .unzip();
         power_law_fit(&q, &c).unwrap().exponent
     }
 
@@ -302,19 +359,32 @@ mod tests {
         for hurst in [-0.5, 0.5, 0.8, 2.5] {
             let exponent = fitted_psd_exponent_2d(hurst, 8);
             let expected = -2.0 * hurst - 2.0;
-            assert!((exponent - expected).abs() < 0.05, "H = {hurst}: slope {exponent} vs {expected}");
+            assert!(
+                (exponent - expected).abs() < 0.05,
+                "H = {hurst}: slope {exponent} vs {expected}"
+            );
         }
     }
 
     #[test]
     fn line_psd_follows_power_law() {
         for hurst in [-0.5, 0.5, 0.8, 2.5] {
-            let spec = LineSpec::new(4096, 1.0, Psd::power_law(hurst).unwrap(), Normalisation::RmsHeight(1.0)).unwrap();
+            let spec = LineSpec::new(
+                4096,
+                1.0,
+                Psd::power_law(hurst).unwrap(),
+                Normalisation::RmsHeight(1.0),
+            )
+            .unwrap();
             let mut generator = LineGenerator::new(&spec).unwrap();
             let mut mean = vec![0.0; 2048];
             let mut q = vec![0.0; 2048];
             for seed in 0..8 {
-                for (i, b) in line_psd(&generator.generate(seed)).iter().take(2048).enumerate() {
+                for (i, b) in line_psd(&generator.generate(seed))
+                    .iter()
+                    .take(2048)
+                    .enumerate()
+                {
                     q[i] = b.q;
                     mean[i] += b.psd / 8.0;
                 }
@@ -322,24 +392,45 @@ mod tests {
             // Exactly the target power in each mode, so the fit is exact but for rounding.
             let fit = power_law_fit(&q[..2047], &mean[..2047]).unwrap();
             let expected = -2.0 * hurst - 1.0;
-            assert!((fit.exponent - expected).abs() < 1e-6, "H = {hurst}: {} vs {expected}", fit.exponent);
+            assert!(
+                (fit.exponent - expected).abs() < 1e-6,
+                "H = {hurst}: {} vs {expected}",
+                fit.exponent
+            );
         }
     }
 
     #[test]
     fn roll_off_flat_and_cut_off_empty_below_q0() {
         let q0 = 6.0;
-        for (long, flat) in [(LongWavelength::RollOff { q0 }, true), (LongWavelength::CutOff { q0 }, false)] {
+        for (long, flat) in [
+            (LongWavelength::RollOff { q0 }, true),
+            (LongWavelength::CutOff { q0 }, false),
+        ] {
             let psd = Psd::new(0.8, long, None).unwrap();
             let spec = SurfaceSpec::new(64, 64, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
             let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3));
             let kappa = |q: f64| q / std::f64::consts::TAU;
-            let at_q0 = bins.iter().find(|b| (kappa(b.q) - q0).abs() < 0.5).unwrap().psd;
+            let at_q0 = bins
+                .iter()
+                .find(|b| (kappa(b.q) - q0).abs() < 0.5)
+                .unwrap()
+                .psd;
             for b in bins.iter().filter(|b| kappa(b.q) < q0 - 0.5) {
                 if flat {
-                    assert!((b.psd / at_q0 - 1.0).abs() < 0.25, "roll-off bin κ={} ratio {}", kappa(b.q), b.psd / at_q0);
+                    assert!(
+                        (b.psd / at_q0 - 1.0).abs() < 0.25,
+                        "roll-off bin κ={} ratio {}",
+                        kappa(b.q),
+                        b.psd / at_q0
+                    );
                 } else {
-                    assert!(b.psd < 1e-20 * at_q0, "cut-off bin κ={} has power {}", kappa(b.q), b.psd);
+                    assert!(
+                        b.psd < 1e-20 * at_q0,
+                        "cut-off bin κ={} has power {}",
+                        kappa(b.q),
+                        b.psd
+                    );
                 }
             }
         }
@@ -348,14 +439,30 @@ mod tests {
     #[test]
     fn normalisation_is_exact() {
         for (rows, cols) in [(64, 64), (33, 47), (40, 90)] {
-            let h = SurfaceGenerator::new(&surface_spec(rows, cols, 0.8, Normalisation::RmsHeight(2.5))).unwrap().generate(1);
+            let h = SurfaceGenerator::new(&surface_spec(
+                rows,
+                cols,
+                0.8,
+                Normalisation::RmsHeight(2.5),
+            ))
+            .unwrap()
+            .generate(1);
             let rms = stats::rms_height(h.heights().iter().copied());
             assert!((rms / 2.5 - 1.0).abs() < 1e-10, "{rows}x{cols}: {rms}");
-            let s = SurfaceGenerator::new(&surface_spec(rows, cols, 0.3, Normalisation::RmsSlope(0.7))).unwrap().generate(1);
+            let s =
+                SurfaceGenerator::new(&surface_spec(rows, cols, 0.3, Normalisation::RmsSlope(0.7)))
+                    .unwrap()
+                    .generate(1);
             let slope = rms_slope_2d(s.heights().view(), s.spacing());
             assert!((slope / 0.7 - 1.0).abs() < 1e-10, "{rows}x{cols}: {slope}");
         }
-        let line_spec = LineSpec::new(1001, 2.0, Psd::power_law(1.0).unwrap(), Normalisation::RmsSlope(0.3)).unwrap();
+        let line_spec = LineSpec::new(
+            1001,
+            2.0,
+            Psd::power_law(1.0).unwrap(),
+            Normalisation::RmsSlope(0.3),
+        )
+        .unwrap();
         let line = LineGenerator::new(&line_spec).unwrap().generate(5);
         let slope = rms_slope_1d(line.heights().as_slice().unwrap(), line.spacing());
         assert!((slope / 0.3 - 1.0).abs() < 1e-10);
@@ -365,14 +472,24 @@ mod tests {
     fn same_seed_same_bits_whatever_the_thread_count() {
         let spec = surface_spec(96, 130, 0.8, Normalisation::RmsHeight(1.0));
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| SurfaceGenerator::new(&spec).unwrap().generate(77))
         };
         let reference = run(1);
         for threads in [2, 3, 7] {
-            assert!(run(threads).heights().iter().zip(reference.heights()).all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert!(run(threads)
+                .heights()
+                .iter()
+                .zip(reference.heights())
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
         }
-        assert_ne!(SurfaceGenerator::new(&spec).unwrap().generate(78), reference);
+        assert_ne!(
+            SurfaceGenerator::new(&spec).unwrap().generate(78),
+            reference
+        );
     }
 
     #[test]
@@ -391,15 +508,25 @@ mod tests {
             let mut ratio = None;
             for (kx, column) in spectrum.chunks(rows).enumerate() {
                 for (ky_index, value) in column.iter().enumerate() {
-                    let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+                    let ky = if ky_index <= rows / 2 {
+                        ky_index as f64
+                    } else {
+                        ky_index as f64 - rows as f64
+                    };
                     let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
                     if target == 0.0 {
-                        assert!(value.norm() < 1e-9, "{rows}x{cols}: mode ({kx},{ky}) should be empty");
+                        assert!(
+                            value.norm() < 1e-9,
+                            "{rows}x{cols}: mode ({kx},{ky}) should be empty"
+                        );
                         continue;
                     }
                     let r = value.norm() / target;
                     let r0 = *ratio.get_or_insert(r);
-                    assert!((r / r0 - 1.0).abs() < 1e-9, "{rows}x{cols}: mode ({kx},{ky}) ratio {r} vs {r0}");
+                    assert!(
+                        (r / r0 - 1.0).abs() < 1e-9,
+                        "{rows}x{cols}: mode ({kx},{ky}) ratio {r} vs {r0}"
+                    );
                 }
             }
         }
@@ -409,6 +536,9 @@ mod tests {
     fn cut_off_beyond_nyquist_is_an_error() {
         let psd = Psd::new(0.5, LongWavelength::CutOff { q0: 100.0 }, None).unwrap();
         let spec = SurfaceSpec::new(16, 16, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
-        assert!(SurfaceGenerator::new(&spec).unwrap().try_generate(0).is_err());
+        assert!(SurfaceGenerator::new(&spec)
+            .unwrap()
+            .try_generate(0)
+            .is_err());
     }
 }

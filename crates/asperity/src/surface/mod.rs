@@ -46,7 +46,10 @@ impl Normalisation {
         if value.is_finite() && value > 0.0 {
             Ok(())
         } else {
-            Err(Error::invalid(name, format!("must be positive and finite, got {value}")))
+            Err(Error::invalid(
+                name,
+                format!("must be positive and finite, got {value}"),
+            ))
         }
     }
 }
@@ -56,7 +59,10 @@ pub(crate) fn validate_size(size: f64) -> Result<()> {
     if size.is_finite() && size > 0.0 {
         Ok(())
     } else {
-        Err(Error::invalid("size", format!("side length must be positive and finite, got {size}")))
+        Err(Error::invalid(
+            "size",
+            format!("side length must be positive and finite, got {size}"),
+        ))
     }
 }
 
@@ -73,7 +79,13 @@ impl Surface {
     pub fn new(heights: Array2<f64>, size: f64) -> Result<Self> {
         validate_size(size)?;
         if heights.nrows() < 2 || heights.ncols() < 2 {
-            return Err(Error::invalid("grid", format!("a surface needs at least 2x2 points, got {:?}", heights.dim())));
+            return Err(Error::invalid(
+                "grid",
+                format!(
+                    "a surface needs at least 2x2 points, got {:?}",
+                    heights.dim()
+                ),
+            ));
         }
         crate::ensure_finite("surface", heights.iter())?;
         Ok(Surface { heights, size })
@@ -118,7 +130,10 @@ impl Line {
     pub fn new(heights: Array1<f64>, size: f64) -> Result<Self> {
         validate_size(size)?;
         if heights.len() < 2 {
-            return Err(Error::invalid("grid", format!("a line needs at least 2 points, got {}", heights.len())));
+            return Err(Error::invalid(
+                "grid",
+                format!("a line needs at least 2 points, got {}", heights.len()),
+            ));
         }
         crate::ensure_finite("line", heights.iter())?;
         Ok(Line { heights, size })

@@ -22,7 +22,9 @@ use crate::fft::RealFft2;
 
 /// Root mean square about the mean.
 pub fn rms_height(values: impl Iterator<Item = f64> + Clone) -> f64 {
-    let (sum, count) = values.clone().fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
+    let (sum, count) = values
+        .clone()
+        .fold((0.0, 0usize), |(s, c), v| (s + v, c + 1));
     let mean = sum / count as f64;
     (values.map(|v| (v - mean).powi(2)).sum::<f64>() / count as f64).sqrt()
 }
@@ -62,7 +64,10 @@ pub fn rms_curvature_2d(heights: ArrayView2<f64>, spacing: f64) -> Option<f64> {
     let mut sum = 0.0;
     for r in 1..rows - 1 {
         for c in 1..cols - 1 {
-            let lap = heights[[r + 1, c]] + heights[[r - 1, c]] + heights[[r, c + 1]] + heights[[r, c - 1]]
+            let lap = heights[[r + 1, c]]
+                + heights[[r - 1, c]]
+                + heights[[r, c + 1]]
+                + heights[[r, c - 1]]
                 - 4.0 * heights[[r, c]];
             sum += lap * lap;
         }
@@ -75,7 +80,10 @@ pub fn rms_curvature_1d(heights: &[f64], spacing: f64) -> Option<f64> {
     if heights.len() < 3 {
         return None;
     }
-    let sum: f64 = heights.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum();
+    let sum: f64 = heights
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
+        .sum();
     Some((sum / (heights.len() - 2) as f64).sqrt() / (spacing * spacing))
 }
 
@@ -109,9 +117,17 @@ pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
     let half = cols / 2 + 1;
     for (kx, column) in spectrum.chunks(rows).enumerate() {
         // Columns 0 < kx < cols/2 stand for ±kx: weight 2 keeps the average over the ring.
-        let weight = if kx == 0 || (cols % 2 == 0 && kx == half - 1) { 1 } else { 2 };
+        let weight = if kx == 0 || (cols % 2 == 0 && kx == half - 1) {
+            1
+        } else {
+            2
+        };
         for (ky_index, value) in column.iter().enumerate() {
-            let ky = if ky_index <= rows / 2 { ky_index as f64 } else { ky_index as f64 - rows as f64 };
+            let ky = if ky_index <= rows / 2 {
+                ky_index as f64
+            } else {
+                ky_index as f64 - rows as f64
+            };
             let kappa = (kx as f64).hypot(ky * aspect);
             let bin = kappa.round() as usize;
             if bin == 0 || bin > kappa_max {
@@ -126,7 +142,11 @@ pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
     sums.into_iter()
         .skip(1)
         .filter(|s| s.2 > 0)
-        .map(|(k, p, m)| PsdBin { q: std::f64::consts::TAU / size * k / m as f64, psd: p / m as f64, modes: m })
+        .map(|(k, p, m)| PsdBin {
+            q: std::f64::consts::TAU / size * k / m as f64,
+            psd: p / m as f64,
+            modes: m,
+        })
         .collect()
 }
 
@@ -138,13 +158,18 @@ pub fn line_psd(line: &Line) -> Vec<PsdBin> {
     let mut centred: Vec<f64> = line.heights().iter().map(|h| h - mean).collect();
     let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(n);
     let mut spectrum = r2c.make_output_vec();
-    r2c.process(&mut centred, &mut spectrum).expect("sizes from plan");
+    r2c.process(&mut centred, &mut spectrum)
+        .expect("sizes from plan");
     let norm = size / (std::f64::consts::TAU * (n as f64).powi(2));
     spectrum
         .iter()
         .enumerate()
         .skip(1)
-        .map(|(k, v)| PsdBin { q: std::f64::consts::TAU * k as f64 / size, psd: v.norm_sqr() * norm, modes: 1 })
+        .map(|(k, v)| PsdBin {
+            q: std::f64::consts::TAU * k as f64 / size,
+            psd: v.norm_sqr() * norm,
+            modes: 1,
+        })
         .collect()
 }
 
@@ -197,15 +222,23 @@ mod tests {
         assert!((s.rms_height / (a / 2f64.sqrt()) - 1.0).abs() < 1e-12);
         // Finite differences are off by (k dx)²/24 ≈ 1e-4, and dropping the one wrap-around
         // pair of each row (no periodicity assumed) by up to 1/(2n) ≈ 1e-3: allow 2e-3.
-        assert!((s.rms_slope / (a * k / 2f64.sqrt()) - 1.0).abs() < 2e-3, "{}", s.rms_slope);
+        assert!(
+            (s.rms_slope / (a * k / 2f64.sqrt()) - 1.0).abs() < 2e-3,
+            "{}",
+            s.rms_slope
+        );
         let curvature = s.rms_curvature.unwrap();
-        assert!((curvature / (a * k * k / (2.0 * 2f64.sqrt())) - 1.0).abs() < 4e-3, "{curvature}");
+        assert!(
+            (curvature / (a * k * k / (2.0 * 2f64.sqrt())) - 1.0).abs() < 4e-3,
+            "{curvature}"
+        );
     }
 
     #[test]
     fn psd_satisfies_parseval() {
         let n = 64;
-        let heights = Array2::from_shape_fn((n, n + 3), |(r, c)| ((r * 31 + c * 17) % 23) as f64 / 23.0);
+        let heights =
+            Array2::from_shape_fn((n, n + 3), |(r, c)| ((r * 31 + c * 17) % 23) as f64 / 23.0);
         let surface = Surface::new(heights, 2.0).unwrap();
         let (rows, cols) = surface.dim();
         // Sum over the full spectrum = rms²: use all modes, not only the radial bins.
@@ -217,7 +250,11 @@ mod tests {
         fft.forward(&centred, &mut spec);
         let mut total = 0.0;
         for (kx, col) in spec.chunks(rows).enumerate() {
-            let w = if kx == 0 || (cols % 2 == 0 && kx == cols / 2) { 1.0 } else { 2.0 };
+            let w = if kx == 0 || (cols % 2 == 0 && kx == cols / 2) {
+                1.0
+            } else {
+                2.0
+            };
             total += w * col.iter().map(|v| v.norm_sqr()).sum::<f64>();
         }
         let c_sum = total * area / (TAU.powi(2) * ((rows * cols) as f64).powi(2));

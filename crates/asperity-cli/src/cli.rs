@@ -1,0 +1,32 @@
+//! The command-line contract (`shared/CLI.md`): one subcommand per task.
+
+use clap::{Parser, Subcommand};
+
+use crate::commands;
+
+/// Contact mechanics of randomly rough surfaces: self-affine surface synthesis, FFT
+/// boundary elements and the method of dimensionality reduction (Pohrt & Popov).
+#[derive(Debug, Parser)]
+#[command(name = "asperity", version, about, long_about = None, arg_required_else_help = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Generate a self-affine rough surface (2D) as .npy with a JSON sidecar.
+    Surface(commands::surface::SurfaceArgs),
+    /// Generate a self-affine rough line (1D, C1D = π q C2D) as .npy with a JSON sidecar.
+    Line(commands::surface::LineArgs),
+    /// Statistics of a surface or line: rms height, slope, curvature, PSD and its slope.
+    Stats(commands::stats::StatsArgs),
+    /// Solve the 3D contact of a rigid rough indenter on an elastic half-space (BEM).
+    Bem(commands::bem::BemArgs),
+    /// Method of dimensionality reduction: force and stiffness of a 1D spring foundation.
+    Mdr(commands::mdr::MdrArgs),
+    /// Regenerate a figure of the paper or the book chapter.
+    Reproduce(commands::reproduce::ReproduceArgs),
+}

@@ -1,0 +1,21 @@
+//! One module per subcommand; each exposes its clap `Args` and a `run` function.
+
+pub mod bem;
+pub mod mdr;
+pub mod reproduce;
+pub mod stats;
+pub mod surface;
+
+use crate::cli::{Cli, Command};
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Surface(args) => surface::run_surface(&args),
+        Command::Line(args) => surface::run_line(&args),
+        Command::Stats(args) => stats::run(&args),
+        Command::Bem(args) => bem::run(&args),
+        Command::Mdr(args) => mdr::run(&args),
+        Command::Reproduce(args) => reproduce::run(&args),
+    }
+}

@@ -1,0 +1,56 @@
+//! `asperity reproduce FIGURE`: regenerate a figure of the paper or the book chapter.
+
+use std::path::PathBuf;
+
+/// Which figure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Figure {
+    /// Paper Fig. 1: α(H) from BEM and MDR with theory.
+    #[value(name = "fig1")]
+    Fig1,
+    /// Paper Fig. 2: k(F) for surfaces with roll-off.
+    #[value(name = "fig2")]
+    Fig2,
+    /// Paper Fig. 5: α(N) for H < 0 against eq. (24).
+    #[value(name = "fig5")]
+    Fig5,
+    /// Paper Fig. 6: grey-scale surfaces and lines for several H.
+    #[value(name = "fig6")]
+    Fig6,
+    /// Book Fig. 15.1: Hertz with linear and non-linear springs.
+    #[value(name = "fig15.1")]
+    Fig15_1,
+    /// Book Fig. 15.2: fractal lines with linear and non-linear springs.
+    #[value(name = "fig15.2")]
+    Fig15_2,
+    /// Every figure.
+    #[value(name = "all")]
+    All,
+}
+
+/// Arguments of `asperity reproduce`.
+#[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Examples:\n  asperity reproduce fig6 --out figs\n  asperity reproduce all --quick --out figs"
+)]
+pub struct ReproduceArgs {
+    /// The figure to regenerate.
+    pub figure: Figure,
+    /// Fewer samples and smaller grids (minutes instead of hours); stated in each report.
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder (one sub-folder per figure).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite existing outputs.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `asperity reproduce`.
+pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
+    anyhow::bail!(
+        "asperity reproduce {:?} is not implemented yet",
+        args.figure
+    )
+}

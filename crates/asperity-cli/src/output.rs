@@ -1,0 +1,51 @@
+//! Tables: CSV files with a header row, written atomically; and JSON sidecars.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+/// A CSV table under construction: header plus rows of already formatted fields.
+#[derive(Debug, Clone, Default)]
+pub struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// An empty table with these column names.
+    pub fn new<S: AsRef<str>>(header: &[S]) -> Self {
+        Table {
+            header: header.iter().map(|s| s.as_ref().to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Appends a row of numbers, printed with full precision (`{:e}` round-trips f64).
+    pub fn push_numbers(&mut self, values: &[f64]) {
+        self.rows
+            .push(values.iter().map(|v| format_number(*v)).collect());
+    }
+
+    /// Appends a row of fields.
+    pub fn push<S: ToString>(&mut self, fields: &[S]) {
+        self.rows
+            .push(fields.iter().map(|f| f.to_string()).collect());
+    }
+
+    /// Writes the table atomically.
+    pub fn write(&self, path: &Path, force: bool) -> Result<()> {
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        writer.write_record(&self.header)?;
+        for row in &self.rows {
+            writer.write_record(row)?;
+        }
+        let bytes = writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
+        asperity::io::write_bytes(path, force, &bytes)?;
+        Ok(())
+    }
+}
+
+/// Shortest text that parses back to the same f64.
+pub fn format_number(v: f64) -> String {
+    format!("{v:?}")
+}

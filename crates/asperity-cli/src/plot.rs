@@ -1,0 +1,368 @@
+//! Plots: line charts (linear or log–log) as PNG and SVG, and grey-scale height maps.
+//!
+//! Fonts are embedded (DejaVu Sans), so plotting works on machines without fontconfig.
+//! Files are written atomically: rendered to a temporary file beside the target, then
+//! renamed.
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use anyhow::{anyhow, Context, Result};
+use ndarray::ArrayView2;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// A solid line.
+    Line,
+    /// A dashed line (theory curves, asymptotes).
+    Dashed,
+    /// Markers only (data points).
+    Points,
+    /// A solid line with markers.
+    LinePoints,
+}
+
+/// One labelled series of `(x, y)` points.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// The points; on log axes, points with non-positive coordinates are skipped.
+    pub points: Vec<(f64, f64)>,
+    /// Drawing style.
+    pub style: Style,
+    /// Colour; `None` picks from a palette by position.
+    pub color: Option<RGBColor>,
+}
+
+impl Series {
+    /// A series with palette colour.
+    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            style,
+            color: None,
+        }
+    }
+
+    /// Sets the colour.
+    pub fn color(mut self, color: RGBColor) -> Self {
+        self.color = Some(color);
+        self
+    }
+}
+
+/// A colour from the Viridis map for `t ∈ [0, 1]` (ordered families such as H values).
+pub fn ordered_color(t: f64) -> RGBColor {
+    ViridisRGB::get_color(t.clamp(0.0, 1.0) as f32)
+}
+
+/// A chart: title, axis labels, axis scales and series.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    /// Caption above the plot.
+    pub title: String,
+    /// x-axis label.
+    pub x_label: String,
+    /// y-axis label.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The series, drawn in order.
+    pub series: Vec<Series>,
+}
+
+const SIZE: (u32, u32) = (900, 650);
+
+fn register_fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        for family in ["sans-serif", "serif", "monospace"] {
+            let _ =
+                plotters::style::register_font(family, FontStyle::Normal, dejavu::sans::regular());
+            let _ = plotters::style::register_font(family, FontStyle::Bold, dejavu::sans::bold());
+        }
+    });
+}
+
+/// `1e-3`, `0.25`, `120`: short tick labels that read well on log axes.
+fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e4).contains(&a) {
+        let e = a.log10().floor() as i32;
+        let m = v / 10f64.powi(e);
+        if (m.abs() - 1.0).abs() < 1e-9 {
+            format!("{}1e{e}", if v < 0.0 { "-" } else { "" })
+        } else {
+            format!("{m:.1}e{e}")
+        }
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+impl Chart {
+    /// Writes the chart as PNG and SVG.
+    pub fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()> {
+        register_fonts();
+        for path in [png, svg] {
+            asperity::io::ensure_new_output(path, force)?;
+        }
+        let tmp_png = temp_with_extension(png, "png");
+        let result = (|| {
+            let root = BitMapBackend::new(&tmp_png, SIZE).into_drawing_area();
+            self.render(&root)?;
+            root.present()
+                .map_err(|e| anyhow!("rendering {}: {e}", png.display()))?;
+            drop(root);
+            std::fs::rename(&tmp_png, png).with_context(|| format!("writing {}", png.display()))
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp_png);
+        }
+        result?;
+        let mut text = String::new();
+        {
+            let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+            self.render(&root)?;
+            root.present()
+                .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
+        }
+        asperity::io::write_bytes(svg, force, text.as_bytes())?;
+        Ok(())
+    }
+
+    fn bounds(&self) -> Result<((f64, f64), (f64, f64))> {
+        let usable = |p: &&(f64, f64)| {
+            p.0.is_finite()
+                && p.1.is_finite()
+                && (!self.log_x || p.0 > 0.0)
+                && (!self.log_y || p.1 > 0.0)
+        };
+        let pts: Vec<(f64, f64)> = self
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(usable).copied())
+            .collect();
+        if pts.is_empty() {
+            return Err(anyhow!("nothing to plot in '{}'", self.title));
+        }
+        let span = |vals: Vec<f64>, log: bool| {
+            let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if log {
+                let (lo, hi) = if hi <= lo {
+                    (lo / 2.0, hi * 2.0)
+                } else {
+                    (lo, hi)
+                };
+                let pad = (hi / lo).powf(0.04);
+                (lo / pad, hi * pad)
+            } else {
+                let (lo, hi) = if hi <= lo {
+                    (lo - 1.0, hi + 1.0)
+                } else {
+                    (lo, hi)
+                };
+                let pad = 0.04 * (hi - lo);
+                (lo - pad, hi + pad)
+            }
+        };
+        Ok((
+            span(pts.iter().map(|p| p.0).collect(), self.log_x),
+            span(pts.iter().map(|p| p.1).collect(), self.log_y),
+        ))
+    }
+
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let ((x0, x1), (y0, y1)) = self.bounds()?;
+        match (self.log_x, self.log_y) {
+            (true, true) => self.draw(root, (x0..x1).log_scale(), (y0..y1).log_scale()),
+            (true, false) => self.draw(root, (x0..x1).log_scale(), y0..y1),
+            (false, true) => self.draw(root, x0..x1, (y0..y1).log_scale()),
+            (false, false) => self.draw(root, x0..x1, y0..y1),
+        }
+    }
+
+    fn draw<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, x: X, y: Y) -> Result<()>
+    where
+        DB: DrawingBackend,
+        DB::ErrorType: 'static,
+        X: AsRangedCoord<Value = f64>,
+        Y: AsRangedCoord<Value = f64>,
+        X::CoordDescType: ValueFormatter<f64>,
+        Y::CoordDescType: ValueFormatter<f64>,
+    {
+        let err =
+            |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plotting '{}': {e}", self.title);
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x, y)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 18))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(err)?;
+        let keep = |p: &&(f64, f64)| {
+            p.0.is_finite()
+                && p.1.is_finite()
+                && (!self.log_x || p.0 > 0.0)
+                && (!self.log_y || p.1 > 0.0)
+        };
+        for (i, s) in self.series.iter().enumerate() {
+            let color = s.color.unwrap_or_else(|| {
+                let c = Palette99::pick(i).to_rgba();
+                RGBColor(c.0, c.1, c.2)
+            });
+            let pts: Vec<(f64, f64)> = s.points.iter().filter(keep).copied().collect();
+            let line = color.stroke_width(2);
+            let anno = match s.style {
+                Style::Line => chart.draw_series(LineSeries::new(pts, line)).map_err(err)?,
+                Style::Dashed => chart
+                    .draw_series(DashedLineSeries::new(pts, 8, 6, line))
+                    .map_err(err)?,
+                Style::Points => chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
+                    .map_err(err)?,
+                Style::LinePoints => {
+                    chart
+                        .draw_series(LineSeries::new(pts.clone(), line))
+                        .map_err(err)?;
+                    chart
+                        .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
+                        .map_err(err)?
+                }
+            };
+            if !s.label.is_empty() {
+                anno.label(s.label.clone()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
+                });
+            }
+        }
+        if self.series.iter().any(|s| !s.label.is_empty()) {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font(("sans-serif", 14))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
+        }
+        Ok(())
+    }
+}
+
+fn temp_with_extension(path: &Path, ext: &str) -> PathBuf {
+    let stem = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{stem}.{}.tmp.{ext}", std::process::id()))
+}
+
+/// Grey-scale image of a height map (black low, white high), one pixel per grid point
+/// (grids above 2048 points a side are subsampled), like the paper's Fig. 6.
+pub fn greyscale_png(path: &Path, heights: ArrayView2<f64>, force: bool) -> Result<()> {
+    asperity::io::ensure_new_output(path, force)?;
+    let (rows, cols) = heights.dim();
+    let step = rows.max(cols).div_ceil(2048).max(1);
+    let (w, h) = (cols.div_ceil(step) as u32, rows.div_ceil(step) as u32);
+    let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let range = if hi > lo { hi - lo } else { 1.0 };
+    let tmp = temp_with_extension(path, "png");
+    let result = (|| {
+        let root = BitMapBackend::new(&tmp, (w, h)).into_drawing_area();
+        for r in 0..h as usize {
+            for c in 0..w as usize {
+                let v = ((heights[[r * step, c * step]] - lo) / range * 255.0).round() as u8;
+                root.draw_pixel((c as i32, r as i32), &RGBColor(v, v, v))
+                    .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+            }
+        }
+        root.present()
+            .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+        drop(root);
+        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(0.001), "0.001");
+        assert_eq!(tick_label(1e-5), "1e-5");
+        assert_eq!(tick_label(250.0), "250");
+        assert_eq!(tick_label(2.5e6), "2.5e6");
+    }
+
+    #[test]
+    fn chart_writes_png_and_svg_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let chart = Chart {
+            title: "test".into(),
+            x_label: "F".into(),
+            y_label: "k".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![
+                Series::new(
+                    "data",
+                    (1..20).map(|i| (i as f64, (i as f64).powf(0.5))).collect(),
+                    Style::LinePoints,
+                ),
+                Series::new(
+                    "theory",
+                    vec![(1.0, 1.0), (20.0, 20f64.sqrt())],
+                    Style::Dashed,
+                ),
+            ],
+        };
+        let (png, svg) = (dir.path().join("c.png"), dir.path().join("c.svg"));
+        chart.save(&png, &svg, false).unwrap();
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+        assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+        assert!(
+            chart.save(&png, &svg, false).is_err(),
+            "no overwrite without force"
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            2,
+            "no temporary files left"
+        );
+    }
+}
