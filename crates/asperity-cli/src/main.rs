@@ -13,7 +13,21 @@ mod progress;
 use clap::Parser;
 
 fn main() {
-    let cli = cli::Cli::parse();
+    let cli = match cli::Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(err) if !err.use_stderr() => err.exit(), // --help, --version
+        Err(err) => {
+            // clap's message is several lines (tip, usage); keep the first, as for every error.
+            let text = err.to_string();
+            let first = text
+                .lines()
+                .next()
+                .unwrap_or("invalid arguments")
+                .trim_start_matches("error: ");
+            eprintln!("error: {first} (see --help)");
+            std::process::exit(2);
+        }
+    };
     if let Err(err) = commands::run(cli) {
         // One line: the chain of causes joined, as a user reads it.
         let chain: Vec<String> = err.chain().map(|c| c.to_string()).collect();

@@ -133,6 +133,23 @@ impl Psd {
             .map_or(0.0, |k| k.powf(-2.0 * self.hurst - 2.0))
     }
 
+    /// `sqrt(C2D(κ)) = κ^(-H-1)`: the Fourier amplitude of a mode (one `powf`, no `sqrt`).
+    pub fn sqrt_c2d(&self, kappa: f64) -> f64 {
+        self.effective_kappa(kappa)
+            .map_or(0.0, |k| k.powf(-self.hurst - 1.0))
+    }
+
+    /// [`Psd::sqrt_c2d`] of `κ²`, computed as `(κ²)^(-(H+1)/2)` to spare a square root in
+    /// the synthesis loop.
+    pub fn sqrt_c2d_of_squared(&self, kappa_sq: f64) -> f64 {
+        let kappa = kappa_sq.sqrt();
+        match self.effective_kappa(kappa) {
+            None => 0.0,
+            Some(k) if k == kappa => kappa_sq.powf(-0.5 * (self.hurst + 1.0)),
+            Some(k) => k.powf(-self.hurst - 1.0),
+        }
+    }
+
     /// Unnormalised 1D spectrum of the equivalent line, `C1D = π κ C2D(κ)` (28); for the
     /// pure power law this is `π κ^(-2H-1)` (29).
     pub fn c1d(&self, kappa: f64) -> f64 {
@@ -169,6 +186,16 @@ mod tests {
             assert_eq!(cut.c2d(k), plain.c2d(k));
         }
         assert_eq!(plain.c2d(0.0), 0.0);
+        for k in [0.0, 1.0, 3.0, 7.5] {
+            assert!(
+                (roll.sqrt_c2d(k) - roll.c2d(k).sqrt()).abs()
+                    <= 1e-15 * roll.c2d(k).sqrt().max(1.0)
+            );
+            let via_sq = roll.sqrt_c2d_of_squared(k * k);
+            assert!((via_sq - roll.sqrt_c2d(k)).abs() <= 1e-14 * roll.sqrt_c2d(k).max(1.0));
+            let far = plain.sqrt_c2d_of_squared((k + 9.0).powi(2));
+            assert!((far / plain.sqrt_c2d(k + 9.0) - 1.0).abs() < 1e-14);
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! One module per subcommand; each exposes its clap `Args` and a `run` function.
 
 pub mod bem;
+pub mod bench;
 pub mod mdr;
 pub mod reproduce;
 pub mod stats;
@@ -16,6 +17,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Stats(args) => stats::run(&args),
         Command::Bem(args) => bem::run(&args),
         Command::Mdr(args) => mdr::run(&args),
+        Command::Bench(args) => bench::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     }
 }

@@ -47,9 +47,12 @@ impl SpectrumArgs {
 
 /// Arguments of `asperity surface`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Examples:\n  \
+#[command(
+    allow_negative_numbers = true,
+    after_help = "Examples:\n  \
     asperity surface --n 512 --hurst 0.8 --rolloff 6 --rms-slope 1 --seed 1 --out s.npy --png s.png\n  \
-    asperity surface --n 256 --m 128 --hurst -0.5 --rms-height 1e-3 --out rect.npy")]
+    asperity surface --n 256 --m 128 --hurst -0.5 --rms-height 1e-3 --out rect.npy"
+)]
 pub struct SurfaceArgs {
     /// Grid points along x (columns).
     #[arg(long)]
@@ -75,7 +78,10 @@ pub struct SurfaceArgs {
 
 /// Arguments of `asperity line`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example:\n  asperity line --n 32768 --hurst 0.5 --seed 3 --out line.npy")]
+#[command(
+    allow_negative_numbers = true,
+    after_help = "Example:\n  asperity line --n 32768 --hurst 0.5 --seed 3 --out line.npy"
+)]
 pub struct LineArgs {
     /// Number of points.
     #[arg(long)]

@@ -89,10 +89,20 @@ pub struct SurfaceGenerator {
     spectrum: Vec<Complex64>,
 }
 
-/// A random sign or unit phase factor for mode `(kx, ky)`.
+/// A unit complex number with uniformly distributed phase.
+///
+/// Drawn by rejection from the unit disk (a point uniform in the disk has a uniform angle),
+/// which avoids a `sin_cos` per mode; the sequence is deterministic for a given stream.
 fn random_phase(rng: &mut ChaCha8Rng) -> Complex64 {
-    let phase = std::f64::consts::TAU * rng.random::<f64>();
-    Complex64::from_polar(1.0, phase)
+    loop {
+        let x = 2.0 * rng.random::<f64>() - 1.0;
+        let y = 2.0 * rng.random::<f64>() - 1.0;
+        let r2 = x * x + y * y;
+        if r2 > 1e-12 && r2 <= 1.0 {
+            let inv = 1.0 / r2.sqrt();
+            return Complex64::new(x * inv, y * inv);
+        }
+    }
 }
 
 fn random_sign(rng: &mut ChaCha8Rng) -> f64 {
@@ -166,8 +176,8 @@ impl SurfaceGenerator {
                     } else {
                         ky_index as f64 - rows as f64
                     };
-                    let kappa = (kx as f64).hypot(ky * aspect);
-                    let amplitude = psd.c2d(kappa).sqrt();
+                    let kappa_sq = (kx * kx) as f64 + (ky * aspect).powi(2);
+                    let amplitude = psd.sqrt_c2d_of_squared(kappa_sq);
                     *value = amplitude * random_phase(&mut rng);
                 }
                 // Columns kx = 0 and kx = Nyquist hold both ±ky: impose h(-ky) = conj h(ky).
@@ -184,7 +194,7 @@ impl SurfaceGenerator {
         self.fft.inverse(&mut self.spectrum, heights);
         let view = ndarray::ArrayView2::from_shape((rows, cols), &*heights).expect("shape");
         let realised = match self.spec.normalisation {
-            Normalisation::RmsHeight(_) => stats::rms_height(view.iter().copied()),
+            Normalisation::RmsHeight(_) => stats::rms_height_2d(view),
             Normalisation::RmsSlope(_) => stats::rms_slope_2d(view, self.spec.size / cols as f64),
         };
         scale_to(heights, realised, self.spec.normalisation)

@@ -14,6 +14,7 @@
 
 use ndarray::ArrayView2;
 use num_complex::Complex64;
+use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use serde::Serialize;
 
@@ -29,21 +30,39 @@ pub fn rms_height(values: impl Iterator<Item = f64> + Clone) -> f64 {
     (values.map(|v| (v - mean).powi(2)).sum::<f64>() / count as f64).sqrt()
 }
 
+/// Sums `f(row_index)` over rows in parallel, then adds the per-row results in order, so
+/// that the total does not depend on how rayon splits the work (bit-identical results
+/// whatever the thread count).
+fn ordered_row_sum(rows: usize, f: impl Fn(usize) -> f64 + Sync + Send) -> f64 {
+    let per_row: Vec<f64> = (0..rows).into_par_iter().map(&f).collect();
+    per_row.iter().sum()
+}
+
+/// rms height of a row-major grid (parallel, deterministic).
+pub fn rms_height_2d(heights: ArrayView2<f64>) -> f64 {
+    let (rows, cols) = heights.dim();
+    let count = (rows * cols) as f64;
+    let row = |r: usize| heights.row(r);
+    let mean = ordered_row_sum(rows, |r| row(r).iter().sum()) / count;
+    (ordered_row_sum(rows, |r| row(r).iter().map(|h| (h - mean).powi(2)).sum()) / count).sqrt()
+}
+
 /// rms slope of a grid with pixel spacing `spacing` (forward differences, no wrap-around).
 pub fn rms_slope_2d(heights: ArrayView2<f64>, spacing: f64) -> f64 {
     let (rows, cols) = heights.dim();
-    let mut sum_x = 0.0;
-    let mut sum_y = 0.0;
-    for r in 0..rows {
-        for c in 0..cols {
-            if c + 1 < cols {
-                sum_x += (heights[[r, c + 1]] - heights[[r, c]]).powi(2);
-            }
-            if r + 1 < rows {
-                sum_y += (heights[[r + 1, c]] - heights[[r, c]]).powi(2);
-            }
-        }
-    }
+    let standard = heights.as_standard_layout();
+    let data = standard.as_slice().expect("standard layout");
+    let row = |r: usize| &data[r * cols..(r + 1) * cols];
+    let sum_x = ordered_row_sum(rows, |r| {
+        row(r).windows(2).map(|w| (w[1] - w[0]).powi(2)).sum()
+    });
+    let sum_y = ordered_row_sum(rows - 1, |r| {
+        row(r)
+            .iter()
+            .zip(row(r + 1))
+            .map(|(a, b)| (b - a).powi(2))
+            .sum()
+    });
     let mean_x = sum_x / (rows * (cols - 1)) as f64;
     let mean_y = sum_y / ((rows - 1) * cols) as f64;
     (mean_x + mean_y).sqrt() / spacing
@@ -188,7 +207,7 @@ pub struct Summary {
 pub fn surface_summary(surface: &Surface) -> Summary {
     let h = surface.heights().view();
     Summary {
-        rms_height: rms_height(h.iter().copied()),
+        rms_height: rms_height_2d(h),
         rms_slope: rms_slope_2d(h, surface.spacing()),
         rms_curvature: rms_curvature_2d(h, surface.spacing()),
     }

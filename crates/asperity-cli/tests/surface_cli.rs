@@ -1,0 +1,179 @@
+//! Drives the real `asperity` binary: surface, line and stats, including bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use ndarray::{array, Array2};
+use ndarray_npy::{read_npy, write_npy};
+
+fn asperity(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run asperity")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Exit status 2, a single `error:` line, and nothing new in the folder.
+fn assert_refused(out: &Output, dir: &Path, files_before: usize, needle: &str) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(err.contains(needle), "expected '{needle}' in: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "one-line error, got: {err}");
+    assert_eq!(
+        std::fs::read_dir(dir).unwrap().count(),
+        files_before,
+        "no partial file left: {err}"
+    );
+}
+
+#[test]
+fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = [
+        "surface",
+        "--n",
+        "64",
+        "--m",
+        "48",
+        "--hurst",
+        "-0.5",
+        "--rms-slope",
+        "0.5",
+        "--seed",
+        "11",
+    ];
+    let out = asperity(
+        &[&args[..], &["--out", "a.npy", "--png", "a.png"]].concat(),
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = asperity(&[&args[..], &["--out", "b.npy"]].concat(), d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let a: Array2<f64> = read_npy(d.join("a.npy")).unwrap();
+    let b: Array2<f64> = read_npy(d.join("b.npy")).unwrap();
+    assert_eq!(a.dim(), (48, 64));
+    assert!(
+        a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "same seed, same bits"
+    );
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("a.npy.json")).unwrap()).unwrap();
+    assert_eq!(sidecar["seed"], 11);
+    assert_eq!(sidecar["spec"]["psd"]["hurst"], -0.5);
+    assert!(std::fs::metadata(d.join("a.png")).unwrap().len() > 100);
+    let stats = asperity(&["stats", "a.npy", "--json"], d);
+    assert!(stats.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
+    assert!((v["stats"]["rms_slope"].as_f64().unwrap() / 0.5 - 1.0).abs() < 1e-10);
+}
+
+#[test]
+fn stats_writes_psd_and_recovers_hurst_of_a_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(asperity(
+        &["line", "--n", "8192", "--hurst", "0.7", "--seed", "2", "--out", "l.npy"],
+        d
+    )
+    .status
+    .success());
+    let out = asperity(&["stats", "l.npy", "--psd", "psd.csv"], d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let hurst: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("hurst_estimate: "))
+        .expect("hurst line")
+        .trim()
+        .parse()
+        .unwrap();
+    assert!((hurst - 0.7).abs() < 1e-6, "{text}");
+    let psd = std::fs::read_to_string(d.join("psd.csv")).unwrap();
+    assert!(psd.starts_with("q,psd\n"));
+    assert_eq!(psd.lines().count(), 1 + 4096);
+}
+
+#[test]
+fn bad_input_is_refused_with_one_line_and_nothing_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = asperity(
+        &["surface", "--n", "32", "--hurst", "3.2", "--out", "x.npy"],
+        d,
+    );
+    assert_refused(&out, d, 0, "hurst");
+    let out = asperity(
+        &["surface", "--n", "1", "--hurst", "0.5", "--out", "x.npy"],
+        d,
+    );
+    assert_refused(&out, d, 0, "at least 2");
+    let out = asperity(&["line", "--n", "1", "--hurst", "0.5", "--out", "x.npy"], d);
+    assert_refused(&out, d, 0, "at least 2");
+    let out = asperity(
+        &[
+            "surface", "--n", "200000", "--hurst", "0.5", "--out", "x.npy",
+        ],
+        d,
+    );
+    assert_refused(&out, d, 0, "MiB");
+    let out = asperity(
+        &[
+            "surface",
+            "--n",
+            "16",
+            "--hurst",
+            "0.5",
+            "--rms-height",
+            "-1",
+            "--out",
+            "x.npy",
+        ],
+        d,
+    );
+    assert_refused(&out, d, 0, "rms-height");
+
+    write_npy(d.join("nan.npy"), &array![[0.0, 1.0], [f64::NAN, 2.0]]).unwrap();
+    write_npy(d.join("f32.npy"), &array![[0.0f32, 1.0], [3.0, 2.0]]).unwrap();
+    write_npy(
+        d.join("cube.npy"),
+        &ndarray::Array3::<f64>::zeros((2, 2, 2)),
+    )
+    .unwrap();
+    let n = 3;
+    assert_refused(&asperity(&["stats", "nan.npy"], d), d, n, "non-finite");
+    assert_refused(&asperity(&["stats", "f32.npy"], d), d, n, "float64");
+    assert_refused(&asperity(&["stats", "cube.npy"], d), d, n, "3 dimensions");
+    assert_refused(&asperity(&["stats", "missing.npy"], d), d, n, "missing.npy");
+
+    assert!(asperity(
+        &["surface", "--n", "16", "--hurst", "0.5", "--out", "s.npy"],
+        d
+    )
+    .status
+    .success());
+    let before = std::fs::read(d.join("s.npy")).unwrap();
+    let out = asperity(
+        &["surface", "--n", "16", "--hurst", "0.9", "--out", "s.npy"],
+        d,
+    );
+    assert_refused(&out, d, n + 2, "already exists");
+    assert_eq!(
+        std::fs::read(d.join("s.npy")).unwrap(),
+        before,
+        "existing output untouched"
+    );
+    let out = asperity(
+        &[
+            "surface", "--n", "16", "--hurst", "0.9", "--out", "s.npy", "--force",
+        ],
+        d,
+    );
+    assert!(out.status.success());
+    assert_ne!(std::fs::read(d.join("s.npy")).unwrap(), before);
+}
