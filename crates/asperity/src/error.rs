@@ -56,6 +56,14 @@ pub enum Error {
         /// Memory available now.
         available_mib: u64,
     },
+    /// A study folder already holds the checkpoint of a different study.
+    #[error("{dir}: holds the checkpoint of another study ({reason}); use another --out, or --force to discard it")]
+    ForeignCheckpoint {
+        /// The study folder.
+        dir: PathBuf,
+        /// What differs.
+        reason: String,
+    },
     /// A metadata (JSON / TOML) file could not be parsed or written.
     #[error("{path}: {reason}")]
     Metadata {

@@ -38,6 +38,7 @@ pub mod io;
 pub mod memory;
 pub mod reference;
 pub mod spectrum;
+pub mod study;
 pub mod surface;
 
 pub use error::{ensure_finite, Error, Result};
