@@ -317,6 +317,89 @@ pub fn greyscale_png(path: &Path, heights: ArrayView2<f64>, force: bool) -> Resu
     result
 }
 
+/// A row of grey-scale height maps with captions (like the paper's Fig. 6), PNG and SVG.
+/// Each map is shown at `tile` pixels a side (nearest-neighbour sampling).
+pub fn greyscale_panel(
+    png: &Path,
+    svg: &Path,
+    maps: &[(String, ArrayView2<f64>)],
+    tile: u32,
+    force: bool,
+) -> Result<()> {
+    register_fonts();
+    for path in [png, svg] {
+        asperity::io::ensure_new_output(path, force)?;
+    }
+    let caption_height = 30;
+    let size = (
+        maps.len() as u32 * (tile + 10) + 10,
+        tile + caption_height + 10,
+    );
+    fn draw<DB: DrawingBackend>(
+        root: &DrawingArea<DB, Shift>,
+        maps: &[(String, ArrayView2<f64>)],
+        tile: u32,
+        caption: u32,
+        block: u32,
+    ) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing panel: {e}");
+        root.fill(&WHITE).map_err(err)?;
+        for (i, (title, heights)) in maps.iter().enumerate() {
+            let x0 = 10 + i as i32 * (tile as i32 + 10);
+            root.draw(&Text::new(
+                title.clone(),
+                (x0, 5),
+                ("sans-serif", 18).into_font(),
+            ))
+            .map_err(err)?;
+            let (rows, cols) = heights.dim();
+            let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let range = if hi > lo { hi - lo } else { 1.0 };
+            for py in (0..tile).step_by(block as usize) {
+                for px in (0..tile).step_by(block as usize) {
+                    let r = (py as usize * rows / tile as usize).min(rows - 1);
+                    let c = (px as usize * cols / tile as usize).min(cols - 1);
+                    let v = ((heights[[r, c]] - lo) / range * 255.0).round() as u8;
+                    let (x, y) = (x0 + px as i32, caption as i32 + py as i32);
+                    root.draw(&Rectangle::new(
+                        [(x, y), (x + block as i32, y + block as i32)],
+                        RGBColor(v, v, v).filled(),
+                    ))
+                    .map_err(err)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    let tmp = temp_with_extension(png, "png");
+    let result = (|| {
+        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+        draw(&root, maps, tile, caption_height, 1)?;
+        root.present()
+            .map_err(|e| anyhow!("rendering {}: {e}", png.display()))?;
+        drop(root);
+        std::fs::rename(&tmp, png).with_context(|| format!("writing {}", png.display()))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result?;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        // One SVG rectangle per 4x4 block keeps the file small.
+        draw(&root, maps, tile, caption_height, 4)?;
+        root.present()
+            .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
+    }
+    asperity::io::write_bytes(svg, force, text.as_bytes())?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

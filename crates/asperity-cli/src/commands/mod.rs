@@ -2,6 +2,7 @@
 
 pub mod bem;
 pub mod bench;
+pub mod figures;
 pub mod mdr;
 pub mod reproduce;
 pub mod stats;

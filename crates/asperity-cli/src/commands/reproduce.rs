@@ -47,10 +47,56 @@ pub struct ReproduceArgs {
     pub force: bool,
 }
 
+impl Figure {
+    /// Folder name under `--out`.
+    pub fn folder(&self) -> &'static str {
+        match self {
+            Figure::Fig1 => "fig1",
+            Figure::Fig2 => "fig2",
+            Figure::Fig5 => "fig5",
+            Figure::Fig6 => "fig6",
+            Figure::Fig15_1 => "fig15.1",
+            Figure::Fig15_2 => "fig15.2",
+            Figure::All => ".",
+        }
+    }
+}
+
+fn run_one(figure: Figure, out: &std::path::Path, quick: bool, force: bool) -> anyhow::Result<()> {
+    let dir = out.join(figure.folder());
+    std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    let start = std::time::Instant::now();
+    match figure {
+        Figure::Fig6 => super::figures::fig6(&dir, quick, force)?,
+        other => anyhow::bail!(
+            "asperity reproduce {} is not implemented yet",
+            other.folder()
+        ),
+    }
+    eprintln!(
+        "{}: done in {:.1} s -> {}",
+        figure.folder(),
+        start.elapsed().as_secs_f64(),
+        dir.display()
+    );
+    Ok(())
+}
+
 /// Runs `asperity reproduce`.
 pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
-    anyhow::bail!(
-        "asperity reproduce {:?} is not implemented yet",
-        args.figure
-    )
+    let figures: Vec<Figure> = match args.figure {
+        Figure::All => vec![
+            Figure::Fig6,
+            Figure::Fig15_1,
+            Figure::Fig15_2,
+            Figure::Fig1,
+            Figure::Fig5,
+            Figure::Fig2,
+        ],
+        one => vec![one],
+    };
+    for figure in figures {
+        run_one(figure, &args.out, args.quick, args.force)?;
+    }
+    Ok(())
 }
