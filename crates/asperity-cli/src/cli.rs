@@ -27,6 +27,8 @@ pub enum Command {
     Bem(commands::bem::BemArgs),
     /// Method of dimensionality reduction: force and stiffness of a 1D spring foundation.
     Mdr(commands::mdr::MdrArgs),
+    /// Ensemble studies: α(H, N) sweeps and mean k(F) curves, checkpointed and resumable.
+    Study(commands::study::StudyArgs),
     /// Time a library kernel (for comparisons with other tools; see bench/).
     Bench(commands::bench::BenchArgs),
     /// Regenerate a figure of the paper or the book chapter.

@@ -65,6 +65,28 @@ impl Progress {
         }
     }
 
+    /// Sets the number of steps done (thread-safe); logs like [`Progress::inc`].
+    pub fn set(&self, done: u64) {
+        let before = self.done.swap(done, std::sync::atomic::Ordering::Relaxed);
+        if done == before {
+            return;
+        }
+        if let Some(bar) = &self.bar {
+            bar.set_position(done);
+        } else if !self.name.is_empty() {
+            let mut last = self.last_log.lock().expect("progress lock");
+            if last.elapsed().as_secs_f64() >= 5.0 || done == self.total {
+                *last = Instant::now();
+                let elapsed = self.start.elapsed().as_secs_f64();
+                let eta = elapsed / done.max(1) as f64 * (self.total - done.min(self.total)) as f64;
+                eprintln!(
+                    "{}: {done}/{} ({elapsed:.0} s elapsed, ETA {eta:.0} s)",
+                    self.name, self.total
+                );
+            }
+        }
+    }
+
     /// Ends the bar.
     pub fn finish(&self) {
         if let Some(bar) = &self.bar {

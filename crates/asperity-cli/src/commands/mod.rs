@@ -6,6 +6,7 @@ pub mod figures;
 pub mod mdr;
 pub mod reproduce;
 pub mod stats;
+pub mod study;
 pub mod surface;
 
 use crate::cli::{Cli, Command};
@@ -18,6 +19,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Stats(args) => stats::run(&args),
         Command::Bem(args) => bem::run(&args),
         Command::Mdr(args) => mdr::run(&args),
+        Command::Study(args) => study::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     }

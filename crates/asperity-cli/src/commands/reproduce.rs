@@ -67,6 +67,9 @@ fn run_one(figure: Figure, out: &std::path::Path, quick: bool, force: bool) -> a
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     let start = std::time::Instant::now();
     match figure {
+        Figure::Fig1 => super::figures::fig1(&dir, quick, force)?,
+        Figure::Fig2 => super::figures::fig2(&dir, quick, force)?,
+        Figure::Fig5 => super::figures::fig5(&dir, quick, force)?,
         Figure::Fig6 => super::figures::fig6(&dir, quick, force)?,
         other => anyhow::bail!(
             "asperity reproduce {} is not implemented yet",

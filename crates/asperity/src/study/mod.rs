@@ -14,6 +14,7 @@
 //! different study is refused ([`Error::ForeignCheckpoint`]) unless `discard` is set.
 
 pub mod curve;
+pub mod samplers;
 pub mod theory;
 
 use std::path::{Path, PathBuf};
@@ -24,6 +25,7 @@ use serde::{Deserialize, Serialize};
 pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
+pub use samplers::run_any_task;
 
 use crate::fit::PowerLawFit;
 use crate::spectrum::HURST_RANGE;
