@@ -126,14 +126,13 @@ pub fn fig6(dir: &Path, quick: bool, force: bool) -> Result<()> {
         if quick { " (--quick: 256² instead of 512²)" } else { "" }
     );
     write_report(dir, &report, force)?;
-    let _ = format_number;
     Ok(())
 }
 
 use asperity::study::theory::{alpha_theory, alpha_white_noise};
 use asperity::study::{parse_range, FitWindow, Method, StudySpec, TaskResult};
 
-use super::study::{alpha_chart, curve_chart, execute, write_alpha, write_curves, Kind};
+use super::study::{execute, write_alpha, write_curves, Kind};
 
 fn study_spec(
     method: Method,
@@ -174,7 +173,7 @@ fn figure_study(
     let outputs = super::study::outputs(kind, &sub);
     let results = execute(spec, &sub, force, false, &outputs)?;
     match kind {
-        Kind::Alpha => write_alpha(&sub, spec, &results, force)?,
+        Kind::Alpha => write_alpha(&sub, &results, force)?,
         Kind::Curve => write_curves(&sub, &results, force, "curve")?,
     }
     Ok(results)
@@ -201,7 +200,7 @@ fn alpha_rows_md(results: &[TaskResult]) -> String {
 
 /// Paper Fig. 1: α(H) from MDR (N = 2^9, 2^11, 2^15) and BEM (N = 2^7 … 2^10).
 pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
-    let hursts = parse_range(if quick { "-1:3:0.25" } else { "-1:3:0.25" })?;
+    let hursts = parse_range("-1:3:0.25")?;
     let mdr = study_spec(
         Method::Mdr,
         vec![1 << 9, 1 << 11, 1 << 15],
@@ -221,8 +220,7 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, force)?;
     let bem_seconds = start.elapsed().as_secs_f64() - mdr_seconds;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();
-    write_alpha(dir, &mdr, &all, force)?;
-    let _ = alpha_chart;
+    write_alpha(dir, &all, force)?;
     let report = format!(
         "# Fig. 1: exponent α of k ∝ F^α versus H\n\n{}\n\n\
          - MDR: N = {:?}, {} samples per (N, H), H = {:?}; {:.1} s.\n\
@@ -260,7 +258,6 @@ pub fn fig2(dir: &Path, quick: bool, force: bool) -> Result<()> {
     let spec = study_spec(Method::Bem, vec![n], hursts, samples, Some(6.0));
     let results = figure_study(dir, "bem", &spec, Kind::Curve, force)?;
     write_curves(dir, &results, force, "fig2")?;
-    let _ = curve_chart;
     let mut md = String::from("| H | low-force α (window) | high-force slope (last third of the curve) |\n|---|---|---|\n");
     for r in &results {
         let tail = &r.mean_curve[2 * r.mean_curve.len() / 3..];

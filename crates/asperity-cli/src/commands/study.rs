@@ -254,7 +254,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
     };
     let results = execute(&spec, out, force, quiet, &outputs(kind, out))?;
     match kind {
-        Kind::Alpha => write_alpha(out, &spec, &results, force),
+        Kind::Alpha => write_alpha(out, &results, force),
         Kind::Curve => write_curves(out, &results, force, "curve"),
     }
 }
@@ -306,12 +306,7 @@ fn opt(v: Option<f64>) -> String {
 }
 
 /// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves.
-pub fn write_alpha(
-    dir: &Path,
-    spec: &StudySpec,
-    results: &[TaskResult],
-    force: bool,
-) -> Result<()> {
+pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()> {
     let mut table = Table::new(&[
         "method",
         "n",
@@ -347,7 +342,7 @@ pub fn write_alpha(
         ]);
     }
     table.write(&dir.join("alpha.csv"), force)?;
-    alpha_chart(spec, results, "α of k ∝ F^α vs H").save(
+    alpha_chart(results, "α of k ∝ F^α vs H").save(
         &dir.join("alpha.png"),
         &dir.join("alpha.svg"),
         force,
@@ -355,7 +350,7 @@ pub fn write_alpha(
 }
 
 /// The α(H) chart: one series per (method, N) and the theory curves (6), 1/3 and (24).
-pub fn alpha_chart(spec: &StudySpec, results: &[TaskResult], title: &str) -> Chart {
+pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
     let mut series = Vec::new();
     let mut sizes: Vec<(Method, usize)> = results.iter().map(|r| (r.method, r.task.n)).collect();
     sizes.dedup();
@@ -404,7 +399,6 @@ pub fn alpha_chart(spec: &StudySpec, results: &[TaskResult], title: &str) -> Cha
                 .color(plotters::style::BLUE),
         );
     }
-    let _ = spec;
     Chart {
         title: title.into(),
         x_label: "Hurst exponent H".into(),
