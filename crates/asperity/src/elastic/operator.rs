@@ -294,9 +294,28 @@ impl ElasticOperator {
 
     /// `displacement = K * pressure` on the `rows × cols` grid (row-major slices).
     pub fn apply(&mut self, pressure: &[f64], displacement: &mut [f64]) {
+        self.convolve(pressure, displacement, false);
+    }
+
+    /// Periodic boundaries only: the pressure whose displacement is `displacement` up to a
+    /// constant, `p = K⁺ u` (pseudo-inverse: the mean of `u` is ignored and `p` has zero
+    /// mean). Free boundaries have no such spectral inverse: an error.
+    pub fn apply_pseudo_inverse(&mut self, displacement: &[f64], pressure: &mut [f64]) -> Result<()> {
+        if self.boundary != Boundary::Periodic {
+            return Err(Error::invalid(
+                "boundary",
+                "the spectral pseudo-inverse exists for periodic boundaries only",
+            ));
+        }
+        self.convolve(displacement, pressure, true);
+        Ok(())
+    }
+
+    fn convolve(&mut self, pressure: &[f64], displacement: &mut [f64], inverse: bool) {
         let (rows, cols) = (self.rows, self.cols);
         let (prow, pcol, half) = (self.padded_rows, self.padded_cols, self.half_cols());
         let kernel_rows = self.kernel_rows();
+        let normalisation = (prow * pcol) as f64;
         assert_eq!(pressure.len(), rows * cols, "pressure length");
         assert_eq!(displacement.len(), rows * cols, "displacement length");
 
@@ -322,7 +341,7 @@ impl ElasticOperator {
 
         // 3. Per column: forward FFT, multiply by the real kernel, inverse FFT.
         let chunk = self.rows_per_lane(half);
-        let (forward, inverse, kernel) = (&self.column_forward, &self.column_inverse, &self.kernel);
+        let (forward, backward, kernel) = (&self.column_forward, &self.column_inverse, &self.kernel);
         self.spectrum
             .par_chunks_mut(chunk * prow)
             .enumerate()
@@ -332,14 +351,24 @@ impl ElasticOperator {
                     let kx = block_index * chunk + i;
                     let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
                     forward.process_with_scratch(column, &mut lane.scratch);
-                    column[0] *= k[0];
+                    let factor = |k: f64| {
+                        if !inverse {
+                            k
+                        } else if k != 0.0 {
+                            1.0 / (k * normalisation * normalisation)
+                        } else {
+                            0.0
+                        }
+                    };
+                    column[0] *= factor(k[0]);
                     for ky in 1..kernel_rows {
-                        column[ky] *= k[ky];
+                        let f = factor(k[ky]);
+                        column[ky] *= f;
                         if ky < prow - ky {
-                            column[prow - ky] *= k[ky];
+                            column[prow - ky] *= f;
                         }
                     }
-                    inverse.process_with_scratch(column, &mut lane.scratch);
+                    backward.process_with_scratch(column, &mut lane.scratch);
                 }
             });
 
@@ -602,6 +631,23 @@ mod tests {
         for (ui, pi) in u.iter().zip(&p) {
             assert!((ui - 2.0 * pi / (e * q)).abs() < 1e-13);
         }
+    }
+
+    #[test]
+    fn periodic_pseudo_inverse_undoes_the_operator_up_to_the_mean() {
+        let (rows, cols) = (9, 12);
+        let mut op = ElasticOperator::new(rows, cols, 0.2, 1.5, Boundary::Periodic).unwrap();
+        let p = pseudo_random(rows * cols, 1);
+        let mean = p.iter().sum::<f64>() / p.len() as f64;
+        let mut u = vec![0.0; rows * cols];
+        let mut back = vec![0.0; rows * cols];
+        op.apply(&p, &mut u);
+        op.apply_pseudo_inverse(&u, &mut back).unwrap();
+        for (b, p) in back.iter().zip(&p) {
+            assert!((b - (p - mean)).abs() < 1e-13);
+        }
+        let mut free = ElasticOperator::new(rows, cols, 0.2, 1.5, Boundary::Free).unwrap();
+        assert!(free.apply_pseudo_inverse(&u, &mut back).is_err());
     }
 
     #[test]
