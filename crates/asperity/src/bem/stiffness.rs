@@ -223,3 +223,131 @@ impl ContactSolver {
         result
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::polonsky_keer::tests::{rough, sphere};
+    use super::super::{HalfSpace, SolverParams};
+    use super::*;
+    use crate::elastic::Boundary;
+    use crate::reference::{FlatPunch, Hertz};
+    use crate::surface::Surface;
+    use ndarray::Array2;
+    use std::f64::consts::PI;
+
+    fn half_space(boundary: Boundary) -> HalfSpace {
+        HalfSpace {
+            modulus: 1.3,
+            boundary,
+        }
+    }
+
+    #[test]
+    fn frozen_set_equals_finite_difference_on_rough_surfaces() {
+        // Barber: k = dF/dd. Central differences with ±1e-3 of the load; the contact set may
+        // gain or lose a few points within the step (measured: 1e-5 free, 2e-4 periodic), so
+        // 0.5 % here, tighter than the 2 % the issue asks for.
+        for (boundary, pressure) in [(Boundary::Free, 0.02), (Boundary::Periodic, 0.05)] {
+            let surface = rough(96, 11);
+            let mut solver =
+                ContactSolver::new(&surface, half_space(boundary), SolverParams::default()).unwrap();
+            solver.solve(Control::MeanPressure(pressure)).unwrap();
+            let (frozen, info) = solver.frozen_set_stiffness().unwrap();
+            assert!(info.residual <= 1e-10);
+            let fd = solver
+                .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
+                .unwrap();
+            let error = frozen / fd - 1.0;
+            eprintln!("{boundary:?}: frozen {frozen:.6e}, fd {fd:.6e}, error {error:.2e}");
+            assert!(error.abs() < 0.005, "{boundary:?}: frozen {frozen} vs fd {fd}");
+        }
+    }
+
+    #[test]
+    fn frozen_set_under_displacement_control_matches_finite_difference() {
+        let surface = rough(64, 12);
+        let mut solver =
+            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        let d = 0.01;
+        solver.solve(Control::Indentation(d)).unwrap();
+        let (frozen, _) = solver.frozen_set_stiffness().unwrap();
+        let fd = solver
+            .finite_difference_stiffness(Control::Indentation(d), 1e-3)
+            .unwrap();
+        assert!((frozen / fd - 1.0).abs() < 0.02, "frozen {frozen} vs fd {fd}");
+    }
+
+    #[test]
+    fn hertz_stiffness_is_two_e_a() {
+        let (n, size, radius) = (64, 1.0, 2.0);
+        let dx = size / n as f64;
+        let hertz = Hertz {
+            radius,
+            modulus: 1.3,
+        };
+        let d = (18.0 * dx).powi(2) / radius;
+        let mut solver =
+            ContactSolver::new(&sphere(n, n, size, radius), half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        solver.solve(Control::Indentation(d)).unwrap();
+        let (k, _) = solver.frozen_set_stiffness().unwrap();
+        let error = k / hertz.stiffness(d) - 1.0;
+        eprintln!("hertz stiffness error {error:.2e}");
+        // The pixelated contact edge costs O(Δ/a) (measured 0.5 % at a = 18 pixels; see the
+        // punch test for the 1/a convergence).
+        assert!(error.abs() < 0.01, "k error {error:e}");
+    }
+
+    #[test]
+    fn flat_punch_stiffness_is_two_e_a() {
+        // A flat circular punch of radius 16 and 32 pixels (heights 0 inside, far below
+        // outside). k = 2E*a with the pixelated disk's area-equivalent radius; the remaining
+        // discretisation error (the edge singularity averaged over a pixel) shrinks like Δ/a:
+        // measured 0.65 % and 0.33 %.
+        let mut errors = Vec::new();
+        for (n, a_pixels) in [(64, 16.0), (128, 32.0)] {
+            let size = 1.0;
+            let dx = size / n as f64;
+            let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+                let r = ((i as f64 - (n / 2) as f64).hypot(j as f64 - (n / 2) as f64)) * dx;
+                if r <= a_pixels * dx {
+                    0.0
+                } else {
+                    -1.0
+                }
+            });
+            let surface = Surface::new(heights, size).unwrap();
+            let mut solver =
+                ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                    .unwrap();
+            let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
+            let (k, _) = solver.frozen_set_stiffness().unwrap();
+            let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
+            let punch = FlatPunch {
+                radius: a,
+                modulus: 1.3,
+            };
+            let error = k / punch.stiffness() - 1.0;
+            // Under displacement control the punch's force is k d exactly.
+            assert!((s.force / (k * 1e-3) - 1.0).abs() < 1e-6);
+            eprintln!("punch a = {a_pixels} px: k error {error:.3e}");
+            errors.push(error);
+        }
+        assert!(errors[0].abs() < 0.01, "{errors:?}");
+        assert!(errors[1].abs() < 0.005, "{errors:?}");
+        assert!(errors[1].abs() < errors[0].abs(), "{errors:?}");
+    }
+
+    #[test]
+    fn stiffness_needs_a_solved_state() {
+        let surface = rough(16, 13);
+        let mut solver =
+            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        assert!(solver.frozen_set_stiffness().is_err());
+        assert!(solver
+            .finite_difference_stiffness(Control::MeanPressure(0.01), 1.5)
+            .is_err());
+    }
+}
