@@ -32,6 +32,8 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod bem;
+pub mod elastic;
 pub mod fft;
 pub mod fit;
 pub mod io;

@@ -159,6 +159,66 @@ impl PowerLaw {
     }
 }
 
+/// Westergaard's periodic contact (Westergaard 1939; Johnson, *Contact Mechanics*, §13.2):
+/// a rigid sinusoid `h(x) = amplitude · cos(2πx/λ)` (one-dimensional waviness, crests at
+/// `x = 0, λ, …`) pressed onto a half-space with mean pressure `p̄`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Westergaard {
+    /// Wavelength λ.
+    pub wavelength: f64,
+    /// Amplitude Δ of the sinusoid (half the peak-to-valley height).
+    pub amplitude: f64,
+    /// Effective modulus E*.
+    pub modulus: f64,
+}
+
+impl Westergaard {
+    /// Mean pressure of full contact `p* = π E* Δ / λ`.
+    pub fn full_contact_pressure(&self) -> f64 {
+        PI * self.modulus * self.amplitude / self.wavelength
+    }
+
+    /// Contact half-width `a` from `p̄ = p* sin²(πa/λ)` (λ/2 at and beyond full contact).
+    pub fn contact_half_width(&self, mean_pressure: f64) -> f64 {
+        let ratio = (mean_pressure.max(0.0) / self.full_contact_pressure()).min(1.0);
+        self.wavelength / PI * ratio.sqrt().asin()
+    }
+
+    /// Fraction of the period in contact, `2a/λ`.
+    pub fn contact_fraction(&self, mean_pressure: f64) -> f64 {
+        2.0 * self.contact_half_width(mean_pressure) / self.wavelength
+    }
+
+    /// Pressure at distance `x` from a crest (`|x| ≤ λ/2`):
+    /// `p = 2p̄ cos(πx/λ) sqrt(sin²(πa/λ) − sin²(πx/λ)) / sin²(πa/λ)` inside the contact.
+    pub fn pressure(&self, mean_pressure: f64, x: f64) -> f64 {
+        let a = self.contact_half_width(mean_pressure);
+        let s_a = (PI * a / self.wavelength).sin().powi(2);
+        let s_x = (PI * x / self.wavelength).sin().powi(2);
+        if x.abs() >= a || s_a == 0.0 {
+            return 0.0;
+        }
+        2.0 * mean_pressure * (PI * x / self.wavelength).cos().abs() * (s_a - s_x).sqrt() / s_a
+    }
+}
+
+/// Boussinesq's point load: a force `F` on the surface of a half-space displaces it by
+/// `u(r) = F / (π E* r)` at distance `r`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointLoad {
+    /// The normal force F.
+    pub force: f64,
+    /// Effective modulus E*.
+    pub modulus: f64,
+}
+
+impl PointLoad {
+    /// Surface displacement at distance `r > 0`.
+    pub fn displacement(&self, r: f64) -> f64 {
+        self.force / (PI * self.modulus * r)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -203,6 +263,40 @@ mod tests {
         let fd = (hertz.force(d + h) - hertz.force(d - h)) / (2.0 * h);
         assert!((fd / hertz.stiffness(d) - 1.0).abs() < 1e-8);
         assert!((hertz.indentation(hertz.force(d)) / d - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn westergaard_limits() {
+        let w = Westergaard {
+            wavelength: 2.0,
+            amplitude: 0.1,
+            modulus: 3.0,
+        };
+        let p_star = w.full_contact_pressure();
+        assert!((p_star - PI * 3.0 * 0.1 / 2.0).abs() < 1e-15);
+        assert!((w.contact_fraction(p_star) - 1.0).abs() < 1e-12);
+        assert!((w.contact_fraction(0.5 * p_star) - 0.5).abs() < 1e-12);
+        // The pressure integrates to the mean pressure over one period.
+        let p_mean = 0.3 * p_star;
+        let n = 200_000;
+        let dx = w.wavelength / n as f64;
+        let integral: f64 = (0..n)
+            .map(|i| w.pressure(p_mean, -1.0 + (i as f64 + 0.5) * dx) * dx)
+            .sum();
+        assert!((integral / w.wavelength / p_mean - 1.0).abs() < 1e-3);
+        // At full contact the pressure is p̄(1 + cos 2πx/λ).
+        let x = 0.3;
+        let full = w.pressure(p_star * (1.0 - 1e-12), x);
+        assert!((full - p_star * (1.0 + (2.0 * PI * x / 2.0).cos())).abs() < 1e-5 * p_star);
+    }
+
+    #[test]
+    fn point_load_is_boussinesq() {
+        let load = PointLoad {
+            force: 2.0,
+            modulus: 0.5,
+        };
+        assert!((load.displacement(4.0) - 2.0 / (PI * 0.5 * 4.0)).abs() < 1e-15);
     }
 
     #[test]

@@ -1,0 +1,157 @@
+//! 3D boundary-element contact of a rigid rough indenter on an elastic half-space
+//! (the paper, *Methods*, "BEM calculations"; `shared/SCIENCE.md` §2).
+//!
+//! * **Problem**: a [`Surface`](crate::surface::Surface) (heights positive up) is pressed
+//!   into a half-space of effective modulus E* with [`Boundary::Free`] or
+//!   [`Boundary::Periodic`] boundaries ([`HalfSpace`]); frictionless and non-adhesive. The
+//!   indenter's profile is `f = max(h) − h ≥ 0`, so the indentation `d` is measured from the
+//!   highest point (first contact at `d = 0`). With the elastic displacement `u = K p`
+//!   (positive down) the gap is `g = u + f − d`, and the solution satisfies
+//!   `p ≥ 0, g ≥ 0, p·g = 0` with either the mean pressure (load control) or `d`
+//!   (displacement control) prescribed ([`Control`]).
+//! * **Solver**: [`ContactSolver`] — Polonsky & Keer's constrained conjugate gradients
+//!   (Wear 231, 206–219, 1999) on the FFT operator of [`crate::elastic`]. It owns the
+//!   operator, its plans and every buffer, so one solver serves many loads, and it starts
+//!   each solve from the previous pressure (warm start).
+//! * **Stiffness**: [`ContactSolver::frozen_set_stiffness`] — the paper's method: keep the
+//!   contact set, impose a uniform `Δd` on it, solve the linear SPD problem for the pressures
+//!   on the set (conjugate gradients), `k = ΔF/Δd`; and
+//!   [`ContactSolver::finite_difference_stiffness`], `dF/dd` from two more solves. Barber's
+//!   theorem makes the two agree.
+//!
+//! ## Convergence measure
+//! The residual of a state is the rms violation of the contact conditions, measured on the
+//! contact set and normalised by the rms height `h_rms` of the surface:
+//! `residual = sqrt[(Σ_{p>0} g² + Σ_{p=0} min(g, 0)²) / n_c] / h_rms`, where `n_c` counts the
+//! points in contact. It is zero exactly when the state solves the problem. The solver stops
+//! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
+
+mod polonsky_keer;
+mod stiffness;
+
+pub use polonsky_keer::ContactSolver;
+
+use ndarray::Array2;
+
+use crate::elastic::Boundary;
+
+/// The elastic body: effective modulus and boundary conditions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfSpace {
+    /// Effective modulus E*, `1/E* = (1−ν₁²)/E₁ + (1−ν₂²)/E₂`.
+    pub modulus: f64,
+    /// Free (zero-padded, the paper's choice) or periodic boundaries.
+    pub boundary: Boundary,
+}
+
+impl Default for HalfSpace {
+    /// E* = 1, free boundaries (the paper's setting).
+    fn default() -> Self {
+        HalfSpace {
+            modulus: 1.0,
+            boundary: Boundary::Free,
+        }
+    }
+}
+
+/// What is prescribed in a solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Control {
+    /// Load control: the mean pressure over the nominal area `rows·cols·Δ²` (> 0).
+    MeanPressure(f64),
+    /// Load control: the total force (> 0).
+    Force(f64),
+    /// Displacement control: the indentation `d` from the highest point (≥ 0; free
+    /// boundaries only).
+    Indentation(f64),
+}
+
+/// Parameters of the contact solver (validated by [`ContactSolver::new`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverParams {
+    /// Stop when the residual (see the module docs) is below this; > 0.
+    pub tolerance: f64,
+    /// Polonsky–Keer iterations before [`SolveError::NoConvergence`]; ≥ 1.
+    pub max_iterations: usize,
+    /// Relative residual `‖K_SS x − 1‖/‖1‖` at which the frozen-set CG stops; > 0.
+    pub stiffness_tolerance: f64,
+    /// Iterations of the frozen-set CG before [`SolveError::NoConvergence`]; ≥ 1.
+    pub stiffness_max_iterations: usize,
+}
+
+impl Default for SolverParams {
+    /// `tolerance = 1e-8` (gaps on the contact set below 1e-8 rms heights), at most 10 000
+    /// iterations; frozen-set CG to `1e-10` relative residual in at most 10 000 iterations.
+    fn default() -> Self {
+        SolverParams {
+            tolerance: 1e-8,
+            max_iterations: 10_000,
+            stiffness_tolerance: 1e-10,
+            stiffness_max_iterations: 10_000,
+        }
+    }
+}
+
+/// How a solve went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveInfo {
+    /// Iterations (Polonsky–Keer steps, or CG steps for the stiffness).
+    pub iterations: usize,
+    /// Final residual (see the module docs; relative CG residual for the stiffness).
+    pub residual: f64,
+}
+
+/// The scalar results of a solved contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSummary {
+    /// Mean pressure over the nominal area.
+    pub mean_pressure: f64,
+    /// Total force `Σ p Δ²`.
+    pub force: f64,
+    /// Indentation `d` from the highest point of the surface.
+    pub indentation: f64,
+    /// Fraction of grid points in contact (`p > 0`).
+    pub area_fraction: f64,
+    /// Number of grid points in contact.
+    pub contact_points: usize,
+}
+
+/// A solved contact with its fields (`rows × cols`, row-major like the surface).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactState {
+    /// The scalar results.
+    pub summary: ContactSummary,
+    /// Contact pressure, ≥ 0.
+    pub pressure: Array2<f64>,
+    /// Gap `u + f − d`, ≥ 0 (zero on the contact set).
+    pub gap: Array2<f64>,
+    /// Elastic surface displacement `u = K p`, positive into the half-space.
+    pub displacement: Array2<f64>,
+}
+
+/// Why a contact solve failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    /// Bad input (parameters, surface, memory).
+    #[error(transparent)]
+    Input(#[from] crate::Error),
+    /// The iteration did not reach the tolerance.
+    #[error("no convergence after {iterations} iterations (residual {residual:.3e})")]
+    NoConvergence {
+        /// Iterations done.
+        iterations: usize,
+        /// Residual reached.
+        residual: f64,
+    },
+    /// The load closes the gap everywhere: no contact problem is left to solve.
+    #[error(
+        "mean pressure {requested:.6e} is beyond full contact{}",
+        match full_contact { Some(p) => format!(" (the gap closes everywhere from a mean pressure of {p:.6e})"), None => String::new() }
+    )]
+    BeyondFullContact {
+        /// The requested mean pressure.
+        requested: f64,
+        /// The mean pressure at which the gap closes everywhere, where known.
+        full_contact: Option<f64>,
+    },
+}

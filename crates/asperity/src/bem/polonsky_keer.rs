@@ -1,0 +1,803 @@
+//! [`ContactSolver`]: Polonsky & Keer's constrained conjugate gradients for the rough
+//! contact problem of [`crate::bem`] (I. A. Polonsky, L. M. Keer, *A numerical method for
+//! solving rough contact problems based on the multi-level multi-summation and conjugate
+//! gradient techniques*, Wear 231, 206–219, 1999), on the FFT half-space operator.
+//!
+//! One iteration (load control; displacement control skips the mean subtractions and the
+//! rescaling, with `d` fixed):
+//! 1. `u = K p`; on the contact set `I_c = {p > 0}` the indentation is the mean of `u + f`,
+//!    `g = u + f − d`, `G = Σ_{I_c} g²`.
+//! 2. Direction `t = g + δ (G/G_old) t` on `I_c`, zero elsewhere (`δ = 0` after the contact
+//!    set grew: a steepest-descent restart).
+//! 3. `r = K t` minus its mean on `I_c`; step `τ = Σ g t / Σ r t`; `p ← max(p − τ t, 0)`.
+//! 4. Points out of contact that penetrate (`p = 0, g < 0`) enter with `p = −τ g`.
+//! 5. Rescale `p` to the prescribed mean pressure.
+//!
+//! Each iteration costs two operator applications and four fused passes over the grid.
+//! The elementwise passes run serially: they are memory bound, and a fixed summation order
+//! keeps results bit-identical for any thread count (the FFTs are parallel and
+//! independent of it too).
+
+use ndarray::{Array2, ArrayView2};
+
+use super::{ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverParams};
+use crate::elastic::{self_influence, Boundary, ElasticOperator};
+use crate::surface::Surface;
+use crate::{memory, Error};
+
+/// What the Polonsky–Keer loop holds fixed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    MeanPressure(f64),
+    Indentation(f64),
+}
+
+/// A Polonsky–Keer contact solver for one surface: owns the elastic operator (plans,
+/// kernel spectrum, buffers) and the fields, so successive solves allocate nothing and
+/// start from the previous pressure.
+pub struct ContactSolver {
+    pub(super) operator: ElasticOperator,
+    pub(super) rows: usize,
+    pub(super) cols: usize,
+    /// Indenter profile `f = max(h) − h ≥ 0`, row-major.
+    pub(super) profile: Vec<f64>,
+    /// rms height about the mean (1 for a flat surface), the residual's scale.
+    height_scale: f64,
+    pub(super) params: SolverParams,
+    pub(super) pressure: Vec<f64>,
+    /// `u` during an iteration, the gap `g` after a solve.
+    gap: Vec<f64>,
+    pub(super) direction: Vec<f64>,
+    pub(super) response: Vec<f64>,
+    /// The last solved state, if any (its pressure is in `pressure`).
+    pub(super) solved: Option<ContactSummary>,
+    /// Mean pressure at which a periodic surface is in full contact (computed once).
+    full_contact_pressure: Option<f64>,
+    /// Two extra fields for the frozen-set CG, allocated on first use.
+    pub(super) stiffness_work: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+impl ContactSolver {
+    /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
+    /// overflow): the operator, five fields and the two stiffness fields.
+    pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
+        let fields = memory::array_bytes(&[7, rows, cols], 8)?;
+        ElasticOperator::memory_bytes(rows, cols, boundary)?.checked_add(fields)
+    }
+
+    /// Plans a solver for `surface` on `half_space`; validates `params`, refuses grids that
+    /// would not fit in memory.
+    pub fn new(
+        surface: &Surface,
+        half_space: HalfSpace,
+        params: SolverParams,
+    ) -> Result<Self, SolveError> {
+        validate_params(&params)?;
+        let (rows, cols) = surface.dim();
+        memory::ensure_fits(
+            &format!(
+                "a BEM solver for a {rows}x{cols} grid ({} boundaries)",
+                half_space.boundary.name()
+            ),
+            Self::memory_bytes(rows, cols, half_space.boundary),
+        )?;
+        let operator = ElasticOperator::new(
+            rows,
+            cols,
+            surface.spacing(),
+            half_space.modulus,
+            half_space.boundary,
+        )?;
+        let heights = surface.heights();
+        let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+        let profile: Vec<f64> = heights.iter().map(|&h| top - h).collect();
+        let n = profile.len() as f64;
+        let mean = profile.iter().sum::<f64>() / n;
+        let rms = (profile.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n).sqrt();
+        let height_scale = if rms > 0.0 { rms } else { 1.0 };
+        let len = rows * cols;
+        Ok(ContactSolver {
+            operator,
+            rows,
+            cols,
+            profile,
+            height_scale,
+            params,
+            pressure: vec![0.0; len],
+            gap: vec![0.0; len],
+            direction: vec![0.0; len],
+            response: vec![0.0; len],
+            solved: None,
+            full_contact_pressure: None,
+            stiffness_work: None,
+        })
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Replaces the parameters (validated).
+    pub fn set_params(&mut self, params: SolverParams) -> Result<(), SolveError> {
+        validate_params(&params)?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// `(rows, cols)` of the grid.
+    pub fn dim(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+
+    /// Nominal (projected) area `rows · cols · Δ²`.
+    pub fn nominal_area(&self) -> f64 {
+        let dx = self.operator.spacing();
+        (self.rows * self.cols) as f64 * dx * dx
+    }
+
+    /// Forgets the previous solution: the next solve starts cold.
+    pub fn reset(&mut self) {
+        self.solved = None;
+    }
+
+    /// The last solved state's scalars, if any.
+    pub fn summary(&self) -> Option<ContactSummary> {
+        self.solved
+    }
+
+    /// Solves the contact under `control`, starting from the previous solution when there
+    /// is one (warm start). Fields of the result: [`ContactSolver::pressure`],
+    /// [`ContactSolver::gap`], [`ContactSolver::state`].
+    pub fn solve(&mut self, control: Control) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let target = match control {
+            Control::MeanPressure(p) => Target::MeanPressure(check_load("mean pressure", p)?),
+            Control::Force(f) => {
+                Target::MeanPressure(check_load("force", f)? / self.nominal_area())
+            }
+            Control::Indentation(d) => {
+                if !(d.is_finite() && d >= 0.0) {
+                    return Err(Error::invalid(
+                        "indentation",
+                        format!("must be finite and >= 0, got {d}"),
+                    )
+                    .into());
+                }
+                if self.operator.boundary() == Boundary::Periodic {
+                    return Err(Error::invalid(
+                        "indentation",
+                        "displacement control needs free boundaries: a periodic half-space \
+                         fixes displacements only up to their mean (use load control)",
+                    )
+                    .into());
+                }
+                Target::Indentation(d)
+            }
+        };
+        if let Target::MeanPressure(p) = target {
+            if self.operator.boundary() == Boundary::Periodic {
+                let full = self.periodic_full_contact_pressure();
+                if p >= full {
+                    self.solved = None;
+                    return Err(SolveError::BeyondFullContact {
+                        requested: p,
+                        full_contact: Some(full),
+                    });
+                }
+            }
+        }
+        let result = self.polonsky_keer(target);
+        match result {
+            Ok((summary, _)) => {
+                if let Target::MeanPressure(p) = target {
+                    if summary.contact_points == self.rows * self.cols {
+                        self.solved = None;
+                        let full = self.free_full_contact_pressure().ok();
+                        return Err(SolveError::BeyondFullContact {
+                            requested: p,
+                            full_contact: full,
+                        });
+                    }
+                }
+                self.solved = Some(summary);
+            }
+            Err(_) => self.solved = None,
+        }
+        result
+    }
+
+    /// Pressure of the last solve, `rows × cols`.
+    pub fn pressure(&self) -> ArrayView2<'_, f64> {
+        ArrayView2::from_shape((self.rows, self.cols), &self.pressure)
+            .expect("buffer has the grid's shape")
+    }
+
+    /// Gap of the last solve, `rows × cols` (≥ 0, zero on the contact set).
+    pub fn gap(&self) -> ArrayView2<'_, f64> {
+        ArrayView2::from_shape((self.rows, self.cols), &self.gap)
+            .expect("buffer has the grid's shape")
+    }
+
+    /// The last solved state with owned copies of its fields; the displacement is computed
+    /// afresh (one operator application). `None` before a successful solve.
+    pub fn state(&mut self) -> Option<ContactState> {
+        let summary = self.solved?;
+        let mut displacement = Array2::zeros((self.rows, self.cols));
+        let out = displacement
+            .as_slice_mut()
+            .expect("a fresh array is contiguous");
+        self.operator.apply(&self.pressure, out);
+        Some(ContactState {
+            summary,
+            pressure: self.pressure().to_owned(),
+            gap: self.gap().to_owned(),
+            displacement,
+        })
+    }
+
+    /// Mean pressure at which a periodic surface comes into full contact: with
+    /// `K p = d − f` everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)`
+    /// (Westergaard's `p* = π E* Δ / λ` for a sinusoid). Uses the gap and direction buffers.
+    fn periodic_full_contact_pressure(&mut self) -> f64 {
+        if let Some(p) = self.full_contact_pressure {
+            return p;
+        }
+        self.operator
+            .apply_pseudo_inverse(&self.profile, &mut self.direction)
+            .expect("called for periodic boundaries only");
+        let full = self
+            .direction
+            .iter()
+            .fold(0.0f64, |m, &v| m.max(v));
+        self.full_contact_pressure = Some(full);
+        full
+    }
+
+    fn polonsky_keer(&mut self, target: Target) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let n = self.rows * self.cols;
+        let load_control = matches!(target, Target::MeanPressure(_));
+        let self_influence = self_influence(self.operator.spacing(), self.operator.modulus());
+        self.initialise(target, self_influence);
+        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
+        let mut indentation = match target {
+            Target::Indentation(d) => d,
+            Target::MeanPressure(_) => self.solved.map_or(0.0, |s| s.indentation),
+        };
+        let mut g_old = 0.0;
+        let mut conjugate = false;
+        let mut iteration = 0;
+        loop {
+            self.operator.apply(&self.pressure, &mut self.gap);
+            let (p, gap, t, f) = (&self.pressure, &mut self.gap, &mut self.direction, &self.profile);
+
+            // Pass A: u + f, and its mean and spread on the contact set, shifted by the
+            // last indentation so that G does not cancel.
+            let shift = indentation;
+            let (mut contact_points, mut sum, mut sum_sq) = (0usize, 0.0, 0.0);
+            for i in 0..n {
+                let v = gap[i] + f[i];
+                gap[i] = v;
+                if p[i] > 0.0 {
+                    let w = v - shift;
+                    contact_points += 1;
+                    sum += w;
+                    sum_sq += w * w;
+                }
+            }
+            let g_estimate = if load_control && contact_points > 0 {
+                let mean = sum / contact_points as f64;
+                indentation = shift + mean;
+                (sum_sq - contact_points as f64 * mean * mean).max(0.0)
+            } else {
+                sum_sq
+            };
+
+            // Pass B: gap, exact G, penetration outside the set, new direction.
+            let beta = if conjugate && g_old > 0.0 {
+                g_estimate / g_old
+            } else {
+                0.0
+            };
+            let (mut g_sum, mut penetration) = (0.0, 0.0);
+            for i in 0..n {
+                let g = gap[i] - indentation;
+                gap[i] = g;
+                if p[i] > 0.0 {
+                    g_sum += g * g;
+                    t[i] = g + beta * t[i];
+                } else {
+                    t[i] = 0.0;
+                    if g < 0.0 {
+                        penetration += g * g;
+                    }
+                }
+            }
+            let residual =
+                ((g_sum + penetration) / contact_points.max(1) as f64).sqrt() / self.height_scale;
+            if residual < tolerance {
+                return Ok((self.finish(indentation, contact_points), SolveInfo { iterations: iteration, residual }));
+            }
+            if iteration >= max_iterations {
+                return Err(SolveError::NoConvergence {
+                    iterations: iteration,
+                    residual,
+                });
+            }
+            if !residual.is_finite() {
+                return Err(SolveError::NoConvergence {
+                    iterations: iteration,
+                    residual,
+                });
+            }
+            g_old = g_sum;
+            iteration += 1;
+
+            self.operator.apply(&self.direction, &mut self.response);
+            let (p, gap, t, r) = (&mut self.pressure, &self.gap, &self.direction, &self.response);
+
+            // Pass C: step length with r's mean on the set removed (load control).
+            let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
+            for i in 0..n {
+                if p[i] > 0.0 {
+                    sum_r += r[i];
+                    sum_rt += r[i] * t[i];
+                    sum_t += t[i];
+                    sum_gt += gap[i] * t[i];
+                }
+            }
+            let mean_r = if load_control && contact_points > 0 {
+                sum_r / contact_points as f64
+            } else {
+                0.0
+            };
+            let denominator = sum_rt - mean_r * sum_t;
+            let tau = if contact_points > 0 && denominator > 0.0 {
+                sum_gt / denominator
+            } else {
+                0.0
+            };
+            // Penetrating points enter with p = −τ g; before any step exists (empty
+            // set), a Jacobi step with the self-influence.
+            let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
+
+            // Pass D: update, clamp, let penetrating points in.
+            let mut entered = false;
+            let mut total = 0.0;
+            for i in 0..n {
+                if p[i] > 0.0 {
+                    p[i] = (p[i] - tau * t[i]).max(0.0);
+                } else if gap[i] < 0.0 {
+                    p[i] = -entry_step * gap[i];
+                    entered = true;
+                }
+                total += p[i];
+            }
+            conjugate = !entered;
+
+            // Pass E: the prescribed load.
+            if let Target::MeanPressure(mean_pressure) = target {
+                if total > 0.0 {
+                    let scale = mean_pressure * n as f64 / total;
+                    p.iter_mut().for_each(|v| *v *= scale);
+                } else {
+                    p.fill(mean_pressure);
+                    conjugate = false;
+                }
+            }
+        }
+    }
+
+    /// Initial pressure: the previous solution (rescaled to the new load) or a cold start
+    /// (uniform pressure under load control; local springs `max(d − f, 0)/K₀₀` under
+    /// displacement control).
+    fn initialise(&mut self, target: Target, self_influence: f64) {
+        let n = (self.rows * self.cols) as f64;
+        let warm = self.solved.is_some();
+        match target {
+            Target::MeanPressure(mean_pressure) => {
+                let current = self.pressure.iter().sum::<f64>() / n;
+                if warm && current > 0.0 {
+                    let scale = mean_pressure / current;
+                    self.pressure.iter_mut().for_each(|p| *p *= scale);
+                } else {
+                    self.pressure.fill(mean_pressure);
+                }
+            }
+            Target::Indentation(d) => {
+                let any = self.pressure.iter().any(|&p| p > 0.0);
+                if !(warm && any) {
+                    for (p, f) in self.pressure.iter_mut().zip(&self.profile) {
+                        *p = (d - f).max(0.0) / self_influence;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Scalars of the converged state; the gap buffer is cleaned to `g ≥ 0`, zero on the
+    /// contact set (its residual there is below the tolerance).
+    fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
+        for (g, p) in self.gap.iter_mut().zip(&self.pressure) {
+            *g = if *p > 0.0 { 0.0 } else { g.max(0.0) };
+        }
+        let n = self.rows * self.cols;
+        let mean_pressure = self.pressure.iter().sum::<f64>() / n as f64;
+        ContactSummary {
+            mean_pressure,
+            force: mean_pressure * self.nominal_area(),
+            indentation,
+            area_fraction: contact_points as f64 / n as f64,
+            contact_points,
+        }
+    }
+}
+
+fn check_load(name: &'static str, value: f64) -> Result<f64, SolveError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid(name, format!("must be positive and finite, got {value}")).into())
+    }
+}
+
+fn validate_params(params: &SolverParams) -> Result<(), SolveError> {
+    let positive = |name: &'static str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(Error::invalid(name, format!("must be positive and finite, got {v}")))
+        }
+    };
+    positive("tolerance", params.tolerance)?;
+    positive("stiffness tolerance", params.stiffness_tolerance)?;
+    if params.max_iterations == 0 || params.stiffness_max_iterations == 0 {
+        return Err(Error::invalid("max iterations", "must be at least 1").into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+    use crate::reference::{Hertz, Westergaard};
+    use std::f64::consts::PI;
+
+    /// A sphere `h = −r²/2R` (peak up) centred on pixel `(rows/2, cols/2)`.
+    pub(crate) fn sphere(rows: usize, cols: usize, size: f64, radius: f64) -> Surface {
+        let dx = size / cols as f64;
+        let heights = Array2::from_shape_fn((rows, cols), |(i, j)| {
+            let y = (i as f64 - (rows / 2) as f64) * dx;
+            let x = (j as f64 - (cols / 2) as f64) * dx;
+            -(x * x + y * y) / (2.0 * radius)
+        });
+        Surface::new(heights, size).unwrap()
+    }
+
+    pub(crate) fn rough(n: usize, seed: u64) -> Surface {
+        use crate::spectrum::{LongWavelength, Psd};
+        use crate::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
+        let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 4.0 }, None).unwrap();
+        let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(0.5)).unwrap();
+        SurfaceGenerator::new(&spec).unwrap().generate(seed)
+    }
+
+    fn free() -> HalfSpace {
+        HalfSpace {
+            modulus: 1.0,
+            boundary: Boundary::Free,
+        }
+    }
+
+    /// Hertz on a grid: force–indentation, contact radius and pressure profile.
+    fn check_hertz(rows: usize, cols: usize) {
+        // Contact radius ≈ 18 pixels on a grid of 48+ pixels: far from the free edges.
+        let (size, radius, modulus) = (1.0, 2.0, 1.7);
+        let dx = size / cols as f64;
+        let hertz = Hertz { radius, modulus };
+        let a_target = 18.0 * dx;
+        let d_target = a_target * a_target / radius;
+        let force = hertz.force(d_target);
+        let surface = sphere(rows, cols, size, radius);
+        let half_space = HalfSpace { modulus, ..free() };
+        let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+        let (s, info) = solver.solve(Control::Force(force)).unwrap();
+        assert!(info.residual < 1e-8);
+        assert!((s.force / force - 1.0).abs() < 1e-12);
+        // Force–indentation within 1 %.
+        let d_error = s.indentation / d_target - 1.0;
+        assert!(d_error.abs() < 0.01, "{rows}x{cols}: indentation error {d_error:e}");
+        // Contact radius (area-equivalent) within one pixel.
+        let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
+        assert!((a - a_target).abs() < dx, "{rows}x{cols}: a = {a}, Hertz {a_target}");
+        // Pressure profile: within 2 % of the peak pressure inside 0.9 a (the last pixels
+        // average the square-root edge over a pixel, where the pointwise error is larger).
+        let p0 = hertz.pressure(d_target, 0.0);
+        let pressure = solver.pressure();
+        let mut worst = 0.0f64;
+        for ((i, j), &p) in pressure.indexed_iter() {
+            let r = (((i as f64) - (rows / 2) as f64).hypot(j as f64 - (cols / 2) as f64)) * dx;
+            if r < 0.9 * a_target {
+                worst = worst.max((p - hertz.pressure(d_target, r)).abs() / p0);
+            }
+        }
+        assert!(worst < 0.02, "{rows}x{cols}: pressure error {worst:e} of p0");
+        eprintln!(
+            "hertz {rows}x{cols}: d error {d_error:.2e}, a {:.3} px, p error {worst:.2e}, {} iterations",
+            (a - a_target) / dx,
+            info.iterations
+        );
+    }
+
+    #[test]
+    fn hertz_even_grid() {
+        check_hertz(64, 64);
+    }
+
+    #[test]
+    fn hertz_odd_grid() {
+        check_hertz(63, 63);
+    }
+
+    #[test]
+    fn hertz_non_square_grid() {
+        check_hertz(50, 72);
+    }
+
+    #[test]
+    fn hertz_displacement_control_gives_the_hertz_force() {
+        let (size, radius) = (1.0, 2.0);
+        let n = 64;
+        let dx = size / n as f64;
+        let hertz = Hertz {
+            radius,
+            modulus: 1.0,
+        };
+        let d = (16.0 * dx).powi(2) / radius;
+        let mut solver =
+            ContactSolver::new(&sphere(n, n, size, radius), free(), SolverParams::default())
+                .unwrap();
+        let (s, _) = solver.solve(Control::Indentation(d)).unwrap();
+        let error = s.force / hertz.force(d) - 1.0;
+        assert!(error.abs() < 0.01, "force error {error:e}");
+        assert_eq!(s.indentation, d);
+        // Load control at that force returns the same state.
+        let (t, _) = solver.solve(Control::Force(s.force)).unwrap();
+        assert!((t.indentation / d - 1.0).abs() < 1e-6);
+        assert_eq!(t.contact_points, s.contact_points);
+    }
+
+    #[test]
+    fn westergaard_partial_contact_and_full_contact() {
+        // Non-square: 8 rows (the problem is one-dimensional), 128 columns = one wavelength.
+        let (rows, cols, size, amplitude, modulus) = (8, 128, 1.0, 0.01, 2.0);
+        let dx = size / cols as f64;
+        let heights = Array2::from_shape_fn((rows, cols), |(_, j)| {
+            amplitude * (2.0 * PI * j as f64 * dx / size).cos()
+        });
+        let surface = Surface::new(heights, size).unwrap();
+        let reference = Westergaard {
+            wavelength: size,
+            amplitude,
+            modulus,
+        };
+        let p_star = reference.full_contact_pressure();
+        let half_space = HalfSpace {
+            modulus,
+            boundary: Boundary::Periodic,
+        };
+        let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+        for ratio in [0.1, 0.5, 0.9] {
+            let (s, _) = solver.solve(Control::MeanPressure(ratio * p_star)).unwrap();
+            let expected = reference.contact_fraction(ratio * p_star);
+            // The contact edge is resolved to a pixel on each side.
+            assert!(
+                (s.area_fraction - expected).abs() <= 2.0 / cols as f64,
+                "p/p* = {ratio}: {} vs {expected}",
+                s.area_fraction
+            );
+            let pressure = solver.pressure();
+            let p_max = reference.pressure(ratio * p_star, 0.0);
+            for j in 0..cols {
+                let x = if j <= cols / 2 { j as f64 } else { j as f64 - cols as f64 } * dx;
+                let a = reference.contact_half_width(ratio * p_star);
+                if x.abs() < a - 2.0 * dx {
+                    let error = (pressure[[3, j]] - reference.pressure(ratio * p_star, x)).abs();
+                    assert!(error < 0.01 * p_max, "p/p* = {ratio}, x = {x}: error {error}");
+                }
+            }
+        }
+        // Full contact at p* = π E* Δ / λ: the threshold is exact for a single mode.
+        match solver.solve(Control::MeanPressure(1.001 * p_star)) {
+            Err(SolveError::BeyondFullContact {
+                full_contact: Some(full),
+                ..
+            }) => assert!((full / p_star - 1.0).abs() < 1e-12, "{full} vs {p_star}"),
+            other => panic!("expected BeyondFullContact, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn free_load_beyond_full_contact_is_an_error() {
+        let surface = rough(32, 1);
+        let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+        match solver.solve(Control::MeanPressure(1e3)) {
+            Err(SolveError::BeyondFullContact {
+                requested,
+                full_contact: Some(full),
+            }) => {
+                assert_eq!(requested, 1e3);
+                assert!(full > 0.0 && full < 1e3, "{full}");
+                // Just below the threshold the contact is partial, just above it is full.
+                let (below, _) = solver.solve(Control::MeanPressure(0.9 * full)).unwrap();
+                assert!(below.area_fraction < 1.0);
+                assert!(matches!(
+                    solver.solve(Control::MeanPressure(1.1 * full)),
+                    Err(SolveError::BeyondFullContact { .. })
+                ));
+            }
+            other => panic!("expected BeyondFullContact, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn free_and_periodic_agree_for_a_small_contact() {
+        // Contact radius 5 pixels on a 96² grid: the periodic images shift the indentation
+        // but barely change the contact area and pressures.
+        let (n, size, radius) = (96, 1.0, 1.0);
+        let dx = size / n as f64;
+        let force = Hertz {
+            radius,
+            modulus: 1.0,
+        }
+        .force((5.0 * dx).powi(2) / radius);
+        let surface = sphere(n, n, size, radius);
+        let mut results = Vec::new();
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary,
+            };
+            let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            let (s, _) = solver.solve(Control::Force(force)).unwrap();
+            let p_max = solver.pressure().iter().fold(0.0f64, |m, &p| m.max(p));
+            results.push((s.contact_points, p_max));
+        }
+        let (free_points, free_peak) = results[0];
+        let (periodic_points, periodic_peak) = results[1];
+        // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images:
+        // the area may differ by one ring of pixels' worth of points at most.
+        assert!(
+            (free_points as i64 - periodic_points as i64).abs() <= 8,
+            "{free_points} vs {periodic_points}"
+        );
+        assert!((free_peak / periodic_peak - 1.0).abs() < 0.03, "{free_peak} vs {periodic_peak}");
+    }
+
+    #[test]
+    fn warm_start_saves_iterations() {
+        let surface = rough(64, 2);
+        let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+        let (_, first) = solver.solve(Control::MeanPressure(0.02)).unwrap();
+        let (warm_state, warm) = solver.solve(Control::MeanPressure(0.022)).unwrap();
+        solver.reset();
+        let (cold_state, cold) = solver.solve(Control::MeanPressure(0.022)).unwrap();
+        assert!(warm.iterations < cold.iterations, "warm {} vs cold {}", warm.iterations, cold.iterations);
+        assert!(first.iterations > 0);
+        assert_eq!(warm_state.contact_points, cold_state.contact_points);
+        assert!((warm_state.indentation / cold_state.indentation - 1.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn results_do_not_depend_on_the_thread_count() {
+        let surface = rough(48, 3);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+                let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
+                let (k, _) = solver.frozen_set_stiffness().unwrap();
+                (solver.pressure().to_owned(), s.indentation, info.iterations, k)
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            assert_eq!(one, run(threads), "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        let surface = rough(16, 4);
+        let bad_tolerance = SolverParams {
+            tolerance: 0.0,
+            ..SolverParams::default()
+        };
+        assert!(matches!(
+            ContactSolver::new(&surface, free(), bad_tolerance),
+            Err(SolveError::Input(Error::InvalidParameter { .. }))
+        ));
+        let negative = SolverParams {
+            tolerance: -1e-6,
+            ..SolverParams::default()
+        };
+        assert!(ContactSolver::new(&surface, free(), negative).is_err());
+        let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+        for control in [
+            Control::MeanPressure(-1.0),
+            Control::MeanPressure(0.0),
+            Control::Force(f64::NAN),
+            Control::Indentation(-0.1),
+        ] {
+            assert!(
+                matches!(solver.solve(control), Err(SolveError::Input(_))),
+                "{control:?}"
+            );
+        }
+        let periodic = HalfSpace {
+            modulus: 1.0,
+            boundary: Boundary::Periodic,
+        };
+        let mut solver = ContactSolver::new(&surface, periodic, SolverParams::default()).unwrap();
+        assert!(solver.solve(Control::Indentation(0.1)).is_err());
+        // A NaN surface cannot be built.
+        let mut heights = surface.heights().clone();
+        heights[[3, 4]] = f64::NAN;
+        assert!(Surface::new(heights, 1.0).is_err());
+        // A grid too large for memory is refused before anything is allocated.
+        let err = memory::ensure_fits(
+            "test",
+            ContactSolver::memory_bytes(1 << 19, 1 << 19, Boundary::Free),
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::OutOfMemory { .. }));
+    }
+
+    #[test]
+    fn no_convergence_is_an_error_with_the_residual() {
+        let surface = rough(32, 5);
+        let params = SolverParams {
+            max_iterations: 3,
+            ..SolverParams::default()
+        };
+        let mut solver = ContactSolver::new(&surface, free(), params).unwrap();
+        match solver.solve(Control::MeanPressure(0.01)) {
+            Err(SolveError::NoConvergence {
+                iterations,
+                residual,
+            }) => {
+                assert_eq!(iterations, 3);
+                assert!(residual > params.tolerance && residual.is_finite());
+            }
+            other => panic!("expected NoConvergence, got {other:?}"),
+        }
+        assert!(solver.summary().is_none());
+        assert!(solver.frozen_set_stiffness().is_err());
+    }
+
+    #[test]
+    fn solution_satisfies_the_contact_conditions() {
+        let surface = rough(64, 6);
+        let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+        let (s, _) = solver.solve(Control::MeanPressure(0.03)).unwrap();
+        let state = solver.state().unwrap();
+        let f_top = surface.heights().iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+        let rms = 0.5 / (2.0 * PI); // loose scale: rms slope 0.5, wavelengths ≥ L/4
+        for ((&p, &u), &h) in state
+            .pressure
+            .iter()
+            .zip(&state.displacement)
+            .zip(surface.heights())
+        {
+            assert!(p >= 0.0);
+            let g = u + (f_top - h) - s.indentation;
+            if p > 0.0 {
+                assert!(g.abs() < 1e-6 * rms, "gap {g} in contact");
+            } else {
+                assert!(g > -1e-6 * rms, "penetration {g}");
+            }
+        }
+        let total: f64 = state.pressure.iter().sum::<f64>() / (64.0 * 64.0);
+        assert!((total / 0.03 - 1.0).abs() < 1e-12);
+        assert!(state.gap.iter().all(|&g| g >= 0.0));
+    }
+}

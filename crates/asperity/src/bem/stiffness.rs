@@ -1,0 +1,353 @@
+//! Contact stiffness of a solved state.
+//!
+//! * [`ContactSolver::frozen_set_stiffness`] — the paper's method (*Methods*, "BEM
+//!   calculations"): keep the contact set `S` of the solved state, impose a uniform extra
+//!   displacement `Δd` on it and solve `K_SS Δp = Δd · 1_S` for the pressures on the set
+//!   (the restriction of the elastic operator to `S` is symmetric positive definite, so
+//!   plain conjugate gradients apply); `k = ΔF/Δd = Δ² Σ Δp / Δd`. It depends on the set
+//!   only, not on the topography.
+//! * [`ContactSolver::finite_difference_stiffness`] — `dF/dd` by central differences of two
+//!   more solves. By Barber's theorem (J. R. Barber, Proc. R. Soc. A 459, 2003) the two are
+//!   equal as long as the contact set does not change within the step.
+//!
+//! The same CG on the full grid gives the mean pressure at which a free-boundary surface
+//! comes into full contact: with `q = K⁻¹ 1` (a flat punch the size of the grid) and
+//! `y = K⁻¹ f`, the pressure `d q − y` is non-negative everywhere from `d = max(y/q)` on.
+
+use super::polonsky_keer::ContactSolver;
+use super::{Control, SolveError, SolveInfo};
+use crate::elastic::ElasticOperator;
+use crate::Error;
+
+/// Right-hand side of a CG on a set.
+#[derive(Clone, Copy)]
+enum RightHandSide<'a> {
+    /// A uniform unit displacement on the set.
+    Ones,
+    /// Given values (read on the set only).
+    Values(&'a [f64]),
+}
+
+/// Solves `K_SS x = b_S` by conjugate gradients (x zero off the set). `direction` and
+/// `response` are scratch. Stops at `‖r‖ ≤ tolerance ‖b‖`.
+#[allow(clippy::too_many_arguments)]
+fn conjugate_gradient_on_set(
+    operator: &mut ElasticOperator,
+    in_set: &[bool],
+    rhs: RightHandSide<'_>,
+    x: &mut [f64],
+    residual: &mut [f64],
+    direction: &mut [f64],
+    response: &mut [f64],
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<SolveInfo, SolveError> {
+    let n = in_set.len();
+    let mut rs = 0.0;
+    for i in 0..n {
+        x[i] = 0.0;
+        let b = if in_set[i] {
+            match rhs {
+                RightHandSide::Ones => 1.0,
+                RightHandSide::Values(v) => v[i],
+            }
+        } else {
+            0.0
+        };
+        residual[i] = b;
+        direction[i] = b;
+        rs += b * b;
+    }
+    let b_norm = rs.sqrt();
+    if b_norm == 0.0 {
+        return Ok(SolveInfo {
+            iterations: 0,
+            residual: 0.0,
+        });
+    }
+    let mut iterations = 0;
+    loop {
+        let relative = rs.sqrt() / b_norm;
+        if relative <= tolerance {
+            return Ok(SolveInfo {
+                iterations,
+                residual: relative,
+            });
+        }
+        if iterations >= max_iterations || !relative.is_finite() {
+            return Err(SolveError::NoConvergence {
+                iterations,
+                residual: relative,
+            });
+        }
+        iterations += 1;
+        operator.apply(direction, response);
+        let mut curvature = 0.0;
+        for i in 0..n {
+            if in_set[i] {
+                curvature += direction[i] * response[i];
+            }
+        }
+        if curvature <= 0.0 {
+            // K_SS is positive definite; this only happens at round-off level.
+            return Err(SolveError::NoConvergence {
+                iterations,
+                residual: relative,
+            });
+        }
+        let alpha = rs / curvature;
+        let mut rs_new = 0.0;
+        for i in 0..n {
+            if in_set[i] {
+                x[i] += alpha * direction[i];
+                residual[i] -= alpha * response[i];
+                rs_new += residual[i] * residual[i];
+            }
+        }
+        let beta = rs_new / rs;
+        for i in 0..n {
+            if in_set[i] {
+                direction[i] = residual[i] + beta * direction[i];
+            }
+        }
+        rs = rs_new;
+    }
+}
+
+impl ContactSolver {
+    fn take_stiffness_work(&mut self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.rows * self.cols;
+        self.stiffness_work
+            .take()
+            .unwrap_or_else(|| (vec![0.0; n], vec![0.0; n]))
+    }
+
+    /// Contact stiffness `k = ΔF/Δd` of the last solved state by the frozen contact set
+    /// (see the module docs), with the CG's iterations and relative residual. Zero when
+    /// nothing is in contact.
+    pub fn frozen_set_stiffness(&mut self) -> Result<(f64, SolveInfo), SolveError> {
+        if self.solved.is_none() {
+            return Err(Error::invalid("stiffness", "no solved contact state yet").into());
+        }
+        let in_set: Vec<bool> = self.pressure.iter().map(|&p| p > 0.0).collect();
+        let (mut x, mut residual) = self.take_stiffness_work();
+        let result = conjugate_gradient_on_set(
+            &mut self.operator,
+            &in_set,
+            RightHandSide::Ones,
+            &mut x,
+            &mut residual,
+            &mut self.direction,
+            &mut self.response,
+            self.params.stiffness_tolerance,
+            self.params.stiffness_max_iterations,
+        );
+        let dx = self.operator.spacing();
+        let stiffness = x.iter().sum::<f64>() * dx * dx;
+        self.stiffness_work = Some((x, residual));
+        result.map(|info| (stiffness, info))
+    }
+
+    /// `dF/dd` by central differences around `control`: two solves at `control·(1 ± step)`
+    /// (`0 < step < 1`), `k = (F₊ − F₋)/(d₊ − d₋)`. Leaves the solver in the upper state.
+    pub fn finite_difference_stiffness(
+        &mut self,
+        control: Control,
+        relative_step: f64,
+    ) -> Result<f64, SolveError> {
+        if !(relative_step > 0.0 && relative_step < 1.0) {
+            return Err(Error::invalid(
+                "relative step",
+                format!("must lie in (0, 1), got {relative_step}"),
+            )
+            .into());
+        }
+        let scaled = |factor: f64| match control {
+            Control::MeanPressure(p) => Control::MeanPressure(p * factor),
+            Control::Force(f) => Control::Force(f * factor),
+            Control::Indentation(d) => Control::Indentation(d * factor),
+        };
+        let (lower, _) = self.solve(scaled(1.0 - relative_step))?;
+        let (upper, _) = self.solve(scaled(1.0 + relative_step))?;
+        Ok((upper.force - lower.force) / (upper.indentation - lower.indentation))
+    }
+
+    /// Mean pressure at which the whole free-boundary grid is in contact (two CG solves on
+    /// the full grid, see the module docs).
+    pub(super) fn free_full_contact_pressure(&mut self) -> Result<f64, SolveError> {
+        let n = self.rows * self.cols;
+        let everywhere = vec![true; n];
+        let (mut flat_punch, mut residual) = self.take_stiffness_work();
+        let mut profile_pressure = vec![0.0; n];
+        let (tolerance, max_iterations) = (
+            self.params.stiffness_tolerance,
+            self.params.stiffness_max_iterations,
+        );
+        let first = conjugate_gradient_on_set(
+            &mut self.operator,
+            &everywhere,
+            RightHandSide::Ones,
+            &mut flat_punch,
+            &mut residual,
+            &mut self.direction,
+            &mut self.response,
+            tolerance,
+            max_iterations,
+        );
+        let second = first.and_then(|_| {
+            conjugate_gradient_on_set(
+                &mut self.operator,
+                &everywhere,
+                RightHandSide::Values(&self.profile),
+                &mut profile_pressure,
+                &mut residual,
+                &mut self.direction,
+                &mut self.response,
+                tolerance,
+                max_iterations,
+            )
+        });
+        let result = second.map(|_| {
+            let d = flat_punch
+                .iter()
+                .zip(&profile_pressure)
+                .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
+            flat_punch
+                .iter()
+                .zip(&profile_pressure)
+                .map(|(q, y)| d * q - y)
+                .sum::<f64>()
+                / n as f64
+        });
+        self.stiffness_work = Some((flat_punch, residual));
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::polonsky_keer::tests::{rough, sphere};
+    use super::super::{HalfSpace, SolverParams};
+    use super::*;
+    use crate::elastic::Boundary;
+    use crate::reference::{FlatPunch, Hertz};
+    use crate::surface::Surface;
+    use ndarray::Array2;
+    use std::f64::consts::PI;
+
+    fn half_space(boundary: Boundary) -> HalfSpace {
+        HalfSpace {
+            modulus: 1.3,
+            boundary,
+        }
+    }
+
+    #[test]
+    fn frozen_set_equals_finite_difference_on_rough_surfaces() {
+        // Barber: k = dF/dd. Central differences with ±1e-3 of the load; the contact set may
+        // gain or lose a few points within the step (measured: 1e-5 free, 2e-4 periodic), so
+        // 0.5 % here, tighter than the 2 % the issue asks for.
+        for (boundary, pressure) in [(Boundary::Free, 0.02), (Boundary::Periodic, 0.05)] {
+            let surface = rough(96, 11);
+            let mut solver =
+                ContactSolver::new(&surface, half_space(boundary), SolverParams::default()).unwrap();
+            solver.solve(Control::MeanPressure(pressure)).unwrap();
+            let (frozen, info) = solver.frozen_set_stiffness().unwrap();
+            assert!(info.residual <= 1e-10);
+            let fd = solver
+                .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
+                .unwrap();
+            let error = frozen / fd - 1.0;
+            eprintln!("{boundary:?}: frozen {frozen:.6e}, fd {fd:.6e}, error {error:.2e}");
+            assert!(error.abs() < 0.005, "{boundary:?}: frozen {frozen} vs fd {fd}");
+        }
+    }
+
+    #[test]
+    fn frozen_set_under_displacement_control_matches_finite_difference() {
+        let surface = rough(64, 12);
+        let mut solver =
+            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        let d = 0.01;
+        solver.solve(Control::Indentation(d)).unwrap();
+        let (frozen, _) = solver.frozen_set_stiffness().unwrap();
+        let fd = solver
+            .finite_difference_stiffness(Control::Indentation(d), 1e-3)
+            .unwrap();
+        assert!((frozen / fd - 1.0).abs() < 0.02, "frozen {frozen} vs fd {fd}");
+    }
+
+    #[test]
+    fn hertz_stiffness_is_two_e_a() {
+        let (n, size, radius) = (64, 1.0, 2.0);
+        let dx = size / n as f64;
+        let hertz = Hertz {
+            radius,
+            modulus: 1.3,
+        };
+        let d = (18.0 * dx).powi(2) / radius;
+        let mut solver =
+            ContactSolver::new(&sphere(n, n, size, radius), half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        solver.solve(Control::Indentation(d)).unwrap();
+        let (k, _) = solver.frozen_set_stiffness().unwrap();
+        let error = k / hertz.stiffness(d) - 1.0;
+        eprintln!("hertz stiffness error {error:.2e}");
+        // The pixelated contact edge costs O(Δ/a) (measured 0.5 % at a = 18 pixels; see the
+        // punch test for the 1/a convergence).
+        assert!(error.abs() < 0.01, "k error {error:e}");
+    }
+
+    #[test]
+    fn flat_punch_stiffness_is_two_e_a() {
+        // A flat circular punch of radius 16 and 32 pixels (heights 0 inside, far below
+        // outside). k = 2E*a with the pixelated disk's area-equivalent radius; the remaining
+        // discretisation error (the edge singularity averaged over a pixel) shrinks like Δ/a:
+        // measured 0.65 % and 0.33 %.
+        let mut errors = Vec::new();
+        for (n, a_pixels) in [(64, 16.0), (128, 32.0)] {
+            let size = 1.0;
+            let dx = size / n as f64;
+            let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+                let r = ((i as f64 - (n / 2) as f64).hypot(j as f64 - (n / 2) as f64)) * dx;
+                if r <= a_pixels * dx {
+                    0.0
+                } else {
+                    -1.0
+                }
+            });
+            let surface = Surface::new(heights, size).unwrap();
+            let mut solver =
+                ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                    .unwrap();
+            let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
+            let (k, _) = solver.frozen_set_stiffness().unwrap();
+            let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
+            let punch = FlatPunch {
+                radius: a,
+                modulus: 1.3,
+            };
+            let error = k / punch.stiffness() - 1.0;
+            // Under displacement control the punch's force is k d exactly.
+            assert!((s.force / (k * 1e-3) - 1.0).abs() < 1e-6);
+            eprintln!("punch a = {a_pixels} px: k error {error:.3e}");
+            errors.push(error);
+        }
+        assert!(errors[0].abs() < 0.01, "{errors:?}");
+        assert!(errors[1].abs() < 0.005, "{errors:?}");
+        assert!(errors[1].abs() < errors[0].abs(), "{errors:?}");
+    }
+
+    #[test]
+    fn stiffness_needs_a_solved_state() {
+        let surface = rough(16, 13);
+        let mut solver =
+            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
+                .unwrap();
+        assert!(solver.frozen_set_stiffness().is_err());
+        assert!(solver
+            .finite_difference_stiffness(Control::MeanPressure(0.01), 1.5)
+            .is_err());
+    }
+}
