@@ -160,7 +160,10 @@ mod tests {
         for r in [20.0, 50.0, 200.0] {
             let u = love_pixel_displacement(r * 0.6, r * 0.8, 1.0, 1.0, e);
             let point = 1.0 / (PI * e * r);
-            assert!((u / point - 1.0).abs() < 0.1 / (r * r), "r={r}: {u} vs {point}");
+            assert!(
+                (u / point - 1.0).abs() < 0.1 / (r * r),
+                "r={r}: {u} vs {point}"
+            );
         }
     }
 

@@ -124,8 +124,17 @@ impl StudySpec {
     }
 }
 
-/// Parses an inclusive range `A:B:STEP` (or a single value) of Hurst exponents.
+/// Parses Hurst exponents: comma-separated items, each a value or an inclusive range
+/// `A:B:STEP` (e.g. `-1:0:0.5,0.8,2:3:1`).
 pub fn parse_range(text: &str) -> Result<Vec<f64>> {
+    let mut values = Vec::new();
+    for item in text.split(',') {
+        values.extend(parse_range_item(item)?);
+    }
+    Ok(values)
+}
+
+fn parse_range_item(text: &str) -> Result<Vec<f64>> {
     let parts: Vec<&str> = text.split(':').collect();
     let num = |s: &str| {
         s.trim()
@@ -399,6 +408,8 @@ mod tests {
         );
         assert_eq!(parse_range("0.1:0.3:0.1").unwrap(), vec![0.1, 0.2, 0.3]);
         assert_eq!(parse_range("0.8").unwrap(), vec![0.8]);
+        assert_eq!(parse_range("-0.5,0.5:1:0.5").unwrap(), vec![-0.5, 0.5, 1.0]);
+        assert!(parse_range("").is_err());
         assert!(parse_range("1:0:0.1").is_err(), "empty range");
         assert!(parse_range("0:1:0").is_err());
         assert!(parse_range("a:b").is_err());
