@@ -37,6 +37,7 @@ mod error;
 pub mod fft;
 pub mod fit;
 pub mod io;
+pub mod mdr;
 pub mod memory;
 pub mod reference;
 pub mod spectrum;

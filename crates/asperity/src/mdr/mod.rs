@@ -1,0 +1,48 @@
+//! The method of dimensionality reduction (MDR): rough lines and axisymmetric indenters on
+//! a Winkler foundation of independent springs (paper *Methods*, "1D MDR calculation";
+//! Popov & Heß ch. 15; SCIENCE.md §3).
+//!
+//! * [`spring`]: the spring laws — linear (`E*·Δx`), the **Hertz microscale law (15.2)**
+//!   and the **fractal microscale law (15.7)** with its critical depth (15.6); the
+//!   asymptote (15.3).
+//! * [`indenter`]: axisymmetric indenters mapped to 1D by the MDR transform
+//!   `g(x) = |x| ∫₀^|x| f'(r)/sqrt(x²−r²) dr` — sphere (15.1), cone, flat punch, power
+//!   laws, and sampled user profiles (numerical transform, singularity integrated exactly).
+//! * [`foundation`]: exact force, stiffness and contact count at given indentations for
+//!   any law (indentation measured from the first contact point — for a rough line, its
+//!   highest point).
+//! * [`linear_curve`]: the whole curve of a line on linear springs in `O(N log N)`, with a
+//!   reusable buffer for ensembles of thousands of lines.
+//! * [`low_force`]: the low-force exponent α of `k ∝ F^α` (3): the documented automatic
+//!   fit window, per-sample and ensemble-mean fits, and the theories (6) and (24).
+//!
+//! # Example
+//! ```
+//! use asperity::mdr::{Axisymmetric, Foundation, Spring, SpringLaw};
+//! use asperity::reference::Hertz;
+//! let (radius, dx) = (1.0, 1e-3);
+//! let profile = Axisymmetric::Sphere { radius }.sample(4001, dx)?;
+//! let spring = Spring::new(SpringLaw::Hertz { radius }, dx, 1.0)?;
+//! let foundation = Foundation::from_profile(&profile, spring)?;
+//! let d = 0.25; // a = 500 Δx
+//! let point = foundation.evaluate(d);
+//! let hertz = Hertz { radius, modulus: 1.0 };
+//! assert!((point.force / hertz.force(d) - 1.0).abs() < 5e-3);
+//! assert!((point.stiffness / hertz.stiffness(d) - 1.0).abs() < 5e-3);
+//! # Ok::<(), asperity::Error>(())
+//! ```
+
+pub mod foundation;
+pub mod indenter;
+pub mod linear_curve;
+pub mod low_force;
+pub mod spring;
+
+pub use foundation::{log_spaced, CurvePoint, Foundation};
+pub use indenter::{spring_positions, Axisymmetric, RadialProfile};
+pub use linear_curve::LinearCurve;
+pub use low_force::{
+    alpha_negative_hurst, alpha_pohrt_popov, ensemble_exponent, low_force_sample, EnsembleExponent,
+    LowForceSample, LowForceWindow,
+};
+pub use spring::{fractal_asymptote, Spring, SpringLaw, FRACTAL_CONSTANT};
