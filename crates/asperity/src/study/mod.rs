@@ -227,11 +227,10 @@ impl TaskResult {
     /// Builds the ensemble quantities from the samples.
     pub fn from_samples(spec: &StudySpec, task: Task, samples: Vec<SampleCurve>) -> Result<Self> {
         let mean_curve = ensemble_curve(&samples, spec.levels)?;
-        let points_total = samples.first().map_or(1, |s| s.points_total);
-        let alpha_ensemble = ensemble_alpha(&mean_curve, &spec.window, points_total);
+        let alpha_ensemble = ensemble_alpha(&samples, &spec.window, spec.levels);
         let alpha_samples = samples
             .iter()
-            .filter_map(|s| s.alpha(&spec.window))
+            .filter_map(|s| s.alpha(&spec.window, spec.levels))
             .map(|f| f.exponent)
             .collect();
         Ok(TaskResult {
@@ -480,6 +479,7 @@ mod tests {
             Ok(SampleCurve {
                 points_total: 64,
                 points,
+                piecewise_constant: false,
             })
         }
     }
