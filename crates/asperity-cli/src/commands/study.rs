@@ -281,6 +281,7 @@ pub fn execute(
     outputs: &[PathBuf],
 ) -> Result<Vec<TaskResult>> {
     spec.validate()?;
+    StudyDir::check(dir, spec, force)?;
     for path in outputs {
         asperity::io::ensure_new_output(path, force)?;
     }

@@ -279,29 +279,38 @@ pub struct StudyDir {
 }
 
 impl StudyDir {
+    /// Checks, without writing, whether `dir` can hold `spec`: `Ok(false)` when it is new
+    /// or holds the same study, `Ok(true)` when it holds another study and `discard` is
+    /// set, [`Error::ForeignCheckpoint`] otherwise.
+    pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
+        let manifest_path = dir.join("study.json");
+        if !manifest_path.exists() {
+            return Ok(false);
+        }
+        let text =
+            std::fs::read_to_string(&manifest_path).map_err(|e| Error::io(&manifest_path, e))?;
+        let same = serde_json::from_str::<Manifest>(&text)
+            .map(|m| m.format == MANIFEST_FORMAT && &m.spec == spec)
+            .unwrap_or(false);
+        match (same, discard) {
+            (true, _) => Ok(false),
+            (false, true) => Ok(true),
+            (false, false) => Err(Error::ForeignCheckpoint {
+                dir: dir.to_path_buf(),
+                reason: "its study.json has other parameters".into(),
+            }),
+        }
+    }
+
     /// Opens (creating) `dir` for `spec`: a folder with the same spec resumes, a folder with
     /// another study is refused unless `discard`, which deletes its checkpoints.
     pub fn open(dir: &Path, spec: &StudySpec, discard: bool) -> Result<Self> {
-        let manifest_path = dir.join("study.json");
-        std::fs::create_dir_all(dir.join("checkpoint")).map_err(|e| Error::io(dir, e))?;
-        if manifest_path.exists() {
-            let text = std::fs::read_to_string(&manifest_path)
-                .map_err(|e| Error::io(&manifest_path, e))?;
-            let same = serde_json::from_str::<Manifest>(&text)
-                .map(|m| m.format == MANIFEST_FORMAT && &m.spec == spec)
-                .unwrap_or(false);
-            if !same {
-                if !discard {
-                    return Err(Error::ForeignCheckpoint {
-                        dir: dir.to_path_buf(),
-                        reason: "its study.json has other parameters".into(),
-                    });
-                }
-                let checkpoints = dir.join("checkpoint");
-                std::fs::remove_dir_all(&checkpoints).map_err(|e| Error::io(&checkpoints, e))?;
-                std::fs::create_dir_all(&checkpoints).map_err(|e| Error::io(&checkpoints, e))?;
-            }
+        if Self::check(dir, spec, discard)? {
+            let checkpoints = dir.join("checkpoint");
+            std::fs::remove_dir_all(&checkpoints).map_err(|e| Error::io(&checkpoints, e))?;
         }
+        std::fs::create_dir_all(dir.join("checkpoint")).map_err(|e| Error::io(dir, e))?;
+        let manifest_path = dir.join("study.json");
         let manifest = Manifest {
             format: MANIFEST_FORMAT.into(),
             spec: spec.clone(),

@@ -1,0 +1,248 @@
+//! Drives `asperity study` through the real binary: outputs, resume, bad input.
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn asperity(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run asperity")
+}
+
+fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn refused(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(needle), "expected '{needle}' in: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
+}
+
+const ALPHA: [&str; 12] = [
+    "study",
+    "alpha",
+    "--method",
+    "mdr",
+    "--n",
+    "1024",
+    "--hurst",
+    "0.5:1:0.5",
+    "--samples",
+    "12",
+    "--quiet",
+    "--out",
+];
+
+#[test]
+fn alpha_study_writes_table_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    ok(&asperity(&[&ALPHA[..], &["a"]].concat(), dir.path()));
+    let csv = std::fs::read_to_string(dir.path().join("a/alpha.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(lines
+        .next()
+        .unwrap()
+        .starts_with("method,n,hurst,alpha,alpha_low,alpha_high,samples"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 2);
+    assert!(rows[0].starts_with("mdr,1024,0.5,"));
+    for ext in ["png", "svg"] {
+        assert!(dir.path().join(format!("a/alpha.{ext}")).exists());
+    }
+    // Running the finished study again refuses to overwrite its outputs.
+    refused(
+        &asperity(&[&ALPHA[..], &["a"]].concat(), dir.path()),
+        "already exists",
+    );
+}
+
+#[test]
+fn truncated_checkpoint_resumes_to_identical_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(&asperity(&[&ALPHA[..], &["s"]].concat(), d));
+    let reference = std::fs::read(d.join("s/alpha.csv")).unwrap();
+    // Simulate an interruption: keep 5 of 12 samples of one task, drop the outputs.
+    let checkpoint = std::fs::read_dir(d.join("s/checkpoint"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&checkpoint).unwrap()).unwrap();
+    json["samples"].as_array_mut().unwrap().truncate(5);
+    std::fs::write(&checkpoint, serde_json::to_vec(&json).unwrap()).unwrap();
+    for ext in ["csv", "png", "svg"] {
+        std::fs::remove_file(d.join(format!("s/alpha.{ext}"))).unwrap();
+    }
+    ok(&asperity(&[&ALPHA[..], &["s"]].concat(), d));
+    assert_eq!(
+        std::fs::read(d.join("s/alpha.csv")).unwrap(),
+        reference,
+        "bit for bit"
+    );
+}
+
+#[test]
+fn killed_study_resumes_to_the_uninterrupted_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = |out: &'static str| {
+        vec![
+            "study",
+            "curve",
+            "--method",
+            "mdr",
+            "--n",
+            "32768",
+            "--hurst",
+            "-1,0,0.5,1,2,3",
+            "--samples",
+            "300",
+            "--quiet",
+            "--out",
+            out,
+        ]
+    };
+    let mut child = Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args("killed"))
+        .current_dir(d)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let checkpoints = d.join("killed/checkpoint");
+    while start.elapsed() < Duration::from_secs(60) {
+        let any = std::fs::read_dir(&checkpoints)
+            .map(|mut r| r.next().is_some())
+            .unwrap_or(false);
+        if any {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap(); // SIGKILL: no chance to clean up
+    child.wait().unwrap();
+    assert!(
+        !d.join("killed/curve.csv").exists(),
+        "killed before the end (study too small for this machine?)"
+    );
+    ok(&asperity(&args("killed"), d));
+    ok(&asperity(&args("straight"), d));
+    assert_eq!(
+        std::fs::read(d.join("killed/curve.csv")).unwrap(),
+        std::fs::read(d.join("straight/curve.csv")).unwrap()
+    );
+}
+
+#[test]
+fn bad_studies_are_refused_and_lose_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["study", "alpha", "--method", "mdr", "--n", "256", "--quiet"];
+    refused(
+        &asperity(
+            &[
+                &base[..],
+                &["--hurst", "1:0:0.1", "--samples", "3", "--out", "x"],
+            ]
+            .concat(),
+            d,
+        ),
+        "empty range",
+    );
+    refused(
+        &asperity(
+            &[
+                &base[..],
+                &["--hurst", "0.5", "--samples", "0", "--out", "x"],
+            ]
+            .concat(),
+            d,
+        ),
+        "samples",
+    );
+    refused(
+        &asperity(
+            &[
+                &base[..],
+                &["--hurst", "3.5", "--samples", "2", "--out", "x"],
+            ]
+            .concat(),
+            d,
+        ),
+        "outside",
+    );
+    assert!(!d.join("x").exists(), "nothing written for invalid studies");
+    ok(&asperity(
+        &[
+            &base[..],
+            &["--hurst", "0.5", "--samples", "3", "--out", "y"],
+        ]
+        .concat(),
+        d,
+    ));
+    let before = std::fs::read(d.join("y/study.json")).unwrap();
+    std::fs::remove_file(d.join("y/alpha.csv")).unwrap();
+    refused(
+        &asperity(
+            &[
+                &base[..],
+                &["--hurst", "0.5", "--samples", "4", "--out", "y"],
+            ]
+            .concat(),
+            d,
+        ),
+        "another study",
+    );
+    assert_eq!(
+        std::fs::read(d.join("y/study.json")).unwrap(),
+        before,
+        "the other study's checkpoint is kept"
+    );
+    ok(&asperity(
+        &[
+            &base[..],
+            &["--hurst", "0.5", "--samples", "4", "--out", "y", "--force"],
+        ]
+        .concat(),
+        d,
+    ));
+}
+
+#[test]
+fn toml_study_file_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("s.toml"),
+        "kind = \"curve\"\nmethod = \"bem\"\nn = [32]\nhurst = [0.5, 2.0]\nsamples = 2\nrolloff = 4\n",
+    )
+    .unwrap();
+    ok(&asperity(
+        &["study", "file", "s.toml", "--out", "t", "--quiet"],
+        d,
+    ));
+    let csv = std::fs::read_to_string(d.join("t/curve.csv")).unwrap();
+    assert!(csv.starts_with("method,n,hurst,force,stiffness,stiffness_low,stiffness_high,samples"));
+    assert!(csv.lines().skip(1).all(|l| l.starts_with("bem,32,")));
+    std::fs::write(
+        d.join("bad.toml"),
+        "kind = \"alpha\"\nmethod = \"mdr\"\nn = [64]\nhurst = \"0.5\"\nsampels = 3\n",
+    )
+    .unwrap();
+    refused(
+        &asperity(&["study", "file", "bad.toml", "--out", "u"], d),
+        "bad.toml",
+    );
+}
