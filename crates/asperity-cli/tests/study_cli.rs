@@ -71,17 +71,17 @@ fn truncated_checkpoint_resumes_to_identical_results() {
     let d = dir.path();
     ok(&asperity(&[&ALPHA[..], &["s"]].concat(), d));
     let reference = std::fs::read(d.join("s/alpha.csv")).unwrap();
-    // Simulate an interruption: keep 5 of 12 samples of one task, drop the outputs.
-    let checkpoint = std::fs::read_dir(d.join("s/checkpoint"))
+    // Simulate an interruption during the second task: the first task's result is read
+    // back from its checkpoint, the second is computed again; outputs were not written.
+    let mut checkpoints: Vec<_> = std::fs::read_dir(d.join("s/checkpoint"))
         .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
-    let mut json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(&checkpoint).unwrap()).unwrap();
-    json["samples"].as_array_mut().unwrap().truncate(5);
-    std::fs::write(&checkpoint, serde_json::to_vec(&json).unwrap()).unwrap();
+        .map(|e| e.unwrap().path())
+        .collect();
+    checkpoints.sort();
+    let done: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&checkpoints[0]).unwrap()).unwrap();
+    assert_eq!(done["state"], "done");
+    std::fs::remove_file(&checkpoints[1]).unwrap();
     for ext in ["csv", "png", "svg"] {
         std::fs::remove_file(d.join(format!("s/alpha.{ext}"))).unwrap();
     }
@@ -110,6 +110,8 @@ fn killed_study_resumes_to_the_uninterrupted_result() {
             "--samples",
             "300",
             "--quiet",
+            "--checkpoint-every",
+            "0",
             "--out",
             out,
         ]
@@ -123,10 +125,15 @@ fn killed_study_resumes_to_the_uninterrupted_result() {
     let start = Instant::now();
     let checkpoints = d.join("killed/checkpoint");
     while start.elapsed() < Duration::from_secs(60) {
-        let any = std::fs::read_dir(&checkpoints)
-            .map(|mut r| r.next().is_some())
-            .unwrap_or(false);
-        if any {
+        // Stop as soon as a task has saved samples while still in progress.
+        let partial = std::fs::read_dir(&checkpoints)
+            .into_iter()
+            .flatten()
+            .any(|e| {
+                let text = std::fs::read_to_string(e.unwrap().path()).unwrap_or_default();
+                text.contains("\"in_progress\"")
+            });
+        if partial {
             break;
         }
         std::thread::sleep(Duration::from_millis(5));

@@ -4,12 +4,12 @@
 //! `k ∝ F^α` (paper eq. 3). The fit is ordinary least squares of `ln y` on `ln x`; the
 //! interval is `p ± t(0.975, n−2) · se(p)` from the residuals (Student t).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
 
 /// A fitted power law.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PowerLawFit {
     /// Exponent p.
     pub exponent: f64,

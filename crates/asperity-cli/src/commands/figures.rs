@@ -132,7 +132,7 @@ pub fn fig6(dir: &Path, quick: bool, force: bool) -> Result<()> {
 use asperity::study::theory::{alpha_theory, alpha_white_noise};
 use asperity::study::{parse_range, FitWindow, Method, StudySpec, TaskResult};
 
-use super::study::{execute, write_alpha, write_curves, Kind};
+use super::study::{execute, write_alpha, write_curves, Kind, RunOptions};
 
 fn study_spec(
     method: Method,
@@ -150,6 +150,15 @@ fn study_spec(
         seed: 2013,
         window: FitWindow::default(),
         levels: 48,
+    }
+}
+
+/// `-1 … 3 (17 values)`.
+fn describe_hursts(hursts: &[f64]) -> String {
+    match hursts {
+        [] => "none".into(),
+        [one] => format!("{one}"),
+        [first, .., last] => format!("{first} … {last} ({} values)", hursts.len()),
     }
 }
 
@@ -171,7 +180,12 @@ fn figure_study(
 ) -> Result<Vec<TaskResult>> {
     let sub = dir.join(name);
     let outputs = super::study::outputs(kind, &sub);
-    let results = execute(spec, &sub, force, false, &outputs)?;
+    let options = RunOptions {
+        force,
+        quiet: false,
+        checkpoint_every: asperity::study::CHECKPOINT_INTERVAL,
+    };
+    let results = execute(spec, &sub, options, &outputs)?;
     match kind {
         Kind::Alpha => write_alpha(&sub, &results, force)?,
         Kind::Curve => write_curves(&sub, &results, force, "curve")?,
@@ -223,8 +237,8 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
     write_alpha(dir, &all, force)?;
     let report = format!(
         "# Fig. 1: exponent α of k ∝ F^α versus H\n\n{}\n\n\
-         - MDR: N = {:?}, {} samples per (N, H), H = {:?}; {:.1} s.\n\
-         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {:?}; {:.1} s.\n\
+         - MDR: N = {:?}, {} samples per (N, H), H = {}; {:.1} s.\n\
+         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {}; {:.1} s.\n\
          - α window: {}; α is fitted on the ensemble-mean k(F) (column `alpha`), and per sample\n  \
            (`alpha_low`, `alpha_high`: 2.5 % and 97.5 % of the per-sample values).\n\n\
          Files: `alpha.csv`, `alpha.png`, `alpha.svg` (both methods with the theory curves);\n\
@@ -236,11 +250,11 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
         setting(quick),
         mdr.sizes,
         mdr.samples,
-        (mdr.hursts.first(), mdr.hursts.last()),
+        describe_hursts(&mdr.hursts),
         mdr_seconds,
         bem.sizes,
         bem.samples,
-        (bem.hursts.first(), bem.hursts.last()),
+        describe_hursts(&bem.hursts),
         bem_seconds,
         mdr.window.describe(),
         alpha_rows_md(&all)

@@ -5,11 +5,13 @@
 //! results. A folder that holds a different study is refused unless `--force`.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
     parse_range, run_any_task, FitWindow, Method, StudyDir, StudySpec, TaskResult,
+    CHECKPOINT_INTERVAL,
 };
 use serde::Deserialize;
 
@@ -69,6 +71,9 @@ pub struct CommonArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Save tasks in progress at most every this many seconds (0: after every batch).
+    #[arg(long, default_value_t = 10.0, value_name = "SECONDS")]
+    pub checkpoint_every: f64,
 }
 
 /// Arguments of `asperity study alpha`.
@@ -204,17 +209,42 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
     }
 }
 
+/// How a study runs (not part of what it computes).
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Overwrite outputs, discard another study's checkpoint.
+    pub force: bool,
+    /// No progress output.
+    pub quiet: bool,
+    /// Longest time between checkpoints of a task in progress.
+    pub checkpoint_every: Duration,
+}
+
+impl RunOptions {
+    fn from_common(common: &CommonArgs) -> Result<Self> {
+        anyhow::ensure!(
+            common.checkpoint_every.is_finite() && common.checkpoint_every >= 0.0,
+            "--checkpoint-every must be a number of seconds >= 0, got {}",
+            common.checkpoint_every
+        );
+        Ok(RunOptions {
+            force: common.force,
+            quiet: common.quiet,
+            checkpoint_every: Duration::from_secs_f64(common.checkpoint_every),
+        })
+    }
+}
+
 /// Runs `asperity study`.
 pub fn run(args: &StudyArgs) -> Result<()> {
-    let (kind, spec, out, force, quiet) = match &args.command {
+    let (kind, spec, out, options) = match &args.command {
         StudyCommand::Alpha(a) => {
             let spec = spec_from(&a.common, a.n.clone(), parse_range(&a.hurst)?);
             (
                 Kind::Alpha,
                 spec,
                 &a.common.out,
-                a.common.force,
-                a.common.quiet,
+                RunOptions::from_common(&a.common)?,
             )
         }
         StudyCommand::Curve(c) => {
@@ -223,8 +253,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 Kind::Curve,
                 spec,
                 &c.common.out,
-                c.common.force,
-                c.common.quiet,
+                RunOptions::from_common(&c.common)?,
             )
         }
         StudyCommand::File(f) => {
@@ -249,13 +278,18 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 },
                 levels: file.levels.unwrap_or(48),
             };
-            (file.kind, spec, &f.out, f.force, f.quiet)
+            let options = RunOptions {
+                force: f.force,
+                quiet: f.quiet,
+                checkpoint_every: CHECKPOINT_INTERVAL,
+            };
+            (file.kind, spec, &f.out, options)
         }
     };
-    let results = execute(&spec, out, force, quiet, &outputs(kind, out))?;
+    let results = execute(&spec, out, options, &outputs(kind, out))?;
     match kind {
-        Kind::Alpha => write_alpha(out, &results, force),
-        Kind::Curve => write_curves(out, &results, force, "curve"),
+        Kind::Alpha => write_alpha(out, &results, options.force),
+        Kind::Curve => write_curves(out, &results, options.force, "curve"),
     }
 }
 
@@ -276,16 +310,20 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
 pub fn execute(
     spec: &StudySpec,
     dir: &Path,
-    force: bool,
-    quiet: bool,
+    options: RunOptions,
     outputs: &[PathBuf],
 ) -> Result<Vec<TaskResult>> {
+    let RunOptions {
+        force,
+        quiet,
+        checkpoint_every,
+    } = options;
     spec.validate()?;
     StudyDir::check(dir, spec, force)?;
     for path in outputs {
         asperity::io::ensure_new_output(path, force)?;
     }
-    let store = StudyDir::open(dir, spec, force)?;
+    let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
     let tasks = spec.tasks();
     let total = (tasks.len() * spec.samples) as u64;
     let progress = Progress::new(&format!("{} study", spec.method.name()), total, quiet);
@@ -331,7 +369,7 @@ pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()
             opt(r.alpha_ensemble.map(|f| f.exponent)),
             opt(lo),
             opt(hi),
-            r.samples.len().to_string(),
+            r.samples.to_string(),
             opt(r.alpha_ensemble.map(|f| f.low)),
             opt(r.alpha_ensemble.map(|f| f.high)),
             opt(r.alpha_sample_mean()),

@@ -206,15 +206,15 @@ pub trait Sampler: Sync {
     fn sample(&self, worker: &mut Self::Worker, seed: u64) -> Result<SampleCurve>;
 }
 
-/// The result of one task: its samples and what follows from them.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The result of one task: what follows from its samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TaskResult {
     /// Method.
     pub method: Method,
     /// The task.
     pub task: Task,
-    /// Sample curves, in sample order.
-    pub samples: Vec<SampleCurve>,
+    /// Number of samples.
+    pub samples: usize,
     /// Ensemble-mean curve at common force levels.
     pub mean_curve: Vec<EnsemblePoint>,
     /// α fitted on the ensemble-mean curve.
@@ -236,7 +236,7 @@ impl TaskResult {
         Ok(TaskResult {
             method: spec.method,
             task,
-            samples,
+            samples: samples.len(),
             mean_curve,
             alpha_ensemble,
             alpha_samples,
@@ -264,11 +264,32 @@ struct Manifest {
     spec: StudySpec,
 }
 
+/// What `checkpoint/<task>.json` holds: the samples of a task in progress, or the result
+/// of a finished one (its sample curves are then no longer kept).
 #[derive(Debug, Serialize, Deserialize)]
-struct TaskCheckpoint {
-    key: String,
-    samples: Vec<SampleCurve>,
+#[serde(tag = "state", rename_all = "snake_case")]
+enum Checkpoint {
+    InProgress {
+        key: String,
+        samples: Vec<SampleCurve>,
+    },
+    Done {
+        key: String,
+        result: TaskResult,
+    },
 }
+
+impl Checkpoint {
+    fn key(&self) -> &str {
+        match self {
+            Checkpoint::InProgress { key, .. } | Checkpoint::Done { key, .. } => key,
+        }
+    }
+}
+
+/// A task in progress saves its samples at most this often (and always when it ends), so
+/// that fast tasks (MDR) do not spend their time rewriting checkpoints.
+pub const CHECKPOINT_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
 
 const MANIFEST_FORMAT: &str = "asperity-study/1";
 
@@ -276,6 +297,7 @@ const MANIFEST_FORMAT: &str = "asperity-study/1";
 #[derive(Debug, Clone)]
 pub struct StudyDir {
     dir: PathBuf,
+    interval: std::time::Duration,
 }
 
 impl StudyDir {
@@ -318,7 +340,15 @@ impl StudyDir {
         io::write_json(&manifest_path, true, &manifest)?;
         Ok(StudyDir {
             dir: dir.to_path_buf(),
+            interval: CHECKPOINT_INTERVAL,
         })
+    }
+
+    /// Saves tasks in progress at most every `interval` instead of [`CHECKPOINT_INTERVAL`]
+    /// (zero: after every batch).
+    pub fn with_checkpoint_interval(mut self, interval: std::time::Duration) -> Self {
+        self.interval = interval;
+        self
     }
 
     /// The folder.
@@ -330,44 +360,50 @@ impl StudyDir {
         self.dir.join("checkpoint").join(format!("{key}.json"))
     }
 
-    fn load(&self, key: &str) -> Result<Vec<SampleCurve>> {
+    fn load(&self, key: &str) -> Result<Option<Checkpoint>> {
         let path = self.checkpoint_path(key);
         if !path.exists() {
-            return Ok(Vec::new());
+            return Ok(None);
         }
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-        let checkpoint: TaskCheckpoint =
-            serde_json::from_str(&text).map_err(|e| Error::Metadata {
-                path: path.clone(),
-                reason: format!("unreadable checkpoint: {e}"),
-            })?;
-        if checkpoint.key != key {
+        let checkpoint: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::Metadata {
+            path: path.clone(),
+            reason: format!("unreadable checkpoint: {e}"),
+        })?;
+        if checkpoint.key() != key {
             return Err(Error::ForeignCheckpoint {
                 dir: self.dir.clone(),
                 reason: format!("{} is not {key}", path.display()),
             });
         }
-        Ok(checkpoint.samples)
+        Ok(Some(checkpoint))
     }
 
-    fn save(&self, key: &str, samples: &[SampleCurve]) -> Result<()> {
-        let checkpoint = TaskCheckpoint {
-            key: key.to_string(),
-            samples: samples.to_vec(),
-        };
-        let path = self.checkpoint_path(key);
-        let text = serde_json::to_vec(&checkpoint).map_err(|e| Error::Metadata {
+    fn save(&self, checkpoint: &Checkpoint) -> Result<()> {
+        let path = self.checkpoint_path(checkpoint.key());
+        let text = serde_json::to_vec(checkpoint).map_err(|e| Error::Metadata {
             path: path.clone(),
             reason: e.to_string(),
         })?;
         io::write_bytes(&path, true, &text)
+    }
+
+    /// Saves the first samples of a task in progress.
+    pub fn save_in_progress(&self, key: &str, samples: &[SampleCurve]) -> Result<()> {
+        self.save(&Checkpoint::InProgress {
+            key: key.to_string(),
+            samples: samples.to_vec(),
+        })
     }
 }
 
 /// Progress of a study: samples done so far (including resumed ones) and the total.
 pub type ProgressFn<'a> = dyn Fn(usize, usize) + Sync + 'a;
 
-/// Runs (or resumes) one task, checkpointing after every batch of samples.
+/// Runs (or resumes) one task: samples in parallel batches, one worker per thread kept for
+/// the whole task, a checkpoint at most every [`CHECKPOINT_INTERVAL`] (or the store's own
+/// interval) and the result saved
+/// when the task ends. A finished task is read back, not recomputed.
 pub fn run_task<S: Sampler>(
     spec: &StudySpec,
     task: Task,
@@ -376,32 +412,53 @@ pub fn run_task<S: Sampler>(
     progress: &ProgressFn,
 ) -> Result<TaskResult> {
     let key = task.key(spec.method);
-    let mut samples = store.load(&key)?;
+    let mut samples = match store.load(&key)? {
+        Some(Checkpoint::Done { result, .. }) if result.samples == spec.samples => {
+            progress(spec.samples, spec.samples);
+            return Ok(result);
+        }
+        Some(Checkpoint::InProgress { samples, .. }) => samples,
+        _ => Vec::new(),
+    };
     samples.truncate(spec.samples);
     progress(samples.len(), spec.samples);
-    let batch = (4 * rayon::current_num_threads()).max(8);
+    let lanes = rayon::current_num_threads().max(1);
+    let mut workers = (0..lanes)
+        .map(|_| sampler.worker())
+        .collect::<Result<Vec<_>>>()?;
+    let batch = 4 * lanes;
+    let mut last_save = std::time::Instant::now();
     while samples.len() < spec.samples {
-        let start = samples.len();
-        let end = (start + batch).min(spec.samples);
-        let done: Vec<Result<SampleCurve>> = (start..end)
-            .into_par_iter()
-            .map_init(
-                || sampler.worker(),
-                |worker, index| {
-                    let worker = worker
-                        .as_mut()
-                        .map_err(|e| Error::invalid("worker", e.to_string()))?;
-                    sampler.sample(worker, sample_seed(spec.seed, spec.method, task, index))
-                },
-            )
+        let indices: Vec<usize> =
+            (samples.len()..(samples.len() + batch).min(spec.samples)).collect();
+        let per_lane = indices.len().div_ceil(lanes);
+        let done: Vec<Vec<Result<SampleCurve>>> = workers
+            .par_iter_mut()
+            .zip(indices.par_chunks(per_lane))
+            .map(|(worker, chunk)| {
+                chunk
+                    .iter()
+                    .map(|&index| {
+                        sampler.sample(worker, sample_seed(spec.seed, spec.method, task, index))
+                    })
+                    .collect()
+            })
             .collect();
-        for curve in done {
+        for curve in done.into_iter().flatten() {
             samples.push(curve?);
         }
-        store.save(&key, &samples)?;
+        if samples.len() < spec.samples && last_save.elapsed() >= store.interval {
+            store.save_in_progress(&key, &samples)?;
+            last_save = std::time::Instant::now();
+        }
         progress(samples.len(), spec.samples);
     }
-    TaskResult::from_samples(spec, task, samples)
+    let result = TaskResult::from_samples(spec, task, samples)?;
+    store.save(&Checkpoint::Done {
+        key,
+        result: result.clone(),
+    })?;
+    Ok(result)
 }
 
 #[cfg(test)]
@@ -512,8 +569,14 @@ mod tests {
         // Interrupted run: keep only the first 7 samples in the checkpoint, then resume.
         let other = tempfile::tempdir().unwrap();
         let store = StudyDir::open(other.path(), &spec(20), false).unwrap();
+        let first: Vec<SampleCurve> = (0..7)
+            .map(|i| {
+                let seed = sample_seed(3, Method::Mdr, task, i);
+                Synthetic.sample(&mut (), seed).unwrap()
+            })
+            .collect();
         store
-            .save(&task.key(Method::Mdr), &full.samples[..7])
+            .save_in_progress(&task.key(Method::Mdr), &first)
             .unwrap();
         let resumed = run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap();
         assert_eq!(resumed, full);
