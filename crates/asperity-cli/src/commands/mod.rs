@@ -1,6 +1,7 @@
 //! One module per subcommand; each exposes its clap `Args` and a `run` function.
 
 pub mod bem;
+mod fig15;
 pub mod mdr;
 pub mod reproduce;
 pub mod stats;
