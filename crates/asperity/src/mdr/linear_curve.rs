@@ -54,6 +54,8 @@ pub struct LinearCurve {
     forces: Vec<f64>,
     /// `E*·Δx`.
     spring_stiffness: f64,
+    /// `Δx`.
+    spacing: f64,
     /// Buffers of the sort, kept between lines.
     scratch: RadixScratch,
 }
@@ -64,6 +66,7 @@ impl PartialEq for LinearCurve {
         self.indentations == other.indentations
             && self.forces == other.forces
             && self.spring_stiffness == other.spring_stiffness
+            && self.spacing == other.spacing
     }
 }
 
@@ -79,6 +82,7 @@ impl LinearCurve {
             indentations: Vec::with_capacity(n),
             forces: Vec::with_capacity(n),
             spring_stiffness: 0.0,
+            spacing: 0.0,
             scratch: RadixScratch::default(),
         }
     }
@@ -113,6 +117,7 @@ impl LinearCurve {
         }
         crate::ensure_finite("line", heights)?;
         self.spring_stiffness = modulus * spacing;
+        self.spacing = spacing;
         // Sort heights descending (radix sort, O(N)); gaps z_max − z are then ascending.
         self.indentations.extend_from_slice(heights);
         sort_descending(&mut self.indentations, &mut self.scratch);
@@ -140,6 +145,21 @@ impl LinearCurve {
     /// True before the first [`LinearCurve::recompute`].
     pub fn is_empty(&self) -> bool {
         self.indentations.is_empty()
+    }
+
+    /// Spring spacing `Δx`.
+    pub fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// Effective modulus `E*`.
+    pub fn modulus(&self) -> f64 {
+        self.spring_stiffness / self.spacing
+    }
+
+    /// Length of the line, `N·Δx`.
+    pub fn size(&self) -> f64 {
+        self.len() as f64 * self.spacing
     }
 
     /// Stiffness of one spring, `E*·Δx`.

@@ -130,24 +130,23 @@ fn normalised_stiffness(sample: &LowForceSample, force: f64) -> f64 {
     sample.normalised_forces.partition_point(|&f| f <= force) as f64 / sample.points as f64
 }
 
-/// The low-force data and fit of one line's curve (`rms_height` and `size` of that line,
-/// modulus from the curve). Errors if the window is empty for this `N` or the line is flat.
+/// The low-force data and fit of one line's curve (`rms_height` of that line; `E*` and
+/// `L = N·Δx` from the curve). Errors if the window does not fit this `N` or the line is
+/// flat.
 pub fn low_force_sample(
     curve: &LinearCurve,
     rms_height: f64,
-    size: f64,
     window: &LowForceWindow,
 ) -> Result<LowForceSample> {
     let n = curve.len();
     let (low, high) = window.contact_range(n)?;
-    if !(rms_height > 0.0 && size > 0.0) {
+    if !(rms_height.is_finite() && rms_height > 0.0) {
         return Err(Error::invalid(
             "rms-height",
-            format!("rms height and size must be positive, got {rms_height} and {size}"),
+            format!("the line's rms height must be positive and finite, got {rms_height}"),
         ));
     }
-    let modulus = curve.spring_stiffness() * n as f64 / size;
-    let scale = 1.0 / (modulus * rms_height * size);
+    let scale = 1.0 / (curve.modulus() * rms_height * curve.size());
     let normalised_forces: Vec<f64> = curve.forces()[..high].iter().map(|f| f * scale).collect();
     let (f_low, f_high) = (normalised_forces[low - 1], normalised_forces[high - 1]);
     if !(f_low > 0.0 && f_high > f_low) {
@@ -308,7 +307,7 @@ mod tests {
                     generator.generate_into(seed, heights).unwrap();
                     curve.recompute(heights, 1.0 / n as f64, 1.0).unwrap();
                     let h = rms_height(heights.iter().copied());
-                    low_force_sample(curve, h, 1.0, window).unwrap()
+                    low_force_sample(curve, h, window).unwrap()
                 },
             )
             .collect()
@@ -394,7 +393,7 @@ mod tests {
                     let window = LowForceWindow::new(first, fraction, 40).unwrap();
                     let samples: Vec<LowForceSample> = curves
                         .iter()
-                        .map(|(c, h)| low_force_sample(c, *h, 1.0, &window).unwrap())
+                        .map(|(c, h)| low_force_sample(c, *h, &window).unwrap())
                         .collect();
                     let r = ensemble_exponent(&samples, &window).unwrap();
                     eprintln!(
@@ -405,6 +404,34 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn ensembles_are_bit_identical_whatever_the_thread_count() {
+        let window = LowForceWindow::default();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let samples = ensemble(0.8, 4096, 24, &window);
+                ensemble_exponent(&samples, &window).unwrap()
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            let other = run(threads);
+            assert_eq!(
+                one.mean_curve.exponent.to_bits(),
+                other.mean_curve.exponent.to_bits()
+            );
+            assert_eq!(
+                one.per_sample_mean.to_bits(),
+                other.per_sample_mean.to_bits()
+            );
+            assert_eq!(one.curve, other.curve);
         }
     }
 
@@ -432,7 +459,7 @@ mod tests {
             .collect();
         let curve = LinearCurve::from_heights(&heights, 1.0 / n as f64, 1.0).unwrap();
         let window = LowForceWindow::new(20, 0.05, 40).unwrap();
-        let sample = low_force_sample(&curve, 1.0, 1.0, &window).unwrap();
+        let sample = low_force_sample(&curve, 1.0, &window).unwrap();
         assert!(
             (sample.fit.exponent - 1.0 / (1.0 + p)).abs() < 0.01,
             "{}",
