@@ -190,6 +190,66 @@ fn line_breakpoints_and_log_spaced_loads() {
 }
 
 #[test]
+fn sampled_radial_profile_is_transformed() {
+    // f = r²/2R sampled on r = 0, 1e-3, …, 1: its MDR transform is x²/R, so the foundation
+    // reproduces Hertz like the closed-form sphere (a ≥ 200 Δx: within 0.5 %).
+    let dir = tempfile::tempdir().unwrap();
+    let radius = 0.5;
+    write_line(
+        &dir.path().join("tip.npy"),
+        (0..=1000)
+            .map(|k| (k as f64 * 1e-3).powi(2) / (2.0 * radius))
+            .collect(),
+    );
+    let out = asperity(
+        &[
+            "mdr",
+            "--radial",
+            "tip.npy",
+            "--radial-step",
+            "1e-3",
+            "--n",
+            "1601",
+            "--dx",
+            "1e-3",
+            "--indentations",
+            "0.05,0.2",
+            "--out",
+            "r.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let hertz = Hertz {
+        radius,
+        modulus: 1.0,
+    };
+    for (d, force, stiffness, _) in read_curve(&dir.path().join("r.csv")) {
+        assert!((force / hertz.force(d) - 1.0).abs() < 5e-3, "d = {d}");
+        assert!(
+            (stiffness / hertz.stiffness(d) - 1.0).abs() < 5e-3,
+            "d = {d}"
+        );
+    }
+    // Springs beyond the sampled radius are refused.
+    let out = asperity(
+        &[
+            "mdr",
+            "--radial",
+            "tip.npy",
+            "--radial-step",
+            "1e-3",
+            "--n",
+            "3001",
+            "--dx",
+            "1e-3",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, "beyond the radial profile");
+}
+
+#[test]
 fn fractal_law_needs_a_valid_hurst_exponent() {
     let dir = tempfile::tempdir().unwrap();
     write_line(
