@@ -84,4 +84,29 @@ fn main() {
             std::hint::black_box(c.forces()[n - 1]);
         },
     );
+    // For comparison: the comparison sort the radix sort replaced, and the radix sort, each
+    // on a fresh copy of the line (the radix sort here also allocates its scratch each
+    // time, which `LinearCurve::recompute` reuses).
+    run(
+        "comparison sort only (for reference)",
+        &spec,
+        500,
+        |g, h, c, _| {
+            if h[0] == 0.0 {
+                g.generate_into(1, h).unwrap();
+            }
+            let mut copy = h.clone();
+            copy.sort_unstable_by(|a, b| b.total_cmp(a));
+            std::hint::black_box((copy[0], c.len()));
+        },
+    );
+    run("radix sort only", &spec, 500, |g, h, _, _| {
+        if h[0] == 0.0 {
+            g.generate_into(1, h).unwrap();
+        }
+        let mut copy = h.clone();
+        let mut scratch = asperity::mdr::radix_sort::RadixScratch::default();
+        asperity::mdr::radix_sort::sort_descending(&mut copy, &mut scratch);
+        std::hint::black_box(copy[0]);
+    });
 }
