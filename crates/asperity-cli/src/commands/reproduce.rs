@@ -31,7 +31,7 @@ pub enum Figure {
 /// Arguments of `asperity reproduce`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Examples:\n  asperity reproduce fig6 --out figs\n  asperity reproduce all --quick --out figs"
+    after_help = "Examples:\n  asperity reproduce fig15.1 --out figs\n  asperity reproduce fig15.2 --quick --out figs\n  asperity reproduce all --quick --out figs\n\nImplemented so far: fig15.1, fig15.2 (book ch. 15); `all` runs those and names the rest."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.

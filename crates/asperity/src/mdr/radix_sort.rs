@@ -1,6 +1,7 @@
 //! Sorting doubles in descending order by an LSD radix sort on order-preserving integer
-//! keys — the `O(N)` core of [`super::LinearCurve`] (a comparison sort of 2^15 doubles was
-//! its bottleneck, ≈ 1.5 ms, more than the FFT that makes the line).
+//! keys — the `O(N)` core of [`super::LinearCurve`]. A comparison sort of 2^15 doubles
+//! (≈ 0.65 ms) was its largest part, more than the FFT that makes the line (≈ 0.5 ms);
+//! this sort takes ≈ 0.35–0.5 ms (see `docs/mdr.md`, "Speed").
 //!
 //! Each `f64` maps to a `u64` key whose unsigned order is [`f64::total_cmp`]'s order (flip
 //! all bits of negatives, set the sign bit of the rest); descending order is ascending order
