@@ -140,13 +140,17 @@ fn need(value: Option<f64>, flag: &str, what: &str) -> Result<f64> {
     value.with_context(|| format!("{what} needs {flag}"))
 }
 
-/// The indenter as a 1D profile: `(heights_or_profile, is_line, spacing, size, rms)`.
+/// The indenter as a 1D profile on its spring grid.
 struct Indenter {
     /// Line heights (positive up) or indenter profile g (lowest point touches first).
     values: Vec<f64>,
+    /// True for a rough line (gaps from the highest point).
     is_line: bool,
+    /// Spring spacing Δx.
     spacing: f64,
+    /// Length L (used by the fractal law).
     size: f64,
+    /// One line for the summary printed after writing.
     description: String,
 }
 

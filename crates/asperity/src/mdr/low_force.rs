@@ -125,9 +125,10 @@ fn log_levels(low: f64, high: f64, count: usize) -> impl Iterator<Item = f64> {
     (0..count).map(move |i| low * (step * i as f64).exp())
 }
 
-/// Stiffness `k̃ = #{j : F̃_j ≤ F̃}/N` of one sample at normalised force `F̃`.
-fn normalised_stiffness(sample: &LowForceSample, force: f64) -> f64 {
-    sample.normalised_forces.partition_point(|&f| f <= force) as f64 / sample.points as f64
+/// Stiffness `k̃ = #{j : F̃_j ≤ F̃}/N` at normalised force `F̃`, from the normalised
+/// breakpoint forces `F̃_j` of a line of `points` springs.
+fn normalised_stiffness(normalised_forces: &[f64], points: usize, force: f64) -> f64 {
+    normalised_forces.partition_point(|&f| f <= force) as f64 / points as f64
 }
 
 /// The low-force data and fit of one line's curve (`rms_height` of that line; `E*` and
@@ -155,25 +156,17 @@ pub fn low_force_sample(
             format!("no force range between {low} and {high} contacts (a flat line?)"),
         ));
     }
-    let mut sample = LowForceSample {
-        points: n,
-        normalised_forces,
-        fit: PowerLawFit {
-            exponent: f64::NAN,
-            prefactor: f64::NAN,
-            stderr: f64::NAN,
-            low: f64::NAN,
-            high: f64::NAN,
-            points: 0,
-        },
-    };
     let forces: Vec<f64> = log_levels(f_low, f_high, window.levels).collect();
     let stiffness: Vec<f64> = forces
         .iter()
-        .map(|&f| normalised_stiffness(&sample, f))
+        .map(|&f| normalised_stiffness(&normalised_forces, n, f))
         .collect();
-    sample.fit = power_law_fit(&forces, &stiffness)?;
-    Ok(sample)
+    let fit = power_law_fit(&forces, &stiffness)?;
+    Ok(LowForceSample {
+        points: n,
+        normalised_forces,
+        fit,
+    })
 }
 
 /// The exponent α of an ensemble, both ways (module docs).
@@ -242,7 +235,7 @@ pub fn ensemble_exponent(
         .map(|f| {
             let k = samples
                 .iter()
-                .map(|s| normalised_stiffness(s, f))
+                .map(|s| normalised_stiffness(&s.normalised_forces, s.points, f))
                 .sum::<f64>()
                 / count;
             (f, k)
