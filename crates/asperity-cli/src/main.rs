@@ -29,9 +29,17 @@ fn main() {
         }
     };
     if let Err(err) = commands::run(cli) {
-        // One line: the chain of causes joined, as a user reads it.
-        let chain: Vec<String> = err.chain().map(|c| c.to_string()).collect();
-        eprintln!("error: {}", chain.join(": "));
+        // One line: the chain of causes joined, as a user reads it; a cause that its
+        // parent's message already ends with (library errors print their source) is skipped.
+        let mut line = String::new();
+        for cause in err.chain().map(|c| c.to_string()) {
+            if line.is_empty() {
+                line = cause;
+            } else if !line.ends_with(&cause) {
+                line = format!("{line}: {cause}");
+            }
+        }
+        eprintln!("error: {line}");
         std::process::exit(2);
     }
 }

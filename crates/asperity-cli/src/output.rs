@@ -32,15 +32,29 @@ impl Table {
             .push(fields.iter().map(|f| f.to_string()).collect());
     }
 
-    /// Writes the table atomically.
-    pub fn write(&self, path: &Path, force: bool) -> Result<()> {
+    /// The table as CSV text.
+    pub fn to_csv(&self) -> Result<Vec<u8>> {
         let mut writer = csv::Writer::from_writer(Vec::new());
         writer.write_record(&self.header)?;
         for row in &self.rows {
             writer.write_record(row)?;
         }
-        let bytes = writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
-        asperity::io::write_bytes(path, force, &bytes)?;
+        writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
+    }
+
+    /// Number of data rows.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// True when the table has no data rows.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Writes the table atomically.
+    pub fn write(&self, path: &Path, force: bool) -> Result<()> {
+        asperity::io::write_bytes(path, force, &self.to_csv()?)?;
         Ok(())
     }
 }

@@ -1,10 +1,352 @@
-//! `asperity mdr`: not yet implemented (placeholder until its issue lands).
+//! `asperity mdr`: force, stiffness and contacts of a rough line or an axisymmetric
+//! indenter on the MDR spring foundation (linear, Hertz 15.2 or fractal 15.7 springs).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use asperity::io::{ensure_new_output, read_npy_1d, sidecar_path};
+use asperity::mdr::{
+    log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
+};
+use asperity::surface::stats::rms_height;
+
+use crate::output::{format_number, Table};
+
+/// Closed-form axisymmetric indenters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ProfileKind {
+    /// Sphere of radius --radius: g = x²/R (book eq. 15.1).
+    Hertz,
+    /// Cone of flank slope --slope (tan θ): g = (π/2) tan θ |x|.
+    Cone,
+    /// Flat cylindrical punch of radius --radius.
+    Punch,
+    /// Power law f = c rⁿ (--coefficient, --exponent): g = κ(n) c |x|ⁿ.
+    Power,
+}
+
+/// Spring laws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpringKind {
+    /// Linear springs of stiffness E*·Δx.
+    Linear,
+    /// Hertz microscale law (15.2); radius from --asperity-radius (or --radius for --profile hertz).
+    Hertz,
+    /// Fractal microscale law (15.7) with critical depth (15.6); needs --hurst.
+    Fractal,
+}
 
 /// Arguments of `asperity mdr`.
 #[derive(Debug, clap::Args)]
-pub struct MdrArgs {}
+#[command(after_help = "Examples:\n  \
+    asperity line --n 32768 --hurst 0.5 --seed 1 --out line.npy\n  \
+    asperity mdr --line line.npy --nloads 40 --out curve.csv\n  \
+    asperity mdr --line line.npy --breakpoints --out breakpoints.csv\n  \
+    asperity mdr --line line.npy --spring fractal --hurst 0.5 --nloads 60 --dmin 1e-6 --out nl.csv\n  \
+    asperity mdr --profile hertz --radius 1 --n 2001 --dx 0.01 --spring hertz --indentations 1e-8,1e-6,1e-4\n  \
+    asperity mdr --profile cone --slope 0.2 --n 4001 --dx 1e-3 --nloads 20 --out cone.csv\n  \
+    asperity mdr --radial tip.npy --radial-step 1e-3 --n 1001 --dx 1e-3 --nloads 30\n\n\
+    Output columns: indentation, force, stiffness, contacts. Indentation is measured from \
+    first contact (the highest point of a line, the tip of an indenter).")]
+pub struct MdrArgs {
+    /// A rough line (1D .npy, float64), heights positive up; spacing = size / n.
+    #[arg(long, value_name = "FILE.npy", group = "indenter")]
+    pub line: Option<PathBuf>,
+    /// A closed-form axisymmetric indenter, mapped to 1D by the MDR transform.
+    #[arg(long, value_enum, group = "indenter")]
+    pub profile: Option<ProfileKind>,
+    /// A user's axisymmetric profile f(r) sampled at r = 0, DR, 2DR, … (1D .npy), mapped to
+    /// 1D numerically.
+    #[arg(
+        long,
+        value_name = "FILE.npy",
+        group = "indenter",
+        requires = "radial_step"
+    )]
+    pub radial: Option<PathBuf>,
+    /// Sample step DR of --radial.
+    #[arg(long, value_name = "DR")]
+    pub radial_step: Option<f64>,
+    /// Sphere or punch radius R (--profile hertz|punch).
+    #[arg(long)]
+    pub radius: Option<f64>,
+    /// Cone flank slope tan θ (--profile cone).
+    #[arg(long)]
+    pub slope: Option<f64>,
+    /// Prefactor c of f = c rⁿ (--profile power).
+    #[arg(long)]
+    pub coefficient: Option<f64>,
+    /// Exponent n of f = c rⁿ (--profile power).
+    #[arg(long)]
+    pub exponent: Option<f64>,
+    /// Number of springs for --profile / --radial (symmetric about the axis; odd puts one on it).
+    #[arg(long, conflicts_with = "line")]
+    pub n: Option<usize>,
+    /// Spring spacing Δx for --profile / --radial (a line's is size / n).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "line")]
+    pub dx: Option<f64>,
+    /// Line length L (--line: default the sidecar's, else 1; fractal law with a profile:
+    /// default n·Δx).
+    #[arg(long, allow_negative_numbers = true)]
+    pub size: Option<f64>,
+    /// Effective modulus E*.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    pub modulus: f64,
+    /// Spring law.
+    #[arg(long, value_enum, default_value_t = SpringKind::Linear)]
+    pub spring: SpringKind,
+    /// Hurst exponent H of the fractal law (15.7), 0 < H < 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub hurst: Option<f64>,
+    /// rms height h of the fractal law (default: the line's own rms height).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rms_height: Option<f64>,
+    /// Asperity radius R of the Hertz law (15.2) (default --radius with --profile hertz).
+    #[arg(long)]
+    pub asperity_radius: Option<f64>,
+    /// Indentations to evaluate, comma separated.
+    #[arg(long, value_delimiter = ',', num_args = 1.., conflicts_with_all = ["nloads", "breakpoints"], allow_negative_numbers = true)]
+    pub indentations: Option<Vec<f64>>,
+    /// Number of log-spaced indentations from --dmin to --dmax (default 50).
+    #[arg(long, conflicts_with = "breakpoints")]
+    pub nloads: Option<usize>,
+    /// Smallest indentation for --nloads (default --dmax · 1e-6).
+    #[arg(long)]
+    pub dmin: Option<f64>,
+    /// Largest indentation for --nloads (default: full contact, the largest finite gap).
+    #[arg(long)]
+    pub dmax: Option<f64>,
+    /// Linear springs on a line: write the exact curve, one row per contact count (the
+    /// breakpoints where each spring first touches).
+    #[arg(long)]
+    pub breakpoints: bool,
+    /// Output CSV (default: standard output).
+    #[arg(long, value_name = "OUT.csv")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an existing output.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The line length recorded in a line's sidecar, if any.
+fn sidecar_size(file: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(sidecar_path(file)).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value["spec"]["size"].as_f64()
+}
+
+fn need(value: Option<f64>, flag: &str, what: &str) -> Result<f64> {
+    value.with_context(|| format!("{what} needs {flag}"))
+}
+
+/// The indenter as a 1D profile on its spring grid.
+struct Indenter {
+    /// Line heights (positive up) or indenter profile g (lowest point touches first).
+    values: Vec<f64>,
+    /// True for a rough line (gaps from the highest point).
+    is_line: bool,
+    /// Spring spacing Δx.
+    spacing: f64,
+    /// Length L (used by the fractal law).
+    size: f64,
+    /// One line for the summary printed after writing.
+    description: String,
+}
+
+fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
+    let n = args
+        .n
+        .with_context(|| format!("{what} needs --n (number of springs)"))?;
+    let dx = need(args.dx, "--dx", what)?;
+    if !(dx.is_finite() && dx > 0.0) {
+        bail!("invalid dx: the spring spacing Δx must be positive and finite, got {dx}");
+    }
+    if n == 0 {
+        bail!("invalid n: need at least one spring");
+    }
+    Ok((n, dx))
+}
+
+fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
+    if let Some(path) = &args.line {
+        let heights = read_npy_1d(path)?.to_vec();
+        let size = args.size.or_else(|| sidecar_size(path)).unwrap_or(1.0);
+        if !(size.is_finite() && size > 0.0) {
+            bail!("invalid size: the line length must be positive and finite, got {size}");
+        }
+        let spacing = size / heights.len() as f64;
+        return Ok(Indenter {
+            description: format!(
+                "line {} ({} points, L = {size})",
+                path.display(),
+                heights.len()
+            ),
+            values: heights,
+            is_line: true,
+            spacing,
+            size,
+        });
+    }
+    if let Some(path) = &args.radial {
+        let step = need(args.radial_step, "--radial-step", "--radial")?;
+        let samples = read_npy_1d(path)?;
+        let profile = RadialProfile::new(samples.as_slice().expect("contiguous"), step)?;
+        let (n, dx) = spring_grid(args, "--radial")?;
+        return Ok(Indenter {
+            values: profile.sample(n, dx)?,
+            is_line: false,
+            spacing: dx,
+            size: args.size.unwrap_or(n as f64 * dx),
+            description: format!(
+                "radial profile {} ({} samples, Δr = {step}), n = {n}, Δx = {dx}",
+                path.display(),
+                samples.len()
+            ),
+        });
+    }
+    let Some(kind) = args.profile else {
+        bail!("give an indenter: --line FILE.npy, --profile hertz|cone|punch|power or --radial FILE.npy");
+    };
+    let shape = match kind {
+        ProfileKind::Hertz => Axisymmetric::Sphere {
+            radius: need(args.radius, "--radius", "--profile hertz")?,
+        },
+        ProfileKind::Punch => Axisymmetric::FlatPunch {
+            radius: need(args.radius, "--radius", "--profile punch")?,
+        },
+        ProfileKind::Cone => Axisymmetric::Cone {
+            slope: need(args.slope, "--slope", "--profile cone")?,
+        },
+        ProfileKind::Power => Axisymmetric::PowerLaw {
+            coefficient: need(args.coefficient, "--coefficient", "--profile power")?,
+            exponent: need(args.exponent, "--exponent", "--profile power")?,
+        },
+    };
+    shape.validate()?;
+    let (n, dx) = spring_grid(args, "--profile")?;
+    Ok(Indenter {
+        values: shape.sample(n, dx)?,
+        is_line: false,
+        spacing: dx,
+        size: args.size.unwrap_or(n as f64 * dx),
+        description: format!("{shape:?}, n = {n}, Δx = {dx}"),
+    })
+}
+
+fn spring_law(args: &MdrArgs, indenter: &Indenter) -> Result<SpringLaw> {
+    Ok(match args.spring {
+        SpringKind::Linear => SpringLaw::Linear,
+        SpringKind::Hertz => {
+            let radius = match (args.asperity_radius, args.profile) {
+                (Some(r), _) => r,
+                (None, Some(ProfileKind::Hertz)) => {
+                    need(args.radius, "--radius", "--profile hertz")?
+                }
+                _ => bail!("the hertz spring law (15.2) needs --asperity-radius"),
+            };
+            SpringLaw::Hertz { radius }
+        }
+        SpringKind::Fractal => {
+            let hurst = args
+                .hurst
+                .context("the fractal spring law (15.7) needs --hurst")?;
+            let rms = match (args.rms_height, indenter.is_line) {
+                (Some(h), _) => h,
+                (None, true) => rms_height(indenter.values.iter().copied()),
+                (None, false) => {
+                    bail!("the fractal spring law (15.7) on a profile needs --rms-height")
+                }
+            };
+            SpringLaw::Fractal {
+                hurst,
+                rms_height: rms,
+                size: indenter.size,
+            }
+        }
+    })
+}
+
+fn indentation_levels(args: &MdrArgs, foundation: &Foundation) -> Result<Vec<f64>> {
+    if let Some(list) = &args.indentations {
+        if let Some(bad) = list.iter().find(|d| !d.is_finite() || **d < 0.0) {
+            bail!("invalid indentations: each must be finite and >= 0, got {bad}");
+        }
+        return Ok(list.clone());
+    }
+    let count = args.nloads.unwrap_or(50);
+    let dmax = match args.dmax {
+        Some(d) => d,
+        None => {
+            let full = foundation.full_contact_indentation();
+            if full <= 0.0 {
+                bail!(
+                    "every spring touches at once (a flat punch?): give --dmax or --indentations"
+                );
+            }
+            full
+        }
+    };
+    let dmin = args.dmin.unwrap_or(dmax * 1e-6);
+    log_spaced(dmin, dmax, count).map_err(|e| anyhow::anyhow!("--dmin/--dmax/--nloads: {e}"))
+}
 
 /// Runs `asperity mdr`.
-pub fn run(_args: &MdrArgs) -> anyhow::Result<()> {
-    anyhow::bail!("asperity mdr is not implemented yet")
+pub fn run(args: &MdrArgs) -> Result<()> {
+    if let Some(out) = &args.out {
+        ensure_new_output(out, args.force)?;
+    }
+    let indenter = load_indenter(args)?;
+    let law = spring_law(args, &indenter)?;
+    let spring = Spring::new(law, indenter.spacing, args.modulus)?;
+    let mut table = Table::new(&["indentation", "force", "stiffness", "contacts"]);
+    let push = |table: &mut Table, p: &CurvePoint| {
+        table.push(&[
+            format_number(p.indentation),
+            format_number(p.force),
+            format_number(p.stiffness),
+            p.contacts.to_string(),
+        ])
+    };
+    if args.breakpoints {
+        if !(spring.is_linear() && indenter.is_line) {
+            bail!(
+                "--breakpoints needs --line with linear springs (the exact piecewise-linear curve)"
+            );
+        }
+        let curve = LinearCurve::from_heights(&indenter.values, spring.spacing(), args.modulus)?;
+        for j in 1..=curve.len() {
+            push(&mut table, &curve.breakpoint(j));
+        }
+    } else {
+        let foundation = if indenter.is_line {
+            Foundation::from_heights(&indenter.values, spring)?
+        } else {
+            Foundation::from_profile(&indenter.values, spring)?
+        };
+        for d in indentation_levels(args, &foundation)? {
+            push(&mut table, &foundation.evaluate(d));
+        }
+    }
+    match &args.out {
+        Some(out) => {
+            table
+                .write(out, args.force)
+                .with_context(|| format!("writing {}", out.display()))?;
+            eprintln!(
+                "wrote {} ({} rows): {}, {} springs (u0 = {:.4e})",
+                out.display(),
+                table.len(),
+                indenter.description,
+                law.name(),
+                spring.critical_depth()
+            );
+        }
+        None => match std::io::stdout().write_all(&table.to_csv()?) {
+            // A closed pipe (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+            other => other?,
+        },
+    }
+    Ok(())
 }

@@ -2,6 +2,7 @@
 
 pub mod bem;
 pub mod bench;
+mod fig15;
 pub mod figures;
 pub mod mdr;
 pub mod reproduce;

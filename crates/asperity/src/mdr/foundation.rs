@@ -284,6 +284,42 @@ mod tests {
     const PI_HALF: f64 = std::f64::consts::FRAC_PI_2;
 
     #[test]
+    fn power_law_indenters_match_their_closed_forms() {
+        // f = c rⁿ → g = κ(n) c |x|ⁿ; F = 2E* n/(n+1) d a, k = 2E*a (reference::PowerLaw).
+        // a ≥ 1000 Δx: stiffness error ≤ Δx/a = 0.1 %, force better.
+        let dx = 1e-3;
+        for exponent in [0.7, 1.5, 3.0] {
+            let (coefficient, modulus) = (0.4, 1.1);
+            let profile = Axisymmetric::PowerLaw {
+                coefficient,
+                exponent,
+            }
+            .sample(8001, dx)
+            .unwrap();
+            let foundation =
+                Foundation::from_profile(&profile, Spring::linear(dx, modulus).unwrap()).unwrap();
+            let reference = crate::reference::PowerLaw {
+                coefficient,
+                exponent,
+                modulus,
+            };
+            for a in [1.0, 2.5] {
+                let d = reference.stretch() * coefficient * f64::powf(a, exponent);
+                let p = foundation.evaluate(d);
+                assert!((reference.contact_radius(d) / a - 1.0).abs() < 1e-12);
+                assert!(
+                    (p.force / reference.force(d) - 1.0).abs() < 1e-3,
+                    "n = {exponent}, a = {a}"
+                );
+                assert!(
+                    (p.stiffness / reference.stiffness(d) - 1.0).abs() < 1e-3,
+                    "n = {exponent}, a = {a}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn flat_punch_has_stiffness_two_modulus_radius() {
         // (2m+1) springs cover |x| ≤ a = (m + ½)Δx exactly: k = E*Δx(2m+1) = 2E*a.
         let dx = 0.01;

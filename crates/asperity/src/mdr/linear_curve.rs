@@ -1,5 +1,6 @@
 //! The whole force–indentation–stiffness curve of a rough line on **linear** springs, in
-//! `O(N log N)`: sort the heights once, then accumulate.
+//! `O(N log N)` — in fact `O(N)`: sort the heights once (a radix sort,
+//! [`super::radix_sort`]), then accumulate.
 //!
 //! With springs of stiffness `E*·Δx` and gaps `s_(1) ≤ s_(2) ≤ … ≤ s_(N)` (sorted,
 //! `s_i = z_max − z_i`, so `s_(1) = 0`), the curve is piecewise linear in `d` with a
@@ -41,10 +42,11 @@
 //! ```
 
 use super::foundation::CurvePoint;
+use super::radix_sort::{sort_descending, RadixScratch};
 use crate::{Error, Result};
 
 /// Breakpoints of the force–indentation curve of a line on linear springs (module docs).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default)]
 pub struct LinearCurve {
     /// `d_j`, ascending; index `j − 1`.
     indentations: Vec<f64>,
@@ -52,6 +54,20 @@ pub struct LinearCurve {
     forces: Vec<f64>,
     /// `E*·Δx`.
     spring_stiffness: f64,
+    /// `Δx`.
+    spacing: f64,
+    /// Buffers of the sort, kept between lines.
+    scratch: RadixScratch,
+}
+
+impl PartialEq for LinearCurve {
+    /// Equal curves: same breakpoints and spring stiffness (the sort's scratch is ignored).
+    fn eq(&self, other: &Self) -> bool {
+        self.indentations == other.indentations
+            && self.forces == other.forces
+            && self.spring_stiffness == other.spring_stiffness
+            && self.spacing == other.spacing
+    }
 }
 
 impl LinearCurve {
@@ -66,6 +82,8 @@ impl LinearCurve {
             indentations: Vec::with_capacity(n),
             forces: Vec::with_capacity(n),
             spring_stiffness: 0.0,
+            spacing: 0.0,
+            scratch: RadixScratch::default(),
         }
     }
 
@@ -99,9 +117,10 @@ impl LinearCurve {
         }
         crate::ensure_finite("line", heights)?;
         self.spring_stiffness = modulus * spacing;
-        // Sort heights descending; gaps z_max − z are then ascending.
+        self.spacing = spacing;
+        // Sort heights descending (radix sort, O(N)); gaps z_max − z are then ascending.
         self.indentations.extend_from_slice(heights);
-        self.indentations.sort_unstable_by(|a, b| b.total_cmp(a));
+        sort_descending(&mut self.indentations, &mut self.scratch);
         let top = self.indentations[0];
         for value in self.indentations.iter_mut() {
             *value = top - *value;
@@ -126,6 +145,21 @@ impl LinearCurve {
     /// True before the first [`LinearCurve::recompute`].
     pub fn is_empty(&self) -> bool {
         self.indentations.is_empty()
+    }
+
+    /// Spring spacing `Δx`.
+    pub fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// Effective modulus `E*`.
+    pub fn modulus(&self) -> f64 {
+        self.spring_stiffness / self.spacing
+    }
+
+    /// Length of the line, `N·Δx`.
+    pub fn size(&self) -> f64 {
+        self.len() as f64 * self.spacing
     }
 
     /// Stiffness of one spring, `E*·Δx`.

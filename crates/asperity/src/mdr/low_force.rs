@@ -125,29 +125,29 @@ fn log_levels(low: f64, high: f64, count: usize) -> impl Iterator<Item = f64> {
     (0..count).map(move |i| low * (step * i as f64).exp())
 }
 
-/// Stiffness `k̃ = #{j : F̃_j ≤ F̃}/N` of one sample at normalised force `F̃`.
-fn normalised_stiffness(sample: &LowForceSample, force: f64) -> f64 {
-    sample.normalised_forces.partition_point(|&f| f <= force) as f64 / sample.points as f64
+/// Stiffness `k̃ = #{j : F̃_j ≤ F̃}/N` at normalised force `F̃`, from the normalised
+/// breakpoint forces `F̃_j` of a line of `points` springs.
+fn normalised_stiffness(normalised_forces: &[f64], points: usize, force: f64) -> f64 {
+    normalised_forces.partition_point(|&f| f <= force) as f64 / points as f64
 }
 
-/// The low-force data and fit of one line's curve (`rms_height` and `size` of that line,
-/// modulus from the curve). Errors if the window is empty for this `N` or the line is flat.
+/// The low-force data and fit of one line's curve (`rms_height` of that line; `E*` and
+/// `L = N·Δx` from the curve). Errors if the window does not fit this `N` or the line is
+/// flat.
 pub fn low_force_sample(
     curve: &LinearCurve,
     rms_height: f64,
-    size: f64,
     window: &LowForceWindow,
 ) -> Result<LowForceSample> {
     let n = curve.len();
     let (low, high) = window.contact_range(n)?;
-    if !(rms_height > 0.0 && size > 0.0) {
+    if !(rms_height.is_finite() && rms_height > 0.0) {
         return Err(Error::invalid(
             "rms-height",
-            format!("rms height and size must be positive, got {rms_height} and {size}"),
+            format!("the line's rms height must be positive and finite, got {rms_height}"),
         ));
     }
-    let modulus = curve.spring_stiffness() * n as f64 / size;
-    let scale = 1.0 / (modulus * rms_height * size);
+    let scale = 1.0 / (curve.modulus() * rms_height * curve.size());
     let normalised_forces: Vec<f64> = curve.forces()[..high].iter().map(|f| f * scale).collect();
     let (f_low, f_high) = (normalised_forces[low - 1], normalised_forces[high - 1]);
     if !(f_low > 0.0 && f_high > f_low) {
@@ -156,25 +156,17 @@ pub fn low_force_sample(
             format!("no force range between {low} and {high} contacts (a flat line?)"),
         ));
     }
-    let mut sample = LowForceSample {
-        points: n,
-        normalised_forces,
-        fit: PowerLawFit {
-            exponent: f64::NAN,
-            prefactor: f64::NAN,
-            stderr: f64::NAN,
-            low: f64::NAN,
-            high: f64::NAN,
-            points: 0,
-        },
-    };
     let forces: Vec<f64> = log_levels(f_low, f_high, window.levels).collect();
     let stiffness: Vec<f64> = forces
         .iter()
-        .map(|&f| normalised_stiffness(&sample, f))
+        .map(|&f| normalised_stiffness(&normalised_forces, n, f))
         .collect();
-    sample.fit = power_law_fit(&forces, &stiffness)?;
-    Ok(sample)
+    let fit = power_law_fit(&forces, &stiffness)?;
+    Ok(LowForceSample {
+        points: n,
+        normalised_forces,
+        fit,
+    })
 }
 
 /// The exponent α of an ensemble, both ways (module docs).
@@ -243,7 +235,7 @@ pub fn ensemble_exponent(
         .map(|f| {
             let k = samples
                 .iter()
-                .map(|s| normalised_stiffness(s, f))
+                .map(|s| normalised_stiffness(&s.normalised_forces, s.points, f))
                 .sum::<f64>()
                 / count;
             (f, k)
@@ -308,7 +300,7 @@ mod tests {
                     generator.generate_into(seed, heights).unwrap();
                     curve.recompute(heights, 1.0 / n as f64, 1.0).unwrap();
                     let h = rms_height(heights.iter().copied());
-                    low_force_sample(curve, h, 1.0, window).unwrap()
+                    low_force_sample(curve, h, window).unwrap()
                 },
             )
             .collect()
@@ -394,7 +386,7 @@ mod tests {
                     let window = LowForceWindow::new(first, fraction, 40).unwrap();
                     let samples: Vec<LowForceSample> = curves
                         .iter()
-                        .map(|(c, h)| low_force_sample(c, *h, 1.0, &window).unwrap())
+                        .map(|(c, h)| low_force_sample(c, *h, &window).unwrap())
                         .collect();
                     let r = ensemble_exponent(&samples, &window).unwrap();
                     eprintln!(
@@ -405,6 +397,34 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn ensembles_are_bit_identical_whatever_the_thread_count() {
+        let window = LowForceWindow::default();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let samples = ensemble(0.8, 4096, 24, &window);
+                ensemble_exponent(&samples, &window).unwrap()
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            let other = run(threads);
+            assert_eq!(
+                one.mean_curve.exponent.to_bits(),
+                other.mean_curve.exponent.to_bits()
+            );
+            assert_eq!(
+                one.per_sample_mean.to_bits(),
+                other.per_sample_mean.to_bits()
+            );
+            assert_eq!(one.curve, other.curve);
         }
     }
 
@@ -432,7 +452,7 @@ mod tests {
             .collect();
         let curve = LinearCurve::from_heights(&heights, 1.0 / n as f64, 1.0).unwrap();
         let window = LowForceWindow::new(20, 0.05, 40).unwrap();
-        let sample = low_force_sample(&curve, 1.0, 1.0, &window).unwrap();
+        let sample = low_force_sample(&curve, 1.0, &window).unwrap();
         assert!(
             (sample.fit.exponent - 1.0 / (1.0 + p)).abs() < 0.01,
             "{}",

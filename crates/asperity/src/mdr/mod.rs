@@ -13,6 +13,7 @@
 //!   highest point).
 //! * [`linear_curve`]: the whole curve of a line on linear springs in `O(N log N)`, with a
 //!   reusable buffer for ensembles of thousands of lines.
+//! * [`radix_sort`]: the `O(N)` descending sort of doubles behind [`LinearCurve`].
 //! * [`low_force`]: the low-force exponent α of `k ∝ F^α` (3): the documented automatic
 //!   fit window, per-sample and ensemble-mean fits, and the theories (6) and (24).
 //!
@@ -36,6 +37,7 @@ pub mod foundation;
 pub mod indenter;
 pub mod linear_curve;
 pub mod low_force;
+pub mod radix_sort;
 pub mod spring;
 
 pub use foundation::{log_spaced, CurvePoint, Foundation};

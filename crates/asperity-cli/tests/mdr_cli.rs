@@ -1,0 +1,424 @@
+//! Integration tests of `asperity mdr` and `asperity reproduce fig15.1|fig15.2`, driving the
+//! real binary.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use asperity::reference::Hertz;
+use ndarray::Array1;
+use ndarray_npy::WriteNpyExt;
+
+fn asperity(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Exit status 2 and a single `error: …` line mentioning `needle`.
+fn assert_refused(output: &Output, needle: &str) {
+    let text = stderr(output);
+    assert_eq!(output.status.code(), Some(2), "stderr: {text}");
+    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "one error line expected: {text}");
+    assert!(
+        errors[0].to_lowercase().contains(&needle.to_lowercase()),
+        "'{needle}' not in: {text}"
+    );
+}
+
+/// Rows of a CSV with header `indentation,force,stiffness,contacts`.
+fn read_curve(path: &Path) -> Vec<(f64, f64, f64, usize)> {
+    let text = std::fs::read_to_string(path).expect("csv written");
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("indentation,force,stiffness,contacts"),
+        "header"
+    );
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                f[0].parse().unwrap(),
+                f[1].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[3].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+fn write_line(path: &Path, values: Vec<f64>) {
+    let file = std::fs::File::create(path).unwrap();
+    Array1::from(values).write_npy(file).unwrap();
+}
+
+#[test]
+fn hertz_profile_reproduces_hertz_force_and_stiffness() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "4001",
+            "--dx",
+            "1e-3",
+            "--modulus",
+            "2",
+            "--indentations",
+            "0.04,0.25,1",
+            "--out",
+            "h.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let hertz = Hertz {
+        radius: 1.0,
+        modulus: 2.0,
+    };
+    let rows = read_curve(&dir.path().join("h.csv"));
+    assert_eq!(rows.len(), 3);
+    for (d, force, stiffness, contacts) in rows {
+        // a = sqrt(R d) ≥ 200 Δx: discretisation ≤ Δx/a = 0.5 %.
+        assert!((force / hertz.force(d) - 1.0).abs() < 5e-3, "d = {d}");
+        assert!(
+            (stiffness / hertz.stiffness(d) - 1.0).abs() < 5e-3,
+            "d = {d}"
+        );
+        assert_eq!(contacts % 2, 1, "symmetric contact about the axis spring");
+    }
+}
+
+#[test]
+fn hertz_spring_law_holds_below_the_resolution() {
+    // Δx²/R = 1e-4; at d = 1e-9 one spring touches.
+    let dir = tempfile::tempdir().unwrap();
+    let run = |spring: &str, name: &str| {
+        let out = asperity(
+            &[
+                "mdr",
+                "--profile",
+                "hertz",
+                "--radius",
+                "1",
+                "--n",
+                "201",
+                "--dx",
+                "0.01",
+                "--spring",
+                spring,
+                "--indentations",
+                "1e-9",
+                "--out",
+                name,
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_curve(&dir.path().join(name))[0]
+    };
+    let hertz = Hertz {
+        radius: 1.0,
+        modulus: 1.0,
+    };
+    let nonlinear = run("hertz", "nl.csv");
+    assert!((nonlinear.1 / hertz.force(1e-9) - 1.0).abs() < 0.02);
+    let linear = run("linear", "l.csv");
+    assert!(linear.1 / hertz.force(1e-9) > 100.0, "linear springs off");
+}
+
+#[test]
+fn line_breakpoints_and_log_spaced_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &[
+            "line", "--n", "1024", "--hurst", "0.5", "--size", "2", "--seed", "3", "--out", "l.npy",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = asperity(
+        &["mdr", "--line", "l.npy", "--breakpoints", "--out", "b.csv"],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows = read_curve(&dir.path().join("b.csv"));
+    assert_eq!(rows.len(), 1024);
+    assert_eq!((rows[0].0, rows[0].1, rows[0].3), (0.0, 0.0, 1));
+    // Size 2 from the sidecar: E*Δx = 2/1024.
+    for (j, row) in rows.iter().enumerate() {
+        assert_eq!(row.3, j + 1);
+        assert!((row.2 / ((j + 1) as f64 * 2.0 / 1024.0) - 1.0).abs() < 1e-12);
+    }
+    assert!(rows
+        .windows(2)
+        .all(|w| w[1].0 >= w[0].0 && w[1].1 >= w[0].1));
+    let out = asperity(
+        &["mdr", "--line", "l.npy", "--nloads", "12", "--out", "n.csv"],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let loads = read_curve(&dir.path().join("n.csv"));
+    assert_eq!(loads.len(), 12);
+    assert!(loads
+        .windows(2)
+        .all(|w| w[1].0 > w[0].0 && w[1].1 >= w[0].1));
+    // The last level is full contact: every spring touches but the lowest.
+    assert!(loads[11].3 >= 1023);
+    // The same curve through the fractal law converges to it once many springs touch.
+    let out = asperity(
+        &[
+            "mdr", "--line", "l.npy", "--spring", "fractal", "--hurst", "0.5", "--nloads", "12",
+            "--out", "f.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let fractal = read_curve(&dir.path().join("f.csv"));
+    assert!((fractal[11].1 / loads[11].1 - 1.0).abs() < 0.05);
+}
+
+#[test]
+fn sampled_radial_profile_is_transformed() {
+    // f = r²/2R sampled on r = 0, 1e-3, …, 1: its MDR transform is x²/R, so the foundation
+    // reproduces Hertz like the closed-form sphere (a ≥ 200 Δx: within 0.5 %).
+    let dir = tempfile::tempdir().unwrap();
+    let radius = 0.5;
+    write_line(
+        &dir.path().join("tip.npy"),
+        (0..=1000)
+            .map(|k| (k as f64 * 1e-3).powi(2) / (2.0 * radius))
+            .collect(),
+    );
+    let out = asperity(
+        &[
+            "mdr",
+            "--radial",
+            "tip.npy",
+            "--radial-step",
+            "1e-3",
+            "--n",
+            "1601",
+            "--dx",
+            "1e-3",
+            "--indentations",
+            "0.05,0.2",
+            "--out",
+            "r.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let hertz = Hertz {
+        radius,
+        modulus: 1.0,
+    };
+    for (d, force, stiffness, _) in read_curve(&dir.path().join("r.csv")) {
+        assert!((force / hertz.force(d) - 1.0).abs() < 5e-3, "d = {d}");
+        assert!(
+            (stiffness / hertz.stiffness(d) - 1.0).abs() < 5e-3,
+            "d = {d}"
+        );
+    }
+    // Springs beyond the sampled radius are refused.
+    let out = asperity(
+        &[
+            "mdr",
+            "--radial",
+            "tip.npy",
+            "--radial-step",
+            "1e-3",
+            "--n",
+            "3001",
+            "--dx",
+            "1e-3",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, "beyond the radial profile");
+}
+
+#[test]
+fn fractal_law_needs_a_valid_hurst_exponent() {
+    let dir = tempfile::tempdir().unwrap();
+    write_line(
+        &dir.path().join("l.npy"),
+        (0..64).map(|i| (i as f64).sin()).collect(),
+    );
+    for hurst in ["0", "-0.5", "2.5"] {
+        let out = asperity(
+            &[
+                "mdr", "--line", "l.npy", "--spring", "fractal", "--hurst", hurst,
+            ],
+            dir.path(),
+        );
+        assert_refused(&out, "hurst");
+    }
+    let out = asperity(
+        &["mdr", "--line", "l.npy", "--spring", "fractal"],
+        dir.path(),
+    );
+    assert_refused(&out, "--hurst");
+}
+
+#[test]
+fn non_positive_spacing_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for dx in ["0", "-0.01"] {
+        let out = asperity(
+            &[
+                "mdr",
+                "--profile",
+                "hertz",
+                "--radius",
+                "1",
+                "--n",
+                "11",
+                "--dx",
+                dx,
+            ],
+            dir.path(),
+        );
+        assert_refused(&out, "dx");
+    }
+    let out = asperity(&["mdr", "--line", "missing.npy", "--size", "0"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn nan_in_the_profile_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    write_line(&dir.path().join("nan.npy"), vec![0.0, 1.0, f64::NAN, 0.5]);
+    let out = asperity(&["mdr", "--line", "nan.npy", "--out", "x.csv"], dir.path());
+    assert_refused(&out, "non-finite");
+    assert!(!dir.path().join("x.csv").exists(), "nothing written");
+    let out = asperity(
+        &[
+            "mdr",
+            "--radial",
+            "nan.npy",
+            "--radial-step",
+            "0.1",
+            "--n",
+            "3",
+            "--dx",
+            "0.1",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, "non-finite");
+}
+
+#[test]
+fn existing_output_is_kept_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("c.csv");
+    std::fs::write(&target, "keep me").unwrap();
+    let args = [
+        "mdr",
+        "--profile",
+        "cone",
+        "--slope",
+        "0.2",
+        "--n",
+        "101",
+        "--dx",
+        "0.01",
+        "--nloads",
+        "5",
+        "--out",
+        "c.csv",
+    ];
+    let out = asperity(&args, dir.path());
+    assert_refused(&out, "already exists");
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
+    let mut forced = args.to_vec();
+    forced.push("--force");
+    let out = asperity(&forced, dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(read_curve(&target).len(), 5);
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no temporary files left"
+    );
+}
+
+#[test]
+fn help_has_examples() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(&["mdr", "--help"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains("Examples:") && text.contains("--breakpoints"),
+        "{text}"
+    );
+}
+
+#[test]
+fn reproduce_book_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    for (figure, files) in [
+        (
+            "fig15.1",
+            &["fig15_1.csv", "fig15_1.png", "fig15_1.svg", "report.md"][..],
+        ),
+        (
+            "fig15.2",
+            &["fig15_2.csv", "fig15_2.png", "fig15_2.svg", "report.md"][..],
+        ),
+    ] {
+        let out = asperity(
+            &["reproduce", figure, "--quick", "--out", "figs"],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{figure}: {}", stderr(&out));
+        for file in files {
+            let path = dir.path().join("figs").join(figure).join(file);
+            assert!(path.exists(), "{} missing", path.display());
+        }
+        let report =
+            std::fs::read_to_string(dir.path().join("figs").join(figure).join("report.md"))
+                .unwrap();
+        assert!(report.contains(if figure == "fig15.1" {
+            "4/3 E* R^½"
+        } else {
+            "(15.3)"
+        }));
+        // A second run refuses to overwrite.
+        let again = asperity(
+            &["reproduce", figure, "--quick", "--out", "figs"],
+            dir.path(),
+        );
+        assert_refused(&again, "already exists");
+    }
+    // Fig. 15.1's non-linear springs reproduce Hertz below the resolution.
+    let csv = std::fs::read_to_string(dir.path().join("figs/fig15.1/fig15_1.csv")).unwrap();
+    let first: Vec<f64> = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(
+        (first[2] / first[3] - 1.0).abs() < 1e-9,
+        "non-linear = Hertz: {first:?}"
+    );
+    assert!(
+        first[1] / first[3] > 10.0,
+        "linear springs far off: {first:?}"
+    );
+}
