@@ -31,9 +31,9 @@
 
 #![warn(missing_docs)]
 
-mod error;
 pub mod bem;
 pub mod elastic;
+mod error;
 pub mod fft;
 pub mod fit;
 pub mod io;

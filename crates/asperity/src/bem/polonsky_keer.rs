@@ -20,7 +20,9 @@
 
 use ndarray::{Array2, ArrayView2};
 
-use super::{ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverParams};
+use super::{
+    ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverParams,
+};
 use crate::elastic::{self_influence, Boundary, ElasticOperator};
 use crate::surface::Surface;
 use crate::{memory, Error};
@@ -245,10 +247,7 @@ impl ContactSolver {
         self.operator
             .apply_pseudo_inverse(&self.profile, &mut self.direction)
             .expect("called for periodic boundaries only");
-        let full = self
-            .direction
-            .iter()
-            .fold(0.0f64, |m, &v| m.max(v));
+        let full = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
         self.full_contact_pressure = Some(full);
         full
     }
@@ -268,7 +267,12 @@ impl ContactSolver {
         let mut iteration = 0;
         loop {
             self.operator.apply(&self.pressure, &mut self.gap);
-            let (p, gap, t, f) = (&self.pressure, &mut self.gap, &mut self.direction, &self.profile);
+            let (p, gap, t, f) = (
+                &self.pressure,
+                &mut self.gap,
+                &mut self.direction,
+                &self.profile,
+            );
 
             // Pass A: u + f, and its mean and spread on the contact set, shifted by the
             // last indentation so that G does not cancel.
@@ -315,7 +319,13 @@ impl ContactSolver {
             let residual =
                 ((g_sum + penetration) / contact_points.max(1) as f64).sqrt() / self.height_scale;
             if residual < tolerance {
-                return Ok((self.finish(indentation, contact_points), SolveInfo { iterations: iteration, residual }));
+                return Ok((
+                    self.finish(indentation, contact_points),
+                    SolveInfo {
+                        iterations: iteration,
+                        residual,
+                    },
+                ));
             }
             if iteration >= max_iterations {
                 return Err(SolveError::NoConvergence {
@@ -333,7 +343,12 @@ impl ContactSolver {
             iteration += 1;
 
             self.operator.apply(&self.direction, &mut self.response);
-            let (p, gap, t, r) = (&mut self.pressure, &self.gap, &self.direction, &self.response);
+            let (p, gap, t, r) = (
+                &mut self.pressure,
+                &self.gap,
+                &self.direction,
+                &self.response,
+            );
 
             // Pass C: step length with r's mean on the set removed (load control).
             let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
@@ -445,7 +460,10 @@ fn validate_params(params: &SolverParams) -> Result<(), SolveError> {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(Error::invalid(name, format!("must be positive and finite, got {v}")))
+            Err(Error::invalid(
+                name,
+                format!("must be positive and finite, got {v}"),
+            ))
         }
     };
     positive("tolerance", params.tolerance)?;
@@ -505,10 +523,16 @@ pub(super) mod tests {
         assert!((s.force / force - 1.0).abs() < 1e-12);
         // Force–indentation within 1 %.
         let d_error = s.indentation / d_target - 1.0;
-        assert!(d_error.abs() < 0.01, "{rows}x{cols}: indentation error {d_error:e}");
+        assert!(
+            d_error.abs() < 0.01,
+            "{rows}x{cols}: indentation error {d_error:e}"
+        );
         // Contact radius (area-equivalent) within one pixel.
         let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
-        assert!((a - a_target).abs() < dx, "{rows}x{cols}: a = {a}, Hertz {a_target}");
+        assert!(
+            (a - a_target).abs() < dx,
+            "{rows}x{cols}: a = {a}, Hertz {a_target}"
+        );
         // Pressure profile: within 2 % of the peak pressure inside 0.9 a (the last pixels
         // average the square-root edge over a pixel, where the pointwise error is larger).
         let p0 = hertz.pressure(d_target, 0.0);
@@ -520,7 +544,10 @@ pub(super) mod tests {
                 worst = worst.max((p - hertz.pressure(d_target, r)).abs() / p0);
             }
         }
-        assert!(worst < 0.02, "{rows}x{cols}: pressure error {worst:e} of p0");
+        assert!(
+            worst < 0.02,
+            "{rows}x{cols}: pressure error {worst:e} of p0"
+        );
         eprintln!(
             "hertz {rows}x{cols}: d error {d_error:.2e}, a {:.3} px, p error {worst:.2e}, {} iterations",
             (a - a_target) / dx,
@@ -598,11 +625,18 @@ pub(super) mod tests {
             let pressure = solver.pressure();
             let p_max = reference.pressure(ratio * p_star, 0.0);
             for j in 0..cols {
-                let x = if j <= cols / 2 { j as f64 } else { j as f64 - cols as f64 } * dx;
+                let x = if j <= cols / 2 {
+                    j as f64
+                } else {
+                    j as f64 - cols as f64
+                } * dx;
                 let a = reference.contact_half_width(ratio * p_star);
                 if x.abs() < a - 2.0 * dx {
                     let error = (pressure[[3, j]] - reference.pressure(ratio * p_star, x)).abs();
-                    assert!(error < 0.01 * p_max, "p/p* = {ratio}, x = {x}: error {error}");
+                    assert!(
+                        error < 0.01 * p_max,
+                        "p/p* = {ratio}, x = {x}: error {error}"
+                    );
                 }
             }
         }
@@ -657,7 +691,8 @@ pub(super) mod tests {
                 modulus: 1.0,
                 boundary,
             };
-            let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            let mut solver =
+                ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
             let (s, _) = solver.solve(Control::Force(force)).unwrap();
             let p_max = solver.pressure().iter().fold(0.0f64, |m, &p| m.max(p));
             results.push((s.contact_points, p_max));
@@ -670,7 +705,10 @@ pub(super) mod tests {
             (free_points as i64 - periodic_points as i64).abs() <= 8,
             "{free_points} vs {periodic_points}"
         );
-        assert!((free_peak / periodic_peak - 1.0).abs() < 0.03, "{free_peak} vs {periodic_peak}");
+        assert!(
+            (free_peak / periodic_peak - 1.0).abs() < 0.03,
+            "{free_peak} vs {periodic_peak}"
+        );
     }
 
     #[test]
@@ -681,7 +719,12 @@ pub(super) mod tests {
         let (warm_state, warm) = solver.solve(Control::MeanPressure(0.022)).unwrap();
         solver.reset();
         let (cold_state, cold) = solver.solve(Control::MeanPressure(0.022)).unwrap();
-        assert!(warm.iterations < cold.iterations, "warm {} vs cold {}", warm.iterations, cold.iterations);
+        assert!(
+            warm.iterations < cold.iterations,
+            "warm {} vs cold {}",
+            warm.iterations,
+            cold.iterations
+        );
         assert!(first.iterations > 0);
         assert_eq!(warm_state.contact_points, cold_state.contact_points);
         assert!((warm_state.indentation / cold_state.indentation - 1.0).abs() < 1e-7);
@@ -691,12 +734,21 @@ pub(super) mod tests {
     fn results_do_not_depend_on_the_thread_count() {
         let surface = rough(48, 3);
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| {
-                let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+                let mut solver =
+                    ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
                 let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
                 let (k, _) = solver.frozen_set_stiffness().unwrap();
-                (solver.pressure().to_owned(), s.indentation, info.iterations, k)
+                (
+                    solver.pressure().to_owned(),
+                    s.indentation,
+                    info.iterations,
+                    k,
+                )
             })
         };
         let one = run(1);
@@ -780,7 +832,10 @@ pub(super) mod tests {
         let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
         let (s, _) = solver.solve(Control::MeanPressure(0.03)).unwrap();
         let state = solver.state().unwrap();
-        let f_top = surface.heights().iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+        let f_top = surface
+            .heights()
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &h| m.max(h));
         let rms = 0.5 / (2.0 * PI); // loose scale: rms slope 0.5, wavelengths ≥ L/4
         for ((&p, &u), &h) in state
             .pressure

@@ -250,7 +250,8 @@ mod tests {
         for (boundary, pressure) in [(Boundary::Free, 0.02), (Boundary::Periodic, 0.05)] {
             let surface = rough(96, 11);
             let mut solver =
-                ContactSolver::new(&surface, half_space(boundary), SolverParams::default()).unwrap();
+                ContactSolver::new(&surface, half_space(boundary), SolverParams::default())
+                    .unwrap();
             solver.solve(Control::MeanPressure(pressure)).unwrap();
             let (frozen, info) = solver.frozen_set_stiffness().unwrap();
             assert!(info.residual <= 1e-10);
@@ -259,23 +260,32 @@ mod tests {
                 .unwrap();
             let error = frozen / fd - 1.0;
             eprintln!("{boundary:?}: frozen {frozen:.6e}, fd {fd:.6e}, error {error:.2e}");
-            assert!(error.abs() < 0.005, "{boundary:?}: frozen {frozen} vs fd {fd}");
+            assert!(
+                error.abs() < 0.005,
+                "{boundary:?}: frozen {frozen} vs fd {fd}"
+            );
         }
     }
 
     #[test]
     fn frozen_set_under_displacement_control_matches_finite_difference() {
         let surface = rough(64, 12);
-        let mut solver =
-            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
-                .unwrap();
+        let mut solver = ContactSolver::new(
+            &surface,
+            half_space(Boundary::Free),
+            SolverParams::default(),
+        )
+        .unwrap();
         let d = 0.01;
         solver.solve(Control::Indentation(d)).unwrap();
         let (frozen, _) = solver.frozen_set_stiffness().unwrap();
         let fd = solver
             .finite_difference_stiffness(Control::Indentation(d), 1e-3)
             .unwrap();
-        assert!((frozen / fd - 1.0).abs() < 0.02, "frozen {frozen} vs fd {fd}");
+        assert!(
+            (frozen / fd - 1.0).abs() < 0.02,
+            "frozen {frozen} vs fd {fd}"
+        );
     }
 
     #[test]
@@ -287,9 +297,12 @@ mod tests {
             modulus: 1.3,
         };
         let d = (18.0 * dx).powi(2) / radius;
-        let mut solver =
-            ContactSolver::new(&sphere(n, n, size, radius), half_space(Boundary::Free), SolverParams::default())
-                .unwrap();
+        let mut solver = ContactSolver::new(
+            &sphere(n, n, size, radius),
+            half_space(Boundary::Free),
+            SolverParams::default(),
+        )
+        .unwrap();
         solver.solve(Control::Indentation(d)).unwrap();
         let (k, _) = solver.frozen_set_stiffness().unwrap();
         let error = k / hertz.stiffness(d) - 1.0;
@@ -318,9 +331,12 @@ mod tests {
                 }
             });
             let surface = Surface::new(heights, size).unwrap();
-            let mut solver =
-                ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
-                    .unwrap();
+            let mut solver = ContactSolver::new(
+                &surface,
+                half_space(Boundary::Free),
+                SolverParams::default(),
+            )
+            .unwrap();
             let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
             let (k, _) = solver.frozen_set_stiffness().unwrap();
             let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
@@ -342,9 +358,12 @@ mod tests {
     #[test]
     fn stiffness_needs_a_solved_state() {
         let surface = rough(16, 13);
-        let mut solver =
-            ContactSolver::new(&surface, half_space(Boundary::Free), SolverParams::default())
-                .unwrap();
+        let mut solver = ContactSolver::new(
+            &surface,
+            half_space(Boundary::Free),
+            SolverParams::default(),
+        )
+        .unwrap();
         assert!(solver.frozen_set_stiffness().is_err());
         assert!(solver
             .finite_difference_stiffness(Control::MeanPressure(0.01), 1.5)

@@ -146,7 +146,10 @@ impl ElasticOperator {
             ));
         }
         memory::ensure_fits(
-            &format!("the {} elastic operator of a {rows}x{cols} grid", boundary.name()),
+            &format!(
+                "the {} elastic operator of a {rows}x{cols} grid",
+                boundary.name()
+            ),
             Self::memory_bytes(rows, cols, boundary),
         )?;
         let pad = boundary.padding();
@@ -237,7 +240,13 @@ impl ElasticOperator {
         let (prow, pcol, half) = (self.padded_rows, self.padded_cols, self.half_cols());
         let (dx, e) = (self.spacing, self.modulus);
         let kernel_rows = self.kernel_rows();
-        let offset = |m: usize, n: usize| if m <= n / 2 { m as f64 } else { m as f64 - n as f64 };
+        let offset = |m: usize, n: usize| {
+            if m <= n / 2 {
+                m as f64
+            } else {
+                m as f64 - n as f64
+            }
+        };
         let lane = &mut self.lanes[0];
         let mut row_out = vec![Complex64::default(); half];
         for r in 0..prow {
@@ -256,8 +265,9 @@ impl ElasticOperator {
         for (kx, column) in self.spectrum.chunks_exact_mut(prow).enumerate() {
             self.column_forward
                 .process_with_scratch(column, &mut lane.scratch);
-            for ky in 0..kernel_rows {
-                self.kernel[kx * kernel_rows + ky] = column[ky].re * scale;
+            let kernel_column = &mut self.kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
+            for (k, value) in kernel_column.iter_mut().zip(column.iter()) {
+                *k = value.re * scale;
             }
         }
     }
@@ -300,7 +310,11 @@ impl ElasticOperator {
     /// Periodic boundaries only: the pressure whose displacement is `displacement` up to a
     /// constant, `p = K⁺ u` (pseudo-inverse: the mean of `u` is ignored and `p` has zero
     /// mean). Free boundaries have no such spectral inverse: an error.
-    pub fn apply_pseudo_inverse(&mut self, displacement: &[f64], pressure: &mut [f64]) -> Result<()> {
+    pub fn apply_pseudo_inverse(
+        &mut self,
+        displacement: &[f64],
+        pressure: &mut [f64],
+    ) -> Result<()> {
         if self.boundary != Boundary::Periodic {
             return Err(Error::invalid(
                 "boundary",
@@ -341,7 +355,8 @@ impl ElasticOperator {
 
         // 3. Per column: forward FFT, multiply by the real kernel, inverse FFT.
         let chunk = self.rows_per_lane(half);
-        let (forward, backward, kernel) = (&self.column_forward, &self.column_inverse, &self.kernel);
+        let (forward, backward, kernel) =
+            (&self.column_forward, &self.column_inverse, &self.kernel);
         self.spectrum
             .par_chunks_mut(chunk * prow)
             .enumerate()
@@ -383,8 +398,9 @@ impl ElasticOperator {
             .zip(displacement.par_chunks_mut(chunk * cols))
             .zip(self.lanes.par_iter_mut())
             .for_each(|((input, output), lane)| {
-                for (row_in, row_out) in
-                    input.chunks_exact_mut(half).zip(output.chunks_exact_mut(cols))
+                for (row_in, row_out) in input
+                    .chunks_exact_mut(half)
+                    .zip(output.chunks_exact_mut(cols))
                 {
                     row_in[0].im = 0.0;
                     if pcol % 2 == 0 {
@@ -502,11 +518,23 @@ mod tests {
             let mut sum = 0.0;
             for ky in 0..rows {
                 for kx in 0..cols {
-                    let sx = if kx <= cols / 2 { kx as f64 } else { kx as f64 - cols as f64 };
-                    let sy = if ky <= rows / 2 { ky as f64 } else { ky as f64 - rows as f64 };
-                    let q = (2.0 * PI * sx / (cols as f64 * dx)).hypot(2.0 * PI * sy / (rows as f64 * dx));
+                    let sx = if kx <= cols / 2 {
+                        kx as f64
+                    } else {
+                        kx as f64 - cols as f64
+                    };
+                    let sy = if ky <= rows / 2 {
+                        ky as f64
+                    } else {
+                        ky as f64 - rows as f64
+                    };
+                    let q = (2.0 * PI * sx / (cols as f64 * dx))
+                        .hypot(2.0 * PI * sy / (rows as f64 * dx));
                     if q > 0.0 {
-                        let phase = 2.0 * PI * (kx as f64 * x as f64 / cols as f64 + ky as f64 * y as f64 / rows as f64);
+                        let phase = 2.0
+                            * PI
+                            * (kx as f64 * x as f64 / cols as f64
+                                + ky as f64 * y as f64 / rows as f64);
                         sum += 2.0 / (e * q) * phase.cos();
                     }
                 }
@@ -561,7 +589,12 @@ mod tests {
             let mut u = vec![f64::NAN; rows * cols];
             for _ in 0..2 {
                 op.apply(&p, &mut u);
-                assert_close(&u, &direct_periodic(&p, rows, cols, dx, e), 1e-12, "periodic");
+                assert_close(
+                    &u,
+                    &direct_periodic(&p, rows, cols, dx, e),
+                    1e-12,
+                    "periodic",
+                );
             }
         }
     }
@@ -573,7 +606,13 @@ mod tests {
         let (rows, cols, dx) = (5, 6, 1.0);
         let op = ElasticOperator::new(rows, cols, dx, 1.0, Boundary::Free).unwrap();
         let (prow, pcol) = (2 * rows, 2 * cols);
-        let offset = |m: usize, n: usize| if m <= n / 2 { m as f64 } else { m as f64 - n as f64 };
+        let offset = |m: usize, n: usize| {
+            if m <= n / 2 {
+                m as f64
+            } else {
+                m as f64 - n as f64
+            }
+        };
         let mut samples = vec![0.0; prow * pcol];
         for r in 0..prow {
             for c in 0..pcol {
@@ -655,7 +694,10 @@ mod tests {
         let (rows, cols) = (33, 20);
         let p = pseudo_random(rows * cols, 5);
         let run = |threads: usize, boundary: Boundary| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| {
                 let mut op = ElasticOperator::new(rows, cols, 0.1, 1.0, boundary).unwrap();
                 let mut u = vec![0.0; rows * cols];
