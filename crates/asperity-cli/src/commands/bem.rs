@@ -241,6 +241,8 @@ pub fn run(args: &BemArgs) -> Result<()> {
         boundary,
     };
     let mut solver = ContactSolver::new(&surface, half_space, params)?;
+    // The solver keeps its own copy of the profile: free the heights (peak memory).
+    drop(surface);
 
     // 2. Solve every load (warm starts in the given order).
     let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
