@@ -622,8 +622,13 @@ pub(super) mod tests {
                 "p/p* = {ratio}: {} vs {expected}",
                 s.area_fraction
             );
+            eprintln!(
+                "westergaard p/p* = {ratio}: area {} vs {expected:.5}",
+                s.area_fraction
+            );
             let pressure = solver.pressure();
             let p_max = reference.pressure(ratio * p_star, 0.0);
+            let mut worst = 0.0f64;
             for j in 0..cols {
                 let x = if j <= cols / 2 {
                     j as f64
@@ -637,15 +642,20 @@ pub(super) mod tests {
                         error < 0.01 * p_max,
                         "p/p* = {ratio}, x = {x}: error {error}"
                     );
+                    worst = worst.max(error / p_max);
                 }
             }
+            eprintln!("westergaard p/p* = {ratio}: pressure error {worst:.2e} of p_max");
         }
         // Full contact at p* = π E* Δ / λ: the threshold is exact for a single mode.
         match solver.solve(Control::MeanPressure(1.001 * p_star)) {
             Err(SolveError::BeyondFullContact {
                 full_contact: Some(full),
                 ..
-            }) => assert!((full / p_star - 1.0).abs() < 1e-12, "{full} vs {p_star}"),
+            }) => {
+                eprintln!("westergaard full contact {full:.12e} vs p* {p_star:.12e}");
+                assert!((full / p_star - 1.0).abs() < 1e-12, "{full} vs {p_star}")
+            }
             other => panic!("expected BeyondFullContact, got {other:?}"),
         }
     }
@@ -699,6 +709,11 @@ pub(super) mod tests {
         }
         let (free_points, free_peak) = results[0];
         let (periodic_points, periodic_peak) = results[1];
+        eprintln!(
+            "free vs periodic: contact points {free_points} vs {periodic_points}, peak pressure \
+             ratio {:.4}",
+            free_peak / periodic_peak
+        );
         // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images:
         // the area may differ by one ring of pixels' worth of points at most.
         assert!(
