@@ -47,7 +47,9 @@ fn solve(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new(boundary.name(), n), |b| {
                 b.iter(|| {
                     solver.reset();
-                    solver.solve(Control::MeanPressure(0.01)).expect("converges")
+                    solver
+                        .solve(Control::MeanPressure(0.01))
+                        .expect("converges")
                 })
             });
         }
@@ -59,7 +61,9 @@ fn stiffness(c: &mut Criterion) {
     let surface = surface(256);
     let mut solver =
         ContactSolver::new(&surface, HalfSpace::default(), SolverParams::default()).expect("fits");
-    solver.solve(Control::MeanPressure(0.01)).expect("converges");
+    solver
+        .solve(Control::MeanPressure(0.01))
+        .expect("converges");
     c.bench_function("frozen_set_stiffness/free/256", |b| {
         b.iter(|| solver.frozen_set_stiffness().expect("converges"))
     });

@@ -714,14 +714,15 @@ pub(super) mod tests {
              ratio {:.4}",
             free_peak / periodic_peak
         );
-        // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images:
-        // the area may differ by one ring of pixels' worth of points at most.
+        // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images
+        // (measured: the same 89 points, peak pressures 8e-4 apart); allow a few edge
+        // pixels and 0.5 %.
         assert!(
-            (free_points as i64 - periodic_points as i64).abs() <= 8,
+            (free_points as i64 - periodic_points as i64).abs() <= 4,
             "{free_points} vs {periodic_points}"
         );
         assert!(
-            (free_peak / periodic_peak - 1.0).abs() < 0.03,
+            (free_peak / periodic_peak - 1.0).abs() < 0.005,
             "{free_peak} vs {periodic_peak}"
         );
     }
