@@ -71,10 +71,10 @@ pub struct BemArgs {
     #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"])]
     pub nloads: Option<usize>,
     /// Smallest mean pressure for --nloads.
-    #[arg(long, value_name = "P", allow_negative_numbers = true)]
+    #[arg(long, value_name = "P", allow_negative_numbers = true, requires = "nloads")]
     pub pmin: Option<f64>,
     /// Largest mean pressure for --nloads.
-    #[arg(long, value_name = "P", allow_negative_numbers = true)]
+    #[arg(long, value_name = "P", allow_negative_numbers = true, requires = "nloads")]
     pub pmax: Option<f64>,
     /// Convergence tolerance: rms gap violation on the contact set over the rms height.
     #[arg(long, default_value_t = SolverParams::default().tolerance, allow_negative_numbers = true)]
