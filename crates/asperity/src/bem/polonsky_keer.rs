@@ -267,135 +267,63 @@ impl ContactSolver {
         let mut iteration = 0;
         loop {
             self.operator.apply(&self.pressure, &mut self.gap);
-            let (p, gap, t, f) = (
+            let pass = gap_and_direction(
                 &self.pressure,
                 &mut self.gap,
                 &mut self.direction,
                 &self.profile,
+                load_control,
+                &mut indentation,
+                if conjugate { g_old } else { 0.0 },
             );
-
-            // Pass A: u + f, and its mean and spread on the contact set, shifted by the
-            // last indentation so that G does not cancel.
-            let shift = indentation;
-            let (mut contact_points, mut sum, mut sum_sq) = (0usize, 0.0, 0.0);
-            for i in 0..n {
-                let v = gap[i] + f[i];
-                gap[i] = v;
-                if p[i] > 0.0 {
-                    let w = v - shift;
-                    contact_points += 1;
-                    sum += w;
-                    sum_sq += w * w;
-                }
-            }
-            let g_estimate = if load_control && contact_points > 0 {
-                let mean = sum / contact_points as f64;
-                indentation = shift + mean;
-                (sum_sq - contact_points as f64 * mean * mean).max(0.0)
-            } else {
-                sum_sq
-            };
-
-            // Pass B: gap, exact G, penetration outside the set, new direction.
-            let beta = if conjugate && g_old > 0.0 {
-                g_estimate / g_old
-            } else {
-                0.0
-            };
-            let (mut g_sum, mut penetration) = (0.0, 0.0);
-            for i in 0..n {
-                let g = gap[i] - indentation;
-                gap[i] = g;
-                if p[i] > 0.0 {
-                    g_sum += g * g;
-                    t[i] = g + beta * t[i];
-                } else {
-                    t[i] = 0.0;
-                    if g < 0.0 {
-                        penetration += g * g;
-                    }
-                }
-            }
-            let residual =
-                ((g_sum + penetration) / contact_points.max(1) as f64).sqrt() / self.height_scale;
+            let residual = ((pass.gap_squared + pass.penetration_squared)
+                / pass.contact_points.max(1) as f64)
+                .sqrt()
+                / self.height_scale;
             if residual < tolerance {
-                return Ok((
-                    self.finish(indentation, contact_points),
-                    SolveInfo {
-                        iterations: iteration,
-                        residual,
-                    },
-                ));
+                let info = SolveInfo {
+                    iterations: iteration,
+                    residual,
+                };
+                return Ok((self.finish(indentation, pass.contact_points), info));
             }
-            if iteration >= max_iterations {
+            if iteration >= max_iterations || !residual.is_finite() {
                 return Err(SolveError::NoConvergence {
                     iterations: iteration,
                     residual,
                 });
             }
-            if !residual.is_finite() {
-                return Err(SolveError::NoConvergence {
-                    iterations: iteration,
-                    residual,
-                });
-            }
-            g_old = g_sum;
+            g_old = pass.gap_squared;
             iteration += 1;
 
             self.operator.apply(&self.direction, &mut self.response);
-            let (p, gap, t, r) = (
-                &mut self.pressure,
+            let tau = step_length(
+                &self.pressure,
                 &self.gap,
                 &self.direction,
                 &self.response,
+                load_control,
+                pass.contact_points,
             );
-
-            // Pass C: step length with r's mean on the set removed (load control).
-            let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
-            for i in 0..n {
-                if p[i] > 0.0 {
-                    sum_r += r[i];
-                    sum_rt += r[i] * t[i];
-                    sum_t += t[i];
-                    sum_gt += gap[i] * t[i];
-                }
-            }
-            let mean_r = if load_control && contact_points > 0 {
-                sum_r / contact_points as f64
-            } else {
-                0.0
-            };
-            let denominator = sum_rt - mean_r * sum_t;
-            let tau = if contact_points > 0 && denominator > 0.0 {
-                sum_gt / denominator
-            } else {
-                0.0
-            };
             // Penetrating points enter with p = −τ g; before any step exists (empty
             // set), a Jacobi step with the self-influence.
             let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
-
-            // Pass D: update, clamp, let penetrating points in.
-            let mut entered = false;
-            let mut total = 0.0;
-            for i in 0..n {
-                if p[i] > 0.0 {
-                    p[i] = (p[i] - tau * t[i]).max(0.0);
-                } else if gap[i] < 0.0 {
-                    p[i] = -entry_step * gap[i];
-                    entered = true;
-                }
-                total += p[i];
-            }
+            let (total, entered) = update_pressure(
+                &mut self.pressure,
+                &self.gap,
+                &self.direction,
+                tau,
+                entry_step,
+            );
             conjugate = !entered;
 
             // Pass E: the prescribed load.
             if let Target::MeanPressure(mean_pressure) = target {
                 if total > 0.0 {
                     let scale = mean_pressure * n as f64 / total;
-                    p.iter_mut().for_each(|v| *v *= scale);
+                    self.pressure.iter_mut().for_each(|v| *v *= scale);
                 } else {
-                    p.fill(mean_pressure);
+                    self.pressure.fill(mean_pressure);
                     conjugate = false;
                 }
             }
@@ -445,6 +373,128 @@ impl ContactSolver {
             contact_points,
         }
     }
+}
+
+/// Sums of passes A and B over the grid.
+struct GapPass {
+    contact_points: usize,
+    /// `G = Σ_{p>0} g²`.
+    gap_squared: f64,
+    /// `Σ_{p=0} min(g, 0)²`.
+    penetration_squared: f64,
+}
+
+/// Passes A and B of an iteration. `gap` holds `u = K p` on entry and `g = u + f − d` on
+/// exit. Under load control `indentation` becomes the mean of `u + f` on the contact set
+/// (summed about its previous value, so that `G` does not cancel); `t` becomes the new
+/// conjugate direction (`previous_g = 0`: steepest descent).
+fn gap_and_direction(
+    p: &[f64],
+    gap: &mut [f64],
+    t: &mut [f64],
+    f: &[f64],
+    load_control: bool,
+    indentation: &mut f64,
+    previous_g: f64,
+) -> GapPass {
+    // Pass A: u + f, its mean and spread on the contact set about the last indentation.
+    let shift = *indentation;
+    let (mut contact_points, mut sum, mut sum_sq) = (0usize, 0.0, 0.0);
+    for ((g, &fi), &pi) in gap.iter_mut().zip(f).zip(p) {
+        *g += fi;
+        if pi > 0.0 {
+            let w = *g - shift;
+            contact_points += 1;
+            sum += w;
+            sum_sq += w * w;
+        }
+    }
+    let g_estimate = if load_control && contact_points > 0 {
+        let mean = sum / contact_points as f64;
+        *indentation = shift + mean;
+        (sum_sq - contact_points as f64 * mean * mean).max(0.0)
+    } else {
+        sum_sq
+    };
+    // Pass B: the gap, exact G, penetration outside the set, the new direction.
+    let beta = if previous_g > 0.0 {
+        g_estimate / previous_g
+    } else {
+        0.0
+    };
+    let d = *indentation;
+    let (mut gap_squared, mut penetration_squared) = (0.0, 0.0);
+    for ((g, ti), &pi) in gap.iter_mut().zip(t.iter_mut()).zip(p) {
+        *g -= d;
+        if pi > 0.0 {
+            gap_squared += *g * *g;
+            *ti = *g + beta * *ti;
+        } else {
+            *ti = 0.0;
+            if *g < 0.0 {
+                penetration_squared += *g * *g;
+            }
+        }
+    }
+    GapPass {
+        contact_points,
+        gap_squared,
+        penetration_squared,
+    }
+}
+
+/// Pass C: `τ = Σ g t / Σ (r − r̄) t` on the contact set, `r̄` its mean there under load
+/// control (zero under displacement control). Zero when the set is empty.
+fn step_length(
+    p: &[f64],
+    gap: &[f64],
+    t: &[f64],
+    r: &[f64],
+    load_control: bool,
+    contact_points: usize,
+) -> f64 {
+    let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
+    for (((&pi, &gi), &ti), &ri) in p.iter().zip(gap).zip(t).zip(r) {
+        if pi > 0.0 {
+            sum_r += ri;
+            sum_rt += ri * ti;
+            sum_t += ti;
+            sum_gt += gi * ti;
+        }
+    }
+    let mean_r = if load_control && contact_points > 0 {
+        sum_r / contact_points as f64
+    } else {
+        0.0
+    };
+    let denominator = sum_rt - mean_r * sum_t;
+    if contact_points > 0 && denominator > 0.0 {
+        sum_gt / denominator
+    } else {
+        0.0
+    }
+}
+
+/// Pass D: `p ← max(p − τ t, 0)` on the contact set; penetrating points outside it enter
+/// with `p = −entry_step · g`. Returns `Σ p` and whether any point entered.
+fn update_pressure(
+    p: &mut [f64],
+    gap: &[f64],
+    t: &[f64],
+    tau: f64,
+    entry_step: f64,
+) -> (f64, bool) {
+    let (mut total, mut entered) = (0.0, false);
+    for ((pi, &gi), &ti) in p.iter_mut().zip(gap).zip(t) {
+        if *pi > 0.0 {
+            *pi = (*pi - tau * ti).max(0.0);
+        } else if gi < 0.0 {
+            *pi = -entry_step * gi;
+            entered = true;
+        }
+        total += *pi;
+    }
+    (total, entered)
 }
 
 fn check_load(name: &'static str, value: f64) -> Result<f64, SolveError> {
@@ -622,8 +672,13 @@ pub(super) mod tests {
                 "p/p* = {ratio}: {} vs {expected}",
                 s.area_fraction
             );
+            eprintln!(
+                "westergaard p/p* = {ratio}: area {} vs {expected:.5}",
+                s.area_fraction
+            );
             let pressure = solver.pressure();
             let p_max = reference.pressure(ratio * p_star, 0.0);
+            let mut worst = 0.0f64;
             for j in 0..cols {
                 let x = if j <= cols / 2 {
                     j as f64
@@ -637,15 +692,20 @@ pub(super) mod tests {
                         error < 0.01 * p_max,
                         "p/p* = {ratio}, x = {x}: error {error}"
                     );
+                    worst = worst.max(error / p_max);
                 }
             }
+            eprintln!("westergaard p/p* = {ratio}: pressure error {worst:.2e} of p_max");
         }
         // Full contact at p* = π E* Δ / λ: the threshold is exact for a single mode.
         match solver.solve(Control::MeanPressure(1.001 * p_star)) {
             Err(SolveError::BeyondFullContact {
                 full_contact: Some(full),
                 ..
-            }) => assert!((full / p_star - 1.0).abs() < 1e-12, "{full} vs {p_star}"),
+            }) => {
+                eprintln!("westergaard full contact {full:.12e} vs p* {p_star:.12e}");
+                assert!((full / p_star - 1.0).abs() < 1e-12, "{full} vs {p_star}")
+            }
             other => panic!("expected BeyondFullContact, got {other:?}"),
         }
     }
@@ -699,14 +759,20 @@ pub(super) mod tests {
         }
         let (free_points, free_peak) = results[0];
         let (periodic_points, periodic_peak) = results[1];
-        // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images:
-        // the area may differ by one ring of pixels' worth of points at most.
+        eprintln!(
+            "free vs periodic: contact points {free_points} vs {periodic_points}, peak pressure \
+             ratio {:.4}",
+            free_peak / periodic_peak
+        );
+        // The two kernels differ at the pixel scale (Love vs 2/(E*q)) and by the images
+        // (measured: the same 89 points, peak pressures 8e-4 apart); allow a few edge
+        // pixels and 0.5 %.
         assert!(
-            (free_points as i64 - periodic_points as i64).abs() <= 8,
+            (free_points as i64 - periodic_points as i64).abs() <= 4,
             "{free_points} vs {periodic_points}"
         );
         assert!(
-            (free_peak / periodic_peak - 1.0).abs() < 0.03,
+            (free_peak / periodic_peak - 1.0).abs() < 0.005,
             "{free_peak} vs {periodic_peak}"
         );
     }

@@ -265,8 +265,9 @@ impl ElasticOperator {
         for (kx, column) in self.spectrum.chunks_exact_mut(prow).enumerate() {
             self.column_forward
                 .process_with_scratch(column, &mut lane.scratch);
-            for ky in 0..kernel_rows {
-                self.kernel[kx * kernel_rows + ky] = column[ky].re * scale;
+            let kernel_column = &mut self.kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
+            for (k, value) in kernel_column.iter_mut().zip(column.iter()) {
+                *k = value.re * scale;
             }
         }
     }
