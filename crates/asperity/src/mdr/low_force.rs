@@ -254,21 +254,11 @@ pub fn ensemble_exponent(
     })
 }
 
-/// The paper's exponent for `H < 0`, eq. (24): `α = (1 + log₂N)/(3 + log₂N)`.
-pub fn alpha_negative_hurst(n: usize) -> f64 {
-    let m = (n as f64).log2();
-    (1.0 + m) / (3.0 + m)
-}
-
-/// The Pohrt–Popov exponent for `0 < H < 2`, eq. (6): `α = 1/(1+H)`.
-pub fn alpha_pohrt_popov(hurst: f64) -> f64 {
-    1.0 / (1.0 + hurst)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::spectrum::Psd;
+    use crate::study::theory::{alpha_pohrt_popov, alpha_white_noise};
     use crate::surface::{stats::rms_height, LineGenerator, LineSpec, Normalisation};
     use rayon::prelude::*;
 
@@ -345,7 +335,7 @@ mod tests {
 
     #[test]
     fn alpha_follows_eq_24_for_negative_hurst() {
-        check(-0.5, alpha_negative_hurst(1 << 15));
+        check(-0.5, alpha_white_noise((1u64 << 15) as f64));
     }
 
     /// The experiment behind the default window (run with `--ignored --nocapture`):
@@ -355,7 +345,7 @@ mod tests {
     fn window_experiment() {
         let n = 1 << 15;
         for (hurst, expected) in [
-            (-0.5, alpha_negative_hurst(n)),
+            (-0.5, alpha_white_noise(n as f64)),
             (0.5, alpha_pohrt_popov(0.5)),
             (1.0, alpha_pohrt_popov(1.0)),
         ] {
@@ -438,7 +428,7 @@ mod tests {
         assert_eq!(w.contact_range(1 << 15).unwrap(), (8, 328));
         assert_eq!(w.contact_range(512).unwrap(), (8, 32));
         assert!(w.contact_range(31).is_err());
-        assert!((alpha_negative_hurst(1 << 15) - 16.0 / 18.0).abs() < 1e-15);
+        assert!((alpha_white_noise((1u64 << 15) as f64) - 16.0 / 18.0).abs() < 1e-15);
     }
 
     #[test]

@@ -44,7 +44,6 @@ pub use foundation::{log_spaced, CurvePoint, Foundation};
 pub use indenter::{spring_positions, Axisymmetric, RadialProfile};
 pub use linear_curve::LinearCurve;
 pub use low_force::{
-    alpha_negative_hurst, alpha_pohrt_popov, ensemble_exponent, low_force_sample, EnsembleExponent,
-    LowForceSample, LowForceWindow,
+    ensemble_exponent, low_force_sample, EnsembleExponent, LowForceSample, LowForceWindow,
 };
 pub use spring::{fractal_asymptote, Spring, SpringLaw, FRACTAL_CONSTANT};
