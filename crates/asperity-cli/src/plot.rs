@@ -185,6 +185,46 @@ impl Chart {
         ))
     }
 
+    /// The corner of the plot whose quarter holds the fewest data points, for the legend.
+    fn emptiest_corner(&self) -> SeriesLabelPosition {
+        let Ok(((x0, x1), (y0, y1))) = self.bounds() else {
+            return SeriesLabelPosition::UpperLeft;
+        };
+        let scale = |v: f64, lo: f64, hi: f64, log: bool| {
+            if log {
+                (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+            } else {
+                (v - lo) / (hi - lo)
+            }
+        };
+        let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
+        for s in &self.series {
+            for &(x, y) in &s.points {
+                if !(x.is_finite() && y.is_finite())
+                    || (self.log_x && x <= 0.0)
+                    || (self.log_y && y <= 0.0)
+                {
+                    continue;
+                }
+                let (u, v) = (scale(x, x0, x1, self.log_x), scale(y, y0, y1, self.log_y));
+                // The legend box covers about 40 % of the width and height.
+                let (left, right, top, bottom) = (u < 0.4, u > 0.6, v > 0.6, v < 0.4);
+                counts[0] += (left && top) as usize;
+                counts[1] += (right && top) as usize;
+                counts[2] += (left && bottom) as usize;
+                counts[3] += (right && bottom) as usize;
+            }
+        }
+        let positions = [
+            SeriesLabelPosition::UpperLeft,
+            SeriesLabelPosition::UpperRight,
+            SeriesLabelPosition::LowerLeft,
+            SeriesLabelPosition::LowerRight,
+        ];
+        let best = (0..4).min_by_key(|&i| counts[i]).unwrap_or(0);
+        positions[best].clone()
+    }
+
     fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
     where
         DB::ErrorType: 'static,
@@ -267,7 +307,7 @@ impl Chart {
         if self.series.iter().any(|s| !s.label.is_empty()) {
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(self.emptiest_corner())
                 .label_font(("sans-serif", 14))
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
