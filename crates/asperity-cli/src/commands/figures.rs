@@ -274,20 +274,27 @@ pub fn fig2(dir: &Path, quick: bool, force: bool) -> Result<()> {
     let spec = study_spec(Method::Bem, vec![n], hursts, samples, Some(6.0));
     let results = figure_study(dir, "bem", &spec, Kind::Curve, force)?;
     write_curves(dir, &results, force, "fig2")?;
-    let mut md = String::from("| H | low-force α (window) | high-force slope (last third of the curve) |\n|---|---|---|\n");
+    let mut md = String::from(
+        "| H | low-force α (window) | intermediate slope (paper: ≈ 1) |\n|---|---|---|\n",
+    );
     for r in &results {
-        let tail = &r.mean_curve[2 * r.mean_curve.len() / 3..];
-        let (f, k): (Vec<f64>, Vec<f64>) = tail.iter().map(|p| (p.force, p.stiffness)).unzip();
-        let high = power_law_fit(&f, &k)
-            .map(|fit| fit.exponent)
-            .unwrap_or(f64::NAN);
-        let _ = writeln!(
-            md,
-            "| {} | {:.3} | {:.3} |",
-            r.task.hurst,
-            r.alpha_ensemble.map_or(f64::NAN, |a| a.exponent),
-            high
-        );
+        // Intermediate forces: past the α window (more than 1 % in contact), before k
+        // reaches half of its largest value (the whole square acting as one punch).
+        let k_max = r.mean_curve.iter().map(|p| p.stiffness).fold(0.0, f64::max);
+        let (f, k): (Vec<f64>, Vec<f64>) = r
+            .mean_curve
+            .iter()
+            .filter(|p| p.fraction > spec.window.max_fraction && p.stiffness < 0.5 * k_max)
+            .map(|p| (p.force, p.stiffness))
+            .unzip();
+        let high = match power_law_fit(&f, &k) {
+            Ok(fit) => format!("{:.3}", fit.exponent),
+            Err(_) => "— (k passes half its maximum below 1 % contact)".into(),
+        };
+        let low = r
+            .alpha_ensemble
+            .map_or("—".to_string(), |a| format!("{:.3}", a.exponent));
+        let _ = writeln!(md, "| {} | {low} | {high} |", r.task.hurst);
     }
     let report = format!(
         "# Fig. 2: contact stiffness vs force with roll-off q0 L/2π = 6\n\n{}\n\n\
@@ -295,7 +302,13 @@ pub fn fig2(dir: &Path, quick: bool, force: bool) -> Result<()> {
          slope. Files: `fig2.csv`, `fig2.png`, `fig2.svg`; `bem/` holds the study and checkpoint.\n\n\
          ## The paper's values beside ours\n\
          The paper (1024², 60 samples): at low force the curves follow k ∝ F^α with α ≥ 1/3;\n\
-         at higher force all collapse onto an almost linear relation (slope ≈ 1).\n\n{md}\n",
+         at higher force all collapse onto an almost linear relation (slope ≈ 1).\n\n\
+         Ours: the *intermediate slope* is fitted on the mean curve from 1 % contact up to half\n\
+         the largest stiffness. With the roll-off at L/6 only about 36 asperity regions carry\n\
+         the load; their elastic interaction drives k towards the stiffness of the whole\n\
+         square, 2E*L/√π ≈ 1.13 E*L, already at a few per cent contact, which bends the curves\n\
+         over. On small grids the intermediate range is short; how long a nearly linear range\n\
+         the paper's 1024² grids give is what the full run (without --quick) measures.\n\n{md}\n",
         setting(quick)
     );
     write_report(dir, &report, force)
