@@ -239,8 +239,8 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
     write_alpha(dir, &all, force)?;
     let report = format!(
         "# Fig. 1: exponent α of k ∝ F^α versus H\n\n{}\n\n\
-         - MDR: N = {:?}, {} samples per (N, H), H = {}; {:.1} s.\n\
-         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {}; {:.1} s.\n\
+         - MDR: N = {:?}, {} samples per (N, H), H = {}; {:.1} s in this run.\n\
+         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {}; {:.1} s in this run.\n\
          - α window: {}; α is fitted on the ensemble-mean k(F) (column `alpha`), and per sample\n  \
            (`alpha_low`, `alpha_high`: 2.5 % and 97.5 % of the per-sample values).\n\n\
          Files: `alpha.csv`, `alpha.png`, `alpha.svg` (both methods with the theory curves);\n\
