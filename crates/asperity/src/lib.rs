@@ -45,3 +45,17 @@ pub mod study;
 pub mod surface;
 
 pub use error::{ensure_finite, Error, Result};
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    //! Helpers shared by the unit tests.
+
+    /// Runs `f` on a fresh rayon pool of `threads` threads (determinism tests).
+    pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool")
+            .install(f)
+    }
+}

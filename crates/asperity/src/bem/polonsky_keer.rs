@@ -800,11 +800,7 @@ pub(super) mod tests {
     fn results_do_not_depend_on_the_thread_count() {
         let surface = rough(48, 3);
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            crate::test_support::with_threads(threads, || {
                 let mut solver =
                     ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
                 let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();

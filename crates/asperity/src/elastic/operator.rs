@@ -694,11 +694,7 @@ mod tests {
         let (rows, cols) = (33, 20);
         let p = pseudo_random(rows * cols, 5);
         let run = |threads: usize, boundary: Boundary| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            crate::test_support::with_threads(threads, || {
                 let mut op = ElasticOperator::new(rows, cols, 0.1, 1.0, boundary).unwrap();
                 let mut u = vec![0.0; rows * cols];
                 op.apply(&p, &mut u);

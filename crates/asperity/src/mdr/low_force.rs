@@ -394,11 +394,7 @@ mod tests {
     fn ensembles_are_bit_identical_whatever_the_thread_count() {
         let window = LowForceWindow::default();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            crate::test_support::with_threads(threads, || {
                 let samples = ensemble(0.8, 4096, 24, &window);
                 ensemble_exponent(&samples, &window).unwrap()
             })

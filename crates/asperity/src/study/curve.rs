@@ -200,7 +200,7 @@ pub fn ensemble_curve(samples: &[SampleCurve], levels: usize) -> Result<Vec<Ense
         .iter()
         .map(|s| s.points[s.points.len() - 1].force)
         .fold(f64::INFINITY, f64::min);
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::invalid(
             "ensemble",
             "the samples' force ranges do not overlap",
@@ -250,7 +250,7 @@ pub fn ensemble_alpha(
         .filter_map(|s| s.window_forces(window))
         .unzip();
     let (lo, hi) = (quantile(&starts, 0.5)?, quantile(&ends, 0.5)?);
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let (f, k): (Vec<f64>, Vec<f64>) = log_levels(lo, hi, levels)

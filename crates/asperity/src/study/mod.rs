@@ -145,7 +145,7 @@ fn parse_range_item(text: &str) -> Result<Vec<f64>> {
         [single] => Ok(vec![num(single)?]),
         [a, b, step] => {
             let (a, b, step) = (num(a)?, num(b)?, num(step)?);
-            if !(step > 0.0) || b < a {
+            if step.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || b < a {
                 return Err(Error::invalid(
                     "hurst",
                     format!("empty range '{text}' (need A <= B and STEP > 0)"),

@@ -248,11 +248,7 @@ mod tests {
         let task = spec.tasks()[0];
         let sampler = BemSampler::new(&spec, task).unwrap();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            crate::test_support::with_threads(threads, || {
                 let mut worker = sampler.worker().unwrap();
                 sampler.sample(&mut worker, 99).unwrap()
             })
@@ -270,12 +266,9 @@ mod tests {
         let spec = spec(Method::Mdr, 4096, vec![0.5], 16);
         let dir = tempfile::tempdir().unwrap();
         let store = StudyDir::open(dir.path(), &spec, false).unwrap();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let result =
-            pool.install(|| run_any_task(&spec, spec.tasks()[0], &store, &|_, _| {}).unwrap());
+        let result = crate::test_support::with_threads(threads, || {
+            run_any_task(&spec, spec.tasks()[0], &store, &|_, _| {}).unwrap()
+        });
         serde_json::to_string(&result).unwrap()
     }
 }

@@ -482,11 +482,9 @@ mod tests {
     fn same_seed_same_bits_whatever_the_thread_count() {
         let spec = surface_spec(96, 130, 0.8, Normalisation::RmsHeight(1.0));
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| SurfaceGenerator::new(&spec).unwrap().generate(77))
+            crate::test_support::with_threads(threads, || {
+                SurfaceGenerator::new(&spec).unwrap().generate(77)
+            })
         };
         let reference = run(1);
         for threads in [2, 3, 7] {
