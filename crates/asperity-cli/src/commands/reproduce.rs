@@ -31,7 +31,7 @@ pub enum Figure {
 /// Arguments of `asperity reproduce`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Examples:\n  asperity reproduce fig15.1 --out figs\n  asperity reproduce fig15.2 --quick --out figs\n  asperity reproduce all --quick --out figs\n\nImplemented so far: fig15.1, fig15.2 (book ch. 15); `all` runs those and names the rest."
+    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours). Studies checkpoint: an interrupted run resumes when run again.\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.
