@@ -64,6 +64,14 @@ pub enum Error {
         /// What differs.
         reason: String,
     },
+    /// A contact solve inside a larger computation (a study sample) failed.
+    #[error("{context}: {source}")]
+    Solve {
+        /// Which computation (e.g. the sample's seed).
+        context: String,
+        /// The solver's error, with its residual where it did not converge.
+        source: Box<crate::bem::SolveError>,
+    },
     /// A metadata (JSON / TOML) file could not be parsed or written.
     #[error("{path}: {reason}")]
     Metadata {

@@ -59,6 +59,23 @@ pub struct ContactSolver {
     pub(super) stiffness_work: Option<(Vec<f64>, Vec<f64>)>,
 }
 
+/// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
+/// `profile` and returns its rms, the scale of the solver's height tolerances.
+fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
+    let heights = surface.heights();
+    let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+    profile.clear();
+    profile.extend(heights.iter().map(|&h| top - h));
+    let n = profile.len() as f64;
+    let mean = profile.iter().sum::<f64>() / n;
+    let rms = (profile.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n).sqrt();
+    if rms > 0.0 {
+        rms
+    } else {
+        1.0
+    }
+}
+
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow): the operator, five fields and the two stiffness fields.
@@ -90,13 +107,8 @@ impl ContactSolver {
             half_space.modulus,
             half_space.boundary,
         )?;
-        let heights = surface.heights();
-        let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
-        let profile: Vec<f64> = heights.iter().map(|&h| top - h).collect();
-        let n = profile.len() as f64;
-        let mean = profile.iter().sum::<f64>() / n;
-        let rms = (profile.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n).sqrt();
-        let height_scale = if rms > 0.0 { rms } else { 1.0 };
+        let mut profile = Vec::with_capacity(rows * cols);
+        let height_scale = fill_profile(surface, &mut profile);
         let len = rows * cols;
         Ok(ContactSolver {
             operator,
@@ -113,6 +125,31 @@ impl ContactSolver {
             full_contact_pressure: None,
             stiffness_work: None,
         })
+    }
+
+    /// Swaps in another surface with the same grid and spacing, keeping the operator (FFT
+    /// plans, kernel spectrum) and all buffers: how an ensemble solves many realisations.
+    /// The next solve starts cold, exactly as with a new solver.
+    pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
+        if surface.dim() != (self.rows, self.cols) || surface.spacing() != self.operator.spacing() {
+            return Err(Error::invalid(
+                "surface",
+                format!(
+                    "the solver was planned for {}x{} points at spacing {}, got {:?} at {}",
+                    self.rows,
+                    self.cols,
+                    self.operator.spacing(),
+                    surface.dim(),
+                    surface.spacing()
+                ),
+            )
+            .into());
+        }
+        self.height_scale = fill_profile(surface, &mut self.profile);
+        self.pressure.fill(0.0);
+        self.solved = None;
+        self.full_contact_pressure = None;
+        Ok(())
     }
 
     /// The parameters in use.
@@ -794,6 +831,29 @@ pub(super) mod tests {
         assert!(first.iterations > 0);
         assert_eq!(warm_state.contact_points, cold_state.contact_points);
         assert!((warm_state.indentation / cold_state.indentation - 1.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn a_reused_solver_equals_a_new_one() {
+        let (first, second) = (rough(40, 1), rough(40, 2));
+        let mut reused = ContactSolver::new(&first, free(), SolverParams::default()).unwrap();
+        reused.solve(Control::MeanPressure(0.02)).unwrap();
+        reused.frozen_set_stiffness().unwrap();
+        reused.set_surface(&second).unwrap();
+        let mut fresh = ContactSolver::new(&second, free(), SolverParams::default()).unwrap();
+        for p in [0.01, 0.03] {
+            let (a, ia) = reused.solve(Control::MeanPressure(p)).unwrap();
+            let (b, ib) = fresh.solve(Control::MeanPressure(p)).unwrap();
+            assert_eq!((a, ia), (b, ib));
+            assert_eq!(
+                reused.frozen_set_stiffness().unwrap(),
+                fresh.frozen_set_stiffness().unwrap()
+            );
+        }
+        assert!(
+            reused.set_surface(&rough(32, 1)).is_err(),
+            "other grid refused"
+        );
     }
 
     #[test]

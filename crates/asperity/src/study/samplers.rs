@@ -60,19 +60,39 @@ impl BemSampler {
     }
 }
 
-impl Sampler for BemSampler {
-    type Worker = SurfaceGenerator;
+/// Per-thread state of the BEM sampler: the surface generator and one contact solver
+/// whose operator (FFT plans, kernel spectrum) and buffers serve every sample.
+pub struct BemWorker {
+    generator: SurfaceGenerator,
+    solver: Option<ContactSolver>,
+}
 
-    fn worker(&self) -> Result<SurfaceGenerator> {
-        SurfaceGenerator::new(&self.surface)
+impl Sampler for BemSampler {
+    type Worker = BemWorker;
+
+    fn worker(&self) -> Result<BemWorker> {
+        Ok(BemWorker {
+            generator: SurfaceGenerator::new(&self.surface)?,
+            solver: None,
+        })
     }
 
-    fn sample(&self, generator: &mut SurfaceGenerator, seed: u64) -> Result<SampleCurve> {
-        let surface = generator.try_generate(seed)?;
-        let bem_error =
-            |e: crate::bem::SolveError| Error::invalid("bem", format!("seed {seed}: {e}"));
-        let mut solver =
-            ContactSolver::new(&surface, HalfSpace::default(), self.params).map_err(bem_error)?;
+    fn sample(&self, worker: &mut BemWorker, seed: u64) -> Result<SampleCurve> {
+        let surface = worker.generator.try_generate(seed)?;
+        let bem_error = |e: crate::bem::SolveError| Error::Solve {
+            context: format!("BEM sample with seed {seed}"),
+            source: Box::new(e),
+        };
+        let solver = match worker.solver.as_mut() {
+            Some(solver) => {
+                solver.set_surface(&surface).map_err(bem_error)?;
+                solver
+            }
+            None => worker.solver.insert(
+                ContactSolver::new(&surface, HalfSpace::default(), self.params)
+                    .map_err(bem_error)?,
+            ),
+        };
         let points_total = self.surface.rows * self.surface.cols;
         let mut points = Vec::with_capacity(self.mean_pressures.len());
         for &p in &self.mean_pressures {
