@@ -62,6 +62,13 @@ pub struct CommonArgs {
     /// Common force levels of the ensemble-mean curves.
     #[arg(long, default_value_t = 48)]
     pub levels: usize,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// Where and how a study runs (not part of what it computes).
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
     /// Output folder (also holds the checkpoint).
     #[arg(long)]
     pub out: PathBuf,
@@ -72,7 +79,7 @@ pub struct CommonArgs {
     #[arg(long)]
     pub quiet: bool,
     /// Save tasks in progress at most every this many seconds (0: after every batch).
-    #[arg(long, default_value_t = 10.0, value_name = "SECONDS")]
+    #[arg(long, default_value_t = CHECKPOINT_INTERVAL.as_secs_f64(), value_name = "SECONDS")]
     pub checkpoint_every: f64,
 }
 
@@ -131,15 +138,8 @@ pub struct CurveArgs {
 pub struct FileArgs {
     /// A TOML study file.
     pub file: PathBuf,
-    /// Output folder (also holds the checkpoint).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Overwrite outputs and discard another study's checkpoint in the folder.
-    #[arg(long)]
-    pub force: bool,
-    /// No progress output.
-    #[arg(long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
 }
 
 /// The study kinds.
@@ -221,16 +221,16 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
-    fn from_common(common: &CommonArgs) -> Result<Self> {
+    fn from_args(run: &RunArgs) -> Result<Self> {
         anyhow::ensure!(
-            common.checkpoint_every.is_finite() && common.checkpoint_every >= 0.0,
+            run.checkpoint_every.is_finite() && run.checkpoint_every >= 0.0,
             "--checkpoint-every must be a number of seconds >= 0, got {}",
-            common.checkpoint_every
+            run.checkpoint_every
         );
         Ok(RunOptions {
-            force: common.force,
-            quiet: common.quiet,
-            checkpoint_every: Duration::from_secs_f64(common.checkpoint_every),
+            force: run.force,
+            quiet: run.quiet,
+            checkpoint_every: Duration::from_secs_f64(run.checkpoint_every),
         })
     }
 }
@@ -243,8 +243,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (
                 Kind::Alpha,
                 spec,
-                &a.common.out,
-                RunOptions::from_common(&a.common)?,
+                &a.common.run.out,
+                RunOptions::from_args(&a.common.run)?,
             )
         }
         StudyCommand::Curve(c) => {
@@ -252,8 +252,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (
                 Kind::Curve,
                 spec,
-                &c.common.out,
-                RunOptions::from_common(&c.common)?,
+                &c.common.run.out,
+                RunOptions::from_args(&c.common.run)?,
             )
         }
         StudyCommand::File(f) => {
@@ -278,12 +278,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 },
                 levels: file.levels.unwrap_or(48),
             };
-            let options = RunOptions {
-                force: f.force,
-                quiet: f.quiet,
-                checkpoint_every: CHECKPOINT_INTERVAL,
-            };
-            (file.kind, spec, &f.out, options)
+            (file.kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
     let results = execute(&spec, out, options, &outputs(kind, out))?;
