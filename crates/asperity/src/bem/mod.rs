@@ -66,6 +66,25 @@ pub enum Control {
     Indentation(f64),
 }
 
+impl Control {
+    /// The prescribed quantity as messages name it: `force`, `mean pressure` or
+    /// `indentation`.
+    pub fn quantity(&self) -> &'static str {
+        match self {
+            Control::MeanPressure(_) => "mean pressure",
+            Control::Force(_) => "force",
+            Control::Indentation(_) => "indentation",
+        }
+    }
+
+    /// The prescribed value.
+    pub fn value(&self) -> f64 {
+        match *self {
+            Control::MeanPressure(v) | Control::Force(v) | Control::Indentation(v) => v,
+        }
+    }
+}
+
 /// Parameters of the contact solver (validated by [`ContactSolver::new`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverParams {
@@ -89,6 +108,35 @@ impl Default for SolverParams {
             stiffness_tolerance: 1e-10,
             stiffness_max_iterations: 10_000,
         }
+    }
+}
+
+impl SolverParams {
+    /// Checks the parameters: tolerances positive and finite, iteration limits at least 1.
+    /// [`ContactSolver::new`] and [`ContactSolver::set_params`] call it; a front end can call
+    /// it before any work.
+    pub fn validate(&self) -> crate::Result<()> {
+        let positive = |name: &'static str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(crate::Error::invalid(
+                    name,
+                    format!("must be positive and finite, got {v}"),
+                ))
+            }
+        };
+        positive("tolerance", self.tolerance)?;
+        positive("stiffness tolerance", self.stiffness_tolerance)?;
+        for (name, v) in [
+            ("max iterations", self.max_iterations),
+            ("stiffness max iterations", self.stiffness_max_iterations),
+        ] {
+            if v == 0 {
+                return Err(crate::Error::invalid(name, "must be at least 1, got 0"));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -143,15 +191,32 @@ pub enum SolveError {
         /// Residual reached.
         residual: f64,
     },
-    /// The load closes the gap everywhere: no contact problem is left to solve.
-    #[error(
-        "mean pressure {requested:.6e} is beyond full contact{}",
-        match full_contact { Some(p) => format!(" (the gap closes everywhere from a mean pressure of {p:.6e})"), None => String::new() }
-    )]
+    /// The load or indentation closes the gap everywhere: no contact problem is left to
+    /// solve. The message names the quantity that was given (force, mean pressure or
+    /// indentation) and the threshold in that quantity.
+    #[error("{}", beyond_full_contact_message(requested, *full_contact))]
     BeyondFullContact {
-        /// The requested mean pressure.
-        requested: f64,
-        /// The mean pressure at which the gap closes everywhere, where known.
+        /// What was asked for, as given.
+        requested: Control,
+        /// The threshold in the same quantity as `requested` from which the gap is closed
+        /// everywhere, where known: the free-boundary indentation `d* = max(K⁻¹f / K⁻¹1)`
+        /// and the load it carries, or the periodic full-contact mean pressure `max(K⁺f)`
+        /// (times the nominal area for a force).
         full_contact: Option<f64>,
     },
+}
+
+fn beyond_full_contact_message(requested: &Control, full_contact: Option<f64>) -> String {
+    let quantity = requested.quantity();
+    let threshold = match full_contact {
+        Some(t) => {
+            let article = if quantity.starts_with('i') { "an" } else { "a" };
+            format!(" (the gap closes everywhere from {article} {quantity} of {t:.6e})")
+        }
+        None => String::new(),
+    };
+    format!(
+        "{quantity} {:.6e} is beyond full contact{threshold}",
+        requested.value()
+    )
 }

@@ -48,15 +48,26 @@ pub struct ContactSolver {
     pub(super) params: SolverParams,
     pub(super) pressure: Vec<f64>,
     /// `u` during an iteration, the gap `g` after a solve.
-    gap: Vec<f64>,
+    pub(super) gap: Vec<f64>,
     pub(super) direction: Vec<f64>,
     pub(super) response: Vec<f64>,
     /// The last solved state, if any (its pressure is in `pressure`).
     pub(super) solved: Option<ContactSummary>,
-    /// Mean pressure at which a periodic surface is in full contact (computed once).
-    full_contact_pressure: Option<f64>,
+    /// Where the surface comes into full contact (computed once per surface, when first
+    /// needed).
+    pub(super) full_contact: Option<FullContact>,
     /// Two extra fields for the frozen-set CG, allocated on first use.
     pub(super) stiffness_work: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+/// The full-contact threshold of a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct FullContact {
+    /// Mean pressure from which the gap is closed everywhere.
+    pub(super) mean_pressure: f64,
+    /// Indentation from which every point is in contact (free boundaries; a periodic
+    /// half-space fixes displacements only up to their mean).
+    pub(super) indentation: Option<f64>,
 }
 
 /// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
@@ -78,7 +89,8 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow): the operator, five fields and the two stiffness fields.
+    /// overflow): the operator, five fields and the two stiffness fields. The caller's
+    /// [`Surface`] (one more `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
         let fields = memory::array_bytes(&[7, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?.checked_add(fields)
@@ -122,7 +134,7 @@ impl ContactSolver {
             direction: vec![0.0; len],
             response: vec![0.0; len],
             solved: None,
-            full_contact_pressure: None,
+            full_contact: None,
             stiffness_work: None,
         })
     }
@@ -148,7 +160,7 @@ impl ContactSolver {
         self.height_scale = fill_profile(surface, &mut self.profile);
         self.pressure.fill(0.0);
         self.solved = None;
-        self.full_contact_pressure = None;
+        self.full_contact = None;
         Ok(())
     }
 
@@ -214,35 +226,47 @@ impl ContactSolver {
             }
         };
         if let Target::MeanPressure(p) = target {
-            if self.operator.boundary() == Boundary::Periodic {
-                let full = self.periodic_full_contact_pressure();
-                if p >= full {
-                    self.solved = None;
-                    return Err(SolveError::BeyondFullContact {
-                        requested: p,
-                        full_contact: Some(full),
-                    });
-                }
+            if self.operator.boundary() == Boundary::Periodic
+                && p >= self.periodic_full_contact_pressure()
+            {
+                self.solved = None;
+                return Err(self.beyond_full_contact(control));
             }
         }
         let result = self.polonsky_keer(target);
         match result {
-            Ok((summary, _)) => {
-                if let Target::MeanPressure(p) = target {
-                    if summary.contact_points == self.rows * self.cols {
-                        self.solved = None;
-                        let full = self.free_full_contact_pressure().ok();
-                        return Err(SolveError::BeyondFullContact {
-                            requested: p,
-                            full_contact: full,
-                        });
-                    }
-                }
-                self.solved = Some(summary);
+            // Every point in contact, under load or displacement control: no contact
+            // problem is left; refused with the threshold (free boundaries: only known
+            // from the solution, periodic: checked above, this is rounding at p ≈ p*).
+            Ok((summary, _)) if summary.contact_points == self.rows * self.cols => {
+                self.solved = None;
+                return Err(self.beyond_full_contact(control));
             }
+            Ok((summary, _)) => self.solved = Some(summary),
             Err(_) => self.solved = None,
         }
         result
+    }
+
+    /// The error for a `requested` load or indentation that closes the gap everywhere, with
+    /// the threshold in the same quantity where it is known.
+    fn beyond_full_contact(&mut self, requested: Control) -> SolveError {
+        let threshold = match self.operator.boundary() {
+            Boundary::Periodic => Some(FullContact {
+                mean_pressure: self.periodic_full_contact_pressure(),
+                indentation: None,
+            }),
+            Boundary::Free => self.free_full_contact().ok(),
+        };
+        let full_contact = threshold.and_then(|t| match requested {
+            Control::MeanPressure(_) => Some(t.mean_pressure),
+            Control::Force(_) => Some(t.mean_pressure * self.nominal_area()),
+            Control::Indentation(_) => t.indentation,
+        });
+        SolveError::BeyondFullContact {
+            requested,
+            full_contact,
+        }
     }
 
     /// Pressure of the last solve, `rows × cols`.
@@ -278,14 +302,22 @@ impl ContactSolver {
     /// `K p = d − f` everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)`
     /// (Westergaard's `p* = π E* Δ / λ` for a sinusoid). Uses the gap and direction buffers.
     fn periodic_full_contact_pressure(&mut self) -> f64 {
-        if let Some(p) = self.full_contact_pressure {
-            return p;
+        if let Some(full) = self.full_contact {
+            return full.mean_pressure;
         }
-        self.operator
+        if self
+            .operator
             .apply_pseudo_inverse(&self.profile, &mut self.direction)
-            .expect("called for periodic boundaries only");
+            .is_err()
+        {
+            // Free boundaries have no spectral inverse (callers check the boundary).
+            return f64::INFINITY;
+        }
         let full = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
-        self.full_contact_pressure = Some(full);
+        self.full_contact = Some(FullContact {
+            mean_pressure: full,
+            indentation: None,
+        });
         full
     }
 
@@ -543,22 +575,7 @@ fn check_load(name: &'static str, value: f64) -> Result<f64, SolveError> {
 }
 
 fn validate_params(params: &SolverParams) -> Result<(), SolveError> {
-    let positive = |name: &'static str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(Error::invalid(
-                name,
-                format!("must be positive and finite, got {v}"),
-            ))
-        }
-    };
-    positive("tolerance", params.tolerance)?;
-    positive("stiffness tolerance", params.stiffness_tolerance)?;
-    if params.max_iterations == 0 || params.stiffness_max_iterations == 0 {
-        return Err(Error::invalid("max iterations", "must be at least 1").into());
-    }
-    Ok(())
+    Ok(params.validate()?)
 }
 
 #[cfg(test)]
@@ -756,7 +773,7 @@ pub(super) mod tests {
                 requested,
                 full_contact: Some(full),
             }) => {
-                assert_eq!(requested, 1e3);
+                assert_eq!(requested, Control::MeanPressure(1e3));
                 assert!(full > 0.0 && full < 1e3, "{full}");
                 // Just below the threshold the contact is partial, just above it is full.
                 let (below, _) = solver.solve(Control::MeanPressure(0.9 * full)).unwrap();
@@ -765,9 +782,95 @@ pub(super) mod tests {
                     solver.solve(Control::MeanPressure(1.1 * full)),
                     Err(SolveError::BeyondFullContact { .. })
                 ));
+                // A force is refused in its own terms: the message names the force and the
+                // threshold force (mean pressure × nominal area, here L = 2).
+                let surface = Surface::new(surface.heights().clone(), 2.0).unwrap();
+                let mut solver =
+                    ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+                let err = solver.solve(Control::Force(20.0)).unwrap_err();
+                let message = err.to_string();
+                assert!(
+                    message.starts_with("force 2.000000e1 is beyond full contact")
+                        && message.contains("from a force of")
+                        && !message.contains("mean pressure"),
+                    "{message}"
+                );
+                match err {
+                    SolveError::BeyondFullContact {
+                        requested: Control::Force(f),
+                        full_contact: Some(full_force),
+                    } => {
+                        assert_eq!(f, 20.0);
+                        // Pressures scale with 1/L for the same heights: p*(L=2) = p*(1)/2.
+                        assert!((full_force / (4.0 * full / 2.0) - 1.0).abs() < 1e-6);
+                    }
+                    other => panic!("expected BeyondFullContact, got {other:?}"),
+                }
             }
             other => panic!("expected BeyondFullContact, got {other:?}"),
         }
+    }
+
+    #[test]
+    fn free_indentation_beyond_full_contact_is_an_error() {
+        // Displacement control is refused beyond full contact like load control, with the
+        // smallest indentation that brings every pixel into contact, d* = max(K⁻¹f / K⁻¹1).
+        let surface = rough(32, 1);
+        let mut solver = ContactSolver::new(&surface, free(), SolverParams::default()).unwrap();
+        let err = solver.solve(Control::Indentation(5.0)).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("indentation 5.000000e0 is beyond full contact"),
+            "{err}"
+        );
+        let SolveError::BeyondFullContact {
+            requested: Control::Indentation(requested),
+            full_contact: Some(d_star),
+        } = err
+        else {
+            panic!("expected BeyondFullContact, got {err:?}");
+        };
+        assert_eq!(requested, 5.0);
+        assert!(solver.summary().is_none());
+        assert!(solver.frozen_set_stiffness().is_err());
+        // Full contact needs d = u + f everywhere with u ≥ 0 (positive pressures push a
+        // free half-space down everywhere): d* is at least the deepest valley, max f.
+        let depth = surface
+            .heights()
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &h| m.max(h))
+            - surface
+                .heights()
+                .iter()
+                .fold(f64::INFINITY, |m, &h| m.min(h));
+        assert!(d_star > depth && d_star < 5.0, "{d_star} vs depth {depth}");
+        // Just below d* the contact is partial (a cold start after the error), and the load
+        // it carries is just below the full-contact mean pressure; just above, refused.
+        let (below, _) = solver.solve(Control::Indentation(0.999 * d_star)).unwrap();
+        assert!(below.area_fraction < 1.0 && below.area_fraction > 0.9);
+        let p_star = match solver.solve(Control::MeanPressure(1e3)) {
+            Err(SolveError::BeyondFullContact {
+                full_contact: Some(p),
+                ..
+            }) => p,
+            other => panic!("expected BeyondFullContact, got {other:?}"),
+        };
+        let ratio = below.mean_pressure / p_star;
+        eprintln!(
+            "free full contact: d* = {d_star:.6e} (depth {depth:.3e}), p(0.999 d*) / p* = {ratio:.6}, area {}",
+            below.area_fraction
+        );
+        assert!(ratio < 1.0 && ratio > 0.99, "{ratio}");
+        assert!(matches!(
+            solver.solve(Control::Indentation(1.001 * d_star)),
+            Err(SolveError::BeyondFullContact {
+                requested: Control::Indentation(_),
+                full_contact: Some(_),
+            })
+        ));
+        // A partial contact still solves after the refusals.
+        let (partial, _) = solver.solve(Control::Indentation(0.5 * d_star)).unwrap();
+        assert!(partial.area_fraction < 1.0);
     }
 
     #[test]

@@ -10,11 +10,15 @@
 //!   more solves. By Barber's theorem (J. R. Barber, Proc. R. Soc. A 459, 2003) the two are
 //!   equal as long as the contact set does not change within the step.
 //!
-//! The same CG on the full grid gives the mean pressure at which a free-boundary surface
-//! comes into full contact: with `q = K⁻¹ 1` (a flat punch the size of the grid) and
-//! `y = K⁻¹ f`, the pressure `d q − y` is non-negative everywhere from `d = max(y/q)` on.
+//! The same CG on the full grid gives the indentation and mean pressure at which a
+//! free-boundary surface comes into full contact: with `q = K⁻¹ 1` (a flat punch the size of
+//! the grid) and `y = K⁻¹ f`, the pressure `d q − y` is non-negative everywhere from
+//! `d* = max(y/q)` on.
+//!
+//! Neither allocates after the first call: the set is tested inline (`p > 0`), and the CG
+//! works in the solver's buffers.
 
-use super::polonsky_keer::ContactSolver;
+use super::polonsky_keer::{ContactSolver, FullContact};
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::Error;
@@ -28,12 +32,12 @@ enum RightHandSide<'a> {
     Values(&'a [f64]),
 }
 
-/// Solves `K_SS x = b_S` by conjugate gradients (x zero off the set). `direction` and
-/// `response` are scratch. Stops at `‖r‖ ≤ tolerance ‖b‖`.
+/// Solves `K_SS x = b_S` by conjugate gradients (x zero off the set `S = {i : in_set(i)}`).
+/// `direction` and `response` are scratch. Stops at `‖r‖ ≤ tolerance ‖b‖`.
 #[allow(clippy::too_many_arguments)]
 fn conjugate_gradient_on_set(
     operator: &mut ElasticOperator,
-    in_set: &[bool],
+    in_set: impl Fn(usize) -> bool,
     rhs: RightHandSide<'_>,
     x: &mut [f64],
     residual: &mut [f64],
@@ -42,11 +46,11 @@ fn conjugate_gradient_on_set(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<SolveInfo, SolveError> {
-    let n = in_set.len();
+    let n = x.len();
     let mut rs = 0.0;
     for i in 0..n {
         x[i] = 0.0;
-        let b = if in_set[i] {
+        let b = if in_set(i) {
             match rhs {
                 RightHandSide::Ones => 1.0,
                 RightHandSide::Values(v) => v[i],
@@ -84,7 +88,7 @@ fn conjugate_gradient_on_set(
         operator.apply(direction, response);
         let mut curvature = 0.0;
         for i in 0..n {
-            if in_set[i] {
+            if in_set(i) {
                 curvature += direction[i] * response[i];
             }
         }
@@ -98,7 +102,7 @@ fn conjugate_gradient_on_set(
         let alpha = rs / curvature;
         let mut rs_new = 0.0;
         for i in 0..n {
-            if in_set[i] {
+            if in_set(i) {
                 x[i] += alpha * direction[i];
                 residual[i] -= alpha * response[i];
                 rs_new += residual[i] * residual[i];
@@ -106,7 +110,7 @@ fn conjugate_gradient_on_set(
         }
         let beta = rs_new / rs;
         for i in 0..n {
-            if in_set[i] {
+            if in_set(i) {
                 direction[i] = residual[i] + beta * direction[i];
             }
         }
@@ -129,11 +133,11 @@ impl ContactSolver {
         if self.solved.is_none() {
             return Err(Error::invalid("stiffness", "no solved contact state yet").into());
         }
-        let in_set: Vec<bool> = self.pressure.iter().map(|&p| p > 0.0).collect();
         let (mut x, mut residual) = self.take_stiffness_work();
+        let pressure = &self.pressure;
         let result = conjugate_gradient_on_set(
             &mut self.operator,
-            &in_set,
+            |i| pressure[i] > 0.0,
             RightHandSide::Ones,
             &mut x,
             &mut residual,
@@ -172,20 +176,23 @@ impl ContactSolver {
         Ok((upper.force - lower.force) / (upper.indentation - lower.indentation))
     }
 
-    /// Mean pressure at which the whole free-boundary grid is in contact (two CG solves on
-    /// the full grid, see the module docs).
-    pub(super) fn free_full_contact_pressure(&mut self) -> Result<f64, SolveError> {
+    /// Indentation `d*` and mean pressure at which the whole free-boundary grid is in
+    /// contact (two CG solves on the full grid, see the module docs); computed once per
+    /// surface. Uses the gap buffer as scratch: call it only when the state is discarded
+    /// (a solve that ended in full contact).
+    pub(super) fn free_full_contact(&mut self) -> Result<FullContact, SolveError> {
+        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
+            return Ok(full);
+        }
         let n = self.rows * self.cols;
-        let everywhere = vec![true; n];
         let (mut flat_punch, mut residual) = self.take_stiffness_work();
-        let mut profile_pressure = vec![0.0; n];
         let (tolerance, max_iterations) = (
             self.params.stiffness_tolerance,
             self.params.stiffness_max_iterations,
         );
         let first = conjugate_gradient_on_set(
             &mut self.operator,
-            &everywhere,
+            |_| true,
             RightHandSide::Ones,
             &mut flat_punch,
             &mut residual,
@@ -194,12 +201,13 @@ impl ContactSolver {
             tolerance,
             max_iterations,
         );
+        let profile_pressure = &mut self.gap;
         let second = first.and_then(|_| {
             conjugate_gradient_on_set(
                 &mut self.operator,
-                &everywhere,
+                |_| true,
                 RightHandSide::Values(&self.profile),
-                &mut profile_pressure,
+                profile_pressure,
                 &mut residual,
                 &mut self.direction,
                 &mut self.response,
@@ -208,18 +216,22 @@ impl ContactSolver {
             )
         });
         let result = second.map(|_| {
-            let d = flat_punch
-                .iter()
-                .zip(&profile_pressure)
+            let q_y = flat_punch.iter().zip(self.gap.iter());
+            let indentation = q_y
+                .clone()
                 .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
-            flat_punch
-                .iter()
-                .zip(&profile_pressure)
-                .map(|(q, y)| d * q - y)
-                .sum::<f64>()
-                / n as f64
+            let mean_pressure = q_y.map(|(q, y)| indentation * q - y).sum::<f64>() / n as f64;
+            FullContact {
+                mean_pressure,
+                indentation: Some(indentation),
+            }
         });
+        // The gap buffer now holds K⁻¹f: no valid gap (the caller discards the state).
+        self.gap.fill(0.0);
         self.stiffness_work = Some((flat_punch, residual));
+        if let Ok(full) = result {
+            self.full_contact = Some(full);
+        }
         result
     }
 }
