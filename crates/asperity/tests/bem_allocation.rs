@@ -1,0 +1,138 @@
+//! The contact solver allocates nothing per iteration: a solve and a frozen-set stiffness
+//! on a warm solver cost the same number of heap allocations whether they take few or many
+//! iterations (and that number is small and fixed).
+//!
+//! A counting global allocator applies to this test binary only (an integration test), so
+//! it stays out of the library and of the other tests. This binary holds one test so that
+//! no other test allocates while it counts.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
+use asperity::elastic::Boundary;
+use asperity::spectrum::{LongWavelength, Psd};
+use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+static BYTES: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: forwards every call to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
+        // SAFETY: the caller's contract for `alloc` is passed on.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
+        // SAFETY: as for `alloc`.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `System` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        BYTES.fetch_add(new_size as u64, Ordering::Relaxed);
+        // SAFETY: as for `dealloc`; `new_size` is the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// `(allocations, bytes)` made while `f` runs.
+fn count<T>(f: impl FnOnce() -> T) -> (T, u64, u64) {
+    let (a, b) = (
+        ALLOCATIONS.load(Ordering::SeqCst),
+        BYTES.load(Ordering::SeqCst),
+    );
+    let value = f();
+    let (a2, b2) = (
+        ALLOCATIONS.load(Ordering::SeqCst),
+        BYTES.load(Ordering::SeqCst),
+    );
+    (value, a2 - a, b2 - b)
+}
+
+#[test]
+fn solves_and_stiffness_allocate_nothing_per_iteration() {
+    // One rayon thread: the FFTs' parallel loops then run inline on this thread, so the
+    // count holds the solver's allocations only (a multi-thread pool's job queues and
+    // wake-ups may allocate a varying amount that says nothing about the solver).
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    pool.install(|| {
+        let n = 64;
+        let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 4.0 }, None).unwrap();
+        let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(0.5)).unwrap();
+        let surface = SurfaceGenerator::new(&spec).unwrap().generate(7);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary,
+            };
+            let mut solver =
+                ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            let pressure = 0.03;
+            // Warm up: the stiffness buffers are allocated on first use.
+            solver.solve(Control::MeanPressure(pressure)).unwrap();
+            solver.frozen_set_stiffness().unwrap();
+
+            let mut run = |tolerance: f64| {
+                solver
+                    .set_params(SolverParams {
+                        tolerance,
+                        ..SolverParams::default()
+                    })
+                    .unwrap();
+                solver.reset(); // a cold start: the iteration count follows the tolerance
+                let ((iterations, cg_iterations), allocations, bytes) = count(|| {
+                    let (_, info) = solver.solve(Control::MeanPressure(pressure)).unwrap();
+                    let (_, cg) = solver.frozen_set_stiffness().unwrap();
+                    (info.iterations, cg.iterations)
+                });
+                (iterations, cg_iterations, allocations, bytes)
+            };
+            let (few, cg_few, allocations_few, bytes_few) = run(1e-4);
+            let (many, cg_many, allocations_many, bytes_many) = run(1e-10);
+            eprintln!(
+                "{boundary:?}: {few} and {many} iterations (+{cg_few}, {cg_many} CG): \
+                 {allocations_few} and {allocations_many} allocations, \
+                 {bytes_few} and {bytes_many} bytes"
+            );
+            assert!(many >= 2 * few, "{few} vs {many} iterations");
+            assert_eq!(
+                allocations_many, allocations_few,
+                "allocations grow with the iterations"
+            );
+            // None at all: with one rayon thread nothing else allocates on the solver's
+            // behalf (with more threads rayon's job bookkeeping may add a few).
+            assert_eq!(allocations_few, 0, "{bytes_few} bytes");
+
+            // A refused load beyond full contact computes its threshold in the solver's own
+            // buffers, once per surface: a repeat allocates nothing.
+            let beyond = Control::MeanPressure(1e3);
+            assert!(matches!(
+                solver.solve(beyond),
+                Err(SolveError::BeyondFullContact { .. })
+            ));
+            let (result, allocations, bytes) = count(|| solver.solve(beyond));
+            assert!(matches!(result, Err(SolveError::BeyondFullContact { .. })));
+            eprintln!("{boundary:?}: refused load: {allocations} allocations, {bytes} bytes");
+            assert_eq!(allocations, 0, "{boundary:?}: {bytes} bytes");
+        }
+    });
+}
