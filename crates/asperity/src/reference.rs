@@ -291,12 +291,41 @@ mod tests {
     }
 
     #[test]
-    fn point_load_is_boussinesq() {
-        let load = PointLoad {
-            force: 2.0,
-            modulus: 0.5,
+    fn point_loads_superpose_to_the_known_centre_displacements() {
+        // Boussinesq's u = F/(πE*r) summed over rings of an axisymmetric pressure must give
+        // the displacement at the centre known independently: 2pa/E* under a uniform disk
+        // (Johnson, Contact Mechanics, eq. 3.28) and d = a²/R under the Hertz pressure.
+        // Fails if the point load's normalisation (or the Hertz pressure) is wrong.
+        let (modulus, a) = (0.7, 0.3);
+        let centre = |pressure: &dyn Fn(f64) -> f64| {
+            let n = 200_000;
+            let dr = a / n as f64;
+            (0..n)
+                .map(|i| {
+                    let r = (i as f64 + 0.5) * dr;
+                    let ring = PointLoad {
+                        force: pressure(r) * 2.0 * PI * r * dr,
+                        modulus,
+                    };
+                    ring.displacement(r)
+                })
+                .sum::<f64>()
         };
-        assert!((load.displacement(4.0) - 2.0 / (PI * 0.5 * 4.0)).abs() < 1e-15);
+        let p = 1.3;
+        let uniform = centre(&|_| p);
+        assert!(
+            (uniform / (2.0 * p * a / modulus) - 1.0).abs() < 1e-10,
+            "{uniform}"
+        );
+        let hertz = Hertz {
+            radius: 2.0,
+            modulus,
+        };
+        let d = a * a / hertz.radius;
+        assert!((hertz.contact_radius(d) / a - 1.0).abs() < 1e-12);
+        // The midpoint rule on the square-root edge converges like (Δr/a)^1.5.
+        let u = centre(&|r| hertz.pressure(d, r));
+        assert!((u / d - 1.0).abs() < 1e-6, "{u} vs {d}");
     }
 
     #[test]

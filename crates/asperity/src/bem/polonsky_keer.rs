@@ -596,10 +596,15 @@ pub(super) mod tests {
     }
 
     pub(crate) fn rough(n: usize, seed: u64) -> Surface {
+        rough_grid(n, n, seed)
+    }
+
+    /// A rough surface on a `rows × cols` grid (L = 1 along the columns).
+    pub(crate) fn rough_grid(rows: usize, cols: usize, seed: u64) -> Surface {
         use crate::spectrum::{LongWavelength, Psd};
         use crate::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
         let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 4.0 }, None).unwrap();
-        let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(0.5)).unwrap();
+        let spec = SurfaceSpec::new(rows, cols, 1.0, psd, Normalisation::RmsSlope(0.5)).unwrap();
         SurfaceGenerator::new(&spec).unwrap().generate(seed)
     }
 
@@ -637,8 +642,9 @@ pub(super) mod tests {
             (a - a_target).abs() < dx,
             "{rows}x{cols}: a = {a}, Hertz {a_target}"
         );
-        // Pressure profile: within 2 % of the peak pressure inside 0.9 a (the last pixels
-        // average the square-root edge over a pixel, where the pointwise error is larger).
+        // Pressure profile inside 0.9 a, relative to the peak pressure: measured 1.7e-3 on
+        // all three grids, bound 0.5 % (the pixels near the edge average the square-root
+        // profile over a pixel, which is where the largest pointwise error sits).
         let p0 = hertz.pressure(d_target, 0.0);
         let pressure = solver.pressure();
         let mut worst = 0.0f64;
@@ -649,7 +655,7 @@ pub(super) mod tests {
             }
         }
         assert!(
-            worst < 0.02,
+            worst < 0.005,
             "{rows}x{cols}: pressure error {worst:e} of p0"
         );
         eprintln!(

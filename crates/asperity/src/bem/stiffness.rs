@@ -238,7 +238,7 @@ impl ContactSolver {
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::{rough, sphere};
+    use super::super::polonsky_keer::tests::{rough, rough_grid, sphere};
     use super::super::{HalfSpace, SolverParams};
     use super::*;
     use crate::elastic::Boundary;
@@ -254,13 +254,20 @@ mod tests {
         }
     }
 
+    /// Grids the stiffness tests run on: even, odd, non-square.
+    const GRIDS: [(usize, usize); 3] = [(64, 64), (63, 63), (50, 72)];
+
     #[test]
     fn frozen_set_equals_finite_difference_on_rough_surfaces() {
         // Barber: k = dF/dd. Central differences with ±1e-3 of the load; the contact set may
         // gain or lose a few points within the step (measured: 1e-5 free, 2e-4 periodic), so
-        // 0.5 % here, tighter than the 2 % the issue asks for.
-        for (boundary, pressure) in [(Boundary::Free, 0.02), (Boundary::Periodic, 0.05)] {
-            let surface = rough(96, 11);
+        // 0.5 % here, tighter than the 2 % the issue asks for. Even, odd and non-square.
+        let grids = [(96, 96), (95, 95), (80, 112)];
+        for ((rows, cols), (boundary, pressure)) in grids
+            .into_iter()
+            .flat_map(|g| [(g, (Boundary::Free, 0.02)), (g, (Boundary::Periodic, 0.05))])
+        {
+            let surface = rough_grid(rows, cols, 11);
             let mut solver =
                 ContactSolver::new(&surface, half_space(boundary), SolverParams::default())
                     .unwrap();
@@ -271,10 +278,12 @@ mod tests {
                 .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
                 .unwrap();
             let error = frozen / fd - 1.0;
-            eprintln!("{boundary:?}: frozen {frozen:.6e}, fd {fd:.6e}, error {error:.2e}");
+            eprintln!(
+                "{rows}x{cols} {boundary:?}: frozen {frozen:.6e}, fd {fd:.6e}, error {error:.2e}"
+            );
             assert!(
                 error.abs() < 0.005,
-                "{boundary:?}: frozen {frozen} vs fd {fd}"
+                "{rows}x{cols} {boundary:?}: frozen {frozen} vs fd {fd}"
             );
         }
     }
@@ -302,69 +311,82 @@ mod tests {
 
     #[test]
     fn hertz_stiffness_is_two_e_a() {
-        let (n, size, radius) = (64, 1.0, 2.0);
-        let dx = size / n as f64;
-        let hertz = Hertz {
-            radius,
-            modulus: 1.3,
-        };
-        let d = (18.0 * dx).powi(2) / radius;
-        let mut solver = ContactSolver::new(
-            &sphere(n, n, size, radius),
-            half_space(Boundary::Free),
-            SolverParams::default(),
-        )
-        .unwrap();
-        solver.solve(Control::Indentation(d)).unwrap();
-        let (k, _) = solver.frozen_set_stiffness().unwrap();
-        let error = k / hertz.stiffness(d) - 1.0;
-        eprintln!("hertz stiffness error {error:.2e}");
-        // The pixelated contact edge costs O(Δ/a) (measured 0.5 % at a = 18 pixels; see the
-        // punch test for the 1/a convergence).
-        assert!(error.abs() < 0.01, "k error {error:e}");
-    }
-
-    #[test]
-    fn flat_punch_stiffness_is_two_e_a() {
-        // A flat circular punch of radius 16 and 32 pixels (heights 0 inside, far below
-        // outside). k = 2E*a with the pixelated disk's area-equivalent radius; the remaining
-        // discretisation error (the edge singularity averaged over a pixel) shrinks like Δ/a:
-        // measured 0.65 % and 0.33 %.
-        let mut errors = Vec::new();
-        for (n, a_pixels) in [(64, 16.0), (128, 32.0)] {
-            let size = 1.0;
-            let dx = size / n as f64;
-            let heights = Array2::from_shape_fn((n, n), |(i, j)| {
-                let r = ((i as f64 - (n / 2) as f64).hypot(j as f64 - (n / 2) as f64)) * dx;
-                if r <= a_pixels * dx {
-                    0.0
-                } else {
-                    -1.0
-                }
-            });
-            let surface = Surface::new(heights, size).unwrap();
+        for (rows, cols) in GRIDS {
+            let (size, radius) = (1.0, 2.0);
+            let dx = size / cols as f64;
+            let hertz = Hertz {
+                radius,
+                modulus: 1.3,
+            };
+            let d = (18.0 * dx).powi(2) / radius;
             let mut solver = ContactSolver::new(
-                &surface,
+                &sphere(rows, cols, size, radius),
                 half_space(Boundary::Free),
                 SolverParams::default(),
             )
             .unwrap();
-            let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
+            solver.solve(Control::Indentation(d)).unwrap();
             let (k, _) = solver.frozen_set_stiffness().unwrap();
-            let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
-            let punch = FlatPunch {
-                radius: a,
-                modulus: 1.3,
-            };
-            let error = k / punch.stiffness() - 1.0;
-            // Under displacement control the punch's force is k d exactly.
-            assert!((s.force / (k * 1e-3) - 1.0).abs() < 1e-6);
-            eprintln!("punch a = {a_pixels} px: k error {error:.3e}");
-            errors.push(error);
+            let error = k / hertz.stiffness(d) - 1.0;
+            eprintln!("hertz stiffness {rows}x{cols}: error {error:.2e}");
+            // The pixelated contact edge costs O(Δ/a) (measured 0.5 % at a = 18 pixels; see
+            // the punch test for the 1/a convergence).
+            assert!(error.abs() < 0.01, "{rows}x{cols}: k error {error:e}");
         }
-        assert!(errors[0].abs() < 0.01, "{errors:?}");
-        assert!(errors[1].abs() < 0.005, "{errors:?}");
-        assert!(errors[1].abs() < errors[0].abs(), "{errors:?}");
+    }
+
+    /// A flat circular punch of radius `a_pixels` centred on a `rows × cols` grid (heights 0
+    /// inside, far below outside) at d = 1e-3: relative error of k against 2E*a with the
+    /// pixelated disk's area-equivalent radius.
+    fn punch_stiffness_error(rows: usize, cols: usize, a_pixels: f64) -> f64 {
+        let size = 1.0;
+        let dx = size / cols as f64;
+        let heights = Array2::from_shape_fn((rows, cols), |(i, j)| {
+            let r = ((i as f64 - (rows / 2) as f64).hypot(j as f64 - (cols / 2) as f64)) * dx;
+            if r <= a_pixels * dx {
+                0.0
+            } else {
+                -1.0
+            }
+        });
+        let surface = Surface::new(heights, size).unwrap();
+        // The residual is measured in rms heights (≈ 0.4 here, 400 d): a tight tolerance so
+        // that the solved force is k d to ~1e-9.
+        let params = SolverParams {
+            tolerance: 1e-11,
+            ..SolverParams::default()
+        };
+        let mut solver =
+            ContactSolver::new(&surface, half_space(Boundary::Free), params).unwrap();
+        let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
+        let (k, _) = solver.frozen_set_stiffness().unwrap();
+        let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
+        let punch = FlatPunch {
+            radius: a,
+            modulus: 1.3,
+        };
+        // Under displacement control the punch's force is k d exactly.
+        // Under displacement control the punch's force is k d exactly (measured 4e-10).
+        assert!((s.force / (k * 1e-3) - 1.0).abs() < 1e-8);
+        let error = k / punch.stiffness() - 1.0;
+        eprintln!("punch {rows}x{cols}, a = {a_pixels} px: k error {error:.3e}");
+        error
+    }
+
+    #[test]
+    fn flat_punch_stiffness_is_two_e_a() {
+        // k = 2E*a; the remaining discretisation error (the edge singularity averaged over a
+        // pixel) shrinks like Δ/a: measured 0.65 % at a = 16 pixels and 0.33 % at 32.
+        let coarse = punch_stiffness_error(64, 64, 16.0);
+        let fine = punch_stiffness_error(128, 128, 32.0);
+        assert!(coarse.abs() < 0.01, "{coarse}");
+        assert!(fine.abs() < 0.005, "{fine}");
+        assert!(fine.abs() < coarse.abs(), "{coarse} vs {fine}");
+        // The same punch on an odd and a non-square grid (free boundaries: the same error).
+        for (rows, cols) in GRIDS[1..].iter().copied() {
+            let error = punch_stiffness_error(rows, cols, 16.0);
+            assert!(error.abs() < 0.01, "{rows}x{cols}: {error}");
+        }
     }
 
     #[test]
