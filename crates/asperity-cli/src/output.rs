@@ -57,6 +57,13 @@ impl Table {
         asperity::io::write_bytes(path, force, &self.to_csv()?)?;
         Ok(())
     }
+
+    /// Writes the table into `batch`: it appears with the batch's other outputs at its
+    /// commit, or not at all.
+    pub fn write_into(&self, batch: &mut asperity::io::OutputBatch, path: &Path) -> Result<()> {
+        batch.write_bytes(path, &self.to_csv()?)?;
+        Ok(())
+    }
 }
 
 /// Shortest text that parses back to the same f64.

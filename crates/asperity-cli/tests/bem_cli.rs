@@ -211,10 +211,32 @@ fn bad_input_is_one_line_exit_2_and_nothing_written() {
     nan[[5, 7]] = f64::NAN;
     let nan_path = dir.path().join("nan.npy");
     write_npy(&nan_path, &nan).unwrap();
+    // A header promising a grid far too large for memory (the data is not there): refused
+    // from the header, before anything is read.
+    let huge = dir.path().join("huge.npy");
+    std::fs::write(&huge, npy_header_only(&[1 << 20, 1 << 20])).unwrap();
     let csv = dir.path().join("out.csv");
     let fields = dir.path().join("fields");
     let s = s.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--surface", huge.to_str().unwrap(), "--pressures", "0.01"],
+            "MiB are available",
+        ),
+        // Displacement control beyond full contact, refused with the threshold indentation.
+        (
+            vec!["--surface", s, "--indentations", "0.01,5"],
+            "indentation 5.000000e0 is beyond full contact (the gap closes everywhere from an indentation of",
+        ),
+        // The message names the quantity given: a force, not the mean pressure 5.
+        (
+            vec!["--surface", s, "--forces", "20", "--size", "2"],
+            "force 2.000000e1 is beyond full contact (the gap closes everywhere from a force of",
+        ),
+        (
+            vec!["--surface", s, "--pressures", "0.01", "--max-iter", "0"],
+            "--max-iter 0: invalid max iterations: must be at least 1",
+        ),
         (
             vec![
                 "--surface",
@@ -294,13 +316,182 @@ fn bad_input_is_one_line_exit_2_and_nothing_written() {
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
         assert!(err.contains(expected), "{extra:?}: {err}");
+        assert!(!err.contains("mean pressure 5"), "{extra:?}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{extra:?}: {err}");
         assert!(!csv.exists(), "{extra:?} wrote the CSV");
         assert!(!fields.exists(), "{extra:?} wrote fields");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            4,
+            "{extra:?} left files in {}",
+            dir.path().display()
+        );
     }
     // A missing load flag is a usage error (clap: exit 2).
     let out = asperity(&["bem", "--surface", s]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// A `.npy` file with a float64 header of `shape` and no data.
+fn npy_header_only(shape: &[usize]) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let mut dict = format!(
+        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}), }}",
+        dims.join(", ")
+    );
+    while (10 + dict.len() + 1) % 64 != 0 {
+        dict.push(' ');
+    }
+    dict.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((dict.len() as u16).to_le_bytes());
+    bytes.extend(dict.as_bytes());
+    bytes.extend([0u8; 64]);
+    bytes
+}
+
+/// Every file under `dir`, recursively (relative paths, sorted).
+fn tree(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files.push(path.strip_prefix(dir).unwrap().to_path_buf());
+            files.extend(
+                tree(&path)
+                    .into_iter()
+                    .map(|p| path.strip_prefix(dir).unwrap().join(p)),
+            );
+        } else {
+            files.push(path.strip_prefix(dir).unwrap().to_path_buf());
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn bad_output_paths_and_late_errors_leave_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let before = tree(dir.path());
+    let existing_dir = dir.path().join("a_dir");
+    std::fs::create_dir(&existing_dir).unwrap();
+    let before_with_dir = tree(dir.path());
+    let path = |p: &str| dir.path().join(p).to_str().unwrap().to_string();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        // --out in a folder that does not exist: refused before solving, so the fields
+        // (which would come first) are not written either.
+        (
+            vec![
+                "--pressures".into(),
+                "0.01".into(),
+                "--out".into(),
+                path("nodir/o.csv"),
+                "--fields".into(),
+                path("f3"),
+            ],
+            "does not exist",
+        ),
+        // --out an existing folder, even with --force.
+        (
+            vec![
+                "--pressures".into(),
+                "0.01".into(),
+                "--out".into(),
+                path("a_dir"),
+                "--force".into(),
+                "--fields".into(),
+                path("f3"),
+            ],
+            "is a directory",
+        ),
+        // A late error (the third load is beyond full contact) after two loads' fields were
+        // written to temporary files, in folders created for them: all removed.
+        (
+            vec![
+                "--pressures".into(),
+                "0.01,0.02,1e4".into(),
+                "--out".into(),
+                path("o.csv"),
+                "--fields".into(),
+                path("new/nested/f"),
+            ],
+            "full contact",
+        ),
+        // The same under displacement control.
+        (
+            vec![
+                "--indentations".into(),
+                "0.01,5".into(),
+                "--out".into(),
+                path("o.csv"),
+                "--fields".into(),
+                path("f"),
+            ],
+            "beyond full contact",
+        ),
+        // --out named as one of the field files.
+        (
+            vec![
+                "--pressures".into(),
+                "0.01".into(),
+                "--out".into(),
+                path("a_dir/gap_0.npy"),
+                "--fields".into(),
+                path("a_dir"),
+            ],
+            "--fields output",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["bem", "--surface", s];
+        args.extend(extra.iter().map(|a| a.as_str()));
+        let out = asperity(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(expected), "{extra:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{extra:?}: {err}");
+        assert_eq!(tree(dir.path()), before_with_dir, "{extra:?} left files");
+    }
+    std::fs::remove_dir(&existing_dir).unwrap();
+    assert_eq!(tree(dir.path()), before);
+
+    // Forced over existing outputs, a late error keeps the old files as they were.
+    let csv = dir.path().join("o.csv");
+    let fields = dir.path().join("f");
+    let ok = [
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.01,0.02",
+        "--out",
+        csv.to_str().unwrap(),
+        "--fields",
+        fields.to_str().unwrap(),
+    ];
+    assert!(asperity(&ok).status.success());
+    let written = tree(dir.path());
+    let old_csv = std::fs::read(&csv).unwrap();
+    let old_gap = std::fs::read(fields.join("gap_1.npy")).unwrap();
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.03,1e4",
+        "--out",
+        csv.to_str().unwrap(),
+        "--fields",
+        fields.to_str().unwrap(),
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_eq!(tree(dir.path()), written, "temporary files left");
+    assert_eq!(std::fs::read(&csv).unwrap(), old_csv);
+    assert_eq!(std::fs::read(fields.join("gap_1.npy")).unwrap(), old_gap);
 }
 
 #[test]

@@ -275,10 +275,11 @@ pub fn read_npy_2d(path: &Path) -> Result<Array2<f64>> {
 /// lets a caller check the memory a file will need before reading it.
 pub fn npy_shape(path: &Path) -> Result<Vec<usize>> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let header = Header::from_reader(&mut BufReader::new(file)).map_err(|e| Error::BadArrayFile {
-        path: path.to_path_buf(),
-        reason: format!("not a readable .npy array ({e})"),
-    })?;
+    let header =
+        Header::from_reader(&mut BufReader::new(file)).map_err(|e| Error::BadArrayFile {
+            path: path.to_path_buf(),
+            reason: format!("not a readable .npy array ({e})"),
+        })?;
     Ok(header.shape)
 }
 
@@ -390,8 +391,13 @@ mod tests {
         batch.create_dir_all(&fields).unwrap();
         let a = array![[1.0, 2.0], [3.0, 4.0]];
         batch.write_npy_2d(&fields.join("p.npy"), a.view()).unwrap();
-        batch.write_bytes(&dir.path().join("t.csv"), b"t\n").unwrap();
-        assert!(!dir.path().join("t.csv").exists(), "nothing before the commit");
+        batch
+            .write_bytes(&dir.path().join("t.csv"), b"t\n")
+            .unwrap();
+        assert!(
+            !dir.path().join("t.csv").exists(),
+            "nothing before the commit"
+        );
         batch.commit().unwrap();
         assert_eq!(read_npy_2d(&fields.join("p.npy")).unwrap(), a);
         assert_eq!(std::fs::read(dir.path().join("t.csv")).unwrap(), b"t\n");

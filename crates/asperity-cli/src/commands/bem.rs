@@ -1,9 +1,11 @@
 //! `asperity bem`: 3D boundary-element contact of a rough surface (Polonsky–Keer on FFTs)
 //! at one or more loads, with the contact stiffness by the frozen contact set.
 //!
-//! Everything is checked before the first solve (surface, parameters, outputs), all loads
-//! are solved, and only then are the CSV and the field files written (atomically), so an
-//! error leaves nothing behind.
+//! Everything is checked before the first solve (surface and the memory it needs,
+//! parameters, every output path). The field files of each load go to temporary files as
+//! soon as it is solved (no copies kept in memory); the CSV and the fields are renamed into
+//! place together only after the last load, and any error removes the temporary files, so
+//! an error leaves nothing behind.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -11,9 +13,9 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
 use asperity::elastic::Boundary;
-use asperity::io::{ensure_new_output, read_npy_2d, sidecar_path, write_npy_2d};
+use asperity::io::{ensure_new_output, npy_shape, read_npy_2d, sidecar_path, OutputBatch};
+use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
-use ndarray::Array2;
 
 use crate::output::{format_number, Table};
 use crate::progress::Progress;
@@ -198,10 +200,30 @@ fn field_paths(dir: &Path, count: usize) -> Vec<(PathBuf, PathBuf)> {
         .collect()
 }
 
+/// Checks an output file before any work: it is not a folder, it is new unless `force`,
+/// and (`parent_must_exist`) its folder exists.
+fn check_output_file(flag: &str, path: &Path, force: bool, parent_must_exist: bool) -> Result<()> {
+    if path.is_dir() {
+        bail!("{flag} {}: is a directory", path.display());
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if parent_must_exist && !parent.is_dir() {
+        bail!(
+            "{flag} {}: folder {} does not exist",
+            path.display(),
+            parent.display()
+        );
+    }
+    ensure_new_output(path, force)?;
+    Ok(())
+}
+
 struct Row {
     values: Vec<f64>,
     stiffness: Option<f64>,
-    fields: Option<(Array2<f64>, Array2<f64>)>,
 }
 
 /// Runs `asperity bem`.
@@ -222,17 +244,48 @@ pub fn run(args: &BemArgs) -> Result<()> {
     if !(args.tol.is_finite() && args.tol > 0.0) {
         bail!("--tol must be positive and finite, got {}", args.tol);
     }
+    let params = SolverParams {
+        tolerance: args.tol,
+        max_iterations: args.max_iter,
+        ..SolverParams::default()
+    };
+    params
+        .validate()
+        .with_context(|| format!("--max-iter {}", args.max_iter))?;
     if let Some(out) = &args.out {
-        ensure_new_output(out, args.force)?;
+        check_output_file("--out", out, args.force, true)?;
     }
-    if let Some(dir) = &args.fields {
+    let fields = args
+        .fields
+        .as_ref()
+        .map(|dir| field_paths(dir, loads.len()));
+    if let (Some(dir), Some(fields)) = (&args.fields, &fields) {
         if dir.exists() && !dir.is_dir() {
             bail!("--fields {}: exists and is not a directory", dir.display());
         }
-        for (p, g) in field_paths(dir, loads.len()) {
-            ensure_new_output(&p, args.force)?;
-            ensure_new_output(&g, args.force)?;
+        for (p, g) in fields {
+            // DIR and its missing parents are created just before the first solve.
+            check_output_file("--fields", p, args.force, false)?;
+            check_output_file("--fields", g, args.force, false)?;
+            if args.out.as_ref().is_some_and(|out| out == p || out == g) {
+                bail!("--out {}: is also a --fields output", p.display());
+            }
         }
+    }
+    // Memory, from the file's header before its data is read: the solver plus the heights,
+    // alive while the solver is built (the fields go to files as they are solved).
+    let shape = npy_shape(&args.surface)?;
+    if let [rows, cols] = shape[..] {
+        let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
+            .zip(array_bytes(&[rows, cols], 8))
+            .and_then(|(solver, heights)| solver.checked_add(heights));
+        ensure_fits(
+            &format!(
+                "asperity bem on a {rows}x{cols} surface ({} boundaries)",
+                boundary.name()
+            ),
+            bytes,
+        )?;
     }
     let size = args
         .size
@@ -241,11 +294,6 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let heights = read_npy_2d(&args.surface)?;
     let surface =
         Surface::new(heights, size).with_context(|| format!("{}", args.surface.display()))?;
-    let params = SolverParams {
-        tolerance: args.tol,
-        max_iterations: args.max_iter.max(1),
-        ..SolverParams::default()
-    };
     let half_space = HalfSpace {
         modulus: args.modulus,
         boundary,
@@ -253,6 +301,12 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let mut solver = ContactSolver::new(&surface, half_space, params)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
+    // Outputs: temporary files from now on, renamed into place at the end; dropped (and
+    // removed, with the --fields folder if it was created here) on any error.
+    let mut batch = OutputBatch::new(args.force);
+    if let Some(dir) = &args.fields {
+        batch.create_dir_all(dir)?;
+    }
 
     // 2. Solve every load (warm starts in the given order).
     let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
@@ -294,15 +348,11 @@ pub fn run(args: &BemArgs) -> Result<()> {
                 peak_rss_mib().unwrap_or(f64::NAN),
             ]);
         }
-        let fields = args
-            .fields
-            .as_ref()
-            .map(|_| (solver.pressure().to_owned(), solver.gap().to_owned()));
-        rows.push(Row {
-            values,
-            stiffness,
-            fields,
-        });
+        if let Some((p_path, g_path)) = fields.as_ref().map(|f| &f[k]) {
+            batch.write_npy_2d(p_path, solver.pressure())?;
+            batch.write_npy_2d(g_path, solver.gap())?;
+        }
+        rows.push(Row { values, stiffness });
         progress.inc();
     }
     progress.finish();
@@ -331,24 +381,18 @@ pub fn run(args: &BemArgs) -> Result<()> {
             })
             .collect()
     };
-    if let Some(dir) = &args.fields {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        for (row, (p_path, g_path)) in rows.iter().zip(field_paths(dir, rows.len())) {
-            if let Some((pressure, gap)) = &row.fields {
-                write_npy_2d(&p_path, args.force, pressure)?;
-                write_npy_2d(&g_path, args.force, gap)?;
-            }
+    if let Some(out) = &args.out {
+        let mut table = Table::new(&header);
+        for row in &rows {
+            table.push(&format_row(row));
         }
+        table
+            .write_into(&mut batch, out)
+            .with_context(|| format!("writing {}", out.display()))?;
     }
+    batch.commit()?;
     match &args.out {
         Some(out) => {
-            let mut table = Table::new(&header);
-            for row in &rows {
-                table.push(&format_row(row));
-            }
-            table
-                .write(out, args.force)
-                .with_context(|| format!("writing {}", out.display()))?;
             if !args.quiet {
                 eprintln!("wrote {} ({} loads)", out.display(), rows.len());
             }

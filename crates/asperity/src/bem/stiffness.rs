@@ -356,8 +356,7 @@ mod tests {
             tolerance: 1e-11,
             ..SolverParams::default()
         };
-        let mut solver =
-            ContactSolver::new(&surface, half_space(Boundary::Free), params).unwrap();
+        let mut solver = ContactSolver::new(&surface, half_space(Boundary::Free), params).unwrap();
         let (s, _) = solver.solve(Control::Indentation(1e-3)).unwrap();
         let (k, _) = solver.frozen_set_stiffness().unwrap();
         let a = (s.contact_points as f64 * dx * dx / PI).sqrt();
