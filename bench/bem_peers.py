@@ -16,13 +16,19 @@ solver) in its own process so that peak memory (VmHWM) is per solve:
 Indentation of the peers is computed the same way as asperity's: apply the code's own
 elastic operator to its pressure and average u + f over the contact set (f = max h − h).
 
+results.json holds {"environment": ..., "results": [...]}: the environment records the
+peers' installed versions, the asperity git commit (and whether the tree was dirty), the
+date, `nproc` and the load average, so that a table can be traced to what produced it.
+
 Usage: bench/bem_peers.py --asperity target/release/asperity --out bench/out
 """
 
 import argparse
 import csv
+import datetime
 import json
 import os
+import platform
 import re
 import subprocess
 import sys
@@ -157,6 +163,41 @@ def run_peer(code, surface, boundary, pressure, tol, timeout):
     return result
 
 
+def command_output(cmd):
+    """stdout of `cmd`, stripped; None when it cannot run or fails."""
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return proc.stdout.strip() if proc.returncode == 0 else None
+
+
+def environment(asperity_exe):
+    """What produced the results: versions, commit, date, cores."""
+    from importlib import metadata
+
+    def version(package):
+        try:
+            return metadata.version(package)
+        except metadata.PackageNotFoundError:
+            return None
+
+    repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    dirty = command_output(["git", "-C", repo, "status", "--porcelain", "--untracked-files=no"])
+    nproc = command_output(["nproc"])
+    return {
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "asperity_commit": command_output(["git", "-C", repo, "rev-parse", "HEAD"]),
+        "asperity_tree_dirty": None if dirty is None else bool(dirty),
+        "asperity_version": command_output([asperity_exe, "--version"]),
+        "peers": {package: version(package) for package in ("tamaas", "ContactMechanics", "numpy")},
+        "python": platform.python_version(),
+        "nproc": int(nproc) if nproc and nproc.isdigit() else os.cpu_count(),
+        "loadavg": list(os.getloadavg()),
+        "platform": platform.platform(),
+    }
+
+
 def padded_minimum_mib(n, boundary):
     """Memory a padded-FFT Polonsky-Keer solve cannot do without: one half spectrum of the
     (padded) grid, the unique values of the real even kernel spectrum and four N² fields
@@ -193,6 +234,8 @@ def main():
         worker(args)
         return
     os.makedirs(args.out, exist_ok=True)
+    env = environment(args.asperity)
+    print(json.dumps({"environment": env}), flush=True)
     results = []
     # asperity's fixed memory (binary, allocator): peak RSS of a 16² solve.
     tiny = os.path.join(args.out, "surface_16.npy")
@@ -221,8 +264,9 @@ def main():
                               "padded_minimum_mib": padded_minimum_mib(n, boundary)})
                     results.append(r)
                     print(json.dumps(r), flush=True)
+    env["loadavg_end"] = list(os.getloadavg())
     with open(os.path.join(args.out, "results.json"), "w") as fh:
-        json.dump(results, fh, indent=1)
+        json.dump({"environment": env, "results": results}, fh, indent=1)
     print_table(results)
 
 

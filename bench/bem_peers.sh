@@ -9,7 +9,9 @@ if [ ! -x bench/.venv/bin/python ]; then
     python3 -m venv bench/.venv
     bench/.venv/bin/pip install --quiet --upgrade pip
 fi
-bench/.venv/bin/pip install --quiet tamaas ContactMechanics numpy
+# Pinned: the versions the published table (README, docs/bem.md) was measured with;
+# bem_peers.py records what is installed in its results.json.
+bench/.venv/bin/pip install --quiet tamaas==2.9.0 ContactMechanics==1.8.3 numpy
 cargo build --release -p asperity-cli
 # Both peers and asperity get the machine's cores (tamaas' PyPI wheel is serial, its
 # "cpp" backend; numpy FFTs in ContactMechanics are serial too).
