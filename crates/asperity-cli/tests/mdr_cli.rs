@@ -292,8 +292,59 @@ fn non_positive_spacing_is_refused() {
         );
         assert_refused(&out, "dx");
     }
-    let out = asperity(&["mdr", "--line", "missing.npy", "--size", "0"], dir.path());
-    assert_eq!(out.status.code(), Some(2));
+    // A line that exists, so that the size (not a missing file) is what is refused.
+    write_line(
+        &dir.path().join("l.npy"),
+        (0..64).map(|i| (i as f64).sin()).collect(),
+    );
+    for size in ["0", "-1"] {
+        let out = asperity(&["mdr", "--line", "l.npy", "--size", size], dir.path());
+        assert_refused(&out, "size");
+    }
+}
+
+#[test]
+fn negative_indentation_range_is_refused_by_the_range_check() {
+    // Without allow_negative_numbers clap would read "-1" as an unknown flag.
+    let dir = tempfile::tempdir().unwrap();
+    let base = [
+        "mdr",
+        "--profile",
+        "hertz",
+        "--radius",
+        "1",
+        "--n",
+        "11",
+        "--dx",
+        "0.1",
+    ];
+    for (flag, needle) in [("--dmin", "--dmin"), ("--dmax", "--dmax")] {
+        let mut args = base.to_vec();
+        args.extend([flag, "-1"]);
+        let out = asperity(&args, dir.path());
+        assert_refused(&out, needle);
+        assert!(
+            stderr(&out).contains("-1") && !stderr(&out).contains("unexpected argument"),
+            "{}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
+fn missing_required_arguments_are_named() {
+    // clap's multi-line message is folded into one line that keeps the missing names.
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &["mdr", "--radial", "tip.npy", "--n", "5", "--dx", "1e-3"],
+        dir.path(),
+    );
+    assert_refused(&out, "--radial-step");
+    assert_refused(&out, "not provided");
+    // `bem` without any load flag names the load options it needs.
+    let out = asperity(&["bem", "--surface", "s.npy"], dir.path());
+    assert_refused(&out, "not provided");
+    assert_refused(&out, "--forces");
 }
 
 #[test]

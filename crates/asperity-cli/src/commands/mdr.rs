@@ -112,10 +112,10 @@ pub struct MdrArgs {
     #[arg(long, conflicts_with = "breakpoints")]
     pub nloads: Option<usize>,
     /// Smallest indentation for --nloads (default --dmax · 1e-6).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dmin: Option<f64>,
     /// Largest indentation for --nloads (default: full contact, the largest finite gap).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dmax: Option<f64>,
     /// Linear springs on a line: write the exact curve, one row per contact count (the
     /// breakpoints where each spring first touches).
