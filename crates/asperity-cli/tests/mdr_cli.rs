@@ -473,3 +473,47 @@ fn reproduce_book_figures() {
         "linear springs far off: {first:?}"
     );
 }
+
+#[test]
+fn alpha_theory_column_uses_eq_24_at_h_zero() {
+    // The paper derives eq. (24) for H = 0 ("valid not only for H = 0, but also for smaller
+    // values"), so the theory column at H = 0 is (1 + log2 N)/(3 + log2 N), not 1/(1+0).
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &[
+            "study",
+            "alpha",
+            "--method",
+            "mdr",
+            "--n",
+            "1024",
+            "--hurst",
+            "-0.5:0.5:0.5",
+            "--samples",
+            "4",
+            "--quiet",
+            "--out",
+            "a",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(dir.path().join("a/alpha.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (hurst, theory) = (col("hurst"), col("alpha_theory"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[hurst].parse().unwrap(), f[theory].parse().unwrap())
+        })
+        .collect();
+    let eq24 = 11.0 / 13.0; // log2 1024 = 10
+    let expected = [(-0.5, eq24), (0.0, eq24), (0.5, 1.0 / 1.5)];
+    assert_eq!(rows.len(), expected.len(), "{csv}");
+    for ((h, t), (eh, et)) in rows.iter().zip(expected) {
+        assert_eq!(*h, eh);
+        assert!((t - et).abs() < 1e-6, "H = {h}: theory {t}, expected {et}");
+    }
+}
