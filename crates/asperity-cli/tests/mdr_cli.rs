@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use asperity::reference::Hertz;
+use asperity::reference::{FlatPunch, Hertz, PowerLaw};
 use ndarray::Array1;
 use ndarray_npy::WriteNpyExt;
 
@@ -515,5 +515,118 @@ fn alpha_theory_column_uses_eq_24_at_h_zero() {
     for ((h, t), (eh, et)) in rows.iter().zip(expected) {
         assert_eq!(*h, eh);
         assert!((t - et).abs() < 1e-6, "H = {h}: theory {t}, expected {et}");
+    }
+}
+
+#[test]
+fn flat_punch_profile_has_stiffness_two_modulus_radius() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |radius: &str, name: &str| {
+        let out = asperity(
+            &[
+                "mdr",
+                "--profile",
+                "punch",
+                "--radius",
+                radius,
+                "--n",
+                "401",
+                "--dx",
+                "1e-3",
+                "--modulus",
+                "0.8",
+                "--indentations",
+                "1e-6,0.01,0.3",
+                "--out",
+                name,
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_curve(&dir.path().join(name))
+    };
+    for (radius, springs) in [(0.1, 201), (0.0375, 75), (0.0505, 101)] {
+        let punch = FlatPunch {
+            radius,
+            modulus: 0.8,
+        };
+        let rows = run(&radius.to_string(), &format!("p{radius}.csv"));
+        assert_eq!(rows.len(), 3);
+        for (d, force, stiffness, contacts) in rows {
+            // 2m+1 springs of E*Δx for a = mΔx (edge springs included): k = 2E*(a + Δx/2),
+            // off by Δx/(2a) ≤ Δx/a; exact for a = (m+½)Δx.
+            assert_eq!(contacts, springs, "a = {radius}");
+            let tolerance = 1e-3 / radius;
+            assert!(
+                (stiffness / punch.stiffness() - 1.0).abs() <= tolerance,
+                "a = {radius}: k = {stiffness} vs {}",
+                punch.stiffness()
+            );
+            assert!((force / punch.force(d) - 1.0).abs() <= tolerance, "d = {d}");
+        }
+    }
+    // Without --dmax or --indentations a punch has no range of indentations.
+    let out = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "punch",
+            "--radius",
+            "0.1",
+            "--n",
+            "401",
+            "--dx",
+            "1e-3",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, "--indentations");
+}
+
+#[test]
+fn power_law_profile_matches_its_closed_form() {
+    // f = c r³: g = κ(3) c |x|³ with κ(3) = 3π/4; F = 2E* n/(n+1) d a, k = 2E*a.
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "power",
+            "--coefficient",
+            "0.5",
+            "--exponent",
+            "3",
+            "--n",
+            "4001",
+            "--dx",
+            "1e-3",
+            "--modulus",
+            "1.5",
+            "--indentations",
+            "0.15,0.5,1.1",
+            "--out",
+            "p.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let power = PowerLaw {
+        coefficient: 0.5,
+        exponent: 3.0,
+        modulus: 1.5,
+    };
+    assert!((power.stretch() - 0.75 * std::f64::consts::PI).abs() < 1e-12);
+    let rows = read_curve(&dir.path().join("p.csv"));
+    assert_eq!(rows.len(), 3);
+    for (d, force, stiffness, _) in rows {
+        // a ≥ 0.5 = 500 Δx: the discrete contact edge costs at most Δx/a = 0.2 %.
+        let a = power.contact_radius(d);
+        assert!(a >= 0.5 && a < 2.0, "a = {a} inside the springs");
+        assert!((force / power.force(d) - 1.0).abs() < 1e-3 / a, "d = {d}");
+        assert!(
+            (stiffness / power.stiffness(d) - 1.0).abs() < 1e-3 / a,
+            "d = {d}: k = {stiffness} vs {}",
+            power.stiffness(d)
+        );
     }
 }
