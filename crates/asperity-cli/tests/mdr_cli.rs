@@ -630,3 +630,46 @@ fn power_law_profile_matches_its_closed_form() {
         );
     }
 }
+
+#[test]
+fn sizes_that_cannot_fit_in_memory_are_refused() {
+    // 1e15 springs need 16 PB; usize::MAX overflows the byte count. Both are refused with
+    // one line before anything is allocated (they used to abort with status 134).
+    let dir = tempfile::tempdir().unwrap();
+    for n in ["1000000000000000", &usize::MAX.to_string()] {
+        let out = asperity(
+            &[
+                "mdr",
+                "--profile",
+                "hertz",
+                "--radius",
+                "1",
+                "--n",
+                n,
+                "--dx",
+                "1e-3",
+            ],
+            dir.path(),
+        );
+        assert_refused(&out, "MiB");
+        assert_refused(&out, "--n");
+    }
+    let out = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "11",
+            "--dx",
+            "0.1",
+            "--nloads",
+            "1000000000000000",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, "--nloads");
+    assert_refused(&out, "MiB");
+}

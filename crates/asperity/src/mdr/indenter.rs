@@ -149,7 +149,11 @@ fn check_grid(n: usize, spacing: f64) -> Result<()> {
             format!("the spring spacing Δx must be positive and finite, got {spacing}"),
         ));
     }
-    Ok(())
+    // The sampled profile is one f64 per spring; refuse it before allocating.
+    crate::memory::ensure_fits(
+        &format!("a profile of {n} springs"),
+        crate::memory::array_bytes(&[n], std::mem::size_of::<f64>()),
+    )
 }
 
 /// The symmetric spring positions `x_i = (i − (n−1)/2)·Δx`, `i = 0..n`.
@@ -357,6 +361,18 @@ mod tests {
         let short = sampled(|r| r, 0.1, 11);
         assert!(short.sample(31, 0.1).is_err());
         assert!(short.sample(21, 0.1).is_ok());
+    }
+
+    #[test]
+    fn a_profile_that_cannot_fit_is_refused_before_allocating() {
+        for n in [1usize << 60, usize::MAX] {
+            let err = Axisymmetric::Sphere { radius: 1.0 }
+                .sample(n, 0.1)
+                .unwrap_err();
+            assert!(matches!(err, Error::OutOfMemory { .. }), "{err}");
+            let err = sampled(|r| r, 0.1, 11).sample(n, 0.1).unwrap_err();
+            assert!(matches!(err, Error::OutOfMemory { .. }), "{err}");
+        }
     }
 
     #[test]
