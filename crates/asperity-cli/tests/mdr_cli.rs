@@ -164,6 +164,25 @@ fn line_breakpoints_and_log_spaced_loads() {
     assert!(rows
         .windows(2)
         .all(|w| w[1].0 >= w[0].0 && w[1].1 >= w[0].1));
+    // At d = 0 --indentations counts springs compressed at d: none (the breakpoint row
+    // above counts the spring just touching). Documented in --help for --breakpoints.
+    let out = asperity(
+        &[
+            "mdr",
+            "--line",
+            "l.npy",
+            "--indentations",
+            "0",
+            "--out",
+            "z.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        read_curve(&dir.path().join("z.csv")),
+        vec![(0.0, 0.0, 0.0, 0)]
+    );
     let out = asperity(
         &["mdr", "--line", "l.npy", "--nloads", "12", "--out", "n.csv"],
         dir.path(),
@@ -414,6 +433,11 @@ fn help_has_examples() {
     assert!(out.status.success());
     assert!(
         text.contains("Examples:") && text.contains("--breakpoints"),
+        "{text}"
+    );
+    // The two meanings of `contacts` are stated: just after a breakpoint vs at d.
+    assert!(
+        text.contains("just after the breakpoint") && text.contains("compressed at d"),
         "{text}"
     );
 }

@@ -118,8 +118,12 @@ pub struct MdrArgs {
     /// Largest indentation for --nloads (default: full contact, the largest finite gap).
     #[arg(long, allow_negative_numbers = true)]
     pub dmax: Option<f64>,
-    /// Linear springs on a line: write the exact curve, one row per contact count (the
-    /// breakpoints where each spring first touches).
+    /// Linear springs on a line: write the exact curve, one row per contact count j = 1..N
+    /// (the breakpoints d_j where the j-th spring first touches). Here `stiffness` and
+    /// `contacts` are those just after the breakpoint: contacts = j counts the spring that
+    /// is just touching (k = E*·Δx·j), so the first row is d = 0, F = 0, contacts = 1. With
+    /// --indentations/--nloads `contacts` counts springs compressed at d (u > 0): at d = 0
+    /// that is 0, and k = 0.
     #[arg(long)]
     pub breakpoints: bool,
     /// Output CSV (default: standard output).
