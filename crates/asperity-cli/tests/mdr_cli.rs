@@ -721,7 +721,7 @@ fn power_law_profile_matches_its_closed_form() {
     for (d, force, stiffness, _) in rows {
         // a ≥ 0.5 = 500 Δx: the discrete contact edge costs at most Δx/a = 0.2 %.
         let a = power.contact_radius(d);
-        assert!(a >= 0.5 && a < 2.0, "a = {a} inside the springs");
+        assert!((0.5..2.0).contains(&a), "a = {a} inside the springs");
         assert!((force / power.force(d) - 1.0).abs() < 1e-3 / a, "d = {d}");
         assert!(
             (stiffness / power.stiffness(d) - 1.0).abs() < 1e-3 / a,
