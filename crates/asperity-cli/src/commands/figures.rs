@@ -246,9 +246,10 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
          Files: `alpha.csv`, `alpha.png`, `alpha.svg` (both methods with the theory curves);\n\
          `mdr/` and `bem/` hold each method's table, plot and checkpoint.\n\n\
          ## The paper's values beside ours\n\
-         The paper: α = 1/3 for H > 2 (Hertz), α = 1/(1+H) for 0 < H < 2 (eq. 6), and for H < 0 an\n\
-         N-dependent α ≈ 0.9 given by eq. (24), α = (1 + log2 N)/(3 + log2 N). Column *theory*\n\
-         is that value for each row.\n\n{}\n",
+         The paper: α = 1/3 for H > 2 (Hertz), α = 1/(1+H) for 0 < H < 2 (eq. 6), and for H ≤ 0 an\n\
+         N-dependent α ≈ 0.9 given by eq. (24), α = (1 + log2 N)/(3 + log2 N), derived for H = 0 and\n\
+         \"valid not only for H = 0, but also for smaller values\". Column *theory* is that value\n\
+         for each row (eq. 24 at H = 0, not 1/(1+0) = 1).\n\n{}\n",
         setting(quick),
         mdr.sizes,
         mdr.samples,
