@@ -24,7 +24,7 @@ pub struct SpectrumArgs {
     /// Side length L (units of the heights).
     #[arg(long, default_value_t = 1.0)]
     pub size: f64,
-    /// Random seed; the same seed gives bit-identical heights on any machine and thread count.
+    /// Random seed; the same seed gives bit-identical heights whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Output file (.npy, float64); a JSON sidecar FILE.npy.json records every parameter.
