@@ -313,7 +313,7 @@ impl LineGenerator {
             *value = amplitude * random_phase(&mut rng);
         }
         self.spectrum[0] = Complex64::default();
-        if n % 2 == 0 {
+        if n.is_multiple_of(2) {
             let v = &mut self.spectrum[n / 2];
             *v = Complex64::new(v.norm() * random_sign(&mut rng), 0.0);
         }
