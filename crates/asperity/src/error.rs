@@ -28,6 +28,15 @@ pub enum Error {
     /// A file exists where an output should go and overwriting was not allowed.
     #[error("{0}: output already exists (use --force to overwrite)")]
     OutputExists(PathBuf),
+    /// An output path cannot be written: its folder is missing, it is a folder, it is
+    /// named twice among one command's outputs, or it is the command's input.
+    #[error("{path}: {reason}")]
+    BadOutput {
+        /// The output concerned.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A `.npy` file could not be read as the array that was expected.
     #[error("{path}: {reason}")]
     BadArrayFile {
