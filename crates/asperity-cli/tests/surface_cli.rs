@@ -177,3 +177,46 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
     assert!(out.status.success());
     assert_ne!(std::fs::read(d.join("s.npy")).unwrap(), before);
 }
+
+#[test]
+fn a_failing_output_leaves_no_other_output_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["surface", "--n", "16", "--hurst", "0.5", "--out", "a.npy"];
+    // The image cannot be written (its folder is missing): nor are the array and sidecar.
+    let out = asperity(&[&base[..], &["--png", "missing/a.png"]].concat(), d);
+    assert_refused(&out, d, 0, "does not exist");
+    let absolute = d.join("nowhere").join("a.png");
+    let out = asperity(
+        &[&base[..], &["--png", absolute.to_str().unwrap()]].concat(),
+        d,
+    );
+    assert_refused(&out, d, 0, "does not exist");
+    // The image would overwrite the array or its sidecar (also with --force).
+    for twin in ["a.npy", "./a.npy", "a.npy.json"] {
+        let out = asperity(&[&base[..], &["--png", twin]].concat(), d);
+        assert_refused(&out, d, 0, "same file");
+        let out = asperity(&[&base[..], &["--png", twin, "--force"]].concat(), d);
+        assert_refused(&out, d, 0, "same file");
+    }
+    // An output that is a folder.
+    std::fs::create_dir(d.join("folder.png")).unwrap();
+    let out = asperity(
+        &[&base[..], &["--png", "folder.png", "--force"]].concat(),
+        d,
+    );
+    assert_refused(&out, d, 1, "is a folder");
+    let out = asperity(
+        &["line", "--n", "16", "--hurst", "0.5", "--out", "no/l.npy"],
+        d,
+    );
+    assert_refused(&out, d, 1, "does not exist");
+    // stats --psd: into a missing folder, or over its own input.
+    assert!(asperity(&base, d).status.success());
+    let out = asperity(&["stats", "a.npy", "--psd", "no/psd.csv"], d);
+    assert_refused(&out, d, 3, "does not exist");
+    let before = std::fs::read(d.join("a.npy")).unwrap();
+    let out = asperity(&["stats", "a.npy", "--psd", "a.npy", "--force"], d);
+    assert_refused(&out, d, 3, "input");
+    assert_eq!(std::fs::read(d.join("a.npy")).unwrap(), before);
+}

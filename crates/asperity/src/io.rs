@@ -130,13 +130,15 @@ impl StagedOutputs {
             let path = path.as_ref();
             let key = checked_output_key(path, force)?;
             if let Some(other) = entries.iter().find(|e| e.key == key) {
-                return Err(bad_output(
-                    path,
+                let reason = if other.target == path {
+                    "is the same file as another output; each output needs its own file".into()
+                } else {
                     format!(
                         "is the same file as the output {}; each output needs its own file",
                         other.target.display()
-                    ),
-                ));
+                    )
+                };
+                return Err(bad_output(path, reason));
             }
             entries.push(Staged {
                 target: path.to_path_buf(),
@@ -537,7 +539,12 @@ mod tests {
     fn atomic_write_into_a_missing_folder_is_a_clear_error() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("no").join("x.csv");
-        let err = write_bytes(&path, false, b"q,psd\n").unwrap_err().to_string();
-        assert!(err.contains("does not exist") && err.contains("x.csv"), "{err}");
+        let err = write_bytes(&path, false, b"q,psd\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("does not exist") && err.contains("x.csv"),
+            "{err}"
+        );
     }
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use asperity::fit::power_law_fit;
-use asperity::io::{read_npy, sidecar_path};
+use asperity::io::{read_npy, sidecar_path, StagedOutputs};
 use asperity::surface::stats::{
     line_psd, line_summary, radial_psd_2d, surface_summary, PsdBin, Summary,
 };
@@ -58,9 +58,15 @@ fn sidecar_hints(file: &std::path::Path) -> (Option<f64>, Option<f64>) {
 
 /// Runs `asperity stats`.
 pub fn run(args: &StatsArgs) -> Result<()> {
-    if let Some(psd) = &args.psd {
-        asperity::io::ensure_new_output(psd, args.force)?;
-    }
+    // The PSD output is checked before the (possibly large) input is read.
+    let mut staged = match &args.psd {
+        Some(psd) => {
+            let staged = StagedOutputs::new([psd], args.force)?;
+            staged.ensure_not_input(&args.file)?;
+            Some(staged)
+        }
+        None => None,
+    };
     let (sidecar_size, sidecar_q0) = sidecar_hints(&args.file);
     let size = args.size.or(sidecar_size).unwrap_or(1.0);
     let array = read_npy(&args.file)?;
@@ -96,13 +102,14 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         .map(|b| (b.q, b.psd))
         .unzip();
     let fit = power_law_fit(&q, &c).ok();
-    if let Some(path) = &args.psd {
+    if let (Some(path), Some(mut staged)) = (&args.psd, staged.take()) {
         let mut table = Table::new(&["q", "psd"]);
         for b in &bins {
             table.push_numbers(&[b.q, b.psd]);
         }
         table
-            .write(path, args.force)
+            .stage(&mut staged, path)
+            .and_then(|()| Ok(staged.commit()?))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
