@@ -55,15 +55,18 @@ pub enum Error {
         /// The bad value.
         value: f64,
     },
-    /// A computation would need more memory than the machine has available.
-    #[error("{what} needs about {needed_mib} MiB but only {available_mib} MiB are available")]
+    /// A computation would need more memory than is available to this process, more than
+    /// the address space can hold, or an allocation was refused.
+    #[error("{}", out_of_memory_message(.what, *.needed_mib, *.available_mib, .limited_by))]
     OutOfMemory {
         /// What was to be allocated.
         what: String,
-        /// Estimated need.
-        needed_mib: u64,
-        /// Memory available now.
-        available_mib: u64,
+        /// Estimated need in MiB (rounded up); `None` when it exceeds the address space.
+        needed_mib: Option<u64>,
+        /// Memory available now in MiB; `None` when the allocator refused the request.
+        available_mib: Option<u64>,
+        /// What sets the available figure (e.g. `cgroup memory.max`), or why it failed.
+        limited_by: String,
     },
     /// A study folder already holds the checkpoint of a different study.
     #[error("{dir}: holds the checkpoint of another study ({reason}); use another --out, or --force to discard it")]
@@ -105,6 +108,24 @@ impl Error {
         Error::Io {
             path: path.into(),
             source,
+        }
+    }
+}
+
+fn out_of_memory_message(
+    what: &str,
+    needed_mib: Option<u64>,
+    available_mib: Option<u64>,
+    limited_by: &str,
+) -> String {
+    match (needed_mib, available_mib) {
+        (None, _) => format!("{what} exceeds addressable memory"),
+        (Some(needed), Some(available)) => format!(
+            "{what} needs about {needed} MiB of memory but only {available} MiB are available \
+             (limited by {limited_by})"
+        ),
+        (Some(needed), None) => {
+            format!("{what} needs about {needed} MiB of memory, which could not be allocated ({limited_by})")
         }
     }
 }

@@ -336,6 +336,60 @@ pub fn write_npy_1d(path: &Path, force: bool, array: &Array1<f64>) -> Result<()>
     write_one(path, force, |s| s.write_npy_1d(path, array))
 }
 
+/// The shape recorded in the header of a `.npy` file, read without loading the data (to
+/// size the work before reading a large file). Only the header is checked here; the data
+/// are validated by [`read_npy`].
+pub fn read_npy_shape(path: &Path) -> Result<Vec<usize>> {
+    use std::io::Read;
+    let bad = |reason: &str| Error::BadArrayFile {
+        path: path.to_path_buf(),
+        reason: format!("not a readable .npy array ({reason})"),
+    };
+    let mut file = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    let mut preamble = [0u8; 8];
+    file.read_exact(&mut preamble)
+        .map_err(|_| bad("too short for a header"))?;
+    if &preamble[..6] != b"\x93NUMPY" {
+        return Err(bad("no NumPy magic string"));
+    }
+    let header_len = match preamble[6] {
+        1 => {
+            let mut len = [0u8; 2];
+            file.read_exact(&mut len)
+                .map_err(|_| bad("truncated header"))?;
+            u16::from_le_bytes(len) as usize
+        }
+        2 | 3 => {
+            let mut len = [0u8; 4];
+            file.read_exact(&mut len)
+                .map_err(|_| bad("truncated header"))?;
+            u32::from_le_bytes(len) as usize
+        }
+        v => return Err(bad(&format!("unknown format version {v}"))),
+    };
+    if header_len > 1 << 20 {
+        return Err(bad("header longer than 1 MiB"));
+    }
+    let mut header = vec![0u8; header_len];
+    file.read_exact(&mut header)
+        .map_err(|_| bad("truncated header"))?;
+    let header = String::from_utf8_lossy(&header);
+    parse_npy_shape(&header).ok_or_else(|| bad("no shape in the header"))
+}
+
+/// The `'shape': (a, b, ...)` entry of a `.npy` header dictionary.
+fn parse_npy_shape(header: &str) -> Option<Vec<usize>> {
+    let after = &header[header.find("'shape'")? + "'shape'".len()..];
+    let after = after.trim_start().strip_prefix(':')?.trim_start();
+    let inner = &after.strip_prefix('(')?[..after.find(')')? - 1];
+    inner
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| t.trim_end_matches('L').parse::<usize>().ok())
+        .collect()
+}
+
 /// Reads a float64 `.npy` of any dimension and checks that all values are finite.
 pub fn read_npy(path: &Path) -> Result<ArrayD<f64>> {
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
@@ -546,5 +600,28 @@ mod tests {
             err.contains("does not exist") && err.contains("x.csv"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn npy_shape_is_read_from_the_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.npy");
+        write_npy_2d(&path, false, &Array2::zeros((3, 5))).unwrap();
+        assert_eq!(read_npy_shape(&path).unwrap(), [3, 5]);
+        let line = dir.path().join("l.npy");
+        write_npy_1d(&line, false, &Array1::zeros(7)).unwrap();
+        assert_eq!(read_npy_shape(&line).unwrap(), [7]);
+        assert_eq!(
+            parse_npy_shape("{'descr': '<f8', 'fortran_order': False, 'shape': (), }"),
+            Some(vec![])
+        );
+        assert_eq!(
+            parse_npy_shape("{'shape':(1099511627776, 4), 'descr': '<f8'}"),
+            Some(vec![1 << 40, 4])
+        );
+        let junk = dir.path().join("junk.npy");
+        std::fs::write(&junk, b"hello world, not an array").unwrap();
+        let err = read_npy_shape(&junk).unwrap_err().to_string();
+        assert!(err.contains("not a readable .npy"), "{err}");
     }
 }

@@ -35,7 +35,7 @@ use std::sync::Arc;
 
 use super::{stats, validate_size, Line, Normalisation, Surface};
 use crate::fft::RealFft2;
-use crate::memory::{array_bytes, ensure_fits};
+use crate::memory::{array_bytes, ensure_fits, try_vec};
 use crate::spectrum::Psd;
 use crate::{Error, Result};
 
@@ -117,10 +117,11 @@ impl SurfaceGenerator {
     /// Plans the transforms; fails if the grid would not fit in memory.
     pub fn new(spec: &SurfaceSpec) -> Result<Self> {
         // heights (8 B) + spectrum and FFT work buffer (2 × 16 B per half-grid point).
+        let what = format!("a {}x{} surface", spec.rows, spec.cols);
         let bytes = array_bytes(&[spec.rows, spec.cols], 8 + 16 + 8);
-        ensure_fits(&format!("a {}x{} surface", spec.rows, spec.cols), bytes)?;
-        let fft = RealFft2::new(spec.rows, spec.cols);
-        let spectrum = vec![Complex64::default(); fft.spectrum_len()];
+        ensure_fits(&what, bytes)?;
+        let fft = RealFft2::new(spec.rows, spec.cols)?;
+        let spectrum = try_vec(&what, fft.spectrum_len(), Complex64::default())?;
         Ok(SurfaceGenerator {
             spec: *spec,
             fft,
@@ -144,11 +145,14 @@ impl SurfaceGenerator {
         }
     }
 
-    /// One realisation for `seed`, written into `heights` (`rows × cols`, row-major).
-    /// Fails only if the spectrum has no power on this grid (e.g. a cut-off above Nyquist).
+    /// One realisation for `seed`. Fails if the spectrum has no power on this grid (e.g. a
+    /// cut-off above Nyquist) or the heights cannot be allocated.
     pub fn try_generate(&mut self, seed: u64) -> Result<Surface> {
-        let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
-        self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))?;
+        let SurfaceSpec { rows, cols, .. } = self.spec;
+        let mut heights = try_vec(&format!("a {rows}x{cols} surface"), rows * cols, 0.0)?;
+        self.generate_into(seed, &mut heights)?;
+        let heights = ndarray::Array2::from_shape_vec((rows, cols), heights)
+            .map_err(|e| Error::invalid("grid", e.to_string()))?;
         Ok(Surface {
             heights,
             size: self.spec.size,
@@ -262,19 +266,21 @@ pub struct LineGenerator {
 impl LineGenerator {
     /// Plans the inverse real FFT of length `n` and tabulates the amplitudes `B(q)` (10).
     pub fn new(spec: &LineSpec) -> Result<Self> {
-        ensure_fits(
-            &format!("a line of {} points", spec.n),
-            array_bytes(&[spec.n], 8 + 16 + 16),
-        )?;
+        let what = format!("a line of {} points", spec.n);
+        ensure_fits(&what, array_bytes(&[spec.n], 8 + 16 + 16))?;
         let c2r = RealFftPlanner::<f64>::new().plan_fft_inverse(spec.n);
         let half = spec.n / 2 + 1;
-        let amplitudes = (0..half).map(|k| spec.psd.c1d(k as f64).sqrt()).collect();
-        let scratch = vec![Complex64::default(); c2r.get_scratch_len()];
+        let mut amplitudes = try_vec(&what, half, 0.0)?;
+        for (k, a) in amplitudes.iter_mut().enumerate() {
+            *a = spec.psd.c1d(k as f64).sqrt();
+        }
+        let scratch = try_vec(&what, c2r.get_scratch_len(), Complex64::default())?;
+        let spectrum = try_vec(&what, half, Complex64::default())?;
         Ok(LineGenerator {
             spec: *spec,
             c2r,
             amplitudes,
-            spectrum: vec![Complex64::default(); half],
+            spectrum,
             scratch,
         })
     }
@@ -295,10 +301,13 @@ impl LineGenerator {
         }
     }
 
-    /// One realisation for `seed`, failing if the spectrum has no power on this grid.
+    /// One realisation for `seed`, failing if the spectrum has no power on this grid or
+    /// the heights cannot be allocated.
     pub fn try_generate(&mut self, seed: u64) -> Result<Line> {
-        let mut heights = ndarray::Array1::zeros(self.spec.n);
-        self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))?;
+        let n = self.spec.n;
+        let mut heights = try_vec(&format!("a line of {n} points"), n, 0.0)?;
+        self.generate_into(seed, &mut heights)?;
+        let heights = ndarray::Array1::from_vec(heights);
         Ok(Line {
             heights,
             size: self.spec.size,
@@ -345,7 +354,7 @@ mod tests {
         let mut generator = SurfaceGenerator::new(&spec).unwrap();
         let mut mean: Vec<(f64, f64)> = Vec::new();
         for seed in 0..realisations {
-            let psd = radial_psd_2d(&generator.generate(seed));
+            let psd = radial_psd_2d(&generator.generate(seed)).unwrap();
             if mean.is_empty() {
                 mean = psd.iter().map(|b| (b.q, 0.0)).collect();
             }
@@ -419,7 +428,7 @@ mod tests {
         ] {
             let psd = Psd::new(0.8, long, None).unwrap();
             let spec = SurfaceSpec::new(64, 64, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
-            let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3));
+            let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3)).unwrap();
             let kappa = |q: f64| q / std::f64::consts::TAU;
             let at_q0 = bins
                 .iter()
@@ -509,7 +518,7 @@ mod tests {
             let s = SurfaceGenerator::new(&spec).unwrap().generate(9);
             let mean = s.heights().mean().unwrap();
             assert!(mean.abs() < 1e-12, "{rows}x{cols}: mean {mean}");
-            let mut fft = RealFft2::new(rows, cols);
+            let mut fft = RealFft2::new(rows, cols).unwrap();
             let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
             fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
             let aspect = cols as f64 / rows as f64;
