@@ -220,3 +220,177 @@ fn a_failing_output_leaves_no_other_output_behind() {
     assert_refused(&out, d, 3, "input");
     assert_eq!(std::fs::read(d.join("a.npy")).unwrap(), before);
 }
+
+fn asperity_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(dir)
+        .output()
+        .expect("run asperity")
+}
+
+#[test]
+fn memory_guard_refuses_before_writing_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let limit = [("ASPERITY_MEMORY_LIMIT_MIB", "1")];
+    let args = [
+        "surface", "--n", "2048", "--hurst", "0.5", "--out", "big.npy", "--png", "big.png",
+    ];
+    let out = asperity_env(&args, d, &limit);
+    assert_refused(&out, d, 0, "memory");
+    let err = stderr(&out);
+    assert!(
+        err.contains("128 MiB") && err.contains("ASPERITY_MEMORY_LIMIT_MIB"),
+        "{err}"
+    );
+    let out = asperity_env(
+        &["line", "--n", "1048576", "--hurst", "0.5", "--out", "l.npy"],
+        d,
+        &limit,
+    );
+    assert_refused(&out, d, 0, "memory");
+    // A malformed limit is an error, not ignored.
+    let out = asperity_env(&args, d, &[("ASPERITY_MEMORY_LIMIT_MIB", "lots")]);
+    assert_refused(&out, d, 0, "ASPERITY_MEMORY_LIMIT_MIB");
+    // stats checks the need (about 4x the file) from the header, before reading.
+    write_npy(d.join("s.npy"), &Array2::<f64>::zeros((256, 512))).unwrap();
+    let out = asperity_env(&["stats", "s.npy", "--psd", "psd.csv"], d, &limit);
+    assert_refused(&out, d, 1, "memory");
+    assert!(stderr(&out).contains("4 MiB"), "{}", stderr(&out));
+    // A generous limit changes nothing.
+    let out = asperity_env(
+        &["surface", "--n", "64", "--hurst", "0.5", "--out", "ok.npy"],
+        d,
+        &[("ASPERITY_MEMORY_LIMIT_MIB", "100000")],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn memory_guard_sees_the_address_space_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let exe = env!("CARGO_BIN_EXE_asperity");
+    // `ulimit -v` (RLIMIT_AS, in KiB): 400 MiB cannot hold a 4096² surface (512 MiB).
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 409600 && exec '{exe}' surface --n 4096 --hurst 0.5 --out big.npy"
+        ))
+        .current_dir(d)
+        .output()
+        .expect("run sh");
+    assert_refused(&out, d, 0, "RLIMIT_AS");
+}
+
+#[test]
+fn huge_grids_exceed_addressable_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = asperity(
+        &[
+            "surface",
+            "--n",
+            "4294967296",
+            "--m",
+            "4294967296",
+            "--hurst",
+            "0.5",
+            "--out",
+            "x.npy",
+        ],
+        d,
+    );
+    assert_refused(&out, d, 0, "exceeds addressable memory");
+    assert!(!stderr(&out).contains("18446744073709551615"));
+}
+
+/// `asperity stats --json` of `file` with extra arguments, parsed.
+fn stats_json(d: &Path, file: &str, extra: &[&str]) -> serde_json::Value {
+    let out = asperity(&[&["stats", file, "--json"], extra].concat(), d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn stats_fit_range_follows_the_sidecar_spectrum() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let generate = |extra: &[&str], out: &str| {
+        let base = ["surface", "--n", "512", "--hurst", "0.8", "--seed", "4"];
+        let o = asperity(&[&base[..], extra, &["--out", out]].concat(), d);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let slope_ok = |v: &serde_json::Value| {
+        let slope = v["psd_slope"].as_f64().unwrap();
+        assert!((slope + 3.6).abs() < 0.05, "slope {slope}: {v}");
+    };
+    // A short cut-off caps the default fit at the last full ring below it (was -27.98).
+    generate(&["--short-cutoff", "64"], "short.npy");
+    let v = stats_json(d, "short.npy", &[]);
+    assert_eq!(v["fit_from"], 2.0);
+    assert_eq!(v["fit_to"], 63.0);
+    slope_ok(&v);
+    // A cut-off: the ring at q0 is half empty, so the default fit starts at q0 + 1.
+    generate(&["--cutoff", "6"], "cut.npy");
+    let v = stats_json(d, "cut.npy", &[]);
+    assert_eq!(v["fit_from"], 7.0);
+    assert_eq!(v["fit_to"], 256.0, "Nyquist, as a number");
+    slope_ok(&v);
+    // A roll-off: from the knee q0 (as before).
+    generate(&["--rolloff", "6", "--short-cutoff", "100.7"], "roll.npy");
+    let v = stats_json(d, "roll.npy", &[]);
+    assert_eq!(v["fit_from"], 6.0);
+    assert_eq!(v["fit_to"], 100.0);
+    slope_ok(&v);
+    // No sidecar: 2 to Nyquist; user bounds are used as given.
+    std::fs::copy(d.join("cut.npy"), d.join("bare.npy")).unwrap();
+    let v = stats_json(d, "bare.npy", &[]);
+    assert_eq!(
+        (v["fit_from"].as_f64(), v["fit_to"].as_f64()),
+        (Some(2.0), Some(256.0))
+    );
+    let v = stats_json(d, "short.npy", &["--fit-from", "4", "--fit-to", "40"]);
+    assert_eq!(
+        (v["fit_from"].as_f64(), v["fit_to"].as_f64()),
+        (Some(4.0), Some(40.0))
+    );
+    slope_ok(&v);
+}
+
+#[test]
+fn stats_refuses_nonsense_fit_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(asperity(
+        &[
+            "surface",
+            "--n",
+            "64",
+            "--hurst",
+            "0.5",
+            "--short-cutoff",
+            "10",
+            "--out",
+            "s.npy"
+        ],
+        d
+    )
+    .status
+    .success());
+    for (args, needle) in [
+        (&["--fit-from", "nan"][..], "--fit-from"),
+        (&["--fit-to", "inf"][..], "--fit-to"),
+        (&["--fit-from", "-3"][..], "--fit-from"),
+        (&["--fit-to", "0"][..], "--fit-to"),
+        (&["--fit-from", "50", "--fit-to", "10"][..], "below"),
+        (&["--fit-from", "5", "--fit-to", "5"][..], "below"),
+        // Above the sidecar's short cut-off (default upper end 9).
+        (&["--fit-from", "20"][..], "empty"),
+    ] {
+        let out = asperity(&[&["stats", "s.npy"], args].concat(), d);
+        assert_refused(&out, d, 2, needle);
+    }
+}
