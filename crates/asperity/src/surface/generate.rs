@@ -485,6 +485,20 @@ mod tests {
         let line = LineGenerator::new(&line_spec).unwrap().generate(5);
         let slope = rms_slope_1d(line.heights().as_slice().unwrap(), line.spacing());
         assert!((slope / 0.3 - 1.0).abs() < 1e-10);
+        for (n, hurst, long) in [
+            (1001, 0.8, LongWavelength::None),
+            (4096, -0.5, LongWavelength::RollOff { q0: 6.0 }),
+            (4097, 2.5, LongWavelength::CutOff { q0: 3.0 }),
+        ] {
+            let psd = Psd::new(hurst, long, None).unwrap();
+            let spec = LineSpec::new(n, 3.0, psd, Normalisation::RmsHeight(0.02)).unwrap();
+            let line = LineGenerator::new(&spec).unwrap().generate(11);
+            let rms = stats::rms_height(line.heights().iter().copied());
+            assert!(
+                (rms / 0.02 - 1.0).abs() < 1e-10,
+                "n = {n}, H = {hurst}: {rms}"
+            );
+        }
     }
 
     #[test]
@@ -509,41 +523,129 @@ mod tests {
         );
     }
 
+    /// Checks every Fourier mode of a generated surface against `sqrt(C2D)` up to one
+    /// common factor (and empty modes empty).
+    fn assert_modes_follow_spectrum(spec: &SurfaceSpec, label: &str) {
+        let (rows, cols) = (spec.rows, spec.cols);
+        let s = SurfaceGenerator::new(spec).unwrap().generate(9);
+        let mean = s.heights().mean().unwrap();
+        assert!(mean.abs() < 1e-12, "{label}: mean {mean}");
+        let mut fft = RealFft2::new(rows, cols).unwrap();
+        let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+        fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
+        let aspect = cols as f64 / rows as f64;
+        let mut ratio = None;
+        let (mut full, mut empty) = (0, 0);
+        for (kx, column) in spectrum.chunks(rows).enumerate() {
+            for (ky_index, value) in column.iter().enumerate() {
+                let ky = if ky_index <= rows / 2 {
+                    ky_index as f64
+                } else {
+                    ky_index as f64 - rows as f64
+                };
+                let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
+                if target == 0.0 {
+                    assert!(
+                        value.norm() < 1e-9,
+                        "{label}: mode ({kx},{ky}) should be empty, has {}",
+                        value.norm()
+                    );
+                    empty += 1;
+                    continue;
+                }
+                let r = value.norm() / target;
+                let r0 = *ratio.get_or_insert(r);
+                assert!(
+                    (r / r0 - 1.0).abs() < 1e-9,
+                    "{label}: mode ({kx},{ky}) ratio {r} vs {r0}"
+                );
+                full += 1;
+            }
+        }
+        assert!(full > 0, "{label}: no mode has power");
+        assert!(empty > 0, "{label}: at least the mean is empty");
+    }
+
     #[test]
     fn every_mode_keeps_its_amplitude_on_odd_even_grids() {
         // If Hermitian symmetry were broken, the inverse real FFT would drop part of some
         // modes; the forward FFT of the heights would then not reproduce sqrt(C2D) · const.
         for (rows, cols) in [(2, 2), (3, 3), (16, 16), (17, 16), (16, 17), (5, 64)] {
             let spec = surface_spec(rows, cols, 0.5, Normalisation::RmsHeight(1.0));
-            let s = SurfaceGenerator::new(&spec).unwrap().generate(9);
-            let mean = s.heights().mean().unwrap();
-            assert!(mean.abs() < 1e-12, "{rows}x{cols}: mean {mean}");
-            let mut fft = RealFft2::new(rows, cols).unwrap();
-            let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
-            fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
-            let aspect = cols as f64 / rows as f64;
-            let mut ratio = None;
-            for (kx, column) in spectrum.chunks(rows).enumerate() {
-                for (ky_index, value) in column.iter().enumerate() {
-                    let ky = if ky_index <= rows / 2 {
-                        ky_index as f64
-                    } else {
-                        ky_index as f64 - rows as f64
-                    };
-                    let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
-                    if target == 0.0 {
-                        assert!(
-                            value.norm() < 1e-9,
-                            "{rows}x{cols}: mode ({kx},{ky}) should be empty"
-                        );
-                        continue;
-                    }
-                    let r = value.norm() / target;
-                    let r0 = *ratio.get_or_insert(r);
-                    assert!(
-                        (r / r0 - 1.0).abs() < 1e-9,
-                        "{rows}x{cols}: mode ({kx},{ky}) ratio {r} vs {r0}"
+            assert_modes_follow_spectrum(&spec, &format!("{rows}x{cols}"));
+        }
+    }
+
+    #[test]
+    fn roll_off_cut_off_and_short_cut_off_hold_mode_by_mode_on_odd_and_rectangular_grids() {
+        // Roll-off: modes below q0 all at the amplitude of q0 (flat); cut-off: modes below
+        // q0 empty; short cut-off: modes above q1 empty. Checked on every mode, against
+        // C2D of eqs. (7)/(8), on odd, even and rectangular grids (κ_y = ky·cols/rows).
+        let spectra = [
+            ("roll-off", LongWavelength::RollOff { q0: 4.0 }, None),
+            ("cut-off", LongWavelength::CutOff { q0: 4.0 }, None),
+            ("short cut-off", LongWavelength::None, Some(9.0)),
+            (
+                "roll-off + short",
+                LongWavelength::RollOff { q0: 3.0 },
+                Some(7.5),
+            ),
+            (
+                "cut-off + short",
+                LongWavelength::CutOff { q0: 2.5 },
+                Some(11.0),
+            ),
+        ];
+        for (name, long, short) in spectra {
+            for (rows, cols) in [(33, 33), (32, 32), (17, 48), (48, 17), (31, 40)] {
+                for hurst in [-0.5, 0.8] {
+                    let psd = Psd::new(hurst, long, short).unwrap();
+                    let spec = SurfaceSpec::new(rows, cols, 1.0, psd, Normalisation::RmsSlope(1.0))
+                        .unwrap();
+                    assert_modes_follow_spectrum(
+                        &spec,
+                        &format!("{name}, {rows}x{cols}, H {hurst}"),
                     );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn line_roll_off_flat_and_cut_off_empty_below_q0() {
+        // On a line, C1D = π q C2D (28): below a roll-off C2D is flat, so C1D/q is constant;
+        // below a cut-off C1D is zero; above q0 every mode has exactly its power (random
+        // phases), for odd and even n.
+        let q0 = 6.0;
+        for n in [1024, 1025] {
+            for (long, flat) in [
+                (LongWavelength::RollOff { q0 }, true),
+                (LongWavelength::CutOff { q0 }, false),
+            ] {
+                let psd = Psd::new(0.8, long, None).unwrap();
+                let spec = LineSpec::new(n, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
+                let bins = line_psd(&LineGenerator::new(&spec).unwrap().generate(3));
+                let kappa = |q: f64| q / std::f64::consts::TAU;
+                let at_q0 = bins.iter().find(|b| kappa(b.q) == q0).unwrap();
+                // Below n/2 (the Nyquist mode of an even line carries a random sign only).
+                for b in bins.iter().filter(|b| kappa(b.q) < (n / 2) as f64) {
+                    let k = kappa(b.q);
+                    if k < q0 {
+                        if flat {
+                            let ratio = (b.psd / k) / (at_q0.psd / q0);
+                            assert!((ratio - 1.0).abs() < 1e-9, "n {n}: roll-off κ={k}: {ratio}");
+                        } else {
+                            assert!(b.psd < 1e-20 * at_q0.psd, "n {n}: cut-off κ={k}: {}", b.psd);
+                        }
+                    }
+                    let expected = psd.c1d(k) / psd.c1d(q0);
+                    let got = b.psd / at_q0.psd;
+                    if expected > 0.0 {
+                        assert!(
+                            (got / expected - 1.0).abs() < 1e-9,
+                            "n {n}: κ={k}: {got} vs {expected}"
+                        );
+                    }
                 }
             }
         }
