@@ -45,6 +45,10 @@ fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
         "-0.5",
         "--rms-slope",
         "0.5",
+        "--rolloff",
+        "4",
+        "--size",
+        "2",
         "--seed",
         "11",
     ];
@@ -64,9 +68,61 @@ fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
     );
     let sidecar: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("a.npy.json")).unwrap()).unwrap();
+    assert_eq!(sidecar["kind"], "surface");
     assert_eq!(sidecar["seed"], 11);
-    assert_eq!(sidecar["spec"]["psd"]["hurst"], -0.5);
-    assert!(std::fs::metadata(d.join("a.png")).unwrap().len() > 100);
+    assert_eq!(sidecar["shape"], serde_json::json!([48, 64]));
+    let spec = &sidecar["spec"];
+    assert_eq!(
+        (spec["rows"].as_u64(), spec["cols"].as_u64()),
+        (Some(48), Some(64))
+    );
+    assert_eq!(spec["size"], 2.0);
+    assert_eq!(spec["psd"]["hurst"], -0.5);
+    assert_eq!(
+        spec["psd"]["long_wavelength"],
+        serde_json::json!({"kind": "roll_off", "q0": 4.0})
+    );
+    assert_eq!(spec["psd"]["short_cutoff"], serde_json::Value::Null);
+    assert_eq!(
+        spec["normalisation"],
+        serde_json::json!({"kind": "rms_slope", "value": 0.5})
+    );
+    let recorded_slope = sidecar["stats"]["rms_slope"].as_f64().unwrap();
+    assert!(
+        (recorded_slope / 0.5 - 1.0).abs() < 1e-10,
+        "{recorded_slope}"
+    );
+    // The PNG: one pixel per grid point, grey, black at the lowest and white at the
+    // highest point.
+    let decoder = png::Decoder::new(std::fs::File::open(d.join("a.png")).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!((info.width, info.height), (64, 48));
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let pixels = &pixels[..info.buffer_size()];
+    assert!(
+        pixels.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]),
+        "grey"
+    );
+    let grey: Vec<u8> = pixels.chunks(3).map(|p| p[0]).collect();
+    assert_eq!(grey.iter().min(), Some(&0), "darkest pixel is black");
+    assert_eq!(grey.iter().max(), Some(&255), "lightest pixel is white");
+    // ... and at the grid's lowest and highest points.
+    let at = |i: usize| grey[i];
+    let argmin = a
+        .iter()
+        .enumerate()
+        .min_by(|x, y| x.1.total_cmp(y.1))
+        .unwrap()
+        .0;
+    let argmax = a
+        .iter()
+        .enumerate()
+        .max_by(|x, y| x.1.total_cmp(y.1))
+        .unwrap()
+        .0;
+    assert_eq!((at(argmin), at(argmax)), (0, 255));
     let stats = asperity(&["stats", "a.npy", "--json"], d);
     assert!(stats.status.success());
     let v: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
@@ -108,6 +164,18 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
         d,
     );
     assert_refused(&out, d, 0, "hurst");
+    for hurst in ["-1.01", "-3"] {
+        let out = asperity(
+            &["surface", "--n", "32", "--hurst", hurst, "--out", "x.npy"],
+            d,
+        );
+        assert_refused(&out, d, 0, "hurst");
+        let out = asperity(
+            &["line", "--n", "32", "--hurst", hurst, "--out", "x.npy"],
+            d,
+        );
+        assert_refused(&out, d, 0, "hurst");
+    }
     let out = asperity(
         &["surface", "--n", "1", "--hurst", "0.5", "--out", "x.npy"],
         d,
@@ -145,8 +213,12 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
         &ndarray::Array3::<f64>::zeros((2, 2, 2)),
     )
     .unwrap();
-    let n = 3;
+    write_npy(d.join("inf.npy"), &array![[0.0, 1.0], [2.0, f64::INFINITY]]).unwrap();
+    write_npy(d.join("ninf.npy"), &array![0.0, f64::NEG_INFINITY, 1.0]).unwrap();
+    let n = 5;
     assert_refused(&asperity(&["stats", "nan.npy"], d), d, n, "non-finite");
+    assert_refused(&asperity(&["stats", "inf.npy"], d), d, n, "inf");
+    assert_refused(&asperity(&["stats", "ninf.npy"], d), d, n, "index 1");
     assert_refused(&asperity(&["stats", "f32.npy"], d), d, n, "float64");
     assert_refused(&asperity(&["stats", "cube.npy"], d), d, n, "3 dimensions");
     assert_refused(&asperity(&["stats", "missing.npy"], d), d, n, "missing.npy");
@@ -393,4 +465,41 @@ fn stats_refuses_nonsense_fit_ranges() {
         let out = asperity(&[&["stats", "s.npy"], args].concat(), d);
         assert_refused(&out, d, 2, needle);
     }
+}
+
+#[test]
+fn an_existing_sidecar_or_png_alone_is_not_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["surface", "--n", "16", "--hurst", "0.5", "--out", "a.npy"];
+    // Only the sidecar exists (the array was deleted): refused, the sidecar kept.
+    std::fs::write(d.join("a.npy.json"), b"{\"mine\": true}").unwrap();
+    let out = asperity(&base, d);
+    assert_refused(&out, d, 1, "a.npy.json: output already exists");
+    assert_eq!(
+        std::fs::read(d.join("a.npy.json")).unwrap(),
+        b"{\"mine\": true}"
+    );
+    let out = asperity(
+        &["line", "--n", "16", "--hurst", "0.5", "--out", "a.npy"],
+        d,
+    );
+    assert_refused(&out, d, 1, "a.npy.json: output already exists");
+    std::fs::remove_file(d.join("a.npy.json")).unwrap();
+    // Only the PNG exists.
+    std::fs::write(d.join("a.png"), b"not mine to overwrite").unwrap();
+    let out = asperity(&[&base[..], &["--png", "a.png"]].concat(), d);
+    assert_refused(&out, d, 1, "a.png: output already exists");
+    assert_eq!(
+        std::fs::read(d.join("a.png")).unwrap(),
+        b"not mine to overwrite"
+    );
+    // With --force all three are written.
+    let out = asperity(&[&base[..], &["--png", "a.png", "--force"]].concat(), d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(d).unwrap().count(), 3);
+    assert_ne!(
+        std::fs::read(d.join("a.png")).unwrap(),
+        b"not mine to overwrite"
+    );
 }
