@@ -267,6 +267,7 @@ fn parse_status_kib(text: &str, key: &str) -> Option<u64> {
 }
 
 #[cfg(unix)]
+#[allow(clippy::unnecessary_cast)] // rlim_t is u64 on Linux but not on every Unix
 fn address_space_limit() -> Option<u64> {
     let mut limit = libc::rlimit {
         rlim_cur: 0,
