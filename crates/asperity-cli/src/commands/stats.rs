@@ -29,12 +29,12 @@ pub struct StatsArgs {
     /// Write the (radially averaged) PSD as CSV with columns q,psd.
     #[arg(long, value_name = "OUT.csv")]
     pub psd: Option<PathBuf>,
-    /// Fit the PSD slope from this q·L/2π [default: 2; the sidecar's roll-off q0, or q0+1
-    /// after a cut-off, if higher].
+    /// Fit the PSD slope from the ring at this q·L/2π [default: 2; the sidecar's roll-off
+    /// q0, or the first ring wholly above its cut-off q0 (q0 + 1), if higher].
     #[arg(long, value_name = "Q")]
     pub fit_from: Option<f64>,
-    /// Fit the PSD slope up to this q·L/2π [default: Nyquist, or the sidecar's short
-    /// cut-off q1 − 1 if lower].
+    /// Fit the PSD slope up to the ring at this q·L/2π [default: Nyquist; the last ring
+    /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower].
     #[arg(long, value_name = "Q")]
     pub fit_to: Option<f64>,
     /// Print the statistics as JSON.
