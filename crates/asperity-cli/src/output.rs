@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::Result;
+use asperity::io::StagedOutputs;
 
 /// A CSV table under construction: header plus rows of already formatted fields.
 #[derive(Debug, Clone, Default)]
@@ -55,6 +56,12 @@ impl Table {
     /// Writes the table atomically.
     pub fn write(&self, path: &Path, force: bool) -> Result<()> {
         asperity::io::write_bytes(path, force, &self.to_csv()?)?;
+        Ok(())
+    }
+
+    /// Stages the table as the output `path` of `staged` (renamed into place on commit).
+    pub fn stage(&self, staged: &mut StagedOutputs, path: &Path) -> Result<()> {
+        staged.write_bytes(path, &self.to_csv()?)?;
         Ok(())
     }
 }

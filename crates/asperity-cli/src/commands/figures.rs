@@ -55,7 +55,7 @@ pub fn fig6(dir: &Path, quick: bool, force: bool) -> Result<()> {
         let line_spec = LineSpec::new(line_n, 1.0, psd, Normalisation::RmsHeight(1.0))?;
         let line = LineGenerator::new(&line_spec)?.try_generate(seed)?;
         let summary = surface_summary(&surface);
-        let slope_2d = psd_exponent(&radial_psd_2d(&surface), 1.0).unwrap_or(f64::NAN);
+        let slope_2d = psd_exponent(&radial_psd_2d(&surface)?, 1.0).unwrap_or(f64::NAN);
         let slope_1d = psd_exponent(&line_psd(&line), 1.0).unwrap_or(f64::NAN);
         table.push_numbers(&[
             hurst,
