@@ -17,14 +17,7 @@ fn main() {
         Ok(cli) => cli,
         Err(err) if !err.use_stderr() => err.exit(), // --help, --version
         Err(err) => {
-            // clap's message is several lines (tip, usage); keep the first, as for every error.
-            let text = err.to_string();
-            let first = text
-                .lines()
-                .next()
-                .unwrap_or("invalid arguments")
-                .trim_start_matches("error: ");
-            eprintln!("error: {first} (see --help)");
+            eprintln!("error: {} (see --help)", one_line(&err.to_string()));
             std::process::exit(2);
         }
     };
@@ -41,5 +34,57 @@ fn main() {
         }
         eprintln!("error: {line}");
         std::process::exit(2);
+    }
+}
+
+/// clap's message in one line. It is several lines (tip, usage); the first is kept, as for
+/// every error, but when it ends with ':' (e.g. "the following required arguments were not
+/// provided:") the indented lines that follow, up to the first blank line, are what it
+/// announces (the missing arguments' names), so they are appended, trimmed and joined
+/// with ", ".
+fn one_line(text: &str) -> String {
+    let mut lines = text.lines();
+    let first = lines
+        .next()
+        .unwrap_or("invalid arguments")
+        .trim_start_matches("error: ")
+        .trim_end();
+    if !first.ends_with(':') {
+        return first.to_string();
+    }
+    let items: Vec<&str> = lines
+        .take_while(|l| !l.trim().is_empty())
+        .take_while(|l| l.starts_with([' ', '\t']))
+        .map(str::trim)
+        .collect();
+    if items.is_empty() {
+        first.trim_end_matches(':').to_string()
+    } else {
+        format!("{first} {}", items.join(", "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[test]
+    fn missing_arguments_are_named() {
+        let text = "error: the following required arguments were not provided:\n  \
+                    --radial-step <DR>\n  --out <FILE>\n\nUsage: asperity mdr --radial <FILE.npy>\n\n\
+                    For more information, try '--help'.\n";
+        assert_eq!(
+            one_line(text),
+            "the following required arguments were not provided: --radial-step <DR>, --out <FILE>"
+        );
+    }
+
+    #[test]
+    fn other_messages_keep_their_first_line() {
+        let text = "error: unexpected argument '--x' found\n\n  tip: to pass '--x' as a value, \
+                    use '-- --x'\n\nUsage: asperity mdr [OPTIONS]\n";
+        assert_eq!(one_line(text), "unexpected argument '--x' found");
+        assert_eq!(one_line(""), "invalid arguments");
+        assert_eq!(one_line("error: a list:\n\nUsage: x\n"), "a list");
     }
 }

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::Result;
+use asperity::io::StagedOutputs;
 
 /// A CSV table under construction: header plus rows of already formatted fields.
 #[derive(Debug, Clone, Default)]
@@ -58,10 +59,9 @@ impl Table {
         Ok(())
     }
 
-    /// Writes the table into `batch`: it appears with the batch's other outputs at its
-    /// commit, or not at all.
-    pub fn write_into(&self, batch: &mut asperity::io::OutputBatch, path: &Path) -> Result<()> {
-        batch.write_bytes(path, &self.to_csv()?)?;
+    /// Stages the table as the output `path` of `staged` (renamed into place on commit).
+    pub fn stage(&self, staged: &mut StagedOutputs, path: &Path) -> Result<()> {
+        staged.write_bytes(path, &self.to_csv()?)?;
         Ok(())
     }
 }

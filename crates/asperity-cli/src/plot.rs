@@ -1,13 +1,15 @@
 //! Plots: line charts (linear or log–log) as PNG and SVG, and grey-scale height maps.
 //!
 //! Fonts are embedded (DejaVu Sans), so plotting works on machines without fontconfig.
-//! Files are written atomically: rendered to a temporary file beside the target, then
-//! renamed.
+//! Files are written through [`StagedOutputs`]: rendered to a temporary file beside the
+//! target and renamed only once every output of the command (a PNG and its SVG, or an
+//! image beside an array) was written.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Once;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
+use asperity::io::StagedOutputs;
 use ndarray::ArrayView2;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
@@ -113,25 +115,11 @@ fn tick_label(v: f64) -> String {
 }
 
 impl Chart {
-    /// Writes the chart as PNG and SVG.
+    /// Writes the chart as PNG and SVG, both or neither.
     pub fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()> {
         register_fonts();
-        for path in [png, svg] {
-            asperity::io::ensure_new_output(path, force)?;
-        }
-        let tmp_png = temp_with_extension(png, "png");
-        let result = (|| {
-            let root = BitMapBackend::new(&tmp_png, SIZE).into_drawing_area();
-            self.render(&root)?;
-            root.present()
-                .map_err(|e| anyhow!("rendering {}: {e}", png.display()))?;
-            drop(root);
-            std::fs::rename(&tmp_png, png).with_context(|| format!("writing {}", png.display()))
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp_png);
-        }
-        result?;
+        let mut staged = StagedOutputs::new([png, svg], force)?;
+        stage_png(&mut staged, png, SIZE, |root| self.render(root))?;
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
@@ -139,7 +127,8 @@ impl Chart {
             root.present()
                 .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
         }
-        asperity::io::write_bytes(svg, force, text.as_bytes())?;
+        staged.write_bytes(svg, text.as_bytes())?;
+        staged.commit()?;
         Ok(())
     }
 
@@ -318,27 +307,36 @@ impl Chart {
     }
 }
 
-fn temp_with_extension(path: &Path, ext: &str) -> PathBuf {
-    let stem = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{stem}.{}.tmp.{ext}", std::process::id()))
+/// Renders a `size` PNG with `draw` into the staged output `path` (a temporary file until
+/// the outputs are committed).
+fn stage_png<F>(staged: &mut StagedOutputs, path: &Path, size: (u32, u32), draw: F) -> Result<()>
+where
+    F: FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<()>,
+{
+    staged.write_file_with(path, Some("png"), |tmp: &Path| -> Result<()> {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        draw(&root)?;
+        root.present()
+            .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+        Ok(())
+    })
 }
 
 /// Grey-scale image of a height map (black low, white high), one pixel per grid point
-/// (grids above 2048 points a side are subsampled), like the paper's Fig. 6.
-pub fn greyscale_png(path: &Path, heights: ArrayView2<f64>, force: bool) -> Result<()> {
-    asperity::io::ensure_new_output(path, force)?;
+/// (grids above 2048 points a side are subsampled), like the paper's Fig. 6. Staged into
+/// `staged` (declared there by the caller, who commits it with the other outputs).
+pub fn greyscale_png(
+    staged: &mut StagedOutputs,
+    path: &Path,
+    heights: ArrayView2<f64>,
+) -> Result<()> {
     let (rows, cols) = heights.dim();
     let step = rows.max(cols).div_ceil(2048).max(1);
     let (w, h) = (cols.div_ceil(step) as u32, rows.div_ceil(step) as u32);
     let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let range = if hi > lo { hi - lo } else { 1.0 };
-    let tmp = temp_with_extension(path, "png");
-    let result = (|| {
-        let root = BitMapBackend::new(&tmp, (w, h)).into_drawing_area();
+    stage_png(staged, path, (w, h), |root| {
         for r in 0..h as usize {
             for c in 0..w as usize {
                 let v = ((heights[[r * step, c * step]] - lo) / range * 255.0).round() as u8;
@@ -346,15 +344,8 @@ pub fn greyscale_png(path: &Path, heights: ArrayView2<f64>, force: bool) -> Resu
                     .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
             }
         }
-        root.present()
-            .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
-        drop(root);
-        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+        Ok(())
+    })
 }
 
 /// A row of grey-scale height maps with captions (like the paper's Fig. 6), PNG and SVG.
@@ -367,9 +358,7 @@ pub fn greyscale_panel(
     force: bool,
 ) -> Result<()> {
     register_fonts();
-    for path in [png, svg] {
-        asperity::io::ensure_new_output(path, force)?;
-    }
+    let mut staged = StagedOutputs::new([png, svg], force)?;
     let caption_height = 30;
     let size = (
         maps.len() as u32 * (tile + 10) + 10,
@@ -415,19 +404,9 @@ pub fn greyscale_panel(
         }
         Ok(())
     }
-    let tmp = temp_with_extension(png, "png");
-    let result = (|| {
-        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-        draw(&root, maps, tile, caption_height, 1)?;
-        root.present()
-            .map_err(|e| anyhow!("rendering {}: {e}", png.display()))?;
-        drop(root);
-        std::fs::rename(&tmp, png).with_context(|| format!("writing {}", png.display()))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result?;
+    stage_png(&mut staged, png, size, |root| {
+        draw(root, maps, tile, caption_height, 1)
+    })?;
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
@@ -436,7 +415,8 @@ pub fn greyscale_panel(
         root.present()
             .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
     }
-    asperity::io::write_bytes(svg, force, text.as_bytes())?;
+    staged.write_bytes(svg, text.as_bytes())?;
+    staged.commit()?;
     Ok(())
 }
 

@@ -405,7 +405,7 @@ fn bad_output_paths_and_late_errors_leave_nothing() {
                 "--fields".into(),
                 path("f3"),
             ],
-            "is a directory",
+            "is a folder",
         ),
         // A late error (the third load is beyond full contact) after two loads' fields were
         // written to temporary files, in folders created for them: all removed.
@@ -442,7 +442,7 @@ fn bad_output_paths_and_late_errors_leave_nothing() {
                 "--fields".into(),
                 path("a_dir"),
             ],
-            "--fields output",
+            "is the same file as",
         ),
     ];
     for (extra, expected) in cases {

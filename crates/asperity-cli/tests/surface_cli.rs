@@ -45,6 +45,10 @@ fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
         "-0.5",
         "--rms-slope",
         "0.5",
+        "--rolloff",
+        "4",
+        "--size",
+        "2",
         "--seed",
         "11",
     ];
@@ -64,9 +68,61 @@ fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
     );
     let sidecar: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("a.npy.json")).unwrap()).unwrap();
+    assert_eq!(sidecar["kind"], "surface");
     assert_eq!(sidecar["seed"], 11);
-    assert_eq!(sidecar["spec"]["psd"]["hurst"], -0.5);
-    assert!(std::fs::metadata(d.join("a.png")).unwrap().len() > 100);
+    assert_eq!(sidecar["shape"], serde_json::json!([48, 64]));
+    let spec = &sidecar["spec"];
+    assert_eq!(
+        (spec["rows"].as_u64(), spec["cols"].as_u64()),
+        (Some(48), Some(64))
+    );
+    assert_eq!(spec["size"], 2.0);
+    assert_eq!(spec["psd"]["hurst"], -0.5);
+    assert_eq!(
+        spec["psd"]["long_wavelength"],
+        serde_json::json!({"kind": "roll_off", "q0": 4.0})
+    );
+    assert_eq!(spec["psd"]["short_cutoff"], serde_json::Value::Null);
+    assert_eq!(
+        spec["normalisation"],
+        serde_json::json!({"kind": "rms_slope", "value": 0.5})
+    );
+    let recorded_slope = sidecar["stats"]["rms_slope"].as_f64().unwrap();
+    assert!(
+        (recorded_slope / 0.5 - 1.0).abs() < 1e-10,
+        "{recorded_slope}"
+    );
+    // The PNG: one pixel per grid point, grey, black at the lowest and white at the
+    // highest point.
+    let decoder = png::Decoder::new(std::fs::File::open(d.join("a.png")).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    assert_eq!((info.width, info.height), (64, 48));
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let pixels = &pixels[..info.buffer_size()];
+    assert!(
+        pixels.chunks(3).all(|p| p[0] == p[1] && p[1] == p[2]),
+        "grey"
+    );
+    let grey: Vec<u8> = pixels.chunks(3).map(|p| p[0]).collect();
+    assert_eq!(grey.iter().min(), Some(&0), "darkest pixel is black");
+    assert_eq!(grey.iter().max(), Some(&255), "lightest pixel is white");
+    // ... and at the grid's lowest and highest points.
+    let at = |i: usize| grey[i];
+    let argmin = a
+        .iter()
+        .enumerate()
+        .min_by(|x, y| x.1.total_cmp(y.1))
+        .unwrap()
+        .0;
+    let argmax = a
+        .iter()
+        .enumerate()
+        .max_by(|x, y| x.1.total_cmp(y.1))
+        .unwrap()
+        .0;
+    assert_eq!((at(argmin), at(argmax)), (0, 255));
     let stats = asperity(&["stats", "a.npy", "--json"], d);
     assert!(stats.status.success());
     let v: serde_json::Value = serde_json::from_slice(&stats.stdout).unwrap();
@@ -108,6 +164,18 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
         d,
     );
     assert_refused(&out, d, 0, "hurst");
+    for hurst in ["-1.01", "-3"] {
+        let out = asperity(
+            &["surface", "--n", "32", "--hurst", hurst, "--out", "x.npy"],
+            d,
+        );
+        assert_refused(&out, d, 0, "hurst");
+        let out = asperity(
+            &["line", "--n", "32", "--hurst", hurst, "--out", "x.npy"],
+            d,
+        );
+        assert_refused(&out, d, 0, "hurst");
+    }
     let out = asperity(
         &["surface", "--n", "1", "--hurst", "0.5", "--out", "x.npy"],
         d,
@@ -145,8 +213,12 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
         &ndarray::Array3::<f64>::zeros((2, 2, 2)),
     )
     .unwrap();
-    let n = 3;
+    write_npy(d.join("inf.npy"), &array![[0.0, 1.0], [2.0, f64::INFINITY]]).unwrap();
+    write_npy(d.join("ninf.npy"), &array![0.0, f64::NEG_INFINITY, 1.0]).unwrap();
+    let n = 5;
     assert_refused(&asperity(&["stats", "nan.npy"], d), d, n, "non-finite");
+    assert_refused(&asperity(&["stats", "inf.npy"], d), d, n, "inf");
+    assert_refused(&asperity(&["stats", "ninf.npy"], d), d, n, "index 1");
     assert_refused(&asperity(&["stats", "f32.npy"], d), d, n, "float64");
     assert_refused(&asperity(&["stats", "cube.npy"], d), d, n, "3 dimensions");
     assert_refused(&asperity(&["stats", "missing.npy"], d), d, n, "missing.npy");
@@ -176,4 +248,258 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
     );
     assert!(out.status.success());
     assert_ne!(std::fs::read(d.join("s.npy")).unwrap(), before);
+}
+
+#[test]
+fn a_failing_output_leaves_no_other_output_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["surface", "--n", "16", "--hurst", "0.5", "--out", "a.npy"];
+    // The image cannot be written (its folder is missing): nor are the array and sidecar.
+    let out = asperity(&[&base[..], &["--png", "missing/a.png"]].concat(), d);
+    assert_refused(&out, d, 0, "does not exist");
+    let absolute = d.join("nowhere").join("a.png");
+    let out = asperity(
+        &[&base[..], &["--png", absolute.to_str().unwrap()]].concat(),
+        d,
+    );
+    assert_refused(&out, d, 0, "does not exist");
+    // The image would overwrite the array or its sidecar (also with --force).
+    for twin in ["a.npy", "./a.npy", "a.npy.json"] {
+        let out = asperity(&[&base[..], &["--png", twin]].concat(), d);
+        assert_refused(&out, d, 0, "same file");
+        let out = asperity(&[&base[..], &["--png", twin, "--force"]].concat(), d);
+        assert_refused(&out, d, 0, "same file");
+    }
+    // An output that is a folder.
+    std::fs::create_dir(d.join("folder.png")).unwrap();
+    let out = asperity(
+        &[&base[..], &["--png", "folder.png", "--force"]].concat(),
+        d,
+    );
+    assert_refused(&out, d, 1, "is a folder");
+    let out = asperity(
+        &["line", "--n", "16", "--hurst", "0.5", "--out", "no/l.npy"],
+        d,
+    );
+    assert_refused(&out, d, 1, "does not exist");
+    // stats --psd: into a missing folder, or over its own input.
+    assert!(asperity(&base, d).status.success());
+    let out = asperity(&["stats", "a.npy", "--psd", "no/psd.csv"], d);
+    assert_refused(&out, d, 3, "does not exist");
+    let before = std::fs::read(d.join("a.npy")).unwrap();
+    let out = asperity(&["stats", "a.npy", "--psd", "a.npy", "--force"], d);
+    assert_refused(&out, d, 3, "input");
+    assert_eq!(std::fs::read(d.join("a.npy")).unwrap(), before);
+}
+
+fn asperity_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(dir)
+        .output()
+        .expect("run asperity")
+}
+
+#[test]
+fn memory_guard_refuses_before_writing_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let limit = [("ASPERITY_MEMORY_LIMIT_MIB", "1")];
+    let args = [
+        "surface", "--n", "2048", "--hurst", "0.5", "--out", "big.npy", "--png", "big.png",
+    ];
+    let out = asperity_env(&args, d, &limit);
+    assert_refused(&out, d, 0, "memory");
+    let err = stderr(&out);
+    assert!(
+        err.contains("128 MiB") && err.contains("ASPERITY_MEMORY_LIMIT_MIB"),
+        "{err}"
+    );
+    let out = asperity_env(
+        &["line", "--n", "1048576", "--hurst", "0.5", "--out", "l.npy"],
+        d,
+        &limit,
+    );
+    assert_refused(&out, d, 0, "memory");
+    // A malformed limit is an error, not ignored.
+    let out = asperity_env(&args, d, &[("ASPERITY_MEMORY_LIMIT_MIB", "lots")]);
+    assert_refused(&out, d, 0, "ASPERITY_MEMORY_LIMIT_MIB");
+    // stats checks the need (about 4x the file) from the header, before reading.
+    write_npy(d.join("s.npy"), &Array2::<f64>::zeros((256, 512))).unwrap();
+    let out = asperity_env(&["stats", "s.npy", "--psd", "psd.csv"], d, &limit);
+    assert_refused(&out, d, 1, "memory");
+    assert!(stderr(&out).contains("4 MiB"), "{}", stderr(&out));
+    // A generous limit changes nothing.
+    let out = asperity_env(
+        &["surface", "--n", "64", "--hurst", "0.5", "--out", "ok.npy"],
+        d,
+        &[("ASPERITY_MEMORY_LIMIT_MIB", "100000")],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn memory_guard_sees_the_address_space_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let exe = env!("CARGO_BIN_EXE_asperity");
+    // `ulimit -v` (RLIMIT_AS, in KiB): 400 MiB cannot hold a 4096² surface (512 MiB).
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 409600 && exec '{exe}' surface --n 4096 --hurst 0.5 --out big.npy"
+        ))
+        .current_dir(d)
+        .output()
+        .expect("run sh");
+    assert_refused(&out, d, 0, "RLIMIT_AS");
+}
+
+#[test]
+fn huge_grids_exceed_addressable_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = asperity(
+        &[
+            "surface",
+            "--n",
+            "4294967296",
+            "--m",
+            "4294967296",
+            "--hurst",
+            "0.5",
+            "--out",
+            "x.npy",
+        ],
+        d,
+    );
+    assert_refused(&out, d, 0, "exceeds addressable memory");
+    assert!(!stderr(&out).contains("18446744073709551615"));
+}
+
+/// `asperity stats --json` of `file` with extra arguments, parsed.
+fn stats_json(d: &Path, file: &str, extra: &[&str]) -> serde_json::Value {
+    let out = asperity(&[&["stats", file, "--json"], extra].concat(), d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn stats_fit_range_follows_the_sidecar_spectrum() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let generate = |extra: &[&str], out: &str| {
+        let base = ["surface", "--n", "512", "--hurst", "0.8", "--seed", "4"];
+        let o = asperity(&[&base[..], extra, &["--out", out]].concat(), d);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let slope_ok = |v: &serde_json::Value| {
+        let slope = v["psd_slope"].as_f64().unwrap();
+        assert!((slope + 3.6).abs() < 0.05, "slope {slope}: {v}");
+    };
+    // A short cut-off caps the default fit at the last full ring below it (was -27.98).
+    generate(&["--short-cutoff", "64"], "short.npy");
+    let v = stats_json(d, "short.npy", &[]);
+    assert_eq!(v["fit_from"], 2.0);
+    assert_eq!(v["fit_to"], 63.0);
+    slope_ok(&v);
+    // A cut-off: the ring at q0 is half empty, so the default fit starts at q0 + 1.
+    generate(&["--cutoff", "6"], "cut.npy");
+    let v = stats_json(d, "cut.npy", &[]);
+    assert_eq!(v["fit_from"], 7.0);
+    assert_eq!(v["fit_to"], 256.0, "Nyquist, as a number");
+    slope_ok(&v);
+    // A roll-off: from the knee q0 (as before).
+    generate(&["--rolloff", "6", "--short-cutoff", "100.7"], "roll.npy");
+    let v = stats_json(d, "roll.npy", &[]);
+    assert_eq!(v["fit_from"], 6.0);
+    assert_eq!(v["fit_to"], 100.0);
+    slope_ok(&v);
+    // No sidecar: 2 to Nyquist; user bounds are used as given.
+    std::fs::copy(d.join("cut.npy"), d.join("bare.npy")).unwrap();
+    let v = stats_json(d, "bare.npy", &[]);
+    assert_eq!(
+        (v["fit_from"].as_f64(), v["fit_to"].as_f64()),
+        (Some(2.0), Some(256.0))
+    );
+    let v = stats_json(d, "short.npy", &["--fit-from", "4", "--fit-to", "40"]);
+    assert_eq!(
+        (v["fit_from"].as_f64(), v["fit_to"].as_f64()),
+        (Some(4.0), Some(40.0))
+    );
+    slope_ok(&v);
+}
+
+#[test]
+fn stats_refuses_nonsense_fit_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    assert!(asperity(
+        &[
+            "surface",
+            "--n",
+            "64",
+            "--hurst",
+            "0.5",
+            "--short-cutoff",
+            "10",
+            "--out",
+            "s.npy"
+        ],
+        d
+    )
+    .status
+    .success());
+    for (args, needle) in [
+        (&["--fit-from", "nan"][..], "--fit-from"),
+        (&["--fit-to", "inf"][..], "--fit-to"),
+        (&["--fit-from", "-3"][..], "--fit-from"),
+        (&["--fit-to", "0"][..], "--fit-to"),
+        (&["--fit-from", "50", "--fit-to", "10"][..], "below"),
+        (&["--fit-from", "5", "--fit-to", "5"][..], "below"),
+        // Above the sidecar's short cut-off (default upper end 9).
+        (&["--fit-from", "20"][..], "empty"),
+    ] {
+        let out = asperity(&[&["stats", "s.npy"], args].concat(), d);
+        assert_refused(&out, d, 2, needle);
+    }
+}
+
+#[test]
+fn an_existing_sidecar_or_png_alone_is_not_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["surface", "--n", "16", "--hurst", "0.5", "--out", "a.npy"];
+    // Only the sidecar exists (the array was deleted): refused, the sidecar kept.
+    std::fs::write(d.join("a.npy.json"), b"{\"mine\": true}").unwrap();
+    let out = asperity(&base, d);
+    assert_refused(&out, d, 1, "a.npy.json: output already exists");
+    assert_eq!(
+        std::fs::read(d.join("a.npy.json")).unwrap(),
+        b"{\"mine\": true}"
+    );
+    let out = asperity(
+        &["line", "--n", "16", "--hurst", "0.5", "--out", "a.npy"],
+        d,
+    );
+    assert_refused(&out, d, 1, "a.npy.json: output already exists");
+    std::fs::remove_file(d.join("a.npy.json")).unwrap();
+    // Only the PNG exists.
+    std::fs::write(d.join("a.png"), b"not mine to overwrite").unwrap();
+    let out = asperity(&[&base[..], &["--png", "a.png"]].concat(), d);
+    assert_refused(&out, d, 1, "a.png: output already exists");
+    assert_eq!(
+        std::fs::read(d.join("a.png")).unwrap(),
+        b"not mine to overwrite"
+    );
+    // With --force all three are written.
+    let out = asperity(&[&base[..], &["--png", "a.png", "--force"]].concat(), d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read_dir(d).unwrap().count(), 3);
+    assert_ne!(
+        std::fs::read(d.join("a.png")).unwrap(),
+        b"not mine to overwrite"
+    );
 }

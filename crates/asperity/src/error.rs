@@ -28,6 +28,15 @@ pub enum Error {
     /// A file exists where an output should go and overwriting was not allowed.
     #[error("{0}: output already exists (use --force to overwrite)")]
     OutputExists(PathBuf),
+    /// An output path cannot be written: its folder is missing, it is a folder, it is
+    /// named twice among one command's outputs, or it is the command's input.
+    #[error("{path}: {reason}")]
+    BadOutput {
+        /// The output concerned.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A `.npy` file could not be read as the array that was expected.
     #[error("{path}: {reason}")]
     BadArrayFile {
@@ -46,15 +55,18 @@ pub enum Error {
         /// The bad value.
         value: f64,
     },
-    /// A computation would need more memory than the machine has available.
-    #[error("{what} needs about {needed_mib} MiB but only {available_mib} MiB are available")]
+    /// A computation would need more memory than is available to this process, more than
+    /// the address space can hold, or an allocation was refused.
+    #[error("{}", out_of_memory_message(.what, *.needed_mib, *.available_mib, .limited_by))]
     OutOfMemory {
         /// What was to be allocated.
         what: String,
-        /// Estimated need.
-        needed_mib: u64,
-        /// Memory available now.
-        available_mib: u64,
+        /// Estimated need in MiB (rounded up); `None` when it exceeds the address space.
+        needed_mib: Option<u64>,
+        /// Memory available now in MiB; `None` when the allocator refused the request.
+        available_mib: Option<u64>,
+        /// What sets the available figure (e.g. `cgroup memory.max`), or why it failed.
+        limited_by: String,
     },
     /// A study folder already holds the checkpoint of a different study.
     #[error("{dir}: holds the checkpoint of another study ({reason}); use another --out, or --force to discard it")]
@@ -96,6 +108,24 @@ impl Error {
         Error::Io {
             path: path.into(),
             source,
+        }
+    }
+}
+
+fn out_of_memory_message(
+    what: &str,
+    needed_mib: Option<u64>,
+    available_mib: Option<u64>,
+    limited_by: &str,
+) -> String {
+    match (needed_mib, available_mib) {
+        (None, _) => format!("{what} exceeds addressable memory"),
+        (Some(needed), Some(available)) => format!(
+            "{what} needs about {needed} MiB of memory but only {available} MiB are available \
+             (limited by {limited_by})"
+        ),
+        (Some(needed), None) => {
+            format!("{what} needs about {needed} MiB of memory, which could not be allocated ({limited_by})")
         }
     }
 }

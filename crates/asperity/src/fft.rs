@@ -16,6 +16,9 @@ use rayon::prelude::*;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 
+use crate::memory::try_vec;
+use crate::{Error, Result};
+
 struct Lane {
     real: Vec<f64>,
     scratch: Vec<Complex64>,
@@ -35,9 +38,27 @@ pub struct RealFft2 {
 }
 
 impl RealFft2 {
-    /// Plans transforms for a `rows × cols` real grid (both at least 1).
-    pub fn new(rows: usize, cols: usize) -> Self {
-        assert!(rows >= 1 && cols >= 1, "empty FFT grid");
+    /// Plans transforms for a `rows × cols` real grid (both at least 1). The work buffers
+    /// are allocated fallibly: [`Error::OutOfMemory`] if the system refuses them.
+    pub fn new(rows: usize, cols: usize) -> Result<Self> {
+        if rows < 1 || cols < 1 {
+            return Err(Error::invalid(
+                "grid",
+                format!("an FFT grid needs at least 1x1 points, got {rows}x{cols}"),
+            ));
+        }
+        let half = cols / 2 + 1;
+        let work_len = rows.checked_mul(half).ok_or_else(|| Error::OutOfMemory {
+            what: format!("the FFT buffer of a {rows}x{cols} grid"),
+            needed_mib: None,
+            available_mib: None,
+            limited_by: "the address space".into(),
+        })?;
+        let work = try_vec(
+            &format!("the FFT buffer of a {rows}x{cols} grid"),
+            work_len,
+            Complex64::default(),
+        )?;
         let mut real_planner = RealFftPlanner::<f64>::new();
         let r2c = real_planner.plan_fft_forward(cols);
         let c2r = real_planner.plan_fft_inverse(cols);
@@ -54,21 +75,23 @@ impl RealFft2 {
         .max()
         .unwrap_or(0);
         let lanes = (0..rayon::current_num_threads().max(1))
-            .map(|_| Lane {
-                real: vec![0.0; cols],
-                scratch: vec![Complex64::default(); scratch_len],
+            .map(|_| {
+                Ok(Lane {
+                    real: try_vec("an FFT row buffer", cols, 0.0)?,
+                    scratch: try_vec("an FFT scratch buffer", scratch_len, Complex64::default())?,
+                })
             })
-            .collect();
-        RealFft2 {
+            .collect::<Result<Vec<_>>>()?;
+        Ok(RealFft2 {
             rows,
             cols,
             r2c,
             c2r,
             col_forward,
             col_inverse,
-            work: vec![Complex64::default(); rows * (cols / 2 + 1)],
+            work,
             lanes,
-        }
+        })
     }
 
     /// Number of rows of the real grid.
@@ -216,7 +239,7 @@ mod tests {
     fn forward_matches_naive_dft_on_odd_even_and_rectangular_grids() {
         for (rows, cols) in [(4, 4), (5, 7), (6, 9), (7, 4), (1, 8), (3, 1)] {
             let input = pseudo_random(rows * cols);
-            let mut fft = RealFft2::new(rows, cols);
+            let mut fft = RealFft2::new(rows, cols).unwrap();
             let mut spec = vec![Complex64::new(9.0, 9.0); fft.spectrum_len()];
             fft.forward(&input, &mut spec);
             let oracle = naive_forward(&input, rows, cols);
@@ -230,7 +253,7 @@ mod tests {
     fn inverse_undoes_forward_with_dirty_buffers() {
         for (rows, cols) in [(8, 8), (9, 15), (16, 10)] {
             let input = pseudo_random(rows * cols);
-            let mut fft = RealFft2::new(rows, cols);
+            let mut fft = RealFft2::new(rows, cols).unwrap();
             let mut spec = vec![Complex64::new(1.0, -3.0); fft.spectrum_len()];
             let mut back = vec![7.0; rows * cols];
             for _ in 0..2 {

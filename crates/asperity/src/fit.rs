@@ -102,9 +102,54 @@ pub fn power_law_fit(x: &[f64], y: &[f64]) -> Result<PowerLawFit> {
     })
 }
 
+/// The steepest power law over any window of `x` spanning at least `span` (a ratio,
+/// e.g. 10 for one decade): slides the window's lower end over the points, fits each
+/// window by [`power_law_fit`] and keeps the largest exponent, with the window's first
+/// and last index. `None` when no window of that span (and at least 3 points) exists.
+///
+/// This is how a person reads "the curve is almost linear over a decade" off a log–log
+/// plot whose slope keeps changing (paper Fig. 2); `x` must be ascending.
+pub fn steepest_power_law(x: &[f64], y: &[f64], span: f64) -> Option<(PowerLawFit, usize, usize)> {
+    let mut best: Option<(PowerLawFit, usize, usize)> = None;
+    for first in 0..x.len() {
+        let Some(last) = (first + 2..x.len()).find(|&j| x[j] >= x[first] * span) else {
+            break;
+        };
+        if let Ok(fit) = power_law_fit(&x[first..=last], &y[first..=last]) {
+            if best.is_none_or(|(b, _, _)| fit.exponent > b.exponent) {
+                best = Some((fit, first, last));
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn steepest_window_finds_the_linear_stretch() {
+        // y = x^0.3 up to x = 1, then y ∝ x^1 up to x = 100, then flat: the steepest
+        // decade is the linear part, and it is found wherever it starts.
+        let x: Vec<f64> = (0..=80)
+            .map(|i| 10f64.powf(-2.0 + i as f64 * 0.05))
+            .collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|&v| match v {
+                v if v <= 1.0 => v.powf(0.3),
+                v if v <= 100.0 => v,
+                _ => 100.0,
+            })
+            .collect();
+        let (fit, first, last) = steepest_power_law(&x, &y, 10.0).unwrap();
+        assert!((fit.exponent - 1.0).abs() < 1e-9, "{}", fit.exponent);
+        assert!(x[first] >= 1.0 - 1e-12 && x[last] <= 100.0 + 1e-9);
+        assert!(x[last] / x[first] >= 10.0 - 1e-9);
+        // No window spans a factor 1e5.
+        assert!(steepest_power_law(&x, &y, 1e5).is_none());
+    }
 
     #[test]
     fn recovers_a_known_exponent_exactly() {

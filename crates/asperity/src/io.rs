@@ -1,11 +1,12 @@
 //! Files: NumPy `.npy` arrays, JSON sidecars, and atomic writes.
 //!
-//! Every output goes through [`atomic_write`]: the data is written to a hidden temporary
-//! file beside the target and renamed over it only once complete, so an interrupted run
-//! never leaves a truncated file; outputs that must appear together (a table and its field
-//! files) go through an [`OutputBatch`], renamed into place only once all are written.
-//! Outputs are never overwritten unless `force` is set. [`npy_shape`] reads a `.npy`
-//! file's shape without its data (to check memory before reading).
+//! Every output goes through [`StagedOutputs`] (or [`atomic_write`], its one-file form): the
+//! data is written to a hidden temporary file beside the target and renamed over it only
+//! once complete, so an interrupted run never leaves a truncated file. A command with several
+//! outputs (an array, its sidecar, an image) stages them all and renames them together only
+//! after every one was written, so a failure part-way leaves none of them. Outputs are
+//! checked before any work starts: each one's folder must exist, none may be a folder,
+//! none may be named twice, and none may already exist unless `force` is set.
 //! Inputs are validated on reading: `.npy` must hold float64 (C or Fortran order), have the
 //! expected number of dimensions, and contain finite values only.
 
@@ -13,7 +14,7 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use ndarray::{Array1, Array2, ArrayD, ArrayView2, Ix1, Ix2};
+use ndarray::{Array1, Array2, ArrayBase, ArrayD, Data, Ix1, Ix2};
 use ndarray_npy::npy::header::Header;
 use ndarray_npy::{ReadNpyError, ReadNpyExt, WriteNpyExt};
 use serde::Serialize;
@@ -37,80 +38,299 @@ pub fn sidecar_path(path: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
-fn temp_path(path: &Path) -> PathBuf {
+fn bad_output(path: &Path, reason: impl Into<String>) -> Error {
+    Error::BadOutput {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    }
+}
+
+/// Checks one output path before any work (see [`StagedOutputs::new`]) and returns the
+/// key that identifies the file it names: the canonical folder joined with the file name,
+/// or the canonical path itself where the file exists (so that links are seen through).
+fn checked_output_key(path: &Path, force: bool) -> Result<PathBuf> {
+    let Some(name) = path.file_name() else {
+        return Err(bad_output(path, "is not a file name"));
+    };
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.exists() {
+        return Err(bad_output(
+            path,
+            format!("folder {} does not exist", parent.display()),
+        ));
+    }
+    if !parent.is_dir() {
+        return Err(bad_output(
+            path,
+            format!("{} is not a folder", parent.display()),
+        ));
+    }
+    if path.is_dir() {
+        return Err(bad_output(path, "is a folder, not a file"));
+    }
+    ensure_new_output(path, force)?;
+    if path.exists() {
+        return std::fs::canonicalize(path).map_err(|e| Error::io(path, e));
+    }
+    let folder = std::fs::canonicalize(parent).map_err(|e| Error::io(parent, e))?;
+    Ok(folder.join(name))
+}
+
+/// A temporary path beside `path`: `.NAME.PID.K.tmp`, or `.NAME.PID.K.tmp.EXT` where the
+/// writer picks the format from the extension (images).
+fn temp_path(path: &Path, index: usize, extension: Option<&str>) -> PathBuf {
     let file_name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "output".into());
-    let tmp = format!(".{file_name}.{}.tmp", std::process::id());
+    let ext = extension.map(|e| format!(".{e}")).unwrap_or_default();
+    let tmp = format!(".{file_name}.{}.{index}.tmp{ext}", std::process::id());
     path.with_file_name(tmp)
 }
 
-/// Writes `path` atomically: `write` fills a temporary file in the same folder, which is
-/// flushed, synced and renamed over `path`. On any error the temporary file is removed and
-/// `path` is left as it was.
-pub fn atomic_write<F>(path: &Path, force: bool, write: F) -> Result<()>
-where
-    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-{
-    ensure_new_output(path, force)?;
-    let tmp = write_temp(path, write)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::io(path, e)
-    })
+struct Staged {
+    target: PathBuf,
+    key: PathBuf,
+    tmp: Option<PathBuf>,
 }
 
-/// Fills, flushes and syncs the temporary file of `path` (see [`atomic_write`]) and returns
-/// its name; removes it on any error.
-fn write_temp<F>(path: &Path, write: F) -> Result<PathBuf>
-where
-    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-{
-    let tmp = temp_path(path);
-    let result = (|| {
-        let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        let mut writer = BufWriter::new(file);
-        write(&mut writer)?;
-        writer.flush().map_err(|e| Error::io(&tmp, e))?;
-        writer.get_ref().sync_all().map_err(|e| Error::io(&tmp, e))
-    })();
-    match result {
-        Ok(()) => Ok(tmp),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
-}
-
-/// Outputs that appear together or not at all. Each is written to its temporary file
-/// beside the target as soon as it is ready ([`OutputBatch::write`]: nothing waits in
-/// memory), and [`OutputBatch::commit`] renames them all into place at the end. A batch
-/// dropped without a commit (an error on the way) removes its temporary files and the
-/// folders it created, so a failed run leaves nothing behind.
-#[derive(Debug)]
-pub struct OutputBatch {
+/// The outputs of one command, written all-or-nothing.
+///
+/// [`StagedOutputs::new`] checks every output before any work starts; each `write_*`
+/// method writes one of them to a synced temporary file beside its target; and
+/// [`StagedOutputs::commit`] renames them all into place once every one was written.
+/// If anything fails before the commit (or the value is dropped without one), the
+/// temporary files are removed and no target is touched.
+///
+/// ```
+/// # let dir = tempfile::tempdir()?;
+/// use asperity::io::StagedOutputs;
+/// let (a, b) = (dir.path().join("a.txt"), dir.path().join("b.txt"));
+/// let mut outputs = StagedOutputs::new([&a, &b], false)?;
+/// outputs.write_bytes(&a, b"first")?;
+/// outputs.write_bytes(&b, b"second")?;
+/// outputs.commit()?;
+/// assert_eq!(std::fs::read(&b)?, b"second");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub struct StagedOutputs {
     force: bool,
-    /// `(temporary file, target, target existed before)`, in the order written.
-    staged: Vec<(PathBuf, PathBuf, bool)>,
-    /// Folders made by [`OutputBatch::create_dir_all`], outermost first.
-    created_dirs: Vec<PathBuf>,
+    entries: Vec<Staged>,
+    /// Folders made by [`StagedOutputs::in_new_folders`], outermost first: removed again
+    /// (if still empty) when the outputs are dropped uncommitted.
+    created_folders: Vec<PathBuf>,
 }
 
-impl OutputBatch {
-    /// An empty batch; `force` allows its outputs to replace existing files.
-    pub fn new(force: bool) -> Self {
-        OutputBatch {
+impl StagedOutputs {
+    /// Declares the outputs and checks them: each one's folder exists, none is a folder,
+    /// no file is named twice (after resolving `.`/`..` and links), and none exists unless
+    /// `force` is set.
+    pub fn new<P: AsRef<Path>>(paths: impl IntoIterator<Item = P>, force: bool) -> Result<Self> {
+        let mut entries: Vec<Staged> = Vec::new();
+        for path in paths {
+            let path = path.as_ref();
+            let key = checked_output_key(path, force)?;
+            if let Some(other) = entries.iter().find(|e| e.key == key) {
+                let reason = if other.target == path {
+                    "is the same file as another output; each output needs its own file".into()
+                } else {
+                    format!(
+                        "is the same file as the output {}; each output needs its own file",
+                        other.target.display()
+                    )
+                };
+                return Err(bad_output(path, reason));
+            }
+            entries.push(Staged {
+                target: path.to_path_buf(),
+                key,
+                tmp: None,
+            });
+        }
+        Ok(StagedOutputs {
             force,
-            staged: Vec::new(),
-            created_dirs: Vec::new(),
+            entries,
+            created_folders: Vec::new(),
+        })
+    }
+
+    /// [`StagedOutputs::new`] for outputs in `folders` that may not exist yet: the missing
+    /// folders (and their missing parents) are made first, and removed again if the checks
+    /// fail or the outputs are dropped without a commit, so a failed run leaves nothing.
+    pub fn in_new_folders<P: AsRef<Path>, Q: AsRef<Path>>(
+        folders: impl IntoIterator<Item = Q>,
+        paths: impl IntoIterator<Item = P>,
+        force: bool,
+    ) -> Result<Self> {
+        let mut created = CreatedFolders(Vec::new());
+        for folder in folders {
+            created.create_all(folder.as_ref())?;
+        }
+        let mut outputs = StagedOutputs::new(paths, force)?;
+        outputs.created_folders = std::mem::take(&mut created.0);
+        Ok(outputs)
+    }
+
+    /// Fails with [`Error::BadOutput`] if an output is the file `input` (which the command
+    /// reads): overwriting it would lose the data the output was computed from.
+    pub fn ensure_not_input(&self, input: &Path) -> Result<()> {
+        let Ok(input_key) = std::fs::canonicalize(input) else {
+            return Ok(()); // a missing input is reported by whoever reads it
+        };
+        match self.entries.iter().find(|e| e.key == input_key) {
+            Some(e) => Err(bad_output(
+                &e.target,
+                format!("is the input file {}", input.display()),
+            )),
+            None => Ok(()),
         }
     }
 
-    /// Creates `dir` and its missing parents; they are removed again (if still empty) when
-    /// the batch is dropped uncommitted.
-    pub fn create_dir_all(&mut self, dir: &Path) -> Result<()> {
+    /// The declared outputs, in order.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.entries.iter().map(|e| e.target.as_path())
+    }
+
+    fn index_of(&self, target: &Path) -> Result<usize> {
+        self.entries
+            .iter()
+            .position(|e| e.target == target)
+            .ok_or_else(|| bad_output(target, "was not declared as an output"))
+    }
+
+    /// Stages `target` by letting `write` create the file at the temporary path it is given
+    /// (for writers that open files themselves, e.g. image encoders, which pick the format
+    /// from `extension`). On error the temporary file is removed.
+    pub fn write_file_with<F, E>(
+        &mut self,
+        target: &Path,
+        extension: Option<&str>,
+        write: F,
+    ) -> std::result::Result<(), E>
+    where
+        F: FnOnce(&Path) -> std::result::Result<(), E>,
+        E: From<Error>,
+    {
+        let index = self.index_of(target)?;
+        let tmp = temp_path(target, index, extension);
+        if let Some(old) = self.entries[index].tmp.take() {
+            let _ = std::fs::remove_file(old);
+        }
+        match write(&tmp) {
+            Ok(()) => {
+                self.entries[index].tmp = Some(tmp);
+                Ok(())
+            }
+            Err(e) => {
+                let _ = std::fs::remove_file(&tmp);
+                Err(e)
+            }
+        }
+    }
+
+    /// Stages `target`: `write` fills a buffered temporary file, which is flushed and synced.
+    pub fn write_with<F>(&mut self, target: &Path, write: F) -> Result<()>
+    where
+        F: FnOnce(&mut BufWriter<File>) -> Result<()>,
+    {
+        self.write_file_with(target, None, |tmp| {
+            let file = File::create(tmp).map_err(|e| Error::io(tmp, e))?;
+            let mut writer = BufWriter::new(file);
+            write(&mut writer)?;
+            writer.flush().map_err(|e| Error::io(tmp, e))?;
+            writer.get_ref().sync_all().map_err(|e| Error::io(tmp, e))
+        })
+    }
+
+    /// Stages `target` with these bytes.
+    pub fn write_bytes(&mut self, target: &Path, bytes: &[u8]) -> Result<()> {
+        self.write_with(target, |w| {
+            w.write_all(bytes).map_err(|e| Error::io(target, e))
+        })
+    }
+
+    /// Stages `target` with a value as pretty JSON.
+    pub fn write_json<T: Serialize>(&mut self, target: &Path, value: &T) -> Result<()> {
+        let text = serde_json::to_string_pretty(value).map_err(|e| Error::Metadata {
+            path: target.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        self.write_bytes(target, format!("{text}\n").as_bytes())
+    }
+
+    fn write_npy<A: WriteNpyExt>(&mut self, target: &Path, array: &A) -> Result<()> {
+        self.write_with(target, |w| {
+            array.write_npy(w).map_err(|e| Error::BadArrayFile {
+                path: target.to_path_buf(),
+                reason: e.to_string(),
+            })
+        })
+    }
+
+    /// Stages `target` with a 2D float64 array (owned or a view) as `.npy` (C order).
+    pub fn write_npy_2d<S: Data<Elem = f64>>(
+        &mut self,
+        target: &Path,
+        array: &ArrayBase<S, Ix2>,
+    ) -> Result<()> {
+        self.write_npy(target, array)
+    }
+
+    /// Stages `target` with a 1D float64 array as `.npy`.
+    pub fn write_npy_1d(&mut self, target: &Path, array: &Array1<f64>) -> Result<()> {
+        self.write_npy(target, array)
+    }
+
+    /// Renames every staged file into place. Fails, touching no target, if an output was
+    /// not written or (without `force`) appeared meanwhile. Should a rename itself fail,
+    /// the outputs already renamed that did not exist before are removed again.
+    pub fn commit(mut self) -> Result<()> {
+        for e in &self.entries {
+            if e.tmp.is_none() {
+                return Err(bad_output(&e.target, "was declared but never written"));
+            }
+            ensure_new_output(&e.target, self.force)?;
+        }
+        let mut renamed: Vec<(PathBuf, bool)> = Vec::new();
+        for e in &mut self.entries {
+            let existed = e.target.exists();
+            let Some(tmp) = e.tmp.take() else { continue };
+            if let Err(err) = std::fs::rename(&tmp, &e.target) {
+                e.tmp = Some(tmp); // removed on drop
+                for (path, existed) in renamed {
+                    if !existed {
+                        let _ = std::fs::remove_file(path);
+                    }
+                }
+                return Err(Error::io(&e.target, err));
+            }
+            renamed.push((e.target.clone(), existed));
+        }
+        self.created_folders.clear();
+        Ok(())
+    }
+}
+
+impl Drop for StagedOutputs {
+    fn drop(&mut self) {
+        for e in &mut self.entries {
+            if let Some(tmp) = e.tmp.take() {
+                let _ = std::fs::remove_file(tmp);
+            }
+        }
+        drop(CreatedFolders(std::mem::take(&mut self.created_folders)));
+    }
+}
+
+/// Folders made for outputs, outermost first; removed (if empty) when dropped.
+struct CreatedFolders(Vec<PathBuf>);
+
+impl CreatedFolders {
+    /// Makes `dir` and its missing parents, recording each.
+    fn create_all(&mut self, dir: &Path) -> Result<()> {
         let mut missing = Vec::new();
         let mut next = Some(dir);
         while let Some(d) = next.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
@@ -119,111 +339,76 @@ impl OutputBatch {
         }
         for d in missing.into_iter().rev() {
             std::fs::create_dir(&d).map_err(|e| Error::io(&d, e))?;
-            self.created_dirs.push(d);
+            self.0.push(d);
         }
-        Ok(())
-    }
-
-    /// Writes the temporary file of `path` now (see [`atomic_write`] for `write`); `path`
-    /// itself appears at [`OutputBatch::commit`]. Refuses an existing `path` unless forced.
-    pub fn write<F>(&mut self, path: &Path, write: F) -> Result<()>
-    where
-        F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-    {
-        ensure_new_output(path, self.force)?;
-        if self.staged.iter().any(|(_, target, _)| target == path) {
-            return Err(Error::invalid(
-                "output",
-                format!("{} is named twice", path.display()),
-            ));
+        if !dir.is_dir() {
+            return Err(bad_output(dir, "exists and is not a folder"));
         }
-        let existed = path.exists();
-        let tmp = write_temp(path, write)?;
-        self.staged.push((tmp, path.to_path_buf(), existed));
-        Ok(())
-    }
-
-    /// [`OutputBatch::write`] of bytes.
-    pub fn write_bytes(&mut self, path: &Path, bytes: &[u8]) -> Result<()> {
-        self.write(path, |w| w.write_all(bytes).map_err(|e| Error::io(path, e)))
-    }
-
-    /// [`OutputBatch::write`] of a 2D float64 array as `.npy` (C order).
-    pub fn write_npy_2d(&mut self, path: &Path, array: ArrayView2<'_, f64>) -> Result<()> {
-        self.write(path, |w| {
-            array.write_npy(w).map_err(|e| Error::BadArrayFile {
-                path: path.to_path_buf(),
-                reason: e.to_string(),
-            })
-        })
-    }
-
-    /// Renames every temporary file over its target, in the order written. Should a rename
-    /// fail, the targets already renamed that did not exist before are removed again.
-    pub fn commit(mut self) -> Result<()> {
-        let staged = std::mem::take(&mut self.staged);
-        for (i, (tmp, path, _)) in staged.iter().enumerate() {
-            if let Err(e) = std::fs::rename(tmp, path) {
-                for (_, done, existed) in &staged[..i] {
-                    if !existed {
-                        let _ = std::fs::remove_file(done);
-                    }
-                }
-                for (tmp, _, _) in &staged[i..] {
-                    let _ = std::fs::remove_file(tmp);
-                }
-                return Err(Error::io(path, e));
-            }
-        }
-        self.created_dirs.clear();
         Ok(())
     }
 }
 
-impl Drop for OutputBatch {
+impl Drop for CreatedFolders {
     fn drop(&mut self) {
-        for (tmp, _, _) in &self.staged {
-            let _ = std::fs::remove_file(tmp);
-        }
-        for dir in self.created_dirs.iter().rev() {
+        for dir in self.0.iter().rev() {
             let _ = std::fs::remove_dir(dir); // only if empty
         }
     }
 }
 
+/// Writes `path` atomically: `write` fills a temporary file in the same folder, which is
+/// flushed, synced and renamed over `path`. On any error the temporary file is removed and
+/// `path` is left as it was. The one-output form of [`StagedOutputs`], with its checks.
+pub fn atomic_write<F>(path: &Path, force: bool, write: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
+{
+    let mut staged = StagedOutputs::new([path], force)?;
+    staged.write_with(path, write)?;
+    staged.commit()
+}
+
+/// Stages one output with `write` and commits it.
+fn write_one<F>(path: &Path, force: bool, write: F) -> Result<()>
+where
+    F: FnOnce(&mut StagedOutputs) -> Result<()>,
+{
+    let mut staged = StagedOutputs::new([path], force)?;
+    write(&mut staged)?;
+    staged.commit()
+}
+
 /// Writes bytes atomically (see [`atomic_write`]).
 pub fn write_bytes(path: &Path, force: bool, bytes: &[u8]) -> Result<()> {
-    atomic_write(path, force, |w| {
-        w.write_all(bytes).map_err(|e| Error::io(path, e))
-    })
+    write_one(path, force, |s| s.write_bytes(path, bytes))
 }
 
 /// Writes a value as pretty JSON, atomically.
 pub fn write_json<T: Serialize>(path: &Path, force: bool, value: &T) -> Result<()> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Metadata {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
-    write_bytes(path, force, format!("{text}\n").as_bytes())
-}
-
-fn write_npy_impl<A: WriteNpyExt>(path: &Path, force: bool, array: &A) -> Result<()> {
-    atomic_write(path, force, |w| {
-        array.write_npy(w).map_err(|e| Error::BadArrayFile {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })
-    })
+    write_one(path, force, |s| s.write_json(path, value))
 }
 
 /// Writes a 2D float64 array as `.npy` (C order), atomically.
 pub fn write_npy_2d(path: &Path, force: bool, array: &Array2<f64>) -> Result<()> {
-    write_npy_impl(path, force, array)
+    write_one(path, force, |s| s.write_npy_2d(path, array))
 }
 
 /// Writes a 1D float64 array as `.npy`, atomically.
 pub fn write_npy_1d(path: &Path, force: bool, array: &Array1<f64>) -> Result<()> {
-    write_npy_impl(path, force, array)
+    write_one(path, force, |s| s.write_npy_1d(path, array))
+}
+
+/// The shape recorded in the header of a `.npy` file, read without loading the data (to
+/// size the work before reading a large file). Only the header is checked here; the data
+/// are validated by [`read_npy`].
+pub fn read_npy_shape(path: &Path) -> Result<Vec<usize>> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let header =
+        Header::from_reader(&mut BufReader::new(file)).map_err(|e| Error::BadArrayFile {
+            path: path.to_path_buf(),
+            reason: format!("not a readable .npy array ({e})"),
+        })?;
+    Ok(header.shape)
 }
 
 /// Reads a float64 `.npy` of any dimension and checks that all values are finite.
@@ -269,18 +454,6 @@ pub fn read_npy_2d(path: &Path) -> Result<Array2<f64>> {
         return Err(wrong_shape(path, "2D array of at least 2x2", &shape));
     }
     Ok(array.as_standard_layout().into_owned())
-}
-
-/// The shape of the array in a `.npy` file, from its header alone (the data is not read):
-/// lets a caller check the memory a file will need before reading it.
-pub fn npy_shape(path: &Path) -> Result<Vec<usize>> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let header =
-        Header::from_reader(&mut BufReader::new(file)).map_err(|e| Error::BadArrayFile {
-            path: path.to_path_buf(),
-            reason: format!("not a readable .npy array ({e})"),
-        })?;
-    Ok(header.shape)
 }
 
 /// Reads a 1D float64 `.npy` (a line): finite values, at least 2 points.
@@ -345,78 +518,144 @@ mod tests {
     }
 
     #[test]
-    fn npy_shape_reads_the_header_only() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("a.npy");
-        write_npy_2d(&path, false, &Array2::zeros((3, 5))).unwrap();
-        assert_eq!(npy_shape(&path).unwrap(), [3, 5]);
-        // A header promising far more data than the file holds: the shape is still read.
-        let mut bytes = std::fs::read(&path).unwrap();
-        let at = bytes.windows(6).position(|w| w == b"(3, 5)").unwrap();
-        bytes[at + 1] = b'9';
-        bytes.truncate(bytes.len() - 15 * 8);
-        std::fs::write(&path, &bytes).unwrap();
-        assert_eq!(npy_shape(&path).unwrap(), [9, 5]);
-        assert!(read_npy_2d(&path).is_err());
-        std::fs::write(&path, b"not npy").unwrap();
-        assert!(matches!(npy_shape(&path), Err(Error::BadArrayFile { .. })));
-    }
-
-    #[test]
-    fn an_uncommitted_batch_leaves_nothing() {
-        let dir = tempfile::tempdir().unwrap();
-        let nested = dir.path().join("a").join("b");
-        let mut batch = OutputBatch::new(false);
-        batch.create_dir_all(&nested).unwrap();
-        batch.write_bytes(&nested.join("x.csv"), b"x").unwrap();
-        batch
-            .write_npy_2d(&dir.path().join("y.npy"), Array2::zeros((2, 2)).view())
-            .unwrap();
-        assert!(batch.write_bytes(&nested.join("x.csv"), b"again").is_err());
-        drop(batch);
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-    }
-
-    #[test]
-    fn a_committed_batch_writes_everything() {
-        let dir = tempfile::tempdir().unwrap();
-        let kept = dir.path().join("kept.csv");
-        std::fs::write(&kept, "old").unwrap();
-        let mut batch = OutputBatch::new(false);
-        assert!(matches!(
-            batch.write_bytes(&kept, b"new"),
-            Err(Error::OutputExists(_))
-        ));
-        let fields = dir.path().join("fields");
-        batch.create_dir_all(&fields).unwrap();
-        let a = array![[1.0, 2.0], [3.0, 4.0]];
-        batch.write_npy_2d(&fields.join("p.npy"), a.view()).unwrap();
-        batch
-            .write_bytes(&dir.path().join("t.csv"), b"t\n")
-            .unwrap();
-        assert!(
-            !dir.path().join("t.csv").exists(),
-            "nothing before the commit"
-        );
-        batch.commit().unwrap();
-        assert_eq!(read_npy_2d(&fields.join("p.npy")).unwrap(), a);
-        assert_eq!(std::fs::read(dir.path().join("t.csv")).unwrap(), b"t\n");
-        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "old");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
-        assert_eq!(std::fs::read_dir(&fields).unwrap().count(), 1);
-        // Forced: replaces.
-        let mut batch = OutputBatch::new(true);
-        batch.write_bytes(&kept, b"new").unwrap();
-        batch.commit().unwrap();
-        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "new");
-    }
-
-    #[test]
     fn failed_write_leaves_nothing() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("x.bin");
         let err = atomic_write(&path, false, |_| Err(Error::invalid("x", "boom")));
         assert!(err.is_err());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn staged_outputs_are_checked_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let a = d.join("a.npy");
+        let missing = d.join("nowhere").join("a.png");
+        let err = StagedOutputs::new([&a, &missing], false).err().unwrap();
+        assert!(matches!(err, Error::BadOutput { .. }), "{err}");
+        assert!(err.to_string().contains("does not exist"), "{err}");
+        // The same file named twice, also through `.`/`..`.
+        let same = d.join("sub").join("..").join("a.npy");
+        std::fs::create_dir(d.join("sub")).unwrap();
+        for twin in [a.clone(), d.join(".").join("a.npy"), same] {
+            let err = StagedOutputs::new([&a, &twin], true).err().unwrap();
+            assert!(err.to_string().contains("same file"), "{err}");
+        }
+        // A folder is refused even with force; an existing file only without it.
+        let err = StagedOutputs::new([d.join("sub")], true).err().unwrap();
+        assert!(err.to_string().contains("is a folder"), "{err}");
+        std::fs::write(&a, b"old").unwrap();
+        let err = StagedOutputs::new([&a], false).err().unwrap();
+        assert!(matches!(err, Error::OutputExists(_)), "{err}");
+        let staged = StagedOutputs::new([&a], true).unwrap();
+        let err = staged.ensure_not_input(&a).unwrap_err();
+        assert!(err.to_string().contains("input"), "{err}");
+        staged.ensure_not_input(&d.join("other.npy")).unwrap();
+        assert_eq!(entries(d), ["a.npy", "sub"]);
+    }
+
+    #[test]
+    fn staged_outputs_are_all_or_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let (a, b, c) = (d.join("a.npy"), d.join("a.npy.json"), d.join("a.png"));
+        // A failure part-way leaves nothing, not even the outputs already staged.
+        {
+            let mut staged = StagedOutputs::new([&a, &b, &c], false).unwrap();
+            staged.write_npy_1d(&a, &array![1.0, 2.0]).unwrap();
+            staged.write_json(&b, &serde_json::json!({"x": 1})).unwrap();
+            let err = staged
+                .write_with(&c, |_| Err(Error::invalid("png", "boom")))
+                .unwrap_err();
+            assert!(err.to_string().contains("boom"));
+        }
+        assert!(entries(d).is_empty(), "{:?}", entries(d));
+        // Committing with an output never written fails and touches nothing.
+        let mut staged = StagedOutputs::new([&a, &b], false).unwrap();
+        staged.write_bytes(&a, b"x").unwrap();
+        let err = staged.commit().unwrap_err();
+        assert!(err.to_string().contains("never written"), "{err}");
+        assert!(entries(d).is_empty(), "{:?}", entries(d));
+        // An output that appeared meanwhile is not overwritten without force.
+        let mut staged = StagedOutputs::new([&a, &b], false).unwrap();
+        staged.write_bytes(&a, b"new a").unwrap();
+        staged.write_bytes(&b, b"new b").unwrap();
+        std::fs::write(&b, b"someone else's").unwrap();
+        assert!(matches!(staged.commit(), Err(Error::OutputExists(_))));
+        assert_eq!(entries(d), ["a.npy.json"]);
+        assert_eq!(std::fs::read(&b).unwrap(), b"someone else's");
+        // Writing an undeclared output is an error; a complete set is renamed into place.
+        let mut staged = StagedOutputs::new([&a, &b], true).unwrap();
+        assert!(staged.write_bytes(&c, b"?").is_err());
+        staged.write_bytes(&a, b"A").unwrap();
+        staged
+            .write_file_with(&b, Some("json"), |tmp| {
+                assert!(tmp.to_string_lossy().ends_with(".json"));
+                std::fs::write(tmp, b"B").map_err(|e| Error::io(tmp, e))
+            })
+            .unwrap();
+        staged.commit().unwrap();
+        assert_eq!(entries(d), ["a.npy", "a.npy.json"]);
+        assert_eq!(std::fs::read(&a).unwrap(), b"A");
+        assert_eq!(std::fs::read(&b).unwrap(), b"B");
+    }
+
+    #[test]
+    fn atomic_write_into_a_missing_folder_is_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("no").join("x.csv");
+        let err = write_bytes(&path, false, b"q,psd\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("does not exist") && err.contains("x.csv"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn new_folders_are_removed_unless_committed() {
+        let dir = tempfile::tempdir().unwrap();
+        let fields = dir.path().join("a/b");
+        let out = fields.join("p.npy");
+        // Dropped uncommitted (an error on the way): the folders made for it go too.
+        let mut staged = StagedOutputs::in_new_folders([&fields], [&out], false).unwrap();
+        assert!(fields.is_dir());
+        staged.write_bytes(&out, b"x").unwrap();
+        drop(staged);
+        assert!(!dir.path().join("a").exists());
+        // Refused outputs (named twice) leave no folder behind either.
+        assert!(StagedOutputs::in_new_folders([&fields], [&out, &out], false).is_err());
+        assert!(!dir.path().join("a").exists());
+        // Committed: folders and file stay.
+        let mut staged = StagedOutputs::in_new_folders([&fields], [&out], false).unwrap();
+        staged.write_bytes(&out, b"x").unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"x");
+    }
+
+    #[test]
+    fn npy_shape_is_read_from_the_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.npy");
+        write_npy_2d(&path, false, &Array2::zeros((3, 5))).unwrap();
+        assert_eq!(read_npy_shape(&path).unwrap(), [3, 5]);
+        let line = dir.path().join("l.npy");
+        write_npy_1d(&line, false, &Array1::zeros(7)).unwrap();
+        assert_eq!(read_npy_shape(&line).unwrap(), [7]);
+        let junk = dir.path().join("junk.npy");
+        std::fs::write(&junk, b"hello world, not an array").unwrap();
+        let err = read_npy_shape(&junk).unwrap_err().to_string();
+        assert!(err.contains("not a readable .npy"), "{err}");
     }
 }

@@ -13,7 +13,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
 use asperity::elastic::Boundary;
-use asperity::io::{ensure_new_output, npy_shape, read_npy_2d, sidecar_path, OutputBatch};
+use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
 
@@ -200,27 +200,6 @@ fn field_paths(dir: &Path, count: usize) -> Vec<(PathBuf, PathBuf)> {
         .collect()
 }
 
-/// Checks an output file before any work: it is not a folder, it is new unless `force`,
-/// and (`parent_must_exist`) its folder exists.
-fn check_output_file(flag: &str, path: &Path, force: bool, parent_must_exist: bool) -> Result<()> {
-    if path.is_dir() {
-        bail!("{flag} {}: is a directory", path.display());
-    }
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if parent_must_exist && !parent.is_dir() {
-        bail!(
-            "{flag} {}: folder {} does not exist",
-            path.display(),
-            parent.display()
-        );
-    }
-    ensure_new_output(path, force)?;
-    Ok(())
-}
-
 struct Row {
     values: Vec<f64>,
     stiffness: Option<f64>,
@@ -252,29 +231,23 @@ pub fn run(args: &BemArgs) -> Result<()> {
     params
         .validate()
         .with_context(|| format!("--max-iter {}", args.max_iter))?;
-    if let Some(out) = &args.out {
-        check_output_file("--out", out, args.force, true)?;
-    }
+    // Outputs, checked before any work: each folder exists (--fields DIR and its missing
+    // parents are made here, and removed again on any error), no output is named twice or
+    // exists without --force. They are written to temporary files as each load is solved
+    // and renamed into place together at the end.
     let fields = args
         .fields
         .as_ref()
         .map(|dir| field_paths(dir, loads.len()));
-    if let (Some(dir), Some(fields)) = (&args.fields, &fields) {
-        if dir.exists() && !dir.is_dir() {
-            bail!("--fields {}: exists and is not a directory", dir.display());
-        }
-        for (p, g) in fields {
-            // DIR and its missing parents are created just before the first solve.
-            check_output_file("--fields", p, args.force, false)?;
-            check_output_file("--fields", g, args.force, false)?;
-            if args.out.as_ref().is_some_and(|out| out == p || out == g) {
-                bail!("--out {}: is also a --fields output", p.display());
-            }
-        }
-    }
+    let output_paths = args
+        .out
+        .iter()
+        .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
+    let mut staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
+    staged.ensure_not_input(&args.surface)?;
     // Memory, from the file's header before its data is read: the solver plus the heights,
     // alive while the solver is built (the fields go to files as they are solved).
-    let shape = npy_shape(&args.surface)?;
+    let shape = read_npy_shape(&args.surface)?;
     if let [rows, cols] = shape[..] {
         let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
             .zip(array_bytes(&[rows, cols], 8))
@@ -301,12 +274,6 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let mut solver = ContactSolver::new(&surface, half_space, params)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
-    // Outputs: temporary files from now on, renamed into place at the end; dropped (and
-    // removed, with the --fields folder if it was created here) on any error.
-    let mut batch = OutputBatch::new(args.force);
-    if let Some(dir) = &args.fields {
-        batch.create_dir_all(dir)?;
-    }
 
     // 2. Solve every load (warm starts in the given order).
     let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
@@ -349,8 +316,8 @@ pub fn run(args: &BemArgs) -> Result<()> {
             ]);
         }
         if let Some((p_path, g_path)) = fields.as_ref().map(|f| &f[k]) {
-            batch.write_npy_2d(p_path, solver.pressure())?;
-            batch.write_npy_2d(g_path, solver.gap())?;
+            staged.write_npy_2d(p_path, &solver.pressure())?;
+            staged.write_npy_2d(g_path, &solver.gap())?;
         }
         rows.push(Row { values, stiffness });
         progress.inc();
@@ -387,10 +354,10 @@ pub fn run(args: &BemArgs) -> Result<()> {
             table.push(&format_row(row));
         }
         table
-            .write_into(&mut batch, out)
+            .stage(&mut staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
     }
-    batch.commit()?;
+    staged.commit()?;
     match &args.out {
         Some(out) => {
             if !args.quiet {

@@ -9,6 +9,7 @@ use asperity::io::{ensure_new_output, read_npy_1d, sidecar_path};
 use asperity::mdr::{
     log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
+use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::rms_height;
 
 use crate::output::{format_number, Table};
@@ -112,13 +113,17 @@ pub struct MdrArgs {
     #[arg(long, conflicts_with = "breakpoints")]
     pub nloads: Option<usize>,
     /// Smallest indentation for --nloads (default --dmax · 1e-6).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dmin: Option<f64>,
     /// Largest indentation for --nloads (default: full contact, the largest finite gap).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dmax: Option<f64>,
-    /// Linear springs on a line: write the exact curve, one row per contact count (the
-    /// breakpoints where each spring first touches).
+    /// Linear springs on a line: write the exact curve, one row per contact count j = 1..N
+    /// (the breakpoints d_j where the j-th spring first touches). Here `stiffness` and
+    /// `contacts` are those just after the breakpoint: contacts = j counts the spring that
+    /// is just touching (k = E*·Δx·j), so the first row is d = 0, F = 0, contacts = 1. With
+    /// --indentations/--nloads `contacts` counts springs compressed at d (u > 0): at d = 0
+    /// that is 0, and k = 0.
     #[arg(long)]
     pub breakpoints: bool,
     /// Output CSV (default: standard output).
@@ -154,6 +159,22 @@ struct Indenter {
     description: String,
 }
 
+/// Estimated bytes of one output row while the table is built and written: the row's
+/// `Vec` of 4 `String`s (24 + 4·24 bytes), their text (up to 24 characters each, 32 bytes as
+/// allocated) and its share of the CSV text (about 4·24 characters).
+const ROW_BYTES: usize = 24 + 4 * 24 + 4 * 32 + 4 * 24;
+
+/// Refuses an output of `rows` rows (plus `extra_per_row` bytes each of other buffers)
+/// that would not fit in memory, before anything is allocated.
+fn ensure_rows_fit(rows: usize, extra_per_row: usize, what: &str) -> Result<()> {
+    let per_row = ROW_BYTES + extra_per_row;
+    ensure_fits(
+        &format!("{what} ({rows} rows of about {per_row} bytes)"),
+        array_bytes(&[rows], per_row),
+    )?;
+    Ok(())
+}
+
 fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
     let n = args
         .n
@@ -165,6 +186,12 @@ fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
     if n == 0 {
         bail!("invalid n: need at least one spring");
     }
+    // The profile g(x_i) and the foundation's sorted copy of it live together: two f64
+    // per spring (the sort is in place).
+    ensure_fits(
+        &format!("--n {n} springs (profile and sorted gaps, 16 bytes each)"),
+        array_bytes(&[n, 2], std::mem::size_of::<f64>()),
+    )?;
     Ok((n, dx))
 }
 
@@ -275,6 +302,7 @@ fn indentation_levels(args: &MdrArgs, foundation: &Foundation) -> Result<Vec<f64
         return Ok(list.clone());
     }
     let count = args.nloads.unwrap_or(50);
+    ensure_rows_fit(count, std::mem::size_of::<f64>(), "--nloads")?;
     let dmax = match args.dmax {
         Some(d) => d,
         None => {
@@ -314,6 +342,12 @@ pub fn run(args: &MdrArgs) -> Result<()> {
                 "--breakpoints needs --line with linear springs (the exact piecewise-linear curve)"
             );
         }
+        // One row per spring, besides the curve's breakpoints and forces (two f64 each).
+        ensure_rows_fit(
+            indenter.values.len(),
+            2 * std::mem::size_of::<f64>(),
+            "--breakpoints",
+        )?;
         let curve = LinearCurve::from_heights(&indenter.values, spring.spacing(), args.modulus)?;
         for j in 1..=curve.len() {
             push(&mut table, &curve.breakpoint(j));

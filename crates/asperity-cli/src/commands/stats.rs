@@ -1,10 +1,11 @@
 //! `asperity stats FILE.npy`: statistics of a surface (2D) or line (1D).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, ensure, Context, Result};
 use asperity::fit::power_law_fit;
-use asperity::io::{read_npy, sidecar_path};
+use asperity::io::{read_npy, read_npy_shape, sidecar_path, StagedOutputs};
+use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::{
     line_psd, line_summary, radial_psd_2d, surface_summary, PsdBin, Summary,
 };
@@ -16,6 +17,7 @@ use crate::output::{format_number, Table};
 /// Arguments of `asperity stats`.
 #[derive(Debug, clap::Args)]
 #[command(
+    allow_negative_numbers = true,
     after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6"
 )]
 pub struct StatsArgs {
@@ -27,10 +29,12 @@ pub struct StatsArgs {
     /// Write the (radially averaged) PSD as CSV with columns q,psd.
     #[arg(long, value_name = "OUT.csv")]
     pub psd: Option<PathBuf>,
-    /// Fit the PSD slope from this q·L/2π (default 2, or the sidecar's roll-off/cut-off if higher).
+    /// Fit the PSD slope from the ring at this q·L/2π [default: 2; the sidecar's roll-off
+    /// q0, or the first ring wholly above its cut-off q0 (q0 + 1), if higher].
     #[arg(long, value_name = "Q")]
     pub fit_from: Option<f64>,
-    /// Fit the PSD slope up to this q·L/2π (default: Nyquist).
+    /// Fit the PSD slope up to the ring at this q·L/2π [default: Nyquist; the last ring
+    /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower].
     #[arg(long, value_name = "Q")]
     pub fit_to: Option<f64>,
     /// Print the statistics as JSON.
@@ -41,28 +45,114 @@ pub struct StatsArgs {
     pub force: bool,
 }
 
-/// Size and the long-wavelength limit recorded in a sidecar, if there is one.
-fn sidecar_hints(file: &std::path::Path) -> (Option<f64>, Option<f64>) {
+/// What a sidecar records that shapes the statistics: the side length and the spectrum's
+/// limits (as q·L/2π). Missing or unreadable sidecars give no hints.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct SidecarHints {
+    size: Option<f64>,
+    /// Roll-off (`true`) or cut-off (`false`) wavenumber q0.
+    long_wavelength: Option<(bool, f64)>,
+    short_cutoff: Option<f64>,
+}
+
+fn sidecar_hints(file: &Path) -> SidecarHints {
     let Ok(text) = std::fs::read_to_string(sidecar_path(file)) else {
-        return (None, None);
+        return SidecarHints::default();
     };
     let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return (None, None);
+        return SidecarHints::default();
     };
     let spec = &value["spec"];
-    (
-        spec["size"].as_f64(),
-        spec["psd"]["long_wavelength"]["q0"].as_f64(),
-    )
+    let long = &spec["psd"]["long_wavelength"];
+    let positive = |v: &serde_json::Value| v.as_f64().filter(|x| x.is_finite() && *x > 0.0);
+    SidecarHints {
+        size: positive(&spec["size"]),
+        long_wavelength: match (long["kind"].as_str(), positive(&long["q0"])) {
+            (Some("roll_off"), Some(q0)) => Some((true, q0)),
+            (Some("cut_off"), Some(q0)) => Some((false, q0)),
+            _ => None,
+        },
+        short_cutoff: positive(&spec["psd"]["short_cutoff"]),
+    }
+}
+
+/// Checks a user-given end of the fit range: a positive, finite q·L/2π.
+fn fit_bound(flag: &str, value: Option<f64>) -> Result<Option<f64>> {
+    match value {
+        Some(v) if !(v.is_finite() && v > 0.0) => {
+            bail!("invalid {flag}: must be a positive number of wavelengths per side, got {v}")
+        }
+        other => Ok(other),
+    }
+}
+
+/// The PSD slope is fitted over the rings (bins) `κ = from ..= to`, `κ = round(q·L/2π)`.
+/// By default: from 2, or from the roll-off q0 (the knee, as the paper fits), or from the
+/// first ring wholly above a cut-off q0 (q0 + 1 for a whole q0: the ring at q0 is half
+/// empty); up to the last ring wholly below a short cut-off q1 (q1 − 1), else Nyquist
+/// (`nyquist`, the last ring).
+fn fit_range(args: &StatsArgs, hints: &SidecarHints, nyquist: f64) -> Result<(f64, f64)> {
+    let user_from = fit_bound("--fit-from", args.fit_from)?;
+    let user_to = fit_bound("--fit-to", args.fit_to)?;
+    let from = user_from.unwrap_or(match hints.long_wavelength {
+        Some((true, q0)) => q0.max(2.0),
+        Some((false, q0)) => (q0 + 0.5).ceil().max(2.0),
+        None => 2.0,
+    });
+    let to = user_to.unwrap_or(match hints.short_cutoff {
+        Some(q1) => (q1 - 0.5).floor().min(nyquist),
+        None => nyquist,
+    });
+    if from > to {
+        bail!(
+            "empty PSD fit range: from q·L/2π = {from} to {to}{}",
+            if user_to.is_none() {
+                " (the default upper end; set --fit-to)"
+            } else {
+                ""
+            }
+        );
+    }
+    Ok((from, to))
 }
 
 /// Runs `asperity stats`.
 pub fn run(args: &StatsArgs) -> Result<()> {
-    if let Some(psd) = &args.psd {
-        asperity::io::ensure_new_output(psd, args.force)?;
+    if let Some(size) = args.size {
+        ensure!(
+            size.is_finite() && size > 0.0,
+            "invalid --size: must be positive and finite, got {size}"
+        );
     }
-    let (sidecar_size, sidecar_q0) = sidecar_hints(&args.file);
-    let size = args.size.or(sidecar_size).unwrap_or(1.0);
+    fit_bound("--fit-from", args.fit_from)?;
+    fit_bound("--fit-to", args.fit_to)?;
+    if let (Some(from), Some(to)) = (args.fit_from, args.fit_to) {
+        ensure!(
+            from < to,
+            "invalid PSD fit range: --fit-from {from} must be below --fit-to {to}"
+        );
+    }
+    // The PSD output is checked before the (possibly large) input is read.
+    let mut staged = match &args.psd {
+        Some(psd) => {
+            let staged = StagedOutputs::new([psd], args.force)?;
+            staged.ensure_not_input(&args.file)?;
+            Some(staged)
+        }
+        None => None,
+    };
+    // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
+    // the file, checked from the header before the data are read.
+    let shape = read_npy_shape(&args.file)?;
+    ensure_fits(
+        &format!(
+            "computing the statistics of {} (shape {shape:?})",
+            args.file.display()
+        ),
+        array_bytes(&shape, 4 * 8),
+    )?;
+    let hints = sidecar_hints(&args.file);
+    let size = args.size.or(hints.size).unwrap_or(1.0);
     let array = read_npy(&args.file)?;
     let (summary, bins, dims, psd_offset): (Summary, Vec<PsdBin>, Vec<usize>, f64) =
         match array.ndim() {
@@ -75,34 +165,33 @@ pub fn run(args: &StatsArgs) -> Result<()> {
                 let (r, c) = surface.dim();
                 (
                     surface_summary(&surface),
-                    radial_psd_2d(&surface),
+                    radial_psd_2d(&surface)?,
                     vec![r, c],
                     2.0,
                 )
             }
-            d => anyhow::bail!(
+            d => bail!(
                 "{}: expected a 1D line or 2D surface, found {d} dimensions",
                 args.file.display()
             ),
         };
-    let kappa = |q: f64| q * size / std::f64::consts::TAU;
-    let from = args
-        .fit_from
-        .unwrap_or_else(|| sidecar_q0.unwrap_or(0.0).max(2.0));
-    let to = args.fit_to.unwrap_or(f64::INFINITY);
+    let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
+    let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
+    let (from, to) = fit_range(args, &hints, nyquist)?;
     let (q, c): (Vec<f64>, Vec<f64>) = bins
         .iter()
-        .filter(|b| (from..=to).contains(&kappa(b.q)) && b.psd > 0.0)
+        .filter(|b| (from..=to).contains(&ring(b.q)) && b.psd > 0.0)
         .map(|b| (b.q, b.psd))
         .unzip();
     let fit = power_law_fit(&q, &c).ok();
-    if let Some(path) = &args.psd {
+    if let (Some(path), Some(mut staged)) = (&args.psd, staged.take()) {
         let mut table = Table::new(&["q", "psd"]);
         for b in &bins {
             table.push_numbers(&[b.q, b.psd]);
         }
         table
-            .write(path, args.force)
+            .stage(&mut staged, path)
+            .and_then(|()| Ok(staged.commit()?))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
@@ -135,7 +224,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
                 f.exponent,
                 f.low,
                 f.high,
-                if to.is_finite() { to.to_string() } else { "Nyquist".into() },
+                if to >= nyquist { format!("{to} (Nyquist)") } else { to.to_string() },
                 f.points
             );
             println!("hurst_estimate: {:.4}", hurst.unwrap_or(f64::NAN));

@@ -408,7 +408,8 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
             .color(ordered_color(t * 0.85)),
         );
     }
-    let pp: Vec<(f64, f64)> = (0..=40)
+    // (6) on (0, 2]: H = 0 itself belongs to (24), drawn below on [-1, 0].
+    let pp: Vec<(f64, f64)> = (1..=40)
         .map(|i| 0.05 * i as f64)
         .map(|h| (h, alpha_pohrt_popov(h)))
         .collect();

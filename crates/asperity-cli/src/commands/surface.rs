@@ -1,9 +1,9 @@
 //! `asperity surface` and `asperity line`: Fourier synthesis of rough surfaces and lines.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Result;
-use asperity::io::{ensure_new_output, sidecar_path, write_json, write_npy_1d, write_npy_2d};
+use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::stats::{line_summary, surface_summary};
 use asperity::surface::{LineGenerator, LineSpec, Normalisation, SurfaceGenerator, SurfaceSpec};
@@ -24,7 +24,7 @@ pub struct SpectrumArgs {
     /// Side length L (units of the heights).
     #[arg(long, default_value_t = 1.0)]
     pub size: f64,
-    /// Random seed; the same seed gives bit-identical heights on any machine and thread count.
+    /// Random seed; the same seed gives bit-identical heights whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Output file (.npy, float64); a JSON sidecar FILE.npy.json records every parameter.
@@ -104,13 +104,6 @@ fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> Normalisati
     }
 }
 
-fn check_outputs(paths: &[&Path], force: bool) -> Result<()> {
-    for path in paths {
-        ensure_new_output(path, force)?;
-    }
-    Ok(())
-}
-
 /// Runs `asperity surface`.
 pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let s = &args.spectrum;
@@ -126,15 +119,15 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let sidecar = sidecar_path(&s.out);
     let mut outputs = vec![s.out.as_path(), sidecar.as_path()];
     outputs.extend(args.png.as_deref());
-    check_outputs(&outputs, s.force)?;
+    // All outputs are checked now and written all-or-nothing after the work.
+    let mut staged = StagedOutputs::new(&outputs, s.force)?;
     let start = std::time::Instant::now();
     let surface = SurfaceGenerator::new(&spec)?.try_generate(s.seed)?;
     let elapsed = start.elapsed().as_secs_f64();
     let summary = surface_summary(&surface);
-    write_npy_2d(&s.out, s.force, surface.heights())?;
-    write_json(
+    staged.write_npy_2d(&s.out, surface.heights())?;
+    staged.write_json(
         &sidecar,
-        s.force,
         &json!({
             "kind": "surface",
             "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
@@ -145,8 +138,9 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
         }),
     )?;
     if let Some(png) = &args.png {
-        crate::plot::greyscale_png(png, surface.heights().view(), s.force)?;
+        crate::plot::greyscale_png(&mut staged, png, surface.heights().view())?;
     }
+    staged.commit()?;
     eprintln!(
         "wrote {} ({rows}x{} in {elapsed:.3} s): rms height {:.6e}, rms slope {:.6e}",
         s.out.display(),
@@ -168,13 +162,12 @@ pub fn run_line(args: &LineArgs) -> Result<()> {
         normalisation(args.rms_height, args.rms_slope),
     )?;
     let sidecar = sidecar_path(&s.out);
-    check_outputs(&[&s.out, &sidecar], s.force)?;
+    let mut staged = StagedOutputs::new([&s.out, &sidecar], s.force)?;
     let line = LineGenerator::new(&spec)?.try_generate(s.seed)?;
     let summary = line_summary(&line);
-    write_npy_1d(&s.out, s.force, line.heights())?;
-    write_json(
+    staged.write_npy_1d(&s.out, line.heights())?;
+    staged.write_json(
         &sidecar,
-        s.force,
         &json!({
             "kind": "line",
             "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
@@ -184,6 +177,7 @@ pub fn run_line(args: &LineArgs) -> Result<()> {
             "stats": summary,
         }),
     )?;
+    staged.commit()?;
     eprintln!(
         "wrote {} ({} points): rms height {:.6e}, rms slope {:.6e}",
         s.out.display(),

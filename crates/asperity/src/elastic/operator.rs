@@ -620,7 +620,7 @@ mod tests {
                     love_pixel_displacement(offset(c, pcol), offset(r, prow), dx, dx, 1.0);
             }
         }
-        let mut fft = crate::fft::RealFft2::new(prow, pcol);
+        let mut fft = crate::fft::RealFft2::new(prow, pcol).unwrap();
         let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
         fft.forward(&samples, &mut spectrum);
         let scale = 1.0 / (prow * pcol) as f64;

@@ -11,7 +11,12 @@
 //! * sphere (paraboloid `f = r²/2R`): `g = x²/R` — eq. (15.1), `R₁ = R/2`;
 //! * cone `f = r·tan θ`: `g = (π/2)·tan θ·|x|`;
 //! * flat punch of radius `a`: `g = 0` for `|x| ≤ a`, `+∞` outside (those springs never
-//!   touch);
+//!   touch). A spring exactly at the edge, `|x| = a`, is inside: the test is
+//!   `|x| ≤ a·(1 + 1e-12)` ([`PUNCH_EDGE_TOLERANCE`]), so that a radius that is a multiple
+//!   `m·Δx` of the spacing takes its `2m + 1` springs (odd `n`) whatever the rounding of
+//!   `x_i = (i − (n−1)/2)·Δx` (e.g. `3 × 0.1 = 0.30000000000000004 > 0.3`). The stiffness is
+//!   then `E*Δx·(springs inside)`, within `Δx/a` of `2E*a`; exactly `2E*a` for
+//!   `a = (m + ½)Δx`;
 //! * power law `f = c·rⁿ`: `g = κ(n)·c·|x|ⁿ` with the stretch factor
 //!   `κ(n) = √π Γ(n/2+1)/Γ(n/2+1/2)` of [`crate::reference::PowerLaw::stretch`].
 //!
@@ -37,6 +42,12 @@ use serde::{Deserialize, Serialize};
 use crate::reference::PowerLaw;
 use crate::{Error, Result};
 
+/// Relative tolerance of the flat punch's edge: a spring at `|x| ≤ a·(1 + 1e-12)` is under
+/// the punch, so springs exactly at `|x| = a` count although their computed position may
+/// be rounded a few ulps outwards. 1e-12 is far above rounding (≈ 1e-16 per operation) and
+/// far below any deliberate distinction between radii.
+pub const PUNCH_EDGE_TOLERANCE: f64 = 1e-12;
+
 /// Closed-form axisymmetric indenters (parameters checked by [`Axisymmetric::validate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -51,7 +62,8 @@ pub enum Axisymmetric {
         /// Flank slope `tan θ`.
         slope: f64,
     },
-    /// Flat-ended cylindrical punch of radius a: `g = 0` on `|x| ≤ a`, `+∞` outside.
+    /// Flat-ended cylindrical punch of radius a: `g = 0` on `|x| ≤ a` (edge included, up to
+    /// a relative [`PUNCH_EDGE_TOLERANCE`]), `+∞` outside.
     FlatPunch {
         /// Punch radius a.
         radius: f64,
@@ -96,7 +108,7 @@ impl Axisymmetric {
             Axisymmetric::Sphere { radius } => x * x / radius,
             Axisymmetric::Cone { slope } => PI / 2.0 * slope * x,
             Axisymmetric::FlatPunch { radius } => {
-                if x <= radius {
+                if x <= radius * (1.0 + PUNCH_EDGE_TOLERANCE) {
                     0.0
                 } else {
                     f64::INFINITY
@@ -137,7 +149,11 @@ fn check_grid(n: usize, spacing: f64) -> Result<()> {
             format!("the spring spacing Δx must be positive and finite, got {spacing}"),
         ));
     }
-    Ok(())
+    // The sampled profile is one f64 per spring; refuse it before allocating.
+    crate::memory::ensure_fits(
+        &format!("a profile of {n} springs"),
+        crate::memory::array_bytes(&[n], std::mem::size_of::<f64>()),
+    )
 }
 
 /// The symmetric spring positions `x_i = (i − (n−1)/2)·Δx`, `i = 0..n`.
@@ -336,9 +352,67 @@ mod tests {
             .unwrap();
         assert_eq!(punch, vec![f64::INFINITY, 0.0, 0.0, 0.0, f64::INFINITY]);
         assert!(RadialProfile::new(&[0.0, 0.1, f64::NAN], 0.1).is_err());
+        // The edge belongs to the punch: a = 0.1 = Δx takes x = ±0.1 above.
+        let one_sided = Axisymmetric::FlatPunch { radius: 0.1 }
+            .sample(4, 0.1)
+            .unwrap();
+        assert_eq!(one_sided, vec![f64::INFINITY, 0.0, 0.0, f64::INFINITY]);
         assert!(RadialProfile::new(&[0.0, 0.1], 0.1).is_err());
         let short = sampled(|r| r, 0.1, 11);
         assert!(short.sample(31, 0.1).is_err());
         assert!(short.sample(21, 0.1).is_ok());
+    }
+
+    #[test]
+    fn a_profile_that_cannot_fit_is_refused_before_allocating() {
+        for n in [1usize << 60, usize::MAX] {
+            let err = Axisymmetric::Sphere { radius: 1.0 }
+                .sample(n, 0.1)
+                .unwrap_err();
+            assert!(matches!(err, Error::OutOfMemory { .. }), "{err}");
+            let err = sampled(|r| r, 0.1, 11).sample(n, 0.1).unwrap_err();
+            assert!(matches!(err, Error::OutOfMemory { .. }), "{err}");
+        }
+    }
+
+    #[test]
+    fn punch_radius_on_the_grid_takes_the_edge_springs() {
+        // a = m·Δx puts springs exactly at the edge, where the computed x_i = (i − c)·Δx may
+        // round either way (3 × 0.1 = 0.30000000000000004 > 0.3). The edge is in, whatever
+        // the rounding: 2m + 1 springs, as for a radius a hair larger, and a hair smaller
+        // (beyond the 1e-12 tolerance) drops them.
+        let count = |radius: f64, n: usize, dx: f64| {
+            Axisymmetric::FlatPunch { radius }
+                .sample(n, dx)
+                .unwrap()
+                .iter()
+                .filter(|g| g.is_finite())
+                .count()
+        };
+        for (m, dx) in [
+            (3usize, 0.1),
+            (7, 0.1),
+            (1, 0.3),
+            (5, 1e-3),
+            (100, 0.01),
+            (13, 0.7),
+        ] {
+            let radius = m as f64 * dx;
+            let n = 2 * m + 41;
+            assert_eq!(count(radius, n, dx), 2 * m + 1, "a = {m}·{dx}");
+            assert_eq!(
+                count(radius * (1.0 + 1e-8), n, dx),
+                2 * m + 1,
+                "a hair larger"
+            );
+            assert_eq!(
+                count(radius * (1.0 - 1e-8), n, dx),
+                2 * m - 1,
+                "a hair smaller"
+            );
+        }
+        // The case of the audit: radius 0.3 and 0.30000001 with Δx = 0.1 agree.
+        assert_eq!(count(0.3, 11, 0.1), 7);
+        assert_eq!(count(0.300_000_01, 11, 0.1), 7);
     }
 }

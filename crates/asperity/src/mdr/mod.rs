@@ -41,7 +41,7 @@ pub mod radix_sort;
 pub mod spring;
 
 pub use foundation::{log_spaced, CurvePoint, Foundation};
-pub use indenter::{spring_positions, Axisymmetric, RadialProfile};
+pub use indenter::{spring_positions, Axisymmetric, RadialProfile, PUNCH_EDGE_TOLERANCE};
 pub use linear_curve::LinearCurve;
 pub use low_force::{
     ensemble_exponent, low_force_sample, EnsembleExponent, LowForceSample, LowForceWindow,

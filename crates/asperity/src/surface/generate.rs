@@ -35,7 +35,7 @@ use std::sync::Arc;
 
 use super::{stats, validate_size, Line, Normalisation, Surface};
 use crate::fft::RealFft2;
-use crate::memory::{array_bytes, ensure_fits};
+use crate::memory::{array_bytes, ensure_fits, try_vec};
 use crate::spectrum::Psd;
 use crate::{Error, Result};
 
@@ -117,10 +117,11 @@ impl SurfaceGenerator {
     /// Plans the transforms; fails if the grid would not fit in memory.
     pub fn new(spec: &SurfaceSpec) -> Result<Self> {
         // heights (8 B) + spectrum and FFT work buffer (2 × 16 B per half-grid point).
+        let what = format!("a {}x{} surface", spec.rows, spec.cols);
         let bytes = array_bytes(&[spec.rows, spec.cols], 8 + 16 + 8);
-        ensure_fits(&format!("a {}x{} surface", spec.rows, spec.cols), bytes)?;
-        let fft = RealFft2::new(spec.rows, spec.cols);
-        let spectrum = vec![Complex64::default(); fft.spectrum_len()];
+        ensure_fits(&what, bytes)?;
+        let fft = RealFft2::new(spec.rows, spec.cols)?;
+        let spectrum = try_vec(&what, fft.spectrum_len(), Complex64::default())?;
         Ok(SurfaceGenerator {
             spec: *spec,
             fft,
@@ -144,11 +145,14 @@ impl SurfaceGenerator {
         }
     }
 
-    /// One realisation for `seed`, written into `heights` (`rows × cols`, row-major).
-    /// Fails only if the spectrum has no power on this grid (e.g. a cut-off above Nyquist).
+    /// One realisation for `seed`. Fails if the spectrum has no power on this grid (e.g. a
+    /// cut-off above Nyquist) or the heights cannot be allocated.
     pub fn try_generate(&mut self, seed: u64) -> Result<Surface> {
-        let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
-        self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))?;
+        let SurfaceSpec { rows, cols, .. } = self.spec;
+        let mut heights = try_vec(&format!("a {rows}x{cols} surface"), rows * cols, 0.0)?;
+        self.generate_into(seed, &mut heights)?;
+        let heights = ndarray::Array2::from_shape_vec((rows, cols), heights)
+            .map_err(|e| Error::invalid("grid", e.to_string()))?;
         Ok(Surface {
             heights,
             size: self.spec.size,
@@ -262,19 +266,21 @@ pub struct LineGenerator {
 impl LineGenerator {
     /// Plans the inverse real FFT of length `n` and tabulates the amplitudes `B(q)` (10).
     pub fn new(spec: &LineSpec) -> Result<Self> {
-        ensure_fits(
-            &format!("a line of {} points", spec.n),
-            array_bytes(&[spec.n], 8 + 16 + 16),
-        )?;
+        let what = format!("a line of {} points", spec.n);
+        ensure_fits(&what, array_bytes(&[spec.n], 8 + 16 + 16))?;
         let c2r = RealFftPlanner::<f64>::new().plan_fft_inverse(spec.n);
         let half = spec.n / 2 + 1;
-        let amplitudes = (0..half).map(|k| spec.psd.c1d(k as f64).sqrt()).collect();
-        let scratch = vec![Complex64::default(); c2r.get_scratch_len()];
+        let mut amplitudes = try_vec(&what, half, 0.0)?;
+        for (k, a) in amplitudes.iter_mut().enumerate() {
+            *a = spec.psd.c1d(k as f64).sqrt();
+        }
+        let scratch = try_vec(&what, c2r.get_scratch_len(), Complex64::default())?;
+        let spectrum = try_vec(&what, half, Complex64::default())?;
         Ok(LineGenerator {
             spec: *spec,
             c2r,
             amplitudes,
-            spectrum: vec![Complex64::default(); half],
+            spectrum,
             scratch,
         })
     }
@@ -295,10 +301,13 @@ impl LineGenerator {
         }
     }
 
-    /// One realisation for `seed`, failing if the spectrum has no power on this grid.
+    /// One realisation for `seed`, failing if the spectrum has no power on this grid or
+    /// the heights cannot be allocated.
     pub fn try_generate(&mut self, seed: u64) -> Result<Line> {
-        let mut heights = ndarray::Array1::zeros(self.spec.n);
-        self.generate_into(seed, heights.as_slice_mut().expect("contiguous"))?;
+        let n = self.spec.n;
+        let mut heights = try_vec(&format!("a line of {n} points"), n, 0.0)?;
+        self.generate_into(seed, &mut heights)?;
+        let heights = ndarray::Array1::from_vec(heights);
         Ok(Line {
             heights,
             size: self.spec.size,
@@ -313,7 +322,7 @@ impl LineGenerator {
             *value = amplitude * random_phase(&mut rng);
         }
         self.spectrum[0] = Complex64::default();
-        if n % 2 == 0 {
+        if n.is_multiple_of(2) {
             let v = &mut self.spectrum[n / 2];
             *v = Complex64::new(v.norm() * random_sign(&mut rng), 0.0);
         }
@@ -345,7 +354,7 @@ mod tests {
         let mut generator = SurfaceGenerator::new(&spec).unwrap();
         let mut mean: Vec<(f64, f64)> = Vec::new();
         for seed in 0..realisations {
-            let psd = radial_psd_2d(&generator.generate(seed));
+            let psd = radial_psd_2d(&generator.generate(seed)).unwrap();
             if mean.is_empty() {
                 mean = psd.iter().map(|b| (b.q, 0.0)).collect();
             }
@@ -419,7 +428,7 @@ mod tests {
         ] {
             let psd = Psd::new(0.8, long, None).unwrap();
             let spec = SurfaceSpec::new(64, 64, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
-            let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3));
+            let bins = radial_psd_2d(&SurfaceGenerator::new(&spec).unwrap().generate(3)).unwrap();
             let kappa = |q: f64| q / std::f64::consts::TAU;
             let at_q0 = bins
                 .iter()
@@ -476,6 +485,20 @@ mod tests {
         let line = LineGenerator::new(&line_spec).unwrap().generate(5);
         let slope = rms_slope_1d(line.heights().as_slice().unwrap(), line.spacing());
         assert!((slope / 0.3 - 1.0).abs() < 1e-10);
+        for (n, hurst, long) in [
+            (1001, 0.8, LongWavelength::None),
+            (4096, -0.5, LongWavelength::RollOff { q0: 6.0 }),
+            (4097, 2.5, LongWavelength::CutOff { q0: 3.0 }),
+        ] {
+            let psd = Psd::new(hurst, long, None).unwrap();
+            let spec = LineSpec::new(n, 3.0, psd, Normalisation::RmsHeight(0.02)).unwrap();
+            let line = LineGenerator::new(&spec).unwrap().generate(11);
+            let rms = stats::rms_height(line.heights().iter().copied());
+            assert!(
+                (rms / 0.02 - 1.0).abs() < 1e-10,
+                "n = {n}, H = {hurst}: {rms}"
+            );
+        }
     }
 
     #[test]
@@ -500,41 +523,129 @@ mod tests {
         );
     }
 
+    /// Checks every Fourier mode of a generated surface against `sqrt(C2D)` up to one
+    /// common factor (and empty modes empty).
+    fn assert_modes_follow_spectrum(spec: &SurfaceSpec, label: &str) {
+        let (rows, cols) = (spec.rows, spec.cols);
+        let s = SurfaceGenerator::new(spec).unwrap().generate(9);
+        let mean = s.heights().mean().unwrap();
+        assert!(mean.abs() < 1e-12, "{label}: mean {mean}");
+        let mut fft = RealFft2::new(rows, cols).unwrap();
+        let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+        fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
+        let aspect = cols as f64 / rows as f64;
+        let mut ratio = None;
+        let (mut full, mut empty) = (0, 0);
+        for (kx, column) in spectrum.chunks(rows).enumerate() {
+            for (ky_index, value) in column.iter().enumerate() {
+                let ky = if ky_index <= rows / 2 {
+                    ky_index as f64
+                } else {
+                    ky_index as f64 - rows as f64
+                };
+                let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
+                if target == 0.0 {
+                    assert!(
+                        value.norm() < 1e-9,
+                        "{label}: mode ({kx},{ky}) should be empty, has {}",
+                        value.norm()
+                    );
+                    empty += 1;
+                    continue;
+                }
+                let r = value.norm() / target;
+                let r0 = *ratio.get_or_insert(r);
+                assert!(
+                    (r / r0 - 1.0).abs() < 1e-9,
+                    "{label}: mode ({kx},{ky}) ratio {r} vs {r0}"
+                );
+                full += 1;
+            }
+        }
+        assert!(full > 0, "{label}: no mode has power");
+        assert!(empty > 0, "{label}: at least the mean is empty");
+    }
+
     #[test]
     fn every_mode_keeps_its_amplitude_on_odd_even_grids() {
         // If Hermitian symmetry were broken, the inverse real FFT would drop part of some
         // modes; the forward FFT of the heights would then not reproduce sqrt(C2D) · const.
         for (rows, cols) in [(2, 2), (3, 3), (16, 16), (17, 16), (16, 17), (5, 64)] {
             let spec = surface_spec(rows, cols, 0.5, Normalisation::RmsHeight(1.0));
-            let s = SurfaceGenerator::new(&spec).unwrap().generate(9);
-            let mean = s.heights().mean().unwrap();
-            assert!(mean.abs() < 1e-12, "{rows}x{cols}: mean {mean}");
-            let mut fft = RealFft2::new(rows, cols);
-            let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
-            fft.forward(s.heights().as_slice().unwrap(), &mut spectrum);
-            let aspect = cols as f64 / rows as f64;
-            let mut ratio = None;
-            for (kx, column) in spectrum.chunks(rows).enumerate() {
-                for (ky_index, value) in column.iter().enumerate() {
-                    let ky = if ky_index <= rows / 2 {
-                        ky_index as f64
-                    } else {
-                        ky_index as f64 - rows as f64
-                    };
-                    let target = spec.psd.c2d((kx as f64).hypot(ky * aspect)).sqrt();
-                    if target == 0.0 {
-                        assert!(
-                            value.norm() < 1e-9,
-                            "{rows}x{cols}: mode ({kx},{ky}) should be empty"
-                        );
-                        continue;
-                    }
-                    let r = value.norm() / target;
-                    let r0 = *ratio.get_or_insert(r);
-                    assert!(
-                        (r / r0 - 1.0).abs() < 1e-9,
-                        "{rows}x{cols}: mode ({kx},{ky}) ratio {r} vs {r0}"
+            assert_modes_follow_spectrum(&spec, &format!("{rows}x{cols}"));
+        }
+    }
+
+    #[test]
+    fn roll_off_cut_off_and_short_cut_off_hold_mode_by_mode_on_odd_and_rectangular_grids() {
+        // Roll-off: modes below q0 all at the amplitude of q0 (flat); cut-off: modes below
+        // q0 empty; short cut-off: modes above q1 empty. Checked on every mode, against
+        // C2D of eqs. (7)/(8), on odd, even and rectangular grids (κ_y = ky·cols/rows).
+        let spectra = [
+            ("roll-off", LongWavelength::RollOff { q0: 4.0 }, None),
+            ("cut-off", LongWavelength::CutOff { q0: 4.0 }, None),
+            ("short cut-off", LongWavelength::None, Some(9.0)),
+            (
+                "roll-off + short",
+                LongWavelength::RollOff { q0: 3.0 },
+                Some(7.5),
+            ),
+            (
+                "cut-off + short",
+                LongWavelength::CutOff { q0: 2.5 },
+                Some(11.0),
+            ),
+        ];
+        for (name, long, short) in spectra {
+            for (rows, cols) in [(33, 33), (32, 32), (17, 48), (48, 17), (31, 40)] {
+                for hurst in [-0.5, 0.8] {
+                    let psd = Psd::new(hurst, long, short).unwrap();
+                    let spec = SurfaceSpec::new(rows, cols, 1.0, psd, Normalisation::RmsSlope(1.0))
+                        .unwrap();
+                    assert_modes_follow_spectrum(
+                        &spec,
+                        &format!("{name}, {rows}x{cols}, H {hurst}"),
                     );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn line_roll_off_flat_and_cut_off_empty_below_q0() {
+        // On a line, C1D = π q C2D (28): below a roll-off C2D is flat, so C1D/q is constant;
+        // below a cut-off C1D is zero; above q0 every mode has exactly its power (random
+        // phases), for odd and even n.
+        let q0 = 6.0;
+        for n in [1024, 1025] {
+            for (long, flat) in [
+                (LongWavelength::RollOff { q0 }, true),
+                (LongWavelength::CutOff { q0 }, false),
+            ] {
+                let psd = Psd::new(0.8, long, None).unwrap();
+                let spec = LineSpec::new(n, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
+                let bins = line_psd(&LineGenerator::new(&spec).unwrap().generate(3));
+                let kappa = |q: f64| q / std::f64::consts::TAU;
+                let at_q0 = bins.iter().find(|b| kappa(b.q) == q0).unwrap();
+                // Below n/2 (the Nyquist mode of an even line carries a random sign only).
+                for b in bins.iter().filter(|b| kappa(b.q) < (n / 2) as f64) {
+                    let k = kappa(b.q);
+                    if k < q0 {
+                        if flat {
+                            let ratio = (b.psd / k) / (at_q0.psd / q0);
+                            assert!((ratio - 1.0).abs() < 1e-9, "n {n}: roll-off κ={k}: {ratio}");
+                        } else {
+                            assert!(b.psd < 1e-20 * at_q0.psd, "n {n}: cut-off κ={k}: {}", b.psd);
+                        }
+                    }
+                    let expected = psd.c1d(k) / psd.c1d(q0);
+                    let got = b.psd / at_q0.psd;
+                    if expected > 0.0 {
+                        assert!(
+                            (got / expected - 1.0).abs() < 1e-9,
+                            "n {n}: κ={k}: {got} vs {expected}"
+                        );
+                    }
                 }
             }
         }

@@ -20,6 +20,8 @@ use serde::Serialize;
 
 use super::{Line, Surface};
 use crate::fft::RealFft2;
+use crate::memory::try_vec;
+use crate::Result;
 
 /// Root mean square about the mean.
 pub fn rms_height(values: impl Iterator<Item = f64> + Clone) -> f64 {
@@ -119,15 +121,23 @@ pub struct PsdBin {
 }
 
 /// Radially averaged 2D PSD `C2D(q)` of a surface, rings of width `2π/L` centred on
-/// integer `κ = qL/2π` from 1 up to the smaller Nyquist wavenumber.
-pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
+/// integer `κ = qL/2π` from 1 up to the smaller Nyquist wavenumber. Fails only with
+/// [`crate::Error::OutOfMemory`] if its buffers (about 3× the surface) cannot be allocated.
+pub fn radial_psd_2d(surface: &Surface) -> Result<Vec<PsdBin>> {
     let (rows, cols) = surface.dim();
     let size = surface.size();
     let area = size * size * rows as f64 / cols as f64;
     let mean = surface.heights().mean().unwrap_or(0.0);
-    let centred: Vec<f64> = surface.heights().iter().map(|h| h - mean).collect();
-    let mut fft = RealFft2::new(rows, cols);
-    let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+    let mut centred = try_vec("the PSD's copy of the surface", rows * cols, 0.0)?;
+    for (c, h) in centred.iter_mut().zip(surface.heights()) {
+        *c = h - mean;
+    }
+    let mut fft = RealFft2::new(rows, cols)?;
+    let mut spectrum = try_vec(
+        "the PSD's spectrum",
+        fft.spectrum_len(),
+        Complex64::default(),
+    )?;
     fft.forward(&centred, &mut spectrum);
     let aspect = cols as f64 / rows as f64;
     let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
@@ -158,7 +168,8 @@ pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
             s.2 += weight;
         }
     }
-    sums.into_iter()
+    Ok(sums
+        .into_iter()
         .skip(1)
         .filter(|s| s.2 > 0)
         .map(|(k, p, m)| PsdBin {
@@ -166,7 +177,7 @@ pub fn radial_psd_2d(surface: &Surface) -> Vec<PsdBin> {
             psd: p / m as f64,
             modes: m,
         })
-        .collect()
+        .collect())
 }
 
 /// 1D PSD `C1D(q)` of a line at `q = 2πk/L`, `k = 1 … n/2`.
@@ -264,7 +275,7 @@ mod tests {
         let area = 4.0 * rows as f64 / cols as f64;
         let mean = surface.heights().mean().unwrap();
         let centred: Vec<f64> = surface.heights().iter().map(|h| h - mean).collect();
-        let mut fft = RealFft2::new(rows, cols);
+        let mut fft = RealFft2::new(rows, cols).unwrap();
         let mut spec = vec![Complex64::default(); fft.spectrum_len()];
         fft.forward(&centred, &mut spec);
         let mut total = 0.0;
@@ -279,7 +290,7 @@ mod tests {
         let c_sum = total * area / (TAU.powi(2) * ((rows * cols) as f64).powi(2));
         let rms = rms_height(surface.heights().iter().copied());
         assert!((c_sum * TAU.powi(2) / area / rms.powi(2) - 1.0).abs() < 1e-12);
-        assert!(!radial_psd_2d(&surface).is_empty());
+        assert!(!radial_psd_2d(&surface).unwrap().is_empty());
     }
 
     #[test]
