@@ -77,7 +77,7 @@
 //! # Ok::<(), asperity::Error>(())
 //! ```
 //! Whole studies (many seeds, several N and H, checkpointed, thread-count independent)
-//! are in [`study`]; the closed forms the solvers are tested against are in [`reference`].
+//! are in [`study`]; the closed forms the solvers are tested against are in [`reference`](mod@reference).
 
 #![warn(missing_docs)]
 

@@ -7,8 +7,9 @@
 //! the thread on which samples run, nor on which other tasks a study contains.
 //!
 //! # Checkpoints
-//! [`run_study`] writes `DIR/study.json` (the spec) and, after every batch of samples,
-//! `DIR/checkpoint/<task>.json` with all samples done so far (atomically). Run again with
+//! [`StudyDir::open`] writes `DIR/study.json` (the spec), and [`run_any_task`] writes,
+//! after every batch of samples, `DIR/checkpoint/<task>.json` with all samples done so far
+//! (atomically). Run again with
 //! the same spec, it resumes where it stopped and — since samples are deterministic and
 //! stored with round-trip precision — gives bit-identical results. A folder holding a
 //! different study is refused ([`Error::ForeignCheckpoint`]) unless `discard` is set.
