@@ -21,6 +21,19 @@ fn main() {
             std::process::exit(2);
         }
     };
+    // Ctrl-C, SIGTERM or SIGHUP: remove the temporary files of outputs not yet renamed into
+    // place (finished outputs and study checkpoints stay; a study resumes from them), then
+    // exit with the conventional status 130.
+    let interrupted = ctrlc::set_handler(|| {
+        asperity::io::abandon_unfinished_outputs();
+        eprintln!("interrupted: unfinished outputs removed (a study resumes when run again)");
+        std::process::exit(130);
+    });
+    if let Err(err) = interrupted {
+        eprintln!(
+            "warning: no interrupt handler ({err}); an interrupted run may leave hidden .tmp files"
+        );
+    }
     if let Err(err) = commands::run(cli) {
         // One line: the chain of causes joined, as a user reads it; a cause that its
         // parent's message already ends with (library errors print their source) is skipped.

@@ -153,6 +153,70 @@ fn killed_study_resumes_to_the_uninterrupted_result() {
 }
 
 #[test]
+fn terminated_study_removes_its_temporary_files_and_resumes() {
+    // SIGTERM (like Ctrl-C) runs the handler: unfinished outputs' temporary files go, the
+    // exit status is 130, and the checkpoints written so far let the study resume.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = [
+        "study",
+        "curve",
+        "--method",
+        "mdr",
+        "--n",
+        "32768",
+        "--hurst",
+        "0,0.5,1,2",
+        "--samples",
+        "300",
+        "--quiet",
+        "--checkpoint-every",
+        "0",
+        "--out",
+        "termed",
+    ];
+    let child = Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(d)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let checkpoints = d.join("termed/checkpoint");
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(60)
+        && std::fs::read_dir(&checkpoints).map_or(true, |mut e| e.next().is_none())
+    {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !d.join("termed/curve.csv").exists(),
+        "terminated before the end (study too small for this machine?)"
+    );
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    let mut stack = vec![d.join("termed")];
+    while let Some(folder) = stack.pop() {
+        for entry in std::fs::read_dir(folder).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy();
+            assert!(!name.contains(".tmp"), "left {}", path.display());
+            if path.is_dir() {
+                stack.push(path);
+            }
+        }
+    }
+    ok(&asperity(&args, d));
+    assert!(d.join("termed/curve.csv").exists());
+}
+
+#[test]
 fn bad_studies_are_refused_and_lose_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

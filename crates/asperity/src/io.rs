@@ -7,12 +7,16 @@
 //! after every one was written, so a failure part-way leaves none of them. Outputs are
 //! checked before any work starts: each one's folder must exist, none may be a folder,
 //! none may be named twice, and none may already exist unless `force` is set.
+//! The temporary files (and folders made for outputs) of unfinished outputs are also listed
+//! process-wide, so that a program interrupted by a signal can remove them before it exits
+//! ([`abandon_unfinished_outputs`]).
 //! Inputs are validated on reading: `.npy` must hold float64 (C or Fortran order), have the
 //! expected number of dimensions, and contain finite values only.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use ndarray::{Array1, Array2, ArrayBase, ArrayD, Data, Ix1, Ix2};
 use ndarray_npy::npy::header::Header;
@@ -29,6 +33,45 @@ pub fn ensure_new_output(path: &Path, force: bool) -> Result<()> {
         return Err(Error::OutputExists(path.to_path_buf()));
     }
     Ok(())
+}
+
+/// Temporary files and folders of this process's unfinished outputs (see the module docs).
+struct Unfinished {
+    files: Vec<PathBuf>,
+    folders: Vec<PathBuf>,
+}
+
+static UNFINISHED: Mutex<Unfinished> = Mutex::new(Unfinished {
+    files: Vec::new(),
+    folders: Vec::new(),
+});
+
+fn unfinished() -> MutexGuard<'static, Unfinished> {
+    // A panic while holding the lock leaves the lists valid: keep using them.
+    UNFINISHED
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+fn forget_path(list: &mut Vec<PathBuf>, path: &Path) {
+    if let Some(i) = list.iter().rposition(|p| p == path) {
+        list.swap_remove(i);
+    }
+}
+
+/// Removes the temporary files of every unfinished output of this process, and the empty
+/// folders made for them, then keeps the list locked, so that no output is renamed into
+/// place afterwards (a commit in progress completes first: its renames hold the same
+/// lock). For a signal handler that exits right after; later commits would wait forever.
+pub fn abandon_unfinished_outputs() {
+    let mut list = unfinished();
+    for file in list.files.drain(..) {
+        let _ = std::fs::remove_file(file);
+    }
+    for folder in list.folders.drain(..).rev() {
+        let _ = std::fs::remove_dir(folder); // only if empty
+    }
+    std::mem::forget(list);
 }
 
 /// The sidecar path of an array file: `surface.npy` → `surface.npy.json`.
@@ -217,8 +260,10 @@ impl StagedOutputs {
         let index = self.index_of(target)?;
         let tmp = temp_path(target, index, extension);
         if let Some(old) = self.entries[index].tmp.take() {
-            let _ = std::fs::remove_file(old);
+            let _ = std::fs::remove_file(&old);
+            forget_path(&mut unfinished().files, &old);
         }
+        unfinished().files.push(tmp.clone());
         match write(&tmp) {
             Ok(()) => {
                 self.entries[index].tmp = Some(tmp);
@@ -226,6 +271,7 @@ impl StagedOutputs {
             }
             Err(e) => {
                 let _ = std::fs::remove_file(&tmp);
+                forget_path(&mut unfinished().files, &tmp);
                 Err(e)
             }
         }
@@ -295,10 +341,14 @@ impl StagedOutputs {
             ensure_new_output(&e.target, self.force)?;
         }
         let mut renamed: Vec<(PathBuf, bool)> = Vec::new();
+        // Held through the renames: an interrupting signal waits until all are done.
+        let mut list = unfinished();
         for e in &mut self.entries {
             let existed = e.target.exists();
             let Some(tmp) = e.tmp.take() else { continue };
+            forget_path(&mut list.files, &tmp);
             if let Err(err) = std::fs::rename(&tmp, &e.target) {
+                list.files.push(tmp.clone());
                 e.tmp = Some(tmp); // removed on drop
                 for (path, existed) in renamed {
                     if !existed {
@@ -309,7 +359,9 @@ impl StagedOutputs {
             }
             renamed.push((e.target.clone(), existed));
         }
-        self.created_folders.clear();
+        for folder in self.created_folders.drain(..) {
+            forget_path(&mut list.folders, &folder);
+        }
         Ok(())
     }
 }
@@ -318,7 +370,8 @@ impl Drop for StagedOutputs {
     fn drop(&mut self) {
         for e in &mut self.entries {
             if let Some(tmp) = e.tmp.take() {
-                let _ = std::fs::remove_file(tmp);
+                let _ = std::fs::remove_file(&tmp);
+                forget_path(&mut unfinished().files, &tmp);
             }
         }
         drop(CreatedFolders(std::mem::take(&mut self.created_folders)));
@@ -339,6 +392,7 @@ impl CreatedFolders {
         }
         for d in missing.into_iter().rev() {
             std::fs::create_dir(&d).map_err(|e| Error::io(&d, e))?;
+            unfinished().folders.push(d.clone());
             self.0.push(d);
         }
         if !dir.is_dir() {
@@ -350,8 +404,10 @@ impl CreatedFolders {
 
 impl Drop for CreatedFolders {
     fn drop(&mut self) {
+        let mut list = unfinished();
         for dir in self.0.iter().rev() {
             let _ = std::fs::remove_dir(dir); // only if empty
+            forget_path(&mut list.folders, dir);
         }
     }
 }
