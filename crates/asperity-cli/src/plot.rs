@@ -307,6 +307,109 @@ impl Chart {
     }
 }
 
+/// The image format of a plot file, chosen by its extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `.png`: a 900×650 (per panel) bitmap.
+    Png,
+    /// `.svg`: vector graphics.
+    Svg,
+}
+
+impl ImageFormat {
+    /// The format of `path` from its extension (`.png` or `.svg`, any case); anything else
+    /// is refused, with `flag` (the option that named the file) in the message.
+    pub fn from_path(path: &Path, flag: &str) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(ImageFormat::Png),
+            Some("svg") => Ok(ImageFormat::Svg),
+            _ => Err(anyhow!(
+                "{flag} {}: the image format follows the extension, which must be .png or .svg",
+                path.display()
+            )),
+        }
+    }
+}
+
+/// Renders `charts` side by side (one 900×650 panel each) into the staged output `path`
+/// (declared there by the caller, who commits it with the other outputs), as PNG or SVG
+/// by its extension (see [`ImageFormat::from_path`]).
+pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -> Result<()> {
+    if charts.is_empty() {
+        return Err(anyhow!("{}: no chart to draw", path.display()));
+    }
+    for chart in charts {
+        if chart.bounds().is_err() {
+            return Err(anyhow!(
+                "nothing to show in '{}': no point with {} values",
+                chart.title,
+                if chart.log_x || chart.log_y {
+                    "finite, positive (log axes)"
+                } else {
+                    "finite"
+                }
+            ));
+        }
+    }
+    register_fonts();
+    let size = (SIZE.0 * charts.len() as u32, SIZE.1);
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, charts: &[Chart]) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        for (chart, panel) in charts.iter().zip(root.split_evenly((1, charts.len()))) {
+            chart.render(&panel)?;
+        }
+        Ok(())
+    }
+    match ImageFormat::from_path(path, "plot")? {
+        ImageFormat::Png => stage_png(staged, path, size, |root| draw(root, charts)),
+        ImageFormat::Svg => {
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+                draw(&root, charts)?;
+                root.present()
+                    .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+            }
+            staged.write_bytes(path, text.as_bytes())?;
+            Ok(())
+        }
+    }
+}
+
+/// The points of a log–log series thinned to about `keep` per x range: a point is kept
+/// when ln x moved by at least 1/`keep` of the range since the last one kept (the last
+/// point is always kept). Points that log axes cannot show are dropped.
+pub fn thin_log(points: impl Iterator<Item = (f64, f64)>, keep: usize) -> Vec<(f64, f64)> {
+    let shown: Vec<(f64, f64)> = points
+        .filter(|(x, y)| x.is_finite() && y.is_finite() && *x > 0.0 && *y > 0.0)
+        .collect();
+    if shown.len() <= keep {
+        return shown;
+    }
+    let (lo, hi) = shown
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0.ln()), hi.max(p.0.ln()))
+        });
+    let step = (hi - lo) / keep as f64;
+    let mut kept: Vec<(f64, f64)> = Vec::with_capacity(keep + 1);
+    for (i, &p) in shown.iter().enumerate() {
+        let far = kept
+            .last()
+            .is_none_or(|last: &(f64, f64)| (p.0.ln() - last.0.ln()).abs() >= step);
+        if far || i + 1 == shown.len() {
+            kept.push(p);
+        }
+    }
+    kept
+}
+
 /// Renders a `size` PNG with `draw` into the staged output `path` (a temporary file until
 /// the outputs are committed).
 fn stage_png<F>(staged: &mut StagedOutputs, path: &Path, size: (u32, u32), draw: F) -> Result<()>
@@ -430,6 +533,56 @@ mod tests {
         assert_eq!(tick_label(1e-5), "1e-5");
         assert_eq!(tick_label(250.0), "250");
         assert_eq!(tick_label(2.5e6), "2.5e6");
+    }
+
+    #[test]
+    fn plot_format_follows_the_extension() {
+        let format = |p: &str| ImageFormat::from_path(Path::new(p), "--plot");
+        assert_eq!(format("a/k.png").unwrap(), ImageFormat::Png);
+        assert_eq!(format("K.SVG").unwrap(), ImageFormat::Svg);
+        for bad in ["k.jpg", "k", "k.png.csv"] {
+            let err = format(bad).unwrap_err().to_string();
+            assert!(err.contains(".png or .svg") && err.contains(bad), "{err}");
+        }
+    }
+
+    #[test]
+    fn staged_charts_are_png_or_svg_side_by_side() {
+        let dir = tempfile::tempdir().unwrap();
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![Series::new(
+                "s",
+                vec![(1.0, 2.0), (10.0, 30.0)],
+                Style::LinePoints,
+            )],
+        };
+        let (png, svg) = (dir.path().join("c.png"), dir.path().join("c.svg"));
+        let mut staged = StagedOutputs::new([&png, &svg], false).unwrap();
+        stage_charts(&mut staged, &png, &[chart.clone(), chart.clone()]).unwrap();
+        stage_charts(&mut staged, &svg, &[chart]).unwrap();
+        staged.commit().unwrap();
+        let decoder = ::png::Decoder::new(std::fs::File::open(&png).unwrap());
+        let info = decoder.read_info().unwrap().info().clone();
+        assert_eq!((info.width, info.height), (2 * SIZE.0, SIZE.1));
+        assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn thinning_keeps_log_spread_points_and_the_ends() {
+        let dense: Vec<(f64, f64)> = (1..=100_000).map(|i| (i as f64, 1.0)).collect();
+        let thin = thin_log(dense.iter().copied(), 100);
+        assert!(thin.len() <= 102 && thin.len() > 50, "{}", thin.len());
+        assert_eq!(thin.first(), Some(&(1.0, 1.0)));
+        assert_eq!(thin.last(), Some(&(100_000.0, 1.0)));
+        // Few points stay as they are, less those log axes cannot show.
+        let few = [(0.0, 1.0), (1.0, 2.0), (2.0, -1.0), (3.0, 4.0)];
+        assert_eq!(thin_log(few.into_iter(), 100), [(1.0, 2.0), (3.0, 4.0)]);
     }
 
     #[test]

@@ -500,4 +500,171 @@ fn help_has_examples() {
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Examples:") && text.contains("--nloads") && text.contains("--fields"));
+    assert!(text.contains("--out curve.csv --plot curve.png"), "{text}");
+}
+
+/// Width and height of a PNG file, decoded.
+fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let reader = decoder.read_info().unwrap();
+    (reader.info().width, reader.info().height)
+}
+
+#[test]
+fn plot_is_written_as_png_or_svg_beside_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let csv = dir.path().join("c.csv");
+    let png = dir.path().join("k.png");
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--nloads",
+        "3",
+        "--pmin",
+        "0.01",
+        "--pmax",
+        "0.05",
+        "--out",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(read_csv(&csv).1.len(), 3);
+    let (w, h) = png_size(&png);
+    assert!(w > 0 && h > 0, "{w}x{h}");
+    // SVG, with the table on standard output.
+    let svg = dir.path().join("k.svg");
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--forces",
+        "0.01,0.02",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout)
+        .trim_start()
+        .starts_with("force"));
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    assert_eq!(
+        tree(dir.path()),
+        ["c.csv", "k.png", "k.svg", "s.npy", "s.npy.json"].map(PathBuf::from),
+        "no temporary files left"
+    );
+}
+
+#[test]
+fn bad_plots_are_refused_before_solving_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let existing = dir.path().join("old.png");
+    std::fs::write(&existing, "precious").unwrap();
+    let before = tree(dir.path());
+    let path = |p: &str| dir.path().join(p).to_str().unwrap().to_string();
+    // Each case would otherwise fail late (the last load is beyond full contact), so the
+    // error named proves the check came before any solve.
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec![
+                "--pressures".into(),
+                "0.01,1e4".into(),
+                "--plot".into(),
+                path("k.jpg"),
+            ],
+            "must be .png or .svg",
+        ),
+        (
+            vec![
+                "--pressures".into(),
+                "0.01,1e4".into(),
+                "--plot".into(),
+                path("k"),
+            ],
+            "must be .png or .svg",
+        ),
+        (
+            vec![
+                "--pressures".into(),
+                "0.01,1e4".into(),
+                "--plot".into(),
+                path("old.png"),
+            ],
+            "already exists",
+        ),
+        // One load is no curve.
+        (
+            vec![
+                "--pressures".into(),
+                "1e4".into(),
+                "--plot".into(),
+                path("k.png"),
+            ],
+            "at least 2 loads",
+        ),
+        (
+            vec![
+                "--nloads".into(),
+                "1".into(),
+                "--pmin".into(),
+                "1e4".into(),
+                "--pmax".into(),
+                "1e4".into(),
+                "--plot".into(),
+                path("k.svg"),
+            ],
+            "at least 2 loads",
+        ),
+        // The plot named as the table.
+        (
+            vec![
+                "--pressures".into(),
+                "0.01,1e4".into(),
+                "--plot".into(),
+                path("k.png"),
+                "--out".into(),
+                path("k.png"),
+            ],
+            "is the same file as",
+        ),
+    ];
+    let (csv, fields) = (path("c.csv"), path("fields"));
+    for (extra, expected) in cases {
+        let mut args = vec!["bem", "--surface", s];
+        args.extend(extra.iter().map(|a| a.as_str()));
+        if !extra.contains(&"--out".to_string()) {
+            args.extend(["--out", &csv]);
+        }
+        args.extend(["--fields", &fields]);
+        let out = asperity(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(expected), "{extra:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{extra:?}: {err}");
+        assert_eq!(tree(dir.path()), before, "{extra:?} left files");
+    }
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "precious");
+    // With --force the old plot is replaced (and the other outputs written with it).
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.01,0.02",
+        "--out",
+        &path("c.csv"),
+        "--plot",
+        &path("old.png"),
+        "--force",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(png_size(&existing).0 > 0);
+    assert!(dir.path().join("c.csv").exists());
 }

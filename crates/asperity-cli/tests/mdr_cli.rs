@@ -456,6 +456,7 @@ fn help_has_examples() {
         text.contains("Examples:") && text.contains("--breakpoints"),
         "{text}"
     );
+    assert!(text.contains("--plot curve.svg"), "{text}");
     // The two meanings of `contacts` are stated: just after a breakpoint vs at d.
     assert!(
         text.contains("just after the breakpoint") && text.contains("compressed at d"),
@@ -773,4 +774,160 @@ fn sizes_that_cannot_fit_in_memory_are_refused() {
     );
     assert_refused(&out, "--nloads");
     assert_refused(&out, "MiB");
+}
+
+/// Width and height of a PNG file, decoded.
+fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let reader = decoder.read_info().unwrap();
+    (reader.info().width, reader.info().height)
+}
+
+/// The file names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn plot_is_written_for_lines_and_profiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let line: Vec<f64> = (0..256)
+        .map(|i| (i as f64 * 0.37).sin() + 0.01 * i as f64)
+        .collect();
+    write_line(&d.join("line.npy"), line);
+    let runs: [&[&str]; 4] = [
+        &[
+            "--line", "line.npy", "--nloads", "20", "--out", "a.csv", "--plot", "a.png",
+        ],
+        &["--line", "line.npy", "--breakpoints", "--plot", "b.svg"],
+        &[
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "201",
+            "--dx",
+            "0.01",
+            "--spring",
+            "hertz",
+            "--indentations",
+            "1e-6,1e-4,1e-3",
+            "--plot",
+            "c.PNG",
+        ],
+        &[
+            "--profile",
+            "cone",
+            "--slope",
+            "0.2",
+            "--n",
+            "101",
+            "--dx",
+            "0.01",
+            "--spring",
+            "fractal",
+            "--hurst",
+            "0.7",
+            "--rms-height",
+            "0.01",
+            "--nloads",
+            "5",
+            "--plot",
+            "d.svg",
+        ],
+    ];
+    for extra in runs {
+        let out = asperity(&[&["mdr"], extra].concat(), d);
+        assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
+    }
+    assert_eq!(read_curve(&d.join("a.csv")).len(), 20);
+    for png in ["a.png", "c.PNG"] {
+        let (w, h) = png_size(&d.join(png));
+        assert!(w > 0 && h > 0, "{png}: {w}x{h}");
+    }
+    for svg in ["b.svg", "d.svg"] {
+        assert!(std::fs::read_to_string(d.join(svg))
+            .unwrap()
+            .contains("<svg"));
+    }
+    assert_eq!(
+        names(d),
+        ["a.csv", "a.png", "b.svg", "c.PNG", "d.svg", "line.npy"],
+        "no temporary files left"
+    );
+}
+
+#[test]
+fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("old.svg"), "keep me").unwrap();
+    // Without --radius the profile fails after the outputs are checked: the errors below
+    // prove the plot was refused first.
+    let base = [
+        "mdr",
+        "--profile",
+        "hertz",
+        "--n",
+        "101",
+        "--dx",
+        "0.01",
+        "--out",
+        "c.csv",
+    ];
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["--nloads", "5", "--plot", "k.pdf"],
+            "must be .png or .svg",
+        ),
+        (&["--nloads", "5", "--plot", "k"], "must be .png or .svg"),
+        (&["--nloads", "5", "--plot", "old.svg"], "already exists"),
+        (
+            &["--indentations", "0.1", "--plot", "k.png"],
+            "at least 2 indentations",
+        ),
+        (
+            &["--nloads", "1", "--plot", "k.png"],
+            "at least 2 indentations",
+        ),
+    ];
+    for (extra, needle) in cases {
+        let out = asperity(&[&base[..], extra].concat(), d);
+        assert_refused(&out, needle);
+        assert_eq!(names(d), ["old.svg"], "{extra:?} wrote files");
+    }
+    assert_eq!(
+        std::fs::read_to_string(d.join("old.svg")).unwrap(),
+        "keep me"
+    );
+    // The missing radius itself, once the plot is acceptable.
+    let out = asperity(
+        &[&base[..], &["--nloads", "5", "--plot", "k.png"]].concat(),
+        d,
+    );
+    assert_refused(&out, "--radius");
+    assert_eq!(names(d), ["old.svg"]);
+    // With --force the old plot is replaced, together with the table.
+    let out = asperity(
+        &[
+            &base[..],
+            &[
+                "--radius", "1", "--nloads", "5", "--plot", "old.svg", "--force",
+            ],
+        ]
+        .concat(),
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read_to_string(d.join("old.svg"))
+        .unwrap()
+        .contains("<svg"));
+    assert_eq!(names(d), ["c.csv", "old.svg"]);
 }

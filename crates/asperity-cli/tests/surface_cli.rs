@@ -503,3 +503,100 @@ fn an_existing_sidecar_or_png_alone_is_not_overwritten() {
         b"not mine to overwrite"
     );
 }
+
+#[test]
+fn stats_plots_the_psd_with_its_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let surface = [
+        "surface",
+        "--n",
+        "64",
+        "--hurst",
+        "0.8",
+        "--rolloff",
+        "4",
+        "--seed",
+        "1",
+        "--out",
+        "s.npy",
+    ];
+    assert!(asperity(&surface, d).status.success());
+    let line = ["line", "--n", "1024", "--hurst", "0.5", "--out", "l.npy"];
+    assert!(asperity(&line, d).status.success());
+    let out = asperity(
+        &["stats", "s.npy", "--psd", "psd.csv", "--plot", "s.png"],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("psd_slope: "));
+    let decoder = png::Decoder::new(std::fs::File::open(d.join("s.png")).unwrap());
+    let reader = decoder.read_info().unwrap();
+    assert!(reader.info().width > 0 && reader.info().height > 0);
+    assert!(d.join("psd.csv").exists());
+    let out = asperity(&["stats", "l.npy", "--json", "--plot", "l.svg"], d);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let slope = value["psd_slope"].as_f64().unwrap();
+    let svg = std::fs::read_to_string(d.join("l.svg")).unwrap();
+    assert!(svg.contains("<svg"));
+    // The legend gives the fitted slope.
+    assert!(
+        svg.contains(&format!("slope {slope:.3}")),
+        "slope {slope:.3}"
+    );
+    // s.npy, l.npy, their sidecars, psd.csv, s.png, l.svg: no temporary files.
+    assert_eq!(std::fs::read_dir(d).unwrap().count(), 7);
+}
+
+#[test]
+fn stats_refuses_bad_plots_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let heights = Array2::from_shape_fn((16, 16), |(i, j)| ((i * 7 + j * 3) % 5) as f64);
+    write_npy(d.join("s.npy"), &heights).unwrap();
+    std::fs::write(d.join("old.png"), b"keep me").unwrap();
+    for (plot, needle) in [
+        ("psd.jpg", "must be .png or .svg"),
+        ("psd", "must be .png or .svg"),
+        ("s.npy", "must be .png or .svg"),
+        ("old.png", "old.png: output already exists"),
+    ] {
+        let out = asperity(&["stats", "s.npy", "--psd", "psd.csv", "--plot", plot], d);
+        assert_refused(&out, d, 2, needle);
+        // Checked before the input is read: a missing input is not what is reported.
+        let out = asperity(&["stats", "missing.npy", "--plot", plot], d);
+        assert_refused(&out, d, 2, needle);
+    }
+    assert_eq!(std::fs::read(d.join("old.png")).unwrap(), b"keep me");
+    let out = asperity(
+        &[
+            "stats", "s.npy", "--plot", "old.png", "--psd", "psd.csv", "--force",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_ne!(std::fs::read(d.join("old.png")).unwrap(), b"keep me");
+    assert_eq!(std::fs::read_dir(d).unwrap().count(), 3);
+    // A flat surface has no power to show on log axes: one line, nothing written.
+    write_npy(d.join("flat.npy"), &Array2::<f64>::ones((16, 16))).unwrap();
+    let out = asperity(
+        &[
+            "stats", "flat.npy", "--psd", "flat.csv", "--plot", "flat.png",
+        ],
+        d,
+    );
+    assert_refused(&out, d, 4, "nothing to show");
+}
+
+#[test]
+fn stats_help_has_a_plot_example() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(&["stats", "--help"], dir.path());
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("asperity stats s.npy --plot psd.png"),
+        "{text}"
+    );
+}

@@ -3,9 +3,9 @@
 //!
 //! Everything is checked before the first solve (surface and the memory it needs,
 //! parameters, every output path). The field files of each load go to temporary files as
-//! soon as it is solved (no copies kept in memory); the CSV and the fields are renamed into
-//! place together only after the last load, and any error removes the temporary files, so
-//! an error leaves nothing behind.
+//! soon as it is solved (no copies kept in memory); the CSV, the plot and the fields are
+//! renamed into place together only after the last load, and any error removes the
+//! temporary files, so an error leaves nothing behind.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -18,6 +18,7 @@ use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
 
 use crate::output::{format_number, Table};
+use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
 use crate::progress::Progress;
 
 /// Arguments of `asperity bem`.
@@ -27,7 +28,8 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out curve.csv\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --fields fields/ --out loads.csv\n  \
     asperity bem --surface s.npy --boundary periodic --forces 0.02 --tol 1e-10\n  \
-    asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n\n\
+    asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
+    asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out curve.csv --plot curve.png\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
 (stiffness by the frozen contact set; indentation measured from the highest point; with\n\
 --timing also solve_seconds, stiffness_seconds, peak_rss_mib).")]
@@ -97,6 +99,11 @@ pub struct BemArgs {
     /// Output table (CSV); printed to stdout when absent.
     #[arg(long, value_name = "OUT.csv")]
     pub out: Option<PathBuf>,
+    /// Also plot the load sweep (needs at least 2 loads), .png or .svg by the extension:
+    /// log–log contact stiffness k vs force F (left) and area fraction vs F (right), with
+    /// F and k divided by E* (length² and length).
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub plot: Option<PathBuf>,
     /// Write pressure_K.npy and gap_K.npy for every load K (0-based) into DIR.
     #[arg(long, value_name = "DIR")]
     pub fields: Option<PathBuf>,
@@ -205,6 +212,38 @@ struct Row {
     stiffness: Option<f64>,
 }
 
+/// The `--plot` panels: k/E* vs F/E* and area fraction vs F/E*, log–log.
+fn sweep_charts(rows: &[Row], modulus: f64, surface: &Path, boundary: &str) -> [Chart; 2] {
+    let name = surface.file_name().map_or_else(
+        || surface.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let force = |row: &Row| row.values[0] / modulus;
+    let points = |y: &dyn Fn(&Row) -> f64| rows.iter().map(|r| (force(r), y(r))).collect();
+    let x_label = "normal force F / E*  [length²]".to_string();
+    let stiffness = Chart {
+        title: format!("{name}: contact stiffness (E* = {modulus}, {boundary} boundaries)"),
+        x_label: x_label.clone(),
+        y_label: "contact stiffness k / E*  [length]".into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series::new(
+            "frozen contact set",
+            points(&|r| r.stiffness.unwrap_or(f64::NAN) / modulus),
+            Style::LinePoints,
+        )],
+    };
+    let area = Chart {
+        title: format!("{name}: true contact area"),
+        x_label,
+        y_label: "area fraction A / A0".into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series::new("", points(&|r| r.values[3]), Style::LinePoints)],
+    };
+    [stiffness, area]
+}
+
 /// Runs `asperity bem`.
 pub fn run(args: &BemArgs) -> Result<()> {
     // 1. Everything that can be checked before solving.
@@ -231,6 +270,15 @@ pub fn run(args: &BemArgs) -> Result<()> {
     params
         .validate()
         .with_context(|| format!("--max-iter {}", args.max_iter))?;
+    if let Some(plot) = &args.plot {
+        ImageFormat::from_path(plot, "--plot")?;
+        if loads.len() < 2 {
+            bail!("--plot needs at least 2 loads (a curve), got 1");
+        }
+        if args.no_stiffness {
+            bail!("--plot draws the stiffness: drop --no-stiffness");
+        }
+    }
     // Outputs, checked before any work: each folder exists (--fields DIR and its missing
     // parents are made here, and removed again on any error), no output is named twice or
     // exists without --force. They are written to temporary files as each load is solved
@@ -242,6 +290,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let output_paths = args
         .out
         .iter()
+        .chain(&args.plot)
         .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
     let mut staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
@@ -356,6 +405,11 @@ pub fn run(args: &BemArgs) -> Result<()> {
         table
             .stage(&mut staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
+    }
+    if let Some(plot) = &args.plot {
+        let charts = sweep_charts(&rows, args.modulus, &args.surface, boundary.name());
+        stage_charts(&mut staged, plot, &charts)
+            .with_context(|| format!("writing {}", plot.display()))?;
     }
     staged.commit()?;
     match &args.out {

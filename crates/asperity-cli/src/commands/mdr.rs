@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use asperity::io::{ensure_new_output, read_npy_1d, sidecar_path};
+use asperity::io::{read_npy_1d, sidecar_path, StagedOutputs};
 use asperity::mdr::{
     log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
@@ -13,6 +13,7 @@ use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::rms_height;
 
 use crate::output::{format_number, Table};
+use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
 
 /// Closed-form axisymmetric indenters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -47,7 +48,8 @@ pub enum SpringKind {
     asperity mdr --line line.npy --spring fractal --hurst 0.5 --nloads 60 --dmin 1e-6 --out nl.csv\n  \
     asperity mdr --profile hertz --radius 1 --n 2001 --dx 0.01 --spring hertz --indentations 1e-8,1e-6,1e-4\n  \
     asperity mdr --profile cone --slope 0.2 --n 4001 --dx 1e-3 --nloads 20 --out cone.csv\n  \
-    asperity mdr --radial tip.npy --radial-step 1e-3 --n 1001 --dx 1e-3 --nloads 30\n\n\
+    asperity mdr --radial tip.npy --radial-step 1e-3 --n 1001 --dx 1e-3 --nloads 30\n  \
+    asperity mdr --line line.npy --nloads 40 --out curve.csv --plot curve.svg\n\n\
     Output columns: indentation, force, stiffness, contacts. Indentation is measured from \
     first contact (the highest point of a line, the tip of an indenter).")]
 pub struct MdrArgs {
@@ -129,7 +131,12 @@ pub struct MdrArgs {
     /// Output CSV (default: standard output).
     #[arg(long, value_name = "OUT.csv")]
     pub out: Option<PathBuf>,
-    /// Overwrite an existing output.
+    /// Also plot the curve (needs at least 2 indentations), .png or .svg by the extension:
+    /// log–log force F vs indentation d (left) and stiffness k vs F (right), with F and k
+    /// divided by E* (length² and length); points at d = 0 or F = 0 are left out.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub plot: Option<PathBuf>,
+    /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
 }
@@ -302,7 +309,11 @@ fn indentation_levels(args: &MdrArgs, foundation: &Foundation) -> Result<Vec<f64
         return Ok(list.clone());
     }
     let count = args.nloads.unwrap_or(50);
-    ensure_rows_fit(count, std::mem::size_of::<f64>(), "--nloads")?;
+    ensure_rows_fit(
+        count,
+        std::mem::size_of::<f64>() + plot_row_bytes(args),
+        "--nloads",
+    )?;
     let dmax = match args.dmax {
         Some(d) => d,
         None => {
@@ -319,15 +330,80 @@ fn indentation_levels(args: &MdrArgs, foundation: &Foundation) -> Result<Vec<f64
     log_spaced(dmin, dmax, count).map_err(|e| anyhow::anyhow!("--dmin/--dmax/--nloads: {e}"))
 }
 
+/// Extra bytes per output row with --plot: the kept curve point and its two plotted
+/// `(x, y)` pairs.
+fn plot_row_bytes(args: &MdrArgs) -> usize {
+    if args.plot.is_some() {
+        std::mem::size_of::<CurvePoint>() + 2 * std::mem::size_of::<(f64, f64)>()
+    } else {
+        0
+    }
+}
+
+/// The `--plot` panels: F/E* vs d and k/E* vs F/E*, log–log (points at zero left out).
+fn curve_charts(points: &[CurvePoint], modulus: f64, description: &str, law: &str) -> [Chart; 2] {
+    // Markers for a readable number of points; a line alone for dense curves (breakpoints),
+    // thinned to what a figure shows.
+    let style = if points.len() <= 200 {
+        Style::LinePoints
+    } else {
+        Style::Line
+    };
+    let force = |p: &CurvePoint| p.force / modulus;
+    let title = format!("{description}, {law} springs");
+    let force_chart = Chart {
+        title: title.clone(),
+        x_label: "indentation d  [length]".into(),
+        y_label: "normal force F / E*  [length²]".into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series::new(
+            "",
+            thin_log(points.iter().map(|p| (p.indentation, force(p))), 4000),
+            style,
+        )],
+    };
+    let stiffness_chart = Chart {
+        title: format!("E* = {modulus}"),
+        x_label: "normal force F / E*  [length²]".into(),
+        y_label: "contact stiffness k / E*  [length]".into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series::new(
+            "",
+            thin_log(
+                points.iter().map(|p| (force(p), p.stiffness / modulus)),
+                4000,
+            ),
+            style,
+        )],
+    };
+    [force_chart, stiffness_chart]
+}
+
 /// Runs `asperity mdr`.
 pub fn run(args: &MdrArgs) -> Result<()> {
-    if let Some(out) = &args.out {
-        ensure_new_output(out, args.force)?;
+    // Every output is checked before any work, and all are written together at the end.
+    if let Some(plot) = &args.plot {
+        ImageFormat::from_path(plot, "--plot")?;
+        let count = match (&args.indentations, args.nloads) {
+            (Some(list), _) => list.len(),
+            (None, Some(n)) if !args.breakpoints => n,
+            _ => 2,
+        };
+        if count < 2 {
+            bail!("--plot needs at least 2 indentations (a curve), got {count}");
+        }
+    }
+    let mut staged = StagedOutputs::new(args.out.iter().chain(&args.plot), args.force)?;
+    for input in args.line.iter().chain(&args.radial) {
+        staged.ensure_not_input(input)?;
     }
     let indenter = load_indenter(args)?;
     let law = spring_law(args, &indenter)?;
     let spring = Spring::new(law, indenter.spacing, args.modulus)?;
     let mut table = Table::new(&["indentation", "force", "stiffness", "contacts"]);
+    let mut plotted: Option<Vec<CurvePoint>> = args.plot.as_ref().map(|_| Vec::new());
     let push = |table: &mut Table, p: &CurvePoint| {
         table.push(&[
             format_number(p.indentation),
@@ -345,12 +421,16 @@ pub fn run(args: &MdrArgs) -> Result<()> {
         // One row per spring, besides the curve's breakpoints and forces (two f64 each).
         ensure_rows_fit(
             indenter.values.len(),
-            2 * std::mem::size_of::<f64>(),
+            2 * std::mem::size_of::<f64>() + plot_row_bytes(args),
             "--breakpoints",
         )?;
         let curve = LinearCurve::from_heights(&indenter.values, spring.spacing(), args.modulus)?;
         for j in 1..=curve.len() {
-            push(&mut table, &curve.breakpoint(j));
+            let point = curve.breakpoint(j);
+            push(&mut table, &point);
+            if let Some(points) = plotted.as_mut() {
+                points.push(point);
+            }
         }
     } else {
         let foundation = if indenter.is_line {
@@ -359,14 +439,29 @@ pub fn run(args: &MdrArgs) -> Result<()> {
             Foundation::from_profile(&indenter.values, spring)?
         };
         for d in indentation_levels(args, &foundation)? {
-            push(&mut table, &foundation.evaluate(d));
+            let point = foundation.evaluate(d);
+            push(&mut table, &point);
+            if let Some(points) = plotted.as_mut() {
+                points.push(point);
+            }
         }
+    }
+    if let (Some(plot), Some(points)) = (&args.plot, &plotted) {
+        let charts = curve_charts(points, args.modulus, &indenter.description, law.name());
+        stage_charts(&mut staged, plot, &charts)
+            .with_context(|| format!("writing {}", plot.display()))?;
+    }
+    if let Some(out) = &args.out {
+        table
+            .stage(&mut staged, out)
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
+    staged.commit()?;
+    if let Some(plot) = &args.plot {
+        eprintln!("wrote {}", plot.display());
     }
     match &args.out {
         Some(out) => {
-            table
-                .write(out, args.force)
-                .with_context(|| format!("writing {}", out.display()))?;
             eprintln!(
                 "wrote {} ({} rows): {}, {} springs (u0 = {:.4e})",
                 out.display(),

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, ensure, Context, Result};
-use asperity::fit::power_law_fit;
+use asperity::fit::{power_law_fit, PowerLawFit};
 use asperity::io::{read_npy, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::{
@@ -13,12 +13,14 @@ use asperity::surface::{Line, Surface};
 use ndarray::{Ix1, Ix2};
 
 use crate::output::{format_number, Table};
+use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
 
 /// Arguments of `asperity stats`.
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6"
+    after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6\n  \
+    asperity stats s.npy --plot psd.png"
 )]
 pub struct StatsArgs {
     /// A surface (2D) or line (1D) `.npy` file, float64.
@@ -37,10 +39,14 @@ pub struct StatsArgs {
     /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower].
     #[arg(long, value_name = "Q")]
     pub fit_to: Option<f64>,
+    /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
+    /// fitted power law over the fit range (its slope in the legend).
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub plot: Option<PathBuf>,
     /// Print the statistics as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Overwrite an existing PSD file.
+    /// Overwrite existing outputs (--psd, --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -116,6 +122,69 @@ fn fit_range(args: &StatsArgs, hints: &SidecarHints, nyquist: f64) -> Result<(f6
     Ok((from, to))
 }
 
+/// The `--plot` chart: the PSD against q·L/2π, log–log, with the fitted power law drawn
+/// over the fit range `[from, to]` (in q·L/2π).
+fn psd_chart(
+    file: &Path,
+    bins: &[PsdBin],
+    size: f64,
+    ndim: usize,
+    (from, to): (f64, f64),
+    fit: Option<PowerLawFit>,
+    hurst: Option<f64>,
+) -> Chart {
+    let wavelengths = |q: f64| q * size / std::f64::consts::TAU;
+    let name = file.file_name().map_or_else(
+        || file.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let (kind, psd_name, unit) = if ndim == 1 {
+        ("line", "C1D(q)", "length³")
+    } else {
+        ("surface", "C2D(q)", "length⁴")
+    };
+    // Every ring of a surface; a line's many noisy bins as points, thinned to what a
+    // figure shows.
+    let points = thin_log(bins.iter().map(|b| (wavelengths(b.q), b.psd)), 5000);
+    let style = if points.len() <= 300 {
+        Style::LinePoints
+    } else {
+        Style::Points
+    };
+    let mut series = vec![Series::new("PSD", points, style)];
+    if let Some(f) = fit {
+        // The fit is C = A q^p in physical q; drawn from the first to the last bin fitted.
+        let fitted: Vec<f64> = bins
+            .iter()
+            .filter(|b| b.psd > 0.0)
+            .map(|b| wavelengths(b.q))
+            .filter(|k| (from..=to).contains(&k.round()))
+            .collect();
+        let ends = [fitted.first(), fitted.last()];
+        let line = ends
+            .into_iter()
+            .flatten()
+            .map(|&k| {
+                let q = k * std::f64::consts::TAU / size;
+                (k, f.prefactor * q.powf(f.exponent))
+            })
+            .collect();
+        let label = match hurst {
+            Some(h) => format!("fit: slope {:.3} (H ≈ {h:.3})", f.exponent),
+            None => format!("fit: slope {:.3}", f.exponent),
+        };
+        series.push(Series::new(label, line, Style::Dashed).color(plotters::style::BLACK));
+    }
+    Chart {
+        title: format!("{name}: power spectrum of the {kind} (L = {size})"),
+        x_label: "wavenumber q·L/2π".into(),
+        y_label: format!("PSD {psd_name}  [{unit}]"),
+        log_x: true,
+        log_y: true,
+        series,
+    }
+}
+
 /// Runs `asperity stats`.
 pub fn run(args: &StatsArgs) -> Result<()> {
     if let Some(size) = args.size {
@@ -132,15 +201,12 @@ pub fn run(args: &StatsArgs) -> Result<()> {
             "invalid PSD fit range: --fit-from {from} must be below --fit-to {to}"
         );
     }
-    // The PSD output is checked before the (possibly large) input is read.
-    let mut staged = match &args.psd {
-        Some(psd) => {
-            let staged = StagedOutputs::new([psd], args.force)?;
-            staged.ensure_not_input(&args.file)?;
-            Some(staged)
-        }
-        None => None,
-    };
+    // The outputs are checked before the (possibly large) input is read.
+    if let Some(plot) = &args.plot {
+        ImageFormat::from_path(plot, "--plot")?;
+    }
+    let staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
+    staged.ensure_not_input(&args.file)?;
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
     // the file, checked from the header before the data are read.
     let shape = read_npy_shape(&args.file)?;
@@ -184,18 +250,24 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         .map(|b| (b.q, b.psd))
         .unzip();
     let fit = power_law_fit(&q, &c).ok();
-    if let (Some(path), Some(mut staged)) = (&args.psd, staged.take()) {
+    // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
+    let hurst = fit.map(|f| -(f.exponent + psd_offset) / 2.0);
+    let mut staged = staged;
+    if let Some(path) = &args.psd {
         let mut table = Table::new(&["q", "psd"]);
         for b in &bins {
             table.push_numbers(&[b.q, b.psd]);
         }
         table
             .stage(&mut staged, path)
-            .and_then(|()| Ok(staged.commit()?))
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
-    let hurst = fit.map(|f| -(f.exponent + psd_offset) / 2.0);
+    if let Some(path) = &args.plot {
+        let chart = psd_chart(&args.file, &bins, size, dims.len(), (from, to), fit, hurst);
+        stage_charts(&mut staged, path, &[chart])
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    staged.commit()?;
     if args.json {
         let value = serde_json::json!({
             "file": args.file, "shape": dims, "size": size, "stats": summary,
