@@ -96,6 +96,36 @@ fn register_fonts() {
 }
 
 /// `1e-3`, `0.25`, `120`: short tick labels that read well on log axes.
+/// Ticks of a log axis from `lo` to `hi` (`0 < lo < hi`): powers of ten (every second,
+/// third, … one where there are many decades); where fewer than four fall in the range,
+/// also 2 and 5 times them, then every whole multiple; on a range too short even for
+/// that, five points evenly spaced in log, rounded to a tenth of the range's magnitude.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let mantissa_sets: [&[f64]; 3] = [
+        &[1.0],
+        &[1.0, 2.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+    ];
+    for mantissas in mantissa_sets {
+        let ticks: Vec<f64> = (first..=last)
+            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| (lo * (1.0 - 1e-12)..=hi * (1.0 + 1e-12)).contains(v))
+            .collect();
+        if ticks.len() >= 4 {
+            let step = ticks.len().div_ceil(12);
+            return ticks.into_iter().step_by(step).collect();
+        }
+    }
+    (0..5)
+        .map(|i| {
+            let v = lo * (hi / lo).powf((0.5 + i as f64) / 5.0);
+            let scale = 10f64.powi((hi - lo).log10().floor() as i32 - 1);
+            (v / scale).round() * scale
+        })
+        .collect()
+}
+
 fn tick_label(v: f64) -> String {
     let a = v.abs();
     if v == 0.0 {
@@ -103,8 +133,8 @@ fn tick_label(v: f64) -> String {
     } else if !(1e-3..1e4).contains(&a) {
         let e = a.log10().floor() as i32;
         let m = v / 10f64.powi(e);
-        if (m.abs() - 1.0).abs() < 1e-9 {
-            format!("{}1e{e}", if v < 0.0 { "-" } else { "" })
+        if (m - m.round()).abs() < 1e-9 {
+            format!("{}e{e}", m.round())
         } else {
             format!("{m:.1}e{e}")
         }
@@ -220,10 +250,18 @@ impl Chart {
     {
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
         let ((x0, x1), (y0, y1)) = self.bounds()?;
+        // Log axes get their own ticks: plotters' own leave a short range with one label.
+        let log_axis = |lo: f64, hi: f64| {
+            let ticks = log_ticks(lo, hi);
+            (lo..hi)
+                .log_scale()
+                .with_key_points(ticks.clone())
+                .with_light_points(ticks)
+        };
         match (self.log_x, self.log_y) {
-            (true, true) => self.draw(root, (x0..x1).log_scale(), (y0..y1).log_scale()),
-            (true, false) => self.draw(root, (x0..x1).log_scale(), y0..y1),
-            (false, true) => self.draw(root, x0..x1, (y0..y1).log_scale()),
+            (true, true) => self.draw(root, log_axis(x0, x1), log_axis(y0, y1)),
+            (true, false) => self.draw(root, log_axis(x0, x1), y0..y1),
+            (false, true) => self.draw(root, x0..x1, log_axis(y0, y1)),
             (false, false) => self.draw(root, x0..x1, y0..y1),
         }
     }
@@ -533,6 +571,25 @@ mod tests {
         assert_eq!(tick_label(1e-5), "1e-5");
         assert_eq!(tick_label(250.0), "250");
         assert_eq!(tick_label(2.5e6), "2.5e6");
+        assert_eq!(tick_label(2.0000000000000004e-5), "2e-5");
+        assert_eq!(tick_label(-1e-7), "-1e-7");
+        assert_eq!(tick_label(0.30000000000000004), "0.3");
+    }
+
+    #[test]
+    fn log_ticks_label_every_axis() {
+        // Many decades: powers of ten, thinned to at most 12.
+        assert_eq!(log_ticks(1e-7, 2e-1).len(), 7);
+        assert_eq!(log_ticks(1e-30, 1e0).len(), 11);
+        // About a decade: 1, 2, 5 steps.
+        let t = log_ticks(0.03, 1.1);
+        assert_eq!(t, [0.05, 0.1, 0.2, 0.5, 1.0]);
+        // Less than a decade: every whole multiple.
+        assert_eq!(log_ticks(2.5, 9.5).len(), 7);
+        // A sliver: five rounded points inside the range.
+        let t = log_ticks(1.02, 1.05);
+        assert_eq!(t.len(), 5);
+        assert!(t.iter().all(|v| (1.02..=1.05).contains(v)), "{t:?}");
     }
 
     #[test]
