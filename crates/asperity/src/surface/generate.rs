@@ -33,7 +33,7 @@ use realfft::{ComplexToReal, RealFftPlanner};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
-use super::{stats, validate_size, Line, Normalisation, Surface};
+use super::{stats, validate_size, validate_spectrum_on_grid, Line, Normalisation, Surface};
 use crate::fft::RealFft2;
 use crate::memory::{array_bytes, ensure_fits, try_vec};
 use crate::spectrum::Psd;
@@ -72,6 +72,8 @@ impl SurfaceSpec {
         }
         validate_size(size)?;
         normalisation.validate()?;
+        // Square pixels of side L/cols: the Nyquist wavenumber along either axis is cols/2.
+        validate_spectrum_on_grid(&psd, cols as f64 / 2.0)?;
         Ok(SurfaceSpec {
             rows,
             cols,
@@ -245,6 +247,7 @@ impl LineSpec {
         }
         validate_size(size)?;
         normalisation.validate()?;
+        validate_spectrum_on_grid(&psd, n as f64 / 2.0)?;
         Ok(LineSpec {
             n,
             size,
@@ -652,12 +655,29 @@ mod tests {
     }
 
     #[test]
-    fn cut_off_beyond_nyquist_is_an_error() {
-        let psd = Psd::new(0.5, LongWavelength::CutOff { q0: 100.0 }, None).unwrap();
-        let spec = SurfaceSpec::new(16, 16, 1.0, psd, Normalisation::RmsHeight(1.0)).unwrap();
-        assert!(SurfaceGenerator::new(&spec)
-            .unwrap()
-            .try_generate(0)
-            .is_err());
+    fn wavenumbers_beyond_the_grid_are_refused_by_the_spec() {
+        let height = Normalisation::RmsHeight(1.0);
+        for long in [
+            LongWavelength::CutOff { q0: 100.0 },
+            LongWavelength::RollOff { q0: 100.0 },
+            LongWavelength::RollOff { q0: 8.0 }, // = Nyquist of 16 points per side
+        ] {
+            let psd = Psd::new(0.5, long, None).unwrap();
+            let err = SurfaceSpec::new(16, 16, 1.0, psd, height).unwrap_err();
+            assert!(err.to_string().contains("Nyquist"), "{err}");
+            // Nyquist follows the columns (square pixels of side L/cols): 64 rows don't help.
+            assert!(SurfaceSpec::new(64, 16, 1.0, psd, height).is_err());
+            assert!(LineSpec::new(16, 1.0, psd, height).is_err());
+        }
+        let just_below = Psd::new(0.5, LongWavelength::RollOff { q0: 7.9 }, None).unwrap();
+        assert!(SurfaceSpec::new(16, 16, 1.0, just_below, height).is_ok());
+        // 64 columns: Nyquist 32, so q0 = 8 is fine there.
+        let eight = Psd::new(0.5, LongWavelength::RollOff { q0: 8.0 }, None).unwrap();
+        assert!(SurfaceSpec::new(16, 64, 1.0, eight, height).is_ok());
+        assert!(LineSpec::new(16, 1.0, just_below, height).is_ok());
+        let no_modes = Psd::new(0.5, LongWavelength::None, Some(0.5)).unwrap();
+        let err = SurfaceSpec::new(16, 16, 1.0, no_modes, height).unwrap_err();
+        assert!(err.to_string().contains("short-cutoff"), "{err}");
+        assert!(LineSpec::new(16, 1.0, no_modes, height).is_err());
     }
 }

@@ -66,6 +66,35 @@ pub(crate) fn validate_size(size: f64) -> Result<()> {
     }
 }
 
+/// Checks that the spectrum's wavenumbers fit the grid: a roll-off or cut-off `q0` must lie
+/// below the grid's Nyquist wavenumber `nyquist` (both as `q·L/2π`), else the roll-off
+/// would flatten every mode (white noise) and the cut-off remove them all; a short
+/// cut-off `q1` must keep at least the fundamental, `q1 ≥ 1`.
+pub(crate) fn validate_spectrum_on_grid(psd: &crate::spectrum::Psd, nyquist: f64) -> Result<()> {
+    use crate::spectrum::LongWavelength;
+    let long = match psd.long_wavelength() {
+        LongWavelength::None => None,
+        LongWavelength::RollOff { q0 } => Some(("rolloff", q0)),
+        LongWavelength::CutOff { q0 } => Some(("cutoff", q0)),
+    };
+    if let Some((name, q0)) = long.filter(|&(_, q0)| q0 >= nyquist) {
+        return Err(Error::invalid(
+            name,
+            format!(
+                "q0 = {q0} wavelengths per side is not below the grid's Nyquist wavenumber \
+                 {nyquist} (half the points per side): refine the grid or lower q0"
+            ),
+        ));
+    }
+    if let Some(q1) = psd.short_cutoff().filter(|&q1| q1 < 1.0) {
+        return Err(Error::invalid(
+            "short-cutoff",
+            format!("q1 = {q1} removes every mode: the longest wavelength is the side (q1 ≥ 1)"),
+        ));
+    }
+    Ok(())
+}
+
 /// A rough surface: heights on a grid of square pixels (see the module docs for layout).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Surface {
