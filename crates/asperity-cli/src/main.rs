@@ -16,6 +16,12 @@ fn main() {
     let cli = match cli::Cli::try_parse() {
         Ok(cli) => cli,
         Err(err) if !err.use_stderr() => err.exit(), // --help, --version
+        // `asperity` or `asperity study` alone: the help (on stderr, status 2) says what to give.
+        Err(err)
+            if err.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            err.exit()
+        }
         Err(err) => {
             eprintln!("error: {} (see --help)", one_line(&err.to_string()));
             std::process::exit(2);

@@ -264,7 +264,7 @@ fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
         is_line: false,
         spacing: dx,
         size: args.size.unwrap_or(n as f64 * dx),
-        description: format!("{shape:?}, n = {n}, Δx = {dx}"),
+        description: format!("{shape}, n = {n}, Δx = {dx}"),
     })
 }
 

@@ -31,7 +31,8 @@ pub enum Figure {
 /// Arguments of `asperity reproduce`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours). Studies checkpoint: an interrupted run resumes when run again.\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
+    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours). Studies checkpoint: an interrupted run resumes when the same command runs
+again (each folder's reproduce.json records the figure and setting that made it).\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.
@@ -62,9 +63,50 @@ impl Figure {
     }
 }
 
+/// What a figure folder was made by: `DIR/<figure>/reproduce.json`. The same command run
+/// again on the same folder resumes there (study checkpoints are kept, and the figure's own
+/// outputs, deterministic, are written anew); a folder holding anything else is refused
+/// before any work unless `--force`.
+#[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+struct FolderStamp {
+    figure: String,
+    quick: bool,
+}
+
+/// Whether the figure may write over files in `dir`: yes when it is empty or new, when it
+/// was made by this same figure and setting, or with `--force`; else a one-line refusal.
+fn may_overwrite(dir: &std::path::Path, stamp: &FolderStamp, force: bool) -> anyhow::Result<bool> {
+    let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
+    if !holds_files {
+        return Ok(force);
+    }
+    let same = std::fs::read_to_string(dir.join(STAMP))
+        .ok()
+        .and_then(|text| serde_json::from_str::<FolderStamp>(&text).ok())
+        .is_some_and(|found| &found == stamp);
+    if same || force {
+        return Ok(true);
+    }
+    anyhow::bail!(
+        "{} holds files not made by `asperity reproduce {}{}`: use another --out, or --force to \
+         overwrite them",
+        dir.display(),
+        stamp.figure,
+        if stamp.quick { " --quick" } else { "" }
+    )
+}
+
+const STAMP: &str = "reproduce.json";
+
 fn run_one(figure: Figure, out: &std::path::Path, quick: bool, force: bool) -> anyhow::Result<()> {
     let dir = out.join(figure.folder());
+    let stamp = FolderStamp {
+        figure: figure.folder().to_string(),
+        quick,
+    };
+    let force = may_overwrite(&dir, &stamp, force)?;
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     let start = std::time::Instant::now();
     match figure {
         Figure::Fig1 => super::figures::fig1(&dir, quick, force)?,
@@ -98,6 +140,14 @@ pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
         ],
         one => vec![one],
     };
+    // Every folder is checked before the first figure starts: a refusal loses no work.
+    for &figure in &figures {
+        let stamp = FolderStamp {
+            figure: figure.folder().to_string(),
+            quick: args.quick,
+        };
+        may_overwrite(&args.out.join(figure.folder()), &stamp, args.force)?;
+    }
     for figure in figures {
         run_one(figure, &args.out, args.quick, args.force)?;
     }

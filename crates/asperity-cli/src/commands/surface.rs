@@ -121,6 +121,14 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     outputs.extend(args.png.as_deref());
     // All outputs are checked now and written all-or-nothing after the work.
     let mut staged = StagedOutputs::new(&outputs, s.force)?;
+    if let Some(png) = &args.png {
+        let is_png = png
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !is_png {
+            anyhow::bail!("--png {}: the file name must end in .png", png.display());
+        }
+    }
     let start = std::time::Instant::now();
     let surface = SurfaceGenerator::new(&spec)?.try_generate(s.seed)?;
     let elapsed = start.elapsed().as_secs_f64();

@@ -77,6 +77,21 @@ pub enum Axisymmetric {
     },
 }
 
+impl std::fmt::Display for Axisymmetric {
+    /// The profile as a reader writes it, e.g. `sphere R = 1` or `power law f = 0.5 r^3`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Axisymmetric::Sphere { radius } => write!(f, "sphere R = {radius}"),
+            Axisymmetric::Cone { slope } => write!(f, "cone tan θ = {slope}"),
+            Axisymmetric::FlatPunch { radius } => write!(f, "flat punch a = {radius}"),
+            Axisymmetric::PowerLaw {
+                coefficient,
+                exponent,
+            } => write!(f, "power law f = {coefficient} r^{exponent}"),
+        }
+    }
+}
+
 impl Axisymmetric {
     /// Checks that every parameter is positive and finite.
     pub fn validate(&self) -> Result<()> {

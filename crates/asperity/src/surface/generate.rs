@@ -218,7 +218,26 @@ fn scale_to(heights: &mut [f64], realised: f64, target: Normalisation) -> Result
         ));
     }
     let factor = want / realised;
-    heights.par_iter_mut().for_each(|h| *h *= factor);
+    // Beyond 1e150 in magnitude, squares (rms, slopes, the solvers' norms) overflow.
+    const LARGEST: f64 = 1e150;
+    let largest = heights
+        .par_iter_mut()
+        .map(|h| {
+            *h *= factor;
+            h.abs()
+        })
+        .reduce(|| 0.0, f64::max);
+    // NaN compares false, so it is refused too.
+    if largest.partial_cmp(&LARGEST) != Some(std::cmp::Ordering::Less) {
+        let (name, _) = target.name_and_value();
+        return Err(Error::invalid(
+            name,
+            format!(
+                "{want} would make heights of {largest:e}, beyond {LARGEST:e} where their \
+                 squares overflow: express the lengths in a larger unit"
+            ),
+        ));
+    }
     Ok(())
 }
 
@@ -652,6 +671,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn heights_too_large_to_square_are_refused() {
+        let psd = Psd::power_law(0.5).unwrap();
+        let huge = Normalisation::RmsHeight(1e160);
+        let spec = SurfaceSpec::new(16, 16, 1.0, psd, huge).unwrap();
+        let err = SurfaceGenerator::new(&spec)
+            .unwrap()
+            .try_generate(1)
+            .unwrap_err();
+        assert!(err.to_string().contains("rms-height"), "{err}");
+        let spec = LineSpec::new(64, 1.0, psd, huge).unwrap();
+        assert!(LineGenerator::new(&spec).unwrap().try_generate(1).is_err());
+        let fine = SurfaceSpec::new(16, 16, 1.0, psd, Normalisation::RmsHeight(1e100)).unwrap();
+        assert!(SurfaceGenerator::new(&fine)
+            .unwrap()
+            .try_generate(1)
+            .is_ok());
     }
 
     #[test]

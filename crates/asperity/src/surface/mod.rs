@@ -37,12 +37,17 @@ impl Default for Normalisation {
 }
 
 impl Normalisation {
-    /// Checks that the target is positive and finite.
-    pub fn validate(&self) -> Result<()> {
-        let (name, value) = match *self {
+    /// The flag that sets it and the requested value.
+    pub(crate) fn name_and_value(&self) -> (&'static str, f64) {
+        match *self {
             Normalisation::RmsHeight(v) => ("rms-height", v),
             Normalisation::RmsSlope(v) => ("rms-slope", v),
-        };
+        }
+    }
+
+    /// Checks that the target is positive and finite.
+    pub fn validate(&self) -> Result<()> {
+        let (name, value) = self.name_and_value();
         if value.is_finite() && value > 0.0 {
             Ok(())
         } else {
