@@ -555,7 +555,15 @@ fn plot_is_written_as_png_or_svg_beside_the_table() {
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
     assert_eq!(
         tree(dir.path()),
-        ["c.csv", "k.png", "k.svg", "s.npy", "s.npy.json"].map(PathBuf::from),
+        [
+            "c.csv",
+            "c.csv.json",
+            "k.png",
+            "k.svg",
+            "s.npy",
+            "s.npy.json"
+        ]
+        .map(PathBuf::from),
         "no temporary files left"
     );
 }
@@ -667,4 +675,429 @@ fn bad_plots_are_refused_before_solving_and_nothing_is_written() {
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(png_size(&existing).0 > 0);
     assert!(dir.path().join("c.csv").exists());
+}
+
+/// Exit status 2 and a one-line error containing `expected`.
+fn assert_refused(out: &Output, expected: &str) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(expected), "expected '{expected}' in: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
+
+#[test]
+fn outputs_never_replace_the_surface_or_its_sidecar() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let sidecar = dir.path().join("s.npy.json");
+    let before = tree(dir.path());
+    let (surface_bytes, sidecar_bytes) =
+        (std::fs::read(&s).unwrap(), std::fs::read(&sidecar).unwrap());
+    let dotted = dir.path().join(".").join("s.npy.json");
+    for (out, expected) in [
+        (sidecar.to_str().unwrap(), "is the sidecar"),
+        (dotted.to_str().unwrap(), "is the sidecar"),
+        // The CSV over the surface: its record OUT.csv.json would be the sidecar too.
+        (s.to_str().unwrap(), "input"),
+    ] {
+        let out = asperity(&[
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01,0.02",
+            "--out",
+            out,
+            "--force",
+        ]);
+        assert_refused(&out, expected);
+        assert_eq!(tree(dir.path()), before);
+    }
+    assert_eq!(std::fs::read(&s).unwrap(), surface_bytes);
+    assert_eq!(std::fs::read(&sidecar).unwrap(), sidecar_bytes);
+}
+
+/// The threshold a refusal states (`... from a mean pressure of X)`).
+fn stated_threshold(err: &str) -> f64 {
+    let tail = err.rsplit(" of ").next().unwrap();
+    tail.trim().trim_end_matches(')').parse().unwrap()
+}
+
+#[test]
+fn loads_beyond_full_contact_are_refused_before_any_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let csv = dir.path().join("o.csv");
+    let csv = csv.to_str().unwrap();
+    let before = tree(dir.path());
+    // --max-iter 1 fails any solve ("no convergence"): the refusal of the last load, with
+    // its index and the threshold in its own quantity, shows that nothing was solved.
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["--pressures", "0.01,0.02,1e4"],
+            "load 2 (mean pressure 10000): mean pressure 1.000000e4 is beyond full contact (the gap closes everywhere from a mean pressure of",
+        ),
+        (
+            &["--forces", "0.02,20", "--size", "2"],
+            "load 1 (force 20): force 2.000000e1 is beyond full contact (the gap closes everywhere from a force of",
+        ),
+        (
+            &["--indentations", "0.01,5"],
+            "load 1 (indentation 5): indentation 5.000000e0 is beyond full contact (the gap closes everywhere from an indentation of",
+        ),
+        (
+            &["--boundary", "periodic", "--pressures", "0.01,1e4"],
+            "load 1 (mean pressure 10000): mean pressure 1.000000e4 is beyond full contact",
+        ),
+        (
+            &["--nloads", "20", "--pmin", "1e-3", "--pmax", "1e4"],
+            "load 19 (mean pressure 10000",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["bem", "--surface", s, "--max-iter", "1", "--out", csv];
+        args.extend(extra);
+        let out = asperity(&args);
+        assert_refused(&out, expected);
+        assert_eq!(tree(dir.path()), before, "{extra:?}");
+    }
+    // Loads below the threshold are solved (here: fail to converge in one iteration).
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--max-iter",
+        "1",
+        "--pressures",
+        "0.01,1",
+    ]);
+    assert_refused(&out, "load 0 (mean pressure 0.01): no convergence");
+    // Just below the threshold, --fd-stiffness's upper step would cross it: refused up
+    // front too, naming the flag; without it the load is accepted.
+    for boundary in ["free", "periodic"] {
+        let out = asperity(&[
+            "bem",
+            "--surface",
+            s,
+            "--boundary",
+            boundary,
+            "--pressures",
+            "1e4",
+        ]);
+        let full = stated_threshold(&stderr(&out));
+        let near = format!("{}", full * (1.0 - 1e-4));
+        let base = [
+            "bem",
+            "--surface",
+            s,
+            "--boundary",
+            boundary,
+            "--max-iter",
+            "1",
+        ];
+        let out = asperity(&[&base[..], &["--pressures", &near, "--fd-stiffness"]].concat());
+        assert_refused(&out, "--fd-stiffness: at load 0");
+        assert!(
+            stderr(&out).contains("beyond full contact"),
+            "{}",
+            stderr(&out)
+        );
+        let out = asperity(&[&base[..], &["--pressures", &near]].concat());
+        assert_refused(&out, "no convergence");
+    }
+}
+
+#[test]
+fn fd_stiffness_agrees_with_the_frozen_set_and_changes_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let run = |extra: &[&str], name: &str| {
+        let csv = dir.path().join(name);
+        let base = [
+            "bem",
+            "--surface",
+            s,
+            "--out",
+            csv.to_str().unwrap(),
+            "--quiet",
+        ];
+        let out = asperity(&[&base[..], extra].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_csv(&csv)
+    };
+    let loads = ["--pressures", "0.005,0.01,0.02,0.04"];
+    let (header, rows) = run(
+        &[&loads[..], &["--fd-stiffness", "--timing"]].concat(),
+        "fd.csv",
+    );
+    // Appended after the contract's columns, before the timing columns.
+    assert_eq!(header[7], "stiffness_fd");
+    assert_eq!(header[8], "solve_seconds");
+    let (k, fd) = (
+        column(&header, "stiffness"),
+        column(&header, "stiffness_fd"),
+    );
+    for row in &rows {
+        let relative = row[fd] / row[k] - 1.0;
+        assert!(
+            relative.abs() < 0.02,
+            "frozen set {} vs fd {}",
+            row[k],
+            row[fd]
+        );
+    }
+    // The frozen-set stiffness and the state of every load are those of a run without it:
+    // the first load exactly, the later ones (warm-started from a re-solved state) to the
+    // solver's tolerance.
+    let (plain_header, plain) = run(&loads, "plain.csv");
+    assert_eq!(plain_header.len(), 7);
+    assert_eq!(rows[0][..7], plain[0][..7]);
+    for (a, b) in rows.iter().zip(&plain) {
+        for name in ["force", "indentation", "area_fraction", "stiffness"] {
+            let i = column(&plain_header, name);
+            assert!(
+                (a[i] / b[i] - 1.0).abs() < 1e-5,
+                "{name}: {} vs {}",
+                a[i],
+                b[i]
+            );
+        }
+    }
+    // Indentation control; no central difference at d = 0 (an empty cell).
+    let csv = dir.path().join("d.csv");
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--indentations",
+        "0,0.02",
+        "--fd-stiffness",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[1].ends_with(','), "{text}");
+    let last: Vec<f64> = lines[2].split(',').map(|v| v.parse().unwrap()).collect();
+    assert!((last[7] / last[4] - 1.0).abs() < 0.02, "{text}");
+    // The help states the step.
+    let help = String::from_utf8_lossy(&asperity(&["bem", "--help"]).stdout).into_owned();
+    assert!(
+        help.contains("--fd-stiffness") && help.contains("1e-3"),
+        "{help}"
+    );
+}
+
+#[test]
+fn stale_field_files_of_an_earlier_run_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let fields = dir.path().join("f");
+    let f = fields.to_str().unwrap();
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.01,0.02,0.03",
+        "--fields",
+        f,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let before = tree(dir.path());
+    let old = std::fs::read(fields.join("gap_2.npy")).unwrap();
+    // Two loads would leave pressure_2.npy and gap_2.npy beside the new files: refused,
+    // with or without --force, before any solve (--max-iter 1 would fail it).
+    for force in [true, false] {
+        let mut args = vec![
+            "bem",
+            "--surface",
+            s,
+            "--pressures",
+            "0.01,0.02",
+            "--fields",
+            f,
+            "--max-iter",
+            "1",
+        ];
+        if force {
+            args.push("--force");
+        }
+        let out = asperity(&args);
+        assert_refused(&out, "gap_2.npy");
+        assert!(stderr(&out).contains("another folder"), "{}", stderr(&out));
+        assert_eq!(tree(dir.path()), before);
+    }
+    // Any other pressure_*.npy / gap_*.npy counts too; other files do not.
+    std::fs::write(dir.path().join("f/notes.txt"), "mine").unwrap();
+    std::fs::write(dir.path().join("f/pressure_old.npy"), "old").unwrap();
+    let args = [
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.01,0.02,0.03",
+        "--fields",
+        f,
+        "--force",
+    ];
+    assert_refused(&asperity(&args), "pressure_old.npy");
+    std::fs::remove_file(dir.path().join("f/pressure_old.npy")).unwrap();
+    // The same loads again replace exactly the files there.
+    let out = asperity(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read(fields.join("gap_2.npy")).unwrap(), old);
+}
+
+#[test]
+fn the_table_records_its_inputs_and_l_is_stated() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let bare = dir.path().join("bare.npy");
+    std::fs::copy(s, &bare).unwrap();
+    let csv = dir.path().join("o.csv");
+    let record = dir.path().join("o.csv.json");
+    let run = |surface: &str, extra: &[&str]| {
+        let base = [
+            "bem",
+            "--surface",
+            surface,
+            "--pressures",
+            "0.01,0.02",
+            "--force",
+        ];
+        let out = asperity(&[&base[..], extra].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let out_args = ["--out", csv.to_str().unwrap()];
+    let err = run(
+        s,
+        &[
+            &out_args[..],
+            &[
+                "--size",
+                "2",
+                "--modulus",
+                "3",
+                "--boundary",
+                "periodic",
+                "--tol",
+                "1e-9",
+            ],
+        ]
+        .concat(),
+    );
+    assert!(err.contains("L = 2 (from --size)"), "{err}");
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&record).unwrap()).unwrap();
+    assert_eq!(value["surface"], s);
+    assert_eq!(value["size"], 2.0);
+    assert_eq!(value["size_source"], "--size");
+    assert_eq!(value["modulus"], 3.0);
+    assert_eq!(value["boundary"], "periodic");
+    assert_eq!(value["tolerance"], 1e-9);
+    assert_eq!(value["grid"], serde_json::json!([64, 64]));
+    assert_eq!(value["loads"]["values"], serde_json::json!([0.01, 0.02]));
+    let (header, _) = read_csv(&csv);
+    assert_eq!(value["columns"], serde_json::json!(header));
+    // L from the sidecar, or the default; stated on stderr (also without --out).
+    let err = run(s, &out_args);
+    assert!(err.contains("L = 1 (from sidecar)"), "{err}");
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&record).unwrap()).unwrap();
+    assert_eq!(value["size_source"], "sidecar");
+    assert_eq!(value["boundary"], "free");
+    let err = run(bare.to_str().unwrap(), &[]);
+    assert!(err.contains("L = 1 (default)"), "{err}");
+    assert!(run(s, &[&out_args[..], &["--quiet"]].concat()).is_empty());
+    // The record is an output like the others: an existing one is kept without --force,
+    // and nothing else is written.
+    std::fs::remove_file(&csv).unwrap();
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--pressures",
+        "0.01",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_refused(&out, "o.csv.json");
+    assert!(!csv.exists());
+}
+
+#[test]
+fn impossible_load_counts_are_refused_without_aborting() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let fields = dir.path().join("f");
+    let before = tree(dir.path());
+    for (k, expected) in [
+        ("18446744073709551615", "exceeds addressable memory"),
+        ("1000000000000000", "MiB"),
+    ] {
+        let out = asperity(&[
+            "bem",
+            "--surface",
+            s,
+            "--nloads",
+            k,
+            "--pmin",
+            "1e-3",
+            "--pmax",
+            "1e-2",
+            "--fields",
+            fields.to_str().unwrap(),
+        ]);
+        assert_refused(&out, expected);
+        assert!(stderr(&out).contains("--nloads"), "{}", stderr(&out));
+        assert_eq!(tree(dir.path()), before);
+    }
+}
+
+#[test]
+fn bad_numbers_name_their_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    for (extra, expected) in [
+        (
+            &["--modulus", "-1"][..],
+            "--modulus must be positive and finite, got -1",
+        ),
+        (
+            &["--size", "-1"][..],
+            "--size must be positive and finite, got -1",
+        ),
+        (
+            &["--size", "0"][..],
+            "--size must be positive and finite, got 0",
+        ),
+        (&["--size", "nan"][..], "--size"),
+        (&["--max-iter", "-1"][..], "--max-iter"),
+        (
+            &["--nloads", "-1", "--pmin", "1", "--pmax", "2"][..],
+            "--nloads",
+        ),
+    ] {
+        let mut args = vec!["bem", "--surface", s];
+        args.extend(extra);
+        if !extra.contains(&"--nloads") {
+            args.extend(["--pressures", "0.01"]);
+        }
+        let out = asperity(&args);
+        assert_refused(&out, expected);
+        assert!(
+            !stderr(&out).contains("unexpected argument"),
+            "{}",
+            stderr(&out)
+        );
+    }
 }

@@ -151,7 +151,7 @@ fn stats_writes_psd_and_recovers_hurst_of_a_line() {
         .unwrap();
     assert!((hurst - 0.7).abs() < 1e-6, "{text}");
     let psd = std::fs::read_to_string(d.join("psd.csv")).unwrap();
-    assert!(psd.starts_with("q,psd\n"));
+    assert!(psd.starts_with("q,psd,q_l_2pi\n"));
     assert_eq!(psd.lines().count(), 1 + 4096);
 }
 
@@ -291,6 +291,13 @@ fn a_failing_output_leaves_no_other_output_behind() {
     let out = asperity(&["stats", "a.npy", "--psd", "a.npy", "--force"], d);
     assert_refused(&out, d, 3, "input");
     assert_eq!(std::fs::read(d.join("a.npy")).unwrap(), before);
+    // ... or over the input's sidecar (its size and generating parameters).
+    let sidecar = std::fs::read(d.join("a.npy.json")).unwrap();
+    for psd in ["a.npy.json", "./a.npy.json"] {
+        let out = asperity(&["stats", "a.npy", "--psd", psd, "--force"], d);
+        assert_refused(&out, d, 3, "is the sidecar a.npy.json of the input a.npy");
+    }
+    assert_eq!(std::fs::read(d.join("a.npy.json")).unwrap(), sidecar);
 }
 
 fn asperity_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
@@ -459,8 +466,21 @@ fn stats_refuses_nonsense_fit_ranges() {
         (&["--fit-to", "0"][..], "--fit-to"),
         (&["--fit-from", "50", "--fit-to", "10"][..], "below"),
         (&["--fit-from", "5", "--fit-to", "5"][..], "below"),
-        // Above the sidecar's short cut-off (default upper end 9).
-        (&["--fit-from", "20"][..], "empty"),
+        // Above the sidecar's short cut-off (default upper end 9): the flag given is named.
+        (
+            &["--fit-from", "20"][..],
+            "invalid --fit-from 20: the PSD fit range would be empty",
+        ),
+        // Beyond Nyquist (32), with --fit-to clamped to it.
+        (
+            &["--fit-from", "40", "--fit-to", "1000"][..],
+            "invalid --fit-from 40",
+        ),
+        // Below the default lower end 2.
+        (
+            &["--fit-to", "1.5"][..],
+            "invalid --fit-to 1.5: the PSD fit range would be empty",
+        ),
     ] {
         let out = asperity(&[&["stats", "s.npy"], args].concat(), d);
         assert_refused(&out, d, 2, needle);
@@ -598,5 +618,117 @@ fn stats_help_has_a_plot_example() {
     assert!(
         text.contains("asperity stats s.npy --plot psd.png"),
         "{text}"
+    );
+}
+
+#[test]
+fn stats_psd_columns_state_their_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (make, file) in [
+        (
+            &[
+                "surface", "--n", "48", "--m", "32", "--hurst", "0.6", "--size", "3",
+            ][..],
+            "s.npy",
+        ),
+        (
+            &["line", "--n", "256", "--hurst", "0.6", "--size", "3"][..],
+            "l.npy",
+        ),
+    ] {
+        let out = asperity(&[make, &["--out", file]].concat(), d);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let csv = format!("{file}.csv");
+        let out = asperity(&["stats", file, "--psd", &csv], d);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = std::fs::read_to_string(d.join(&csv)).unwrap();
+        let mut lines = text.lines();
+        // The contract's q,psd first; q_l_2pi appended.
+        assert_eq!(lines.next(), Some("q,psd,q_l_2pi"));
+        let mut rows = 0;
+        for line in lines {
+            let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+            let want = v[0] * 3.0 / std::f64::consts::TAU;
+            assert!((v[2] / want - 1.0).abs() < 1e-14, "{line}");
+            rows += 1;
+        }
+        assert!(rows > 10);
+    }
+    let help = asperity(&["stats", "--help"], d);
+    let help = String::from_utf8_lossy(&help.stdout);
+    for unit in [
+        "radians per unit length",
+        "wavelengths per side",
+        "q_l_2pi",
+        "length⁴",
+    ] {
+        assert!(help.contains(unit), "{unit}: {help}");
+    }
+}
+
+#[test]
+fn stats_fit_range_is_clamped_and_an_empty_default_is_no_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let make = |extra: &[&str], out: &str| {
+        let base = ["surface", "--n", "128", "--hurst", "0.8", "--seed", "5"];
+        let o = asperity(&[&base[..], extra, &["--out", out]].concat(), d);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    make(&["--rolloff", "6"], "s.npy");
+    // --fit-to beyond Nyquist (64) is clamped, and said so.
+    let v = stats_json(d, "s.npy", &["--fit-to", "1000"]);
+    assert_eq!(v["fit_to"], 64.0);
+    assert!(v["fit_note"].as_str().unwrap().contains("clamped"), "{v}");
+    assert!(v["psd_slope"].as_f64().is_some());
+    let out = asperity(&["stats", "s.npy", "--fit-to", "1000"], d);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("64 (Nyquist; --fit-to 1000 clamped to it)"),
+        "{text}"
+    );
+    assert!(!text.contains("1000 (Nyquist)"), "{text}");
+    // Within range: no note.
+    assert!(stats_json(d, "s.npy", &["--fit-to", "40"])["fit_note"].is_null());
+    // Defaults that leave no range: the statistics, psd_slope n/a and the cause; exit 0.
+    make(&["--rolloff", "100"], "high.npy");
+    make(&[], "tiny.npy");
+    let tiny = Array2::from_shape_fn((2, 2), |(i, j)| (i * 2 + j) as f64 * 0.3);
+    write_npy(d.join("tiny.npy"), &tiny).unwrap();
+    std::fs::remove_file(d.join("tiny.npy.json")).unwrap();
+    for (file, cause) in [
+        (
+            "high.npy",
+            "from 100 (the sidecar's roll-off q0 = 100) to 64 (Nyquist)",
+        ),
+        ("tiny.npy", "from 2 (the default lower end) to 1 (Nyquist)"),
+    ] {
+        let out = asperity(&["stats", file], d);
+        assert!(out.status.success(), "{file}: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains("rms_height: ") && text.contains("rms_slope: "),
+            "{text}"
+        );
+        let line = text.lines().find(|l| l.starts_with("psd_slope")).unwrap();
+        assert!(
+            line.starts_with("psd_slope: n/a (") && line.contains(cause),
+            "{line}"
+        );
+        let v = stats_json(d, file, &[]);
+        assert!(v["psd_slope"].is_null() && v["fit_from"].is_null(), "{v}");
+        assert!(v["fit_note"].as_str().unwrap().contains(cause), "{v}");
+        // Outputs are still written (the PSD, its plot without a fit).
+        let out = asperity(&["stats", file, "--psd", &format!("{file}.csv")], d);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    // A given --fit-from beyond Nyquist is an error naming it.
+    let out = asperity(&["stats", "s.npy", "--fit-from", "100"], d);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("invalid --fit-from 100"),
+        "{}",
+        stderr(&out)
     );
 }

@@ -11,11 +11,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
+use serde_json::json;
 
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
@@ -31,18 +32,21 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out curve.csv --plot curve.png\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
-(stiffness by the frozen contact set; indentation measured from the highest point; with\n\
---timing also solve_seconds, stiffness_seconds, peak_rss_mib).")]
+(stiffness by the frozen contact set; indentation measured from the highest point); then\n\
+stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_seconds, peak_rss_mib with\n\
+--timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
+E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
+any solve.")]
 #[command(group(clap::ArgGroup::new("loads").required(true).args(["forces", "pressures", "indentations", "nloads"])))]
 pub struct BemArgs {
     /// Surface heights (.npy, float64, 2D), positive up.
     #[arg(long, value_name = "FILE.npy")]
     pub surface: PathBuf,
     /// Side length L along x; defaults to the surface's sidecar, else 1.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub size: Option<f64>,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub modulus: f64,
     /// Boundary conditions: free (zero-padded, no periodic images; the paper's) or periodic.
     #[arg(long, default_value = "free", value_parser = ["free", "periodic"])]
@@ -72,7 +76,7 @@ pub struct BemArgs {
     )]
     pub indentations: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
-    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"])]
+    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"], allow_negative_numbers = true)]
     pub nloads: Option<usize>,
     /// Smallest mean pressure for --nloads.
     #[arg(
@@ -94,9 +98,10 @@ pub struct BemArgs {
     #[arg(long, default_value_t = SolverParams::default().tolerance, allow_negative_numbers = true)]
     pub tol: f64,
     /// Maximum Polonsky–Keer iterations per load.
-    #[arg(long, default_value_t = SolverParams::default().max_iterations)]
+    #[arg(long, default_value_t = SolverParams::default().max_iterations, allow_negative_numbers = true)]
     pub max_iter: usize,
-    /// Output table (CSV); printed to stdout when absent.
+    /// Output table (CSV); printed to stdout when absent. Its inputs go to OUT.csv.json
+    /// beside it (surface, L and its source, E*, boundary, tolerance, loads, columns).
     #[arg(long, value_name = "OUT.csv")]
     pub out: Option<PathBuf>,
     /// Also plot the load sweep (needs at least 2 loads), .png or .svg by the extension:
@@ -104,9 +109,18 @@ pub struct BemArgs {
     /// F and k divided by E* (length² and length).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// Write pressure_K.npy and gap_K.npy for every load K (0-based) into DIR.
+    /// Write pressure_K.npy and gap_K.npy for every load K (0-based) into DIR. Refused if
+    /// DIR holds pressure_*.npy or gap_*.npy files this run would not replace (an earlier
+    /// run's; use another folder).
     #[arg(long, value_name = "DIR")]
     pub fields: Option<PathBuf>,
+    /// Add the column stiffness_fd: the finite-difference dF/dd by central differences of
+    /// two extra solves at the load × (1 ± 1e-3), after the frozen-set stiffness and the
+    /// fields (which are unaffected); the load is then solved again, so the next load
+    /// warm-starts from it. About three more (warm-started) solves per load; empty at
+    /// indentation 0.
+    #[arg(long)]
+    pub fd_stiffness: bool,
     /// Add timing columns (solve_seconds, stiffness_seconds, peak_rss_mib), for benchmarks.
     #[arg(long)]
     pub timing: bool,
@@ -119,6 +133,19 @@ pub struct BemArgs {
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
+}
+
+/// Relative step of `--fd-stiffness`: the load × (1 ± FD_STEP).
+const FD_STEP: f64 = 1e-3;
+
+/// Memory kept per load besides the solver (control, row, CSV cells, JSON record), and with
+/// `--fields` per load also (two field paths, their staged entries): generous estimates.
+const BYTES_PER_LOAD: usize = 1024;
+const BYTES_PER_FIELD_LOAD: usize = 2048;
+
+fn bookkeeping_bytes(loads: usize, fields: bool) -> Option<u64> {
+    let per_load = BYTES_PER_LOAD + if fields { BYTES_PER_FIELD_LOAD } else { 0 };
+    array_bytes(&[loads], per_load)
 }
 
 /// The loads requested, as solver controls.
@@ -169,6 +196,11 @@ fn controls(args: &BemArgs) -> Result<Vec<Control>> {
     if pmax < pmin {
         bail!("--pmax ({pmax}) must not be smaller than --pmin ({pmin})");
     }
+    // K loads are listed (and, with --fields, 2K files): check before allocating.
+    ensure_fits(
+        &format!("--nloads {k}: the bookkeeping of {k} loads"),
+        bookkeeping_bytes(k, args.fields.is_some()),
+    )?;
     Ok((0..k)
         .map(|i| {
             let t = if k == 1 {
@@ -207,31 +239,223 @@ fn field_paths(dir: &Path, count: usize) -> Vec<(PathBuf, PathBuf)> {
         .collect()
 }
 
+/// Refuses a `--fields` folder that holds `pressure_*.npy` or `gap_*.npy` files this run
+/// would not write (`count` loads): left beside the new ones, they would pass for its own.
+fn ensure_no_stale_fields(dir: &Path, count: usize) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(()); // a missing folder is made; anything else is reported when staging
+    };
+    let ours = |name: &str| {
+        let index = name
+            .strip_prefix("pressure_")
+            .or_else(|| name.strip_prefix("gap_"))
+            .and_then(|rest| rest.strip_suffix(".npy"));
+        index.and_then(|k| k.parse::<usize>().ok()).map(|k| {
+            // Only the canonical spelling of an index below `count` is written.
+            k < count && name.ends_with(&format!("_{k}.npy"))
+        })
+    };
+    let mut stale: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|name| {
+            let pattern = (name.starts_with("pressure_") || name.starts_with("gap_"))
+                && name.ends_with(".npy");
+            pattern && ours(name) != Some(true)
+        })
+        .collect();
+    stale.sort();
+    if let Some(first) = stale.first() {
+        let more = match stale.len() {
+            1 => String::new(),
+            n => format!(" and {} more", n - 1),
+        };
+        bail!(
+            "--fields {}: holds {first}{more} from an earlier run, which this run ({count} load{}) would not replace; use another folder (or remove the old field files)",
+            dir.display(),
+            if count == 1 { "" } else { "s" }
+        );
+    }
+    Ok(())
+}
+
+/// Refuses an output that is the JSON sidecar of `input` (it holds the input's L and
+/// generating parameters), one line naming it.
+pub(crate) fn ensure_not_sidecar(staged: &StagedOutputs, input: &Path) -> Result<()> {
+    let sidecar = sidecar_path(input);
+    if staged.ensure_not_input(&sidecar).is_err() {
+        let output = staged
+            .paths()
+            .find(|p| std::fs::canonicalize(p).ok() == std::fs::canonicalize(&sidecar).ok())
+            .unwrap_or(&sidecar);
+        bail!(
+            "{}: is the sidecar {} of the input {} (its size and generating parameters); choose another output name",
+            output.display(),
+            sidecar.display(),
+            input.display()
+        );
+    }
+    Ok(())
+}
+
+/// A load as messages name it: `load 3 (mean pressure 0.01)`.
+fn describe(k: usize, control: Control) -> String {
+    format!("load {k} ({} {})", control.quantity(), control.value())
+}
+
+/// Refuses, before any solve, the largest load of each kind if it is beyond full contact
+/// (and, with `--fd-stiffness`, its upper finite-difference step). The threshold is computed
+/// only where the cheap lower bound does not already clear the loads: periodic boundaries
+/// always (one FFT pair), free boundaries when a load reaches the bound (two CG solves on
+/// the full grid, about one solve's time; cached by the solver).
+fn check_full_contact(
+    solver: &mut ContactSolver,
+    loads: &[Control],
+    fd_step: Option<f64>,
+) -> Result<()> {
+    let area = solver.nominal_area();
+    let same_kind =
+        |a: &Control, b: &Control| std::mem::discriminant(a) == std::mem::discriminant(b);
+    let mut kinds: Vec<Control> = Vec::new();
+    for c in loads {
+        if !kinds.iter().any(|k| same_kind(k, c)) {
+            kinds.push(*c);
+        }
+    }
+    for kind in kinds {
+        let Some((k, &largest)) = loads
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| same_kind(c, &kind))
+            .max_by(|a, b| a.1.value().total_cmp(&b.1.value()))
+        else {
+            continue;
+        };
+        let top = largest.value() * (1.0 + fd_step.unwrap_or(0.0));
+        let bound = solver.full_contact_lower_bound()?;
+        match bound.in_units_of(largest, area) {
+            Some(b) if top < b => continue,
+            None => continue, // no threshold in this quantity (left to the solver)
+            Some(_) => {}
+        }
+        let threshold = solver.full_contact_threshold()?;
+        let Some(full) = threshold.in_units_of(largest, area) else {
+            continue;
+        };
+        if largest.value() >= full {
+            let error = SolveError::BeyondFullContact {
+                requested: largest,
+                full_contact: Some(full),
+            };
+            return Err(anyhow::Error::new(error).context(describe(k, largest)));
+        }
+        if top >= full {
+            bail!(
+                "--fd-stiffness: at {} the upper finite-difference step ({} {:.6e}, the load × (1 + {})) is beyond full contact (the gap closes everywhere from {:.6e}); lower the load or drop --fd-stiffness",
+                describe(k, largest),
+                largest.quantity(),
+                top,
+                fd_step.unwrap_or(0.0),
+                full
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Where L came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SizeSource {
+    Flag,
+    Sidecar,
+    Default,
+}
+
+impl SizeSource {
+    fn name(self) -> &'static str {
+        match self {
+            SizeSource::Flag => "--size",
+            SizeSource::Sidecar => "sidecar",
+            SizeSource::Default => "default",
+        }
+    }
+
+    /// As the stderr line states it: `from --size`, `from sidecar`, `default`.
+    fn phrase(self) -> &'static str {
+        match self {
+            SizeSource::Flag => "from --size",
+            SizeSource::Sidecar => "from sidecar",
+            SizeSource::Default => "default",
+        }
+    }
+}
+
+/// The loads as given on the command line, for the record in OUT.csv.json.
+fn loads_record(args: &BemArgs) -> serde_json::Value {
+    if let Some(v) = &args.forces {
+        json!({ "quantity": "force", "values": v })
+    } else if let Some(v) = &args.pressures {
+        json!({ "quantity": "mean pressure", "values": v })
+    } else if let Some(v) = &args.indentations {
+        json!({ "quantity": "indentation", "values": v })
+    } else {
+        json!({
+            "quantity": "mean pressure", "nloads": args.nloads, "pmin": args.pmin,
+            "pmax": args.pmax, "spacing": "logarithmic",
+        })
+    }
+}
+
+/// One CSV row: a value per column, `None` where not computed (an empty CSV cell).
 struct Row {
-    values: Vec<f64>,
-    stiffness: Option<f64>,
+    values: Vec<Option<f64>>,
 }
 
 /// The `--plot` panels: k/E* vs F/E* and area fraction vs F/E*, log–log.
-fn sweep_charts(rows: &[Row], modulus: f64, surface: &Path, boundary: &str) -> [Chart; 2] {
+fn sweep_charts(
+    rows: &[Row],
+    header: &[&str],
+    modulus: f64,
+    surface: &Path,
+    boundary: &str,
+) -> [Chart; 2] {
     let name = surface.file_name().map_or_else(
         || surface.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
-    let force = |row: &Row| row.values[0] / modulus;
-    let points = |y: &dyn Fn(&Row) -> f64| rows.iter().map(|r| (force(r), y(r))).collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let value = |row: &Row, i: Option<usize>| i.and_then(|i| row.values[i]).unwrap_or(f64::NAN);
+    let (force, stiffness, fd, area) = (
+        col("force"),
+        col("stiffness"),
+        col("stiffness_fd"),
+        col("area_fraction"),
+    );
+    let points = |y: &dyn Fn(&Row) -> f64| {
+        rows.iter()
+            .map(|r| (value(r, force) / modulus, y(r)))
+            .collect()
+    };
     let x_label = "normal force F / E*  [length²]".to_string();
+    let mut series = vec![Series::new(
+        "frozen contact set",
+        points(&|r| value(r, stiffness) / modulus),
+        Style::LinePoints,
+    )];
+    if fd.is_some() {
+        series.push(Series::new(
+            "finite difference dF/dd",
+            points(&|r| value(r, fd) / modulus),
+            Style::Dashed,
+        ));
+    }
     let stiffness = Chart {
         title: format!("{name}: contact stiffness (E* = {modulus}, {boundary} boundaries)"),
         x_label: x_label.clone(),
         y_label: "contact stiffness k / E*  [length]".into(),
         log_x: true,
         log_y: true,
-        series: vec![Series::new(
-            "frozen contact set",
-            points(&|r| r.stiffness.unwrap_or(f64::NAN) / modulus),
-            Style::LinePoints,
-        )],
+        series,
     };
     let area = Chart {
         title: format!("{name}: true contact area"),
@@ -239,7 +463,11 @@ fn sweep_charts(rows: &[Row], modulus: f64, surface: &Path, boundary: &str) -> [
         y_label: "area fraction A / A0".into(),
         log_x: true,
         log_y: true,
-        series: vec![Series::new("", points(&|r| r.values[3]), Style::LinePoints)],
+        series: vec![Series::new(
+            "",
+            points(&|r| value(r, area)),
+            Style::LinePoints,
+        )],
     };
     [stiffness, area]
 }
@@ -258,6 +486,11 @@ pub fn run(args: &BemArgs) -> Result<()> {
             "--modulus must be positive and finite, got {}",
             args.modulus
         );
+    }
+    if let Some(size) = args.size {
+        if !(size.is_finite() && size > 0.0) {
+            bail!("--size must be positive and finite, got {size}");
+        }
     }
     if !(args.tol.is_finite() && args.tol > 0.0) {
         bail!("--tol must be positive and finite, got {}", args.tol);
@@ -281,26 +514,36 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     // Outputs, checked before any work: each folder exists (--fields DIR and its missing
     // parents are made here, and removed again on any error), no output is named twice or
-    // exists without --force. They are written to temporary files as each load is solved
-    // and renamed into place together at the end.
+    // exists without --force, none is the surface or its sidecar, and --fields DIR holds no
+    // field files of another run. They are written to temporary files as each load is
+    // solved and renamed into place together at the end.
+    if let Some(dir) = &args.fields {
+        ensure_no_stale_fields(dir, loads.len())?;
+    }
     let fields = args
         .fields
         .as_ref()
         .map(|dir| field_paths(dir, loads.len()));
+    let record_path = args.out.as_deref().map(sidecar_path);
     let output_paths = args
         .out
         .iter()
+        .chain(&record_path)
         .chain(&args.plot)
         .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
     let mut staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
+    ensure_not_sidecar(&staged, &args.surface)?;
     // Memory, from the file's header before its data is read: the solver plus the heights,
-    // alive while the solver is built (the fields go to files as they are solved).
+    // alive while the solver is built (the fields go to files as they are solved), plus the
+    // per-load bookkeeping.
     let shape = read_npy_shape(&args.surface)?;
     if let [rows, cols] = shape[..] {
         let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
             .zip(array_bytes(&[rows, cols], 8))
-            .and_then(|(solver, heights)| solver.checked_add(heights));
+            .and_then(|(solver, heights)| solver.checked_add(heights))
+            .zip(bookkeeping_bytes(loads.len(), fields.is_some()))
+            .and_then(|(solver, loads)| solver.checked_add(loads));
         ensure_fits(
             &format!(
                 "asperity bem on a {rows}x{cols} surface ({} boundaries)",
@@ -309,13 +552,21 @@ pub fn run(args: &BemArgs) -> Result<()> {
             bytes,
         )?;
     }
-    let size = args
-        .size
-        .or_else(|| sidecar_size(&args.surface))
-        .unwrap_or(1.0);
+    let (size, size_source) = match (args.size, sidecar_size(&args.surface)) {
+        (Some(size), _) => (size, SizeSource::Flag),
+        (None, Some(size)) => (size, SizeSource::Sidecar),
+        (None, None) => (1.0, SizeSource::Default),
+    };
     let heights = read_npy_2d(&args.surface)?;
-    let surface =
-        Surface::new(heights, size).with_context(|| format!("{}", args.surface.display()))?;
+    let surface = Surface::new(heights, size).with_context(|| match size_source {
+        SizeSource::Sidecar => format!(
+            "{} (L = {size} from its sidecar {})",
+            args.surface.display(),
+            sidecar_path(&args.surface).display()
+        ),
+        _ => format!("{}", args.surface.display()),
+    })?;
+    let grid = surface.dim();
     let half_space = HalfSpace {
         modulus: args.modulus,
         boundary,
@@ -323,57 +574,10 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let mut solver = ContactSolver::new(&surface, half_space, params)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
+    let fd_step = args.fd_stiffness.then_some(FD_STEP);
+    check_full_contact(&mut solver, &loads, fd_step)?;
 
     // 2. Solve every load (warm starts in the given order).
-    let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
-    let mut rows = Vec::with_capacity(loads.len());
-    for (k, &control) in loads.iter().enumerate() {
-        let describe = || match control {
-            Control::Force(f) => format!("load {k} (force {f})"),
-            Control::MeanPressure(p) => format!("load {k} (mean pressure {p})"),
-            Control::Indentation(d) => format!("load {k} (indentation {d})"),
-        };
-        let start = Instant::now();
-        let (summary, info) = solver.solve(control).with_context(describe)?;
-        let solve_seconds = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let stiffness = if args.no_stiffness {
-            None
-        } else {
-            Some(
-                solver
-                    .frozen_set_stiffness()
-                    .with_context(|| format!("stiffness at {}", describe()))?
-                    .0,
-            )
-        };
-        let stiffness_seconds = start.elapsed().as_secs_f64();
-        let mut values = vec![
-            summary.force,
-            summary.mean_pressure,
-            summary.indentation,
-            summary.area_fraction,
-            stiffness.unwrap_or(f64::NAN),
-            info.iterations as f64,
-            info.residual,
-        ];
-        if args.timing {
-            values.extend([
-                solve_seconds,
-                stiffness_seconds,
-                peak_rss_mib().unwrap_or(f64::NAN),
-            ]);
-        }
-        if let Some((p_path, g_path)) = fields.as_ref().map(|f| &f[k]) {
-            staged.write_npy_2d(p_path, &solver.pressure())?;
-            staged.write_npy_2d(g_path, &solver.gap())?;
-        }
-        rows.push(Row { values, stiffness });
-        progress.inc();
-    }
-    progress.finish();
-
-    // 3. Write.
     let mut header = vec![
         "force",
         "mean_pressure",
@@ -383,55 +587,142 @@ pub fn run(args: &BemArgs) -> Result<()> {
         "iterations",
         "residual",
     ];
+    if args.fd_stiffness {
+        header.push("stiffness_fd");
+    }
     if args.timing {
         header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
     }
-    let format_row = |row: &Row| -> Vec<String> {
+    let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
+    let mut rows = Vec::with_capacity(loads.len());
+    for (k, &control) in loads.iter().enumerate() {
+        let start = Instant::now();
+        let (summary, info) = solver
+            .solve(control)
+            .with_context(|| describe(k, control))?;
+        let solve_seconds = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let stiffness = if args.no_stiffness {
+            None
+        } else {
+            Some(
+                solver
+                    .frozen_set_stiffness()
+                    .with_context(|| format!("stiffness at {}", describe(k, control)))?
+                    .0,
+            )
+        };
+        let stiffness_seconds = start.elapsed().as_secs_f64();
+        if let Some((p_path, g_path)) = fields.as_ref().map(|f| &f[k]) {
+            staged.write_npy_2d(p_path, &solver.pressure())?;
+            staged.write_npy_2d(g_path, &solver.gap())?;
+        }
+        let mut values = vec![
+            Some(summary.force),
+            Some(summary.mean_pressure),
+            Some(summary.indentation),
+            Some(summary.area_fraction),
+            stiffness,
+            Some(info.iterations as f64),
+            Some(info.residual),
+        ];
+        // After everything taken from the state at this load: the two steps move the
+        // solver, so the load is solved again (warm, from the upper step) for the next
+        // load's warm start, except after the last one.
+        if let Some(step) = fd_step {
+            let fd = if control.value() > 0.0 {
+                let context = || format!("--fd-stiffness at {}", describe(k, control));
+                let fd = solver
+                    .finite_difference_stiffness(control, step)
+                    .with_context(context)?;
+                if k + 1 < loads.len() {
+                    solver.solve(control).with_context(context)?;
+                }
+                Some(fd)
+            } else {
+                None // no central difference at indentation 0
+            };
+            values.push(fd);
+        }
+        if args.timing {
+            values.extend([
+                Some(solve_seconds),
+                Some(stiffness_seconds),
+                Some(peak_rss_mib().unwrap_or(f64::NAN)),
+            ]);
+        }
+        rows.push(Row { values });
+        progress.inc();
+    }
+    progress.finish();
+
+    // 3. Write.
+    let iterations = header.iter().position(|h| *h == "iterations");
+    let format_row = |row: &Row, empty: &str, number: &dyn Fn(f64) -> String| -> Vec<String> {
         row.values
             .iter()
             .enumerate()
-            .map(|(i, v)| match i {
-                4 if row.stiffness.is_none() => String::new(),
-                5 => format!("{}", *v as u64),
-                _ => format_number(*v),
+            .map(|(i, v)| match v {
+                None => empty.to_string(),
+                Some(v) if Some(i) == iterations => format!("{}", *v as u64),
+                Some(v) => number(*v),
             })
             .collect()
     };
     if let Some(out) = &args.out {
         let mut table = Table::new(&header);
         for row in &rows {
-            table.push(&format_row(row));
+            table.push(&format_row(row, "", &|v| format_number(v)));
         }
         table
             .stage(&mut staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
+        let record = json!({
+            "command": "asperity bem",
+            "version": env!("CARGO_PKG_VERSION"),
+            "surface": args.surface,
+            "grid": [grid.0, grid.1],
+            "size": size,
+            "size_source": size_source.name(),
+            "modulus": args.modulus,
+            "boundary": boundary.name(),
+            "tolerance": args.tol,
+            "max_iterations": args.max_iter,
+            "loads": loads_record(args),
+            "stiffness": if args.no_stiffness { None } else { Some("frozen contact set") },
+            "fd_relative_step": fd_step,
+            "fields": args.fields,
+            "columns": header,
+        });
+        let record_path = record_path.as_deref().expect("set with --out");
+        staged
+            .write_json(record_path, &record)
+            .with_context(|| format!("writing {}", record_path.display()))?;
     }
     if let Some(plot) = &args.plot {
-        let charts = sweep_charts(&rows, args.modulus, &args.surface, boundary.name());
+        let charts = sweep_charts(&rows, &header, args.modulus, &args.surface, boundary.name());
         stage_charts(&mut staged, plot, &charts)
             .with_context(|| format!("writing {}", plot.display()))?;
     }
     staged.commit()?;
+    if !args.quiet {
+        eprintln!("L = {size} ({})", size_source.phrase());
+    }
     match &args.out {
         Some(out) => {
             if !args.quiet {
-                eprintln!("wrote {} ({} loads)", out.display(), rows.len());
+                eprintln!(
+                    "wrote {} and {} ({} loads)",
+                    out.display(),
+                    sidecar_path(out).display(),
+                    rows.len()
+                );
             }
         }
         None => {
             let cells: Vec<Vec<String>> = rows
                 .iter()
-                .map(|row| {
-                    row.values
-                        .iter()
-                        .enumerate()
-                        .map(|(i, v)| match i {
-                            4 if row.stiffness.is_none() => "-".to_string(),
-                            5 => format!("{}", *v as u64),
-                            _ => format!("{v:.6e}"),
-                        })
-                        .collect()
-                })
+                .map(|row| format_row(row, "-", &|v| format!("{v:.6e}")))
                 .collect();
             let widths: Vec<usize> = header
                 .iter()

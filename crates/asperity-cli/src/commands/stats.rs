@@ -28,7 +28,10 @@ pub struct StatsArgs {
     /// Side length L; defaults to the sidecar's, else 1.
     #[arg(long)]
     pub size: Option<f64>,
-    /// Write the (radially averaged) PSD as CSV with columns q,psd.
+    /// Write the (radially averaged) PSD as CSV with columns q (the wavenumber, radians
+    /// per unit length), psd (C2D(q) in length⁴ for a surface, C1D(q) in length³ for a
+    /// line) and q_l_2pi (q·L/2π: wavelengths per side, the unit of --fit-from, --fit-to
+    /// and the plot's axis).
     #[arg(long, value_name = "OUT.csv")]
     pub psd: Option<PathBuf>,
     /// Fit the PSD slope from the ring at this q·L/2π [default: 2; the sidecar's roll-off
@@ -36,7 +39,7 @@ pub struct StatsArgs {
     #[arg(long, value_name = "Q")]
     pub fit_from: Option<f64>,
     /// Fit the PSD slope up to the ring at this q·L/2π [default: Nyquist; the last ring
-    /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower].
+    /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower]. Clamped to Nyquist.
     #[arg(long, value_name = "Q")]
     pub fit_to: Option<f64>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
@@ -92,34 +95,86 @@ fn fit_bound(flag: &str, value: Option<f64>) -> Result<Option<f64>> {
     }
 }
 
+/// The PSD fit range, and what the output says about it.
+#[derive(Debug, Clone, PartialEq)]
+struct FitPlan {
+    /// Rings `from ..= to` (as q·L/2π); `None` when the default range is empty.
+    range: Option<(f64, f64)>,
+    /// A clamped --fit-to, or why there is no range.
+    note: Option<String>,
+    /// Where the ends come from, e.g. `the sidecar's roll-off q0 = 6 to Nyquist`.
+    origin: String,
+}
+
 /// The PSD slope is fitted over the rings (bins) `κ = from ..= to`, `κ = round(q·L/2π)`.
 /// By default: from 2, or from the roll-off q0 (the knee, as the paper fits), or from the
 /// first ring wholly above a cut-off q0 (q0 + 1 for a whole q0: the ring at q0 is half
 /// empty); up to the last ring wholly below a short cut-off q1 (q1 − 1), else Nyquist
-/// (`nyquist`, the last ring).
-fn fit_range(args: &StatsArgs, hints: &SidecarHints, nyquist: f64) -> Result<(f64, f64)> {
+/// (`nyquist`, the last ring). A --fit-to beyond Nyquist is clamped to it. A range left
+/// empty by the defaults (a sidecar's roll-off at or above Nyquist, a tiny grid) gives no
+/// fit and a note; one made empty by a given --fit-from or --fit-to is an error naming it.
+fn fit_range(args: &StatsArgs, hints: &SidecarHints, nyquist: f64) -> Result<FitPlan> {
     let user_from = fit_bound("--fit-from", args.fit_from)?;
     let user_to = fit_bound("--fit-to", args.fit_to)?;
-    let from = user_from.unwrap_or(match hints.long_wavelength {
-        Some((true, q0)) => q0.max(2.0),
-        Some((false, q0)) => (q0 + 0.5).ceil().max(2.0),
-        None => 2.0,
-    });
-    let to = user_to.unwrap_or(match hints.short_cutoff {
-        Some(q1) => (q1 - 0.5).floor().min(nyquist),
-        None => nyquist,
-    });
-    if from > to {
-        bail!(
-            "empty PSD fit range: from q·L/2π = {from} to {to}{}",
-            if user_to.is_none() {
-                " (the default upper end; set --fit-to)"
-            } else {
-                ""
-            }
-        );
+    let (default_from, from_why) = match hints.long_wavelength {
+        Some((true, q0)) if q0 > 2.0 => (q0, format!("the sidecar's roll-off q0 = {q0}")),
+        Some((false, q0)) if (q0 + 0.5).ceil() > 2.0 => (
+            (q0 + 0.5).ceil(),
+            format!("the first ring wholly above the sidecar's cut-off q0 = {q0}"),
+        ),
+        _ => (2.0, "the default lower end".to_string()),
+    };
+    let (default_to, to_why) = match hints.short_cutoff {
+        Some(q1) if (q1 - 0.5).floor() < nyquist => (
+            (q1 - 0.5).floor(),
+            format!("the last ring wholly below the sidecar's short cut-off q1 = {q1}"),
+        ),
+        _ => (nyquist, "Nyquist".to_string()),
+    };
+    let mut note = None;
+    let (to, to_given, to_why) = match user_to {
+        Some(t) if t > nyquist => {
+            note = Some(format!(
+                "--fit-to {t} is beyond Nyquist ({nyquist}): clamped to it"
+            ));
+            (
+                nyquist,
+                false,
+                format!("Nyquist; --fit-to {t} clamped to it"),
+            )
+        }
+        Some(t) => (t, true, "--fit-to".to_string()),
+        None => (default_to, false, to_why),
+    };
+    let from = user_from.unwrap_or(default_from);
+    let from_why = if user_from.is_some() {
+        "--fit-from".to_string()
+    } else {
+        from_why
+    };
+    let origin = format!("from {from_why} to {to_why}");
+    if from <= to {
+        return Ok(FitPlan {
+            range: Some((from, to)),
+            note,
+            origin,
+        });
     }
-    Ok((from, to))
+    match (user_from, to_given) {
+        (Some(f), _) => bail!(
+            "invalid --fit-from {f}: the PSD fit range would be empty, its upper end is {to} ({to_why}); give a smaller --fit-from"
+        ),
+        (None, true) => bail!(
+            "invalid --fit-to {to}: the PSD fit range would be empty, its lower end is {from} ({from_why}); give a larger --fit-to or a smaller --fit-from"
+        ),
+        (None, false) => Ok(FitPlan {
+            range: None,
+            note: Some(format!(
+                "no PSD fit: the default range is empty, from {from} ({from_why}) to {to} ({to_why}); set --fit-from and --fit-to"
+            )),
+            origin,
+        }),
+    }
 }
 
 /// The `--plot` chart: the PSD against q·L/2π, log–log, with the fitted power law drawn
@@ -207,6 +262,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
     let staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
     staged.ensure_not_input(&args.file)?;
+    crate::commands::bem::ensure_not_sidecar(&staged, &args.file)?;
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
     // the file, checked from the header before the data are read.
     let shape = read_npy_shape(&args.file)?;
@@ -243,27 +299,30 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         };
     let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
     let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
-    let (from, to) = fit_range(args, &hints, nyquist)?;
-    let (q, c): (Vec<f64>, Vec<f64>) = bins
-        .iter()
-        .filter(|b| (from..=to).contains(&ring(b.q)) && b.psd > 0.0)
-        .map(|b| (b.q, b.psd))
-        .unzip();
-    let fit = power_law_fit(&q, &c).ok();
+    let plan = fit_range(args, &hints, nyquist)?;
+    let fit = plan.range.and_then(|(from, to)| {
+        let (q, c): (Vec<f64>, Vec<f64>) = bins
+            .iter()
+            .filter(|b| (from..=to).contains(&ring(b.q)) && b.psd > 0.0)
+            .map(|b| (b.q, b.psd))
+            .unzip();
+        power_law_fit(&q, &c).ok()
+    });
     // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
     let hurst = fit.map(|f| -(f.exponent + psd_offset) / 2.0);
     let mut staged = staged;
     if let Some(path) = &args.psd {
-        let mut table = Table::new(&["q", "psd"]);
+        let mut table = Table::new(&["q", "psd", "q_l_2pi"]);
         for b in &bins {
-            table.push_numbers(&[b.q, b.psd]);
+            table.push_numbers(&[b.q, b.psd, b.q * size / std::f64::consts::TAU]);
         }
         table
             .stage(&mut staged, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let chart = psd_chart(&args.file, &bins, size, dims.len(), (from, to), fit, hurst);
+        let range = plan.range.unwrap_or((0.0, 0.0));
+        let chart = psd_chart(&args.file, &bins, size, dims.len(), range, fit, hurst);
         stage_charts(&mut staged, path, &[chart])
             .with_context(|| format!("writing {}", path.display()))?;
     }
@@ -272,7 +331,8 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         let value = serde_json::json!({
             "file": args.file, "shape": dims, "size": size, "stats": summary,
             "psd_slope": fit.map(|f| f.exponent), "psd_slope_low": fit.map(|f| f.low),
-            "psd_slope_high": fit.map(|f| f.high), "fit_from": from, "fit_to": to, "hurst_estimate": hurst,
+            "psd_slope_high": fit.map(|f| f.high), "fit_from": plan.range.map(|r| r.0),
+            "fit_to": plan.range.map(|r| r.1), "fit_note": plan.note, "hurst_estimate": hurst,
         });
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
@@ -289,19 +349,30 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         Some(c) => println!("rms_curvature: {}", format_number(c)),
         None => println!("rms_curvature: n/a (grid too small)"),
     }
-    match fit {
-        Some(f) => {
+    match (fit, plan.range) {
+        (Some(f), Some((from, to))) => {
+            let end = match &plan.note {
+                Some(_) => format!(
+                    "{to} (Nyquist; --fit-to {} clamped to it)",
+                    args.fit_to.unwrap_or(to)
+                ),
+                None if to >= nyquist => format!("{to} (Nyquist)"),
+                None => to.to_string(),
+            };
             println!(
-                "psd_slope: {:.4} (95% interval {:.4} .. {:.4}; fit over q·L/2π in [{from}, {}], {} bins)",
-                f.exponent,
-                f.low,
-                f.high,
-                if to >= nyquist { format!("{to} (Nyquist)") } else { to.to_string() },
-                f.points
+                "psd_slope: {:.4} (95% interval {:.4} .. {:.4}; fit over q·L/2π in [{from}, {end}], {} bins)",
+                f.exponent, f.low, f.high, f.points
             );
             println!("hurst_estimate: {:.4}", hurst.unwrap_or(f64::NAN));
         }
-        None => println!("psd_slope: n/a (fewer than 2 bins with power in the fit range)"),
+        (_, None) => println!(
+            "psd_slope: n/a ({})",
+            plan.note.as_deref().unwrap_or("no PSD fit range")
+        ),
+        (None, Some((from, to))) => println!(
+            "psd_slope: n/a (fewer than 2 bins with power in the fit range [{from}, {to}], {})",
+            plan.origin
+        ),
     }
     Ok(())
 }

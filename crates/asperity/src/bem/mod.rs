@@ -26,9 +26,11 @@
 //! points in contact. It is zero exactly when the state solves the problem. The solver stops
 //! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
 
+mod full_contact;
 mod polonsky_keer;
 mod stiffness;
 
+pub use full_contact::FullContactThreshold;
 pub use polonsky_keer::ContactSolver;
 
 use ndarray::Array2;
