@@ -317,3 +317,103 @@ fn toml_study_file_runs() {
         "bad.toml",
     );
 }
+
+#[test]
+fn a_study_refused_for_memory_creates_nothing_and_the_folder_stays_free() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = |n: &'static str| {
+        vec![
+            "study",
+            "alpha",
+            "--method",
+            "bem",
+            "--n",
+            n,
+            "--hurst",
+            "0.5",
+            "--samples",
+            "2",
+            "--quiet",
+            "--out",
+            "D",
+        ]
+    };
+    let out = asperity(&args("100000"), d);
+    refused(&out, "100000x100000");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("MiB"));
+    assert!(!d.join("D").exists(), "nothing created");
+    // The largest N counts, wherever it is in the list.
+    refused(&asperity(&args("32,100000"), d), "memory");
+    assert!(!d.join("D").exists(), "nothing created");
+    ok(&asperity(&args("32"), d));
+    assert!(d.join("D/alpha.csv").exists());
+}
+
+#[test]
+fn a_folder_whose_study_saved_no_sample_is_free() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["study", "alpha", "--method", "mdr", "--n", "256", "--quiet"];
+    ok(&asperity(
+        &[
+            &base[..],
+            &["--hurst", "0.5", "--samples", "3", "--out", "y"],
+        ]
+        .concat(),
+        d,
+    ));
+    // As if that study had stopped before its first checkpoint (and before its outputs).
+    std::fs::remove_dir_all(d.join("y/checkpoint")).unwrap();
+    std::fs::create_dir(d.join("y/checkpoint")).unwrap();
+    for ext in ["csv", "png", "svg"] {
+        std::fs::remove_file(d.join(format!("y/alpha.{ext}"))).unwrap();
+    }
+    ok(&asperity(
+        &[&base[..], &["--hurst", "1", "--samples", "4", "--out", "y"]].concat(),
+        d,
+    ));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("y/study.json")).unwrap()).unwrap();
+    assert_eq!(manifest["spec"]["samples"], 4);
+    assert_eq!(manifest["normalisation"]["rms_height"], 1.0);
+    assert!(d.join("y/alpha.csv").exists());
+}
+
+#[test]
+fn hurst_values_sharing_a_checkpoint_name_or_repeated_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |command: &str, n: &str, hurst: &str| {
+        asperity(
+            &[
+                "study",
+                command,
+                "--method",
+                "mdr",
+                "--n",
+                n,
+                "--hurst",
+                hurst,
+                "--samples",
+                "2",
+                "--quiet",
+                "--out",
+                "c",
+            ],
+            d,
+        )
+    };
+    let out = run("curve", "512", "0.5000001,0.5000002");
+    refused(&out, "0.5000001");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("0.5000002"));
+    refused(
+        &run("alpha", "512", "0.5,0:1:0.5"),
+        "H = 0.5 is given twice",
+    );
+    refused(
+        &run("alpha", "512,256,512", "0.5"),
+        "N = 512 is given twice",
+    );
+    assert!(!d.join("c").exists());
+}

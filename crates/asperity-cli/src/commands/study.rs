@@ -300,8 +300,9 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Validates, checks outputs, opens (or resumes) the study folder and runs every task with
-/// a progress bar. Returns the task results in task order.
+/// Validates (the spec, then whether its largest task fits in memory), checks outputs,
+/// opens (or resumes) the study folder and runs every task with a progress bar. Nothing
+/// is created before every check has passed. Returns the task results in task order.
 pub fn execute(
     spec: &StudySpec,
     dir: &Path,
@@ -314,6 +315,7 @@ pub fn execute(
         checkpoint_every,
     } = options;
     spec.validate()?;
+    spec.ensure_fits()?;
     StudyDir::check(dir, spec, force)?;
     for path in outputs {
         asperity::io::ensure_new_output(path, force)?;
