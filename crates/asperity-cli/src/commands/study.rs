@@ -5,12 +5,13 @@
 //! results. A folder that holds a different study is refused unless `--force`.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    parse_range, run_any_task, FitWindow, Method, StudyDir, StudySpec, TaskResult,
+    parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
     CHECKPOINT_INTERVAL,
 };
 use serde::Deserialize;
@@ -303,6 +304,10 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
 /// Validates (the spec, then whether its largest task fits in memory), checks outputs,
 /// opens (or resumes) the study folder and runs every task with a progress bar. Nothing
 /// is created before every check has passed. Returns the task results in task order.
+///
+/// The progress bar counts samples; its ETA weighs each sample by
+/// [`sample_cost`] and leaves out samples read back from checkpoints (see
+/// [`crate::progress`]).
 pub fn execute(
     spec: &StudySpec,
     dir: &Path,
@@ -322,13 +327,22 @@ pub fn execute(
     }
     let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
     let tasks = spec.tasks();
-    let total = (tasks.len() * spec.samples) as u64;
-    let progress = Progress::new(&format!("{} study", spec.method.name()), total, quiet);
+    let segments: Vec<(u64, f64)> = tasks
+        .iter()
+        .map(|t| (spec.samples as u64, sample_cost(spec.method, t.n)))
+        .collect();
+    let progress = Progress::weighted(&format!("{} study", spec.method.name()), &segments, quiet);
     let mut results = Vec::with_capacity(tasks.len());
     for (i, task) in tasks.iter().enumerate() {
         let offset = (i * spec.samples) as u64;
+        // The first report of a task is what its checkpoint held (run_task's contract).
+        let first = AtomicBool::new(true);
         let result = run_any_task(spec, *task, &store, &|done, _| {
-            progress.set(offset + done as u64)
+            if first.swap(false, Ordering::Relaxed) {
+                progress.restore(offset + done as u64)
+            } else {
+                progress.set(offset + done as u64)
+            }
         })
         .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
         results.push(result);
