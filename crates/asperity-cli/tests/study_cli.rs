@@ -417,3 +417,38 @@ fn hurst_values_sharing_a_checkpoint_name_or_repeated_are_refused() {
     );
     assert!(!d.join("c").exists());
 }
+
+#[test]
+fn curve_accepts_hurst_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(&asperity(
+        &[
+            "study",
+            "curve",
+            "--method",
+            "mdr",
+            "--n",
+            "256",
+            "--hurst",
+            "-1:3:1",
+            "--samples",
+            "3",
+            "--quiet",
+            "--out",
+            "r",
+        ],
+        d,
+    ));
+    let csv = std::fs::read_to_string(d.join("r/curve.csv")).unwrap();
+    let mut hursts: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap())
+        .collect();
+    hursts.dedup();
+    assert_eq!(hursts, ["-1.0", "0.0", "1.0", "2.0", "3.0"]);
+    for ext in ["png", "svg"] {
+        assert!(d.join(format!("r/curve.{ext}")).exists());
+    }
+}

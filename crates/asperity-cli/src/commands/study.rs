@@ -96,7 +96,7 @@ pub struct AlphaArgs {
     /// Grid sizes N (comma-separated).
     #[arg(long, value_delimiter = ',', required = true)]
     pub n: Vec<usize>,
-    /// Hurst exponents: an inclusive range A:B:STEP or one value.
+    /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
     #[command(flatten)]
@@ -107,21 +107,17 @@ pub struct AlphaArgs {
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Example:\n  \
-    asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves"
+    after_help = "Examples:\n  \
+    asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves\n  \
+    asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves"
 )]
 pub struct CurveArgs {
     /// Grid size N.
     #[arg(long)]
     pub n: usize,
-    /// Hurst exponents (comma-separated).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        required = true,
-        allow_hyphen_values = true
-    )]
-    pub hurst: Vec<f64>,
+    /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
+    #[arg(long, allow_hyphen_values = true)]
+    pub hurst: String,
     #[command(flatten)]
     pub common: CommonArgs,
 }
@@ -249,7 +245,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = spec_from(&c.common, vec![c.n], c.hurst.clone());
+            let spec = spec_from(&c.common, vec![c.n], parse_range(&c.hurst)?);
             (
                 Kind::Curve,
                 spec,
