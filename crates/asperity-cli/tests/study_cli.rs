@@ -452,3 +452,42 @@ fn curve_accepts_hurst_ranges() {
         assert!(d.join(format!("r/curve.{ext}")).exists());
     }
 }
+
+#[test]
+fn the_example_study_file_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/sweep.toml");
+    ok(&asperity(
+        &[
+            "study",
+            "file",
+            example.to_str().unwrap(),
+            "--out",
+            "sweep",
+            "--quiet",
+        ],
+        d,
+    ));
+    let csv = std::fs::read_to_string(d.join("sweep/alpha.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2 * 17, "2 sizes x 17 H");
+    // Single values for n and hurst; errors name line, column and key.
+    std::fs::write(
+        d.join("one.toml"),
+        "kind = \"curve\"\nmethod = \"mdr\"\nn = 256\nhurst = 0.5\nsamples = 2\n",
+    )
+    .unwrap();
+    ok(&asperity(
+        &["study", "file", "one.toml", "--out", "one", "--quiet"],
+        d,
+    ));
+    std::fs::write(
+        d.join("bad.toml"),
+        "kind = \"curve\"\nmethod = \"mdr\"\nn = 256\nhurst = \"x\"\nsamples = 2\n",
+    )
+    .unwrap();
+    refused(
+        &asperity(&["study", "file", "bad.toml", "--out", "bad"], d),
+        "bad.toml, line 4, column 9 (key `hurst`)",
+    );
+}

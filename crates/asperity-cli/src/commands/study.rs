@@ -14,6 +14,7 @@ use asperity::study::{
     parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
     CHECKPOINT_INTERVAL,
 };
+use serde::de::{self, Visitor};
 use serde::Deserialize;
 
 use crate::output::{format_number, Table};
@@ -122,16 +123,98 @@ pub struct CurveArgs {
     pub common: CommonArgs,
 }
 
+/// The keys of a study file: `(key, type, default, meaning)`, for `--help` and the README.
+pub const FILE_KEYS: [(&str, &str, &str, &str); 10] = [
+    (
+        "kind",
+        "\"alpha\" or \"curve\"",
+        "required",
+        "what to write: alpha.csv or curve.csv, with plots",
+    ),
+    ("method", "\"mdr\" or \"bem\"", "required", "solver"),
+    (
+        "n",
+        "integer or list of integers",
+        "required",
+        "grid sizes N",
+    ),
+    (
+        "hurst",
+        "number, \"A:B:STEP\" string or list of both",
+        "required",
+        "Hurst exponents (ranges inclusive)",
+    ),
+    (
+        "samples",
+        "integer >= 1",
+        "required",
+        "realisations per (N, H)",
+    ),
+    (
+        "rolloff",
+        "number > 0",
+        "none (pure power law)",
+        "long-wavelength roll-off q0*L/2pi",
+    ),
+    ("seed", "integer >= 0", "1", "study seed"),
+    (
+        "min_contacts",
+        "integer >= 1",
+        "8",
+        "alpha window: fewest points in contact",
+    ),
+    (
+        "max_fraction",
+        "number in (0, 1]",
+        "0.01",
+        "alpha window: largest contact fraction",
+    ),
+    (
+        "levels",
+        "integer >= 3",
+        "48",
+        "common force levels of the ensemble curves",
+    ),
+];
+
+/// `--help` of `study file`: the keys (from [`FILE_KEYS`]) and an example.
+fn file_help() -> String {
+    let mut text = String::from("Keys of a study file (TOML); other keys are refused:\n");
+    let width = |i: usize| {
+        FILE_KEYS
+            .iter()
+            .map(|k| [k.0, k.1, k.2][i].len())
+            .max()
+            .unwrap_or(0)
+    };
+    let (w0, w1, w2) = (width(0), width(1), width(2));
+    text.push_str(&format!(
+        "  {:w0$}  {:w1$}  {:w2$}  meaning\n",
+        "key", "type", "default"
+    ));
+    for (key, kind, default, meaning) in FILE_KEYS {
+        text.push_str(&format!(
+            "  {key:w0$}  {kind:w1$}  {default:w2$}  {meaning}\n"
+        ));
+    }
+    text.push_str(
+        "The keys mean what the options of study alpha / study curve mean (see their --help \
+         for the outputs and the scales).\n\n\
+         Example (docs/sweep.toml):\n",
+    );
+    for line in SWEEP_EXAMPLE.lines() {
+        text.push_str(&format!("  {line}\n"));
+    }
+    text.push_str("\nRun: asperity study file docs/sweep.toml --out sweep");
+    text
+}
+
+/// The example study file shipped as `docs/sweep.toml`.
+const SWEEP_EXAMPLE: &str = include_str!("../../../../docs/sweep.toml");
+
 /// Arguments of `asperity study file`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example study file (study.toml):\n  \
-    kind = \"alpha\"          # or \"curve\"\n  \
-    method = \"mdr\"\n  \
-    n = [512, 2048, 32768]\n  \
-    hurst = \"-1:3:0.25\"     # or a list [0.5, 0.8]\n  \
-    samples = 500\n  \
-    seed = 1                # optional; also rolloff, min_contacts, max_fraction, levels\n\n\
-    Run: asperity study file study.toml --out sweep")]
+#[command(after_help = file_help())]
 pub struct FileArgs {
     /// A TOML study file.
     pub file: PathBuf,
@@ -168,11 +251,101 @@ pub enum Kind {
     Curve,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-enum HurstSpec {
-    Range(String),
-    List(Vec<f64>),
+/// `n` of a study file: one size or a list.
+#[derive(Debug)]
+struct Sizes(Vec<usize>);
+
+impl<'de> Deserialize<'de> for Sizes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> Visitor<'de> for Visit {
+            type Value = Sizes;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a grid size (e.g. 512) or a list of sizes (e.g. [512, 2048])")
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> std::result::Result<Sizes, E> {
+                usize::try_from(v)
+                    .map(|n| Sizes(vec![n]))
+                    .map_err(|_| E::invalid_value(de::Unexpected::Unsigned(v), &self))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> std::result::Result<Sizes, E> {
+                usize::try_from(v)
+                    .map(|n| Sizes(vec![n]))
+                    .map_err(|_| E::invalid_value(de::Unexpected::Signed(v), &self))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<Sizes, A::Error> {
+                let mut sizes = Vec::new();
+                while let Some(n) = seq.next_element::<usize>()? {
+                    sizes.push(n);
+                }
+                Ok(Sizes(sizes))
+            }
+        }
+        d.deserialize_any(Visit)
+    }
+}
+
+/// `hurst` of a study file: a number, a range string (`"A:B:STEP"`, or anything
+/// [`parse_range`] reads), or a list of numbers and range strings.
+#[derive(Debug)]
+struct Hursts(Vec<f64>);
+
+struct HurstVisit {
+    list: bool,
+}
+
+impl<'de> Visitor<'de> for HurstVisit {
+    type Value = Hursts;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        if self.list {
+            f.write_str(
+                "a Hurst exponent (e.g. 0.5), a range \"A:B:STEP\" or a list of them \
+                 (e.g. [0.5, \"1:2:0.5\"])",
+            )
+        } else {
+            f.write_str("a Hurst exponent or a range \"A:B:STEP\" in a list")
+        }
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v]))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v as f64]))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v as f64]))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> std::result::Result<Hursts, E> {
+        parse_range(v).map(Hursts).map_err(E::custom)
+    }
+    fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Hursts, A::Error> {
+        if !self.list {
+            return Err(de::Error::invalid_type(de::Unexpected::Seq, &self));
+        }
+        let mut values = Vec::new();
+        while let Some(item) = seq.next_element::<HurstItem>()? {
+            values.extend(item.0 .0);
+        }
+        Ok(Hursts(values))
+    }
+}
+
+impl<'de> Deserialize<'de> for Hursts {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(HurstVisit { list: true })
+    }
+}
+
+/// One item of a `hurst` list: a number or a range string.
+struct HurstItem(Hursts);
+
+impl<'de> Deserialize<'de> for HurstItem {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(HurstVisit { list: false }).map(HurstItem)
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -180,14 +353,71 @@ enum HurstSpec {
 struct StudyFile {
     kind: Kind,
     method: MethodArg,
-    n: Vec<usize>,
-    hurst: HurstSpec,
+    n: Sizes,
+    hurst: Hursts,
     samples: usize,
     rolloff: Option<f64>,
     seed: Option<u64>,
     min_contacts: Option<usize>,
     max_fraction: Option<f64>,
     levels: Option<usize>,
+}
+
+/// Default number of common force levels.
+const LEVELS: usize = 48;
+
+/// Reads a study file's text: the kind and the spec (not yet validated). Errors name the
+/// file, the line and column, and the key concerned, in one line.
+fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
+    let file: StudyFile =
+        toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", toml_error(path, text, &e)))?;
+    let window = FitWindow::default();
+    let spec = StudySpec {
+        method: file.method.into(),
+        sizes: file.n.0,
+        hursts: file.hurst.0,
+        samples: file.samples,
+        rolloff: file.rolloff,
+        seed: file.seed.unwrap_or(1),
+        window: FitWindow {
+            min_contacts: file.min_contacts.unwrap_or(window.min_contacts),
+            max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
+        },
+        levels: file.levels.unwrap_or(LEVELS),
+    };
+    Ok((file.kind, spec))
+}
+
+/// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on
+/// the line the error points at; line and column are left out where toml gives no span.
+fn toml_error(path: &Path, text: &str, error: &toml::de::Error) -> String {
+    let message = error.message().trim().replace('\n', " ");
+    // A missing key is reported at the start of its table: a place that means nothing.
+    let Some(span) = error
+        .span()
+        .filter(|s| s.start < text.len().max(1) && !message.starts_with("missing field"))
+    else {
+        return format!("{}: {message}", path.display());
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before[line_start..].chars().count() + 1;
+    let line_text = text[line_start..].lines().next().unwrap_or("");
+    let key = line_text
+        .split_once('=')
+        .map(|(k, _)| k.trim().trim_matches('"'))
+        .filter(|k| !k.is_empty() && !k.starts_with('#') && !k.starts_with('['));
+    match key {
+        Some(key) if !message.contains(&format!("`{key}`")) => format!(
+            "{}, line {line}, column {column} (key `{key}`): {message}",
+            path.display()
+        ),
+        _ => format!(
+            "{}, line {line}, column {column}: {message}",
+            path.display()
+        ),
+    }
 }
 
 fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudySpec {
@@ -256,26 +486,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         StudyCommand::File(f) => {
             let text = std::fs::read_to_string(&f.file)
                 .with_context(|| format!("reading {}", f.file.display()))?;
-            let file: StudyFile = toml::from_str(&text)
-                .map_err(|e| anyhow::anyhow!("{}: {}", f.file.display(), e.message()))?;
-            let window = FitWindow::default();
-            let spec = StudySpec {
-                method: file.method.into(),
-                sizes: file.n,
-                hursts: match file.hurst {
-                    HurstSpec::Range(r) => parse_range(&r)?,
-                    HurstSpec::List(l) => l,
-                },
-                samples: file.samples,
-                rolloff: file.rolloff,
-                seed: file.seed.unwrap_or(1),
-                window: FitWindow {
-                    min_contacts: file.min_contacts.unwrap_or(window.min_contacts),
-                    max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
-                },
-                levels: file.levels.unwrap_or(48),
-            };
-            (file.kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
+            let (kind, spec) = parse_study_file(&f.file, &text)?;
+            (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
     let results = execute(&spec, out, options, &outputs(kind, out))?;
@@ -527,5 +739,90 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
         log_x: true,
         log_y: true,
         series,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn study_files_take_single_values_and_lists() {
+        let parse = |text: &str| parse_study_file(Path::new("s.toml"), text);
+        let base = "kind = \"curve\"\nmethod = \"mdr\"\nsamples = 3\n";
+        let (kind, spec) = parse(&format!("{base}n = 512\nhurst = 0.5\n")).unwrap();
+        assert_eq!(kind, Kind::Curve);
+        assert_eq!((spec.sizes, spec.hursts), (vec![512], vec![0.5]));
+        let (_, spec) = parse(&format!("{base}n = [512, 1024]\nhurst = 1\n")).unwrap();
+        assert_eq!((spec.sizes, spec.hursts), (vec![512, 1024], vec![1.0]));
+        let (_, spec) = parse(&format!("{base}n = 64\nhurst = \"-1:0:0.5\"\n")).unwrap();
+        assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0]);
+        let (_, spec) = parse(&format!("{base}n = 64\nhurst = [\"-1:0:0.5\", 2, 2.5]\n")).unwrap();
+        assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0, 2.0, 2.5]);
+        assert_eq!(spec.seed, 1);
+        assert_eq!(spec.levels, 48);
+        assert_eq!(spec.window, FitWindow::default());
+    }
+
+    #[test]
+    fn study_file_errors_name_the_line_column_and_key() {
+        let parse = |text: &str| {
+            parse_study_file(Path::new("s.toml"), text)
+                .unwrap_err()
+                .to_string()
+        };
+        let err =
+            parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = \"512\"\nhurst = 0.5\nsamples = 3\n");
+        assert!(
+            err.starts_with("s.toml, line 3, column 5 (key `n`): "),
+            "{err}"
+        );
+        assert!(err.contains("grid size"), "{err}");
+        assert!(!err.contains('\n'), "{err}");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = true\nsamples = 3\n");
+        assert!(err.contains("line 4") && err.contains("`hurst`"), "{err}");
+        let err =
+            parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = \"1:0:1\"\nsamples = 3\n");
+        assert!(
+            err.contains("line 4") && err.contains("empty range"),
+            "{err}"
+        );
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = 0.5\nsampels = 3\n");
+        assert!(err.contains("line 5") && err.contains("sampels"), "{err}");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = 0.5\n");
+        assert_eq!(err, "s.toml: missing field `samples`");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = [64\n");
+        assert!(err.contains("line 3") || err.contains("line 4"), "{err}");
+    }
+
+    #[test]
+    fn the_example_file_parses_and_help_and_readme_list_every_key() {
+        let (kind, spec) = parse_study_file(Path::new("docs/sweep.toml"), SWEEP_EXAMPLE).unwrap();
+        assert_eq!(kind, Kind::Alpha);
+        spec.validate().unwrap();
+        let help = file_help();
+        let readme = include_str!("../../../../README.md");
+        for (key, kind, default, _) in FILE_KEYS {
+            let row = help
+                .lines()
+                .find(|l| l.trim_start().starts_with(&format!("{key} ")))
+                .unwrap_or_else(|| panic!("{key} missing from --help"));
+            assert!(row.contains(kind) && row.contains(default), "{row}");
+            let row = readme
+                .lines()
+                .find(|l| l.starts_with(&format!("| `{key}` |")))
+                .unwrap_or_else(|| panic!("{key} missing from README's table"));
+            assert!(row.contains(default), "README: {row}");
+        }
+        // Every key the parser knows is in the table: an unknown key's error lists them.
+        let err = parse_study_file(Path::new("s.toml"), "nokey = 1\n")
+            .unwrap_err()
+            .to_string();
+        let listed = err.split("expected one of").nth(1).unwrap_or_default();
+        let known: Vec<&str> = listed.split('`').skip(1).step_by(2).collect();
+        assert_eq!(known.len(), FILE_KEYS.len(), "{err}");
+        for key in known {
+            assert!(FILE_KEYS.iter().any(|k| k.0 == key), "{key} not documented");
+        }
     }
 }
