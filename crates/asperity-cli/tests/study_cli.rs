@@ -454,6 +454,42 @@ fn curve_accepts_hurst_ranges() {
 }
 
 #[test]
+fn help_explains_intervals_and_scales() {
+    let dir = tempfile::tempdir().unwrap();
+    for command in ["alpha", "curve"] {
+        let out = asperity(&["study", command, "--help"], dir.path());
+        ok(&out);
+        let help = String::from_utf8_lossy(&out.stdout);
+        for needle in [
+            "unit rms height",
+            "unit rms slope",
+            "free boundaries",
+            "A:B:STEP",
+        ] {
+            assert!(help.contains(needle), "{command}: no '{needle}' in {help}");
+        }
+    }
+    let out = asperity(&["study", "curve", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        help.contains("95 % confidence interval of that mean"),
+        "{help}"
+    );
+    let out = asperity(&["study", "file", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&out.stdout);
+    for key in [
+        "kind",
+        "method",
+        "rolloff",
+        "min_contacts",
+        "max_fraction",
+        "levels",
+    ] {
+        assert!(help.contains(key), "{key}");
+    }
+}
+
+#[test]
 fn the_example_study_file_runs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -11,8 +11,8 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
-    CHECKPOINT_INTERVAL,
+    parse_range, run_any_task, sample_cost, EnsemblePoint, FitWindow, Method, StudyDir, StudySpec,
+    TaskResult, CHECKPOINT_INTERVAL,
 };
 use serde::de::{self, Visitor};
 use serde::Deserialize;
@@ -85,13 +85,42 @@ pub struct RunArgs {
     pub checkpoint_every: f64,
 }
 
+/// What `--help` of `study alpha` and `study curve` says about H values and scales (a macro,
+/// so that `concat!` can join it into the help texts).
+macro_rules! scales_help {
+    () => {
+        "\
+Hurst exponents: comma-separated values and inclusive ranges A:B:STEP, e.g. -1:3:0.25 or
+-1:0:0.5,0.8,2:3:1. Each N may be given once, and H values must be at least 1e-6 apart
+(checkpoints are named by H to 6 decimals).
+
+Scales (also in DIR/study.json, \"normalisation\"): MDR lines have unit rms height, L = 1,
+E* = 1 and linear springs at spacing dx = L/N; BEM surfaces have unit rms slope, L = 1,
+E* = 1 and free boundaries. Forces and stiffnesses of the two methods are therefore on
+different scales; compare exponents, not values.
+
+The folder also holds the checkpoint: run the same command again to resume."
+    };
+}
+
 /// Arguments of `asperity study alpha`.
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Examples:\n  \
-    asperity study alpha --method mdr --n 512,2048 --hurst -1:3:0.25 --samples 100 --out alpha\n  \
-    asperity study alpha --method bem --n 64 --hurst 0.5 --samples 20 --out alpha-bem"
+    after_help = concat!("\
+Output: DIR/alpha.csv, one row per (N, H): method, n, hurst, alpha, alpha_low, alpha_high,
+samples, then alpha_fit_low, alpha_fit_high, alpha_sample_mean, samples_fitted,
+alpha_theory; and the plot DIR/alpha.png, DIR/alpha.svg.
+  alpha                        alpha fitted on the ensemble-mean curve k(F)
+  alpha_fit_low/alpha_fit_high 95 % interval of that fit
+  alpha_low/alpha_high         2.5 % and 97.5 % quantiles of the per-sample alpha: the
+                               spread over samples, not an interval of the mean
+
+", scales_help!(), "
+
+Examples:
+  asperity study alpha --method mdr --n 512,2048 --hurst -1:3:0.25 --samples 100 --out alpha
+  asperity study alpha --method bem --n 64 --hurst 0.5 --samples 20 --out alpha-bem")
 )]
 pub struct AlphaArgs {
     /// Grid sizes N (comma-separated).
@@ -108,9 +137,21 @@ pub struct AlphaArgs {
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Examples:\n  \
-    asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves\n  \
-    asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves"
+    after_help = concat!("\
+Output: DIR/curve.csv, one row per (H, force level): method, n, hurst, force, stiffness,
+stiffness_low, stiffness_high, samples, area_fraction; and the plot DIR/curve.png,
+DIR/curve.svg (log-log, dashed: the interval).
+  stiffness                     mean stiffness over samples at that force
+  stiffness_low/stiffness_high  95 % confidence interval of that mean (Student t over the
+                                samples), unlike alpha_low/alpha_high of study alpha, which
+                                are the 2.5-97.5 % spread over samples
+  area_fraction                 mean contact fraction at that force
+
+", scales_help!(), "
+
+Examples:
+  asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves
+  asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves")
 )]
 pub struct CurveArgs {
     /// Grid size N.
@@ -704,37 +745,63 @@ pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str)
     )
 }
 
-/// Log–log k(F), one series per task, coloured by H.
+/// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
+/// dashed in the same colour. Interval ends that are not positive (a wide interval at few
+/// samples) cannot sit on a log axis: they are left out, not clamped, and the dashed line
+/// is broken there rather than drawn across the gap.
 pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     let (hmin, hmax) = results
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
             (a.min(r.task.hurst), b.max(r.task.hurst))
         });
-    let series = results
-        .iter()
-        .map(|r| {
-            let t = if hmax > hmin {
-                (r.task.hurst - hmin) / (hmax - hmin)
-            } else {
-                0.5
-            };
-            let points = r
-                .mean_curve
-                .iter()
-                .map(|p| (p.force, p.stiffness))
-                .collect();
+    let mut series = Vec::new();
+    for r in results {
+        let t = if hmax > hmin {
+            (r.task.hurst - hmin) / (hmax - hmin)
+        } else {
+            0.5
+        };
+        let color = ordered_color(t * 0.9);
+        let points = r
+            .mean_curve
+            .iter()
+            .map(|p| (p.force, p.stiffness))
+            .collect();
+        series.push(
             Series::new(
                 format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
                 points,
                 Style::Line,
             )
-            .color(ordered_color(t * 0.9))
-        })
-        .collect();
+            .color(color),
+        );
+        if r.samples > 1 {
+            let ends: [fn(&EnsemblePoint) -> f64; 2] = [|p| p.stiffness_low, |p| p.stiffness_high];
+            for end in ends {
+                // Runs of drawable points; a gap is left open, not bridged.
+                let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+                for p in &r.mean_curve {
+                    let (f, k) = (p.force, end(p));
+                    if f > 0.0 && k > 0.0 && k.is_finite() {
+                        runs.last_mut().expect("one run").push((f, k));
+                    } else if !runs.last().expect("one run").is_empty() {
+                        runs.push(Vec::new());
+                    }
+                }
+                for run in runs.into_iter().filter(|run| run.len() >= 2) {
+                    series.push(Series::new("", run, Style::Dashed).color(color));
+                }
+            }
+        }
+    }
+    let scale = match results.first().map(|r| r.method) {
+        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
+        _ => "L = 1, E* = 1, unit rms height",
+    };
     Chart {
         title: title.into(),
-        x_label: "normal force F (E* = 1, unit rms)".into(),
+        x_label: format!("normal force F ({scale})"),
         y_label: "contact stiffness k".into(),
         log_x: true,
         log_y: true,
@@ -745,6 +812,44 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use asperity::study::Task;
+
+    fn result(lows: &[f64]) -> TaskResult {
+        let point = |i: usize, &low: &f64| EnsemblePoint {
+            force: (i + 1) as f64,
+            stiffness: 1.0,
+            stiffness_low: low,
+            stiffness_high: 2.0,
+            fraction: 0.1,
+            samples: 3,
+        };
+        TaskResult {
+            method: Method::Mdr,
+            task: Task { n: 64, hurst: 0.5 },
+            samples: 3,
+            mean_curve: lows.iter().enumerate().map(|(i, l)| point(i, l)).collect(),
+            alpha_ensemble: None,
+            alpha_samples: vec![],
+        }
+    }
+
+    #[test]
+    fn curve_plots_leave_out_non_positive_interval_ends() {
+        let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
+        let points = |i: usize| chart.series[i].points.clone();
+        assert_eq!(chart.series.len(), 4, "mean, low in two pieces, high");
+        assert_eq!(points(1), vec![(1.0, 0.5), (2.0, 0.6)]);
+        assert_eq!(points(2), vec![(5.0, 0.7), (6.0, 0.8)]);
+        assert_eq!(points(3).len(), 6, "the high end");
+        assert!(chart.series[1..].iter().all(|s| s.label.is_empty()));
+        // A lone positive point between gaps draws nothing; all positive: one line.
+        assert_eq!(
+            curve_chart(&[result(&[-1.0, 0.5, -1.0])], "t").series.len(),
+            2
+        );
+        let whole = curve_chart(&[result(&[0.1, 0.2, 0.3])], "t");
+        assert_eq!(whole.series[1].points.len(), 3);
+    }
 
     #[test]
     fn study_files_take_single_values_and_lists() {
