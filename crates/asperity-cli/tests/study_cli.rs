@@ -317,3 +317,213 @@ fn toml_study_file_runs() {
         "bad.toml",
     );
 }
+
+#[test]
+fn a_study_refused_for_memory_creates_nothing_and_the_folder_stays_free() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = |n: &'static str| {
+        vec![
+            "study",
+            "alpha",
+            "--method",
+            "bem",
+            "--n",
+            n,
+            "--hurst",
+            "0.5",
+            "--samples",
+            "2",
+            "--quiet",
+            "--out",
+            "D",
+        ]
+    };
+    let out = asperity(&args("100000"), d);
+    refused(&out, "100000x100000");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("MiB"));
+    assert!(!d.join("D").exists(), "nothing created");
+    // The largest N counts, wherever it is in the list.
+    refused(&asperity(&args("32,100000"), d), "memory");
+    assert!(!d.join("D").exists(), "nothing created");
+    ok(&asperity(&args("32"), d));
+    assert!(d.join("D/alpha.csv").exists());
+}
+
+#[test]
+fn a_folder_whose_study_saved_no_sample_is_free() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["study", "alpha", "--method", "mdr", "--n", "256", "--quiet"];
+    ok(&asperity(
+        &[
+            &base[..],
+            &["--hurst", "0.5", "--samples", "3", "--out", "y"],
+        ]
+        .concat(),
+        d,
+    ));
+    // As if that study had stopped before its first checkpoint (and before its outputs).
+    std::fs::remove_dir_all(d.join("y/checkpoint")).unwrap();
+    std::fs::create_dir(d.join("y/checkpoint")).unwrap();
+    for ext in ["csv", "png", "svg"] {
+        std::fs::remove_file(d.join(format!("y/alpha.{ext}"))).unwrap();
+    }
+    ok(&asperity(
+        &[&base[..], &["--hurst", "1", "--samples", "4", "--out", "y"]].concat(),
+        d,
+    ));
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("y/study.json")).unwrap()).unwrap();
+    assert_eq!(manifest["spec"]["samples"], 4);
+    assert_eq!(manifest["normalisation"]["rms_height"], 1.0);
+    assert!(d.join("y/alpha.csv").exists());
+}
+
+#[test]
+fn hurst_values_sharing_a_checkpoint_name_or_repeated_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |command: &str, n: &str, hurst: &str| {
+        asperity(
+            &[
+                "study",
+                command,
+                "--method",
+                "mdr",
+                "--n",
+                n,
+                "--hurst",
+                hurst,
+                "--samples",
+                "2",
+                "--quiet",
+                "--out",
+                "c",
+            ],
+            d,
+        )
+    };
+    let out = run("curve", "512", "0.5000001,0.5000002");
+    refused(&out, "0.5000001");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("0.5000002"));
+    refused(
+        &run("alpha", "512", "0.5,0:1:0.5"),
+        "H = 0.5 is given twice",
+    );
+    refused(
+        &run("alpha", "512,256,512", "0.5"),
+        "N = 512 is given twice",
+    );
+    assert!(!d.join("c").exists());
+}
+
+#[test]
+fn curve_accepts_hurst_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(&asperity(
+        &[
+            "study",
+            "curve",
+            "--method",
+            "mdr",
+            "--n",
+            "256",
+            "--hurst",
+            "-1:3:1",
+            "--samples",
+            "3",
+            "--quiet",
+            "--out",
+            "r",
+        ],
+        d,
+    ));
+    let csv = std::fs::read_to_string(d.join("r/curve.csv")).unwrap();
+    let mut hursts: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap())
+        .collect();
+    hursts.dedup();
+    assert_eq!(hursts, ["-1.0", "0.0", "1.0", "2.0", "3.0"]);
+    for ext in ["png", "svg"] {
+        assert!(d.join(format!("r/curve.{ext}")).exists());
+    }
+}
+
+#[test]
+fn help_explains_intervals_and_scales() {
+    let dir = tempfile::tempdir().unwrap();
+    for command in ["alpha", "curve"] {
+        let out = asperity(&["study", command, "--help"], dir.path());
+        ok(&out);
+        let help = String::from_utf8_lossy(&out.stdout);
+        for needle in [
+            "unit rms height",
+            "unit rms slope",
+            "free boundaries",
+            "A:B:STEP",
+        ] {
+            assert!(help.contains(needle), "{command}: no '{needle}' in {help}");
+        }
+    }
+    let out = asperity(&["study", "curve", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        help.contains("95 % confidence interval of that mean"),
+        "{help}"
+    );
+    let out = asperity(&["study", "file", "--help"], dir.path());
+    let help = String::from_utf8_lossy(&out.stdout);
+    for key in [
+        "kind",
+        "method",
+        "rolloff",
+        "min_contacts",
+        "max_fraction",
+        "levels",
+    ] {
+        assert!(help.contains(key), "{key}");
+    }
+}
+
+#[test]
+fn the_example_study_file_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/sweep.toml");
+    ok(&asperity(
+        &[
+            "study",
+            "file",
+            example.to_str().unwrap(),
+            "--out",
+            "sweep",
+            "--quiet",
+        ],
+        d,
+    ));
+    let csv = std::fs::read_to_string(d.join("sweep/alpha.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2 * 17, "2 sizes x 17 H");
+    // Single values for n and hurst; errors name line, column and key.
+    std::fs::write(
+        d.join("one.toml"),
+        "kind = \"curve\"\nmethod = \"mdr\"\nn = 256\nhurst = 0.5\nsamples = 2\n",
+    )
+    .unwrap();
+    ok(&asperity(
+        &["study", "file", "one.toml", "--out", "one", "--quiet"],
+        d,
+    ));
+    std::fs::write(
+        d.join("bad.toml"),
+        "kind = \"curve\"\nmethod = \"mdr\"\nn = 256\nhurst = \"x\"\nsamples = 2\n",
+    )
+    .unwrap();
+    refused(
+        &asperity(&["study", "file", "bad.toml", "--out", "bad"], d),
+        "bad.toml, line 4, column 9 (key `hurst`)",
+    );
+}

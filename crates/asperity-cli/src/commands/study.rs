@@ -5,14 +5,16 @@
 //! results. A folder that holds a different study is refused unless `--force`.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    parse_range, run_any_task, FitWindow, Method, StudyDir, StudySpec, TaskResult,
-    CHECKPOINT_INTERVAL,
+    parse_range, run_any_task, sample_cost, EnsemblePoint, FitWindow, Method, StudyDir, StudySpec,
+    TaskResult, CHECKPOINT_INTERVAL,
 };
+use serde::de::{self, Visitor};
 use serde::Deserialize;
 
 use crate::output::{format_number, Table};
@@ -83,19 +85,48 @@ pub struct RunArgs {
     pub checkpoint_every: f64,
 }
 
+/// What `--help` of `study alpha` and `study curve` says about H values and scales (a macro,
+/// so that `concat!` can join it into the help texts).
+macro_rules! scales_help {
+    () => {
+        "\
+Hurst exponents: comma-separated values and inclusive ranges A:B:STEP, e.g. -1:3:0.25 or
+-1:0:0.5,0.8,2:3:1. Each N may be given once, and H values must be at least 1e-6 apart
+(checkpoints are named by H to 6 decimals).
+
+Scales (also in DIR/study.json, \"normalisation\"): MDR lines have unit rms height, L = 1,
+E* = 1 and linear springs at spacing dx = L/N; BEM surfaces have unit rms slope, L = 1,
+E* = 1 and free boundaries. Forces and stiffnesses of the two methods are therefore on
+different scales; compare exponents, not values.
+
+The folder also holds the checkpoint: run the same command again to resume."
+    };
+}
+
 /// Arguments of `asperity study alpha`.
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Examples:\n  \
-    asperity study alpha --method mdr --n 512,2048 --hurst -1:3:0.25 --samples 100 --out alpha\n  \
-    asperity study alpha --method bem --n 64 --hurst 0.5 --samples 20 --out alpha-bem"
+    after_help = concat!("\
+Output: DIR/alpha.csv, one row per (N, H): method, n, hurst, alpha, alpha_low, alpha_high,
+samples, then alpha_fit_low, alpha_fit_high, alpha_sample_mean, samples_fitted,
+alpha_theory; and the plot DIR/alpha.png, DIR/alpha.svg.
+  alpha                        alpha fitted on the ensemble-mean curve k(F)
+  alpha_fit_low/alpha_fit_high 95 % interval of that fit
+  alpha_low/alpha_high         2.5 % and 97.5 % quantiles of the per-sample alpha: the
+                               spread over samples, not an interval of the mean
+
+", scales_help!(), "
+
+Examples:
+  asperity study alpha --method mdr --n 512,2048 --hurst -1:3:0.25 --samples 100 --out alpha
+  asperity study alpha --method bem --n 64 --hurst 0.5 --samples 20 --out alpha-bem")
 )]
 pub struct AlphaArgs {
     /// Grid sizes N (comma-separated).
     #[arg(long, value_delimiter = ',', required = true)]
     pub n: Vec<usize>,
-    /// Hurst exponents: an inclusive range A:B:STEP or one value.
+    /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
     #[command(flatten)]
@@ -106,35 +137,125 @@ pub struct AlphaArgs {
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
-    after_help = "Example:\n  \
-    asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves"
+    after_help = concat!("\
+Output: DIR/curve.csv, one row per (H, force level): method, n, hurst, force, stiffness,
+stiffness_low, stiffness_high, samples, area_fraction; and the plot DIR/curve.png,
+DIR/curve.svg (log-log, dashed: the interval).
+  stiffness                     mean stiffness over samples at that force
+  stiffness_low/stiffness_high  95 % confidence interval of that mean (Student t over the
+                                samples), unlike alpha_low/alpha_high of study alpha, which
+                                are the 2.5-97.5 % spread over samples
+  area_fraction                 mean contact fraction at that force
+
+", scales_help!(), "
+
+Examples:
+  asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves
+  asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves")
 )]
 pub struct CurveArgs {
     /// Grid size N.
     #[arg(long)]
     pub n: usize,
-    /// Hurst exponents (comma-separated).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        required = true,
-        allow_hyphen_values = true
-    )]
-    pub hurst: Vec<f64>,
+    /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
+    #[arg(long, allow_hyphen_values = true)]
+    pub hurst: String,
     #[command(flatten)]
     pub common: CommonArgs,
 }
 
+/// The keys of a study file: `(key, type, default, meaning)`, for `--help` and the README.
+pub const FILE_KEYS: [(&str, &str, &str, &str); 10] = [
+    (
+        "kind",
+        "\"alpha\" or \"curve\"",
+        "required",
+        "what to write: alpha.csv or curve.csv, with plots",
+    ),
+    ("method", "\"mdr\" or \"bem\"", "required", "solver"),
+    (
+        "n",
+        "integer or list of integers",
+        "required",
+        "grid sizes N",
+    ),
+    (
+        "hurst",
+        "number, \"A:B:STEP\" string or list of both",
+        "required",
+        "Hurst exponents (ranges inclusive)",
+    ),
+    (
+        "samples",
+        "integer >= 1",
+        "required",
+        "realisations per (N, H)",
+    ),
+    (
+        "rolloff",
+        "number > 0",
+        "none (pure power law)",
+        "long-wavelength roll-off q0*L/2pi",
+    ),
+    ("seed", "integer >= 0", "1", "study seed"),
+    (
+        "min_contacts",
+        "integer >= 1",
+        "8",
+        "alpha window: fewest points in contact",
+    ),
+    (
+        "max_fraction",
+        "number in (0, 1]",
+        "0.01",
+        "alpha window: largest contact fraction",
+    ),
+    (
+        "levels",
+        "integer >= 3",
+        "48",
+        "common force levels of the ensemble curves",
+    ),
+];
+
+/// `--help` of `study file`: the keys (from [`FILE_KEYS`]) and an example.
+fn file_help() -> String {
+    let mut text = String::from("Keys of a study file (TOML); other keys are refused:\n");
+    let width = |i: usize| {
+        FILE_KEYS
+            .iter()
+            .map(|k| [k.0, k.1, k.2][i].len())
+            .max()
+            .unwrap_or(0)
+    };
+    let (w0, w1, w2) = (width(0), width(1), width(2));
+    text.push_str(&format!(
+        "  {:w0$}  {:w1$}  {:w2$}  meaning\n",
+        "key", "type", "default"
+    ));
+    for (key, kind, default, meaning) in FILE_KEYS {
+        text.push_str(&format!(
+            "  {key:w0$}  {kind:w1$}  {default:w2$}  {meaning}\n"
+        ));
+    }
+    text.push_str(
+        "The keys mean what the options of study alpha / study curve mean (see their --help \
+         for the outputs and the scales).\n\n\
+         Example (docs/sweep.toml):\n",
+    );
+    for line in SWEEP_EXAMPLE.lines() {
+        text.push_str(&format!("  {line}\n"));
+    }
+    text.push_str("\nRun: asperity study file docs/sweep.toml --out sweep");
+    text
+}
+
+/// The example study file shipped as `docs/sweep.toml`.
+const SWEEP_EXAMPLE: &str = include_str!("../../../../docs/sweep.toml");
+
 /// Arguments of `asperity study file`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example study file (study.toml):\n  \
-    kind = \"alpha\"          # or \"curve\"\n  \
-    method = \"mdr\"\n  \
-    n = [512, 2048, 32768]\n  \
-    hurst = \"-1:3:0.25\"     # or a list [0.5, 0.8]\n  \
-    samples = 500\n  \
-    seed = 1                # optional; also rolloff, min_contacts, max_fraction, levels\n\n\
-    Run: asperity study file study.toml --out sweep")]
+#[command(after_help = file_help())]
 pub struct FileArgs {
     /// A TOML study file.
     pub file: PathBuf,
@@ -171,11 +292,101 @@ pub enum Kind {
     Curve,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-enum HurstSpec {
-    Range(String),
-    List(Vec<f64>),
+/// `n` of a study file: one size or a list.
+#[derive(Debug)]
+struct Sizes(Vec<usize>);
+
+impl<'de> Deserialize<'de> for Sizes {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> Visitor<'de> for Visit {
+            type Value = Sizes;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a grid size (e.g. 512) or a list of sizes (e.g. [512, 2048])")
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> std::result::Result<Sizes, E> {
+                usize::try_from(v)
+                    .map(|n| Sizes(vec![n]))
+                    .map_err(|_| E::invalid_value(de::Unexpected::Unsigned(v), &self))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> std::result::Result<Sizes, E> {
+                usize::try_from(v)
+                    .map(|n| Sizes(vec![n]))
+                    .map_err(|_| E::invalid_value(de::Unexpected::Signed(v), &self))
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<Sizes, A::Error> {
+                let mut sizes = Vec::new();
+                while let Some(n) = seq.next_element::<usize>()? {
+                    sizes.push(n);
+                }
+                Ok(Sizes(sizes))
+            }
+        }
+        d.deserialize_any(Visit)
+    }
+}
+
+/// `hurst` of a study file: a number, a range string (`"A:B:STEP"`, or anything
+/// [`parse_range`] reads), or a list of numbers and range strings.
+#[derive(Debug)]
+struct Hursts(Vec<f64>);
+
+struct HurstVisit {
+    list: bool,
+}
+
+impl<'de> Visitor<'de> for HurstVisit {
+    type Value = Hursts;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        if self.list {
+            f.write_str(
+                "a Hurst exponent (e.g. 0.5), a range \"A:B:STEP\" or a list of them \
+                 (e.g. [0.5, \"1:2:0.5\"])",
+            )
+        } else {
+            f.write_str("a Hurst exponent or a range \"A:B:STEP\" in a list")
+        }
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v]))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v as f64]))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> std::result::Result<Hursts, E> {
+        Ok(Hursts(vec![v as f64]))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> std::result::Result<Hursts, E> {
+        parse_range(v).map(Hursts).map_err(E::custom)
+    }
+    fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Hursts, A::Error> {
+        if !self.list {
+            return Err(de::Error::invalid_type(de::Unexpected::Seq, &self));
+        }
+        let mut values = Vec::new();
+        while let Some(item) = seq.next_element::<HurstItem>()? {
+            values.extend(item.0 .0);
+        }
+        Ok(Hursts(values))
+    }
+}
+
+impl<'de> Deserialize<'de> for Hursts {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(HurstVisit { list: true })
+    }
+}
+
+/// One item of a `hurst` list: a number or a range string.
+struct HurstItem(Hursts);
+
+impl<'de> Deserialize<'de> for HurstItem {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        d.deserialize_any(HurstVisit { list: false }).map(HurstItem)
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -183,14 +394,71 @@ enum HurstSpec {
 struct StudyFile {
     kind: Kind,
     method: MethodArg,
-    n: Vec<usize>,
-    hurst: HurstSpec,
+    n: Sizes,
+    hurst: Hursts,
     samples: usize,
     rolloff: Option<f64>,
     seed: Option<u64>,
     min_contacts: Option<usize>,
     max_fraction: Option<f64>,
     levels: Option<usize>,
+}
+
+/// Default number of common force levels.
+const LEVELS: usize = 48;
+
+/// Reads a study file's text: the kind and the spec (not yet validated). Errors name the
+/// file, the line and column, and the key concerned, in one line.
+fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
+    let file: StudyFile =
+        toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", toml_error(path, text, &e)))?;
+    let window = FitWindow::default();
+    let spec = StudySpec {
+        method: file.method.into(),
+        sizes: file.n.0,
+        hursts: file.hurst.0,
+        samples: file.samples,
+        rolloff: file.rolloff,
+        seed: file.seed.unwrap_or(1),
+        window: FitWindow {
+            min_contacts: file.min_contacts.unwrap_or(window.min_contacts),
+            max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
+        },
+        levels: file.levels.unwrap_or(LEVELS),
+    };
+    Ok((file.kind, spec))
+}
+
+/// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on
+/// the line the error points at; line and column are left out where toml gives no span.
+fn toml_error(path: &Path, text: &str, error: &toml::de::Error) -> String {
+    let message = error.message().trim().replace('\n', " ");
+    // A missing key is reported at the start of its table: a place that means nothing.
+    let Some(span) = error
+        .span()
+        .filter(|s| s.start < text.len().max(1) && !message.starts_with("missing field"))
+    else {
+        return format!("{}: {message}", path.display());
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before[line_start..].chars().count() + 1;
+    let line_text = text[line_start..].lines().next().unwrap_or("");
+    let key = line_text
+        .split_once('=')
+        .map(|(k, _)| k.trim().trim_matches('"'))
+        .filter(|k| !k.is_empty() && !k.starts_with('#') && !k.starts_with('['));
+    match key {
+        Some(key) if !message.contains(&format!("`{key}`")) => format!(
+            "{}, line {line}, column {column} (key `{key}`): {message}",
+            path.display()
+        ),
+        _ => format!(
+            "{}, line {line}, column {column}: {message}",
+            path.display()
+        ),
+    }
 }
 
 fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudySpec {
@@ -248,7 +516,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = spec_from(&c.common, vec![c.n], c.hurst.clone());
+            let spec = spec_from(&c.common, vec![c.n], parse_range(&c.hurst)?);
             (
                 Kind::Curve,
                 spec,
@@ -259,26 +527,8 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         StudyCommand::File(f) => {
             let text = std::fs::read_to_string(&f.file)
                 .with_context(|| format!("reading {}", f.file.display()))?;
-            let file: StudyFile = toml::from_str(&text)
-                .map_err(|e| anyhow::anyhow!("{}: {}", f.file.display(), e.message()))?;
-            let window = FitWindow::default();
-            let spec = StudySpec {
-                method: file.method.into(),
-                sizes: file.n,
-                hursts: match file.hurst {
-                    HurstSpec::Range(r) => parse_range(&r)?,
-                    HurstSpec::List(l) => l,
-                },
-                samples: file.samples,
-                rolloff: file.rolloff,
-                seed: file.seed.unwrap_or(1),
-                window: FitWindow {
-                    min_contacts: file.min_contacts.unwrap_or(window.min_contacts),
-                    max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
-                },
-                levels: file.levels.unwrap_or(48),
-            };
-            (file.kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
+            let (kind, spec) = parse_study_file(&f.file, &text)?;
+            (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
     let results = execute(&spec, out, options, &outputs(kind, out))?;
@@ -300,8 +550,13 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Validates, checks outputs, opens (or resumes) the study folder and runs every task with
-/// a progress bar. Returns the task results in task order.
+/// Validates (the spec, then whether its largest task fits in memory), checks outputs,
+/// opens (or resumes) the study folder and runs every task with a progress bar. Nothing
+/// is created before every check has passed. Returns the task results in task order.
+///
+/// The progress bar counts samples; its ETA weighs each sample by
+/// [`sample_cost`] and leaves out samples read back from checkpoints (see
+/// [`crate::progress`]).
 pub fn execute(
     spec: &StudySpec,
     dir: &Path,
@@ -314,19 +569,29 @@ pub fn execute(
         checkpoint_every,
     } = options;
     spec.validate()?;
+    spec.ensure_fits()?;
     StudyDir::check(dir, spec, force)?;
     for path in outputs {
         asperity::io::ensure_new_output(path, force)?;
     }
     let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
     let tasks = spec.tasks();
-    let total = (tasks.len() * spec.samples) as u64;
-    let progress = Progress::new(&format!("{} study", spec.method.name()), total, quiet);
+    let segments: Vec<(u64, f64)> = tasks
+        .iter()
+        .map(|t| (spec.samples as u64, sample_cost(spec.method, t.n)))
+        .collect();
+    let progress = Progress::weighted(&format!("{} study", spec.method.name()), &segments, quiet);
     let mut results = Vec::with_capacity(tasks.len());
     for (i, task) in tasks.iter().enumerate() {
         let offset = (i * spec.samples) as u64;
+        // The first report of a task is what its checkpoint held (run_task's contract).
+        let first = AtomicBool::new(true);
         let result = run_any_task(spec, *task, &store, &|done, _| {
-            progress.set(offset + done as u64)
+            if first.swap(false, Ordering::Relaxed) {
+                progress.restore(offset + done as u64)
+            } else {
+                progress.set(offset + done as u64)
+            }
         })
         .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
         results.push(result);
@@ -480,40 +745,189 @@ pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str)
     )
 }
 
-/// Log–log k(F), one series per task, coloured by H.
+/// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
+/// dashed in the same colour. Interval ends that are not positive (a wide interval at few
+/// samples) cannot sit on a log axis: they are left out, not clamped, and the dashed line
+/// is broken there rather than drawn across the gap.
 pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     let (hmin, hmax) = results
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
             (a.min(r.task.hurst), b.max(r.task.hurst))
         });
-    let series = results
-        .iter()
-        .map(|r| {
-            let t = if hmax > hmin {
-                (r.task.hurst - hmin) / (hmax - hmin)
-            } else {
-                0.5
-            };
-            let points = r
-                .mean_curve
-                .iter()
-                .map(|p| (p.force, p.stiffness))
-                .collect();
+    let mut series = Vec::new();
+    for r in results {
+        let t = if hmax > hmin {
+            (r.task.hurst - hmin) / (hmax - hmin)
+        } else {
+            0.5
+        };
+        let color = ordered_color(t * 0.9);
+        let points = r
+            .mean_curve
+            .iter()
+            .map(|p| (p.force, p.stiffness))
+            .collect();
+        series.push(
             Series::new(
                 format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
                 points,
                 Style::Line,
             )
-            .color(ordered_color(t * 0.9))
-        })
-        .collect();
+            .color(color),
+        );
+        if r.samples > 1 {
+            let ends: [fn(&EnsemblePoint) -> f64; 2] = [|p| p.stiffness_low, |p| p.stiffness_high];
+            for end in ends {
+                // Runs of drawable points; a gap is left open, not bridged.
+                let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+                for p in &r.mean_curve {
+                    let (f, k) = (p.force, end(p));
+                    if f > 0.0 && k > 0.0 && k.is_finite() {
+                        runs.last_mut().expect("one run").push((f, k));
+                    } else if !runs.last().expect("one run").is_empty() {
+                        runs.push(Vec::new());
+                    }
+                }
+                for run in runs.into_iter().filter(|run| run.len() >= 2) {
+                    series.push(Series::new("", run, Style::Dashed).color(color));
+                }
+            }
+        }
+    }
+    let scale = match results.first().map(|r| r.method) {
+        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
+        _ => "L = 1, E* = 1, unit rms height",
+    };
     Chart {
         title: title.into(),
-        x_label: "normal force F (E* = 1, unit rms)".into(),
+        x_label: format!("normal force F ({scale})"),
         y_label: "contact stiffness k".into(),
         log_x: true,
         log_y: true,
         series,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asperity::study::Task;
+
+    fn result(lows: &[f64]) -> TaskResult {
+        let point = |i: usize, &low: &f64| EnsemblePoint {
+            force: (i + 1) as f64,
+            stiffness: 1.0,
+            stiffness_low: low,
+            stiffness_high: 2.0,
+            fraction: 0.1,
+            samples: 3,
+        };
+        TaskResult {
+            method: Method::Mdr,
+            task: Task { n: 64, hurst: 0.5 },
+            samples: 3,
+            mean_curve: lows.iter().enumerate().map(|(i, l)| point(i, l)).collect(),
+            alpha_ensemble: None,
+            alpha_samples: vec![],
+        }
+    }
+
+    #[test]
+    fn curve_plots_leave_out_non_positive_interval_ends() {
+        let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
+        let points = |i: usize| chart.series[i].points.clone();
+        assert_eq!(chart.series.len(), 4, "mean, low in two pieces, high");
+        assert_eq!(points(1), vec![(1.0, 0.5), (2.0, 0.6)]);
+        assert_eq!(points(2), vec![(5.0, 0.7), (6.0, 0.8)]);
+        assert_eq!(points(3).len(), 6, "the high end");
+        assert!(chart.series[1..].iter().all(|s| s.label.is_empty()));
+        // A lone positive point between gaps draws nothing; all positive: one line.
+        assert_eq!(
+            curve_chart(&[result(&[-1.0, 0.5, -1.0])], "t").series.len(),
+            2
+        );
+        let whole = curve_chart(&[result(&[0.1, 0.2, 0.3])], "t");
+        assert_eq!(whole.series[1].points.len(), 3);
+    }
+
+    #[test]
+    fn study_files_take_single_values_and_lists() {
+        let parse = |text: &str| parse_study_file(Path::new("s.toml"), text);
+        let base = "kind = \"curve\"\nmethod = \"mdr\"\nsamples = 3\n";
+        let (kind, spec) = parse(&format!("{base}n = 512\nhurst = 0.5\n")).unwrap();
+        assert_eq!(kind, Kind::Curve);
+        assert_eq!((spec.sizes, spec.hursts), (vec![512], vec![0.5]));
+        let (_, spec) = parse(&format!("{base}n = [512, 1024]\nhurst = 1\n")).unwrap();
+        assert_eq!((spec.sizes, spec.hursts), (vec![512, 1024], vec![1.0]));
+        let (_, spec) = parse(&format!("{base}n = 64\nhurst = \"-1:0:0.5\"\n")).unwrap();
+        assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0]);
+        let (_, spec) = parse(&format!("{base}n = 64\nhurst = [\"-1:0:0.5\", 2, 2.5]\n")).unwrap();
+        assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0, 2.0, 2.5]);
+        assert_eq!(spec.seed, 1);
+        assert_eq!(spec.levels, 48);
+        assert_eq!(spec.window, FitWindow::default());
+    }
+
+    #[test]
+    fn study_file_errors_name_the_line_column_and_key() {
+        let parse = |text: &str| {
+            parse_study_file(Path::new("s.toml"), text)
+                .unwrap_err()
+                .to_string()
+        };
+        let err =
+            parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = \"512\"\nhurst = 0.5\nsamples = 3\n");
+        assert!(
+            err.starts_with("s.toml, line 3, column 5 (key `n`): "),
+            "{err}"
+        );
+        assert!(err.contains("grid size"), "{err}");
+        assert!(!err.contains('\n'), "{err}");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = true\nsamples = 3\n");
+        assert!(err.contains("line 4") && err.contains("`hurst`"), "{err}");
+        let err =
+            parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = \"1:0:1\"\nsamples = 3\n");
+        assert!(
+            err.contains("line 4") && err.contains("empty range"),
+            "{err}"
+        );
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = 0.5\nsampels = 3\n");
+        assert!(err.contains("line 5") && err.contains("sampels"), "{err}");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = 64\nhurst = 0.5\n");
+        assert_eq!(err, "s.toml: missing field `samples`");
+        let err = parse("kind = \"alpha\"\nmethod = \"mdr\"\nn = [64\n");
+        assert!(err.contains("line 3") || err.contains("line 4"), "{err}");
+    }
+
+    #[test]
+    fn the_example_file_parses_and_help_and_readme_list_every_key() {
+        let (kind, spec) = parse_study_file(Path::new("docs/sweep.toml"), SWEEP_EXAMPLE).unwrap();
+        assert_eq!(kind, Kind::Alpha);
+        spec.validate().unwrap();
+        let help = file_help();
+        let readme = include_str!("../../../../README.md");
+        for (key, kind, default, _) in FILE_KEYS {
+            let row = help
+                .lines()
+                .find(|l| l.trim_start().starts_with(&format!("{key} ")))
+                .unwrap_or_else(|| panic!("{key} missing from --help"));
+            assert!(row.contains(kind) && row.contains(default), "{row}");
+            let row = readme
+                .lines()
+                .find(|l| l.starts_with(&format!("| `{key}` |")))
+                .unwrap_or_else(|| panic!("{key} missing from README's table"));
+            assert!(row.contains(default), "README: {row}");
+        }
+        // Every key the parser knows is in the table: an unknown key's error lists them.
+        let err = parse_study_file(Path::new("s.toml"), "nokey = 1\n")
+            .unwrap_err()
+            .to_string();
+        let listed = err.split("expected one of").nth(1).unwrap_or_default();
+        let known: Vec<&str> = listed.split('`').skip(1).step_by(2).collect();
+        assert_eq!(known.len(), FILE_KEYS.len(), "{err}");
+        for key in known {
+            assert!(FILE_KEYS.iter().any(|k| k.0 == key), "{key} not documented");
+        }
     }
 }

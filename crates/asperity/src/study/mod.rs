@@ -12,7 +12,15 @@
 //! (atomically). Run again with
 //! the same spec, it resumes where it stopped and — since samples are deterministic and
 //! stored with round-trip precision — gives bit-identical results. A folder holding a
-//! different study is refused ([`Error::ForeignCheckpoint`]) unless `discard` is set.
+//! different study is refused ([`Error::ForeignCheckpoint`]) unless `discard` is set; a
+//! folder whose `study.json` names another study but whose checkpoints hold no sample (a
+//! study that stopped before its first checkpoint) is free and reused. Every checkpoint
+//! names its task, and a checkpoint whose task is not the one requested (bit for bit) is
+//! refused rather than silently reused.
+//!
+//! `study.json` also records the scales of the samples (`normalisation`, see
+//! [`samplers::Scales`]); it is informative only and not compared on resume, so folders
+//! written before it existed resume as before.
 
 pub mod curve;
 pub mod samplers;
@@ -26,7 +34,7 @@ use serde::{Deserialize, Serialize};
 pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
-pub use samplers::run_any_task;
+pub use samplers::{run_any_task, Scales};
 
 use crate::fit::PowerLawFit;
 use crate::spectrum::HURST_RANGE;
@@ -89,6 +97,11 @@ impl StudySpec {
                 format!("N = {n} is below the smallest useful size {min_n}"),
             ));
         }
+        for (i, n) in self.sizes.iter().enumerate() {
+            if self.sizes[..i].contains(n) {
+                return Err(Error::invalid("n", format!("N = {n} is given twice")));
+            }
+        }
         if self.hursts.is_empty() {
             return Err(Error::invalid("hurst", "the range of H is empty"));
         }
@@ -98,6 +111,23 @@ impl StudySpec {
                 "hurst",
                 format!("H = {h} is outside [{lo}, {hi}]"),
             ));
+        }
+        for (i, &h) in self.hursts.iter().enumerate() {
+            for &earlier in &self.hursts[..i] {
+                if earlier == h {
+                    return Err(Error::invalid("hurst", format!("H = {h} is given twice")));
+                }
+                if hurst_key(earlier) == hurst_key(h) {
+                    return Err(Error::invalid(
+                        "hurst",
+                        format!(
+                            "H = {earlier} and H = {h} would share one checkpoint (H is kept \
+                             to 6 decimals in its name, {}); give values at least 1e-6 apart",
+                            hurst_key(h)
+                        ),
+                    ));
+                }
+            }
         }
         if self.samples == 0 {
             return Err(Error::invalid("samples", "need at least 1 sample"));
@@ -175,9 +205,32 @@ pub struct Task {
 }
 
 impl Task {
-    /// File-name key, e.g. `mdr_n512_h-0.2500`.
+    /// File-name key, e.g. `mdr_n512_h-0.250000`: H rounded to 6 decimals, so
+    /// [`StudySpec::validate`] refuses H values that would share a key.
     pub fn key(&self, method: Method) -> String {
-        format!("{}_n{}_h{:+.6}", method.name(), self.n, self.hurst)
+        format!("{}_n{}_h{}", method.name(), self.n, hurst_key(self.hurst))
+    }
+
+    /// Same N and the same H bit for bit.
+    pub fn same_as(&self, other: &Task) -> bool {
+        self.n == other.n && self.hurst.to_bits() == other.hurst.to_bits()
+    }
+}
+
+/// H as it appears in checkpoint names: signed, 6 decimals.
+fn hurst_key(hurst: f64) -> String {
+    format!("{hurst:+.6}")
+}
+
+/// Relative cost of one sample of `method` at grid size `n`, the weight of a sample in
+/// progress estimates: `N² log₂ N` for BEM (FFTs of the N×N grid in every iteration of
+/// every load) and `N log₂ N` for MDR (FFT synthesis of the line, then its sort). Only
+/// ratios within one method are meaningful.
+pub fn sample_cost(method: Method, n: usize) -> f64 {
+    let n = n.max(2) as f64;
+    match method {
+        Method::Bem => n * n * n.log2(),
+        Method::Mdr => n * n.log2(),
     }
 }
 
@@ -263,6 +316,10 @@ impl TaskResult {
 struct Manifest {
     format: String,
     spec: StudySpec,
+    /// Scales of the samples; informative, not compared on resume (absent in folders
+    /// written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    normalisation: Option<Scales>,
 }
 
 /// What `checkpoint/<task>.json` holds: the samples of a task in progress, or the result
@@ -272,6 +329,9 @@ struct Manifest {
 enum Checkpoint {
     InProgress {
         key: String,
+        /// The task (absent in checkpoints written before it was recorded).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        task: Option<Task>,
         samples: Vec<SampleCurve>,
     },
     Done {
@@ -286,6 +346,22 @@ impl Checkpoint {
             Checkpoint::InProgress { key, .. } | Checkpoint::Done { key, .. } => key,
         }
     }
+
+    /// The task it holds, where recorded.
+    fn task(&self) -> Option<Task> {
+        match self {
+            Checkpoint::InProgress { task, .. } => *task,
+            Checkpoint::Done { result, .. } => Some(result.task),
+        }
+    }
+
+    /// Whether it holds anything worth keeping: a finished task or at least one sample.
+    fn holds_samples(&self) -> bool {
+        match self {
+            Checkpoint::InProgress { samples, .. } => !samples.is_empty(),
+            Checkpoint::Done { .. } => true,
+        }
+    }
 }
 
 /// A task in progress saves its samples at most this often (and always when it ends), so
@@ -298,13 +374,18 @@ const MANIFEST_FORMAT: &str = "asperity-study/1";
 #[derive(Debug, Clone)]
 pub struct StudyDir {
     dir: PathBuf,
+    method: Method,
     interval: std::time::Duration,
 }
 
 impl StudyDir {
-    /// Checks, without writing, whether `dir` can hold `spec`: `Ok(false)` when it is new
-    /// or holds the same study, `Ok(true)` when it holds another study and `discard` is
-    /// set, [`Error::ForeignCheckpoint`] otherwise.
+    /// Checks, without writing, whether `dir` can hold `spec`:
+    ///
+    /// * `Ok(false)` when it is new or holds the same study (which then resumes);
+    /// * `Ok(true)` when its checkpoints are to be cleared first: it holds another study
+    ///   and `discard` is set, or its `study.json` names another study but no checkpoint
+    ///   holds a sample (that study stopped before its first checkpoint: nothing is lost);
+    /// * [`Error::ForeignCheckpoint`] when it holds samples of another study.
     pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
         let manifest_path = dir.join("study.json");
         if !manifest_path.exists() {
@@ -315,32 +396,69 @@ impl StudyDir {
         let same = serde_json::from_str::<Manifest>(&text)
             .map(|m| m.format == MANIFEST_FORMAT && &m.spec == spec)
             .unwrap_or(false);
-        match (same, discard) {
-            (true, _) => Ok(false),
-            (false, true) => Ok(true),
-            (false, false) => Err(Error::ForeignCheckpoint {
-                dir: dir.to_path_buf(),
-                reason: "its study.json has other parameters".into(),
-            }),
+        if same {
+            return Ok(false);
         }
+        if discard || !Self::holds_samples(dir)? {
+            return Ok(true);
+        }
+        Err(Error::ForeignCheckpoint {
+            dir: dir.to_path_buf(),
+            reason: "its study.json has other parameters".into(),
+        })
+    }
+
+    /// Whether any checkpoint in `dir` holds a finished task or a sample. A checkpoint that
+    /// cannot be read counts as holding one (nothing is discarded that might matter);
+    /// temporary files of unfinished writes do not count.
+    fn holds_samples(dir: &Path) -> Result<bool> {
+        let folder = dir.join("checkpoint");
+        let entries = match std::fs::read_dir(&folder) {
+            Ok(entries) => entries,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
+            Err(e) => return Err(Error::io(&folder, e)),
+        };
+        for entry in entries {
+            let path = entry.map_err(|e| Error::io(&folder, e))?.path();
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            if name.starts_with('.') || !name.ends_with(".json") {
+                continue;
+            }
+            let holds = std::fs::read_to_string(&path)
+                .ok()
+                .and_then(|text| serde_json::from_str::<Checkpoint>(&text).ok())
+                .is_none_or(|c| c.holds_samples());
+            if holds {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// Opens (creating) `dir` for `spec`: a folder with the same spec resumes, a folder with
-    /// another study is refused unless `discard`, which deletes its checkpoints.
+    /// another study is refused unless `discard`, which deletes its checkpoints (see
+    /// [`StudyDir::check`]).
     pub fn open(dir: &Path, spec: &StudySpec, discard: bool) -> Result<Self> {
         if Self::check(dir, spec, discard)? {
             let checkpoints = dir.join("checkpoint");
-            std::fs::remove_dir_all(&checkpoints).map_err(|e| Error::io(&checkpoints, e))?;
+            match std::fs::remove_dir_all(&checkpoints) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(Error::io(&checkpoints, e))
+                }
+                _ => {}
+            }
         }
         std::fs::create_dir_all(dir.join("checkpoint")).map_err(|e| Error::io(dir, e))?;
         let manifest_path = dir.join("study.json");
         let manifest = Manifest {
             format: MANIFEST_FORMAT.into(),
             spec: spec.clone(),
+            normalisation: Some(Scales::of(spec.method)),
         };
         io::write_json(&manifest_path, true, &manifest)?;
         Ok(StudyDir {
             dir: dir.to_path_buf(),
+            method: spec.method,
             interval: CHECKPOINT_INTERVAL,
         })
     }
@@ -361,8 +479,11 @@ impl StudyDir {
         self.dir.join("checkpoint").join(format!("{key}.json"))
     }
 
-    fn load(&self, key: &str) -> Result<Option<Checkpoint>> {
-        let path = self.checkpoint_path(key);
+    /// The checkpoint of `task`, if any; refused when the file holds another task (its
+    /// name or, where recorded, its N and H bit for bit).
+    fn load(&self, task: Task) -> Result<Option<Checkpoint>> {
+        let key = task.key(self.method);
+        let path = self.checkpoint_path(&key);
         if !path.exists() {
             return Ok(None);
         }
@@ -377,6 +498,19 @@ impl StudyDir {
                 reason: format!("{} is not {key}", path.display()),
             });
         }
+        if let Some(stored) = checkpoint.task().filter(|stored| !stored.same_as(&task)) {
+            return Err(Error::ForeignCheckpoint {
+                dir: self.dir.clone(),
+                reason: format!(
+                    "{} holds N = {}, H = {}, not the requested N = {}, H = {}",
+                    path.display(),
+                    stored.n,
+                    stored.hurst,
+                    task.n,
+                    task.hurst
+                ),
+            });
+        }
         Ok(Some(checkpoint))
     }
 
@@ -389,16 +523,21 @@ impl StudyDir {
         io::write_bytes(&path, true, &text)
     }
 
-    /// Saves the first samples of a task in progress.
-    pub fn save_in_progress(&self, key: &str, samples: &[SampleCurve]) -> Result<()> {
+    /// Saves the first samples of `task`, in progress.
+    pub fn save_in_progress(&self, task: Task, samples: &[SampleCurve]) -> Result<()> {
         self.save(&Checkpoint::InProgress {
-            key: key.to_string(),
+            key: task.key(self.method),
+            task: Some(task),
             samples: samples.to_vec(),
         })
     }
 }
 
-/// Progress of a study: samples done so far (including resumed ones) and the total.
+/// Progress of a task: `progress(done, total)` with the samples done so far and the
+/// task's total. The first call of a task (before any sample is computed) reports the
+/// samples read back from its checkpoint — all of them for a finished task — and every
+/// later call the samples done after another batch computed in this run, so a caller can
+/// tell restored samples from computed ones (e.g. for a rate or an ETA).
 pub type ProgressFn<'a> = dyn Fn(usize, usize) + Sync + 'a;
 
 /// Runs (or resumes) one task: samples in parallel batches, one worker per thread kept for
@@ -413,7 +552,7 @@ pub fn run_task<S: Sampler>(
     progress: &ProgressFn,
 ) -> Result<TaskResult> {
     let key = task.key(spec.method);
-    let mut samples = match store.load(&key)? {
+    let mut samples = match store.load(task)? {
         Some(Checkpoint::Done { result, .. }) if result.samples == spec.samples => {
             progress(spec.samples, spec.samples);
             return Ok(result);
@@ -449,7 +588,7 @@ pub fn run_task<S: Sampler>(
             samples.push(curve?);
         }
         if samples.len() < spec.samples && last_save.elapsed() >= store.interval {
-            store.save_in_progress(&key, &samples)?;
+            store.save_in_progress(task, &samples)?;
             last_save = std::time::Instant::now();
         }
         progress(samples.len(), spec.samples);
@@ -524,6 +663,132 @@ mod tests {
         assert!(s.validate().is_err());
     }
 
+    #[test]
+    fn repeated_or_colliding_values_are_refused() {
+        let message = |s: &StudySpec| s.validate().unwrap_err().to_string();
+        let mut s = spec(3);
+        s.sizes = vec![64, 128, 64];
+        assert!(
+            message(&s).contains("N = 64 is given twice"),
+            "{}",
+            message(&s)
+        );
+        s.sizes = vec![64];
+        s.hursts = vec![0.5, 1.0, 0.5];
+        assert!(
+            message(&s).contains("H = 0.5 is given twice"),
+            "{}",
+            message(&s)
+        );
+        s.hursts = vec![0.0, -0.0];
+        assert!(s.validate().is_err(), "0 and -0 are one H");
+        // Distinct values that round to the same checkpoint name: both named.
+        s.hursts = vec![0.5000001, 0.5000002];
+        let m = message(&s);
+        assert!(m.contains("0.5000001") && m.contains("0.5000002"), "{m}");
+        s.hursts = vec![0.500001, 0.500002];
+        s.validate().unwrap();
+        assert_ne!(s.tasks()[0].key(Method::Mdr), s.tasks()[1].key(Method::Mdr));
+    }
+
+    #[test]
+    fn a_checkpoint_of_another_task_under_the_same_name_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = spec(5);
+        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        let stored = Task {
+            n: 64,
+            hurst: 0.5000001,
+        };
+        let asked = Task {
+            n: 64,
+            hurst: 0.5000002,
+        };
+        assert_eq!(stored.key(Method::Mdr), asked.key(Method::Mdr));
+        // In progress.
+        let first = vec![Synthetic.sample(&mut (), 1).unwrap()];
+        store.save_in_progress(stored, &first).unwrap();
+        let err = run_task(&spec, asked, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+        assert!(err.to_string().contains("0.5000001"), "{err}");
+        // Finished.
+        run_task(&spec, stored, &Synthetic, &store, &|_, _| {}).unwrap();
+        let err = run_task(&spec, asked, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+        // The stored task itself is read back.
+        run_task(&spec, stored, &Synthetic, &store, &|_, _| {}).unwrap();
+    }
+
+    #[test]
+    fn a_folder_without_samples_is_free_for_another_study() {
+        let dir = tempfile::tempdir().unwrap();
+        // study.json written, then stopped before any checkpoint.
+        StudyDir::open(dir.path(), &spec(20), false).unwrap();
+        let store = StudyDir::open(dir.path(), &spec(21), false).unwrap();
+        // An in-progress checkpoint without samples keeps nothing either.
+        store
+            .save_in_progress(Task { n: 64, hurst: 0.5 }, &[])
+            .unwrap();
+        let store = StudyDir::open(dir.path(), &spec(22), false).unwrap();
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("study.json")).unwrap()).unwrap();
+        assert_eq!(manifest["spec"]["samples"], 22);
+        assert_eq!(manifest["normalisation"]["rms_height"], 1.0);
+        // One sample makes it another study's again.
+        let one = vec![Synthetic.sample(&mut (), 1).unwrap()];
+        store
+            .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
+            .unwrap();
+        let err = StudyDir::open(dir.path(), &spec(23), false).unwrap_err();
+        assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+        // A file that cannot be read counts as holding samples.
+        std::fs::write(dir.path().join("checkpoint/x.json"), "{").unwrap();
+        std::fs::remove_file(dir.path().join("checkpoint").join(format!(
+            "{}.json",
+            Task { n: 64, hurst: 0.5 }.key(Method::Mdr)
+        )))
+        .unwrap();
+        assert!(StudyDir::open(dir.path(), &spec(23), false).is_err());
+    }
+
+    #[test]
+    fn study_json_written_before_the_normalisation_was_recorded_resumes() {
+        let dir = tempfile::tempdir().unwrap();
+        let task = Task { n: 64, hurst: 0.5 };
+        let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
+        let first = vec![Synthetic.sample(&mut (), 1).unwrap()];
+        store.save_in_progress(task, &first).unwrap();
+        // The old format: no normalisation, no task in the checkpoint.
+        let old = serde_json::json!({"format": MANIFEST_FORMAT, "spec": spec(4)});
+        std::fs::write(dir.path().join("study.json"), old.to_string()).unwrap();
+        let path = dir
+            .path()
+            .join("checkpoint")
+            .join(format!("{}.json", task.key(Method::Mdr)));
+        let mut checkpoint: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        checkpoint.as_object_mut().unwrap().remove("task");
+        std::fs::write(&path, checkpoint.to_string()).unwrap();
+        let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
+        let restored = std::sync::Mutex::new(Vec::new());
+        run_task(&spec(4), task, &Synthetic, &store, &|done, _| {
+            restored.lock().unwrap().push(done)
+        })
+        .unwrap();
+        assert_eq!(
+            restored.into_inner().unwrap()[0],
+            1,
+            "the sample was resumed"
+        );
+    }
+
+    #[test]
+    fn sample_costs_grow_with_n() {
+        assert!(sample_cost(Method::Bem, 128) / sample_cost(Method::Bem, 64) > 4.0);
+        let mdr = sample_cost(Method::Mdr, 1 << 15) / sample_cost(Method::Mdr, 1 << 9);
+        assert!((mdr - 64.0 * 15.0 / 9.0).abs() < 1e-9);
+    }
+
     /// A sampler whose curve is a deterministic function of the seed.
     struct Synthetic;
     impl Sampler for Synthetic {
@@ -576,9 +841,7 @@ mod tests {
                 Synthetic.sample(&mut (), seed).unwrap()
             })
             .collect();
-        store
-            .save_in_progress(&task.key(Method::Mdr), &first)
-            .unwrap();
+        store.save_in_progress(task, &first).unwrap();
         let resumed = run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap();
         assert_eq!(resumed, full);
         let a = serde_json::to_string(&resumed).unwrap();

@@ -9,16 +9,178 @@
 //!   warm starts; the stiffness at each load by the frozen contact set.
 //!   The pressures span `0.05/N²` to `0.2` E*: with the area–load law `A/A0 ≈ 2 p/(E* ḡ)`
 //!   (ḡ = 1) this runs from below one pixel in contact to roughly 30–40 % contact.
+//!
+//! Both use L = 1 and E* = 1, but MDR lines have unit rms *height* and BEM surfaces unit
+//! rms *slope*, so forces (and stiffnesses) of the two methods are on different scales;
+//! [`Scales`] records this in each study's `study.json`.
+//!
+//! # Memory
+//! [`StudySpec::ensure_fits`] checks, before a study creates anything, that the largest
+//! task fits: one worker per thread (generator, solver and buffers, sized as below by
+//! [`task_memory_bytes`]) and the sample curves a task keeps until it ends.
 
 use super::{
     run_task, CurvePoint, Method, ProgressFn, SampleCurve, Sampler, StudyDir, StudySpec, Task,
     TaskResult,
 };
 use crate::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use crate::elastic::Boundary;
 use crate::mdr::LinearCurve;
+use crate::memory::{array_bytes, ensure_fits};
 use crate::spectrum::{LongWavelength, Psd};
 use crate::surface::{LineGenerator, LineSpec, Normalisation, SurfaceGenerator, SurfaceSpec};
 use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Side length L of every sample.
+const SIZE: f64 = 1.0;
+/// Effective modulus E* of every sample.
+const MODULUS: f64 = 1.0;
+/// rms height of every MDR line.
+const LINE_RMS_HEIGHT: f64 = 1.0;
+/// rms slope of every BEM surface.
+const SURFACE_RMS_SLOPE: f64 = 1.0;
+
+/// The scales of a method's samples, as recorded in `study.json` (`normalisation`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Scales {
+    /// Side length L.
+    pub size: f64,
+    /// Effective modulus E*.
+    pub modulus: f64,
+    /// rms height of each line (MDR).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_height: Option<f64>,
+    /// rms slope of each surface (BEM).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_slope: Option<f64>,
+    /// Spring spacing Δx (MDR), as a formula in L and N.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<String>,
+    /// Boundary conditions (BEM).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub boundary: Option<String>,
+    /// One line for people.
+    pub description: String,
+}
+
+impl Scales {
+    /// The scales the sampler of `method` uses.
+    pub fn of(method: Method) -> Scales {
+        match method {
+            Method::Mdr => Scales {
+                size: SIZE,
+                modulus: MODULUS,
+                rms_height: Some(LINE_RMS_HEIGHT),
+                rms_slope: None,
+                spacing: Some("L/N".into()),
+                boundary: None,
+                description: "MDR lines: unit rms height, L = 1, E* = 1, linear springs at \
+                              Δx = L/N; forces are not on the scale of BEM studies"
+                    .into(),
+            },
+            Method::Bem => Scales {
+                size: SIZE,
+                modulus: MODULUS,
+                rms_height: None,
+                rms_slope: Some(SURFACE_RMS_SLOPE),
+                spacing: None,
+                boundary: Some(Boundary::Free.name().into()),
+                description: "BEM surfaces: unit rms slope, L = 1, E* = 1, free boundaries; \
+                              forces are not on the scale of MDR studies"
+                    .into(),
+            },
+        }
+    }
+}
+
+/// Contact counts an MDR sample keeps for a line of `n` points: every count up to 1024
+/// (the α window needs them exactly), then ~40 per decade (for the plotted curve).
+fn mdr_kept_contacts(n: usize) -> Vec<usize> {
+    let mut kept_contacts: Vec<usize> = (1..=n.min(1024)).collect();
+    let per_decade = 40.0;
+    let mut j = 1024.0f64;
+    while (j as usize) < n {
+        j *= 10f64.powf(1.0 / per_decade);
+        let count = (j.round() as usize).min(n);
+        if count > *kept_contacts.last().unwrap_or(&0) {
+            kept_contacts.push(count);
+        }
+    }
+    kept_contacts
+}
+
+/// Estimated peak memory of running `task` of `spec` on `lanes` threads, in bytes (`None`
+/// on overflow):
+///
+/// * per thread, MDR: the line generator (spectrum, scratch, amplitudes: 40 B per point),
+///   the heights (8 B), the curve's two breakpoint buffers (16 B) and the sort's two key
+///   buffers (16 B);
+/// * per thread, BEM: the surface generator (32 B per pixel), one generated surface
+///   (8 B) and the contact solver ([`ContactSolver::memory_bytes`], free boundaries);
+/// * for the task, the curves of all its samples (kept until it ends): 24 B per point,
+///   every kept contact count for MDR, [`BemSampler::LOADS`] loads for BEM.
+pub fn task_memory_bytes(spec: &StudySpec, task: Task, lanes: usize) -> Option<u64> {
+    let n = task.n;
+    let (per_lane, points) = match spec.method {
+        Method::Mdr => (
+            array_bytes(&[n], 40 + 8 + 16 + 16)?,
+            mdr_kept_contacts_len(n),
+        ),
+        Method::Bem => (
+            array_bytes(&[n, n], 32 + 8)?.checked_add(ContactSolver::memory_bytes(
+                n,
+                n,
+                Boundary::Free,
+            )?)?,
+            BemSampler::LOADS,
+        ),
+    };
+    let curves = array_bytes(&[spec.samples, points], 24)?;
+    per_lane
+        .checked_mul(lanes.max(1) as u64)?
+        .checked_add(curves)
+}
+
+/// Number of kept contact counts of an MDR sample (see [`mdr_kept_contacts`]) without
+/// building the list for large N.
+fn mdr_kept_contacts_len(n: usize) -> usize {
+    if n <= 1 << 24 {
+        mdr_kept_contacts(n).len()
+    } else {
+        // 1024 exact counts, then 40 per decade.
+        1024 + (40.0 * (n as f64 / 1024.0).log10()).ceil() as usize + 1
+    }
+}
+
+impl StudySpec {
+    /// Refuses ([`crate::Error::OutOfMemory`]) a study whose largest task would not fit in
+    /// the memory available on the current rayon pool's threads (see
+    /// [`task_memory_bytes`]); meant to run before anything is written.
+    pub fn ensure_fits(&self) -> Result<()> {
+        let lanes = rayon::current_num_threads().max(1);
+        let Some((task, bytes)) = self
+            .tasks()
+            .into_iter()
+            .map(|task| (task, task_memory_bytes(self, task, lanes)))
+            .max_by_key(|(_, bytes)| bytes.map_or(u64::MAX, |b| b))
+        else {
+            return Ok(());
+        };
+        let grid = match self.method {
+            Method::Mdr => format!("lines of {} points", task.n),
+            Method::Bem => format!("{n}x{n} surfaces", n = task.n),
+        };
+        ensure_fits(
+            &format!(
+                "a {} study of {grid} ({} samples on {lanes} threads)",
+                self.method.name(),
+                self.samples
+            ),
+            bytes,
+        )
+    }
+}
 
 fn psd_of(spec: &StudySpec, task: Task) -> Result<Psd> {
     let long = spec
@@ -44,9 +206,9 @@ impl BemSampler {
         let surface = SurfaceSpec::new(
             task.n,
             task.n,
-            1.0,
+            SIZE,
             psd_of(spec, task)?,
-            Normalisation::RmsSlope(1.0),
+            Normalisation::RmsSlope(SURFACE_RMS_SLOPE),
         )?;
         let (lo, hi) = (0.05 / (task.n * task.n) as f64, 0.2f64);
         let mean_pressures = (0..Self::LOADS)
@@ -89,8 +251,15 @@ impl Sampler for BemSampler {
                 solver
             }
             None => worker.solver.insert(
-                ContactSolver::new(&surface, HalfSpace::default(), self.params)
-                    .map_err(bem_error)?,
+                ContactSolver::new(
+                    &surface,
+                    HalfSpace {
+                        modulus: MODULUS,
+                        boundary: Boundary::Free,
+                    },
+                    self.params,
+                )
+                .map_err(bem_error)?,
             ),
         };
         let points_total = self.surface.rows * self.surface.cols;
@@ -125,25 +294,13 @@ impl MdrSampler {
     pub fn new(spec: &StudySpec, task: Task) -> Result<Self> {
         let line = LineSpec::new(
             task.n,
-            1.0,
+            SIZE,
             psd_of(spec, task)?,
-            Normalisation::RmsHeight(1.0),
+            Normalisation::RmsHeight(LINE_RMS_HEIGHT),
         )?;
-        // Every breakpoint up to 1024 contacts (the α window needs them exactly), then ~40
-        // per decade for the plotted curve.
-        let mut kept_contacts: Vec<usize> = (1..=task.n.min(1024)).collect();
-        let per_decade = 40.0;
-        let mut j = 1024.0f64;
-        while (j as usize) < task.n {
-            j *= 10f64.powf(1.0 / per_decade);
-            let count = (j.round() as usize).min(task.n);
-            if count > *kept_contacts.last().unwrap_or(&0) {
-                kept_contacts.push(count);
-            }
-        }
         Ok(MdrSampler {
             line,
-            kept_contacts,
+            kept_contacts: mdr_kept_contacts(task.n),
         })
     }
 }
@@ -171,7 +328,7 @@ impl Sampler for MdrSampler {
         let n = self.line.n;
         worker
             .curve
-            .recompute(&worker.heights, self.line.size / n as f64, 1.0)?;
+            .recompute(&worker.heights, self.line.size / n as f64, MODULUS)?;
         let forces = worker.curve.forces();
         let points = self
             .kept_contacts
@@ -235,6 +392,29 @@ mod tests {
                 (task.hurst, result.alpha_ensemble.unwrap().exponent)
             })
             .collect()
+    }
+
+    #[test]
+    fn the_memory_check_sizes_the_largest_task() {
+        let mut s = spec(Method::Bem, 64, vec![0.5], 2);
+        s.ensure_fits().unwrap();
+        s.sizes = vec![64, 100_000];
+        let err = s.ensure_fits().unwrap_err();
+        assert!(matches!(err, Error::OutOfMemory { .. }), "{err}");
+        assert!(err.to_string().contains("100000x100000"), "{err}");
+        let task = Task { n: 256, hurst: 0.5 };
+        let bytes = task_memory_bytes(&s, task, 2).unwrap();
+        let solver = ContactSolver::memory_bytes(256, 256, Boundary::Free).unwrap();
+        assert!(bytes > 2 * solver, "two solvers and more");
+        // MDR: the samples' curves count; absurd sample counts are refused.
+        let mut m = spec(Method::Mdr, 1 << 15, vec![0.5], 500);
+        m.ensure_fits().unwrap();
+        m.samples = usize::MAX / 2;
+        assert!(m.ensure_fits().is_err());
+        assert_eq!(
+            mdr_kept_contacts_len(1 << 20),
+            mdr_kept_contacts(1 << 20).len()
+        );
     }
 
     #[test]
