@@ -200,6 +200,22 @@ impl Westergaard {
         }
         2.0 * mean_pressure * (PI * x / self.wavelength).cos().abs() * (s_a - s_x).sqrt() / s_a
     }
+
+    /// Indentation `d = Δ r (1 − ln r)`, `r = p̄/p*` (`Δ` at and beyond full contact), in the
+    /// convention of periodic half-spaces: displacements of zero mean, `d = u + f` at the
+    /// crest with the profile `f = Δ(1 − cos 2πx/λ)` measured from the crest — the approach
+    /// of the crest relative to the mean elastic displacement. From the zero-mean periodic
+    /// kernel `u(x) = −(2/πE*) ∫ p(s) ln|2 sin(π(x − s)/λ)| ds` (the Fourier kernel
+    /// `2/(E*|q|)` summed) at `x = 0`, with `sin(πs/λ) = sin(πa/λ) t`:
+    /// `d = (λp̄/πE*)(1 − 2 ln sin(πa/λ))`. At full contact `d = Δ = mean(f)`; the slope
+    /// `dd/dp̄ = −(λ/πE*) ln r` vanishes there (the stiffness diverges).
+    pub fn indentation(&self, mean_pressure: f64) -> f64 {
+        let ratio = (mean_pressure.max(0.0) / self.full_contact_pressure()).min(1.0);
+        if ratio == 0.0 {
+            return 0.0;
+        }
+        self.amplitude * ratio * (1.0 - ratio.ln())
+    }
 }
 
 /// Boussinesq's point load: a force `F` on the surface of a half-space displaces it by
@@ -288,6 +304,42 @@ mod tests {
         let x = 0.3;
         let full = w.pressure(p_star * (1.0 - 1e-12), x);
         assert!((full - p_star * (1.0 + (2.0 * PI * x / 2.0).cos())).abs() < 1e-5 * p_star);
+        // The indentation: 0 without load, Δ (the mean of the profile) at full contact.
+        assert_eq!(w.indentation(0.0), 0.0);
+        assert!((w.indentation(p_star) - 0.1).abs() < 1e-15);
+        assert!((w.indentation(2.0 * p_star) - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn westergaard_indentation_matches_the_periodic_kernel() {
+        // d = u(0) with u = −(2/πE*) ∫ p(s) ln|2 sin(πs/λ)| ds, summed numerically from the
+        // closed-form pressure (midpoint rule; the log and the square-root edge are
+        // integrable): fails if the closed form, its derivation or the kernel's
+        // normalisation is wrong.
+        let w = Westergaard {
+            wavelength: 2.0,
+            amplitude: 0.1,
+            modulus: 3.0,
+        };
+        let p_star = w.full_contact_pressure();
+        for ratio in [0.05, 0.3, 0.5, 0.9] {
+            let p_mean = ratio * p_star;
+            let a = w.contact_half_width(p_mean);
+            let n = 400_000;
+            let ds = 2.0 * a / n as f64;
+            let u0: f64 = (0..n)
+                .map(|i| {
+                    let s = -a + (i as f64 + 0.5) * ds;
+                    let log = (2.0 * (PI * s / w.wavelength).sin().abs()).ln();
+                    -2.0 / (PI * w.modulus) * w.pressure(p_mean, s) * log * ds
+                })
+                .sum();
+            let closed = w.indentation(p_mean);
+            assert!(
+                (u0 / closed - 1.0).abs() < 1e-4,
+                "p/p* = {ratio}: {u0} vs {closed}"
+            );
+        }
     }
 
     #[test]
