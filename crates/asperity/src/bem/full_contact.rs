@@ -18,19 +18,20 @@
 //! set the pressure of full contact). On self-affine surfaces the bound is a few percent of
 //! the threshold (about 0.12 E*·h′ for an rms slope h′, measured: 512², H = 0.8, roll-off 6).
 
-use super::polonsky_keer::{ContactSolver, FullContact};
+use super::polonsky_keer::ContactSolver;
 use super::{Control, SolveError};
 use crate::elastic::Boundary;
 
-/// Where the gap closes everywhere: the mean pressure, and the indentation where it is
-/// defined (free boundaries), as [`ContactSolver::full_contact_threshold`] computes them;
-/// or bounds below them ([`ContactSolver::full_contact_lower_bound`]).
+/// Where the gap closes everywhere: the mean pressure and the indentation, as
+/// [`ContactSolver::full_contact_threshold`] computes them; or bounds below them
+/// ([`ContactSolver::full_contact_lower_bound`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FullContactThreshold {
     /// Mean pressure over the nominal area.
     pub mean_pressure: f64,
-    /// Indentation from the highest point; `None` where displacements have no reference
-    /// (periodic boundaries).
+    /// Indentation of the highest point: free boundaries `d* = max(K⁻¹f / K⁻¹1)`;
+    /// periodic boundaries, with displacements of zero mean, `max(h) − mean(h)` (see
+    /// [`Control::Indentation`]). `None` where unknown.
     pub indentation: Option<f64>,
 }
 
@@ -56,17 +57,20 @@ enum Weights {
 impl ContactSolver {
     /// The full-contact threshold of the surface: the values that
     /// [`SolveError::BeyondFullContact`] states. Periodic boundaries: `max(K⁺f)`, one
-    /// spectral pseudo-inverse. Free boundaries: two conjugate-gradient solves on the full
+    /// spectral pseudo-inverse, and the indentation `max(h) − mean(h)`. Free boundaries: two conjugate-gradient solves on the full
     /// grid (about the cost of one solve), computed once per surface; computing them uses
     /// the solver's gap buffer, so **the last solved state is forgotten** (the next solve
     /// starts cold) when they were not known yet. Call it before the first solve to keep
     /// every warm start.
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
         match self.operator.boundary() {
-            Boundary::Periodic => Ok(FullContactThreshold {
-                mean_pressure: self.periodic_threshold()?,
-                indentation: None,
-            }),
+            Boundary::Periodic => {
+                let full = self.periodic_full_contact();
+                Ok(FullContactThreshold {
+                    mean_pressure: full.mean_pressure,
+                    indentation: full.indentation,
+                })
+            }
             Boundary::Free => {
                 if self
                     .full_contact
@@ -142,22 +146,6 @@ impl ContactSolver {
             }
         }
     }
-
-    /// Periodic `p* = max(K⁺f)`, as the solver computes it before a periodic solve, cached
-    /// with the solver's own. Uses the direction buffer as scratch.
-    fn periodic_threshold(&mut self) -> Result<f64, SolveError> {
-        if let Some(full) = self.full_contact {
-            return Ok(full.mean_pressure);
-        }
-        self.operator
-            .apply_pseudo_inverse(&self.profile, &mut self.direction)?;
-        let full = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
-        self.full_contact = Some(FullContact {
-            mean_pressure: full,
-            indentation: None,
-        });
-        Ok(full)
-    }
 }
 
 #[cfg(test)]
@@ -193,7 +181,6 @@ mod tests {
             );
             match (bound.indentation, threshold.indentation) {
                 (Some(b), Some(t)) => assert!(b > 0.0 && b <= t, "{b} vs {t}"),
-                (None, None) => assert_eq!(boundary, Boundary::Periodic),
                 other => panic!("{other:?}"),
             }
             // A fresh solver refuses 10 × the threshold stating the same threshold.

@@ -8,11 +8,16 @@
 //!   highest point (first contact at `d = 0`). With the elastic displacement `u = K p`
 //!   (positive down) the gap is `g = u + f − d`, and the solution satisfies
 //!   `p ≥ 0, g ≥ 0, p·g = 0` with either the mean pressure (load control) or `d`
-//!   (displacement control) prescribed ([`Control`]).
+//!   (displacement control) prescribed ([`Control`]). A periodic half-space fixes
+//!   displacements only up to a constant: there `u` has zero mean (the `q = 0` mode of the
+//!   kernel is zero), so `d` is the approach of the highest point relative to the mean
+//!   elastic displacement, the same under load and displacement control; full contact
+//!   comes at `d = mean(f) = max(h) − mean(h)`.
 //! * **Solver**: [`ContactSolver`] — Polonsky & Keer's constrained conjugate gradients
 //!   (Wear 231, 206–219, 1999) on the FFT operator of [`crate::elastic`]. It owns the
 //!   operator, its plans and every buffer, so one solver serves many loads, and it starts
-//!   each solve from the previous pressure (warm start).
+//!   each solve from the previous pressure (warm start). Periodic displacement control is a
+//!   root find on the mean pressure over load-controlled solves (`periodic_indentation.rs`).
 //! * **Stiffness**: [`ContactSolver::frozen_set_stiffness`] — the paper's method: keep the
 //!   contact set, impose a uniform `Δd` on it, solve the linear SPD problem for the pressures
 //!   on the set (conjugate gradients), `k = ΔF/Δd`; and
@@ -27,6 +32,7 @@
 //! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
 
 mod full_contact;
+mod periodic_indentation;
 mod polonsky_keer;
 mod stiffness;
 
@@ -63,8 +69,10 @@ pub enum Control {
     MeanPressure(f64),
     /// Load control: the total force (> 0).
     Force(f64),
-    /// Displacement control: the indentation `d` from the highest point (≥ 0; free
-    /// boundaries only).
+    /// Displacement control: the indentation `d` (≥ 0) of the highest point of the surface.
+    /// Free boundaries: from first contact, the displacements vanishing far away; periodic:
+    /// relative to the mean elastic displacement (zero-mean convention, as the indentation
+    /// that load control reports), below full contact at `max(h) − mean(h)`.
     Indentation(f64),
 }
 
@@ -158,7 +166,8 @@ pub struct ContactSummary {
     pub mean_pressure: f64,
     /// Total force `Σ p Δ²`.
     pub force: f64,
-    /// Indentation `d` from the highest point of the surface.
+    /// Indentation `d` of the highest point of the surface (periodic: relative to the mean
+    /// elastic displacement, see [`Control::Indentation`]).
     pub indentation: f64,
     /// Fraction of grid points in contact (`p > 0`).
     pub area_fraction: f64,
@@ -203,7 +212,7 @@ pub enum SolveError {
         /// The threshold in the same quantity as `requested` from which the gap is closed
         /// everywhere, where known: the free-boundary indentation `d* = max(K⁻¹f / K⁻¹1)`
         /// and the load it carries, or the periodic full-contact mean pressure `max(K⁺f)`
-        /// (times the nominal area for a force).
+        /// (times the nominal area for a force) and indentation `mean(f) = max(h) − mean(h)`.
         full_contact: Option<f64>,
     },
 }

@@ -3,8 +3,9 @@
 //! solving rough contact problems based on the multi-level multi-summation and conjugate
 //! gradient techniques*, Wear 231, 206–219, 1999), on the FFT half-space operator.
 //!
-//! One iteration (load control; displacement control skips the mean subtractions and the
-//! rescaling, with `d` fixed):
+//! One iteration (load control; displacement control on free boundaries skips the mean
+//! subtractions and the rescaling, with `d` fixed; periodic displacement control is a root
+//! find on the mean pressure over load-controlled solves, see [`super::periodic_indentation`]):
 //! 1. `u = K p`; on the contact set `I_c = {p > 0}` the indentation is the mean of `u + f`,
 //!    `g = u + f − d`, `G = Σ_{I_c} g²`.
 //! 2. Direction `t = g + δ (G/G_old) t` on `I_c`, zero elsewhere (`δ = 0` after the contact
@@ -29,7 +30,7 @@ use crate::{memory, Error};
 
 /// What the Polonsky–Keer loop holds fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Target {
+pub(super) enum Target {
     MeanPressure(f64),
     Indentation(f64),
 }
@@ -44,7 +45,7 @@ pub struct ContactSolver {
     /// Indenter profile `f = max(h) − h ≥ 0`, row-major.
     pub(super) profile: Vec<f64>,
     /// rms height about the mean (1 for a flat surface), the residual's scale.
-    height_scale: f64,
+    pub(super) height_scale: f64,
     pub(super) params: SolverParams,
     pub(super) pressure: Vec<f64>,
     /// `u` during an iteration, the gap `g` after a solve.
@@ -65,8 +66,9 @@ pub struct ContactSolver {
 pub(super) struct FullContact {
     /// Mean pressure from which the gap is closed everywhere.
     pub(super) mean_pressure: f64,
-    /// Indentation from which every point is in contact (free boundaries; a periodic
-    /// half-space fixes displacements only up to their mean).
+    /// Indentation from which every point is in contact: free boundaries `d* = max(K⁻¹f /
+    /// K⁻¹1)`; periodic boundaries, with displacements of zero mean, `mean(f)` (`u = d − f`
+    /// everywhere and `mean(u) = 0`). `None` until computed.
     pub(super) indentation: Option<f64>,
 }
 
@@ -214,26 +216,27 @@ impl ContactSolver {
                     )
                     .into());
                 }
-                if self.operator.boundary() == Boundary::Periodic {
-                    return Err(Error::invalid(
-                        "indentation",
-                        "displacement control needs free boundaries: a periodic half-space \
-                         fixes displacements only up to their mean (use load control)",
-                    )
-                    .into());
-                }
                 Target::Indentation(d)
             }
         };
-        if let Target::MeanPressure(p) = target {
-            if self.operator.boundary() == Boundary::Periodic
-                && p >= self.periodic_full_contact_pressure()
-            {
+        let periodic = self.operator.boundary() == Boundary::Periodic;
+        if periodic {
+            // Exact thresholds, known before solving: the mean pressure max(K⁺f) and, with
+            // displacements of zero mean, the indentation mean(f).
+            let full = self.periodic_full_contact();
+            let beyond = match target {
+                Target::MeanPressure(p) => p >= full.mean_pressure,
+                Target::Indentation(d) => full.indentation.is_some_and(|d_full| d >= d_full),
+            };
+            if beyond {
                 self.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
         }
-        let result = self.polonsky_keer(target);
+        let result = match target {
+            Target::Indentation(d) if periodic => self.periodic_indentation(d),
+            _ => self.polonsky_keer(target, self.params.tolerance, self.params.max_iterations),
+        };
         match result {
             // Every point in contact, under load or displacement control: no contact
             // problem is left; refused with the threshold (free boundaries: only known
@@ -252,10 +255,7 @@ impl ContactSolver {
     /// the threshold in the same quantity where it is known.
     fn beyond_full_contact(&mut self, requested: Control) -> SolveError {
         let threshold = match self.operator.boundary() {
-            Boundary::Periodic => Some(FullContact {
-                mean_pressure: self.periodic_full_contact_pressure(),
-                indentation: None,
-            }),
+            Boundary::Periodic => Some(self.periodic_full_contact()),
             Boundary::Free => self.free_full_contact().ok(),
         };
         let full_contact = threshold.and_then(|t| match requested {
@@ -298,12 +298,15 @@ impl ContactSolver {
         })
     }
 
-    /// Mean pressure at which a periodic surface comes into full contact: with
-    /// `K p = d − f` everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)`
-    /// (Westergaard's `p* = π E* Δ / λ` for a sinusoid). Uses the gap and direction buffers.
-    fn periodic_full_contact_pressure(&mut self) -> f64 {
-        if let Some(full) = self.full_contact {
-            return full.mean_pressure;
+    /// Where a periodic surface comes into full contact. Mean pressure: with `K p = d − f`
+    /// everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)` (Westergaard's
+    /// `p* = π E* Δ / λ` for a sinusoid). Indentation: `K p` has zero mean, so
+    /// `d = mean(f) = max(h) − mean(h)`; below it some gap stays open (`d` is the mean of
+    /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface; uses
+    /// the direction buffer.
+    pub(super) fn periodic_full_contact(&mut self) -> FullContact {
+        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
+            return full;
         }
         if self
             .operator
@@ -311,22 +314,33 @@ impl ContactSolver {
             .is_err()
         {
             // Free boundaries have no spectral inverse (callers check the boundary).
-            return f64::INFINITY;
+            return FullContact {
+                mean_pressure: f64::INFINITY,
+                indentation: None,
+            };
         }
-        let full = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
-        self.full_contact = Some(FullContact {
-            mean_pressure: full,
-            indentation: None,
-        });
+        let mean_pressure = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
+        let indentation = self.profile.iter().sum::<f64>() / self.profile.len() as f64;
+        let full = FullContact {
+            mean_pressure,
+            indentation: Some(indentation),
+        };
+        self.full_contact = Some(full);
         full
     }
 
-    fn polonsky_keer(&mut self, target: Target) -> Result<(ContactSummary, SolveInfo), SolveError> {
+    /// The Polonsky–Keer iteration for `target` to `tolerance` in at most `max_iterations`
+    /// iterations, from the current pressure (see [`ContactSolver::solve`]).
+    pub(super) fn polonsky_keer(
+        &mut self,
+        target: Target,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let n = self.rows * self.cols;
         let load_control = matches!(target, Target::MeanPressure(_));
         let self_influence = self_influence(self.operator.spacing(), self.operator.modulus());
         self.initialise(target, self_influence);
-        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
         let mut indentation = match target {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => self.solved.map_or(0.0, |s| s.indentation),
@@ -345,10 +359,7 @@ impl ContactSolver {
                 &mut indentation,
                 if conjugate { g_old } else { 0.0 },
             );
-            let residual = ((pass.gap_squared + pass.penetration_squared)
-                / pass.contact_points.max(1) as f64)
-                .sqrt()
-                / self.height_scale;
+            let residual = pass.residual(self.height_scale);
             if residual < tolerance {
                 let info = SolveInfo {
                     iterations: iteration,
@@ -428,7 +439,7 @@ impl ContactSolver {
 
     /// Scalars of the converged state; the gap buffer is cleaned to `g ≥ 0`, zero on the
     /// contact set (its residual there is below the tolerance).
-    fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
+    pub(super) fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
         for (g, p) in self.gap.iter_mut().zip(&self.pressure) {
             *g = if *p > 0.0 { 0.0 } else { g.max(0.0) };
         }
@@ -445,19 +456,27 @@ impl ContactSolver {
 }
 
 /// Sums of passes A and B over the grid.
-struct GapPass {
-    contact_points: usize,
+pub(super) struct GapPass {
+    pub(super) contact_points: usize,
     /// `G = Σ_{p>0} g²`.
-    gap_squared: f64,
+    pub(super) gap_squared: f64,
     /// `Σ_{p=0} min(g, 0)²`.
-    penetration_squared: f64,
+    pub(super) penetration_squared: f64,
+}
+
+impl GapPass {
+    /// The residual of the module docs: `sqrt[(G + Σ_{p=0} min(g,0)²) / n_c] / h_rms`.
+    pub(super) fn residual(&self, height_scale: f64) -> f64 {
+        ((self.gap_squared + self.penetration_squared) / self.contact_points.max(1) as f64).sqrt()
+            / height_scale
+    }
 }
 
 /// Passes A and B of an iteration. `gap` holds `u = K p` on entry and `g = u + f − d` on
 /// exit. Under load control `indentation` becomes the mean of `u + f` on the contact set
 /// (summed about its previous value, so that `G` does not cancel); `t` becomes the new
 /// conjugate direction (`previous_g = 0`: steepest descent).
-fn gap_and_direction(
+pub(super) fn gap_and_direction(
     p: &[f64],
     gap: &mut [f64],
     t: &mut [f64],
@@ -1021,7 +1040,12 @@ pub(super) mod tests {
             boundary: Boundary::Periodic,
         };
         let mut solver = ContactSolver::new(&surface, periodic, SolverParams::default()).unwrap();
-        assert!(solver.solve(Control::Indentation(0.1)).is_err());
+        for control in [Control::Indentation(-0.1), Control::Indentation(f64::NAN)] {
+            assert!(
+                matches!(solver.solve(control), Err(SolveError::Input(_))),
+                "{control:?}"
+            );
+        }
         // A NaN surface cannot be built.
         let mut heights = surface.heights().clone();
         heights[[3, 4]] = f64::NAN;

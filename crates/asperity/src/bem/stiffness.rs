@@ -133,6 +133,20 @@ impl ContactSolver {
         if self.solved.is_none() {
             return Err(Error::invalid("stiffness", "no solved contact state yet").into());
         }
+        let (tolerance, max_iterations) = (
+            self.params.stiffness_tolerance,
+            self.params.stiffness_max_iterations,
+        );
+        self.set_stiffness(tolerance, max_iterations)
+    }
+
+    /// The frozen-set stiffness of the current pressure's contact set, by CG to `tolerance`
+    /// relative residual in at most `max_iterations` iterations.
+    pub(super) fn set_stiffness(
+        &mut self,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(f64, SolveInfo), SolveError> {
         let (mut x, mut residual) = self.take_stiffness_work();
         let pressure = &self.pressure;
         let result = conjugate_gradient_on_set(
@@ -143,8 +157,8 @@ impl ContactSolver {
             &mut residual,
             &mut self.direction,
             &mut self.response,
-            self.params.stiffness_tolerance,
-            self.params.stiffness_max_iterations,
+            tolerance,
+            max_iterations,
         );
         let dx = self.operator.spacing();
         let stiffness = x.iter().sum::<f64>() * dx * dx;
@@ -307,6 +321,47 @@ mod tests {
             (frozen / fd - 1.0).abs() < 0.02,
             "frozen {frozen} vs fd {fd}"
         );
+    }
+
+    #[test]
+    fn periodic_frozen_set_under_displacement_control_matches_finite_difference() {
+        // Periodic displacement control (zero-mean displacements): the frozen-set k after a
+        // solve at d equals dF/dd from two more displacement-controlled solves at d(1 ± 1e-3)
+        // (Barber), on even, odd and non-square grids; d is the indentation of light and
+        // moderate loads (p̄/p* = 0.01 and 0.1, where d/mean(f) ≈ 0.6 and 0.9).
+        for (rows, cols) in GRIDS {
+            let surface = rough_grid(rows, cols, 14);
+            let periodic = half_space(Boundary::Periodic);
+            let mut load = ContactSolver::new(&surface, periodic, SolverParams::default()).unwrap();
+            let p_star = match load.solve(Control::MeanPressure(1e6)) {
+                Err(SolveError::BeyondFullContact {
+                    full_contact: Some(p),
+                    ..
+                }) => p,
+                other => panic!("expected BeyondFullContact, got {other:?}"),
+            };
+            for ratio in [0.01, 0.1] {
+                let (s, _) = load.solve(Control::MeanPressure(ratio * p_star)).unwrap();
+                let d = s.indentation;
+                let mut solver =
+                    ContactSolver::new(&surface, periodic, SolverParams::default()).unwrap();
+                solver.solve(Control::Indentation(d)).unwrap();
+                let (frozen, info) = solver.frozen_set_stiffness().unwrap();
+                assert!(info.residual <= 1e-10);
+                let fd = solver
+                    .finite_difference_stiffness(Control::Indentation(d), 1e-3)
+                    .unwrap();
+                let error = frozen / fd - 1.0;
+                eprintln!(
+                    "periodic displacement control {rows}x{cols}, p/p* = {ratio}: frozen \
+                     {frozen:.6e}, fd {fd:.6e}, error {error:.2e}"
+                );
+                assert!(
+                    error.abs() < 0.02,
+                    "{rows}x{cols} p/p* = {ratio}: frozen {frozen} vs fd {fd}"
+                );
+            }
+        }
     }
 
     #[test]
