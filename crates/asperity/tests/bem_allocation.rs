@@ -133,6 +133,19 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
             assert!(matches!(result, Err(SolveError::BeyondFullContact { .. })));
             eprintln!("{boundary:?}: refused load: {allocations} allocations, {bytes} bytes");
             assert_eq!(allocations, 0, "{boundary:?}: {bytes} bytes");
+
+            // Displacement control (periodic: a root find over load-controlled solves with
+            // frozen-set slopes) works in the same buffers.
+            let (state, _) = solver.solve(Control::MeanPressure(pressure)).unwrap();
+            let indentation = Control::Indentation(0.98 * state.indentation);
+            let (result, allocations, bytes) = count(|| solver.solve(indentation));
+            let (_, info) = result.unwrap();
+            eprintln!(
+                "{boundary:?}: displacement control, {} iterations: {allocations} \
+                 allocations, {bytes} bytes",
+                info.iterations
+            );
+            assert_eq!(allocations, 0, "{boundary:?}: {bytes} bytes");
         }
     });
 }
