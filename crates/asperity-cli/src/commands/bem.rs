@@ -67,7 +67,10 @@ pub struct BemArgs {
         value_name = "P1,P2,…"
     )]
     pub pressures: Option<Vec<f64>>,
-    /// Indentations from the highest point (displacement control, free boundaries).
+    /// Indentations (displacement control), comma separated. Free boundaries: from the
+    /// highest point of the surface (first contact at 0); periodic: relative to the mean
+    /// elastic displacement (zero-mean convention, as load control reports it; full contact
+    /// at max(h) − mean(h)).
     #[arg(
         long,
         value_delimiter = ',',
@@ -477,10 +480,6 @@ pub fn run(args: &BemArgs) -> Result<()> {
     // 1. Everything that can be checked before solving.
     let boundary: Boundary = args.boundary.parse()?;
     let loads = controls(args)?;
-    if boundary == Boundary::Periodic && loads.iter().any(|c| matches!(c, Control::Indentation(_)))
-    {
-        bail!("--indentations needs --boundary free: a periodic half-space fixes displacements only up to their mean (use --pressures or --forces)");
-    }
     if !(args.modulus.is_finite() && args.modulus > 0.0) {
         bail!(
             "--modulus must be positive and finite, got {}",
