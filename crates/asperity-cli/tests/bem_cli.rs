@@ -279,7 +279,7 @@ fn bad_input_is_one_line_exit_2_and_nothing_written() {
                 "--indentations",
                 "0.1",
             ],
-            "free",
+            "indentation 1.000000e-1 is beyond full contact (the gap closes everywhere from an indentation of",
         ),
         (
             vec![
