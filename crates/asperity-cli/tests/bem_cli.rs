@@ -1101,3 +1101,83 @@ fn bad_numbers_name_their_flag() {
         );
     }
 }
+
+#[test]
+fn periodic_indentations_agree_with_load_control() {
+    // Periodic displacement control measures d relative to the mean elastic displacement,
+    // as load control reports it: the indentations of a load-controlled run, given back
+    // with --indentations, reproduce its pressures, areas and stiffnesses.
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let loads = dir.path().join("loads.csv");
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--boundary",
+        "periodic",
+        "--pressures",
+        "0.01,0.05",
+        "--out",
+        loads.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (header, by_load) = read_csv(&loads);
+    let d = column(&header, "indentation");
+    let indentations = by_load
+        .iter()
+        .map(|row| format!("{:e}", row[d]))
+        .collect::<Vec<_>>()
+        .join(",");
+    let displacements = dir.path().join("displacements.csv");
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--boundary",
+        "periodic",
+        "--indentations",
+        &indentations,
+        "--out",
+        displacements.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (header_d, by_indentation) = read_csv(&displacements);
+    assert_eq!(header_d, header);
+    assert_eq!(by_indentation.len(), 2);
+    for (l, i) in by_load.iter().zip(&by_indentation) {
+        assert_eq!(i[d], l[d]);
+        for name in ["force", "mean_pressure", "stiffness"] {
+            let c = column(&header, name);
+            assert!(
+                (i[c] / l[c] - 1.0).abs() < 1e-6,
+                "{name}: {} vs {}",
+                i[c],
+                l[c]
+            );
+        }
+        let area = column(&header, "area_fraction");
+        assert_eq!(i[area], l[area]);
+        assert!(i[column(&header, "residual")] < 1e-8);
+    }
+    // At and beyond full contact, d = max(h) − mean(h), refused in terms of the indentation.
+    let heights: Array2<f64> = read_npy(s).unwrap();
+    let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+    let full = top - heights.mean().unwrap();
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s,
+        "--boundary",
+        "periodic",
+        "--indentations",
+        &format!("{:e}", 1.01 * full),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains("is beyond full contact (the gap closes everywhere from an indentation of"),
+        "{err}"
+    );
+}
