@@ -500,7 +500,7 @@ fn help_has_examples() {
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Examples:") && text.contains("--nloads") && text.contains("--fields"));
-    assert!(text.contains("--out curve.csv --plot curve.png"), "{text}");
+    assert!(text.contains("--out sweep.csv --plot sweep.png"), "{text}");
 }
 
 /// Width and height of a PNG file, decoded.

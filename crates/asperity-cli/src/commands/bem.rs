@@ -30,9 +30,10 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --pressures 0.01,0.05 --fields fields/ --out loads.csv\n  \
     asperity bem --surface s.npy --boundary periodic --forces 0.02 --tol 1e-10\n  \
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
-    asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out curve.csv --plot curve.png\n\n\
+    asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
-(stiffness by the frozen contact set; indentation measured from the highest point); then\n\
+(stiffness by the frozen contact set; indentation from the highest point, or with\n\
+periodic boundaries relative to the mean elastic displacement); then\n\
 stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_seconds, peak_rss_mib with\n\
 --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
