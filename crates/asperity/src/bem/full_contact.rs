@@ -64,13 +64,7 @@ impl ContactSolver {
     /// every warm start.
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
         match self.operator.boundary() {
-            Boundary::Periodic => {
-                let full = self.periodic_full_contact();
-                Ok(FullContactThreshold {
-                    mean_pressure: full.mean_pressure,
-                    indentation: full.indentation,
-                })
-            }
+            Boundary::Periodic => Ok(self.periodic_full_contact()),
             Boundary::Free => {
                 if self
                     .full_contact
@@ -79,11 +73,7 @@ impl ContactSolver {
                 {
                     self.solved = None;
                 }
-                let full = self.free_full_contact()?;
-                Ok(FullContactThreshold {
-                    mean_pressure: full.mean_pressure,
-                    indentation: full.indentation,
-                })
+                self.free_full_contact()
             }
         }
     }

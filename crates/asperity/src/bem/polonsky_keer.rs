@@ -21,6 +21,7 @@
 
 use ndarray::{Array2, ArrayView2};
 
+use super::full_contact::FullContactThreshold;
 use super::{
     ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverParams,
 };
@@ -56,20 +57,9 @@ pub struct ContactSolver {
     pub(super) solved: Option<ContactSummary>,
     /// Where the surface comes into full contact (computed once per surface, when first
     /// needed).
-    pub(super) full_contact: Option<FullContact>,
+    pub(super) full_contact: Option<FullContactThreshold>,
     /// Two extra fields for the frozen-set CG, allocated on first use.
     pub(super) stiffness_work: Option<(Vec<f64>, Vec<f64>)>,
-}
-
-/// The full-contact threshold of a surface.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct FullContact {
-    /// Mean pressure from which the gap is closed everywhere.
-    pub(super) mean_pressure: f64,
-    /// Indentation from which every point is in contact: free boundaries `d* = max(K⁻¹f /
-    /// K⁻¹1)`; periodic boundaries, with displacements of zero mean, `mean(f)` (`u = d − f`
-    /// everywhere and `mean(u) = 0`). `None` until computed.
-    pub(super) indentation: Option<f64>,
 }
 
 /// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
@@ -304,7 +294,7 @@ impl ContactSolver {
     /// `d = mean(f) = max(h) − mean(h)`; below it some gap stays open (`d` is the mean of
     /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface; uses
     /// the direction buffer.
-    pub(super) fn periodic_full_contact(&mut self) -> FullContact {
+    pub(super) fn periodic_full_contact(&mut self) -> FullContactThreshold {
         if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
             return full;
         }
@@ -314,14 +304,14 @@ impl ContactSolver {
             .is_err()
         {
             // Free boundaries have no spectral inverse (callers check the boundary).
-            return FullContact {
+            return FullContactThreshold {
                 mean_pressure: f64::INFINITY,
                 indentation: None,
             };
         }
         let mean_pressure = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
         let indentation = self.profile.iter().sum::<f64>() / self.profile.len() as f64;
-        let full = FullContact {
+        let full = FullContactThreshold {
             mean_pressure,
             indentation: Some(indentation),
         };

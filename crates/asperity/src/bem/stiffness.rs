@@ -18,7 +18,8 @@
 //! Neither allocates after the first call: the set is tested inline (`p > 0`), and the CG
 //! works in the solver's buffers.
 
-use super::polonsky_keer::{ContactSolver, FullContact};
+use super::full_contact::FullContactThreshold;
+use super::polonsky_keer::ContactSolver;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::Error;
@@ -194,7 +195,7 @@ impl ContactSolver {
     /// contact (two CG solves on the full grid, see the module docs); computed once per
     /// surface. Uses the gap buffer as scratch: call it only when the state is discarded
     /// (a solve that ended in full contact).
-    pub(super) fn free_full_contact(&mut self) -> Result<FullContact, SolveError> {
+    pub(super) fn free_full_contact(&mut self) -> Result<FullContactThreshold, SolveError> {
         if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
             return Ok(full);
         }
@@ -235,7 +236,7 @@ impl ContactSolver {
                 .clone()
                 .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
             let mean_pressure = q_y.map(|(q, y)| indentation * q - y).sum::<f64>() / n as f64;
-            FullContact {
+            FullContactThreshold {
                 mean_pressure,
                 indentation: Some(indentation),
             }
