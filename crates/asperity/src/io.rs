@@ -81,6 +81,14 @@ pub fn sidecar_path(path: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// The side length `spec.size` recorded in the JSON sidecar of `path`, if there is a
+/// readable one (surfaces and lines written by asperity have it).
+pub fn sidecar_size(path: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(sidecar_path(path)).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value["spec"]["size"].as_f64()
+}
+
 fn bad_output(path: &Path, reason: impl Into<String>) -> Error {
     Error::BadOutput {
         path: path.to_path_buf(),
@@ -218,18 +226,30 @@ impl StagedOutputs {
     }
 
     /// Fails with [`Error::BadOutput`] if an output is the file `input` (which the command
-    /// reads): overwriting it would lose the data the output was computed from.
+    /// reads) or its JSON sidecar (read for the side length and the generating
+    /// parameters): overwriting either would lose what the output was computed from.
     pub fn ensure_not_input(&self, input: &Path) -> Result<()> {
-        let Ok(input_key) = std::fs::canonicalize(input) else {
-            return Ok(()); // a missing input is reported by whoever reads it
-        };
-        match self.entries.iter().find(|e| e.key == input_key) {
-            Some(e) => Err(bad_output(
-                &e.target,
-                format!("is the input file {}", input.display()),
-            )),
-            None => Ok(()),
+        let sidecar = sidecar_path(input);
+        for (file, reason) in [
+            (input, format!("is the input file {}", input.display())),
+            (
+                sidecar.as_path(),
+                format!(
+                    "is the sidecar {} of the input {} (its size and generating parameters); \
+                     choose another output name",
+                    sidecar.display(),
+                    input.display()
+                ),
+            ),
+        ] {
+            let Ok(key) = std::fs::canonicalize(file) else {
+                continue; // a missing input is reported by whoever reads it
+            };
+            if let Some(e) = self.entries.iter().find(|e| e.key == key) {
+                return Err(bad_output(&e.target, reason));
+            }
         }
+        Ok(())
     }
 
     /// The declared outputs, in order.
@@ -419,9 +439,7 @@ pub fn atomic_write<F>(path: &Path, force: bool, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<()>,
 {
-    let mut staged = StagedOutputs::new([path], force)?;
-    staged.write_with(path, write)?;
-    staged.commit()
+    write_one(path, force, |s| s.write_with(path, write))
 }
 
 /// Stages one output with `write` and commits it.

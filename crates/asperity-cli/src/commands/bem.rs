@@ -217,13 +217,6 @@ fn controls(args: &BemArgs) -> Result<Vec<Control>> {
         .collect())
 }
 
-/// Side length from the surface's JSON sidecar, if there is one.
-fn sidecar_size(file: &Path) -> Option<f64> {
-    let text = std::fs::read_to_string(sidecar_path(file)).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-    value["spec"]["size"].as_f64()
-}
-
 /// Peak resident memory of this process (MiB), from /proc/self/status (Linux).
 fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -278,25 +271,6 @@ fn ensure_no_stale_fields(dir: &Path, count: usize) -> Result<()> {
             "--fields {}: holds {first}{more} from an earlier run, which this run ({count} load{}) would not replace; use another folder (or remove the old field files)",
             dir.display(),
             if count == 1 { "" } else { "s" }
-        );
-    }
-    Ok(())
-}
-
-/// Refuses an output that is the JSON sidecar of `input` (it holds the input's L and
-/// generating parameters), one line naming it.
-pub(crate) fn ensure_not_sidecar(staged: &StagedOutputs, input: &Path) -> Result<()> {
-    let sidecar = sidecar_path(input);
-    if staged.ensure_not_input(&sidecar).is_err() {
-        let output = staged
-            .paths()
-            .find(|p| std::fs::canonicalize(p).ok() == std::fs::canonicalize(&sidecar).ok())
-            .unwrap_or(&sidecar);
-        bail!(
-            "{}: is the sidecar {} of the input {} (its size and generating parameters); choose another output name",
-            output.display(),
-            sidecar.display(),
-            input.display()
         );
     }
     Ok(())
@@ -533,7 +507,6 @@ pub fn run(args: &BemArgs) -> Result<()> {
         .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
     let mut staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
-    ensure_not_sidecar(&staged, &args.surface)?;
     // Memory, from the file's header before its data is read: the solver plus the heights,
     // alive while the solver is built (the fields go to files as they are solved), plus the
     // per-load bookkeeping.
@@ -552,7 +525,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
             bytes,
         )?;
     }
-    let (size, size_source) = match (args.size, sidecar_size(&args.surface)) {
+    let (size, size_source) = match (args.size, asperity::io::sidecar_size(&args.surface)) {
         (Some(size), _) => (size, SizeSource::Flag),
         (None, Some(size)) => (size, SizeSource::Sidecar),
         (None, None) => (1.0, SizeSource::Default),

@@ -2,10 +2,10 @@
 //! indenter on the MDR spring foundation (linear, Hertz 15.2 or fractal 15.7 springs).
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use asperity::io::{read_npy_1d, sidecar_path, StagedOutputs};
+use asperity::io::{read_npy_1d, StagedOutputs};
 use asperity::mdr::{
     log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
@@ -141,13 +141,6 @@ pub struct MdrArgs {
     pub force: bool,
 }
 
-/// The line length recorded in a line's sidecar, if any.
-fn sidecar_size(file: &Path) -> Option<f64> {
-    let text = std::fs::read_to_string(sidecar_path(file)).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-    value["spec"]["size"].as_f64()
-}
-
 fn need(value: Option<f64>, flag: &str, what: &str) -> Result<f64> {
     value.with_context(|| format!("{what} needs {flag}"))
 }
@@ -205,7 +198,10 @@ fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
 fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
     if let Some(path) = &args.line {
         let heights = read_npy_1d(path)?.to_vec();
-        let size = args.size.or_else(|| sidecar_size(path)).unwrap_or(1.0);
+        let size = args
+            .size
+            .or_else(|| asperity::io::sidecar_size(path))
+            .unwrap_or(1.0);
         if !(size.is_finite() && size > 0.0) {
             bail!("invalid size: the line length must be positive and finite, got {size}");
         }

@@ -98,13 +98,13 @@ fn may_overwrite(dir: &std::path::Path, stamp: &FolderStamp, force: bool) -> any
 
 const STAMP: &str = "reproduce.json";
 
+/// Runs one figure; `force` lets it write over files in its folder ([`may_overwrite`]).
 fn run_one(figure: Figure, out: &std::path::Path, quick: bool, force: bool) -> anyhow::Result<()> {
     let dir = out.join(figure.folder());
     let stamp = FolderStamp {
         figure: figure.folder().to_string(),
         quick,
     };
-    let force = may_overwrite(&dir, &stamp, force)?;
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     let start = std::time::Instant::now();
@@ -141,15 +141,18 @@ pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
         one => vec![one],
     };
     // Every folder is checked before the first figure starts: a refusal loses no work.
-    for &figure in &figures {
-        let stamp = FolderStamp {
-            figure: figure.folder().to_string(),
-            quick: args.quick,
-        };
-        may_overwrite(&args.out.join(figure.folder()), &stamp, args.force)?;
-    }
-    for figure in figures {
-        run_one(figure, &args.out, args.quick, args.force)?;
+    let overwrite = figures
+        .iter()
+        .map(|figure| {
+            let stamp = FolderStamp {
+                figure: figure.folder().to_string(),
+                quick: args.quick,
+            };
+            may_overwrite(&args.out.join(figure.folder()), &stamp, args.force)
+        })
+        .collect::<anyhow::Result<Vec<bool>>>()?;
+    for (figure, force) in figures.into_iter().zip(overwrite) {
+        run_one(figure, &args.out, args.quick, force)?;
     }
     Ok(())
 }

@@ -262,7 +262,6 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
     let staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
     staged.ensure_not_input(&args.file)?;
-    crate::commands::bem::ensure_not_sidecar(&staged, &args.file)?;
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
     // the file, checked from the header before the data are read.
     let shape = read_npy_shape(&args.file)?;
