@@ -93,6 +93,7 @@ pub mod reference;
 pub mod spectrum;
 pub mod study;
 pub mod surface;
+pub mod topography;
 
 pub use error::{ensure_finite, Error, Result};
 
