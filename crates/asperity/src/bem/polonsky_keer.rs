@@ -96,6 +96,17 @@ impl ContactSolver {
         params: SolverParams,
     ) -> Result<Self, SolveError> {
         validate_params(&params)?;
+        if !surface.has_square_pixels() {
+            return Err(Error::invalid(
+                "surface",
+                format!(
+                    "the BEM needs square pixels for now, got {:.3e} x {:.3e}",
+                    surface.spacing(),
+                    surface.spacing_y()
+                ),
+            )
+            .into());
+        }
         let (rows, cols) = surface.dim();
         memory::ensure_fits(
             &format!(
@@ -135,7 +146,10 @@ impl ContactSolver {
     /// plans, kernel spectrum) and all buffers: how an ensemble solves many realisations.
     /// The next solve starts cold, exactly as with a new solver.
     pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
-        if surface.dim() != (self.rows, self.cols) || surface.spacing() != self.operator.spacing() {
+        if surface.dim() != (self.rows, self.cols)
+            || surface.spacing() != self.operator.spacing()
+            || !surface.has_square_pixels()
+        {
             return Err(Error::invalid(
                 "surface",
                 format!(

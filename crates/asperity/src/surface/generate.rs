@@ -141,9 +141,11 @@ impl SurfaceGenerator {
         let mut heights = ndarray::Array2::zeros((self.spec.rows, self.spec.cols));
         self.generate_into(seed, heights.as_slice_mut().expect("standard layout"))
             .expect("a validated spec has power on its grid");
+        let size_y = self.spec.size * self.spec.rows as f64 / self.spec.cols as f64;
         Surface {
             heights,
             size: self.spec.size,
+            size_y,
         }
     }
 
@@ -155,9 +157,11 @@ impl SurfaceGenerator {
         self.generate_into(seed, &mut heights)?;
         let heights = ndarray::Array2::from_shape_vec((rows, cols), heights)
             .map_err(|e| Error::invalid("grid", e.to_string()))?;
+        let size_y = self.spec.size * rows as f64 / cols as f64;
         Ok(Surface {
             heights,
             size: self.spec.size,
+            size_y,
         })
     }
 

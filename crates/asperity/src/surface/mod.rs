@@ -100,11 +100,13 @@ pub(crate) fn validate_spectrum_on_grid(psd: &crate::spectrum::Psd, nyquist: f64
     Ok(())
 }
 
-/// A rough surface: heights on a grid of square pixels (see the module docs for layout).
+/// A rough surface: heights on a grid of pixels `Δx = size_x / cols` by `Δy = size_y / rows`
+/// (see the module docs for layout); square unless made by [`Surface::with_sizes`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Surface {
     heights: Array2<f64>,
     size: f64,
+    size_y: f64,
 }
 
 impl Surface {
@@ -122,7 +124,37 @@ impl Surface {
             ));
         }
         crate::ensure_finite("surface", heights.iter())?;
-        Ok(Surface { heights, size })
+        let size_y = size * heights.nrows() as f64 / heights.ncols() as f64;
+        Ok(Surface {
+            heights,
+            size,
+            size_y,
+        })
+    }
+
+    /// Wraps heights with the physical sizes along x (columns) and y (rows), for pixels
+    /// that need not be square (measured topographies); the checks of [`Surface::new`].
+    pub fn with_sizes(heights: Array2<f64>, size_x: f64, size_y: f64) -> Result<Self> {
+        validate_size(size_y)?;
+        let mut surface = Surface::new(heights, size_x)?;
+        surface.size_y = size_y;
+        Ok(surface)
+    }
+
+    /// Side length along y (rows).
+    pub fn size_y(&self) -> f64 {
+        self.size_y
+    }
+
+    /// Pixel spacing along y, `size_y / rows`.
+    pub fn spacing_y(&self) -> f64 {
+        self.size_y / self.heights.nrows() as f64
+    }
+
+    /// Whether `Δx = Δy` to rounding (relative 1e-12).
+    pub fn has_square_pixels(&self) -> bool {
+        let (dx, dy) = (self.spacing(), self.spacing_y());
+        (dx - dy).abs() <= 1e-12 * dx.max(dy)
     }
 
     /// Heights, `rows × cols`.
@@ -135,12 +167,12 @@ impl Surface {
         self.heights
     }
 
-    /// Side length along x (columns).
+    /// Side length along x (columns), `size_x`.
     pub fn size(&self) -> f64 {
         self.size
     }
 
-    /// Pixel spacing `size / cols`.
+    /// Pixel spacing along x, `size / cols` (`Δx`).
     pub fn spacing(&self) -> f64 {
         self.size / self.heights.ncols() as f64
     }
