@@ -143,9 +143,23 @@ class _Progress:
 
 
 def _plain_progress(description: str) -> Callable[[int, int], None]:
+    """Progress on stderr without tqdm: one line rewritten in place on a terminal, else a
+    line at most every 5 s and at the end."""
+    import time
+
+    tty = sys.stderr.isatty()
+    last = [float("-inf")]
+
     def report(done: int, total: int) -> None:
-        end = "\n" if done >= total else ""
-        print(f"\r{description}: {done}/{total}", end=end, file=sys.stderr, flush=True)
+        now = time.monotonic()
+        if done < total and (now - last[0] < (0.1 if tty else 5.0)):
+            return
+        last[0] = now
+        text = f"{description}: {done}/{total}"
+        if tty:
+            print("\r" + text, end="\n" if done >= total else "", file=sys.stderr, flush=True)
+        else:
+            print(text, file=sys.stderr, flush=True)
 
     return report
 
