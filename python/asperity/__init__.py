@@ -511,8 +511,10 @@ class Solver:
         fields: bool = True,
     ) -> ContactResult:
         """Solves the contact under one load: a mean ``pressure`` or total ``force`` (load
-        control, > 0) or an ``indentation`` (displacement control, ≥ 0). A load beyond
-        full contact raises :class:`BeyondFullContactError` before solving.
+        control, > 0) or an ``indentation`` (displacement control, ≥ 0), warm-started from
+        the last solve. A load beyond full contact raises :class:`BeyondFullContactError`
+        (periodic boundaries: before solving; free: once the solve finds every point in
+        contact). The solve is exactly the library's ``ContactSolver::solve``.
         ``fields=False`` skips the copies of the fields (and the displacement's one
         operator application).
 
