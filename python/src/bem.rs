@@ -387,8 +387,7 @@ impl Solver {
     /// Frozen-set stiffness of the last solve: `(k, iterations, residual)`.
     fn stiffness(&mut self, py: Python<'_>) -> PyResult<(f64, usize, f64)> {
         let solver = &mut self.solver;
-        let (k, info) =
-            run_detached(py, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
+        let (k, info) = run_detached(py, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
         Ok((k, info.iterations, info.residual))
     }
 
@@ -402,8 +401,7 @@ impl Solver {
     ) -> PyResult<f64> {
         let control = control(quantity, value)?;
         let solver = &mut self.solver;
-        run_detached(py, |_| solver.finite_difference_stiffness(control, step))?
-            .map_err(from_solve)
+        run_detached(py, |_| solver.finite_difference_stiffness(control, step))?.map_err(from_solve)
     }
 
     /// A load sweep as `asperity bem` runs it (module docs); returns the columns.
@@ -425,7 +423,15 @@ impl Solver {
             .collect::<PyResult<Vec<_>>>()?;
         let solver = &mut self.solver;
         let columns = run_detached(py, |cancel| {
-            sweep_loads(solver, &loads, stiffness, fd_step, fields, progress.as_ref(), cancel)
+            sweep_loads(
+                solver,
+                &loads,
+                stiffness,
+                fd_step,
+                fields,
+                progress.as_ref(),
+                cancel,
+            )
         })?
         .map_err(Stop::into_py)?;
         columns_dict(py, columns, stiffness, fd_step.is_some(), fields)

@@ -22,7 +22,10 @@ use pyo3::prelude::*;
 fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("ConvergenceError", py.get_type::<errors::ConvergenceError>())?;
+    m.add(
+        "ConvergenceError",
+        py.get_type::<errors::ConvergenceError>(),
+    )?;
     m.add(
         "BeyondFullContactError",
         py.get_type::<errors::BeyondFullContactError>(),

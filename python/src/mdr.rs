@@ -8,8 +8,7 @@
 //! (`Foundation::evaluate`, `LinearCurve::breakpoint`), so the numbers are the CLI's.
 
 use asperity::mdr::{
-    log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring,
-    SpringLaw,
+    log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::rms_height as rms_of;
@@ -170,11 +169,7 @@ fn spring_law(
             let radius = match (asperity_radius, o.profile.as_deref()) {
                 (Some(r), _) => r,
                 (None, Some("hertz")) => need(o.radius, "radius", "profile 'hertz'")?,
-                _ => {
-                    return Err(invalid(
-                        "the hertz spring law (15.2) needs asperity_radius",
-                    ))
-                }
+                _ => return Err(invalid("the hertz spring law (15.2) needs asperity_radius")),
             };
             SpringLaw::Hertz { radius }
         }
@@ -316,7 +311,9 @@ fn mdr_curve<'py>(
         }
         .map_err(from_error)?;
         let levels = indentation_levels(indentations, nloads, dmin, dmax, &foundation)?;
-        run_detached(py, |_| levels.iter().map(|&d| foundation.evaluate(d)).collect())?
+        run_detached(py, |_| {
+            levels.iter().map(|&d| foundation.evaluate(d)).collect()
+        })?
     };
     let dict = PyDict::new(py);
     let column = |f: &dyn Fn(&CurvePoint) -> f64| PyArray1::from_iter(py, points.iter().map(f));

@@ -122,8 +122,10 @@ fn run_study(
     let store = StudyDir::open(&out, &spec, force)
         .map_err(from_error)?
         .with_checkpoint_interval(Duration::from_secs_f64(checkpoint_every));
-    let results = run_detached(py, |cancel| run_tasks(&spec, &store, progress.as_ref(), cancel))?
-        .map_err(from_error)?;
+    let results = run_detached(py, |cancel| {
+        run_tasks(&spec, &store, progress.as_ref(), cancel)
+    })?
+    .map_err(from_error)?;
     let records: Vec<serde_json::Value> = results
         .iter()
         .map(|r| {
@@ -152,13 +154,32 @@ fn run_tasks(
         let offset = i * spec.samples;
         let report = |done: usize, _: usize| cancel.call(progress, offset + done, total);
         let result = match spec.method {
-            Method::Bem => run_one(spec, task, BemSampler::new(spec, task)?, store, &report, cancel),
-            Method::Mdr => run_one(spec, task, MdrSampler::new(spec, task)?, store, &report, cancel),
+            Method::Bem => run_one(
+                spec,
+                task,
+                BemSampler::new(spec, task)?,
+                store,
+                &report,
+                cancel,
+            ),
+            Method::Mdr => run_one(
+                spec,
+                task,
+                MdrSampler::new(spec, task)?,
+                store,
+                &report,
+                cancel,
+            ),
         };
         let result = result.map_err(|e| match e {
             // The CLI's context: `mdr N = 512 H = 0.5: ...`.
             Error::Solve { context, source } => Error::Solve {
-                context: format!("{} N = {} H = {}: {context}", spec.method.name(), task.n, task.hurst),
+                context: format!(
+                    "{} N = {} H = {}: {context}",
+                    spec.method.name(),
+                    task.n,
+                    task.hurst
+                ),
                 source,
             },
             other => other,

@@ -54,7 +54,13 @@ fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> PyResult<No
 }
 
 /// The sidecar the CLI writes beside its .npy, as JSON text.
-fn sidecar(kind: &str, shape: &[usize], seed: u64, spec: serde_json::Value, stats: &Summary) -> String {
+fn sidecar(
+    kind: &str,
+    shape: &[usize],
+    seed: u64,
+    spec: serde_json::Value,
+    stats: &Summary,
+) -> String {
     json!({
         "kind": kind,
         "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
@@ -83,7 +89,8 @@ fn generate_surface<'py>(
     size: f64,
     seed: u64,
 ) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, String)> {
-    let psd = Psd::new(hurst, long_wavelength(rolloff, cutoff)?, short_cutoff).map_err(from_error)?;
+    let psd =
+        Psd::new(hurst, long_wavelength(rolloff, cutoff)?, short_cutoff).map_err(from_error)?;
     let rows = m.unwrap_or(n);
     let spec = SurfaceSpec::new(rows, n, size, psd, normalisation(rms_height, rms_slope)?)
         .map_err(from_error)?;
@@ -113,8 +120,8 @@ fn generate_line<'py>(
     seed: u64,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, String)> {
     let psd = Psd::new(hurst, long_wavelength(rolloff, cutoff)?, None).map_err(from_error)?;
-    let spec = LineSpec::new(n, size, psd, normalisation(rms_height, rms_slope)?)
-        .map_err(from_error)?;
+    let spec =
+        LineSpec::new(n, size, psd, normalisation(rms_height, rms_slope)?).map_err(from_error)?;
     let line = run_detached(py, |_| {
         LineGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
     })?
@@ -218,8 +225,11 @@ fn fit_power_law<'py>(
     y: PyReadonlyArray1<'_, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (x, y) = (owned_1d(&x), owned_1d(&y));
-    let fit = power_law_fit(x.as_slice().expect("contiguous"), y.as_slice().expect("contiguous"))
-        .map_err(from_error)?;
+    let fit = power_law_fit(
+        x.as_slice().expect("contiguous"),
+        y.as_slice().expect("contiguous"),
+    )
+    .map_err(from_error)?;
     let dict = PyDict::new(py);
     dict.set_item("exponent", fit.exponent)?;
     dict.set_item("prefactor", fit.prefactor)?;

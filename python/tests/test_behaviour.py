@@ -238,31 +238,38 @@ solvers = [asperity.Solver(s) for _ in range(2)]
 def job(solver):
     solver.reset()
     solver.sweep(pressures=[0.002, 0.005, 0.01, 0.02, 0.05])
-job(solvers[0])  # warm up
-one = min(_t for _t in [(lambda t0: (job(solvers[0]), time.perf_counter() - t0)[1])(time.perf_counter()) for _ in range(2)])
-best = float('inf')
-for _ in range(2):
+job(solvers[0]); job(solvers[1])  # warm up
+serial, parallel = float('inf'), float('inf')
+for _ in range(3):
+    t0 = time.perf_counter()
+    job(solvers[0]); job(solvers[1])
+    serial = min(serial, time.perf_counter() - t0)
     threads = [threading.Thread(target=job, args=(sv,)) for sv in solvers]
     t0 = time.perf_counter()
     [t.start() for t in threads]; [t.join() for t in threads]
-    best = min(best, time.perf_counter() - t0)
-print(one, best)
+    parallel = min(parallel, time.perf_counter() - t0)
+print(serial, parallel)
 """
 
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs 2 cores")
 def test_two_solves_in_two_threads_take_about_the_time_of_one():
-    """With one library thread per solve (RAYON_NUM_THREADS=1), two threads on 2 cores
-    finish in about the time of one when the GIL is released, and take twice as long when
-    it is held. The bound (1.6x) is generous: the test machine is shared with other builds,
-    which steal a core now and then; a held GIL would give 2x or more."""
+    """With one library thread per solve (RAYON_NUM_THREADS=1), two sweeps in two threads
+    on 2 cores take about the time of one when the GIL is released (ratio ≈ 0.5 to the
+    same two sweeps run one after the other), and at least as long as the serial run when it
+    is held (ratio ≥ 1: the threads take turns). Serial and parallel runs alternate, minimum
+    of 3 each, so that a change in the machine's load hits both. The bound 0.9 is generous
+    because the test machine is shared with other builds, which take the second core now
+    and then (measured: 0.58 at load average 4, 0.74 at load average 7.5 on 2 cores);
+    test_the_gil_is_released_during_a_solve shows the release independently of load."""
     env = dict(os.environ, RAYON_NUM_THREADS="1")
     out = subprocess.run([sys.executable, "-c", GIL_TIMING], env=env, capture_output=True,
                          text=True, cwd="/")
     assert out.returncode == 0, out.stderr
-    one, two = map(float, out.stdout.split())
-    print(f"one sweep {one:.3f} s, two in parallel {two:.3f} s, ratio {two / one:.2f}")
-    assert two < 1.6 * one, f"one {one:.3f} s, two threads {two:.3f} s"
+    serial, parallel = map(float, out.stdout.split())
+    print(f"two sweeps one after the other {serial:.3f} s, in two threads {parallel:.3f} s, "
+          f"ratio {parallel / serial:.2f}")
+    assert parallel < 0.9 * serial, f"serial {serial:.3f} s, two threads {parallel:.3f} s"
 
 
 def test_ctrl_c_stops_a_sweep_between_loads(tmp_path):
