@@ -296,6 +296,7 @@ print("finished")
     elapsed = time.monotonic() - start
     assert code == 130 and "KeyboardInterrupt" in process.stdout.read()
     # One warm 256² load takes well under a second; allow for the loaded machine.
+    print(f"sweep stopped {elapsed:.3f} s after SIGINT")
     assert elapsed < 3.0, f"took {elapsed:.2f} s to stop"
 
 

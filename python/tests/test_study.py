@@ -129,6 +129,7 @@ print("finished", flush=True)
     assert code == 130 and "KeyboardInterrupt" in out, (code, out, process.stderr.read())
     # One BEM sample of 64² (24 solves) takes about 0.1-0.3 s; the samples in flight finish
     # first. A few seconds allow for the loaded test machine.
+    print(f"study stopped {elapsed:.3f} s after SIGINT")
     assert elapsed < 5.0, f"took {elapsed:.2f} s to stop"
     assert (folder / "study.json").exists() and checkpoint_samples(folder) > 0
 
