@@ -1,0 +1,894 @@
+"""asperity: contact mechanics of randomly rough surfaces, from Python.
+
+The Python face of the ``asperity`` Rust library (the same code as the ``asperity``
+command line, so the same seed gives the same numbers bit for bit):
+
+* :func:`surface`, :func:`line` -- self-affine rough surfaces and lines (Fourier
+  synthesis, ``C2D(q) ∝ q^(-2H-2)``, roll-off / cut-off / short cut-off, rms height or
+  slope), returned as numpy arrays with their metadata;
+* :func:`stats`, :func:`psd` -- rms height, slope, curvature and the (radially averaged)
+  power spectrum with an optional power-law fit;
+* :class:`Solver` -- the boundary-element contact solver (Polonsky & Keer on FFTs, free or
+  periodic boundaries), reusable across loads, with frozen-set and finite-difference
+  stiffness and load sweeps;
+* :func:`mdr` -- the method of dimensionality reduction: rough lines and axisymmetric
+  indenters on linear, Hertz (15.2) or fractal (15.7) spring foundations;
+* :func:`study_alpha`, :func:`study_curve` -- checkpointed ensemble studies of the exponent
+  α of ``k ∝ F^α`` and of mean ``k(F)`` curves, in the CLI's folders (a study started here
+  resumes from ``asperity study`` and the other way round).
+
+Conventions (as the library's): lengths in the unit of the heights, E* = 1 by default,
+side L = 1 by default; arrays row-major ``(row, col) = (y, x)`` with square pixels
+``L / cols``; wavenumbers as wavelengths per side ``q L / 2π``; heights positive up,
+pressure ≥ 0, gap ≥ 0; forces in ``E* · length²``.
+
+Long computations release the GIL (other Python threads run meanwhile) and stop on Ctrl-C
+between loads of a sweep or samples of a study (a single solve runs to its end).
+Errors: ``ValueError`` for bad input (the CLI's one-line message), ``MemoryError`` when a
+grid would not fit in memory, :class:`ConvergenceError` and
+:class:`BeyondFullContactError` from the solver.
+
+Example::
+
+    >>> import asperity
+    >>> s = asperity.surface(128, hurst=0.8, rolloff=4, rms_slope=1.0, seed=1)
+    >>> solver = asperity.Solver(s)
+    >>> result = solver.solve(pressure=0.01)
+    >>> 0 < result.area_fraction < 0.2
+    True
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _asperity as _core
+from ._asperity import BeyondFullContactError, ConvergenceError, __version__
+
+__all__ = [
+    "BeyondFullContactError",
+    "ContactResult",
+    "ConvergenceError",
+    "Line",
+    "MdrCurve",
+    "Psd",
+    "Solver",
+    "StudyResult",
+    "Surface",
+    "Sweep",
+    "line",
+    "mdr",
+    "psd",
+    "stats",
+    "study_alpha",
+    "study_curve",
+    "surface",
+    "__version__",
+]
+
+_EXACT_INT = 2**53  # integers above this do not convert to float64 without loss
+
+
+def _float64(values: Any, what: str) -> np.ndarray:
+    """``values`` as a float64 array in native byte order: the array itself when it already
+    is one (any strides: no copy here), else a converted copy. Refuses dtypes that do not
+    convert without loss (complex, object, strings, float128, integers beyond 2^53)."""
+    array = np.asarray(values)
+    if array.dtype == np.float64:
+        return array
+    if array.dtype.kind not in "biuf":
+        raise ValueError(f"{what}: expected real numbers, got dtype {array.dtype}")
+    if not np.can_cast(array.dtype, np.float64, casting="safe"):
+        raise ValueError(f"{what}: dtype {array.dtype} does not convert to float64 without loss")
+    if array.dtype.kind in "iu" and array.dtype.itemsize >= 8 and array.size:
+        if max(abs(int(array.min())), abs(int(array.max()))) > _EXACT_INT:
+            raise ValueError(f"{what}: integers beyond 2^53 do not convert to float64 without loss")
+    return array.astype(np.float64)
+
+
+def _positive(value: Optional[float], name: str) -> Optional[float]:
+    if value is not None:
+        value = float(value)
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be positive and finite, got {value}")
+    return value
+
+
+# --------------------------------------------------------------------------------------
+# Progress
+# --------------------------------------------------------------------------------------
+
+ProgressArg = Union[None, bool, str, Callable[[int, int], Any]]
+
+
+class _Progress:
+    """What a ``progress=`` argument asks for: nothing (None/False), a tqdm bar (True or
+    ``"tqdm"``; a plain line on stderr when tqdm is not installed) or a callable
+    ``progress(done, total)``."""
+
+    def __init__(self, progress: ProgressArg, description: str):
+        self.bar = None
+        self.callback: Optional[Callable[[int, int], Any]] = None
+        if progress is None or progress is False:
+            return
+        if callable(progress):
+            self.callback = progress
+            return
+        if progress is True or progress == "tqdm":
+            try:
+                from tqdm.auto import tqdm
+            except ImportError:
+                self.callback = _plain_progress(description)
+                return
+            self.bar = tqdm(desc=description, total=None)
+            self.callback = self._update
+            return
+        raise ValueError(f"progress: expected None, True, 'tqdm' or a callable, got {progress!r}")
+
+    def _update(self, done: int, total: int) -> None:
+        if self.bar.total != total:
+            self.bar.total = total
+        self.bar.n = done
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _plain_progress(description: str) -> Callable[[int, int], None]:
+    """Progress on stderr without tqdm: one line rewritten in place on a terminal, else a
+    line at most every 5 s and at the end."""
+    import time
+
+    tty = sys.stderr.isatty()
+    last = [float("-inf")]
+
+    def report(done: int, total: int) -> None:
+        now = time.monotonic()
+        if done < total and (now - last[0] < (0.1 if tty else 5.0)):
+            return
+        last[0] = now
+        text = f"{description}: {done}/{total}"
+        if tty:
+            print("\r" + text, end="\n" if done >= total else "", file=sys.stderr, flush=True)
+        else:
+            print(text, file=sys.stderr, flush=True)
+
+    return report
+
+
+# --------------------------------------------------------------------------------------
+# Surfaces and lines
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class Surface:
+    """A rough surface: ``heights`` (rows × cols = y × x, float64) with its metadata.
+
+    ``metadata`` is the JSON sidecar ``asperity surface`` writes (kind, generator, shape,
+    seed, spec with the PSD and normalisation, stats). The object also looks like a
+    SurfaceTopography topography (``physical_sizes``; ``np.asarray(surface)`` gives the
+    heights), and :meth:`save` writes the CLI's ``.npy`` + ``.npy.json`` pair.
+
+    Example::
+
+        >>> s = asperity.surface(64, hurst=0.5, rms_height=1e-3, seed=3)
+        >>> s.heights.shape, s.size, round(s.stats["rms_height"], 12)
+        ((64, 64), 1.0, 0.001)
+    """
+
+    heights: np.ndarray
+    size: float = 1.0
+    metadata: Dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def shape(self) -> Tuple[int, int]:
+        return self.heights.shape
+
+    @property
+    def size_y(self) -> float:
+        """Side along y (rows); pixels are square."""
+        rows, cols = self.heights.shape
+        return self.size * rows / cols
+
+    @property
+    def physical_sizes(self) -> Tuple[float, float]:
+        """``(size_x, size_y)``."""
+        return (self.size, self.size_y)
+
+    @property
+    def seed(self) -> Optional[int]:
+        return self.metadata.get("seed")
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """rms height, slope, curvature (recorded at generation)."""
+        return self.metadata.get("stats", {})
+
+    def __array__(self, dtype=None, copy=None):
+        return self.heights if dtype is None else self.heights.astype(dtype)
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (.npy, float64) and its sidecar ``path.json``, as the CLI does
+        (both or neither; an existing file is refused unless ``force``)."""
+        _core.save_heights(os.fspath(path), self.heights, json.dumps(self.metadata), force)
+
+
+@dataclass
+class Line:
+    """A rough line: ``heights`` (n, float64), its length ``size`` and the metadata of
+    ``asperity line`` (see :class:`Surface`)."""
+
+    heights: np.ndarray
+    size: float = 1.0
+    metadata: Dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def seed(self) -> Optional[int]:
+        return self.metadata.get("seed")
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        return self.metadata.get("stats", {})
+
+    def __len__(self) -> int:
+        return len(self.heights)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.heights if dtype is None else self.heights.astype(dtype)
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (.npy) and ``path.json`` as ``asperity line`` does."""
+        _core.save_heights(os.fspath(path), self.heights, json.dumps(self.metadata), force)
+
+
+def surface(
+    n: int,
+    *,
+    hurst: float,
+    m: Optional[int] = None,
+    rolloff: Optional[float] = None,
+    cutoff: Optional[float] = None,
+    short_cutoff: Optional[float] = None,
+    rms_height: Optional[float] = None,
+    rms_slope: Optional[float] = None,
+    size: float = 1.0,
+    seed: int = 0,
+) -> Surface:
+    """A self-affine rough surface, as ``asperity surface`` (bit-identical for a seed).
+
+    Parameters (the CLI's options): ``n`` points along x (columns), ``m`` along y (rows,
+    default n); ``hurst`` H in [-1, 3], ``C2D(q) ∝ q^(-2H-2)``; ``rolloff`` q0·L/2π (flat
+    below q0, paper eq. 7) or ``cutoff`` q0·L/2π (no power below, eq. 8); ``short_cutoff``
+    q1·L/2π (no power above); ``rms_height`` or ``rms_slope`` (default: unit rms height);
+    ``size`` L along x; ``seed``.
+
+    Example::
+
+        >>> s = asperity.surface(256, hurst=0.8, rolloff=6, rms_slope=1.0, seed=1)
+        >>> round(s.stats["rms_slope"], 9)
+        1.0
+    """
+    heights, meta = _core.generate_surface(
+        n, m, float(hurst), _opt(rolloff), _opt(cutoff), _opt(short_cutoff),
+        _opt(rms_height), _opt(rms_slope), float(size), int(seed),
+    )
+    return Surface(heights, float(size), json.loads(meta))
+
+
+def line(
+    n: int,
+    *,
+    hurst: float,
+    rolloff: Optional[float] = None,
+    cutoff: Optional[float] = None,
+    rms_height: Optional[float] = None,
+    rms_slope: Optional[float] = None,
+    size: float = 1.0,
+    seed: int = 0,
+) -> Line:
+    """A self-affine rough line (``C1D = π q C2D``, paper eqs. 9-11), as ``asperity line``.
+
+    Example::
+
+        >>> l = asperity.line(4096, hurst=0.5, seed=3)
+        >>> len(l), round(l.stats["rms_height"], 9)
+        (4096, 1.0)
+    """
+    heights, meta = _core.generate_line(
+        n, float(hurst), _opt(rolloff), _opt(cutoff), _opt(rms_height), _opt(rms_slope),
+        float(size), int(seed),
+    )
+    return Line(heights, float(size), json.loads(meta))
+
+
+def _opt(value: Optional[float]) -> Optional[float]:
+    return None if value is None else float(value)
+
+
+def _heights_and_size(values: Any, size: Optional[float], what: str) -> Tuple[np.ndarray, float]:
+    if isinstance(values, (Surface, Line)):
+        return values.heights, values.size if size is None else float(size)
+    size = 1.0 if size is None else float(size)
+    return _float64(values, what), size
+
+
+def stats(values: Any, *, size: Optional[float] = None) -> Dict[str, Optional[float]]:
+    """rms height, rms slope (forward differences) and rms curvature of a surface (2D) or
+    line (1D), as ``asperity stats``. ``size`` is L along x (default: the object's, else 1).
+
+    Example::
+
+        >>> asperity.stats(asperity.line(1024, hurst=0.5, rms_slope=2.0))["rms_slope"]
+        2.0...
+    """
+    heights, size = _heights_and_size(values, size, "heights")
+    return _core.summary(heights, size)
+
+
+@dataclass
+class Psd:
+    """A power spectrum: wavenumbers ``q`` (rad/length), values ``psd`` (C2D for a surface,
+    radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; with
+    ``fit`` (exponent, prefactor, interval) and ``hurst`` when a fit range was given."""
+
+    q: np.ndarray
+    psd: np.ndarray
+    modes: np.ndarray
+    wavenumber: np.ndarray
+    fit: Optional[Dict[str, float]] = None
+    hurst: Optional[float] = None
+
+
+def psd(
+    values: Any,
+    *,
+    size: Optional[float] = None,
+    fit_from: Optional[float] = None,
+    fit_to: Optional[float] = None,
+) -> Psd:
+    """The PSD of a surface or line, as ``asperity stats --psd``, and, with ``fit_from``
+    and/or ``fit_to`` (wavelengths per side, q·L/2π; defaults 1 and the last bin), the
+    least-squares power law ``C ∝ q^p`` over the bins whose rounded q·L/2π lies in the
+    range, with the Hurst estimate ``H = -(p + d)/2`` (d = 2 for surfaces, 1 for lines).
+
+    Example::
+
+        >>> s = asperity.surface(256, hurst=0.8, seed=2)
+        >>> spectrum = asperity.psd(s, fit_from=4, fit_to=64)
+        >>> abs(spectrum.hurst - 0.8) < 0.1
+        True
+    """
+    heights, size = _heights_and_size(values, size, "heights")
+    q, c, modes = _core.psd(heights, size)
+    wavenumber = q * size / (2 * np.pi)
+    result = Psd(q, c, modes, wavenumber)
+    if fit_from is not None or fit_to is not None:
+        low = 1.0 if fit_from is None else _positive(fit_from, "fit_from")
+        high = float(np.round(wavenumber[-1])) if fit_to is None else _positive(fit_to, "fit_to")
+        if not low < high:
+            raise ValueError(f"invalid PSD fit range: fit_from {low} must be below fit_to {high}")
+        ring = np.round(wavenumber)
+        keep = (ring >= low) & (ring <= high) & (c > 0)
+        result.fit = _core.fit_power_law(np.ascontiguousarray(q[keep]), np.ascontiguousarray(c[keep]))
+        offset = 2.0 if np.ndim(heights) == 2 else 1.0
+        result.hurst = -(result.fit["exponent"] + offset) / 2.0
+    return result
+
+
+# --------------------------------------------------------------------------------------
+# BEM
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class ContactResult:
+    """A solved contact: scalars and (with ``fields=True``) the fields.
+
+    ``force`` (E*·length²), ``mean_pressure``, ``indentation`` (free boundaries: from the
+    highest point; periodic: relative to the mean elastic displacement),
+    ``area_fraction``, ``contact_points``, ``iterations``, ``residual``; ``pressure``
+    (≥ 0), ``gap`` (≥ 0) and ``displacement`` (u = K p, positive into the half-space),
+    rows × cols numpy arrays, or None.
+    """
+
+    force: float
+    mean_pressure: float
+    indentation: float
+    area_fraction: float
+    contact_points: int
+    iterations: int
+    residual: float
+    pressure: Optional[np.ndarray] = None
+    gap: Optional[np.ndarray] = None
+    displacement: Optional[np.ndarray] = None
+
+
+@dataclass
+class Sweep:
+    """A load sweep: one numpy array per column of ``asperity bem``'s CSV (``force``,
+    ``mean_pressure``, ``indentation``, ``area_fraction``, ``stiffness``, ``iterations``,
+    ``residual``, ``stiffness_fd``; NaN where not computed), plus ``contact_points`` and,
+    with ``fields=True``, lists ``pressure`` and ``gap`` of the fields of every load."""
+
+    columns: Dict[str, Any]
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self.__dict__["columns"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __getitem__(self, name: str) -> Any:
+        return self.columns[name]
+
+    def __len__(self) -> int:
+        return len(self.columns["force"])
+
+
+_BOUNDARIES = ("free", "periodic")
+
+
+def _one_load(pressure, force, indentation, what: str) -> Tuple[str, float]:
+    given = [(k, v) for k, v in (("pressure", pressure), ("force", force), ("indentation", indentation)) if v is not None]
+    if len(given) != 1:
+        raise ValueError(f"{what}: give exactly one of pressure=, force= or indentation=")
+    quantity, value = given[0]
+    return quantity, float(value)
+
+
+class Solver:
+    """A reusable BEM contact solver for one surface (``asperity bem``).
+
+    ``surface``: a 2D array of heights (rows × cols = y × x, positive up; any real dtype
+    that converts to float64 without loss, any memory order), an :class:`asperity.Surface`,
+    or any object with SurfaceTopography's ``heights()`` and ``physical_sizes`` (its
+    ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels must be square).
+    ``size``: side L along x (default: the object's, else 1). ``modulus`` E*;
+    ``boundary`` ``"free"`` (zero-padded, the paper's) or ``"periodic"``; ``tolerance``
+    (rms gap violation on the contact set over the rms height) and ``max_iterations``;
+    ``solver``: ``"default"`` or ``"pk"`` (Polonsky–Keer). Today both select
+    Polonsky–Keer, the only solver of the library; ``"default"`` will follow the library's
+    default when another solver is added.
+
+    The solver plans its FFTs once and keeps its buffers: each solve starts from the last
+    pressure (warm start), so a rising load sweep is cheap.
+
+    Example::
+
+        >>> s = asperity.surface(128, hurst=0.8, rolloff=4, rms_slope=1.0, seed=1)
+        >>> solver = asperity.Solver(s, boundary="periodic")
+        >>> r = solver.solve(pressure=0.02)
+        >>> k = solver.stiffness()               # frozen contact set, k = ΔF/Δd
+        >>> sweep = solver.sweep(nloads=5, pmin=1e-3, pmax=1e-1)
+        >>> sweep.area_fraction.shape
+        (5,)
+    """
+
+    def __init__(
+        self,
+        surface: Any,
+        size: Optional[float] = None,
+        *,
+        modulus: float = 1.0,
+        boundary: str = "free",
+        tolerance: float = 1e-8,
+        max_iterations: int = 10_000,
+        solver: str = "default",
+    ):
+        heights, size_x, size_y = _surface_input(surface, size)
+        if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
+            raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
+        if max_iterations < 0:
+            raise ValueError(f"invalid max iterations: must be at least 1, got {max_iterations}")
+        self._core = _core.Solver(
+            heights, size_x, size_y, float(modulus), str(boundary), float(tolerance),
+            int(max_iterations), str(solver),
+        )
+
+    shape = property(lambda self: self._core.shape, doc="(rows, cols)")
+    size = property(lambda self: self._core.size, doc="side L along x")
+    modulus = property(lambda self: self._core.modulus, doc="E*")
+    boundary = property(lambda self: self._core.boundary, doc="'free' or 'periodic'")
+    tolerance = property(lambda self: self._core.tolerance)
+    max_iterations = property(lambda self: self._core.max_iterations)
+    nominal_area = property(lambda self: self._core.nominal_area, doc="rows·cols·Δ²")
+
+    def solve(
+        self,
+        *,
+        pressure: Optional[float] = None,
+        force: Optional[float] = None,
+        indentation: Optional[float] = None,
+        fields: bool = True,
+    ) -> ContactResult:
+        """Solves the contact under one load: a mean ``pressure`` or total ``force`` (load
+        control, > 0) or an ``indentation`` (displacement control, ≥ 0), warm-started from
+        the last solve. A load beyond full contact raises :class:`BeyondFullContactError`
+        (periodic boundaries: before solving; free: once the solve finds every point in
+        contact). The solve is exactly the library's ``ContactSolver::solve``.
+        ``fields=False`` skips the copies of the fields (and the displacement's one
+        operator application).
+
+        Example::
+
+            >>> r = solver.solve(force=0.01)
+            >>> r.pressure.sum() * (solver.size / solver.shape[1]) ** 2   # ≈ r.force
+        """
+        quantity, value = _one_load(pressure, force, indentation, "solve")
+        return ContactResult(**self._core.solve(quantity, value, bool(fields)))
+
+    def stiffness(self) -> float:
+        """Contact stiffness of the last solve by the frozen contact set (the paper's
+        method): the contact set is pushed down uniformly, ``k = ΔF/Δd`` (E*·length)."""
+        k, _, _ = self._core.stiffness()
+        return k
+
+    def fd_stiffness(
+        self,
+        *,
+        pressure: Optional[float] = None,
+        force: Optional[float] = None,
+        indentation: Optional[float] = None,
+        step: float = 1e-3,
+    ) -> float:
+        """``dF/dd`` by central differences: two solves at the load × (1 ± step). Leaves
+        the solver in the upper state."""
+        quantity, value = _one_load(pressure, force, indentation, "fd_stiffness")
+        return self._core.fd_stiffness(quantity, value, float(step))
+
+    def sweep(
+        self,
+        *,
+        pressures: Optional[Sequence[float]] = None,
+        forces: Optional[Sequence[float]] = None,
+        indentations: Optional[Sequence[float]] = None,
+        nloads: Optional[int] = None,
+        pmin: Optional[float] = None,
+        pmax: Optional[float] = None,
+        stiffness: bool = True,
+        fd_stiffness: bool = False,
+        fd_step: float = 1e-3,
+        fields: bool = False,
+        progress: ProgressArg = None,
+    ) -> Sweep:
+        """A load sweep exactly as ``asperity bem`` runs it (same numbers bit for bit):
+        ``pressures``, ``forces`` or ``indentations`` in the given order, or ``nloads``
+        mean pressures log-spaced from ``pmin`` to ``pmax``. Every load is checked against
+        full contact before the first solve; each solve warm-starts from the previous one.
+        ``stiffness``: frozen-set stiffness per load; ``fd_stiffness``: also ``dF/dd``
+        from two more solves at the load × (1 ± fd_step); ``fields``: keep pressure and
+        gap of every load. ``progress``: a callable ``progress(done, total)``, or True for
+        a tqdm bar. Ctrl-C stops the sweep between loads (``KeyboardInterrupt``).
+
+        Example::
+
+            >>> sweep = solver.sweep(nloads=20, pmin=1e-4, pmax=1e-1)
+            >>> sweep.force, sweep.stiffness, sweep.area_fraction
+        """
+        quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax)
+        fd = float(fd_step) if fd_stiffness else None
+        bar = _Progress(progress, "bem")
+        try:
+            columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields), bar.callback)
+        finally:
+            bar.close()
+        return Sweep(columns)
+
+    def full_contact_threshold(self) -> Dict[str, Optional[float]]:
+        """Mean pressure and indentation from which the gap is closed everywhere. On free
+        boundaries the first call costs about one solve and forgets the warm start."""
+        p, d = self._core.full_contact_threshold()
+        return {"mean_pressure": p, "force": p * self.nominal_area, "indentation": d}
+
+    def reset(self) -> None:
+        """Forgets the last solution: the next solve starts cold."""
+        self._core.reset()
+
+    def __repr__(self) -> str:
+        rows, cols = self.shape
+        return f"Solver({rows}x{cols}, size={self.size}, modulus={self.modulus}, boundary={self.boundary!r})"
+
+
+def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, float, Optional[float]]:
+    """Heights (rows × cols), size along x and (for SurfaceTopography objects) along y."""
+    if isinstance(surface, Surface):
+        return surface.heights, surface.size if size is None else float(size), None
+    heights_of = getattr(surface, "heights", None)
+    if callable(heights_of) and hasattr(surface, "physical_sizes"):
+        # SurfaceTopography: heights()[x, y] with physical_sizes (sx, sy).
+        sizes = surface.physical_sizes
+        if sizes is None or len(sizes) != 2:
+            raise ValueError(f"surface: expected two physical sizes (sx, sy), got {sizes!r}")
+        heights = _float64(heights_of(), "surface").T
+        if heights.ndim != 2:
+            raise ValueError(f"surface: expected 2D heights, got shape {heights.shape}")
+        if size is not None:
+            raise ValueError("size: the topography has its own physical_sizes")
+        return heights, float(sizes[0]), float(sizes[1])
+    heights = _float64(surface, "surface")
+    if heights.ndim != 2:
+        raise ValueError(f"surface: expected a 2D array of heights (rows, cols), got shape {heights.shape}")
+    return heights, 1.0 if size is None else float(size), None
+
+
+def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax) -> Tuple[str, List[float]]:
+    lists = [(name, v) for name, v in (("pressures", pressures), ("forces", forces), ("indentations", indentations)) if v is not None]
+    if len(lists) + (nloads is not None) != 1:
+        raise ValueError("give one of pressures=, forces=, indentations= or nloads= with pmin= and pmax=")
+    if lists:
+        name, values = lists[0]
+        values = [float(v) for v in np.atleast_1d(np.asarray(values, dtype=np.float64))]
+        _core.check_loads(name, values, name == "indentations")
+        return {"pressures": "pressure", "forces": "force", "indentations": "indentation"}[name], values
+    if pmin is None or pmax is None:
+        raise ValueError("nloads needs pmin= and pmax=")
+    if isinstance(nloads, bool) or int(nloads) != nloads or nloads < 0:
+        raise ValueError(f"nloads must be a count, got {nloads!r}")
+    return "pressure", _core.log_pressures(int(nloads), float(pmin), float(pmax))
+
+
+# --------------------------------------------------------------------------------------
+# MDR
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class MdrCurve:
+    """An MDR curve (``asperity mdr``): ``indentation`` (from first contact), ``force``,
+    ``stiffness`` (dF/dd), ``contacts`` (springs compressed), with a ``description`` of the
+    indenter, the ``spring`` law and its ``critical_depth`` u0."""
+
+    indentation: np.ndarray
+    force: np.ndarray
+    stiffness: np.ndarray
+    contacts: np.ndarray
+    description: str
+    spring: str
+    critical_depth: float
+
+
+def mdr(
+    *,
+    line: Any = None,
+    profile: Optional[str] = None,
+    radial: Any = None,
+    radial_step: Optional[float] = None,
+    radius: Optional[float] = None,
+    slope: Optional[float] = None,
+    coefficient: Optional[float] = None,
+    exponent: Optional[float] = None,
+    n: Optional[int] = None,
+    dx: Optional[float] = None,
+    size: Optional[float] = None,
+    modulus: float = 1.0,
+    spring: str = "linear",
+    hurst: Optional[float] = None,
+    rms_height: Optional[float] = None,
+    asperity_radius: Optional[float] = None,
+    indentations: Optional[Sequence[float]] = None,
+    nloads: Optional[int] = None,
+    dmin: Optional[float] = None,
+    dmax: Optional[float] = None,
+    breakpoints: bool = False,
+) -> MdrCurve:
+    """Force, stiffness and contacts of an indenter on the MDR spring foundation, with
+    every option of ``asperity mdr``.
+
+    Indenter (one of): ``line`` (1D heights or :class:`Line`; spacing = size / n, size
+    default the Line's, else 1); ``profile`` ``"hertz"`` (``radius``), ``"cone"``
+    (``slope`` tan θ), ``"punch"`` (``radius``) or ``"power"`` (``coefficient``,
+    ``exponent``: f = c rⁿ), on ``n`` springs at spacing ``dx``; ``radial`` samples of
+    f(r) at steps ``radial_step``, mapped by the MDR transform.
+    Springs: ``"linear"`` (E*·Δx), ``"hertz"`` (15.2, ``asperity_radius``; default
+    ``radius`` for a Hertz profile) or ``"fractal"`` (15.7, ``hurst`` 0 < H < 2,
+    ``rms_height`` default the line's own).
+    Indentations: a list, or ``nloads`` (default 50) log-spaced from ``dmin`` (default
+    dmax·1e-6) to ``dmax`` (default: full contact); or ``breakpoints=True``: the exact
+    piecewise-linear curve of linear springs on a line, one row per contact count.
+
+    Example::
+
+        >>> c = asperity.mdr(profile="hertz", radius=1.0, n=2001, dx=0.01, spring="hertz",
+        ...                  indentations=[1e-6, 1e-4])
+        >>> l = asperity.line(32768, hurst=0.5, seed=1)
+        >>> curve = asperity.mdr(line=l, nloads=40)
+    """
+    line_heights = None
+    if line is not None:
+        if isinstance(line, Line):
+            size = line.size if size is None else size
+            line_heights = line.heights
+        else:
+            line_heights = _float64(line, "line")
+        if line_heights.ndim != 1:
+            raise ValueError(f"line: expected a 1D array, got shape {line_heights.shape}")
+    radial_values = None
+    if radial is not None:
+        radial_values = _float64(radial, "radial")
+        if radial_values.ndim != 1:
+            raise ValueError(f"radial: expected a 1D array, got shape {radial_values.shape}")
+    levels = None
+    if indentations is not None:
+        levels = [float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
+    out = _core.mdr_curve(
+        line_heights, profile, radial_values, _opt(radial_step), _opt(radius), _opt(slope),
+        _opt(coefficient), _opt(exponent), n, _opt(dx), _opt(size), float(modulus), str(spring),
+        _opt(hurst), _opt(rms_height), _opt(asperity_radius), levels, nloads, _opt(dmin),
+        _opt(dmax), bool(breakpoints),
+    )
+    return MdrCurve(**out)
+
+
+# --------------------------------------------------------------------------------------
+# Studies
+# --------------------------------------------------------------------------------------
+
+
+@dataclass
+class StudyResult:
+    """A finished study: ``columns`` (numpy arrays named as the CLI's ``alpha.csv`` or
+    ``curve.csv``), ``rows`` (the same as a list of dicts) and ``tasks`` (every task's
+    result as the checkpoint stores it: mean curve, α fit, per-sample α)."""
+
+    columns: Dict[str, np.ndarray]
+    rows: List[Dict[str, Any]]
+    tasks: List[Dict[str, Any]]
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self.__dict__["columns"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+
+def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
+    if isinstance(hurst, str):
+        return _core.hurst_range(hurst)
+    return [float(h) for h in np.atleast_1d(np.asarray(hurst, dtype=np.float64))]
+
+
+def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
+               levels, force, checkpoint_every, progress, description):
+    window = _core.default_window()
+    bar = _Progress(progress, description)
+    try:
+        text = _core.run_study(
+            str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
+            int(seed), window[0] if min_contacts is None else int(min_contacts),
+            window[1] if max_fraction is None else float(max_fraction), int(levels),
+            os.fspath(out), bool(force), float(checkpoint_every), bar.callback,
+        )
+    finally:
+        bar.close()
+    return json.loads(text)
+
+
+def _columns(rows: List[Dict[str, Any]], names: Sequence[str]) -> Dict[str, np.ndarray]:
+    columns = {}
+    for name in names:
+        values = [r[name] for r in rows]
+        if name == "method":
+            columns[name] = np.array(values, dtype=object)
+        elif name in ("n", "samples", "samples_fitted"):
+            columns[name] = np.array(values, dtype=np.int64)
+        else:
+            columns[name] = np.array([np.nan if v is None else v for v in values], dtype=np.float64)
+    return columns
+
+
+_ALPHA_COLUMNS = ("method", "n", "hurst", "alpha", "alpha_low", "alpha_high", "samples",
+                  "alpha_fit_low", "alpha_fit_high", "alpha_sample_mean", "samples_fitted",
+                  "alpha_theory")
+_CURVE_COLUMNS = ("method", "n", "hurst", "force", "stiffness", "stiffness_low",
+                  "stiffness_high", "samples", "area_fraction")
+
+
+def study_alpha(
+    *,
+    method: str,
+    n: Union[int, Sequence[int]],
+    hurst: Union[str, float, Sequence[float]],
+    samples: int,
+    out: Union[str, os.PathLike],
+    rolloff: Optional[float] = None,
+    seed: int = 1,
+    min_contacts: Optional[int] = None,
+    max_fraction: Optional[float] = None,
+    levels: int = 48,
+    force: bool = False,
+    checkpoint_every: float = 10.0,
+    progress: ProgressArg = None,
+) -> StudyResult:
+    """The exponent α of ``k ∝ F^α`` over grid sizes ``n`` and Hurst exponents ``hurst``
+    (a list, or the CLI's text ``"-1:3:0.25"``), ``samples`` realisations each, as
+    ``asperity study alpha`` -- in the same checkpoint folder ``out`` (``study.json``,
+    ``checkpoint/``): a study started here resumes from the CLI and the other way round,
+    with bit-identical results. Nothing else is written (no CSV, no plots).
+
+    ``method``: ``"mdr"`` (rough lines, unit rms height) or ``"bem"`` (surfaces, unit rms
+    slope, free boundaries); ``rolloff`` q0·L/2π; ``seed`` (study seed); the α window
+    ``min_contacts``, ``max_fraction`` (the CLI's defaults); ``levels`` force levels of the
+    mean curves; ``force`` discards another study's checkpoints in ``out``;
+    ``checkpoint_every`` seconds between checkpoints of a task in progress (0: every
+    batch). Ctrl-C stops after the samples in flight (``KeyboardInterrupt``); run again
+    to resume.
+
+    Returns the rows of ``alpha.csv`` (``alpha`` fitted on the ensemble-mean curve,
+    ``alpha_low``/``alpha_high`` the 2.5 %/97.5 % quantiles of the per-sample α, ...).
+
+    Example::
+
+        >>> r = asperity.study_alpha(method="mdr", n=[512], hurst="0:1:0.5", samples=50,
+        ...                          out="alpha-study")
+        >>> r.hurst, r.alpha
+    """
+    sizes = [n] if np.ndim(n) == 0 else list(n)
+    records = _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
+                         max_fraction, levels, force, checkpoint_every, progress, f"{method} study")
+    rows = []
+    for rec in records:
+        r = rec["result"]
+        fit = r["alpha_ensemble"] or {}
+        interval = rec["alpha_sample_interval"] or (None, None)
+        rows.append({
+            "method": r["method"], "n": r["task"]["n"], "hurst": r["task"]["hurst"],
+            "alpha": fit.get("exponent"), "alpha_low": interval[0], "alpha_high": interval[1],
+            "samples": r["samples"], "alpha_fit_low": fit.get("low"),
+            "alpha_fit_high": fit.get("high"), "alpha_sample_mean": rec["alpha_sample_mean"],
+            "samples_fitted": len(r["alpha_samples"]), "alpha_theory": rec["alpha_theory"],
+        })
+    return StudyResult(_columns(rows, _ALPHA_COLUMNS), rows, [rec["result"] for rec in records])
+
+
+def study_curve(
+    *,
+    method: str,
+    n: int,
+    hurst: Union[str, float, Sequence[float]],
+    samples: int,
+    out: Union[str, os.PathLike],
+    rolloff: Optional[float] = None,
+    seed: int = 1,
+    min_contacts: Optional[int] = None,
+    max_fraction: Optional[float] = None,
+    levels: int = 48,
+    force: bool = False,
+    checkpoint_every: float = 10.0,
+    progress: ProgressArg = None,
+) -> StudyResult:
+    """Ensemble-mean ``k(F)`` curves at one grid size ``n`` over ``hurst``, as
+    ``asperity study curve`` (same folder, checkpoints and numbers; see
+    :func:`study_alpha`). Returns the rows of ``curve.csv``: ``force``, ``stiffness``
+    (mean), ``stiffness_low``/``stiffness_high`` (95 % interval of the mean),
+    ``samples``, ``area_fraction``, per (method, n, hurst).
+
+    Example::
+
+        >>> c = asperity.study_curve(method="bem", n=32, hurst=[0.5], samples=4, out="curves")
+        >>> c.force, c.stiffness
+    """
+    records = _run_study(method, [n], hurst, samples, out, rolloff, seed, min_contacts,
+                         max_fraction, levels, force, checkpoint_every, progress, f"{method} study")
+    rows = []
+    for rec in records:
+        r = rec["result"]
+        for p in r["mean_curve"]:
+            rows.append({
+                "method": r["method"], "n": r["task"]["n"], "hurst": r["task"]["hurst"],
+                "force": p["force"], "stiffness": p["stiffness"],
+                "stiffness_low": p["stiffness_low"], "stiffness_high": p["stiffness_high"],
+                "samples": p["samples"], "area_fraction": p["fraction"],
+            })
+    return StudyResult(_columns(rows, _CURVE_COLUMNS), rows, [rec["result"] for rec in records])

@@ -1,0 +1,181 @@
+"""Type stubs of the public API of asperity (see the docstrings in __init__.py)."""
+
+import os
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from ._asperity import BeyondFullContactError as BeyondFullContactError
+from ._asperity import ConvergenceError as ConvergenceError
+
+__version__: str
+__all__: List[str]
+
+F64 = npt.NDArray[np.float64]
+ArrayLike = npt.ArrayLike
+ProgressArg = Union[None, bool, str, Callable[[int, int], Any]]
+PathLike = Union[str, os.PathLike]
+
+@dataclass
+class Surface:
+    heights: F64
+    size: float = ...
+    metadata: Dict[str, Any] = ...
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    @property
+    def size_y(self) -> float: ...
+    @property
+    def physical_sizes(self) -> Tuple[float, float]: ...
+    @property
+    def seed(self) -> Optional[int]: ...
+    @property
+    def stats(self) -> Dict[str, Any]: ...
+    def __array__(self, dtype: Any = ..., copy: Any = ...) -> np.ndarray: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
+
+@dataclass
+class Line:
+    heights: F64
+    size: float = ...
+    metadata: Dict[str, Any] = ...
+    @property
+    def seed(self) -> Optional[int]: ...
+    @property
+    def stats(self) -> Dict[str, Any]: ...
+    def __len__(self) -> int: ...
+    def __array__(self, dtype: Any = ..., copy: Any = ...) -> np.ndarray: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
+
+def surface(
+    n: int, *, hurst: float, m: Optional[int] = ..., rolloff: Optional[float] = ...,
+    cutoff: Optional[float] = ..., short_cutoff: Optional[float] = ...,
+    rms_height: Optional[float] = ..., rms_slope: Optional[float] = ..., size: float = ...,
+    seed: int = ...,
+) -> Surface: ...
+def line(
+    n: int, *, hurst: float, rolloff: Optional[float] = ..., cutoff: Optional[float] = ...,
+    rms_height: Optional[float] = ..., rms_slope: Optional[float] = ..., size: float = ...,
+    seed: int = ...,
+) -> Line: ...
+def stats(values: Any, *, size: Optional[float] = ...) -> Dict[str, Optional[float]]: ...
+
+@dataclass
+class Psd:
+    q: F64
+    psd: F64
+    modes: npt.NDArray[np.uint64]
+    wavenumber: F64
+    fit: Optional[Dict[str, float]] = ...
+    hurst: Optional[float] = ...
+
+def psd(
+    values: Any, *, size: Optional[float] = ..., fit_from: Optional[float] = ...,
+    fit_to: Optional[float] = ...,
+) -> Psd: ...
+
+@dataclass
+class ContactResult:
+    force: float
+    mean_pressure: float
+    indentation: float
+    area_fraction: float
+    contact_points: int
+    iterations: int
+    residual: float
+    pressure: Optional[F64] = ...
+    gap: Optional[F64] = ...
+    displacement: Optional[F64] = ...
+
+@dataclass
+class Sweep:
+    columns: Dict[str, Any]
+    force: F64
+    mean_pressure: F64
+    indentation: F64
+    area_fraction: F64
+    stiffness: F64
+    iterations: npt.NDArray[np.uint64]
+    residual: F64
+    stiffness_fd: F64
+    contact_points: npt.NDArray[np.uint64]
+    pressure: List[F64]
+    gap: List[F64]
+    def __getitem__(self, name: str) -> Any: ...
+    def __len__(self) -> int: ...
+
+class Solver:
+    shape: Tuple[int, int]
+    size: float
+    modulus: float
+    boundary: str
+    tolerance: float
+    max_iterations: int
+    nominal_area: float
+    def __init__(
+        self, surface: Any, size: Optional[float] = ..., *, modulus: float = ...,
+        boundary: str = ..., tolerance: float = ..., max_iterations: int = ...,
+        solver: str = ...,
+    ) -> None: ...
+    def solve(
+        self, *, pressure: Optional[float] = ..., force: Optional[float] = ...,
+        indentation: Optional[float] = ..., fields: bool = ...,
+    ) -> ContactResult: ...
+    def stiffness(self) -> float: ...
+    def fd_stiffness(
+        self, *, pressure: Optional[float] = ..., force: Optional[float] = ...,
+        indentation: Optional[float] = ..., step: float = ...,
+    ) -> float: ...
+    def sweep(
+        self, *, pressures: Optional[Sequence[float]] = ..., forces: Optional[Sequence[float]] = ...,
+        indentations: Optional[Sequence[float]] = ..., nloads: Optional[int] = ...,
+        pmin: Optional[float] = ..., pmax: Optional[float] = ..., stiffness: bool = ...,
+        fd_stiffness: bool = ..., fd_step: float = ..., fields: bool = ...,
+        progress: ProgressArg = ...,
+    ) -> Sweep: ...
+    def full_contact_threshold(self) -> Dict[str, Optional[float]]: ...
+    def reset(self) -> None: ...
+
+@dataclass
+class MdrCurve:
+    indentation: F64
+    force: F64
+    stiffness: F64
+    contacts: npt.NDArray[np.uint64]
+    description: str
+    spring: str
+    critical_depth: float
+
+def mdr(
+    *, line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
+    radial_step: Optional[float] = ..., radius: Optional[float] = ..., slope: Optional[float] = ...,
+    coefficient: Optional[float] = ..., exponent: Optional[float] = ..., n: Optional[int] = ...,
+    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: float = ...,
+    spring: str = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
+    asperity_radius: Optional[float] = ..., indentations: Optional[Sequence[float]] = ...,
+    nloads: Optional[int] = ..., dmin: Optional[float] = ..., dmax: Optional[float] = ...,
+    breakpoints: bool = ...,
+) -> MdrCurve: ...
+
+@dataclass
+class StudyResult:
+    columns: Dict[str, np.ndarray]
+    rows: List[Dict[str, Any]]
+    tasks: List[Dict[str, Any]]
+    def __getitem__(self, name: str) -> np.ndarray: ...
+    def __getattr__(self, name: str) -> np.ndarray: ...
+
+def study_alpha(
+    *, method: str, n: Union[int, Sequence[int]], hurst: Union[str, float, Sequence[float]],
+    samples: int, out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
+    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: int = ...,
+    force: bool = ..., checkpoint_every: float = ..., progress: ProgressArg = ...,
+) -> StudyResult: ...
+def study_curve(
+    *, method: str, n: int, hurst: Union[str, float, Sequence[float]], samples: int,
+    out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
+    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: int = ...,
+    force: bool = ..., checkpoint_every: float = ..., progress: ProgressArg = ...,
+) -> StudyResult: ...

@@ -1,0 +1,76 @@
+"""The compiled core of asperity (PyO3). Use the functions of `asperity` instead: they
+check and convert their arguments and document them."""
+
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class ConvergenceError(RuntimeError):
+    iterations: int
+    residual: float
+
+class BeyondFullContactError(ValueError):
+    threshold: Optional[float]
+    quantity: str
+    requested: float
+
+Progress = Optional[Callable[[int, int], Any]]
+F64 = npt.NDArray[np.float64]
+
+def generate_surface(
+    n: int, m: Optional[int], hurst: float, rolloff: Optional[float], cutoff: Optional[float],
+    short_cutoff: Optional[float], rms_height: Optional[float], rms_slope: Optional[float],
+    size: float, seed: int,
+) -> Tuple[F64, str]: ...
+def generate_line(
+    n: int, hurst: float, rolloff: Optional[float], cutoff: Optional[float],
+    rms_height: Optional[float], rms_slope: Optional[float], size: float, seed: int,
+) -> Tuple[F64, str]: ...
+def save_heights(path: str, array: F64, metadata: str, force: bool) -> None: ...
+def summary(array: F64, size: float) -> Dict[str, Optional[float]]: ...
+def psd(array: F64, size: float) -> Tuple[F64, F64, npt.NDArray[np.uint64]]: ...
+def fit_power_law(x: F64, y: F64) -> Dict[str, float]: ...
+def check_loads(name: str, values: List[float], allow_zero: bool) -> None: ...
+def log_pressures(nloads: int, pmin: float, pmax: float) -> List[float]: ...
+
+class Solver:
+    def __init__(
+        self, heights: F64, size_x: float, size_y: Optional[float], modulus: float,
+        boundary: str, tolerance: float, max_iterations: int, solver: str,
+    ) -> None: ...
+    shape: Tuple[int, int]
+    nominal_area: float
+    modulus: float
+    boundary: str
+    size: float
+    tolerance: float
+    max_iterations: int
+    def reset(self) -> None: ...
+    def full_contact_threshold(self) -> Tuple[float, Optional[float]]: ...
+    def solve(self, quantity: str, value: float, fields: bool) -> Dict[str, Any]: ...
+    def stiffness(self) -> Tuple[float, int, float]: ...
+    def fd_stiffness(self, quantity: str, value: float, step: float) -> float: ...
+    def sweep(
+        self, quantity: str, values: List[float], stiffness: bool, fd_step: Optional[float],
+        fields: bool, progress: Progress,
+    ) -> Dict[str, Any]: ...
+
+def mdr_curve(
+    line: Optional[F64], profile: Optional[str], radial: Optional[F64],
+    radial_step: Optional[float], radius: Optional[float], slope: Optional[float],
+    coefficient: Optional[float], exponent: Optional[float], n: Optional[int],
+    dx: Optional[float], size: Optional[float], modulus: float, spring: str,
+    hurst: Optional[float], rms_height: Optional[float], asperity_radius: Optional[float],
+    indentations: Optional[List[float]], nloads: Optional[int], dmin: Optional[float],
+    dmax: Optional[float], breakpoints: bool,
+) -> Dict[str, Any]: ...
+def run_study(
+    method_name: str, sizes: List[int], hursts: List[float], samples: int,
+    rolloff: Optional[float], seed: int, min_contacts: int, max_fraction: float, levels: int,
+    out: str, force: bool, checkpoint_every: float, progress: Progress,
+) -> str: ...
+def hurst_range(text: str) -> List[float]: ...
+def default_window() -> Tuple[int, float]: ...

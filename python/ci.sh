@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Builds the Python package and runs its test suite, on a machine with only a Rust
+# toolchain, Python >= 3.9 and pip (network to PyPI and crates.io).
+#
+#   python/ci.sh            # from anywhere; PYTHON=python3.12 python/ci.sh to pick one
+#
+# 1. a virtual environment python/.venv (git-ignored; reused when present);
+# 2. the build and test dependencies from PyPI: maturin, numpy, pytest, matplotlib and the
+#    peers ContactMechanics + SurfaceTopography (the cross-check tests need them);
+# 3. the `asperity` binary the tests compare against (cargo build --release, warm after
+#    the Rust tests), then `pip install ./python` (maturin builds the abi3 extension);
+# 4. pytest on python/tests. Exit status: pytest's, except that "no tests collected"
+#    (pytest's 5) is a failure too.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+repo="$(dirname "$here")"
+python="${PYTHON:-python3}"
+venv="$here/.venv"
+start=$(date +%s)
+
+if [ ! -x "$venv/bin/python" ]; then
+    "$python" -m venv "$venv"
+fi
+"$venv/bin/python" -m pip install --quiet --upgrade pip
+"$venv/bin/python" -m pip install --quiet "maturin>=1.16,<2" numpy pytest matplotlib \
+    ContactMechanics SurfaceTopography
+
+(cd "$repo" && cargo build --release --quiet -p asperity-cli)
+export ASPERITY_BIN="${ASPERITY_BIN:-$repo/target/release/asperity}"
+
+# The README's install command (from the repository root).
+(cd "$repo" && "$venv/bin/python" -m pip install --quiet ./python)
+
+# From the repository root, not python/: there the source folder python/asperity (without
+# the compiled module) would shadow the installed package.
+cd "$repo"
+status=0
+MPLBACKEND=Agg "$venv/bin/python" -m pytest -q -p no:cacheprovider "$here/tests" || status=$?
+if [ "$status" -eq 5 ]; then
+    echo "python/ci.sh: pytest collected no tests" >&2
+    status=1
+fi
+echo "python/ci.sh: exit $status after $(( $(date +%s) - start )) s" >&2
+exit "$status"

@@ -1,0 +1,534 @@
+//! The BEM contact solver (`asperity bem`): one planned [`ContactSolver`] per Python
+//! `Solver`, reused across loads (warm starts) as the CLI does.
+//!
+//! [`check_full_contact`] and the sweep loop in [`Solver::sweep`] follow
+//! `crates/asperity-cli/src/commands/bem.rs` step for step (the full-contact check of
+//! every load kind before any solve, then per load: solve, frozen-set stiffness, fields,
+//! finite-difference stiffness and the re-solve for the next warm start), so a sweep gives
+//! the CLI's numbers bit for bit. They are reimplemented here rather than moved into the
+//! library: the CLI's versions are interleaved with its output staging and messages.
+
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
+use asperity::elastic::Boundary;
+use asperity::memory::{array_bytes, ensure_fits};
+use asperity::surface::Surface;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::arrays::owned_2d;
+use crate::errors::{from_error, from_solve, invalid};
+use crate::interrupt::{run_detached, Cancel};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Solver>()?;
+    m.add_function(wrap_pyfunction!(check_loads, m)?)?;
+    m.add_function(wrap_pyfunction!(log_pressures, m)?)?;
+    Ok(())
+}
+
+/// The CLI's check of a list of loads (`forces`, `pressures` > 0; `indentations` ≥ 0).
+#[pyfunction]
+fn check_loads(name: &str, values: Vec<f64>, allow_zero: bool) -> PyResult<()> {
+    if values.is_empty() {
+        return Err(invalid(format!("{name}: give at least one value")));
+    }
+    for v in values {
+        if !(v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0))) {
+            return Err(invalid(format!(
+                "{name}: {v} is not allowed (values must be finite and {})",
+                if allow_zero { ">= 0" } else { "> 0" }
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `nloads` mean pressures log-spaced from `pmin` to `pmax`, as `asperity bem --nloads`.
+#[pyfunction]
+fn log_pressures(nloads: usize, pmin: f64, pmax: f64) -> PyResult<Vec<f64>> {
+    if nloads == 0 {
+        return Err(invalid("nloads must be at least 1"));
+    }
+    check_loads("pmin", vec![pmin], false)?;
+    check_loads("pmax", vec![pmax], false)?;
+    if pmax < pmin {
+        return Err(invalid(format!(
+            "pmax ({pmax}) must not be smaller than pmin ({pmin})"
+        )));
+    }
+    ensure_fits(
+        &format!("nloads {nloads}: the bookkeeping of {nloads} loads"),
+        array_bytes(&[nloads], 1024),
+    )
+    .map_err(from_error)?;
+    Ok((0..nloads)
+        .map(|i| {
+            let t = if nloads == 1 {
+                0.0
+            } else {
+                i as f64 / (nloads - 1) as f64
+            };
+            pmin * (pmax / pmin).powf(t)
+        })
+        .collect())
+}
+
+/// The solver choice. `SolverParams` has no field for it yet: Polonsky–Keer is the only
+/// solver, and both names select it. When the library adds one, "default" maps onto its
+/// default and "pk" onto Polonsky–Keer.
+fn check_solver_name(name: &str) -> PyResult<()> {
+    match name {
+        "default" | "pk" => Ok(()),
+        other => Err(invalid(format!(
+            "invalid solver: expected \"default\" or \"pk\" (Polonsky–Keer), got {other:?}"
+        ))),
+    }
+}
+
+/// A load as the library's control: `quantity` is `pressure`, `force` or `indentation`.
+fn control(quantity: &str, value: f64) -> PyResult<Control> {
+    match quantity {
+        "pressure" => Ok(Control::MeanPressure(value)),
+        "force" => Ok(Control::Force(value)),
+        "indentation" => Ok(Control::Indentation(value)),
+        other => Err(invalid(format!(
+            "unknown load quantity {other:?} (pressure, force or indentation)"
+        ))),
+    }
+}
+
+/// A load as messages name it: `load 3 (mean pressure 0.01)` (the CLI's wording).
+fn describe(k: usize, control: Control) -> String {
+    format!("load {k} ({} {})", control.quantity(), control.value())
+}
+
+/// `error` with `context: ` in front (a `SolveError` keeps its type and attributes).
+fn with_context(error: SolveError, context: &str) -> PyErr {
+    let err = from_solve(error);
+    Python::attach(|py| {
+        let value = err.value(py);
+        let message = value.str().map(|s| s.to_string()).unwrap_or_default();
+        let _ = value.setattr("args", (format!("{context}: {message}"),));
+    });
+    err
+}
+
+/// Why a sweep stopped: a solver error with its context, or the cancel flag.
+enum Stop {
+    Solve(SolveError, String),
+    Message(String),
+    Cancelled,
+}
+
+impl Stop {
+    fn into_py(self) -> PyErr {
+        match self {
+            Stop::Solve(e, context) if context.is_empty() => from_solve(e),
+            Stop::Solve(e, context) => with_context(e, &context),
+            Stop::Message(m) => invalid(m),
+            // The exception that cancelled is raised by `run_detached`.
+            Stop::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted"),
+        }
+    }
+}
+
+/// The CLI's up-front check: the largest load of each kind (and, with a finite-difference
+/// step, its upper step) must lie below full contact. The threshold itself is computed
+/// only where the cheap lower bound does not clear the loads.
+fn check_full_contact(
+    solver: &mut ContactSolver,
+    loads: &[Control],
+    fd_step: Option<f64>,
+) -> Result<(), Stop> {
+    let area = solver.nominal_area();
+    let same_kind =
+        |a: &Control, b: &Control| std::mem::discriminant(a) == std::mem::discriminant(b);
+    let mut kinds: Vec<Control> = Vec::new();
+    for c in loads {
+        if !kinds.iter().any(|k| same_kind(k, c)) {
+            kinds.push(*c);
+        }
+    }
+    let context = describe;
+    for kind in kinds {
+        let Some((k, &largest)) = loads
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| same_kind(c, &kind))
+            .max_by(|a, b| a.1.value().total_cmp(&b.1.value()))
+        else {
+            continue;
+        };
+        let top = largest.value() * (1.0 + fd_step.unwrap_or(0.0));
+        let bound = solver
+            .full_contact_lower_bound()
+            .map_err(|e| Stop::Solve(e, context(k, largest)))?;
+        match bound.in_units_of(largest, area) {
+            Some(b) if top < b => continue,
+            None => continue,
+            Some(_) => {}
+        }
+        let threshold = solver
+            .full_contact_threshold()
+            .map_err(|e| Stop::Solve(e, context(k, largest)))?;
+        let Some(full) = threshold.in_units_of(largest, area) else {
+            continue;
+        };
+        if largest.value() >= full {
+            let error = SolveError::BeyondFullContact {
+                requested: largest,
+                full_contact: Some(full),
+            };
+            return Err(Stop::Solve(error, context(k, largest)));
+        }
+        if top >= full {
+            return Err(Stop::Message(format!(
+                "fd_stiffness: at {} the upper finite-difference step ({} {:.6e}, the load × (1 + {})) is beyond full contact (the gap closes everywhere from {:.6e}); lower the load or drop fd_stiffness",
+                describe(k, largest),
+                largest.quantity(),
+                top,
+                fd_step.unwrap_or(0.0),
+                full
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Columns of a sweep, one value per load.
+#[derive(Default)]
+struct Columns {
+    force: Vec<f64>,
+    mean_pressure: Vec<f64>,
+    indentation: Vec<f64>,
+    area_fraction: Vec<f64>,
+    contact_points: Vec<u64>,
+    stiffness: Vec<f64>,
+    iterations: Vec<u64>,
+    residual: Vec<f64>,
+    stiffness_fd: Vec<f64>,
+    pressures: Vec<ndarray::Array2<f64>>,
+    gaps: Vec<ndarray::Array2<f64>>,
+}
+
+/// A reusable BEM contact solver (the compiled core of `asperity.Solver`).
+#[pyclass(module = "asperity._asperity")]
+pub struct Solver {
+    solver: ContactSolver,
+    modulus: f64,
+    boundary: Boundary,
+    size: f64,
+}
+
+#[pymethods]
+impl Solver {
+    #[new]
+    #[pyo3(signature = (heights, size_x, size_y, modulus, boundary, tolerance, max_iterations, solver))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        heights: PyReadonlyArray2<'_, f64>,
+        size_x: f64,
+        size_y: Option<f64>,
+        modulus: f64,
+        boundary: &str,
+        tolerance: f64,
+        max_iterations: usize,
+        solver: &str,
+    ) -> PyResult<Self> {
+        check_solver_name(solver)?;
+        let boundary: Boundary = boundary.parse().map_err(from_error)?;
+        if !(modulus.is_finite() && modulus > 0.0) {
+            return Err(invalid(format!(
+                "modulus must be positive and finite, got {modulus}"
+            )));
+        }
+        for (name, size) in [("size", Some(size_x)), ("size_y", size_y)] {
+            if let Some(size) = size.filter(|s| !(s.is_finite() && *s > 0.0)) {
+                return Err(invalid(format!(
+                    "{name} must be positive and finite, got {size}"
+                )));
+            }
+        }
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(invalid(format!(
+                "tolerance must be positive and finite, got {tolerance}"
+            )));
+        }
+        let params = SolverParams {
+            tolerance,
+            max_iterations,
+            ..SolverParams::default()
+        };
+        params.validate().map_err(from_error)?;
+        let (rows, cols) = heights.as_array().dim();
+        let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
+            .zip(array_bytes(&[rows, cols], 8))
+            .and_then(|(solver, heights)| solver.checked_add(heights));
+        ensure_fits(
+            &format!(
+                "a BEM solver on a {rows}x{cols} surface ({} boundaries)",
+                boundary.name()
+            ),
+            bytes,
+        )
+        .map_err(from_error)?;
+        if rows < 2 || cols < 2 {
+            return Err(invalid(format!(
+                "invalid grid: a surface needs at least 2x2 points, got ({rows}, {cols})"
+            )));
+        }
+        let owned = owned_2d(&heights);
+        let surface = match size_y {
+            Some(size_y) => Surface::with_sizes(owned, size_x, size_y),
+            None => Surface::new(owned, size_x),
+        }
+        .map_err(from_error)?;
+        let half_space = HalfSpace { modulus, boundary };
+        let solver = run_detached(py, |_| ContactSolver::new(&surface, half_space, params))?
+            .map_err(from_solve)?;
+        Ok(Solver {
+            solver,
+            modulus,
+            boundary,
+            size: size_x,
+        })
+    }
+
+    /// `(rows, cols)`.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        self.solver.dim()
+    }
+
+    /// Nominal area `rows · cols · Δ²`.
+    #[getter]
+    fn nominal_area(&self) -> f64 {
+        self.solver.nominal_area()
+    }
+
+    #[getter]
+    fn modulus(&self) -> f64 {
+        self.modulus
+    }
+
+    #[getter]
+    fn boundary(&self) -> &'static str {
+        self.boundary.name()
+    }
+
+    #[getter]
+    fn size(&self) -> f64 {
+        self.size
+    }
+
+    #[getter]
+    fn tolerance(&self) -> f64 {
+        self.solver.params().tolerance
+    }
+
+    #[getter]
+    fn max_iterations(&self) -> usize {
+        self.solver.params().max_iterations
+    }
+
+    /// Forgets the last solution (the next solve starts cold).
+    fn reset(&mut self) {
+        self.solver.reset();
+    }
+
+    /// `(mean_pressure, indentation)` of full contact (see the library's
+    /// `full_contact_threshold`; on free boundaries it forgets the warm start).
+    fn full_contact_threshold(&mut self, py: Python<'_>) -> PyResult<(f64, Option<f64>)> {
+        let solver = &mut self.solver;
+        let t = run_detached(py, |_| solver.full_contact_threshold())?.map_err(from_solve)?;
+        Ok((t.mean_pressure, t.indentation))
+    }
+
+    /// One solve; returns the scalars and, with `fields`, pressure, gap, displacement.
+    #[pyo3(signature = (quantity, value, fields))]
+    fn solve<'py>(
+        &mut self,
+        py: Python<'py>,
+        quantity: &str,
+        value: f64,
+        fields: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let control = control(quantity, value)?;
+        let solver = &mut self.solver;
+        // No up-front full-contact check here (the CLI's is for sweeps): the library's
+        // solve refuses such a load itself, with the same threshold, and a single solve
+        // then costs exactly what the library's does.
+        let (summary, info, state) = run_detached(py, |_| {
+            let (summary, info) = solver
+                .solve(control)
+                .map_err(|e| Stop::Solve(e, String::new()))?;
+            let state = if fields { solver.state() } else { None };
+            Ok((summary, info, state))
+        })?
+        .map_err(Stop::into_py)?;
+        let dict = PyDict::new(py);
+        dict.set_item("force", summary.force)?;
+        dict.set_item("mean_pressure", summary.mean_pressure)?;
+        dict.set_item("indentation", summary.indentation)?;
+        dict.set_item("area_fraction", summary.area_fraction)?;
+        dict.set_item("contact_points", summary.contact_points)?;
+        dict.set_item("iterations", info.iterations)?;
+        dict.set_item("residual", info.residual)?;
+        if let Some(state) = state {
+            dict.set_item("pressure", state.pressure.into_pyarray(py))?;
+            dict.set_item("gap", state.gap.into_pyarray(py))?;
+            dict.set_item("displacement", state.displacement.into_pyarray(py))?;
+        }
+        Ok(dict)
+    }
+
+    /// Frozen-set stiffness of the last solve: `(k, iterations, residual)`.
+    fn stiffness(&mut self, py: Python<'_>) -> PyResult<(f64, usize, f64)> {
+        let solver = &mut self.solver;
+        let (k, info) = run_detached(py, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
+        Ok((k, info.iterations, info.residual))
+    }
+
+    /// Finite-difference `dF/dd` around a load (leaves the solver at the upper step).
+    fn fd_stiffness(
+        &mut self,
+        py: Python<'_>,
+        quantity: &str,
+        value: f64,
+        step: f64,
+    ) -> PyResult<f64> {
+        let control = control(quantity, value)?;
+        let solver = &mut self.solver;
+        run_detached(py, |_| solver.finite_difference_stiffness(control, step))?.map_err(from_solve)
+    }
+
+    /// A load sweep as `asperity bem` runs it (module docs); returns the columns.
+    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress))]
+    #[allow(clippy::too_many_arguments)]
+    fn sweep<'py>(
+        &mut self,
+        py: Python<'py>,
+        quantity: &str,
+        values: Vec<f64>,
+        stiffness: bool,
+        fd_step: Option<f64>,
+        fields: bool,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let loads = values
+            .iter()
+            .map(|&v| control(quantity, v))
+            .collect::<PyResult<Vec<_>>>()?;
+        let solver = &mut self.solver;
+        let columns = run_detached(py, |cancel| {
+            sweep_loads(
+                solver,
+                &loads,
+                stiffness,
+                fd_step,
+                fields,
+                progress.as_ref(),
+                cancel,
+            )
+        })?
+        .map_err(Stop::into_py)?;
+        columns_dict(py, columns, stiffness, fd_step.is_some(), fields)
+    }
+}
+
+/// The CLI's loop over loads (step 2 of `asperity bem`), stopping between loads when
+/// cancelled.
+fn sweep_loads(
+    solver: &mut ContactSolver,
+    loads: &[Control],
+    stiffness: bool,
+    fd_step: Option<f64>,
+    fields: bool,
+    progress: Option<&Py<PyAny>>,
+    cancel: &Cancel,
+) -> Result<Columns, Stop> {
+    check_full_contact(solver, loads, fd_step)?;
+    let mut c = Columns::default();
+    cancel.call(progress, 0, loads.len());
+    for (k, &control) in loads.iter().enumerate() {
+        if cancel.is_set() {
+            return Err(Stop::Cancelled);
+        }
+        let (summary, info) = solver
+            .solve(control)
+            .map_err(|e| Stop::Solve(e, describe(k, control)))?;
+        let k_frozen = if stiffness {
+            solver
+                .frozen_set_stiffness()
+                .map_err(|e| Stop::Solve(e, format!("stiffness at {}", describe(k, control))))?
+                .0
+        } else {
+            f64::NAN
+        };
+        if fields {
+            c.pressures.push(solver.pressure().to_owned());
+            c.gaps.push(solver.gap().to_owned());
+        }
+        if let Some(step) = fd_step {
+            let fd = if control.value() > 0.0 {
+                let context = format!("fd_stiffness at {}", describe(k, control));
+                let fd = solver
+                    .finite_difference_stiffness(control, step)
+                    .map_err(|e| Stop::Solve(e, context.clone()))?;
+                if k + 1 < loads.len() {
+                    solver.solve(control).map_err(|e| Stop::Solve(e, context))?;
+                }
+                fd
+            } else {
+                f64::NAN // no central difference at indentation 0
+            };
+            c.stiffness_fd.push(fd);
+        }
+        c.force.push(summary.force);
+        c.mean_pressure.push(summary.mean_pressure);
+        c.indentation.push(summary.indentation);
+        c.area_fraction.push(summary.area_fraction);
+        c.contact_points.push(summary.contact_points as u64);
+        c.stiffness.push(k_frozen);
+        c.iterations.push(info.iterations as u64);
+        c.residual.push(info.residual);
+        cancel.call(progress, k + 1, loads.len());
+    }
+    Ok(c)
+}
+
+fn columns_dict(
+    py: Python<'_>,
+    c: Columns,
+    stiffness: bool,
+    fd: bool,
+    fields: bool,
+) -> PyResult<Bound<'_, PyDict>> {
+    let dict = PyDict::new(py);
+    let column = |v: Vec<f64>| PyArray1::from_vec(py, v);
+    dict.set_item("force", column(c.force))?;
+    dict.set_item("mean_pressure", column(c.mean_pressure))?;
+    dict.set_item("indentation", column(c.indentation))?;
+    dict.set_item("area_fraction", column(c.area_fraction))?;
+    if stiffness {
+        dict.set_item("stiffness", column(c.stiffness))?;
+    }
+    dict.set_item("iterations", PyArray1::from_vec(py, c.iterations))?;
+    dict.set_item("residual", column(c.residual))?;
+    if fd {
+        dict.set_item("stiffness_fd", column(c.stiffness_fd))?;
+    }
+    dict.set_item("contact_points", PyArray1::from_vec(py, c.contact_points))?;
+    if fields {
+        let list = |arrays: Vec<ndarray::Array2<f64>>| -> PyResult<Bound<'_, PyList>> {
+            let items: Vec<Bound<'_, PyArray2<f64>>> =
+                arrays.into_iter().map(|a| a.into_pyarray(py)).collect();
+            PyList::new(py, items)
+        };
+        dict.set_item("pressure", list(c.pressures)?)?;
+        dict.set_item("gap", list(c.gaps)?)?;
+    }
+    Ok(dict)
+}

@@ -1,0 +1,89 @@
+//! The library's errors as Python exceptions.
+//!
+//! * bad input ([`Error::InvalidParameter`], non-finite values, bad files, foreign
+//!   checkpoints, ...) → `ValueError` with the library's one-line message, the line the
+//!   CLI prints after `error: `;
+//! * the memory guard ([`Error::OutOfMemory`]) → `MemoryError`;
+//! * [`SolveError::NoConvergence`] → `asperity.ConvergenceError` with `.iterations` and
+//!   `.residual`;
+//! * [`SolveError::BeyondFullContact`] → `asperity.BeyondFullContactError` (a
+//!   `ValueError`) with `.threshold` (the full-contact value in the quantity asked for, or
+//!   `None`), `.quantity` and `.requested`;
+//! * I/O errors → `OSError`.
+
+use asperity::bem::SolveError;
+use asperity::Error;
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    asperity,
+    ConvergenceError,
+    PyRuntimeError,
+    "A contact solve (or the frozen-set CG) did not reach its tolerance.\n\n\
+     Attributes: ``iterations`` (done) and ``residual`` (reached)."
+);
+pyo3::create_exception!(
+    asperity,
+    BeyondFullContactError,
+    PyValueError,
+    "The load or indentation closes the gap everywhere: no contact problem is left.\n\n\
+     Attributes: ``threshold`` (the full-contact value in the quantity asked for, or None),\n\
+     ``quantity`` ('force', 'mean pressure' or 'indentation') and ``requested``."
+);
+
+/// A library error as a Python exception.
+pub fn from_error(error: Error) -> PyErr {
+    match error {
+        Error::OutOfMemory { .. } => PyMemoryError::new_err(error.to_string()),
+        Error::Io { .. } => PyOSError::new_err(error.to_string()),
+        Error::Solve { context, source } => {
+            let err = from_solve(*source);
+            Python::attach(|py| prefix(py, err, &context))
+        }
+        other => PyValueError::new_err(other.to_string()),
+    }
+}
+
+/// A solver error as a Python exception (see the module docs).
+pub fn from_solve(error: SolveError) -> PyErr {
+    let message = error.to_string();
+    match error {
+        SolveError::Input(e) => from_error(e),
+        SolveError::NoConvergence {
+            iterations,
+            residual,
+        } => Python::attach(|py| {
+            let err = ConvergenceError::new_err(message);
+            let value = err.value(py);
+            // Setting attributes on a fresh exception instance cannot fail.
+            let _ = value.setattr("iterations", iterations);
+            let _ = value.setattr("residual", residual);
+            err
+        }),
+        SolveError::BeyondFullContact {
+            requested,
+            full_contact,
+        } => Python::attach(|py| {
+            let err = BeyondFullContactError::new_err(message);
+            let value = err.value(py);
+            let _ = value.setattr("threshold", full_contact);
+            let _ = value.setattr("quantity", requested.quantity());
+            let _ = value.setattr("requested", requested.value());
+            err
+        }),
+    }
+}
+
+/// The same exception with `context: ` before its message (attributes kept).
+fn prefix(py: Python<'_>, err: PyErr, context: &str) -> PyErr {
+    let value = err.value(py);
+    let message = value.str().map(|s| s.to_string()).unwrap_or_default();
+    let _ = value.setattr("args", (format!("{context}: {message}"),));
+    err
+}
+
+/// `ValueError(message)`: for the binding's own checks of its arguments.
+pub fn invalid(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}

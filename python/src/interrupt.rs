@@ -1,0 +1,94 @@
+//! Long computations with the GIL released, interruptible by Ctrl-C.
+//!
+//! Python runs its signal handlers (the `KeyboardInterrupt` of Ctrl-C) only on the main
+//! thread and only while that thread holds the GIL. So [`run_detached`] releases the GIL,
+//! runs the work on a helper thread and keeps the calling thread waiting on it, waking
+//! every [`POLL`] to take the GIL for a moment and run the handlers
+//! (`Python::check_signals`). A raised signal (or an exception of the user's progress
+//! callback, see [`Cancel::call`]) sets the [`Cancel`] flag, which the work checks between
+//! its steps (loads of a sweep, samples of a study) and then stops; the exception is
+//! re-raised once the work has returned. A single contact solve has no such step inside:
+//! it runs to its end (the library's solver offers no cancellation point).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Mutex};
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+/// How often the waiting thread runs Python's signal handlers.
+pub const POLL: Duration = Duration::from_millis(50);
+
+/// Set when the work is to stop; holds the exception that stopped it.
+#[derive(Default)]
+pub struct Cancel {
+    flag: AtomicBool,
+    error: Mutex<Option<PyErr>>,
+}
+
+impl Cancel {
+    /// Whether the work should stop now.
+    pub fn is_set(&self) -> bool {
+        self.flag.load(Ordering::Relaxed)
+    }
+
+    /// Stops the work with `error` (the first error is kept).
+    pub fn fail(&self, error: PyErr) {
+        let mut slot = self.error.lock().unwrap_or_else(|e| e.into_inner());
+        slot.get_or_insert(error);
+        self.flag.store(true, Ordering::Relaxed);
+    }
+
+    /// Calls the user's `progress(done, total)` (if any) with the GIL; an exception it
+    /// raises stops the work.
+    pub fn call(&self, progress: Option<&Py<PyAny>>, done: usize, total: usize) {
+        if let Some(callback) = progress {
+            if let Err(e) = Python::attach(|py| callback.call1(py, (done, total)).map(drop)) {
+                self.fail(e);
+            }
+        }
+    }
+
+    fn take(&self) -> Option<PyErr> {
+        self.error.lock().unwrap_or_else(|e| e.into_inner()).take()
+    }
+}
+
+/// Runs `work` without the GIL on a helper thread while this thread watches for signals
+/// (module docs). Returns the work's result, or the exception that cancelled it.
+pub fn run_detached<R: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&Cancel) -> R + Send,
+) -> PyResult<R> {
+    let cancel = Cancel::default();
+    let result = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (sender, receiver) = mpsc::channel();
+            let cancel = &cancel;
+            scope.spawn(move || {
+                let _ = sender.send(work(cancel));
+            });
+            loop {
+                match receiver.recv_timeout(POLL) {
+                    Ok(result) => return Some(result),
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        if !cancel.is_set() {
+                            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                                cancel.fail(e);
+                            }
+                        }
+                    }
+                    // The work panicked; the scope re-raises its panic when it ends.
+                    Err(mpsc::RecvTimeoutError::Disconnected) => return None,
+                }
+            }
+        })
+    });
+    match (cancel.take(), result) {
+        (Some(error), _) => Err(error),
+        (None, Some(result)) => Ok(result),
+        (None, None) => Err(pyo3::exceptions::PyRuntimeError::new_err(
+            "the computation stopped unexpectedly",
+        )),
+    }
+}

@@ -1,0 +1,38 @@
+//! `asperity._asperity`: the compiled part of the Python package `asperity`.
+//!
+//! A thin layer over the `asperity` library: every number comes from the same library
+//! functions the command line calls, in the same order, so results are bit-identical to
+//! the CLI's. The Python package (`python/asperity/__init__.py`) adds keyword-only
+//! signatures, input coercion to float64 and the progress bar; this crate does the work
+//! with the GIL released ([`interrupt::run_detached`]), maps the library's errors to Python
+//! exceptions ([`errors`]) and hands results back as numpy arrays without copying them.
+
+mod arrays;
+mod bem;
+mod errors;
+mod interrupt;
+mod mdr;
+mod study;
+mod surface;
+
+use pyo3::prelude::*;
+
+/// The compiled module.
+#[pymodule]
+fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add(
+        "ConvergenceError",
+        py.get_type::<errors::ConvergenceError>(),
+    )?;
+    m.add(
+        "BeyondFullContactError",
+        py.get_type::<errors::BeyondFullContactError>(),
+    )?;
+    surface::register(m)?;
+    bem::register(m)?;
+    mdr::register(m)?;
+    study::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,241 @@
+//! Surfaces and lines (`asperity surface`, `asperity line`), their statistics and PSD
+//! (`asperity stats`): the same library calls as `crates/asperity-cli/src/commands/
+//! surface.rs` and `stats.rs`.
+
+use std::path::PathBuf;
+
+use asperity::fit::power_law_fit;
+use asperity::io::{sidecar_path, StagedOutputs};
+use asperity::spectrum::{LongWavelength, Psd};
+use asperity::surface::stats::{line_psd, line_summary, radial_psd_2d, surface_summary, Summary};
+use asperity::surface::{
+    Line, LineGenerator, LineSpec, Normalisation, Surface, SurfaceGenerator, SurfaceSpec,
+};
+use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde_json::json;
+
+use crate::arrays::{heights, owned_1d, Heights};
+use crate::errors::{from_error, invalid};
+use crate::interrupt::run_detached;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(generate_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(generate_line, m)?)?;
+    m.add_function(wrap_pyfunction!(save_heights, m)?)?;
+    m.add_function(wrap_pyfunction!(summary, m)?)?;
+    m.add_function(wrap_pyfunction!(psd, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_power_law, m)?)?;
+    Ok(())
+}
+
+/// The long-wavelength end of the spectrum, as the CLI's `--rolloff` / `--cutoff`.
+fn long_wavelength(rolloff: Option<f64>, cutoff: Option<f64>) -> PyResult<LongWavelength> {
+    match (rolloff, cutoff) {
+        (Some(_), Some(_)) => Err(invalid(
+            "give at most one of rolloff and cutoff (a roll-off keeps the power below q0 flat, a cut-off removes it)",
+        )),
+        (Some(q0), None) => Ok(LongWavelength::RollOff { q0 }),
+        (None, Some(q0)) => Ok(LongWavelength::CutOff { q0 }),
+        (None, None) => Ok(LongWavelength::None),
+    }
+}
+
+/// The normalisation, as the CLI's `--rms-height` / `--rms-slope` (unit rms height when
+/// neither is given).
+fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> PyResult<Normalisation> {
+    match (rms_height, rms_slope) {
+        (Some(_), Some(_)) => Err(invalid("give at most one of rms_height and rms_slope")),
+        (_, Some(s)) => Ok(Normalisation::RmsSlope(s)),
+        (Some(h), None) => Ok(Normalisation::RmsHeight(h)),
+        (None, None) => Ok(Normalisation::default()),
+    }
+}
+
+/// The sidecar the CLI writes beside its .npy, as JSON text.
+fn sidecar(
+    kind: &str,
+    shape: &[usize],
+    seed: u64,
+    spec: serde_json::Value,
+    stats: &Summary,
+) -> String {
+    json!({
+        "kind": kind,
+        "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
+        "shape": shape,
+        "seed": seed,
+        "spec": spec,
+        "stats": stats,
+    })
+    .to_string()
+}
+
+/// Generates a surface; returns its heights and the CLI's sidecar (JSON text).
+#[pyfunction]
+#[pyo3(signature = (n, m, hurst, rolloff, cutoff, short_cutoff, rms_height, rms_slope, size, seed))]
+#[allow(clippy::too_many_arguments)]
+fn generate_surface<'py>(
+    py: Python<'py>,
+    n: usize,
+    m: Option<usize>,
+    hurst: f64,
+    rolloff: Option<f64>,
+    cutoff: Option<f64>,
+    short_cutoff: Option<f64>,
+    rms_height: Option<f64>,
+    rms_slope: Option<f64>,
+    size: f64,
+    seed: u64,
+) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, String)> {
+    let psd =
+        Psd::new(hurst, long_wavelength(rolloff, cutoff)?, short_cutoff).map_err(from_error)?;
+    let rows = m.unwrap_or(n);
+    let spec = SurfaceSpec::new(rows, n, size, psd, normalisation(rms_height, rms_slope)?)
+        .map_err(from_error)?;
+    let surface = run_detached(py, |_| {
+        SurfaceGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
+    })?
+    .map_err(from_error)?;
+    let stats = surface_summary(&surface);
+    let spec_json = serde_json::to_value(spec).expect("a spec serialises");
+    let meta = sidecar("surface", &[rows, n], seed, spec_json, &stats);
+    Ok((surface.into_heights().into_pyarray(py), meta))
+}
+
+/// Generates a line; returns its heights and the CLI's sidecar (JSON text).
+#[pyfunction]
+#[pyo3(signature = (n, hurst, rolloff, cutoff, rms_height, rms_slope, size, seed))]
+#[allow(clippy::too_many_arguments)]
+fn generate_line<'py>(
+    py: Python<'py>,
+    n: usize,
+    hurst: f64,
+    rolloff: Option<f64>,
+    cutoff: Option<f64>,
+    rms_height: Option<f64>,
+    rms_slope: Option<f64>,
+    size: f64,
+    seed: u64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, String)> {
+    let psd = Psd::new(hurst, long_wavelength(rolloff, cutoff)?, None).map_err(from_error)?;
+    let spec =
+        LineSpec::new(n, size, psd, normalisation(rms_height, rms_slope)?).map_err(from_error)?;
+    let line = run_detached(py, |_| {
+        LineGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
+    })?
+    .map_err(from_error)?;
+    let stats = line_summary(&line);
+    let spec_json = serde_json::to_value(spec).expect("a spec serialises");
+    let meta = sidecar("line", &[n], seed, spec_json, &stats);
+    Ok((line.into_heights().into_pyarray(py), meta))
+}
+
+/// Writes heights as `.npy` with the sidecar `FILE.npy.json` (JSON text `metadata`),
+/// both or neither, as the CLI does.
+#[pyfunction]
+#[pyo3(signature = (path, array, metadata, force))]
+fn save_heights(
+    path: PathBuf,
+    array: PyReadonlyArrayDyn<'_, f64>,
+    metadata: &str,
+    force: bool,
+) -> PyResult<()> {
+    let record: serde_json::Value =
+        serde_json::from_str(metadata).map_err(|e| invalid(format!("metadata: {e}")))?;
+    let sidecar = sidecar_path(&path);
+    let mut staged = StagedOutputs::new([&path, &sidecar], force).map_err(from_error)?;
+    match heights(&array, "heights")? {
+        Heights::Line(h) => staged.write_npy_1d(&path, &h),
+        Heights::Surface(h) => staged.write_npy_2d(&path, &h),
+    }
+    .map_err(from_error)?;
+    staged.write_json(&sidecar, &record).map_err(from_error)?;
+    staged.commit().map_err(from_error)
+}
+
+/// A line or a surface of the given heights and side length.
+enum Profile {
+    Line(Line),
+    Surface(Surface),
+}
+
+fn profile(array: &PyReadonlyArrayDyn<'_, f64>, size: f64) -> PyResult<Profile> {
+    match heights(array, "heights")? {
+        Heights::Line(h) => Line::new(h, size).map(Profile::Line),
+        Heights::Surface(h) => Surface::new(h, size).map(Profile::Surface),
+    }
+    .map_err(from_error)
+}
+
+/// rms height, slope and curvature (`asperity stats`).
+#[pyfunction]
+fn summary<'py>(
+    py: Python<'py>,
+    array: PyReadonlyArrayDyn<'_, f64>,
+    size: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = match profile(&array, size)? {
+        Profile::Line(line) => line_summary(&line),
+        Profile::Surface(surface) => surface_summary(&surface),
+    };
+    let dict = PyDict::new(py);
+    dict.set_item("rms_height", s.rms_height)?;
+    dict.set_item("rms_slope", s.rms_slope)?;
+    dict.set_item("rms_curvature", s.rms_curvature)?;
+    Ok(dict)
+}
+
+/// The PSD (radially averaged for a surface): wavenumbers q, PSD values and the number of
+/// Fourier modes of each bin.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn psd<'py>(
+    py: Python<'py>,
+    array: PyReadonlyArrayDyn<'_, f64>,
+    size: f64,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<u64>>,
+)> {
+    let profile = profile(&array, size)?;
+    let bins = run_detached(py, move |_| match profile {
+        Profile::Line(line) => Ok(line_psd(&line)),
+        Profile::Surface(surface) => radial_psd_2d(&surface),
+    })?
+    .map_err(from_error)?;
+    let column = |f: &dyn Fn(&asperity::surface::stats::PsdBin) -> f64| {
+        ndarray::Array1::from_iter(bins.iter().map(f)).into_dyn()
+    };
+    let modes = ndarray::Array1::from_iter(bins.iter().map(|b| b.modes as u64)).into_dyn();
+    Ok((
+        column(&|b| b.q).into_pyarray(py),
+        column(&|b| b.psd).into_pyarray(py),
+        modes.into_pyarray(py),
+    ))
+}
+
+/// Least-squares power law `y = A x^p` on log–log axes, with the 95 % interval of `p`.
+#[pyfunction]
+fn fit_power_law<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'_, f64>,
+    y: PyReadonlyArray1<'_, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (x, y) = (owned_1d(&x), owned_1d(&y));
+    let fit = power_law_fit(
+        x.as_slice().expect("contiguous"),
+        y.as_slice().expect("contiguous"),
+    )
+    .map_err(from_error)?;
+    let dict = PyDict::new(py);
+    dict.set_item("exponent", fit.exponent)?;
+    dict.set_item("prefactor", fit.prefactor)?;
+    dict.set_item("stderr", fit.stderr)?;
+    dict.set_item("low", fit.low)?;
+    dict.set_item("high", fit.high)?;
+    dict.set_item("points", fit.points)?;
+    Ok(dict)
+}

@@ -1,0 +1,178 @@
+"""Python gives the CLI's numbers bit for bit: same seed → the same .npy heights and
+sidecar, same surface → the same solve, sweep, fields, stats, PSD and MDR curves.
+
+Both call the same library functions in the same order; these tests compare every value
+exactly (`==` on floats, `array_equal` on arrays). The CLI writes floats with Rust's
+shortest round-trip formatting, which Python's float() reads back exactly."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import asperity
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    columns = {}
+    for name in rows[0]:
+        columns[name] = [float(r[name]) if r[name] != "" else None for r in rows]
+    return columns
+
+
+SURFACES = [
+    # CLI options, Python keywords
+    (["--n", 64, "--m", 32, "--hurst", 0.7, "--rolloff", 3, "--short-cutoff", 20,
+      "--rms-slope", 0.5, "--size", 2, "--seed", 5],
+     dict(n=64, m=32, hurst=0.7, rolloff=3, short_cutoff=20, rms_slope=0.5, size=2, seed=5)),
+    (["--n", 48, "--hurst", -0.5, "--cutoff", 2, "--rms-height", 1e-3, "--seed", 11],
+     dict(n=48, hurst=-0.5, cutoff=2, rms_height=1e-3, seed=11)),
+    (["--n", 32, "--hurst", 2.5, "--seed", 0], dict(n=32, hurst=2.5)),
+]
+
+
+@pytest.mark.parametrize("flags,kwargs", SURFACES)
+def test_surface_heights_and_sidecar_equal_the_cli(cli, tmp_path, flags, kwargs):
+    cli("surface", *flags, "--out", tmp_path / "s.npy")
+    ours = asperity.surface(**kwargs)
+    theirs = np.load(tmp_path / "s.npy")
+    assert ours.heights.dtype == np.float64 and ours.heights.shape == theirs.shape
+    assert ours.heights.tobytes() == theirs.tobytes()
+    assert ours.metadata == json.loads((tmp_path / "s.npy.json").read_text())
+    # And what Python saves is what the CLI wrote, byte for byte.
+    ours.save(tmp_path / "p.npy")
+    assert (tmp_path / "p.npy").read_bytes() == (tmp_path / "s.npy").read_bytes()
+    assert json.loads((tmp_path / "p.npy.json").read_text()) == ours.metadata
+
+
+def test_line_equals_the_cli(cli, tmp_path):
+    cli("line", "--n", 4096, "--hurst", 0.5, "--rolloff", 4, "--rms-slope", 3, "--size", 5,
+        "--seed", 3, "--out", tmp_path / "l.npy")
+    ours = asperity.line(4096, hurst=0.5, rolloff=4, rms_slope=3, size=5, seed=3)
+    assert ours.heights.tobytes() == np.load(tmp_path / "l.npy").tobytes()
+    assert ours.metadata == json.loads((tmp_path / "l.npy.json").read_text())
+
+
+def test_stats_and_psd_equal_the_cli(cli, tmp_path):
+    s = asperity.surface(64, hurst=0.8, rolloff=2, seed=4, size=3)
+    s.save(tmp_path / "s.npy")
+    report = json.loads(cli("stats", tmp_path / "s.npy", "--json", "--psd", tmp_path / "psd.csv").stdout)
+    assert asperity.stats(s) == report["stats"]
+    table = read_csv(tmp_path / "psd.csv")
+    spectrum = asperity.psd(s, fit_from=report["fit_from"], fit_to=report["fit_to"])
+    assert spectrum.q.tolist() == table["q"]
+    assert spectrum.psd.tolist() == table["psd"]
+    assert spectrum.wavenumber.tolist() == table["q_l_2pi"]
+    assert spectrum.fit["exponent"] == report["psd_slope"]
+    assert spectrum.hurst == report["hurst_estimate"]
+    line = asperity.line(1024, hurst=0.3, seed=2)
+    line.save(tmp_path / "l.npy")
+    report = json.loads(cli("stats", tmp_path / "l.npy", "--json").stdout)
+    assert asperity.stats(line) == report["stats"]
+
+
+BEM_CASES = [
+    ("free", ["--pressures", "0.003,0.01,0.03"], dict(pressures=[0.003, 0.01, 0.03])),
+    ("periodic", ["--forces", "0.02,0.005"], dict(forces=[0.02, 0.005])),
+    ("free", ["--indentations", "0,0.01,0.02"], dict(indentations=[0, 0.01, 0.02])),
+    ("periodic", ["--indentations", "0.005,0.01"], dict(indentations=[0.005, 0.01])),
+    ("free", ["--nloads", 4, "--pmin", 1e-3, "--pmax", 3e-2], dict(nloads=4, pmin=1e-3, pmax=3e-2)),
+]
+
+
+@pytest.mark.parametrize("boundary,flags,kwargs", BEM_CASES)
+def test_bem_sweep_and_fields_equal_the_cli(cli, tmp_path, boundary, flags, kwargs):
+    s = asperity.surface(48, m=40, hurst=0.8, rolloff=3, rms_slope=0.5, seed=7, size=2.0)
+    s.save(tmp_path / "s.npy")
+    cli("bem", "--surface", tmp_path / "s.npy", "--boundary", boundary, *flags, "--fd-stiffness",
+        "--tol", 1e-9, "--fields", tmp_path / "fields", "--out", tmp_path / "out.csv", "--quiet")
+    table = read_csv(tmp_path / "out.csv")
+    # The surface as a plain array with its size, as a user would load it.
+    solver = asperity.Solver(np.load(tmp_path / "s.npy"), 2.0, boundary=boundary, tolerance=1e-9)
+    sweep = solver.sweep(**kwargs, fd_stiffness=True, fields=True)
+    for name in ("force", "mean_pressure", "indentation", "area_fraction", "stiffness",
+                 "iterations", "residual"):
+        assert sweep[name].tolist() == table[name], name
+    fd = [None if np.isnan(v) else v for v in sweep.stiffness_fd]
+    assert fd == table["stiffness_fd"]
+    for k in range(len(sweep)):
+        assert np.array_equal(sweep.pressure[k], np.load(tmp_path / "fields" / f"pressure_{k}.npy"))
+        assert np.array_equal(sweep.gap[k], np.load(tmp_path / "fields" / f"gap_{k}.npy"))
+
+
+@pytest.mark.parametrize("boundary", ["free", "periodic"])
+def test_a_single_solve_equals_the_cli(cli, tmp_path, boundary):
+    s = asperity.surface(64, hurst=0.6, rolloff=4, rms_slope=1.0, seed=2)
+    s.save(tmp_path / "s.npy")
+    cli("bem", "--surface", tmp_path / "s.npy", "--boundary", boundary, "--forces", 0.02,
+        "--fields", tmp_path / "f", "--out", tmp_path / "out.csv", "--quiet")
+    row = read_csv(tmp_path / "out.csv")
+    solver = asperity.Solver(s, boundary=boundary)
+    r = solver.solve(force=0.02)
+    assert [r.force] == row["force"] and [r.indentation] == row["indentation"]
+    assert [r.area_fraction] == row["area_fraction"] and [r.iterations] == row["iterations"]
+    assert [r.residual] == row["residual"]
+    assert [solver.stiffness()] == row["stiffness"]
+    assert np.array_equal(r.pressure, np.load(tmp_path / "f" / "pressure_0.npy"))
+    assert np.array_equal(r.gap, np.load(tmp_path / "f" / "gap_0.npy"))
+    # The displacement is the gap's: g = u + f − d, except that the solver sets g = 0
+    # exactly on the contact set, where u + f − d is zero only to the tolerance (rms
+    # violation 1e-8 h_rms; pointwise a few times that, hence 100x).
+    f = s.heights.max() - s.heights
+    if boundary == "free":
+        atol = 100 * solver.tolerance * np.std(s.heights)
+        assert np.allclose(r.gap, r.displacement + f - r.indentation, rtol=0, atol=atol)
+
+
+MDR_CASES = [
+    (["--nloads", 30], dict(nloads=30)),
+    (["--breakpoints"], dict(breakpoints=True)),
+    (["--spring", "fractal", "--hurst", 0.5, "--nloads", 20, "--dmin", 1e-6],
+     dict(spring="fractal", hurst=0.5, nloads=20, dmin=1e-6)),
+    (["--spring", "hertz", "--asperity-radius", 0.01, "--indentations", "0,1e-3,0.5"],
+     dict(spring="hertz", asperity_radius=0.01, indentations=[0, 1e-3, 0.5])),
+]
+
+
+@pytest.mark.parametrize("flags,kwargs", MDR_CASES)
+def test_mdr_on_a_line_equals_the_cli(cli, tmp_path, flags, kwargs):
+    line = asperity.line(2048, hurst=0.5, seed=9, size=3.0)
+    line.save(tmp_path / "l.npy")
+    cli("mdr", "--line", tmp_path / "l.npy", *flags, "--out", tmp_path / "c.csv")
+    table = read_csv(tmp_path / "c.csv")
+    curve = asperity.mdr(line=line, **kwargs)
+    for name in ("indentation", "force", "stiffness", "contacts"):
+        assert getattr(curve, name).tolist() == table[name], name
+
+
+@pytest.mark.parametrize("flags,kwargs", [
+    (["--profile", "hertz", "--radius", 1, "--n", 2001, "--dx", 0.01, "--spring", "hertz",
+      "--indentations", "1e-8,1e-6,1e-4"],
+     dict(profile="hertz", radius=1, n=2001, dx=0.01, spring="hertz", indentations=[1e-8, 1e-6, 1e-4])),
+    (["--profile", "cone", "--slope", 0.2, "--n", 401, "--dx", 1e-3, "--nloads", 20],
+     dict(profile="cone", slope=0.2, n=401, dx=1e-3, nloads=20)),
+    (["--profile", "power", "--coefficient", 2, "--exponent", 3, "--n", 301, "--dx", 1e-2,
+      "--spring", "fractal", "--hurst", 0.8, "--rms-height", 1e-3, "--nloads", 10],
+     dict(profile="power", coefficient=2, exponent=3, n=301, dx=1e-2, spring="fractal",
+          hurst=0.8, rms_height=1e-3, nloads=10)),
+])
+def test_mdr_on_profiles_equals_the_cli(cli, tmp_path, flags, kwargs):
+    cli("mdr", *flags, "--out", tmp_path / "c.csv")
+    table = read_csv(tmp_path / "c.csv")
+    curve = asperity.mdr(**kwargs)
+    for name in ("indentation", "force", "stiffness", "contacts"):
+        assert getattr(curve, name).tolist() == table[name], name
+
+
+def test_mdr_on_a_radial_profile_equals_the_cli(cli, tmp_path):
+    r = np.arange(200) * 1e-2
+    np.save(tmp_path / "tip.npy", r**2 / 2)
+    cli("mdr", "--radial", tmp_path / "tip.npy", "--radial-step", 1e-2, "--n", 101, "--dx", 1e-2,
+        "--nloads", 10, "--out", tmp_path / "c.csv")
+    table = read_csv(tmp_path / "c.csv")
+    curve = asperity.mdr(radial=r**2 / 2, radial_step=1e-2, n=101, dx=1e-2, nloads=10)
+    assert curve.force.tolist() == table["force"]
+    assert curve.stiffness.tolist() == table["stiffness"]

@@ -1,0 +1,150 @@
+"""Studies share the CLI's checkpoint folders: a study stopped in Python resumes from the
+CLI and one stopped in the CLI resumes from Python, with the numbers of an uninterrupted
+run bit for bit; Ctrl-C (SIGINT) stops a long Python study within seconds, keeping its
+checkpoints."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import asperity
+
+from conftest import cli_path
+
+
+def checkpoint_samples(folder: Path) -> int:
+    """Samples held by the in-progress checkpoints of a study folder."""
+    total = 0
+    for path in (folder / "checkpoint").glob("*.json"):
+        try:
+            record = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue  # being replaced
+        if record.get("state") == "in_progress":
+            total += len(record["samples"])
+    return total
+
+
+def alpha_csv(path: Path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+class Stop(Exception):
+    pass
+
+
+MDR = dict(method="mdr", n=[256, 512], hurst="0:1:0.5", samples=40, seed=3)
+MDR_FLAGS = ["--method", "mdr", "--n", "256,512", "--hurst", "0:1:0.5", "--samples", 40,
+             "--seed", 3]
+
+
+def test_an_mdr_study_equals_the_cli_and_resumes_there(cli, tmp_path):
+    cli("study", "alpha", *MDR_FLAGS, "--out", tmp_path / "cli", "--quiet")
+    reference = alpha_csv(tmp_path / "cli" / "alpha.csv")
+    ours = asperity.study_alpha(**MDR, out=tmp_path / "py")
+    for name in reference[0]:
+        theirs = [r[name] for r in reference]
+        mine = ours[name].tolist()
+        if name == "method":
+            assert mine == theirs
+            continue
+        # Empty CSV cells are NaN in the columns.
+        mine = [None if isinstance(v, float) and np.isnan(v) else v for v in mine]
+        assert mine == [float(v) if v != "" else None for v in theirs], name
+
+    # Stopped in Python after the first batch (checkpoint after every batch)...
+    def stop_after_first_batch(done, total):
+        if done > 0:
+            raise Stop()
+
+    with pytest.raises(Stop):
+        asperity.study_alpha(**MDR, out=tmp_path / "resumed", checkpoint_every=0,
+                             progress=stop_after_first_batch)
+    assert 0 < checkpoint_samples(tmp_path / "resumed") < 40
+    # ... resumed by the CLI: the same table as the uninterrupted run, byte for byte.
+    cli("study", "alpha", *MDR_FLAGS, "--out", tmp_path / "resumed", "--quiet")
+    assert (tmp_path / "resumed" / "alpha.csv").read_bytes() == (tmp_path / "cli" / "alpha.csv").read_bytes()
+
+
+BEM = dict(method="bem", n=32, hurst=[0.5], samples=16, seed=5)
+BEM_FLAGS = ["--method", "bem", "--n", 32, "--hurst", 0.5, "--samples", 16, "--seed", 5]
+
+
+def test_a_bem_curve_study_stopped_in_the_cli_resumes_in_python(tmp_path):
+    reference = asperity.study_curve(**BEM, out=tmp_path / "reference")
+    folder = tmp_path / "stopped"
+    process = subprocess.Popen(
+        [str(cli_path()), "study", "curve", *map(str, BEM_FLAGS), "--out", str(folder),
+         "--checkpoint-every", "0", "--quiet"],
+        stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while checkpoint_samples(folder) == 0 and process.poll() is None:
+        assert time.monotonic() < deadline, "no checkpoint after 120 s"
+        time.sleep(0.01)
+    process.send_signal(signal.SIGINT)
+    assert process.wait(timeout=30) == 130, process.stderr.read()
+    kept = checkpoint_samples(folder)
+    assert 0 < kept < 16, f"the CLI should have stopped mid-study ({kept} samples kept)"
+    restored = []
+    resumed = asperity.study_curve(**BEM, out=folder, progress=lambda d, t: restored.append(d))
+    assert restored[0] == kept, "Python resumed from the CLI's checkpoint"
+    assert resumed.rows == reference.rows
+    assert resumed.tasks == reference.tasks
+
+
+def test_ctrl_c_stops_a_long_study_within_seconds_keeping_its_checkpoints(tmp_path):
+    folder = tmp_path / "long"
+    script = f"""
+import sys, asperity
+def report(done, total):
+    if done > 0:
+        print("running", flush=True)
+try:
+    asperity.study_alpha(method="bem", n=[64], hurst=[0.5], samples=10000, seed=1,
+                         out={str(folder)!r}, checkpoint_every=0, progress=report)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+    sys.exit(130)
+print("finished", flush=True)
+"""
+    # cwd: not python/, whose asperity/ source folder would shadow the installed package.
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, cwd=tmp_path,
+                               stderr=subprocess.PIPE, text=True)
+    assert process.stdout.readline().strip() == "running", process.stderr.read()
+    assert checkpoint_samples(folder) > 0
+    start = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    code = process.wait(timeout=60)
+    elapsed = time.monotonic() - start
+    out = process.stdout.read()
+    assert code == 130 and "KeyboardInterrupt" in out, (code, out, process.stderr.read())
+    # One BEM sample of 64² (24 solves) takes about 0.1-0.3 s; the samples in flight finish
+    # first. A few seconds allow for the loaded test machine.
+    print(f"study stopped {elapsed:.3f} s after SIGINT")
+    assert elapsed < 5.0, f"took {elapsed:.2f} s to stop"
+    assert (folder / "study.json").exists() and checkpoint_samples(folder) > 0
+
+
+def test_study_arguments_are_checked_like_the_cli(cli, tmp_path):
+    message = cli("study", "alpha", "--method", "mdr", "--n", 512, "--hurst", "4", "--samples",
+                  2, "--out", tmp_path / "a", ok=False).stderr
+    with pytest.raises(ValueError) as err:
+        asperity.study_alpha(method="mdr", n=512, hurst=4, samples=2, out=tmp_path / "b")
+    assert str(err.value) in message
+    with pytest.raises(ValueError, match="expected mdr or bem"):
+        asperity.study_alpha(method="fem", n=512, hurst=0.5, samples=2, out=tmp_path / "c")
+    with pytest.raises(ValueError, match="given twice"):
+        asperity.study_alpha(method="mdr", n=[512, 512], hurst=0.5, samples=2, out=tmp_path / "d")
+    # Another study's folder is refused, as by the CLI.
+    asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=4, out=tmp_path / "e")
+    with pytest.raises(ValueError, match="holds the checkpoint of another study"):
+        asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=5, out=tmp_path / "e")
