@@ -84,6 +84,14 @@ pub enum Error {
         /// The solver's error, with its residual where it did not converge.
         source: Box<crate::bem::SolveError>,
     },
+    /// An instrument's topography file is truncated, corrupt or of an unsupported variant.
+    #[error("not a readable {format} file: {reason}")]
+    BadTopography {
+        /// The format's short name (e.g. `sur`, `di`).
+        format: &'static str,
+        /// What is wrong, in words.
+        reason: String,
+    },
     /// A metadata (JSON / TOML) file could not be parsed or written.
     #[error("{path}: {reason}")]
     Metadata {

@@ -48,3 +48,8 @@ pub struct Reading {
     /// Every channel the file holds, in file order (at least one).
     pub channels: Vec<Channel>,
 }
+
+pub(crate) mod bytes;
+#[cfg(test)]
+mod testkit;
+pub(crate) mod tmd;
