@@ -49,7 +49,10 @@ pub struct Reading {
     pub channels: Vec<Channel>,
 }
 
+pub(crate) mod al3d;
 pub(crate) mod bytes;
+pub(crate) mod di;
 #[cfg(test)]
 mod testkit;
 pub(crate) mod tmd;
+pub(crate) mod wsxm;
