@@ -52,6 +52,11 @@ pub struct Reading {
 pub(crate) mod al3d;
 pub(crate) mod bytes;
 pub(crate) mod di;
+pub(crate) mod frt;
+pub(crate) mod metropro;
+pub(crate) mod opd;
+pub(crate) mod plu;
+pub(crate) mod sur;
 #[cfg(test)]
 mod testkit;
 pub(crate) mod tmd;

@@ -210,3 +210,14 @@ pub(crate) fn assert_robust(
 pub(crate) fn transposed(r: &Reference) -> Array2<f64> {
     r.heights_xy.t().as_standard_layout().into_owned()
 }
+
+/// Element-wise equality to 1e-12 relative (both NaN counts as equal), for the synthetic
+/// files whose expected values are written as decimal products.
+pub(crate) fn assert_close<'a>(got: impl IntoIterator<Item = &'a f64>, want: &[f64]) {
+    let got: Vec<f64> = got.into_iter().copied().collect();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(want) {
+        let same = (g.is_nan() && w.is_nan()) || (g - w).abs() <= 1e-12 * w.abs();
+        assert!(same, "{got:?} vs {want:?}");
+    }
+}
