@@ -111,10 +111,9 @@ fn depth_image(
     ny: usize,
     invalid: f64,
 ) -> Result<ndarray::Array2<f64>> {
-    let stride = (nx * 4).div_ceil(8) * 8 / 4;
-    let count = stride
-        .checked_mul(ny)
-        .ok_or_else(|| bad(FORMAT, "depth image too large"))?;
+    let too_large = || bad(FORMAT, "depth image too large");
+    let stride = nx.checked_mul(4).ok_or_else(too_large)?.div_ceil(8) * 2;
+    let count = stride.checked_mul(ny).ok_or_else(too_large)?;
     let block = sample_block(FORMAT, bytes, offset, count, Sample::F32)?;
     let mut values = Vec::with_capacity(nx * ny);
     for row in block.chunks_exact(stride * 4) {

@@ -176,7 +176,7 @@ impl Context<'_> {
             ));
         }
         let points = grid_points(FORMAT, nx, ny)? as u64;
-        let elsize = if self.version >= VERSION_32BIT && length >= 4 * points {
+        let elsize = if self.version >= VERSION_32BIT && length >= points.saturating_mul(4) {
             4
         } else {
             bpp
