@@ -37,12 +37,21 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
-    /// A `.npy` file could not be read as the array that was expected.
+    /// A `.npy` or topography file could not be read as the array that was expected.
     #[error("{path}: {reason}")]
     BadArrayFile {
         /// The file concerned.
         path: PathBuf,
         /// What was wrong (dtype, shape, ...).
+        reason: String,
+    },
+    /// The bytes of a topography file do not hold what its format prescribes (a reader's
+    /// error, before the file's path is known; [`crate::topography::read_file`] adds it).
+    #[error("{format} file: {reason}")]
+    BadTopography {
+        /// The format's short name (e.g. `x3p`).
+        format: &'static str,
+        /// What is wrong (truncated, wrong magic, impossible size, ...).
         reason: String,
     },
     /// An input array holds NaN or infinity.
@@ -83,14 +92,6 @@ pub enum Error {
         context: String,
         /// The solver's error, with its residual where it did not converge.
         source: Box<crate::bem::SolveError>,
-    },
-    /// An instrument's topography file is truncated, corrupt or of an unsupported variant.
-    #[error("not a readable {format} file: {reason}")]
-    BadTopography {
-        /// The format's short name (e.g. `sur`, `di`).
-        format: &'static str,
-        /// What is wrong, in words.
-        reason: String,
     },
     /// A metadata (JSON / TOML) file could not be parsed or written.
     #[error("{path}: {reason}")]

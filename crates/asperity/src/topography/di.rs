@@ -459,6 +459,36 @@ mod tests {
     }
 
     #[test]
+    fn a_version_9_2_file_has_32_bit_samples() {
+        let header = |offset: usize| {
+            format!(
+                "\\*File list\r\n\\Version: 0x09200000\r\n\\*Scanner list\r\n\
+                 \\@Sens. Zsens: V 10 nm/V\r\n\\*Ciao scan list\r\n\\Samps/line: 2\r\n\
+                 \\Lines: 1\r\n\\*Ciao image list\r\n\\Data offset: {offset:05}\r\n\
+                 \\Data length: 8\r\n\\Bytes/pixel: 4\r\n\\Samps/line: 2\r\n\
+                 \\Number of lines: 1\r\n\\Scan Size: 4 2 ~m\r\n\
+                 \\@2:Image Data: S [ZSensor] \"Height Sensor\"\r\n\
+                 \\@2:Z scale: V [Sens. Zsens] (0.0001 V/LSB) 4294967.296 V\r\n\
+                 \\*File list end\r\n"
+            )
+        };
+        let offset = header(0).len();
+        let mut f = header(offset).into_bytes();
+        for v in [100i32, -300] {
+            f.extend_from_slice(&v.to_le_bytes());
+        }
+        let reading = read(&f).unwrap();
+        let c = &reading.channels[0];
+        assert_eq!((c.name.as_str(), c.is_height), ("ZSensor", true));
+        assert_eq!(c.size, [Some(4e-6), Some(2e-6)]);
+        // 4294967.296 V / 256^4 = 1 mV per count, times 10 nm/V.
+        let Heights::Areal(h) = &c.heights else {
+            panic!()
+        };
+        super::super::testkit::assert_close(h, &[1e-9, -3e-9]);
+    }
+
+    #[test]
     fn header_values_and_units() {
         let v = Value::parse("V [Sens. Zsens] (0.005035400 V/LSB) 2.910461 V");
         assert_eq!(

@@ -19,7 +19,8 @@
 //!
 //! Not supported: compressed data (a point size other than 16 or 32 bits).
 
-use super::bytes::{areal, bad, flip_cols, flip_rows, grid_points, metres_per, samples};
+use super::bytes::samples;
+use super::bytes::{areal, bad, flip_cols, flip_rows, grid_points, length_unit, metres_per};
 use super::bytes::{Cursor, Endian, Sample};
 use super::{Channel, Heights, Reading};
 use crate::Result;
@@ -58,9 +59,24 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     })
 }
 
-/// The object whose header starts at `start`: its channel, where it ends, and how many
-/// objects the file says it holds.
-fn object(bytes: &[u8], start: usize, first: bool) -> Result<(Channel, usize, usize)> {
+/// What one object's 512-byte header says.
+struct Header {
+    endian: Endian,
+    objects: usize,
+    name: String,
+    special: bool,
+    sample: Sample,
+    zmin: i32,
+    nx: usize,
+    ny: usize,
+    steps: [f32; 3],
+    units: [String; 3],
+    inversion: u16,
+    data: usize,
+}
+
+/// The header of the object starting at `start`.
+fn header(bytes: &[u8], start: usize) -> Result<Header> {
     let mut c = Cursor::new(FORMAT, bytes);
     c.seek(start)?;
     if c.take(12)? != MAGIC {
@@ -92,56 +108,78 @@ fn object(bytes: &[u8], start: usize, first: bool) -> Result<(Channel, usize, us
     };
     let zmin = c.i32(e)?;
     c.skip(4)?;
-    let (nx, ny) = (c.i32(e)?, c.i32(e)?);
-    let points = c.u32(e)?;
-    let (dx, dy, dz) = (c.f32(e)?, c.f32(e)?, c.f32(e)?);
-    c.seek(start + 180)?;
-    let units = [c.text(16)?, c.text(16)?, c.text(16)?];
-    c.seek(start + 290)?;
-    let inversion = c.u16(e)?;
-    c.seek(start + 334)?;
-    let (comment, private) = (usize::from(c.u16(e)?), usize::from(c.u16(e)?));
+    let (nx, ny, points) = (c.i32(e)?, c.i32(e)?, c.u32(e)?);
     if nx <= 0 || ny <= 0 || i64::from(points) != i64::from(nx) * i64::from(ny) {
         return Err(bad(
             FORMAT,
             format!("grid {nx} × {ny} does not hold {points} points"),
         ));
     }
-    let n = grid_points(FORMAT, nx as u64, ny as u64)?;
-    let data = start + HEADER + comment + private;
-    let mut values = samples(FORMAT, bytes, data, n, sample, e)?;
-    let z_unit = metres_per(FORMAT, "the height", &units[2])?;
-    let sign = if (1..=3).contains(&inversion) {
+    let steps = [c.f32(e)?, c.f32(e)?, c.f32(e)?];
+    c.seek(start + 180)?;
+    let units = [c.text(16)?, c.text(16)?, c.text(16)?];
+    c.seek(start + 290)?;
+    let inversion = c.u16(e)?;
+    c.seek(start + 334)?;
+    let (comment, private) = (usize::from(c.u16(e)?), usize::from(c.u16(e)?));
+    Ok(Header {
+        endian: e,
+        objects,
+        name,
+        special,
+        sample,
+        zmin,
+        nx: nx as usize,
+        ny: ny as usize,
+        steps,
+        units,
+        inversion,
+        data: start + HEADER + comment + private,
+    })
+}
+
+/// The object whose header starts at `start`: its channel, where it ends, and how many
+/// objects the file says it holds.
+fn object(bytes: &[u8], start: usize, first: bool) -> Result<(Channel, usize, usize)> {
+    let h = header(bytes, start)?;
+    let n = grid_points(FORMAT, h.nx as u64, h.ny as u64)?;
+    let mut values = samples(FORMAT, bytes, h.data, n, h.sample, h.endian)?;
+    let sign = if (1..=3).contains(&h.inversion) {
         -1.0
     } else {
         1.0
     };
-    let scale = sign * f64::from(dz) * z_unit;
-    let missing = f64::from(zmin) - 2.0;
+    let scale = sign * f64::from(h.steps[2]) * metres_per(FORMAT, "the height", &h.units[2])?;
+    let missing = f64::from(h.zmin) - 2.0;
     for v in &mut values {
-        *v = if special && *v == missing {
+        *v = if h.special && *v == missing {
             f64::NAN
         } else {
             *v * scale
         };
     }
-    let size_x = f64::from(dx) * metres_per(FORMAT, "the x step", &units[0])? * nx as f64;
-    let size_y = f64::from(dy) * metres_per(FORMAT, "the y step", &units[1])? * ny as f64;
-    for (axis, s) in [("x", size_x), ("y", size_y)] {
+    // A profile (one row) has a size along x only; its y step may be anything.
+    let mut size = [None, None];
+    let axes = if h.ny == 1 { 1 } else { 2 };
+    for axis in 0..axes {
+        let what = ["the x step", "the y step"][axis];
+        let step = f64::from(h.steps[axis]) * metres_per(FORMAT, what, &h.units[axis])?;
+        let s = step * [h.nx, h.ny][axis] as f64;
         if !(s.is_finite() && s > 0.0) {
-            return Err(bad(FORMAT, format!("size along {axis} is {s}")));
+            return Err(bad(FORMAT, format!("{what} gives a size of {s} m")));
         }
+        size[axis] = Some(s);
     }
-    let heights = if ny == 1 {
+    let heights = if h.ny == 1 {
         let mut line = Array1::from(values);
-        if inversion == 2 {
+        if h.inversion == 2 {
             line.invert_axis(ndarray::Axis(0));
             line = line.as_standard_layout().into_owned();
         }
         Heights::Profile(line)
     } else {
-        let mut map = areal(FORMAT, ny as usize, nx as usize, values)?;
-        match inversion {
+        let mut map = areal(FORMAT, h.ny, h.nx, values)?;
+        match h.inversion {
             2 => flip_cols(&mut map),
             3 => flip_rows(&mut map),
             _ => {}
@@ -149,17 +187,17 @@ fn object(bytes: &[u8], start: usize, first: bool) -> Result<(Channel, usize, us
         Heights::Areal(map)
     };
     let channel = Channel {
-        name: if first || name.is_empty() {
+        name: if first || h.name.is_empty() {
             "Default".into()
         } else {
-            name
+            h.name
         },
-        size: [Some(size_x), (ny > 1).then_some(size_y)],
-        unit: super::bytes::length_unit(&units[2]).map(|(u, _)| u.to_string()),
+        size,
+        unit: length_unit(&h.units[2]).map(|(u, _)| u.to_string()),
         heights,
         is_height: true,
     };
-    Ok((channel, data + n * sample.size(), objects))
+    Ok((channel, h.data + n * h.sample.size(), h.objects))
 }
 
 #[cfg(test)]
@@ -232,6 +270,22 @@ mod tests {
             f.extend_from_slice(&u16b(v as u16));
         }
         f
+    }
+
+    #[test]
+    fn a_one_row_object_is_a_profile() {
+        let mut f = synthetic(Endian::Little, 2, false);
+        f[108..112].copy_from_slice(&4u32.to_le_bytes());
+        f[112..116].copy_from_slice(&1u32.to_le_bytes());
+        f[124..128].copy_from_slice(&0f32.to_le_bytes()); // no y step
+        let reading = read(&f).unwrap();
+        let c = &reading.channels[0];
+        assert_eq!(c.size, [Some(2e-6), None]);
+        let Heights::Profile(p) = &c.heights else {
+            panic!("a profile")
+        };
+        // Inverted and reversed.
+        assert_close(p, &[-8e-9, 24e-9, -4e-9, -2e-9]);
     }
 
     #[test]
