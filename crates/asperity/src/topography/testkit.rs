@@ -183,11 +183,21 @@ pub(crate) fn assert_robust(
         assert!(!sniff(&wrong), "a wrong signature is not recognised");
         assert!(read(&wrong).is_err(), "a wrong signature is refused");
     }
+    // `ASPERITY_FUZZ_MS` lengthens the loop for a longer run by hand (milliseconds).
+    let budget = std::env::var("ASPERITY_FUZZ_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(budget, Duration::from_millis);
+    let max_tries = if budget > Duration::from_secs(1) {
+        usize::MAX
+    } else {
+        20_000
+    };
     let mut work = bytes.to_vec();
     let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
     let start = Instant::now();
     let mut tries = 0;
-    while start.elapsed() < budget && tries < 20_000 {
+    while start.elapsed() < budget && tries < max_tries {
         tries += 1;
         let flips: Vec<usize> = (0..1 + rng.below(4)).map(|_| rng.below(header)).collect();
         for &i in &flips {
@@ -201,6 +211,7 @@ pub(crate) fn assert_robust(
         }
     }
     assert!(tries > 0);
+    eprintln!("{tries} corrupted headers read without a panic");
 }
 
 /// The reference's `[x, y]` heights as our `(row, col) = (y, x)` map: the transpose.
