@@ -48,3 +48,16 @@ pub struct Reading {
     /// Every channel the file holds, in file order (at least one).
     pub channels: Vec<Channel>,
 }
+
+pub(crate) mod al3d;
+pub(crate) mod bytes;
+pub(crate) mod di;
+pub(crate) mod frt;
+pub(crate) mod metropro;
+pub(crate) mod opd;
+pub(crate) mod plu;
+pub(crate) mod sur;
+#[cfg(test)]
+mod testkit;
+pub(crate) mod tmd;
+pub(crate) mod wsxm;

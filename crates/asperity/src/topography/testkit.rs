@@ -1,0 +1,231 @@
+//! Shared checks of the binary readers' tests: a real file of `shared/topographies` read to
+//! the reference that SurfaceTopography 1.27.1 made of it, and the robustness loop that every
+//! reader must survive (truncations, header bytes flipped at random, a wrong signature).
+
+use super::{Heights, Reading};
+use crate::Result;
+use ndarray::Array2;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// The folder of the real files: `shared/` beside the repository (CI), or beside the
+/// folder of worktrees (development checkouts one level deeper).
+fn shared_dir() -> Option<PathBuf> {
+    [
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/topographies"),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../../shared/topographies"
+        ),
+    ]
+    .iter()
+    .map(PathBuf::from)
+    .find(|p| p.is_dir())
+}
+
+/// SurfaceTopography's reading of one file.
+pub(crate) struct Reference {
+    /// The file's bytes.
+    pub bytes: Vec<u8>,
+    /// The reference heights in metres, indexed `[x, y]` as SurfaceTopography gives them.
+    pub heights_xy: Array2<f64>,
+    /// The channel names, in file order.
+    pub channels: Vec<String>,
+    /// The name of the default channel.
+    pub default_channel: String,
+    /// Physical sizes `[x, y]` in metres.
+    pub size_m: [f64; 2],
+    /// The file's own height unit.
+    pub unit: String,
+    /// The number of undefined points.
+    pub undefined: usize,
+}
+
+/// The file `name` and its reference, or `None` (with a notice) where the folder is absent.
+pub(crate) fn reference(name: &str) -> Option<Reference> {
+    let Some(dir) = shared_dir() else {
+        eprintln!("shared/topographies not found beside the repository: skipping {name}");
+        return None;
+    };
+    let bytes = std::fs::read(dir.join(name)).expect("reading the shared file");
+    let heights_xy: Array2<f64> =
+        ndarray_npy::read_npy(dir.join(format!("{name}.reference.npy"))).expect("reference npy");
+    let json = std::fs::read_to_string(dir.join(format!("{name}.reference.json"))).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let text = |v: &serde_json::Value| v.as_str().unwrap().to_string();
+    Some(Reference {
+        bytes,
+        heights_xy,
+        channels: meta["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(text)
+            .collect(),
+        default_channel: text(&meta["default_channel"]),
+        size_m: [
+            meta["physical_sizes_m"][0].as_f64().unwrap(),
+            meta["physical_sizes_m"][1].as_f64().unwrap(),
+        ],
+        unit: text(&meta["unit"]),
+        undefined: meta["undefined_points"].as_u64().unwrap() as usize,
+    })
+}
+
+/// Checks a reading against the reference: channel names and count, the default channel's
+/// sizes (1e-12 relative), its unit, its undefined points (same places) and every height
+/// to 1e-12 relative (both are the file's numbers times the same factors; the largest
+/// difference measured is 2.2e-16, the rounding of a different order of products).
+/// `expected` is the reference heights already mapped to our `(row, col) = (y, x)` order
+/// (the caller states the mapping, a transpose and the flips the peer applies).
+pub(crate) fn assert_matches(reading: &Reading, r: &Reference, expected: &Array2<f64>) {
+    let names: Vec<&str> = reading.channels.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, r.channels, "channel names");
+    let default = reading
+        .channels
+        .iter()
+        .find(|c| c.is_height)
+        .expect("a height channel");
+    assert_eq!(default.name, r.default_channel, "default channel");
+    assert_eq!(default.unit.as_deref(), Some(r.unit.as_str()), "unit");
+    for (axis, want) in r.size_m.iter().enumerate() {
+        let got = default.size[axis].expect("a size");
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs(),
+            "size[{axis}] {got} vs {want}"
+        );
+    }
+    let Heights::Areal(h) = &default.heights else {
+        panic!("an areal channel expected")
+    };
+    assert_eq!(h.dim(), expected.dim(), "grid (rows, cols)");
+    let mut undefined = 0;
+    for ((idx, got), want) in h.indexed_iter().zip(expected.iter()) {
+        if want.is_nan() {
+            undefined += 1;
+            assert!(
+                got.is_nan(),
+                "{idx:?}: {got} where the reference is undefined"
+            );
+        } else {
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "{idx:?}: {got} vs reference {want}"
+            );
+        }
+    }
+    assert_eq!(undefined, r.undefined, "undefined points of the reference");
+}
+
+/// A tiny deterministic generator (xorshift64*), so the loop needs no seeded crate state.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+/// A reader's entry points, for the robustness loop.
+pub(crate) type ReadFn = fn(&[u8]) -> Result<Reading>;
+
+/// What any reading must satisfy: at least one channel and no more points than the file has
+/// bytes (so a corrupt size could not have been allocated from).
+fn assert_bounded(reading: &Reading, file_len: usize) {
+    assert!(!reading.channels.is_empty());
+    let points: usize = reading
+        .channels
+        .iter()
+        .map(|c| match &c.heights {
+            Heights::Areal(a) => a.len(),
+            Heights::Profile(p) => p.len(),
+        })
+        .sum();
+    assert!(points <= file_len, "{points} points from {file_len} bytes");
+}
+
+/// The robustness loop: the intact file is recognised; every truncation tried is an error
+/// (lengths at a stride of about 1/400 of the first `header` bytes, and 64 spread over the
+/// rest); flipping 1–4 random bits of the first `header` bytes (seeded, for about `budget`)
+/// never panics and never gives more points than bytes; and, where `magic` is given, a file
+/// whose first `magic` bytes are changed is neither recognised nor read.
+pub(crate) fn assert_robust(
+    bytes: &[u8],
+    sniff: fn(&[u8]) -> bool,
+    read: ReadFn,
+    header: usize,
+    magic: Option<usize>,
+    budget: Duration,
+) {
+    assert!(sniff(bytes), "the intact file is recognised");
+    let len = bytes.len();
+    let header = header.min(len);
+    let stride = (header / 400).max(1);
+    let spread = (0..64).map(|k| header + (len - header) * k / 64);
+    for cut in (0..header).step_by(stride).chain(spread).chain([len - 1]) {
+        assert!(
+            read(&bytes[..cut]).is_err(),
+            "a file cut to {cut} of {len} bytes was read"
+        );
+    }
+    if let Some(m) = magic {
+        let mut wrong = bytes.to_vec();
+        for b in &mut wrong[..m] {
+            *b = b.wrapping_add(0x5a);
+        }
+        assert!(!sniff(&wrong), "a wrong signature is not recognised");
+        assert!(read(&wrong).is_err(), "a wrong signature is refused");
+    }
+    // `ASPERITY_FUZZ_MS` lengthens the loop for a longer run by hand (milliseconds).
+    let budget = std::env::var("ASPERITY_FUZZ_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(budget, Duration::from_millis);
+    let max_tries = if budget > Duration::from_secs(1) {
+        usize::MAX
+    } else {
+        20_000
+    };
+    let mut work = bytes.to_vec();
+    let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+    let start = Instant::now();
+    let mut tries = 0;
+    while start.elapsed() < budget && tries < max_tries {
+        tries += 1;
+        let flips: Vec<usize> = (0..1 + rng.below(4)).map(|_| rng.below(header)).collect();
+        for &i in &flips {
+            work[i] ^= 1 << rng.below(8);
+        }
+        if let Ok(reading) = read(&work) {
+            assert_bounded(&reading, len);
+        }
+        for &i in &flips {
+            work[i] = bytes[i];
+        }
+    }
+    assert!(tries > 0);
+    eprintln!("{tries} corrupted headers read without a panic");
+}
+
+/// The reference's `[x, y]` heights as our `(row, col) = (y, x)` map: the transpose.
+pub(crate) fn transposed(r: &Reference) -> Array2<f64> {
+    r.heights_xy.t().as_standard_layout().into_owned()
+}
+
+/// Element-wise equality to 1e-12 relative (both NaN counts as equal), for the synthetic
+/// files whose expected values are written as decimal products.
+pub(crate) fn assert_close<'a>(got: impl IntoIterator<Item = &'a f64>, want: &[f64]) {
+    let got: Vec<f64> = got.into_iter().copied().collect();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(want) {
+        let same = (g.is_nan() && w.is_nan()) || (g - w).abs() <= 1e-12 * w.abs();
+        assert!(same, "{got:?} vs {want:?}");
+    }
+}
