@@ -57,24 +57,13 @@ enum Weights {
 impl ContactSolver {
     /// The full-contact threshold of the surface: the values that
     /// [`SolveError::BeyondFullContact`] states. Periodic boundaries: `max(K⁺f)`, one
-    /// spectral pseudo-inverse, and the indentation `max(h) − mean(h)`. Free boundaries: two conjugate-gradient solves on the full
-    /// grid (about the cost of one solve), computed once per surface; computing them uses
-    /// the solver's gap buffer, so **the last solved state is forgotten** (the next solve
-    /// starts cold) when they were not known yet. Call it before the first solve to keep
-    /// every warm start.
+    /// spectral pseudo-inverse, and the indentation `max(h) − mean(h)`. Free boundaries:
+    /// two preconditioned conjugate-gradient solves on the full grid, computed once per
+    /// surface. Either way the last solved state and its warm start are kept.
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
         match self.operator.boundary() {
             Boundary::Periodic => Ok(self.periodic_full_contact()),
-            Boundary::Free => {
-                if self
-                    .full_contact
-                    .filter(|f| f.indentation.is_some())
-                    .is_none()
-                {
-                    self.solved = None;
-                }
-                self.free_full_contact()
-            }
+            Boundary::Free => self.free_full_contact(),
         }
     }
 

@@ -171,6 +171,7 @@ impl ContactSolver {
             let info = SolveInfo {
                 iterations: 0,
                 residual,
+                operator_applications: 0,
             };
             return Ok((self.finish(indentation, 0), info));
         }
@@ -198,6 +199,7 @@ impl ContactSolver {
                 let info = SolveInfo {
                     iterations: 0,
                     residual: r,
+                    operator_applications: 1,
                 };
                 return Ok((self.finish(indentation, contact_points), info));
             }
@@ -222,7 +224,7 @@ impl ContactSolver {
             .sum::<f64>()
             / (n * self_influence(self.operator.spacing(), self.operator.modulus()));
 
-        let mut used = 0;
+        let (mut used, mut applications) = (0, 0);
         for _ in 0..MAX_EVALUATIONS {
             if root.hi.pressure - root.lo.pressure <= 4.0 * f64::EPSILON * root.hi.pressure {
                 break;
@@ -249,6 +251,7 @@ impl ContactSolver {
                 Err(other) => return Err(other),
             };
             used += info.iterations;
+            applications += info.operator_applications;
             self.solved = Some(summary);
             let (r, contact_points) = self.residual_at(indentation);
             residual = r;
@@ -256,6 +259,7 @@ impl ContactSolver {
                 let info = SolveInfo {
                     iterations: used,
                     residual,
+                    operator_applications: applications,
                 };
                 return Ok((self.finish(indentation, contact_points), info));
             }
