@@ -51,7 +51,7 @@
 //! constraint removes that mode.
 
 use super::polonsky_keer::{gap_and_direction, ContactSolver, Target};
-use super::{ContactSummary, SolveError, SolveInfo};
+use super::{ContactSummary, SolveError, SolveInfo, SolverKind};
 use crate::elastic::self_influence;
 
 /// Evaluations of `d(p̄)` after which the root find gives up (bisection alone shrinks the
@@ -145,9 +145,23 @@ impl RootFind {
 impl ContactSolver {
     /// Displacement control on periodic boundaries (see the module docs); the caller has
     /// checked `0 ≤ indentation < mean(f)`.
+    /// A load-controlled solve by the chosen iteration.
+    fn load_controlled(
+        &mut self,
+        target: Target,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        match self.params.solver {
+            SolverKind::Bccg => self.bccg(target, tolerance, max_iterations),
+            SolverKind::PolonskyKeer => self.polonsky_keer(target, tolerance, max_iterations),
+        }
+    }
+
     pub(super) fn periodic_indentation(
         &mut self,
         indentation: f64,
+        spent: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let full = self.periodic_full_contact();
         let full_indentation = full
@@ -224,7 +238,7 @@ impl ContactSolver {
             .sum::<f64>()
             / (n * self_influence(self.operator.spacing(), self.operator.modulus()));
 
-        let (mut used, mut applications) = (0, 0);
+        let (mut used, mut applications) = (spent, 0);
         for _ in 0..MAX_EVALUATIONS {
             if root.hi.pressure - root.lo.pressure <= 4.0 * f64::EPSILON * root.hi.pressure {
                 break;
@@ -236,7 +250,7 @@ impl ContactSolver {
                     (1e-3 * b.excess.abs() / self.height_scale).min(LOOSEST_INNER_TOLERANCE)
                 })
                 .max(0.5 * tolerance);
-            let solved = self.polonsky_keer(
+            let solved = self.load_controlled(
                 Target::MeanPressure(pressure),
                 inner_tolerance,
                 max_iterations - used,

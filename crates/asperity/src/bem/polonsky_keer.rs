@@ -256,9 +256,12 @@ impl ContactSolver {
         }
         let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
         let result = match (self.params.solver, target) {
+            (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
+                self.bccg_periodic_indentation(d)
+            }
             (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
             (SolverKind::PolonskyKeer, Target::Indentation(d)) if periodic => {
-                self.periodic_indentation(d)
+                self.periodic_indentation(d, 0)
             }
             (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
         };
