@@ -557,7 +557,10 @@ mod tests {
             (threshold / d_full - 1.0).abs() < 1e-12,
             "{threshold} vs {d_full}"
         );
-        for d in [d_full, 1.5 * d_full] {
+        // At and above the solver's own threshold (d_full above is summed in another order
+        // and may lie an ulp below it, where a solver may find a partial contact with one
+        // point open by rounding).
+        for d in [threshold, 1.5 * threshold] {
             match solver.solve(Control::Indentation(d)) {
                 Err(SolveError::BeyondFullContact {
                     requested: Control::Indentation(requested),
