@@ -1191,7 +1191,7 @@ fn both_solvers_give_the_same_contact_and_the_record_names_the_solver() {
     let s = surface(dir.path());
     let mut tables = Vec::new();
     for solver in ["pk", "bccg", ""] {
-        let csv = dir.path().join(format!("{solver}.csv"));
+        let csv = dir.path().join(format!("run_{solver}.csv"));
         let mut args = vec![
             "bem",
             "--surface",

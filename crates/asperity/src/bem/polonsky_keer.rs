@@ -91,11 +91,11 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow): the operator, the preconditioner, five fields, the two BCCG fields and
+    /// overflow): the operator, the preconditioner, five fields, the three BCCG fields and
     /// the four stiffness and full-contact fields. The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let fields = memory::array_bytes(&[11, rows, cols], 8)?;
+        let fields = memory::array_bytes(&[12, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
             .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
             .checked_add(fields)
@@ -137,6 +137,8 @@ impl ContactSolver {
         )?;
         let preconditioner =
             FourierPreconditioner::new(rows, cols, surface.spacing(), half_space.modulus)?;
+        let mut operator = operator;
+        let bccg_scratch = BccgScratch::new(&mut operator);
         let mut profile = Vec::with_capacity(rows * cols);
         let height_scale = fill_profile(surface, &mut profile);
         let len = rows * cols;
@@ -155,7 +157,7 @@ impl ContactSolver {
             full_contact: None,
             stiffness_work: None,
             preconditioner,
-            bccg_scratch: BccgScratch::new(len),
+            bccg_scratch,
         })
     }
 
