@@ -52,6 +52,10 @@ pub(super) const REFRESH_INTERVAL: usize = 25;
 /// full contact).
 const DIRECT_BUDGET: usize = 150;
 
+/// Relative load error below which the rescaling of `p` and `u` is skipped: a step that
+/// cut nothing keeps `Σ p` up to rounding (the direction sums to zero on the free set).
+const LOAD_ROUNDING: f64 = 1e-14;
+
 /// Pressures cut by the projection in one step that are corrected in `u` by their point
 /// responses (each one pass over the grid); beyond this many `u` is recomputed.
 const CUT_LIMIT: usize = 16;
@@ -400,11 +404,12 @@ impl ContactSolver {
         }
         if let Target::MeanPressure(mean_pressure) = target {
             let n = self.pressure.len() as f64;
-            if total > 0.0 {
-                let scale = mean_pressure * n / total;
+            let scale = mean_pressure * n / total;
+            // A step that cut nothing keeps Σ p up to rounding: the two passes are saved.
+            if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
                 self.pressure.iter_mut().for_each(|v| *v *= scale);
                 self.gap.iter_mut().for_each(|v| *v *= scale);
-            } else {
+            } else if total <= 0.0 {
                 self.pressure.fill(mean_pressure);
                 cut = true;
             }
