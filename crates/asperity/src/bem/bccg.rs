@@ -325,7 +325,7 @@ impl ContactSolver {
         };
         // Centring s on F leaves sᵀΠg unchanged (Σ_F Πg = 0); a direction that is not
         // downhill is replaced by steepest descent −z.
-        let restart = !(sg < 0.0);
+        let restart = sg >= 0.0 || sg.is_nan();
         if s_mean != 0.0 || restart {
             for ((si, &zi), (&ui, (&fi, &pi))) in
                 s.iter_mut().zip(z).zip(u.iter().zip(f.iter().zip(p)))
