@@ -25,7 +25,7 @@
 //!   (`periodic_indentation.rs`).
 //! * **Stiffness**: [`ContactSolver::frozen_set_stiffness`] — the paper's method: keep the
 //!   contact set, impose a uniform `Δd` on it, solve the linear SPD problem for the pressures
-//!   on the set (conjugate gradients), `k = ΔF/Δd`; and
+//!   on the set (conjugate gradients with the Fourier preconditioner of the solver), `k = ΔF/Δd`; and
 //!   [`ContactSolver::finite_difference_stiffness`], `dF/dd` from two more solves. Barber's
 //!   theorem makes the two agree.
 //!
