@@ -1181,3 +1181,60 @@ fn periodic_indentations_agree_with_load_control() {
         "{err}"
     );
 }
+
+#[test]
+fn both_solvers_give_the_same_contact_and_the_record_names_the_solver() {
+    // --solver pk (the reference) and the default bccg to 1e-11: the same contact area and
+    // stiffness, indentations to 1e-9 relative; pk takes more iterations. A bad name is
+    // refused with exit 2.
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let mut tables = Vec::new();
+    for solver in ["pk", "bccg", ""] {
+        let csv = dir.path().join(format!("run_{solver}.csv"));
+        let mut args = vec![
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01,0.03",
+            "--tol",
+            "1e-11",
+            "--out",
+            csv.to_str().unwrap(),
+        ];
+        if !solver.is_empty() {
+            args.extend(["--solver", solver]);
+        }
+        let out = asperity(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let record = csv.with_extension("csv.json");
+        let value: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(record).unwrap()).unwrap();
+        let expected = if solver.is_empty() { "bccg" } else { solver };
+        assert_eq!(value["solver"], expected);
+        tables.push(read_csv(&csv));
+    }
+    let (header, pk) = &tables[0];
+    let (_, bccg) = &tables[1];
+    assert_eq!(tables[1], tables[2], "bccg is the default");
+    let [area, d, k, it] = ["area_fraction", "indentation", "stiffness", "iterations"]
+        .map(|name| column(header, name));
+    for (a, b) in pk.iter().zip(bccg) {
+        assert_eq!(a[area], b[area]);
+        assert!((a[d] / b[d] - 1.0).abs() < 1e-9, "{} vs {}", a[d], b[d]);
+        assert!((a[k] / b[k] - 1.0).abs() < 1e-6, "{} vs {}", a[k], b[k]);
+        assert!(b[it] < a[it], "bccg {} vs pk {} iterations", b[it], a[it]);
+    }
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s.to_str().unwrap(),
+        "--pressures",
+        "0.01",
+        "--solver",
+        "cg",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--solver"), "{}", stderr(&out));
+}

@@ -9,7 +9,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
@@ -79,13 +79,19 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
         let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 4.0 }, None).unwrap();
         let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(0.5)).unwrap();
         let surface = SurfaceGenerator::new(&spec).unwrap().generate(7);
-        for boundary in [Boundary::Free, Boundary::Periodic] {
+        let cases = [SolverKind::Bccg, SolverKind::PolonskyKeer]
+            .into_iter()
+            .flat_map(|kind| [(kind, Boundary::Free), (kind, Boundary::Periodic)]);
+        for (kind, boundary) in cases {
             let half_space = HalfSpace {
                 modulus: 1.0,
                 boundary,
             };
-            let mut solver =
-                ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            let base = SolverParams {
+                solver: kind,
+                ..SolverParams::default()
+            };
+            let mut solver = ContactSolver::new(&surface, half_space, base).unwrap();
             let pressure = 0.03;
             // Warm up: the stiffness buffers are allocated on first use.
             solver.solve(Control::MeanPressure(pressure)).unwrap();
@@ -93,10 +99,7 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
 
             let mut run = |tolerance: f64| {
                 solver
-                    .set_params(SolverParams {
-                        tolerance,
-                        ..SolverParams::default()
-                    })
+                    .set_params(SolverParams { tolerance, ..base })
                     .unwrap();
                 solver.reset(); // a cold start: the iteration count follows the tolerance
                 let ((iterations, cg_iterations), allocations, bytes) = count(|| {
@@ -109,7 +112,7 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
             let (few, cg_few, allocations_few, bytes_few) = run(1e-4);
             let (many, cg_many, allocations_many, bytes_many) = run(1e-10);
             eprintln!(
-                "{boundary:?}: {few} and {many} iterations (+{cg_few}, {cg_many} CG): \
+                "{kind:?} {boundary:?}: {few} and {many} iterations (+{cg_few}, {cg_many} CG): \
                  {allocations_few} and {allocations_many} allocations, \
                  {bytes_few} and {bytes_many} bytes"
             );
@@ -131,8 +134,10 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
             ));
             let (result, allocations, bytes) = count(|| solver.solve(beyond));
             assert!(matches!(result, Err(SolveError::BeyondFullContact { .. })));
-            eprintln!("{boundary:?}: refused load: {allocations} allocations, {bytes} bytes");
-            assert_eq!(allocations, 0, "{boundary:?}: {bytes} bytes");
+            eprintln!(
+                "{kind:?} {boundary:?}: refused load: {allocations} allocations, {bytes} bytes"
+            );
+            assert_eq!(allocations, 0, "{kind:?} {boundary:?}: {bytes} bytes");
 
             // Displacement control (periodic: a root find over load-controlled solves with
             // frozen-set slopes) works in the same buffers.
@@ -141,11 +146,11 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
             let (result, allocations, bytes) = count(|| solver.solve(indentation));
             let (_, info) = result.unwrap();
             eprintln!(
-                "{boundary:?}: displacement control, {} iterations: {allocations} \
+                "{kind:?} {boundary:?}: displacement control, {} iterations: {allocations} \
                  allocations, {bytes} bytes",
                 info.iterations
             );
-            assert_eq!(allocations, 0, "{boundary:?}: {bytes} bytes");
+            assert_eq!(allocations, 0, "{kind:?} {boundary:?}: {bytes} bytes");
         }
     });
 }

@@ -4,6 +4,8 @@
 use std::time::Instant;
 
 use anyhow::Result;
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
+use asperity::elastic::{Boundary, ElasticOperator};
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
 
@@ -12,6 +14,11 @@ use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
 pub enum Kernel {
     /// Surface generation: one N×N realisation (spectrum, inverse real FFT, normalisation).
     Surface,
+    /// BEM solves: one cold solve of an N×N surface (H, roll-off 6, rms slope 1, seed 0) per
+    /// mean pressure of --pressures, by each solver (pk, bccg), free and periodic, with the
+    /// iterations, operator applications and the time of one operator application (a
+    /// padded FFT pair on free boundaries), to state an iteration's cost in FFT pairs.
+    BemSolve,
 }
 
 /// Arguments of `asperity bench`.
@@ -19,7 +26,8 @@ pub enum Kernel {
 #[command(
     after_help = "Prints the time with planning and buffer set-up (cold, what one `asperity surface`\n\
                   pays) and with the plan and buffers reused (steady, as in a study).\n\n\
-                  Example:\n  asperity bench surface --n 4096 --repeat 5"
+                  Examples:\n  asperity bench surface --n 4096 --repeat 5\n  \
+                  asperity bench bem-solve --n 512 --pressures 0.01,0.05 --repeat 3"
 )]
 pub struct BenchArgs {
     /// The kernel to time.
@@ -33,6 +41,12 @@ pub struct BenchArgs {
     /// Hurst exponent.
     #[arg(long, default_value_t = 0.8)]
     pub hurst: f64,
+    /// bem-solve: mean pressures (units of E*), comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
+    pub pressures: Vec<f64>,
+    /// bem-solve: solver tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub tol: f64,
 }
 
 /// Minimum and median of some timings (seconds).
@@ -50,8 +64,12 @@ fn min_median(mut times: Vec<f64>) -> (f64, f64) {
 /// a study that draws many realisations.
 pub fn run(args: &BenchArgs) -> Result<()> {
     anyhow::ensure!(args.repeat > 0, "--repeat must be at least 1");
+    if args.kernel == Kernel::BemSolve {
+        return bem_solve(args);
+    }
     let (mut cold, mut steady) = (Vec::new(), Vec::new());
     match args.kernel {
+        Kernel::BemSolve => unreachable!("handled above"),
         Kernel::Surface => {
             let psd = Psd::new(args.hurst, LongWavelength::RollOff { q0: 6.0 }, None)?;
             let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
@@ -83,4 +101,86 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         rayon::current_num_threads(),
     );
     Ok(())
+}
+
+/// `asperity bench bem-solve`: one line per boundary, mean pressure and solver,
+/// `kernel n threads boundary solver mean_pressure iterations operator_applications
+/// area_fraction indentation solve_min_s solve_median_s fft_pair_s iteration_fft_pairs`.
+/// Each repetition is a cold solve (the solver reset); `fft_pair_s` is the minimum time of
+/// one operator application, `iteration_fft_pairs = solve_min_s / iterations / fft_pair_s`.
+fn bem_solve(args: &BenchArgs) -> Result<()> {
+    anyhow::ensure!(
+        args.tol.is_finite() && args.tol > 0.0,
+        "--tol must be positive and finite, got {}",
+        args.tol
+    );
+    for &p in &args.pressures {
+        anyhow::ensure!(
+            p.is_finite() && p > 0.0,
+            "--pressures must be positive, got {p}"
+        );
+    }
+    let psd = Psd::new(args.hurst, LongWavelength::RollOff { q0: 6.0 }, None)?;
+    let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
+    let surface = SurfaceGenerator::new(&spec)?.try_generate(0)?;
+    for boundary in [Boundary::Free, Boundary::Periodic] {
+        let fft_pair = operator_time(args, boundary)?;
+        let half_space = HalfSpace {
+            modulus: 1.0,
+            boundary,
+        };
+        for &pressure in &args.pressures {
+            for solver in [SolverKind::PolonskyKeer, SolverKind::Bccg] {
+                let params = SolverParams {
+                    solver,
+                    tolerance: args.tol,
+                    ..SolverParams::default()
+                };
+                let mut contact = ContactSolver::new(&surface, half_space, params)?;
+                let mut times = Vec::new();
+                let mut last = None;
+                for _ in 0..args.repeat {
+                    contact.reset();
+                    let start = Instant::now();
+                    let solved = contact.solve(Control::MeanPressure(pressure))?;
+                    times.push(start.elapsed().as_secs_f64());
+                    last = Some(solved);
+                }
+                let (summary, info) = last.expect("repeat is at least 1");
+                let (min, median) = min_median(times);
+                println!(
+                    "kernel=bem-solve n={} threads={} boundary={} solver={} mean_pressure={pressure} \
+                     iterations={} operator_applications={} area_fraction={:.6} indentation={:.9e} \
+                     solve_min_s={min:.4} solve_median_s={median:.4} fft_pair_s={fft_pair:.5} \
+                     iteration_fft_pairs={:.2}",
+                    args.n,
+                    rayon::current_num_threads(),
+                    boundary.name(),
+                    solver.name(),
+                    info.iterations,
+                    info.operator_applications,
+                    summary.area_fraction,
+                    summary.indentation,
+                    min / info.iterations.max(1) as f64 / fft_pair,
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Minimum time of one operator application on an N×N grid (plans and buffers reused).
+fn operator_time(args: &BenchArgs, boundary: Boundary) -> Result<f64> {
+    let mut operator = ElasticOperator::new(args.n, args.n, 1.0 / args.n as f64, 1.0, boundary)?;
+    let pressure = vec![1.0; args.n * args.n];
+    let mut displacement = vec![0.0; args.n * args.n];
+    operator.apply(&pressure, &mut displacement); // first touch
+    let times = (0..args.repeat.max(5))
+        .map(|_| {
+            let start = Instant::now();
+            operator.apply(&pressure, &mut displacement);
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    Ok(min_median(times).0)
 }

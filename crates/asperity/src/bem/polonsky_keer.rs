@@ -21,9 +21,13 @@
 
 use ndarray::{Array2, ArrayView2};
 
+use super::bccg::BccgScratch;
 use super::full_contact::FullContactThreshold;
+use super::preconditioner::FourierPreconditioner;
+use super::stiffness::StiffnessWork;
 use super::{
-    ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverParams,
+    ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
+    SolverParams,
 };
 use crate::elastic::{self_influence, Boundary, ElasticOperator};
 use crate::surface::Surface;
@@ -58,8 +62,14 @@ pub struct ContactSolver {
     /// Where the surface comes into full contact (computed once per surface, when first
     /// needed).
     pub(super) full_contact: Option<FullContactThreshold>,
-    /// Two extra fields for the frozen-set CG, allocated on first use.
-    pub(super) stiffness_work: Option<(Vec<f64>, Vec<f64>)>,
+    /// The fields of the frozen-set CG and of the free-boundary full-contact threshold,
+    /// allocated on first use (their own: a stiffness or a threshold never touches the
+    /// solved state).
+    pub(super) stiffness_work: Option<StiffnessWork>,
+    /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG.
+    pub(super) preconditioner: FourierPreconditioner,
+    /// The BCCG's own fields.
+    pub(super) bccg_scratch: BccgScratch,
 }
 
 /// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
@@ -81,11 +91,14 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow): the operator, five fields and the two stiffness fields. The caller's
-    /// [`Surface`] (one more `rows × cols` field while the solver is built) is not included.
+    /// overflow): the operator, the preconditioner, five fields, the three BCCG fields and
+    /// the four stiffness and full-contact fields. The caller's [`Surface`] (one more
+    /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let fields = memory::array_bytes(&[7, rows, cols], 8)?;
-        ElasticOperator::memory_bytes(rows, cols, boundary)?.checked_add(fields)
+        let fields = memory::array_bytes(&[12, rows, cols], 8)?;
+        ElasticOperator::memory_bytes(rows, cols, boundary)?
+            .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
+            .checked_add(fields)
     }
 
     /// Plans a solver for `surface` on `half_space`; validates `params`, refuses grids that
@@ -122,6 +135,10 @@ impl ContactSolver {
             half_space.modulus,
             half_space.boundary,
         )?;
+        let preconditioner =
+            FourierPreconditioner::new(rows, cols, surface.spacing(), half_space.modulus)?;
+        let mut operator = operator;
+        let bccg_scratch = BccgScratch::new(&mut operator);
         let mut profile = Vec::with_capacity(rows * cols);
         let height_scale = fill_profile(surface, &mut profile);
         let len = rows * cols;
@@ -139,6 +156,8 @@ impl ContactSolver {
             solved: None,
             full_contact: None,
             stiffness_work: None,
+            preconditioner,
+            bccg_scratch,
         })
     }
 
@@ -237,9 +256,16 @@ impl ContactSolver {
                 return Err(self.beyond_full_contact(control));
             }
         }
-        let result = match target {
-            Target::Indentation(d) if periodic => self.periodic_indentation(d),
-            _ => self.polonsky_keer(target, self.params.tolerance, self.params.max_iterations),
+        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
+        let result = match (self.params.solver, target) {
+            (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
+                self.bccg_periodic_indentation(d)
+            }
+            (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
+            (SolverKind::PolonskyKeer, Target::Indentation(d)) if periodic => {
+                self.periodic_indentation(d, 0)
+            }
+            (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
         };
         match result {
             // Every point in contact, under load or displacement control: no contact
@@ -368,6 +394,7 @@ impl ContactSolver {
                 let info = SolveInfo {
                     iterations: iteration,
                     residual,
+                    operator_applications: 2 * iteration + 1,
                 };
                 return Ok((self.finish(indentation, pass.contact_points), info));
             }
@@ -417,7 +444,7 @@ impl ContactSolver {
     /// Initial pressure: the previous solution (rescaled to the new load) or a cold start
     /// (uniform pressure under load control; local springs `max(d − f, 0)/K₀₀` under
     /// displacement control).
-    fn initialise(&mut self, target: Target, self_influence: f64) {
+    pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
         let n = (self.rows * self.cols) as f64;
         let warm = self.solved.is_some();
         match target {

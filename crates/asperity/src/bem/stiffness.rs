@@ -15,11 +15,14 @@
 //! the grid) and `y = K⁻¹ f`, the pressure `d q − y` is non-negative everywhere from
 //! `d* = max(y/q)` on.
 //!
-//! Neither allocates after the first call: the set is tested inline (`p > 0`), and the CG
-//! works in the solver's buffers.
+//! Both CGs are preconditioned with the Fourier approximate inverse of the operator
+//! restricted to the set (`P_S M P_S`, [`super::preconditioner`]). Neither allocates after
+//! the first call: the set is tested inline (`p > 0`), and the CG works in fields of its own
+//! ([`StiffnessWork`]), so neither touches the solved state.
 
 use super::full_contact::FullContactThreshold;
 use super::polonsky_keer::ContactSolver;
+use super::preconditioner::FourierPreconditioner;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::Error;
@@ -33,50 +36,99 @@ enum RightHandSide<'a> {
     Values(&'a [f64]),
 }
 
-/// Solves `K_SS x = b_S` by conjugate gradients (x zero off the set `S = {i : in_set(i)}`).
-/// `direction` and `response` are scratch. Stops at `‖r‖ ≤ tolerance ‖b‖`.
-#[allow(clippy::too_many_arguments)]
+/// The fields of the stiffness and full-contact CGs, owned by the solver and allocated on
+/// first use: never the solved state's.
+pub(super) struct StiffnessWork {
+    /// The CG's unknown (the pressures on the set).
+    x: Vec<f64>,
+    residual: Vec<f64>,
+    preconditioned: Vec<f64>,
+    direction: Vec<f64>,
+    response: Vec<f64>,
+    /// `K⁻¹f` of the full-contact threshold.
+    profile_pressure: Vec<f64>,
+}
+
+impl StiffnessWork {
+    fn new(len: usize) -> Self {
+        StiffnessWork {
+            x: vec![0.0; len],
+            residual: vec![0.0; len],
+            preconditioned: vec![0.0; len],
+            direction: vec![0.0; len],
+            response: vec![0.0; len],
+            profile_pressure: vec![0.0; len],
+        }
+    }
+}
+
+/// `z = P_S M P_S r` (zero off the set).
+fn precondition_on_set(
+    preconditioner: &mut FourierPreconditioner,
+    in_set: &impl Fn(usize) -> bool,
+    residual: &[f64],
+    z: &mut [f64],
+) -> f64 {
+    z.copy_from_slice(residual);
+    preconditioner.apply(z);
+    let mut rz = 0.0;
+    for i in 0..z.len() {
+        if in_set(i) {
+            rz += residual[i] * z[i];
+        } else {
+            z[i] = 0.0;
+        }
+    }
+    rz
+}
+
+/// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
+/// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
+/// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
+/// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual). The result is in `work.x`.
 fn conjugate_gradient_on_set(
     operator: &mut ElasticOperator,
+    preconditioner: &mut FourierPreconditioner,
     in_set: impl Fn(usize) -> bool,
     rhs: RightHandSide<'_>,
-    x: &mut [f64],
-    residual: &mut [f64],
-    direction: &mut [f64],
-    response: &mut [f64],
+    work: &mut StiffnessWork,
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<SolveInfo, SolveError> {
-    let n = x.len();
-    let mut rs = 0.0;
-    for i in 0..n {
+    let StiffnessWork {
+        x,
+        residual,
+        preconditioned: z,
+        direction,
+        response,
+        ..
+    } = work;
+    let mut rr = 0.0;
+    for i in 0..x.len() {
         x[i] = 0.0;
-        let b = if in_set(i) {
-            match rhs {
-                RightHandSide::Ones => 1.0,
-                RightHandSide::Values(v) => v[i],
-            }
+        let b = match rhs {
+            _ if !in_set(i) => 0.0,
+            RightHandSide::Ones => 1.0,
+            RightHandSide::Values(v) => v[i],
+        };
+        residual[i] = b;
+        rr += b * b;
+    }
+    let b_norm = rr.sqrt();
+    let mut rz = precondition_on_set(preconditioner, &in_set, residual, z);
+    direction.copy_from_slice(z);
+    let mut iterations = 0;
+    loop {
+        let relative = if b_norm > 0.0 {
+            rr.sqrt() / b_norm
         } else {
             0.0
         };
-        residual[i] = b;
-        direction[i] = b;
-        rs += b * b;
-    }
-    let b_norm = rs.sqrt();
-    if b_norm == 0.0 {
-        return Ok(SolveInfo {
-            iterations: 0,
-            residual: 0.0,
-        });
-    }
-    let mut iterations = 0;
-    loop {
-        let relative = rs.sqrt() / b_norm;
         if relative <= tolerance {
             return Ok(SolveInfo {
                 iterations,
                 residual: relative,
+                operator_applications: iterations,
             });
         }
         if iterations >= max_iterations || !relative.is_finite() {
@@ -87,44 +139,45 @@ fn conjugate_gradient_on_set(
         }
         iterations += 1;
         operator.apply(direction, response);
-        let mut curvature = 0.0;
-        for i in 0..n {
-            if in_set(i) {
-                curvature += direction[i] * response[i];
-            }
-        }
-        if curvature <= 0.0 {
-            // K_SS is positive definite; this only happens at round-off level.
+        let curvature: f64 = (0..x.len())
+            .filter(|&i| in_set(i))
+            .map(|i| direction[i] * response[i])
+            .sum();
+        if !(curvature > 0.0 && rz > 0.0) {
+            // K_SS and M_SS are positive definite; this only happens at round-off level.
             return Err(SolveError::NoConvergence {
                 iterations,
                 residual: relative,
             });
         }
-        let alpha = rs / curvature;
-        let mut rs_new = 0.0;
-        for i in 0..n {
+        let alpha = rz / curvature;
+        rr = 0.0;
+        for i in 0..x.len() {
             if in_set(i) {
                 x[i] += alpha * direction[i];
                 residual[i] -= alpha * response[i];
-                rs_new += residual[i] * residual[i];
+                rr += residual[i] * residual[i];
             }
         }
-        let beta = rs_new / rs;
-        for i in 0..n {
-            if in_set(i) {
-                direction[i] = residual[i] + beta * direction[i];
-            }
+        let rz_new = precondition_on_set(preconditioner, &in_set, residual, z);
+        let beta = rz_new / rz;
+        for i in 0..x.len() {
+            direction[i] = if in_set(i) {
+                z[i] + beta * direction[i]
+            } else {
+                0.0
+            };
         }
-        rs = rs_new;
+        rz = rz_new;
     }
 }
 
 impl ContactSolver {
-    fn take_stiffness_work(&mut self) -> (Vec<f64>, Vec<f64>) {
+    fn stiffness_work(&mut self) -> StiffnessWork {
         let n = self.rows * self.cols;
         self.stiffness_work
             .take()
-            .unwrap_or_else(|| (vec![0.0; n], vec![0.0; n]))
+            .unwrap_or_else(|| StiffnessWork::new(n))
     }
 
     /// Contact stiffness `k = ΔF/Δd` of the last solved state by the frozen contact set
@@ -148,22 +201,20 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(f64, SolveInfo), SolveError> {
-        let (mut x, mut residual) = self.take_stiffness_work();
+        let mut work = self.stiffness_work();
         let pressure = &self.pressure;
         let result = conjugate_gradient_on_set(
             &mut self.operator,
+            &mut self.preconditioner,
             |i| pressure[i] > 0.0,
             RightHandSide::Ones,
-            &mut x,
-            &mut residual,
-            &mut self.direction,
-            &mut self.response,
+            &mut work,
             tolerance,
             max_iterations,
         );
         let dx = self.operator.spacing();
-        let stiffness = x.iter().sum::<f64>() * dx * dx;
-        self.stiffness_work = Some((x, residual));
+        let stiffness = work.x.iter().sum::<f64>() * dx * dx;
+        self.stiffness_work = Some(work);
         result.map(|info| (stiffness, info))
     }
 
@@ -193,45 +244,41 @@ impl ContactSolver {
 
     /// Indentation `d*` and mean pressure at which the whole free-boundary grid is in
     /// contact (two CG solves on the full grid, see the module docs); computed once per
-    /// surface. Uses the gap buffer as scratch: call it only when the state is discarded
-    /// (a solve that ended in full contact).
+    /// surface. Works in the CG's own fields: the solved state is kept.
     pub(super) fn free_full_contact(&mut self) -> Result<FullContactThreshold, SolveError> {
         if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
             return Ok(full);
         }
         let n = self.rows * self.cols;
-        let (mut flat_punch, mut residual) = self.take_stiffness_work();
+        let mut work = self.stiffness_work();
         let (tolerance, max_iterations) = (
             self.params.stiffness_tolerance,
             self.params.stiffness_max_iterations,
         );
-        let first = conjugate_gradient_on_set(
+        // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
+        let result = conjugate_gradient_on_set(
             &mut self.operator,
+            &mut self.preconditioner,
             |_| true,
-            RightHandSide::Ones,
-            &mut flat_punch,
-            &mut residual,
-            &mut self.direction,
-            &mut self.response,
+            RightHandSide::Values(&self.profile),
+            &mut work,
             tolerance,
             max_iterations,
-        );
-        let profile_pressure = &mut self.gap;
-        let second = first.and_then(|_| {
+        )
+        .and_then(|_| {
+            std::mem::swap(&mut work.x, &mut work.profile_pressure);
             conjugate_gradient_on_set(
                 &mut self.operator,
+                &mut self.preconditioner,
                 |_| true,
-                RightHandSide::Values(&self.profile),
-                profile_pressure,
-                &mut residual,
-                &mut self.direction,
-                &mut self.response,
+                RightHandSide::Ones,
+                &mut work,
                 tolerance,
                 max_iterations,
             )
-        });
-        let result = second.map(|_| {
-            let q_y = flat_punch.iter().zip(self.gap.iter());
+        })
+        .map(|_| {
+            let q_y = work.x.iter().zip(work.profile_pressure.iter());
             let indentation = q_y
                 .clone()
                 .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
@@ -241,9 +288,7 @@ impl ContactSolver {
                 indentation: Some(indentation),
             }
         });
-        // The gap buffer now holds K⁻¹f: no valid gap (the caller discards the state).
-        self.gap.fill(0.0);
-        self.stiffness_work = Some((flat_punch, residual));
+        self.stiffness_work = Some(work);
         if let Ok(full) = result {
             self.full_contact = Some(full);
         }

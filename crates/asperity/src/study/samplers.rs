@@ -5,8 +5,9 @@
 //!   in O(N log N) ([`LinearCurve`]). The sample keeps the breakpoints `(F_j, k_j = E*Δx·j)`
 //!   of every contact count `j ≤ 1024` and of ~40 log-spaced counts per decade above.
 //! * **BEM**: an N×N surface (unit rms slope, the study's H and roll-off), free boundaries,
-//!   E* = 1, solved by Polonsky–Keer under load control at log-spaced mean pressures with
-//!   warm starts; the stiffness at each load by the frozen contact set.
+//!   E* = 1, solved by the default solver ([`crate::bem::SolverKind::Bccg`]) under load
+//!   control at log-spaced mean pressures with warm starts; the stiffness at each load by
+//!   the frozen contact set.
 //!   The pressures span `0.05/N²` to `0.2` E*: with the area–load law `A/A0 ≈ 2 p/(E* ḡ)`
 //!   (ḡ = 1) this runs from below one pixel in contact to roughly 30–40 % contact.
 //!
