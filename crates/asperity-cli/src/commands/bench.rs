@@ -3,7 +3,8 @@
 
 use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
 use asperity::elastic::{Boundary, ElasticOperator};
 use asperity::fft::RealFft2;
 use asperity::memory::{self, try_vec};
@@ -19,6 +20,10 @@ pub enum Kernel {
     /// (2N×2N for free boundaries, N×N periodic), and one application of the elastic
     /// operator (the pruned, fused convolution) for comparison.
     FftPair,
+    /// Up-front estimate of a BEM study's run time (the paper's full setting by default):
+    /// measured cost per iteration at each N times iteration counts measured at small
+    /// probe sizes and extrapolated in N (docs/bem.md, "Estimating a BEM study").
+    BemEstimate,
 }
 
 /// Arguments of `asperity bench`.
@@ -27,9 +32,12 @@ pub enum Kernel {
     after_help = "surface: prints the time with planning and buffer set-up (cold, what one\n\
                   `asperity surface` pays) and with the plan and buffers reused (steady, as in a study).\n\
                   fft-pair: prints the time of one padded forward + inverse real FFT pair and of one\n\
-                  elastic operator application (plans and buffers reused), minimum and median.\n\n\
+                  elastic operator application (plans and buffers reused), minimum and median.\n\
+                  bem-estimate: prints, per N and in total, the estimated run time of a BEM study\n\
+                  (free boundaries, 24 loads per sample, frozen-set stiffness at each).\n\n\
                   Examples:\n  asperity bench surface --n 4096 --repeat 5\n  \
-                  asperity bench fft-pair --n 512 --boundary free --repeat 20"
+                  asperity bench fft-pair --n 512 --boundary free --repeat 20\n  \
+                  asperity bench bem-estimate --sizes 256,512,1024 --samples 60 --hursts=-1:3:0.25"
 )]
 pub struct BenchArgs {
     /// The kernel to time.
@@ -47,6 +55,22 @@ pub struct BenchArgs {
     /// periodic (N×N).
     #[arg(long, default_value = "free")]
     pub boundary: String,
+    /// Grid sizes N of the study (bem-estimate), comma-separated.
+    #[arg(long, default_value = "1024")]
+    pub sizes: String,
+    /// Samples per (N, H) (bem-estimate).
+    #[arg(long, default_value_t = 60)]
+    pub samples: usize,
+    /// Hurst exponents of the study (bem-estimate): values and ranges A:B:STEP.
+    #[arg(long, default_value = "-1:3:0.25", allow_hyphen_values = true)]
+    pub hursts: String,
+    /// Roll-off q0·L/2π of the study's surfaces (bem-estimate); none by default, as in a
+    /// study without `rolloff`.
+    #[arg(long)]
+    pub rolloff: Option<f64>,
+    /// Two probe sizes at which iteration counts are measured (bem-estimate).
+    #[arg(long, default_value = "64,128")]
+    pub probes: String,
 }
 
 /// Minimum and median of some timings (seconds).
@@ -62,6 +86,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     match args.kernel {
         Kernel::Surface => time_surface(args),
         Kernel::FftPair => time_fft_pair(args),
+        Kernel::BemEstimate => estimate_bem_study(args),
     }
 }
 
@@ -163,6 +188,178 @@ fn time_fft_pair(args: &BenchArgs) -> Result<()> {
         boundary.name(),
         rayon::current_num_threads(),
         apply_min / pair_min,
+    );
+    Ok(())
+}
+
+/// Loads per sample and their range, as the study's BEM sampler
+/// (`asperity::study::samplers`): 24 mean pressures log-spaced from `0.05/N²` to `0.2` E*.
+fn study_pressures(n: usize) -> Vec<f64> {
+    const LOADS: usize = 24;
+    let (lo, hi) = (0.05 / (n * n) as f64, 0.2f64);
+    (0..LOADS)
+        .map(|i| (lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (LOADS - 1) as f64).exp())
+        .collect()
+}
+
+/// The study's surface of size `n` and Hurst exponent `hurst` (unit rms slope, L = 1).
+fn study_surface(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<asperity::surface::Surface> {
+    let long = rolloff.map_or(LongWavelength::None, |q0| LongWavelength::RollOff { q0 });
+    let psd = Psd::new(hurst, long, None)?;
+    let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
+    Ok(SurfaceGenerator::new(&spec)?.try_generate(1)?)
+}
+
+const FREE: HalfSpace = HalfSpace {
+    modulus: 1.0,
+    boundary: Boundary::Free,
+};
+
+/// Solver and frozen-set CG iterations of one study sample (seed 1): the 24 loads solved in
+/// turn with warm starts, the stiffness after each.
+fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<(f64, f64)> {
+    let surface = study_surface(n, hurst, rolloff)?;
+    let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
+    let (mut solve, mut cg) = (0usize, 0usize);
+    for p in study_pressures(n) {
+        let (_, info) = solver.solve(Control::MeanPressure(p))?;
+        let (_, stiffness) = solver.frozen_set_stiffness()?;
+        solve += info.iterations;
+        cg += stiffness.iterations;
+    }
+    Ok((solve as f64, cg as f64))
+}
+
+/// Seconds per solver iteration and per frozen-set CG iteration on an `n × n` grid: solves
+/// and stiffness CGs cut off after a few iterations (their `NoConvergence` carries the
+/// count; one that converges earlier counts its own iterations), timed; the minimum of three.
+/// The CG runs on the contact set of a loose solve at p̄ = 0.01 E* (a few percent contact).
+fn iteration_costs(n: usize) -> Result<(f64, f64)> {
+    const CUT: usize = 6;
+    let surface = study_surface(n, 0.8, None)?;
+    let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
+    let loose = SolverParams {
+        tolerance: 1e-4,
+        ..SolverParams::default()
+    };
+    let cut = SolverParams {
+        max_iterations: CUT,
+        stiffness_max_iterations: CUT,
+        ..SolverParams::default()
+    };
+    let per_iteration = |result: std::result::Result<usize, SolveError>, start: Instant| {
+        let iterations = match result {
+            Ok(iterations) | Err(SolveError::NoConvergence { iterations, .. }) => iterations,
+            Err(e) => return Err(anyhow::Error::from(e)),
+        };
+        anyhow::ensure!(
+            iterations > 0,
+            "the cost probe at N = {n} took no iteration"
+        );
+        Ok(start.elapsed().as_secs_f64() / iterations as f64)
+    };
+    let (mut solve, mut cg) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..3 {
+        solver.set_params(loose)?;
+        solver.reset();
+        solver.solve(Control::MeanPressure(0.01))?;
+        solver.set_params(cut)?;
+        let start = Instant::now();
+        let result = solver
+            .frozen_set_stiffness()
+            .map(|(_, info)| info.iterations);
+        cg = cg.min(per_iteration(result, start)?);
+        solver.reset();
+        let start = Instant::now();
+        let result = solver
+            .solve(Control::MeanPressure(0.05))
+            .map(|(_, info)| info.iterations);
+        solve = solve.min(per_iteration(result, start)?);
+    }
+    Ok((solve, cg))
+}
+
+/// `count(n)` from counts at two probe sizes by the power law through them (exponent
+/// clamped at ≥ 0); the measured count at a probe size itself.
+fn extrapolate(count: (f64, f64), probes: (usize, usize), n: usize) -> f64 {
+    if n == probes.0 {
+        return count.0;
+    }
+    let slope = ((count.1 / count.0).ln() / (probes.1 as f64 / probes.0 as f64).ln()).max(0.0);
+    count.1 * (n as f64 / probes.1 as f64).powf(slope)
+}
+
+fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
+    text.split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n >= 8)
+                .with_context(|| format!("{flag} takes sizes of at least 8, got {s:?}"))
+        })
+        .collect()
+}
+
+/// Prints per N one line `n samples hursts lanes solve_iterations cg_iterations
+/// solve_iteration_s cg_iteration_s seconds`, then `total_seconds` and `total_hours`.
+///
+/// Per (N, H) one sample costs `I_solve·c_solve(N) + I_cg·c_cg(N)`: the per-iteration costs
+/// `c` are measured at each N on one thread ([`iteration_costs`], so they include everything
+/// an iteration does on this machine), the iteration counts `I` of a whole 24-load sample are
+/// measured at the two probe sizes for every H ([`sample_iterations`]) and carried to N by
+/// the power law through them ([`extrapolate`]). A study runs its samples side by side, one
+/// lane per thread (`study::run_task`), so a task of S samples takes `⌈S/lanes⌉` sample
+/// times; total = Σ_N Σ_H ⌈S/lanes⌉ · sample time. Left out: the lanes' competition for
+/// memory bandwidth (the estimate is low where it matters, at large N on many lanes),
+/// surface generation and planning (< 1 %).
+fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
+    anyhow::ensure!(args.samples > 0, "--samples must be at least 1");
+    let sizes = parse_sizes(&args.sizes, "--sizes")?;
+    let probes = parse_sizes(&args.probes, "--probes")?;
+    let probes = match probes[..] {
+        [a, b] if a < b => (a, b),
+        _ => anyhow::bail!("--probes takes two increasing sizes, got {:?}", args.probes),
+    };
+    let hursts = asperity::study::parse_range(&args.hursts)?;
+    for n in sizes.iter().copied().chain([probes.0, probes.1]) {
+        memory::ensure_fits(
+            &format!("a BEM solver for a {n}x{n} grid"),
+            ContactSolver::memory_bytes(n, n, Boundary::Free),
+        )?;
+    }
+    let lanes = rayon::current_num_threads().max(1);
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let mut counts = Vec::with_capacity(hursts.len());
+    for &hurst in &hursts {
+        let small = sample_iterations(probes.0, hurst, args.rolloff)?;
+        let large = sample_iterations(probes.1, hurst, args.rolloff)?;
+        counts.push(((small.0, large.0), (small.1, large.1)));
+    }
+    let samples_per_lane = args.samples.div_ceil(lanes) as f64;
+    let mut total = 0.0;
+    for &n in &sizes {
+        let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
+        // Iterations of one sample per H, summed over H.
+        let (solve, cg) = counts.iter().fold((0.0, 0.0), |(s, c), (solve, cg)| {
+            (
+                s + extrapolate(*solve, probes, n),
+                c + extrapolate(*cg, probes, n),
+            )
+        });
+        let seconds = samples_per_lane * (solve * c_solve + cg * c_cg);
+        total += seconds;
+        println!(
+            "n={n} samples={} hursts={} lanes={lanes} solve_iterations={solve:.0} \
+             cg_iterations={cg:.0} solve_iteration_s={c_solve:.3e} cg_iteration_s={c_cg:.3e} \
+             seconds={seconds:.1}",
+            args.samples,
+            hursts.len(),
+        );
+    }
+    println!(
+        "total_seconds={total:.1} total_hours={:.2} lanes={lanes}",
+        total / 3600.0
     );
     Ok(())
 }
