@@ -252,26 +252,41 @@ impl RealFft2 {
     }
 
     /// Forward transform of a whole `rows × cols` grid (padding included) whose rows are
-    /// produced one at a time by `row(r, buffer)`, which must fill all `cols` values: for
-    /// inputs that fill the transform grid but need not be stored, such as a sampled
-    /// convolution kernel. The row pass is serial (a planning-time use); the columns run in
-    /// parallel.
-    pub fn forward_rows_from<G>(&mut self, mut row: G, spectrum: &mut [Complex64])
+    /// produced by `row(r, buffer)`, which must fill all `cols` values: for inputs that fill
+    /// the transform grid but need not be stored, such as a sampled convolution kernel. Rows
+    /// are generated and transformed in parallel, `data_rows` at a time (the work buffer's
+    /// capacity), and scattered into the columns; the result does not depend on the thread
+    /// count.
+    pub fn forward_rows_from<G>(&mut self, row: G, spectrum: &mut [Complex64])
     where
-        G: FnMut(usize, &mut [f64]),
+        G: Fn(usize, &mut [f64]) + Sync,
     {
         let (rows, half) = (self.rows, self.half_cols());
         assert_eq!(spectrum.len(), self.spectrum_len(), "spectrum length");
-        let lane = &mut self.lanes[0];
-        let row_out = &mut self.work[..half];
-        for r in 0..rows {
-            row(r, &mut lane.real);
-            self.r2c
-                .process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
-                .expect("buffer sizes are fixed at planning");
-            for (kx, value) in row_out.iter().enumerate() {
-                spectrum[kx * rows + r] = *value;
-            }
+        for first in (0..rows).step_by(self.data_rows) {
+            let count = self.data_rows.min(rows - first);
+            let chunk = per_lane(count, self.lanes.len());
+            let r2c = &self.r2c;
+            self.work[..count * half]
+                .par_chunks_mut(chunk * half)
+                .enumerate()
+                .zip(self.lanes.par_iter_mut())
+                .for_each(|((block, out), lane)| {
+                    for (i, row_out) in out.chunks_exact_mut(half).enumerate() {
+                        row(first + block * chunk + i, &mut lane.real);
+                        r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
+                            .expect("buffer sizes are fixed at planning");
+                    }
+                });
+            let work = &self.work;
+            spectrum
+                .par_chunks_mut(rows)
+                .enumerate()
+                .for_each(|(kx, column)| {
+                    for (i, value) in column[first..first + count].iter_mut().enumerate() {
+                        *value = work[i * half + kx];
+                    }
+                });
         }
         let fft = &self.col_forward;
         for_each_column(spectrum, rows, &mut self.lanes, |_, column, scratch| {

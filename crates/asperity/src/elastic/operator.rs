@@ -239,9 +239,9 @@ impl ElasticOperator {
         self.padded_rows() / 2 + 1
     }
 
-    /// Spectrum of Love's coefficients sampled on the padded grid, row by row (the samples
-    /// are never stored): each padded row's real transform is real (the row is even), so
-    /// the real parts of the column transforms are the whole kernel.
+    /// Spectrum of Love's coefficients sampled on the padded grid, row by row in parallel
+    /// (the samples are never stored): each padded row's real transform is real (the row is
+    /// even), so the real parts of the column transforms are the whole kernel.
     fn fill_free_kernel(&mut self) {
         let (prow, pcol) = (self.fft.rows(), self.fft.cols());
         let (dx, dy, e) = (self.spacing_x, self.spacing_y, self.modulus);
@@ -255,9 +255,14 @@ impl ElasticOperator {
         };
         self.fft.forward_rows_from(
             |r, row| {
+                // Even in x: columns past the middle mirror those before it (the kernel
+                // takes |x|, so the values are the same bits).
                 let y = offset(r, prow) * dy;
-                for (c, value) in row.iter_mut().enumerate() {
+                for (c, value) in row[..=pcol / 2].iter_mut().enumerate() {
                     *value = love_pixel_displacement(offset(c, pcol) * dx, y, dx, dy, e);
+                }
+                for c in pcol / 2 + 1..pcol {
+                    row[c] = row[pcol - c];
                 }
             },
             &mut self.spectrum,
