@@ -6,21 +6,39 @@ For every grid size N the script generates one surface with `asperity surface`
 same mean pressures with every code and boundary condition, each solve cold (a new
 solver) in its own process so that peak memory (VmHWM) is per solve:
 
-  asperity      `asperity bem --pressures p --timing` (solve time from the CSV, excludes
-                reading the surface and planning, like the peers' timings)
+  asperity      `asperity bem --solver S --pressures p --timing` for every solver S of
+                --solvers and every thread count of --threads (RAYON_NUM_THREADS); solve
+                time from the CSV, excludes reading the surface and planning, like the
+                peers' timings. A binary without `--solver` runs "pk" without the flag and
+                skips the other solvers.
   tamaas        PolonskyKeerRey (periodic: default operator; free: the non-periodic
                 Boussinesq operator registered by ModelFactory.registerNonPeriodic)
-  ContactMech.  constrained_conjugate_gradients on PeriodicFFTElasticHalfSpace /
-                FreeFFTElasticHalfSpace
+  contactmechanics
+                constrained_conjugate_gradients (Polonsky-Keer) on
+                PeriodicFFTElasticHalfSpace / FreeFFTElasticHalfSpace
+  cm-ccg        ContactMechanics' CCG without restart (Bugnicourt et al. 2018):
+                NonSmoothContactSystem.dual_minimize_proxy(offset,
+                solver="ccg-without-restart", gtol=tol·h_rms) at the offset of
+                ContactMechanics' own Polonsky-Keer solution of the same case (solved
+                untimed in the worker when the contactmechanics run did not provide it),
+                starting from the uniform pixel force p̄·A/n (unpadded shape)
 
 Indentation of the peers is computed the same way as asperity's: apply the code's own
 elastic operator to its pressure and average u + f over the contact set (f = max h − h).
 
-results.json holds {"environment": ..., "results": [...]}: the environment records the
-peers' installed versions, the asperity git commit (and whether the tree was dirty), the
-date, `nproc` and the load average, so that a table can be traced to what produced it.
+The unit of cost: for every N and boundary, `asperity bench fft-pair` times one padded
+forward + inverse real FFT pair (2N×2N free, N×N periodic) on each thread count used, in
+the same run; a solve's cost per iteration is reported in those pairs (peers, which run on
+one thread: in asperity's one-thread pair; their own numpy pair is recorded beside it).
+
+results.json holds {"environment": ..., "fft_pairs": [...], "results": [...]}: the
+environment records the peers' installed versions, the asperity git commit (and whether the
+tree was dirty), the date, `nproc` and the load average, so that a table can be traced to
+what produced it.
 
 Usage: bench/bem_peers.py --asperity target/release/asperity --out bench/out
+       [--sizes 256,512,1024] [--solvers bccg,pk] [--threads 2,1]
+       [--peers tamaas,contactmechanics,cm-ccg]
 """
 
 import argparse
@@ -51,67 +69,138 @@ def indentation_from(u, f, contact):
     return float(np.mean(plus)) if np.std(plus) <= np.std(minus) else float(np.mean(minus))
 
 
+def numpy_pair_seconds(shape, repeat=5):
+    """Minimum time of one numpy rfft2 + irfft2 pair of a real grid of `shape`."""
+    import numpy as np
+
+    grid = np.random.default_rng(1).random(shape)
+    best = float("inf")
+    for _ in range(repeat + 1):
+        start = time.perf_counter()
+        np.fft.irfft2(np.fft.rfft2(grid), s=shape)
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def solve_tamaas(args, heights):
+    """PolonskyKeerRey; returns (seconds, pressure, u, iterations=None, extra)."""
+    import numpy as np
+    import tamaas as tm
+
+    n_rows, n_cols = heights.shape
+    tm.set_log_level(tm.LogLevel.info)
+    model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, n_rows / n_cols], [n_rows, n_cols])
+    model.E, model.nu = 1.0, 0.0
+    solver = tm.PolonskyKeerRey(model, heights, args.tol)
+    solver.setMaxIterations(100000)
+    if args.boundary == "free":
+        tm.ModelFactory.registerNonPeriodic(model, "dcfft")
+        solver.setIntegralOperator("dcfft")
+    sys.stdout.flush()
+    start = time.perf_counter()
+    solver.solve(args.pressure)
+    seconds = time.perf_counter() - start
+    pressure = np.array(model.traction, copy=True)
+    u = np.zeros_like(pressure)
+    if args.boundary == "free":
+        model.operators["dcfft"](model.traction, u)
+    else:
+        model.solveNeumann()
+        u = np.array(model.displacement, copy=True)
+    return seconds, pressure, u, None, {}  # iterations parsed from tamaas' log by the parent
+
+
+def cm_substrate(args, shape):
+    from ContactMechanics import FreeFFTElasticHalfSpace, PeriodicFFTElasticHalfSpace
+
+    cls = FreeFFTElasticHalfSpace if args.boundary == "free" else PeriodicFFTElasticHalfSpace
+    n_rows, n_cols = shape
+    return cls(shape, 1.0, physical_sizes=(n_rows / n_cols, 1.0))
+
+
+def cm_polonsky_keer(args, heights, substrate):
+    """ContactMechanics' Polonsky-Keer; returns (seconds, result) or raises on failure."""
+    import numpy as np
+    from ContactMechanics.Optimization import constrained_conjugate_gradients
+
+    n_rows, n_cols = heights.shape
+    area = n_rows / n_cols
+    rms = float(np.std(heights))
+    start = time.perf_counter()
+    result = constrained_conjugate_gradients(
+        substrate, heights, external_force=args.pressure * area,
+        pentol=args.tol * rms, forcetol=1e-12 * args.pressure * area / (n_rows * n_cols),
+        thermotol=args.tol, maxiter=100000)
+    seconds = time.perf_counter() - start
+    if not result.success:
+        raise RuntimeError(f"Polonsky-Keer: {result.message}")
+    return seconds, result
+
+
+def solve_contactmechanics(args, heights):
+    import numpy as np
+
+    n_rows, n_cols = heights.shape
+    substrate = cm_substrate(args, heights.shape)
+    seconds, result = cm_polonsky_keer(args, heights, substrate)
+    pixel_area = (n_rows / n_cols) / (n_rows * n_cols)
+    force = np.asarray(result.jac)
+    u = np.asarray(substrate.evaluate_disp(force))[:n_rows, :n_cols]
+    return seconds, force / pixel_area, u, int(result.nit), {"offset": float(result.offset)}
+
+
+def solve_cm_ccg(args, heights):
+    """CCG without restart at ContactMechanics' Polonsky-Keer offset (--offset, or solved
+    here untimed)."""
+    import numpy as np
+    from ContactMechanics.Systems import NonSmoothContactSystem
+    from SurfaceTopography import Topography
+
+    n_rows, n_cols = heights.shape
+    substrate = cm_substrate(args, heights.shape)
+    offset = args.offset
+    if offset is None:
+        offset = float(cm_polonsky_keer(args, heights, substrate)[1].offset)
+        substrate = cm_substrate(args, heights.shape)
+    topography = Topography(heights, physical_sizes=(n_rows / n_cols, 1.0),
+                            periodic=args.boundary == "periodic")
+    system = NonSmoothContactSystem(substrate=substrate, surface=topography)
+    area = n_rows / n_cols
+    init_force = np.full((n_rows, n_cols), args.pressure * area / (n_rows * n_cols))
+    rms = float(np.std(heights))
+    start = time.perf_counter()
+    result = system.dual_minimize_proxy(offset, init_force=init_force, solver="ccg-without-restart",
+                                        gtol=args.tol * rms, maxiter=100000)
+    seconds = time.perf_counter() - start
+    if not result.success:
+        raise RuntimeError(f"CCG without restart: {result.message}")
+    force = np.asarray(result.x).reshape(n_rows, n_cols)
+    pixel_area = area / (n_rows * n_cols)
+    u = np.asarray(substrate.evaluate_disp(force))[:n_rows, :n_cols]
+    return seconds, force / pixel_area, u, int(result.nit), {"offset": offset}
+
+
 def worker(args):
     """One cold solve with a peer; prints one JSON line."""
     import numpy as np
 
     heights = np.load(args.surface)
     n_rows, n_cols = heights.shape
-    size = 1.0
     f = heights.max() - heights
     baseline = vm_hwm_mib()
-    if args.code == "tamaas":
-        import tamaas as tm
-
-        tm.set_log_level(tm.LogLevel.info)
-        model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [size, size * n_rows / n_cols], [n_rows, n_cols])
-        model.E, model.nu = 1.0, 0.0
-        solver = tm.PolonskyKeerRey(model, heights, args.tol)
-        solver.setMaxIterations(100000)
-        if args.boundary == "free":
-            tm.ModelFactory.registerNonPeriodic(model, "dcfft")
-            solver.setIntegralOperator("dcfft")
-        sys.stdout.flush()
-        start = time.perf_counter()
-        solver.solve(args.pressure)
-        seconds = time.perf_counter() - start
-        peak = vm_hwm_mib()
-        pressure = np.array(model.traction, copy=True)
-        u = np.zeros_like(pressure)
-        if args.boundary == "free":
-            model.operators["dcfft"](model.traction, u)
-        else:
-            model.solveNeumann()
-            u = np.array(model.displacement, copy=True)
-        iterations = None  # parsed from tamaas' log by the parent
-    else:
-        from ContactMechanics import FreeFFTElasticHalfSpace, PeriodicFFTElasticHalfSpace
-        from ContactMechanics.Optimization import constrained_conjugate_gradients
-
-        cls = FreeFFTElasticHalfSpace if args.boundary == "free" else PeriodicFFTElasticHalfSpace
-        substrate = cls((n_rows, n_cols), 1.0, physical_sizes=(size * n_rows / n_cols, size))
-        area = size * size * n_rows / n_cols
-        rms = float(np.std(heights))
-        start = time.perf_counter()
-        result = constrained_conjugate_gradients(
-            substrate, heights, external_force=args.pressure * area,
-            pentol=args.tol * rms, forcetol=1e-12 * args.pressure * area / (n_rows * n_cols),
-            thermotol=args.tol, maxiter=100000)
-        seconds = time.perf_counter() - start
-        peak = vm_hwm_mib()
-        if not result.success:
-            print(json.dumps({"error": str(result.message)}))
-            return
-        pixel_area = area / (n_rows * n_cols)
-        pressure = np.asarray(result.jac) / pixel_area
-        u = substrate.evaluate_disp(np.asarray(result.jac) if args.boundary == "periodic" else
-                                    np.asarray(result.jac))
-        u = np.asarray(u)[:n_rows, :n_cols]
-        iterations = int(result.nit)
+    solve = {"tamaas": solve_tamaas, "contactmechanics": solve_contactmechanics,
+             "cm-ccg": solve_cm_ccg}[args.code]
+    try:
+        seconds, pressure, u, iterations, extra = solve(args, heights)
+    except RuntimeError as err:
+        print(json.dumps({"error": str(err)}))
+        return
+    peak = vm_hwm_mib()
     contact = pressure > 0
     if args.boundary == "periodic":
         # Periodic displacements are defined up to a constant; use asperity's (zero mean).
         u = u - np.mean(u)
+    pad = 2 if args.boundary == "free" else 1
     print(json.dumps({
         "seconds": seconds,
         "iterations": iterations,
@@ -120,16 +209,27 @@ def worker(args):
         "indentation": indentation_from(u, f, contact),
         "peak_rss_mib": peak,
         "baseline_rss_mib": baseline,
+        "numpy_pair_seconds": numpy_pair_seconds((pad * n_rows, pad * n_cols)),
+        **extra,
     }))
 
 
-def run_asperity(exe, surface, boundary, pressure, tol, out_dir, threads=None):
+def asperity_has_solver_flag(exe):
+    """Whether `asperity bem` takes --solver (it arrives with the preconditioned solver)."""
+    proc = subprocess.run([exe, "bem", "--help"], capture_output=True, text=True)
+    return "--solver" in proc.stdout
+
+
+def run_asperity(exe, surface, boundary, pressure, tol, out_dir, threads=None, solver=None):
+    """One cold `asperity bem` solve; `solver` None runs the binary's default."""
     out = os.path.join(out_dir, "asperity_tmp.csv")
     env = dict(os.environ)
     if threads:
         env["RAYON_NUM_THREADS"] = str(threads)
     cmd = [exe, "bem", "--surface", surface, "--boundary", boundary, "--pressures", repr(pressure),
            "--tol", repr(tol), "--timing", "--no-stiffness", "--quiet", "--force", "--out", out]
+    if solver:
+        cmd += ["--solver", solver]
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if proc.returncode != 0:
         return {"error": proc.stderr.strip()}
@@ -145,9 +245,24 @@ def run_asperity(exe, surface, boundary, pressure, tol, out_dir, threads=None):
     }
 
 
-def run_peer(code, surface, boundary, pressure, tol, timeout):
+def fft_pair_seconds(exe, n, boundary, threads, repeat):
+    """`asperity bench fft-pair`: minimum seconds of one padded forward + inverse pair and of
+    one operator application; None where the binary lacks the kernel."""
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+    proc = subprocess.run([exe, "bench", "fft-pair", "--n", str(n), "--boundary", boundary,
+                           "--repeat", str(repeat)], capture_output=True, text=True, env=env)
+    if proc.returncode != 0:
+        return None
+    fields = dict(item.split("=", 1) for item in proc.stdout.split() if "=" in item)
+    return {"n": n, "boundary": boundary, "threads": threads,
+            "pair_seconds": float(fields["pair_min_s"]), "apply_seconds": float(fields["apply_min_s"])}
+
+
+def run_peer(code, surface, boundary, pressure, tol, timeout, offset=None):
     cmd = [sys.executable, os.path.abspath(__file__), "worker", "--code", code, "--surface", surface,
            "--boundary", boundary, "--pressure", repr(pressure), "--tol", repr(tol)]
+    if offset is not None:
+        cmd += ["--offset", repr(offset)]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -157,7 +272,7 @@ def run_peer(code, surface, boundary, pressure, tol, timeout):
         tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
         return {"error": " | ".join(tail)}
     result = json.loads(lines[-1])
-    if code == "tamaas":
+    if code == "tamaas" and "error" not in result:
         its = [int(m.group(1)) for m in re.finditer(r"^\s*(\d+)\s+\S+\s+\S+\s*$", proc.stdout + proc.stderr, re.M)]
         result["iterations"] = its[-1] if its else None
     return result
@@ -190,7 +305,7 @@ def environment(asperity_exe):
         "asperity_commit": command_output(["git", "-C", repo, "rev-parse", "HEAD"]),
         "asperity_tree_dirty": None if dirty is None else bool(dirty),
         "asperity_version": command_output([asperity_exe, "--version"]),
-        "peers": {package: version(package) for package in ("tamaas", "ContactMechanics", "numpy")},
+        "peers": {package: version(package) for package in ("tamaas", "ContactMechanics", "NuMPI", "SurfaceTopography", "numpy", "scipy")},
         "python": platform.python_version(),
         "nproc": int(nproc) if nproc and nproc.isdigit() else os.cpu_count(),
         "loadavg": list(os.getloadavg()),
@@ -210,6 +325,55 @@ def padded_minimum_mib(n, boundary):
     return (spectrum + kernel + fields) / 2**20
 
 
+def asperity_configs(args):
+    """(code name, solver flag or None, threads) for every asperity run of a case."""
+    has_flag = asperity_has_solver_flag(args.asperity)
+    configs = []
+    for solver in [s for s in args.solvers.split(",") if s]:
+        for threads in [int(t) for t in args.threads.split(",") if t]:
+            name = f"asperity-{solver}-{threads}t"
+            if has_flag:
+                configs.append((name, solver, threads))
+            elif solver == "pk":
+                configs.append((name, None, threads))  # the only solver of such a binary
+            else:
+                configs.append((name, "unavailable", threads))
+    return configs
+
+
+def run_case(args, surface, n, boundary, pressure, configs, pairs):
+    """Every code on one (surface, boundary, pressure); returns the result records."""
+    results = []
+    offset = None
+    for name, solver, threads in configs:
+        if solver == "unavailable":
+            r = {"error": "skipped: this asperity binary has no --solver"}
+        else:
+            r = run_asperity(args.asperity, surface, boundary, pressure, args.tol, args.out, threads, solver)
+            r["baseline_rss_mib"] = args.baseline
+        r.update({"code": name, "threads": threads})
+        results.append(r)
+    for code in [p for p in args.peers.split(",") if p]:
+        tol = args.tamaas_tol if (code == "tamaas" and args.tamaas_tol) else args.tol
+        r = run_peer(code, surface, boundary, pressure, tol, args.timeout,
+                     offset=offset if code == "cm-ccg" else None)
+        if code == "contactmechanics" and "offset" in r:
+            offset = r["offset"]
+        r.update({"code": code, "threads": 1})
+        results.append(r)
+    for r in results:
+        pair = pairs.get((n, boundary, r["threads"]))
+        if pair and "error" not in r and r.get("iterations"):
+            r["pair_seconds"] = pair["pair_seconds"]
+            r["iteration_in_pairs"] = r["seconds"] / r["iterations"] / pair["pair_seconds"]
+        if "numpy_pair_seconds" in r and r.get("iterations"):
+            r["iteration_in_numpy_pairs"] = r["seconds"] / r["iterations"] / r["numpy_pair_seconds"]
+        r.update({"n": n, "boundary": boundary, "pressure": pressure,
+                  "padded_minimum_mib": padded_minimum_mib(n, boundary)})
+        print(json.dumps(r), flush=True)
+    return results
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command")
@@ -219,15 +383,21 @@ def main():
     w.add_argument("--boundary", required=True)
     w.add_argument("--pressure", type=float, required=True)
     w.add_argument("--tol", type=float, required=True)
+    w.add_argument("--offset", type=float, default=None)
     parser.add_argument("--asperity", default="target/release/asperity")
     parser.add_argument("--out", default="bench/out")
     parser.add_argument("--sizes", default="256,512,1024")
     parser.add_argument("--pressures", default="0.01,0.05")
     parser.add_argument("--boundaries", default="free,periodic")
-    parser.add_argument("--peers", default="tamaas,contactmechanics")
+    parser.add_argument("--solvers", default="bccg,pk",
+                        help="asperity solvers (values of `asperity bem --solver`); the first that "
+                             "ran is the reference of the agreement columns")
+    parser.add_argument("--threads", default="2,1", help="asperity thread counts (RAYON_NUM_THREADS)")
+    parser.add_argument("--peers", default="tamaas,contactmechanics,cm-ccg")
     parser.add_argument("--tol", type=float, default=1e-8, help="asperity's tolerance")
     parser.add_argument("--tamaas-tol", type=float, default=None,
                         help="tamaas' tolerance (its error measure differs; default: same value)")
+    parser.add_argument("--pair-repeat", type=int, default=10, help="repetitions of the FFT pair timing")
     parser.add_argument("--timeout", type=float, default=1800)
     args = parser.parse_args()
     if args.command == "worker":
@@ -236,64 +406,77 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     env = environment(args.asperity)
     print(json.dumps({"environment": env}), flush=True)
-    results = []
+    configs = asperity_configs(args)
     # asperity's fixed memory (binary, allocator): peak RSS of a 16² solve.
     tiny = os.path.join(args.out, "surface_16.npy")
     subprocess.run([args.asperity, "surface", "--n", "16", "--hurst", "0.8", "--rms-slope", "1",
                     "--out", tiny, "--force"], check=True, capture_output=True)
-    baseline = run_asperity(args.asperity, tiny, "free", 0.01, args.tol, args.out)["peak_rss_mib"]
+    args.baseline = run_asperity(args.asperity, tiny, "free", 0.01, args.tol, args.out)["peak_rss_mib"]
+    thread_counts = sorted({t for _, _, t in configs} | {1})
+    results, pairs = [], {}
     for n in [int(s) for s in args.sizes.split(",")]:
         surface = os.path.join(args.out, f"surface_{n}.npy")
         subprocess.run([args.asperity, "surface", "--n", str(n), "--hurst", "0.8", "--rolloff", "6",
                         "--rms-slope", "1", "--seed", "1", "--out", surface, "--force"], check=True,
                        capture_output=True)
         for boundary in args.boundaries.split(","):
+            for threads in thread_counts:
+                pair = fft_pair_seconds(args.asperity, n, boundary, threads, args.pair_repeat)
+                if pair:
+                    pairs[(n, boundary, threads)] = pair
+                    print(json.dumps({"fft_pair": pair}), flush=True)
             for pressure in [float(p) for p in args.pressures.split(",")]:
-                codes = ["asperity", "asperity-1thread"] + [p for p in args.peers.split(",") if p]
-                for code in codes:
-                    if code == "asperity":
-                        r = run_asperity(args.asperity, surface, boundary, pressure, args.tol, args.out)
-                        r["baseline_rss_mib"] = baseline
-                    elif code == "asperity-1thread":
-                        r = run_asperity(args.asperity, surface, boundary, pressure, args.tol, args.out, threads=1)
-                        r["baseline_rss_mib"] = baseline
-                    else:
-                        tol = args.tamaas_tol if (code == "tamaas" and args.tamaas_tol) else args.tol
-                        r = run_peer(code, surface, boundary, pressure, tol, args.timeout)
-                    r.update({"n": n, "boundary": boundary, "pressure": pressure, "code": code,
-                              "padded_minimum_mib": padded_minimum_mib(n, boundary)})
-                    results.append(r)
-                    print(json.dumps(r), flush=True)
+                results += run_case(args, surface, n, boundary, pressure, configs, pairs)
     env["loadavg_end"] = list(os.getloadavg())
     with open(os.path.join(args.out, "results.json"), "w") as fh:
-        json.dump({"environment": env, "results": results}, fh, indent=1)
-    print_table(results)
+        json.dump({"environment": env, "fft_pairs": list(pairs.values()), "results": results}, fh, indent=1)
+    with open(os.path.join(args.out, "results.md"), "w") as fh:
+        fh.write(tables(results, [name for name, _, _ in configs]))
+    print(tables(results, [name for name, _, _ in configs]))
 
 
-def print_table(results):
-    print("\n| N | boundary | p̄ | code | time/solve (s) | iterations | peak RSS (MiB) | RSS − start-up (MiB) | ÷ padded minimum | area fraction | indentation | Δarea rel. | Δd rel. | time ÷ asperity |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    ref = {}
+def fmt(value, spec):
+    return "" if value is None else format(value, spec)
+
+
+def tables(results, asperity_codes):
+    """Markdown: one row per solve (agreement with the reference: the first asperity run of
+    the case that succeeded), then the ratios of every peer's time to every asperity run's."""
+    ok = {(r["n"], r["boundary"], r["pressure"], r["code"]): r for r in results if "error" not in r}
+    lines = ["| N | boundary | p̄ | code | threads | time/solve (s) | iterations | iteration ÷ FFT pair "
+             "| iteration ÷ numpy pair | peak RSS (MiB) | RSS − start-up (MiB) | ÷ padded minimum "
+             "| area fraction | indentation | Δarea rel. | Δd rel. |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
-        key = (r["n"], r["boundary"], r["pressure"])
-        if r["code"] == "asperity" and "error" not in r:
-            ref[key] = r
-    for r in results:
-        key = (r["n"], r["boundary"], r["pressure"])
+        head = f"| {r['n']} | {r['boundary']} | {r['pressure']} | {r['code']} | {r['threads']} |"
         if "error" in r:
-            print(f"| {r['n']} | {r['boundary']} | {r['pressure']} | {r['code']} | error: {r['error']} |||||||||")
+            lines.append(f"{head} {r['error']} ||||||||||||")
             continue
-        a = ref.get(key)
-        d_area = d_ind = speed = ""
-        if a and r["code"] != "asperity":
+        case = (r["n"], r["boundary"], r["pressure"])
+        reference = next((c for c in asperity_codes if case + (c,) in ok), None)
+        a = ok.get(case + (reference,))
+        d_area = d_ind = ""
+        if a and r["code"] != reference:
             d_area = f"{abs(r['area_fraction'] / a['area_fraction'] - 1):.1e}"
             d_ind = f"{abs(r['indentation'] / a['indentation'] - 1):.1e}"
-            speed = f"{r['seconds'] / a['seconds']:.1f}×"
         net = r["peak_rss_mib"] - r.get("baseline_rss_mib", 0.0)
-        print(f"| {r['n']} | {r['boundary']} | {r['pressure']} | {r['code']} | {r['seconds']:.3f} | "
-              f"{r['iterations']} | {r['peak_rss_mib']:.0f} | {net:.0f} | {net / r['padded_minimum_mib']:.2f} | "
-              f"{r['area_fraction']:.5f} | {r['indentation']:.6e} | "
-              f"{d_area} | {d_ind} | {speed} |")
+        lines.append(f"{head} {r['seconds']:.3f} | {r['iterations']} | {fmt(r.get('iteration_in_pairs'), '.2f')} | "
+                     f"{fmt(r.get('iteration_in_numpy_pairs'), '.2f')} | "
+                     f"{r['peak_rss_mib']:.0f} | {net:.0f} | {net / r['padded_minimum_mib']:.2f} | "
+                     f"{r['area_fraction']:.5f} | {r['indentation']:.6e} | {d_area} | {d_ind} |")
+    lines += ["", "| N | boundary | p̄ | peer | time/solve (s) | " +
+              " | ".join(f"÷ {c}" for c in asperity_codes) + " |",
+              "|---|---|---|---|---|" + "---|" * len(asperity_codes)]
+    for r in results:
+        if r["code"] in asperity_codes or "error" in r:
+            continue
+        ratios = []
+        for c in asperity_codes:
+            a = ok.get((r["n"], r["boundary"], r["pressure"], c))
+            ratios.append(f"{r['seconds'] / a['seconds']:.1f}×" if a else "")
+        lines.append(f"| {r['n']} | {r['boundary']} | {r['pressure']} | {r['code']} | {r['seconds']:.3f} | " +
+                     " | ".join(ratios) + " |")
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

@@ -1,11 +1,25 @@
-//! Two-dimensional real FFTs, planned once and run many times without allocating.
+//! Two-dimensional real FFTs, planned once and run many times without allocating: the one
+//! engine behind surface synthesis, surface statistics and the elastic half-space operator.
 //!
 //! [`RealFft2`] transforms a real `rows × cols` grid (row-major) to its half spectrum and
 //! back. The spectrum is kept **transposed**: `cols/2 + 1` rows (one per `kx`), each of
 //! length `rows` (all `ky`), which makes both passes contiguous. Rows are transformed in
 //! parallel with rayon; each worker lane owns a scratch buffer allocated at planning time,
-//! so [`RealFft2::forward`] and [`RealFft2::inverse`] allocate nothing. Results do not depend
-//! on the number of threads (each row is one independent transform).
+//! so no transform allocates. Results do not depend on the number of threads (each row and
+//! each column is one independent transform, always computed whole by one lane).
+//!
+//! **Zero padding, pruned** ([`RealFft2::zero_padded`]): convolutions without periodic
+//! images (Hockney 1970) embed a `data_rows × data_cols` block in a larger transform grid,
+//! typically `2·data_rows × 2·data_cols`. The forward transform then skips the rows of
+//! zeros (only `data_rows` real row transforms, the columns get zeros appended), and the
+//! inverse transform returns only the `data_rows × data_cols` block: after the column pass
+//! only `data_rows` real row transforms are run. For a 2N × 2N grid padding an N × N block,
+//! a forward + inverse pair costs N + N row transforms of length 2N instead of 2N + 2N, and
+//! the 2·(N+1) column transforms of length 2N of the full pair.
+//!
+//! [`RealFft2::convolve`] fuses forward and inverse for filters applied column by column:
+//! each `kx` column is transformed forward, filtered and transformed back while it is in
+//! cache.
 //!
 //! Neither direction is normalised: `inverse(forward(x)) = rows·cols·x`.
 
@@ -24,15 +38,19 @@ struct Lane {
     scratch: Vec<Complex64>,
 }
 
-/// A planned 2D real-to-complex FFT of a `rows × cols` grid (see the module docs).
+/// A planned 2D real-to-complex FFT of a `rows × cols` grid, optionally zero-padding a
+/// smaller data block (see the module docs).
 pub struct RealFft2 {
     rows: usize,
     cols: usize,
+    data_rows: usize,
+    data_cols: usize,
     r2c: Arc<dyn RealToComplex<f64>>,
     c2r: Arc<dyn ComplexToReal<f64>>,
     col_forward: Arc<dyn Fft<f64>>,
     col_inverse: Arc<dyn Fft<f64>>,
-    /// Row-major half spectrum `rows × (cols/2+1)` between the two passes.
+    /// Row-major half spectra of the data rows, `data_rows × (cols/2+1)`, between the row
+    /// and the column passes.
     work: Vec<Complex64>,
     lanes: Vec<Lane>,
 }
@@ -41,24 +59,43 @@ impl RealFft2 {
     /// Plans transforms for a `rows × cols` real grid (both at least 1). The work buffers
     /// are allocated fallibly: [`Error::OutOfMemory`] if the system refuses them.
     pub fn new(rows: usize, cols: usize) -> Result<Self> {
-        if rows < 1 || cols < 1 {
+        Self::zero_padded(rows, cols, rows, cols)
+    }
+
+    /// Plans transforms of a `rows × cols` grid whose input is a `data_rows × data_cols`
+    /// block at its top-left corner, zeros elsewhere, and whose inverse returns that block
+    /// only (see the module docs). `data_rows ≤ rows`, `data_cols ≤ cols`, all at least 1.
+    pub fn zero_padded(
+        data_rows: usize,
+        data_cols: usize,
+        rows: usize,
+        cols: usize,
+    ) -> Result<Self> {
+        if data_rows < 1 || data_cols < 1 {
             return Err(Error::invalid(
                 "grid",
-                format!("an FFT grid needs at least 1x1 points, got {rows}x{cols}"),
+                format!("an FFT grid needs at least 1x1 points, got {data_rows}x{data_cols}"),
+            ));
+        }
+        if rows < data_rows || cols < data_cols {
+            return Err(Error::invalid(
+                "grid",
+                format!(
+                    "a {rows}x{cols} transform cannot hold a {data_rows}x{data_cols} data block"
+                ),
             ));
         }
         let half = cols / 2 + 1;
-        let work_len = rows.checked_mul(half).ok_or_else(|| Error::OutOfMemory {
-            what: format!("the FFT buffer of a {rows}x{cols} grid"),
-            needed_mib: None,
-            available_mib: None,
-            limited_by: "the address space".into(),
-        })?;
-        let work = try_vec(
-            &format!("the FFT buffer of a {rows}x{cols} grid"),
-            work_len,
-            Complex64::default(),
-        )?;
+        let what = format!("the FFT buffer of a {rows}x{cols} grid");
+        let work_len = data_rows
+            .checked_mul(half)
+            .ok_or_else(|| Error::OutOfMemory {
+                what: what.clone(),
+                needed_mib: None,
+                available_mib: None,
+                limited_by: "the address space".into(),
+            })?;
+        let work = try_vec(&what, work_len, Complex64::default())?;
         let mut real_planner = RealFftPlanner::<f64>::new();
         let r2c = real_planner.plan_fft_forward(cols);
         let c2r = real_planner.plan_fft_inverse(cols);
@@ -85,6 +122,8 @@ impl RealFft2 {
         Ok(RealFft2 {
             rows,
             cols,
+            data_rows,
+            data_cols,
             r2c,
             c2r,
             col_forward,
@@ -94,14 +133,24 @@ impl RealFft2 {
         })
     }
 
-    /// Number of rows of the real grid.
+    /// Number of rows of the transform grid.
     pub fn rows(&self) -> usize {
         self.rows
     }
 
-    /// Number of columns of the real grid.
+    /// Number of columns of the transform grid.
     pub fn cols(&self) -> usize {
         self.cols
+    }
+
+    /// Rows of the data block (`rows` unless zero-padded).
+    pub fn data_rows(&self) -> usize {
+        self.data_rows
+    }
+
+    /// Columns of the data block (`cols` unless zero-padded).
+    pub fn data_cols(&self) -> usize {
+        self.data_cols
     }
 
     /// Number of `kx` values kept, `cols/2 + 1` (rows of the transposed spectrum).
@@ -114,70 +163,210 @@ impl RealFft2 {
         self.half_cols() * self.rows
     }
 
-    fn rows_per_lane(&self, total_rows: usize) -> usize {
-        total_rows.div_ceil(self.lanes.len()).max(1)
+    fn check_lengths(&self, real: &[f64], spectrum: &[Complex64]) {
+        assert_eq!(
+            real.len(),
+            self.data_rows * self.data_cols,
+            "real grid length"
+        );
+        assert_eq!(spectrum.len(), self.spectrum_len(), "spectrum length");
     }
 
-    /// Forward transform of `input` (`rows × cols`, row-major) into `spectrum`
-    /// (transposed half spectrum, `(cols/2+1) × rows`).
+    /// Forward transform of `input` (the `data_rows × data_cols` block, row-major; the
+    /// whole grid unless zero-padded) into `spectrum` (transposed half spectrum,
+    /// `(cols/2+1) × rows`).
     pub fn forward(&mut self, input: &[f64], spectrum: &mut [Complex64]) {
-        let (rows, cols, half) = (self.rows, self.cols, self.half_cols());
-        assert_eq!(input.len(), rows * cols, "input length");
-        assert_eq!(spectrum.len(), half * rows, "spectrum length");
-        let chunk = self.rows_per_lane(rows);
+        self.check_lengths(input, spectrum);
+        self.forward_rows(input);
+        transpose_into_columns(
+            &self.work,
+            spectrum,
+            self.data_rows,
+            self.half_cols(),
+            self.rows,
+        );
+        let fft = &self.col_forward;
+        for_each_column(
+            spectrum,
+            self.rows,
+            &mut self.lanes,
+            |_, column, scratch| fft.process_with_scratch(column, scratch),
+        );
+    }
+
+    /// Inverse transform of a transposed half `spectrum` (overwritten) into `output` (the
+    /// `data_rows × data_cols` block; the whole grid unless zero-padded). The imaginary
+    /// parts that a real signal cannot have (at `kx = 0` and, for even `cols`,
+    /// `kx = cols/2`) are dropped.
+    pub fn inverse(&mut self, spectrum: &mut [Complex64], output: &mut [f64]) {
+        self.check_lengths(output, spectrum);
+        let fft = &self.col_inverse;
+        for_each_column(
+            spectrum,
+            self.rows,
+            &mut self.lanes,
+            |_, column, scratch| fft.process_with_scratch(column, scratch),
+        );
+        let half = self.half_cols();
+        transpose_from_columns(spectrum, &mut self.work, self.data_rows, half, self.rows);
+        self.inverse_rows(output);
+    }
+
+    /// `output = inverse(filter(forward(input)))` with the column passes fused: every
+    /// `kx` column of the spectrum is transformed forward, handed to `filter(kx, column)`
+    /// (all `rows` values of `ky`) and transformed back before the next. `spectrum` is the
+    /// scratch spectrum (overwritten); `input` and `output` are data blocks.
+    pub fn convolve<F>(
+        &mut self,
+        input: &[f64],
+        spectrum: &mut [Complex64],
+        output: &mut [f64],
+        filter: F,
+    ) where
+        F: Fn(usize, &mut [Complex64]) + Sync,
+    {
+        self.check_lengths(input, spectrum);
+        self.check_lengths(output, spectrum);
+        self.forward_rows(input);
+        transpose_into_columns(
+            &self.work,
+            spectrum,
+            self.data_rows,
+            self.half_cols(),
+            self.rows,
+        );
+        let (forward, backward) = (&self.col_forward, &self.col_inverse);
+        for_each_column(
+            spectrum,
+            self.rows,
+            &mut self.lanes,
+            |kx, column, scratch| {
+                forward.process_with_scratch(column, scratch);
+                filter(kx, column);
+                backward.process_with_scratch(column, scratch);
+            },
+        );
+        let half = self.half_cols();
+        transpose_from_columns(spectrum, &mut self.work, self.data_rows, half, self.rows);
+        self.inverse_rows(output);
+    }
+
+    /// Forward transform of a whole `rows × cols` grid (padding included) whose rows are
+    /// produced by `row(r, buffer)`, which must fill all `cols` values: for inputs that fill
+    /// the transform grid but need not be stored, such as a sampled convolution kernel. Rows
+    /// are generated and transformed in parallel, `data_rows` at a time (the work buffer's
+    /// capacity), and scattered into the columns; the result does not depend on the thread
+    /// count.
+    pub fn forward_rows_from<G>(&mut self, row: G, spectrum: &mut [Complex64])
+    where
+        G: Fn(usize, &mut [f64]) + Sync,
+    {
+        let (rows, half) = (self.rows, self.half_cols());
+        assert_eq!(spectrum.len(), self.spectrum_len(), "spectrum length");
+        for first in (0..rows).step_by(self.data_rows) {
+            let count = self.data_rows.min(rows - first);
+            let chunk = per_lane(count, self.lanes.len());
+            let r2c = &self.r2c;
+            self.work[..count * half]
+                .par_chunks_mut(chunk * half)
+                .enumerate()
+                .zip(self.lanes.par_iter_mut())
+                .for_each(|((block, out), lane)| {
+                    for (i, row_out) in out.chunks_exact_mut(half).enumerate() {
+                        row(first + block * chunk + i, &mut lane.real);
+                        r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
+                            .expect("buffer sizes are fixed at planning");
+                    }
+                });
+            let work = &self.work;
+            spectrum
+                .par_chunks_mut(rows)
+                .enumerate()
+                .for_each(|(kx, column)| {
+                    for (i, value) in column[first..first + count].iter_mut().enumerate() {
+                        *value = work[i * half + kx];
+                    }
+                });
+        }
+        let fft = &self.col_forward;
+        for_each_column(spectrum, rows, &mut self.lanes, |_, column, scratch| {
+            fft.process_with_scratch(column, scratch)
+        });
+    }
+
+    /// Real transforms of the `data_rows` input rows (zero-extended to `cols`) into `work`.
+    fn forward_rows(&mut self, input: &[f64]) {
+        let (data_cols, half) = (self.data_cols, self.half_cols());
+        let chunk = per_lane(self.data_rows, self.lanes.len());
         let r2c = &self.r2c;
         input
-            .par_chunks(chunk * cols)
+            .par_chunks(chunk * data_cols)
             .zip(self.work.par_chunks_mut(chunk * half))
             .zip(self.lanes.par_iter_mut())
             .for_each(|((inp, out), lane)| {
-                for (row_in, row_out) in inp.chunks_exact(cols).zip(out.chunks_exact_mut(half)) {
-                    lane.real.copy_from_slice(row_in);
+                for (row_in, row_out) in inp.chunks_exact(data_cols).zip(out.chunks_exact_mut(half))
+                {
+                    // The transform uses its input as scratch: refill the zeros every row.
+                    lane.real[..data_cols].copy_from_slice(row_in);
+                    lane.real[data_cols..].fill(0.0);
                     r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
                         .expect("buffer sizes are fixed at planning");
                 }
             });
-        transpose(&self.work, spectrum, rows, half);
-        let chunk = self.rows_per_lane(half);
-        let fft = &self.col_forward;
-        spectrum
-            .par_chunks_mut(chunk * rows)
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|(block, lane)| fft.process_with_scratch(block, &mut lane.scratch));
     }
 
-    /// Inverse transform of a transposed half `spectrum` (overwritten) into `output`
-    /// (`rows × cols`). The imaginary parts that a real signal cannot have (at `kx = 0` and,
-    /// for even `cols`, `kx = cols/2`) are dropped.
-    pub fn inverse(&mut self, spectrum: &mut [Complex64], output: &mut [f64]) {
-        let (rows, cols, half) = (self.rows, self.cols, self.half_cols());
-        assert_eq!(output.len(), rows * cols, "output length");
-        assert_eq!(spectrum.len(), half * rows, "spectrum length");
-        let chunk = self.rows_per_lane(half);
-        let fft = &self.col_inverse;
-        spectrum
-            .par_chunks_mut(chunk * rows)
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|(block, lane)| fft.process_with_scratch(block, &mut lane.scratch));
-        transpose(spectrum, &mut self.work, half, rows);
-        let chunk = self.rows_per_lane(rows);
+    /// Inverse real transforms of the `data_rows` rows in `work`, cropped to `data_cols`.
+    fn inverse_rows(&mut self, output: &mut [f64]) {
+        let (cols, data_cols, half) = (self.cols, self.data_cols, self.half_cols());
+        let chunk = per_lane(self.data_rows, self.lanes.len());
         let c2r = &self.c2r;
         self.work
             .par_chunks_mut(chunk * half)
-            .zip(output.par_chunks_mut(chunk * cols))
+            .zip(output.par_chunks_mut(chunk * data_cols))
             .zip(self.lanes.par_iter_mut())
             .for_each(|((inp, out), lane)| {
-                for (row_in, row_out) in inp.chunks_exact_mut(half).zip(out.chunks_exact_mut(cols))
+                for (row_in, row_out) in inp
+                    .chunks_exact_mut(half)
+                    .zip(out.chunks_exact_mut(data_cols))
                 {
                     row_in[0].im = 0.0;
                     if cols % 2 == 0 {
                         row_in[half - 1].im = 0.0;
                     }
-                    c2r.process_with_scratch(row_in, row_out, &mut lane.scratch)
-                        .expect("buffer sizes are fixed at planning");
+                    if data_cols == cols {
+                        c2r.process_with_scratch(row_in, row_out, &mut lane.scratch)
+                            .expect("buffer sizes are fixed at planning");
+                    } else {
+                        c2r.process_with_scratch(row_in, &mut lane.real, &mut lane.scratch)
+                            .expect("buffer sizes are fixed at planning");
+                        row_out.copy_from_slice(&lane.real[..data_cols]);
+                    }
                 }
             });
     }
+}
+
+/// Rows per lane when `total` rows are shared among `lanes` lanes.
+fn per_lane(total: usize, lanes: usize) -> usize {
+    total.div_ceil(lanes.max(1)).max(1)
+}
+
+/// Runs `f(kx, column, scratch)` on every `rows`-long column of the transposed `spectrum`,
+/// the columns shared among the lanes in contiguous blocks.
+fn for_each_column<F>(spectrum: &mut [Complex64], rows: usize, lanes: &mut [Lane], f: F)
+where
+    F: Fn(usize, &mut [Complex64], &mut [Complex64]) + Sync,
+{
+    let chunk = per_lane(spectrum.len() / rows, lanes.len());
+    spectrum
+        .par_chunks_mut(chunk * rows)
+        .enumerate()
+        .zip(lanes.par_iter_mut())
+        .for_each(|((block_index, block), lane)| {
+            for (i, column) in block.chunks_exact_mut(rows).enumerate() {
+                f(block_index * chunk + i, column, &mut lane.scratch);
+            }
+        });
 }
 
 /// Blocked parallel transpose of a row-major `rows × cols` matrix into `cols × rows`.
@@ -197,6 +386,73 @@ pub fn transpose<T: Copy + Send + Sync>(input: &[T], output: &mut [T], rows: usi
                     let out_row = &mut out_block[dc * rows..(dc + 1) * rows];
                     for r in r0..r1 {
                         out_row[r] = input[r * cols + c0 + dc];
+                    }
+                }
+            }
+        });
+}
+
+/// `work` (`rows × half`, row-major) into `spectrum` (`half × padded_rows`): column `kx`
+/// gets the `rows` values followed by zeros.
+fn transpose_into_columns(
+    work: &[Complex64],
+    spectrum: &mut [Complex64],
+    rows: usize,
+    half: usize,
+    padded_rows: usize,
+) {
+    if rows == padded_rows {
+        transpose(work, spectrum, rows, half);
+        return;
+    }
+    const BLOCK: usize = 16;
+    spectrum
+        .par_chunks_mut(BLOCK * padded_rows)
+        .enumerate()
+        .for_each(|(block_index, out_block)| {
+            let kx0 = block_index * BLOCK;
+            let block_cols = out_block.len() / padded_rows;
+            for r0 in (0..rows).step_by(BLOCK) {
+                let r1 = (r0 + BLOCK).min(rows);
+                for dk in 0..block_cols {
+                    let column = &mut out_block[dk * padded_rows..(dk + 1) * padded_rows];
+                    for r in r0..r1 {
+                        column[r] = work[r * half + kx0 + dk];
+                    }
+                }
+            }
+            for dk in 0..block_cols {
+                out_block[dk * padded_rows + rows..(dk + 1) * padded_rows]
+                    .fill(Complex64::default());
+            }
+        });
+}
+
+/// The first `rows` values of every column of `spectrum` (`half × padded_rows`) back into
+/// `work` (`rows × half`).
+fn transpose_from_columns(
+    spectrum: &[Complex64],
+    work: &mut [Complex64],
+    rows: usize,
+    half: usize,
+    padded_rows: usize,
+) {
+    if rows == padded_rows {
+        transpose(spectrum, work, half, rows);
+        return;
+    }
+    const BLOCK: usize = 16;
+    work.par_chunks_mut(BLOCK * half)
+        .enumerate()
+        .for_each(|(block_index, out_block)| {
+            let r0 = block_index * BLOCK;
+            let block_rows = out_block.len() / half;
+            for k0 in (0..half).step_by(BLOCK) {
+                let k1 = (k0 + BLOCK).min(half);
+                for dr in 0..block_rows {
+                    let row = &mut out_block[dr * half..(dr + 1) * half];
+                    for kx in k0..k1 {
+                        row[kx] = spectrum[kx * padded_rows + r0 + dr];
                     }
                 }
             }
@@ -265,6 +521,167 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `data` (`data_rows × data_cols`) at the top-left corner of a zero `rows × cols` grid.
+    fn embed(
+        data: &[f64],
+        data_rows: usize,
+        data_cols: usize,
+        rows: usize,
+        cols: usize,
+    ) -> Vec<f64> {
+        let mut grid = vec![0.0; rows * cols];
+        for r in 0..data_rows {
+            grid[r * cols..r * cols + data_cols]
+                .copy_from_slice(&data[r * data_cols..(r + 1) * data_cols]);
+        }
+        grid
+    }
+
+    const PADDED_SHAPES: [(usize, usize, usize, usize); 5] = [
+        (4, 4, 8, 8),
+        (5, 7, 10, 14),
+        (3, 6, 7, 9),
+        (6, 1, 12, 2),
+        (1, 5, 1, 10),
+    ];
+
+    #[test]
+    fn zero_padded_forward_matches_naive_dft_of_the_padded_grid() {
+        for (data_rows, data_cols, rows, cols) in PADDED_SHAPES {
+            let data = pseudo_random(data_rows * data_cols);
+            let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut spec = vec![Complex64::new(5.0, -2.0); fft.spectrum_len()];
+            fft.forward(&data, &mut spec);
+            let oracle = naive_forward(&embed(&data, data_rows, data_cols, rows, cols), rows, cols);
+            for (a, b) in spec.iter().zip(&oracle) {
+                assert!((a - b).norm() < 1e-12, "{rows}x{cols}: {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn zero_padded_inverse_returns_the_data_block_of_the_full_inverse() {
+        for (data_rows, data_cols, rows, cols) in PADDED_SHAPES {
+            // A full-grid signal (not zero outside the block): its spectrum, inverted by
+            // the pruned transform, gives back the block, scaled by rows·cols.
+            let full = pseudo_random(rows * cols);
+            let mut plain = RealFft2::new(rows, cols).unwrap();
+            let mut spec = vec![Complex64::default(); plain.spectrum_len()];
+            plain.forward(&full, &mut spec);
+            let mut pruned = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut block = vec![f64::NAN; data_rows * data_cols];
+            pruned.inverse(&mut spec, &mut block);
+            let scale = (rows * cols) as f64;
+            for r in 0..data_rows {
+                for c in 0..data_cols {
+                    let (a, b) = (block[r * data_cols + c] / scale, full[r * cols + c]);
+                    assert!((a - b).abs() < 1e-14, "{rows}x{cols} ({r},{c}): {a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn convolve_equals_forward_filter_inverse_and_a_cyclic_direct_sum() {
+        // Filter: multiplication by the spectrum of a kernel k on the padded grid, so the
+        // result is the cyclic convolution k ⊛ embed(x), cropped: checked against the
+        // direct sum and against forward, multiply, inverse done separately.
+        for (data_rows, data_cols, rows, cols) in PADDED_SHAPES {
+            let data = pseudo_random(data_rows * data_cols);
+            let kernel: Vec<f64> = (0..rows * cols)
+                .map(|i| ((i * 31 + 7) % 17) as f64 - 8.0)
+                .collect();
+            let mut plain = RealFft2::new(rows, cols).unwrap();
+            let mut kernel_spec = vec![Complex64::default(); plain.spectrum_len()];
+            plain.forward(&kernel, &mut kernel_spec);
+            let scale = 1.0 / (rows * cols) as f64;
+            let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+            let mut fused = vec![f64::NAN; data_rows * data_cols];
+            fft.convolve(&data, &mut spec, &mut fused, |kx, column| {
+                for (v, k) in column
+                    .iter_mut()
+                    .zip(&kernel_spec[kx * rows..(kx + 1) * rows])
+                {
+                    *v *= k * scale;
+                }
+            });
+            let mut separate = vec![f64::NAN; data_rows * data_cols];
+            fft.forward(&data, &mut spec);
+            for (v, k) in spec.iter_mut().zip(&kernel_spec) {
+                *v *= k * scale;
+            }
+            fft.inverse(&mut spec, &mut separate);
+            let grid = embed(&data, data_rows, data_cols, rows, cols);
+            for r in 0..data_rows {
+                for c in 0..data_cols {
+                    let mut direct = 0.0;
+                    for i in 0..rows {
+                        for j in 0..cols {
+                            let k = kernel[((r + rows - i) % rows) * cols + (c + cols - j) % cols];
+                            direct += k * grid[i * cols + j];
+                        }
+                    }
+                    let got = fused[r * data_cols + c];
+                    assert!(
+                        (got - direct).abs() < 1e-11,
+                        "{rows}x{cols} ({r},{c}): {got} vs {direct}"
+                    );
+                    assert_eq!(got, separate[r * data_cols + c]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rows_from_a_generator_equal_the_forward_transform_of_the_whole_grid() {
+        for (data_rows, data_cols, rows, cols) in PADDED_SHAPES {
+            let full = pseudo_random(rows * cols);
+            let mut plain = RealFft2::new(rows, cols).unwrap();
+            let mut expected = vec![Complex64::default(); plain.spectrum_len()];
+            plain.forward(&full, &mut expected);
+            let mut padded = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut spec = vec![Complex64::new(3.0, 3.0); padded.spectrum_len()];
+            padded.forward_rows_from(
+                |r, row| row.copy_from_slice(&full[r * cols..(r + 1) * cols]),
+                &mut spec,
+            );
+            assert_eq!(spec, expected, "{rows}x{cols}");
+        }
+    }
+
+    #[test]
+    fn padded_results_do_not_depend_on_the_thread_count() {
+        let (data_rows, data_cols) = (19, 23);
+        let data = pseudo_random(data_rows * data_cols);
+        let run = |threads: usize| {
+            crate::test_support::with_threads(threads, || {
+                let mut fft = RealFft2::zero_padded(data_rows, data_cols, 38, 46).unwrap();
+                let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+                let mut out = vec![0.0; data_rows * data_cols];
+                fft.convolve(&data, &mut spec, &mut out, |kx, column| {
+                    column
+                        .iter_mut()
+                        .enumerate()
+                        .for_each(|(ky, v)| *v *= 1.0 / (1.0 + (kx + ky) as f64));
+                });
+                out
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3, 8] {
+            assert_eq!(one, run(threads), "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn bad_shapes_are_refused() {
+        assert!(RealFft2::new(0, 4).is_err());
+        assert!(RealFft2::zero_padded(4, 4, 3, 8).is_err());
+        assert!(RealFft2::zero_padded(4, 5, 8, 4).is_err());
+        assert!(RealFft2::zero_padded(0, 5, 8, 8).is_err());
     }
 
     #[test]

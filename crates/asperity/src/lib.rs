@@ -8,8 +8,9 @@
 //! ## Conventions
 //! * **Units** are the user's: lengths in the unit of the surface, moduli in any unit
 //!   (E* defaults to 1 in the CLI). Forces come out in `E* · length²`.
-//! * **Grids** are row-major, index `(row, col)` = `(y, x)`, square pixels of spacing
-//!   `size / cols`; the side `size` is the length along x.
+//! * **Grids** are row-major, index `(row, col)` = `(y, x)`, pixels of spacing
+//!   `Δx = size / cols` (the side `size` is the length along x) and `Δy = size_y / rows`,
+//!   square unless made with `Surface::with_sizes` (the BEM takes either).
 //! * **Wavenumbers** are given as wavelengths per side, `κ = q L / 2π` (roll-off `κ0 = 6`
 //!   is the paper's Fig. 2).
 //! * **Signs**: heights positive up; the rigid indenter is pushed down into the

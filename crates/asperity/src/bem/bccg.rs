@@ -42,7 +42,7 @@
 
 use super::polonsky_keer::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
-use crate::elastic::{self_influence, Boundary, ElasticOperator};
+use crate::elastic::{Boundary, ElasticOperator};
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -155,7 +155,7 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let self_influence = self_influence(self.operator.spacing(), self.operator.modulus());
+        let self_influence = self.operator.self_influence();
         self.initialise(target, self_influence);
         let mut indentation = match target {
             Target::Indentation(d) => d,

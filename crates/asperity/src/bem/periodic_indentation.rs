@@ -52,7 +52,6 @@
 
 use super::polonsky_keer::{gap_and_direction, ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo, SolverKind};
-use crate::elastic::self_influence;
 
 /// Evaluations of `d(p̄)` after which the root find gives up (bisection alone shrinks the
 /// bracket geometrically; never approached in the tests).
@@ -236,7 +235,7 @@ impl ContactSolver {
             .iter()
             .map(|f| (indentation - f).max(0.0))
             .sum::<f64>()
-            / (n * self_influence(self.operator.spacing(), self.operator.modulus()));
+            / (n * self.operator.self_influence());
 
         let (mut used, mut applications) = (spent, 0);
         for _ in 0..MAX_EVALUATIONS {

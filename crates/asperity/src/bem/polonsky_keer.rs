@@ -29,7 +29,7 @@ use super::{
     ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
     SolverParams,
 };
-use crate::elastic::{self_influence, Boundary, ElasticOperator};
+use crate::elastic::{Boundary, ElasticOperator};
 use crate::surface::Surface;
 use crate::{memory, Error};
 
@@ -109,17 +109,6 @@ impl ContactSolver {
         params: SolverParams,
     ) -> Result<Self, SolveError> {
         validate_params(&params)?;
-        if !surface.has_square_pixels() {
-            return Err(Error::invalid(
-                "surface",
-                format!(
-                    "the BEM needs square pixels for now, got {:.3e} x {:.3e}",
-                    surface.spacing(),
-                    surface.spacing_y()
-                ),
-            )
-            .into());
-        }
         let (rows, cols) = surface.dim();
         memory::ensure_fits(
             &format!(
@@ -128,15 +117,21 @@ impl ContactSolver {
             ),
             Self::memory_bytes(rows, cols, half_space.boundary),
         )?;
-        let operator = ElasticOperator::new(
+        let operator = ElasticOperator::with_spacings(
             rows,
             cols,
             surface.spacing(),
+            surface.spacing_y(),
             half_space.modulus,
             half_space.boundary,
         )?;
-        let preconditioner =
-            FourierPreconditioner::new(rows, cols, surface.spacing(), half_space.modulus)?;
+        let preconditioner = FourierPreconditioner::new(
+            rows,
+            cols,
+            surface.spacing(),
+            surface.spacing_y(),
+            half_space.modulus,
+        )?;
         let mut operator = operator;
         let bccg_scratch = BccgScratch::new(&mut operator);
         let mut profile = Vec::with_capacity(rows * cols);
@@ -167,17 +162,19 @@ impl ContactSolver {
     pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
         if surface.dim() != (self.rows, self.cols)
             || surface.spacing() != self.operator.spacing()
-            || !surface.has_square_pixels()
+            || surface.spacing_y() != self.operator.spacing_y()
         {
             return Err(Error::invalid(
                 "surface",
                 format!(
-                    "the solver was planned for {}x{} points at spacing {}, got {:?} at {}",
+                    "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
                     self.rows,
                     self.cols,
                     self.operator.spacing(),
+                    self.operator.spacing_y(),
                     surface.dim(),
-                    surface.spacing()
+                    surface.spacing(),
+                    surface.spacing_y()
                 ),
             )
             .into());
@@ -206,10 +203,10 @@ impl ContactSolver {
         (self.rows, self.cols)
     }
 
-    /// Nominal (projected) area `rows · cols · Δ²`.
+    /// Nominal (projected) area `rows · cols · Δx · Δy`.
     pub fn nominal_area(&self) -> f64 {
-        let dx = self.operator.spacing();
-        (self.rows * self.cols) as f64 * dx * dx
+        // Multiplied in this order so that square pixels give today's value bit for bit.
+        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
     }
 
     /// Forgets the previous solution: the next solve starts cold.
@@ -369,7 +366,7 @@ impl ContactSolver {
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let n = self.rows * self.cols;
         let load_control = matches!(target, Target::MeanPressure(_));
-        let self_influence = self_influence(self.operator.spacing(), self.operator.modulus());
+        let self_influence = self.operator.self_influence();
         self.initialise(target, self_influence);
         let mut indentation = match target {
             Target::Indentation(d) => d,

@@ -46,15 +46,15 @@ impl FourierPreconditioner {
         memory::array_bytes(&[3, rows, cols], 8)
     }
 
-    /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of square
-    /// pixels `spacing` on a half-space of modulus `modulus`.
-    pub(super) fn new(rows: usize, cols: usize, spacing: f64, modulus: f64) -> Result<Self> {
+    /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of pixels
+    /// `dx × dy` on a half-space of modulus `modulus`.
+    pub(super) fn new(rows: usize, cols: usize, dx: f64, dy: f64, modulus: f64) -> Result<Self> {
         let fft = RealFft2::new(rows, cols)?;
         let (half, len) = (fft.half_cols(), fft.spectrum_len());
         let mut symbol = try_vec("the preconditioner's symbol", len, 0.0)?;
         let spectrum = try_vec("the preconditioner's spectrum", len, Complex64::default())?;
-        let qx_unit = 2.0 * PI / (cols as f64 * spacing);
-        let qy_unit = 2.0 * PI / (rows as f64 * spacing);
+        let qx_unit = 2.0 * PI / (cols as f64 * dx);
+        let qy_unit = 2.0 * PI / (rows as f64 * dy);
         let q_lowest = qx_unit.min(qy_unit);
         let normalisation = 1.0 / (rows * cols) as f64;
         for kx in 0..half {
@@ -93,7 +93,7 @@ mod tests {
         // exactly 2/(E*|q|)): a zero-mean random field comes back to rounding.
         let (rows, cols, dx, modulus) = (24, 30, 0.1, 1.7);
         let mut op = ElasticOperator::new(rows, cols, dx, modulus, Boundary::Periodic).unwrap();
-        let mut m = FourierPreconditioner::new(rows, cols, dx, modulus).unwrap();
+        let mut m = FourierPreconditioner::new(rows, cols, dx, dx, modulus).unwrap();
         let mut state = 12345u64;
         let mut p: Vec<f64> = (0..rows * cols)
             .map(|_| {

@@ -212,8 +212,8 @@ impl ContactSolver {
             tolerance,
             max_iterations,
         );
-        let dx = self.operator.spacing();
-        let stiffness = work.x.iter().sum::<f64>() * dx * dx;
+        let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
+        let stiffness = work.x.iter().sum::<f64>() * dx * dy;
         self.stiffness_work = Some(work);
         result.map(|info| (stiffness, info))
     }

@@ -15,5 +15,5 @@
 pub mod love;
 pub mod operator;
 
-pub use love::{love_pixel_displacement, self_influence};
+pub use love::{love_pixel_displacement, rectangle_self_influence, self_influence};
 pub use operator::{Boundary, ElasticOperator};

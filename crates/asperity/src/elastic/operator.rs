@@ -1,21 +1,27 @@
 //! [`ElasticOperator`]: the surface displacement `u = K * p` of an elastic half-space under a
-//! pixel-wise uniform pressure `p`, computed by real FFTs.
+//! pixel-wise uniform pressure `p`, computed by real FFTs with [`RealFft2`], the crate's one
+//! 2D FFT engine.
+//!
+//! Pixels are rectangles `Δx × Δy` (columns run along x, rows along y); square pixels are
+//! the case `Δx = Δy` ([`ElasticOperator::new`]).
 //!
 //! **Free boundaries** (the paper's choice, *Methods*): the `rows × cols` grid is embedded in
 //! a zero-padded `2·rows × 2·cols` grid and convolved cyclically with Love's pixel
-//! coefficients ([`love_pixel_displacement`]) sampled at offsets `−rows+1 … rows−1`; the
-//! padding keeps every periodic image out of the result, which equals the direct
-//! summation `u_i = Σ_j K(x_i − x_j) p_j` to rounding (Hockney 1970; Liu, Wang & Liu,
-//! Wear 243, 2000).
+//! coefficients ([`love_pixel_displacement`], uniform pressure on a `Δx × Δy` rectangle)
+//! sampled at offsets `−rows+1 … rows−1` (times Δy) and `−cols+1 … cols−1` (times Δx); the
+//! padding keeps every periodic image out of the result, which equals the direct summation
+//! `u_i = Σ_j K(x_i − x_j) p_j` to rounding (Hockney 1970; Liu, Wang & Liu, Wear 243, 2000).
 //!
-//! **Periodic boundaries**: the grid is one period; the kernel is the half-space Green's
-//! function in Fourier space, `û(q) = 2 p̂(q) / (E* |q|)` (Stanley & Kato 1997), with the
-//! mean (`q = 0`) mode of `u` set to zero: a periodic surface under a mean pressure sinks
-//! without bound, so displacements are measured from their mean.
+//! **Periodic boundaries**: the grid is one period `cols·Δx × rows·Δy`; the kernel is the
+//! half-space Green's function in Fourier space, `û(q) = 2 p̂(q) / (E* |q|)` (Stanley & Kato
+//! 1997) with `q = (2π kx / (cols·Δx), 2π ky / (rows·Δy))`, and the mean (`q = 0`) mode of
+//! `u` set to zero: a periodic surface under a mean pressure sinks without bound, so
+//! displacements are measured from their mean.
 //!
 //! Both kernels are even in x and in y, so their spectra are **real and even**: only the
 //! `(cols_padded/2 + 1) × (rows_padded/2 + 1)` unique values are stored, as `f64`, with the
-//! `1/(rows·cols)` normalisation folded in. One `apply` runs
+//! `1/(rows·cols)` normalisation folded in. One `apply` is one pruned, fused
+//! [`RealFft2::convolve`] of the padded grid:
 //! * `rows` real row transforms of length `cols_padded` (rows of zero padding are skipped),
 //! * one fused pass per kept column: forward FFT, multiplication by the kernel, inverse FFT,
 //! * `rows` inverse real row transforms (only the rows that are returned).
@@ -25,15 +31,11 @@
 //! number of threads (every row and column transform is independent).
 
 use std::f64::consts::PI;
-use std::sync::Arc;
 
 use num_complex::Complex64;
-use rayon::prelude::*;
-use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
-use rustfft::{Fft, FftPlanner};
 
-use super::love::love_pixel_displacement;
-use crate::fft::transpose;
+use super::love::{love_pixel_displacement, rectangle_self_influence, self_influence};
+use crate::fft::RealFft2;
 use crate::{memory, Error, Result};
 
 /// Boundary conditions of the half-space grid.
@@ -55,7 +57,7 @@ impl Boundary {
     }
 
     /// Padding factor per direction: 2 for free boundaries, 1 for periodic.
-    fn padding(&self) -> usize {
+    pub fn padding(&self) -> usize {
         match self {
             Boundary::Free => 2,
             Boundary::Periodic => 1,
@@ -77,32 +79,32 @@ impl std::str::FromStr for Boundary {
     }
 }
 
-struct Lane {
-    real: Vec<f64>,
-    scratch: Vec<Complex64>,
-}
-
 /// The half-space convolution operator of one grid (see the module docs).
 pub struct ElasticOperator {
     rows: usize,
     cols: usize,
-    padded_rows: usize,
-    padded_cols: usize,
-    spacing: f64,
+    spacing_x: f64,
+    spacing_y: f64,
     modulus: f64,
     boundary: Boundary,
-    r2c: Arc<dyn RealToComplex<f64>>,
-    c2r: Arc<dyn ComplexToReal<f64>>,
-    column_forward: Arc<dyn Fft<f64>>,
-    column_inverse: Arc<dyn Fft<f64>>,
+    /// The padded (free) or plain (periodic) transform of the grid.
+    fft: RealFft2,
     /// Unique values of the real, even kernel spectrum, `half_cols × kernel_rows`,
     /// normalised by `1/(padded_rows · padded_cols)`.
     kernel: Vec<f64>,
     /// Transposed half spectrum, `half_cols × padded_rows`.
     spectrum: Vec<Complex64>,
-    /// Row-pass results of the `rows` data rows, `rows × half_cols`.
-    work: Vec<Complex64>,
-    lanes: Vec<Lane>,
+}
+
+fn check_positive(name: &'static str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            name,
+            format!("must be positive and finite, got {value}"),
+        ))
+    }
 }
 
 impl ElasticOperator {
@@ -127,24 +129,29 @@ impl ElasticOperator {
         modulus: f64,
         boundary: Boundary,
     ) -> Result<Self> {
+        Self::with_spacings(rows, cols, spacing, spacing, modulus, boundary)
+    }
+
+    /// Plans the operator of a `rows × cols` grid of rectangular pixels, `spacing_x` along
+    /// the columns (x) by `spacing_y` along the rows (y), on a half-space of effective
+    /// modulus `modulus` (E*). With equal spacings this is [`ElasticOperator::new`].
+    pub fn with_spacings(
+        rows: usize,
+        cols: usize,
+        spacing_x: f64,
+        spacing_y: f64,
+        modulus: f64,
+        boundary: Boundary,
+    ) -> Result<Self> {
         if rows < 1 || cols < 1 {
             return Err(Error::invalid(
                 "grid",
                 format!("need at least 1x1 points, got {rows}x{cols}"),
             ));
         }
-        if !(spacing.is_finite() && spacing > 0.0) {
-            return Err(Error::invalid(
-                "spacing",
-                format!("must be positive and finite, got {spacing}"),
-            ));
-        }
-        if !(modulus.is_finite() && modulus > 0.0) {
-            return Err(Error::invalid(
-                "modulus",
-                format!("must be positive and finite, got {modulus}"),
-            ));
-        }
+        check_positive("spacing", spacing_x)?;
+        check_positive("spacing_y", spacing_y)?;
+        check_positive("modulus", modulus)?;
         memory::ensure_fits(
             &format!(
                 "the {} elastic operator of a {rows}x{cols} grid",
@@ -153,45 +160,23 @@ impl ElasticOperator {
             Self::memory_bytes(rows, cols, boundary),
         )?;
         let pad = boundary.padding();
-        let (padded_rows, padded_cols) = (rows * pad, cols * pad);
-        let half_cols = padded_cols / 2 + 1;
-        let mut real_planner = RealFftPlanner::<f64>::new();
-        let r2c = real_planner.plan_fft_forward(padded_cols);
-        let c2r = real_planner.plan_fft_inverse(padded_cols);
-        let mut planner = FftPlanner::<f64>::new();
-        let column_forward = planner.plan_fft_forward(padded_rows);
-        let column_inverse = planner.plan_fft_inverse(padded_rows);
-        let scratch_len = [
-            r2c.get_scratch_len(),
-            c2r.get_scratch_len(),
-            column_forward.get_inplace_scratch_len(),
-            column_inverse.get_inplace_scratch_len(),
-        ]
-        .into_iter()
-        .max()
-        .unwrap_or(0);
-        let lanes = (0..rayon::current_num_threads().max(1))
-            .map(|_| Lane {
-                real: vec![0.0; padded_cols],
-                scratch: vec![Complex64::default(); scratch_len],
-            })
-            .collect();
+        let fft = RealFft2::zero_padded(rows, cols, rows * pad, cols * pad)?;
+        let (kernel_len, spectrum_len) =
+            (fft.half_cols() * (fft.rows() / 2 + 1), fft.spectrum_len());
         let mut operator = ElasticOperator {
             rows,
             cols,
-            padded_rows,
-            padded_cols,
-            spacing,
+            spacing_x,
+            spacing_y,
             modulus,
             boundary,
-            r2c,
-            c2r,
-            column_forward,
-            column_inverse,
-            kernel: vec![0.0; half_cols * (padded_rows / 2 + 1)],
-            spectrum: vec![Complex64::default(); half_cols * padded_rows],
-            work: vec![Complex64::default(); rows * half_cols],
-            lanes,
+            fft,
+            kernel: memory::try_vec("the elastic kernel's spectrum", kernel_len, 0.0)?,
+            spectrum: memory::try_vec(
+                "the elastic operator's spectrum",
+                spectrum_len,
+                Complex64::default(),
+            )?,
         };
         match boundary {
             Boundary::Free => operator.fill_free_kernel(),
@@ -210,9 +195,19 @@ impl ElasticOperator {
         self.cols
     }
 
-    /// Pixel side Δ.
+    /// Pixel side along x (columns), Δx; the pixel side for square pixels.
     pub fn spacing(&self) -> f64 {
-        self.spacing
+        self.spacing_x
+    }
+
+    /// Pixel side along y (rows), Δy.
+    pub fn spacing_y(&self) -> f64 {
+        self.spacing_y
+    }
+
+    /// Area of one pixel, `Δx · Δy`.
+    pub fn pixel_area(&self) -> f64 {
+        self.spacing_x * self.spacing_y
     }
 
     /// Effective modulus E*.
@@ -225,20 +220,31 @@ impl ElasticOperator {
         self.boundary
     }
 
-    fn half_cols(&self) -> usize {
-        self.padded_cols / 2 + 1
+    /// Displacement at a pixel's centre per unit pressure on it, Love's value for a
+    /// `Δx × Δy` rectangle ([`rectangle_self_influence`]; for square pixels exactly
+    /// [`self_influence`]).
+    pub fn self_influence(&self) -> f64 {
+        if self.spacing_x == self.spacing_y {
+            self_influence(self.spacing_x, self.modulus)
+        } else {
+            rectangle_self_influence(self.spacing_x, self.spacing_y, self.modulus)
+        }
+    }
+
+    fn padded_rows(&self) -> usize {
+        self.fft.rows()
     }
 
     fn kernel_rows(&self) -> usize {
-        self.padded_rows / 2 + 1
+        self.padded_rows() / 2 + 1
     }
 
-    /// Spectrum of Love's coefficients sampled on the padded grid. Built row by row with the
-    /// operator's own plans and buffers: each padded row's real transform is real (the row
-    /// is even), the columns are then transformed in place.
+    /// Spectrum of Love's coefficients sampled on the padded grid, row by row in parallel
+    /// (the samples are never stored): each padded row's real transform is real (the row is
+    /// even), so the real parts of the column transforms are the whole kernel.
     fn fill_free_kernel(&mut self) {
-        let (prow, pcol, half) = (self.padded_rows, self.padded_cols, self.half_cols());
-        let (dx, e) = (self.spacing, self.modulus);
+        let (prow, pcol) = (self.fft.rows(), self.fft.cols());
+        let (dx, dy, e) = (self.spacing_x, self.spacing_y, self.modulus);
         let kernel_rows = self.kernel_rows();
         let offset = |m: usize, n: usize| {
             if m <= n / 2 {
@@ -247,38 +253,39 @@ impl ElasticOperator {
                 m as f64 - n as f64
             }
         };
-        let lane = &mut self.lanes[0];
-        let mut row_out = vec![Complex64::default(); half];
-        for r in 0..prow {
-            let y = offset(r, prow) * dx;
-            for (c, value) in lane.real.iter_mut().enumerate() {
-                *value = love_pixel_displacement(offset(c, pcol) * dx, y, dx, dx, e);
-            }
-            self.r2c
-                .process_with_scratch(&mut lane.real, &mut row_out, &mut lane.scratch)
-                .expect("buffer sizes are fixed at planning");
-            for (kx, v) in row_out.iter().enumerate() {
-                self.spectrum[kx * prow + r] = *v;
-            }
-        }
+        self.fft.forward_rows_from(
+            |r, row| {
+                // Even in x: columns past the middle mirror those before it (the kernel
+                // takes |x|, so the values are the same bits).
+                let y = offset(r, prow) * dy;
+                for (c, value) in row[..=pcol / 2].iter_mut().enumerate() {
+                    *value = love_pixel_displacement(offset(c, pcol) * dx, y, dx, dy, e);
+                }
+                for c in pcol / 2 + 1..pcol {
+                    row[c] = row[pcol - c];
+                }
+            },
+            &mut self.spectrum,
+        );
         let scale = 1.0 / (prow * pcol) as f64;
-        for (kx, column) in self.spectrum.chunks_exact_mut(prow).enumerate() {
-            self.column_forward
-                .process_with_scratch(column, &mut lane.scratch);
-            let kernel_column = &mut self.kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
-            for (k, value) in kernel_column.iter_mut().zip(column.iter()) {
+        for (column, kernel_column) in self
+            .spectrum
+            .chunks_exact(prow)
+            .zip(self.kernel.chunks_exact_mut(kernel_rows))
+        {
+            for (k, value) in kernel_column.iter_mut().zip(column) {
                 *k = value.re * scale;
             }
         }
     }
 
-    /// `2 / (E* |q|) / (rows · cols)`, zero at `q = 0`.
+    /// `2 / (E* |q|) / (rows · cols)`, zero at `q = 0`, on the period `cols·Δx × rows·Δy`.
     fn fill_periodic_kernel(&mut self) {
-        let (prow, pcol, half) = (self.padded_rows, self.padded_cols, self.half_cols());
+        let (prow, pcol, half) = (self.fft.rows(), self.fft.cols(), self.fft.half_cols());
         let kernel_rows = self.kernel_rows();
         let scale = 1.0 / (prow * pcol) as f64;
-        let qx_unit = 2.0 * PI / (pcol as f64 * self.spacing);
-        let qy_unit = 2.0 * PI / (prow as f64 * self.spacing);
+        let qx_unit = 2.0 * PI / (pcol as f64 * self.spacing_x);
+        let qy_unit = 2.0 * PI / (prow as f64 * self.spacing_y);
         for kx in 0..half {
             for ky in 0..kernel_rows {
                 let q = (kx as f64 * qx_unit).hypot(ky as f64 * qy_unit);
@@ -294,12 +301,8 @@ impl ElasticOperator {
     /// The kernel's spectrum value at `(kx, ky)` of the padded grid (normalised), for tests
     /// and preconditioners.
     pub fn kernel_spectrum(&self, kx: usize, ky: usize) -> f64 {
-        let ky = ky.min(self.padded_rows - ky);
+        let ky = ky.min(self.padded_rows() - ky);
         self.kernel[kx * self.kernel_rows() + ky]
-    }
-
-    fn rows_per_lane(&self, total: usize) -> usize {
-        total.div_ceil(self.lanes.len()).max(1)
     }
 
     /// `displacement = K * pressure` on the `rows × cols` grid (row-major slices).
@@ -325,159 +328,42 @@ impl ElasticOperator {
         Ok(())
     }
 
-    fn convolve(&mut self, pressure: &[f64], displacement: &mut [f64], inverse: bool) {
-        let (rows, cols) = (self.rows, self.cols);
-        let (prow, pcol, half) = (self.padded_rows, self.padded_cols, self.half_cols());
+    /// One fused, pruned convolution with the kernel (`inverse`: with its pseudo-inverse).
+    fn convolve(&mut self, input: &[f64], output: &mut [f64], inverse: bool) {
+        assert_eq!(input.len(), self.rows * self.cols, "input length");
+        assert_eq!(output.len(), self.rows * self.cols, "output length");
+        let prow = self.padded_rows();
         let kernel_rows = self.kernel_rows();
-        let normalisation = (prow * pcol) as f64;
-        assert_eq!(pressure.len(), rows * cols, "pressure length");
-        assert_eq!(displacement.len(), rows * cols, "displacement length");
-
-        // 1. Real transforms of the data rows (the padding rows are zero: skipped).
-        let chunk = self.rows_per_lane(rows);
-        let r2c = &self.r2c;
-        pressure
-            .par_chunks(chunk * cols)
-            .zip(self.work.par_chunks_mut(chunk * half))
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|((input, output), lane)| {
-                for (row_in, row_out) in input.chunks_exact(cols).zip(output.chunks_exact_mut(half))
-                {
-                    lane.real[..cols].copy_from_slice(row_in);
-                    lane.real[cols..].fill(0.0);
-                    r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
-                        .expect("buffer sizes are fixed at planning");
-                }
-            });
-
-        // 2. Into the transposed spectrum, padding rows zero.
-        transpose_into_columns(&self.work, &mut self.spectrum, rows, half, prow);
-
-        // 3. Per column: forward FFT, multiply by the real kernel, inverse FFT.
-        let chunk = self.rows_per_lane(half);
-        let (forward, backward, kernel) =
-            (&self.column_forward, &self.column_inverse, &self.kernel);
-        self.spectrum
-            .par_chunks_mut(chunk * prow)
-            .enumerate()
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|((block_index, block), lane)| {
-                for (i, column) in block.chunks_exact_mut(prow).enumerate() {
-                    let kx = block_index * chunk + i;
-                    let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
-                    forward.process_with_scratch(column, &mut lane.scratch);
+        let normalisation = (prow * self.fft.cols()) as f64;
+        let kernel = &self.kernel;
+        self.fft
+            .convolve(input, &mut self.spectrum, output, |kx, column| {
+                let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
+                // The spectrum is even in ky: value ky serves ky and prow − ky, so the
+                // column's upper part, read backwards, meets the kernel from ky = 1.
+                let (low, high) = column.split_at_mut(kernel_rows);
+                if inverse {
                     let factor = |k: f64| {
-                        if !inverse {
-                            k
-                        } else if k != 0.0 {
+                        if k != 0.0 {
                             1.0 / (k * normalisation * normalisation)
                         } else {
                             0.0
                         }
                     };
-                    column[0] *= factor(k[0]);
-                    for ky in 1..kernel_rows {
-                        let f = factor(k[ky]);
-                        column[ky] *= f;
-                        if ky < prow - ky {
-                            column[prow - ky] *= f;
-                        }
-                    }
-                    backward.process_with_scratch(column, &mut lane.scratch);
-                }
-            });
-
-        // 4. Back to rows, only the `rows` that are returned.
-        transpose_from_columns(&self.spectrum, &mut self.work, rows, half, prow);
-
-        // 5. Inverse real transforms of the returned rows.
-        let chunk = self.rows_per_lane(rows);
-        let c2r = &self.c2r;
-        self.work
-            .par_chunks_mut(chunk * half)
-            .zip(displacement.par_chunks_mut(chunk * cols))
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|((input, output), lane)| {
-                for (row_in, row_out) in input
-                    .chunks_exact_mut(half)
-                    .zip(output.chunks_exact_mut(cols))
-                {
-                    row_in[0].im = 0.0;
-                    if pcol % 2 == 0 {
-                        row_in[half - 1].im = 0.0;
-                    }
-                    c2r.process_with_scratch(row_in, &mut lane.real, &mut lane.scratch)
-                        .expect("buffer sizes are fixed at planning");
-                    row_out.copy_from_slice(&lane.real[..cols]);
+                    low.iter_mut().zip(k).for_each(|(v, &k)| *v *= factor(k));
+                    high.iter_mut()
+                        .rev()
+                        .zip(&k[1..])
+                        .for_each(|(v, &k)| *v *= factor(k));
+                } else {
+                    low.iter_mut().zip(k).for_each(|(v, &k)| *v *= k);
+                    high.iter_mut()
+                        .rev()
+                        .zip(&k[1..])
+                        .for_each(|(v, &k)| *v *= k);
                 }
             });
     }
-}
-
-/// `work` (`rows × half`, row-major) into `spectrum` (`half × padded_rows`): column `kx`
-/// gets the `rows` values followed by zeros.
-fn transpose_into_columns(
-    work: &[Complex64],
-    spectrum: &mut [Complex64],
-    rows: usize,
-    half: usize,
-    padded_rows: usize,
-) {
-    if rows == padded_rows {
-        transpose(work, spectrum, rows, half);
-        return;
-    }
-    const BLOCK: usize = 16;
-    spectrum
-        .par_chunks_mut(BLOCK * padded_rows)
-        .enumerate()
-        .for_each(|(block_index, out_block)| {
-            let kx0 = block_index * BLOCK;
-            let block_cols = out_block.len() / padded_rows;
-            for r0 in (0..rows).step_by(BLOCK) {
-                let r1 = (r0 + BLOCK).min(rows);
-                for dk in 0..block_cols {
-                    let column = &mut out_block[dk * padded_rows..(dk + 1) * padded_rows];
-                    for r in r0..r1 {
-                        column[r] = work[r * half + kx0 + dk];
-                    }
-                }
-            }
-            for dk in 0..block_cols {
-                out_block[dk * padded_rows + rows..(dk + 1) * padded_rows]
-                    .fill(Complex64::default());
-            }
-        });
-}
-
-/// The first `rows` values of every column of `spectrum` back into `work` (`rows × half`).
-fn transpose_from_columns(
-    spectrum: &[Complex64],
-    work: &mut [Complex64],
-    rows: usize,
-    half: usize,
-    padded_rows: usize,
-) {
-    if rows == padded_rows {
-        transpose(spectrum, work, half, rows);
-        return;
-    }
-    const BLOCK: usize = 16;
-    work.par_chunks_mut(BLOCK * half)
-        .enumerate()
-        .for_each(|(block_index, out_block)| {
-            let r0 = block_index * BLOCK;
-            let block_rows = out_block.len() / half;
-            for k0 in (0..half).step_by(BLOCK) {
-                let k1 = (k0 + BLOCK).min(half);
-                for dr in 0..block_rows {
-                    let row = &mut out_block[dr * half..(dr + 1) * half];
-                    for kx in k0..k1 {
-                        row[kx] = spectrum[kx * padded_rows + r0 + dr];
-                    }
-                }
-            }
-        });
 }
 
 #[cfg(test)]
@@ -491,7 +377,7 @@ mod tests {
     }
 
     /// Direct O(N²M²) summation with Love's coefficients: the free-boundary oracle.
-    fn direct_free(p: &[f64], rows: usize, cols: usize, dx: f64, e: f64) -> Vec<f64> {
+    fn direct_free(p: &[f64], rows: usize, cols: usize, (dx, dy): (f64, f64), e: f64) -> Vec<f64> {
         let mut u = vec![0.0; rows * cols];
         for i in 0..rows {
             for j in 0..cols {
@@ -499,8 +385,8 @@ mod tests {
                 for k in 0..rows {
                     for l in 0..cols {
                         let x = (j as f64 - l as f64) * dx;
-                        let y = (i as f64 - k as f64) * dx;
-                        sum += love_pixel_displacement(x, y, dx, dx, e) * p[k * cols + l];
+                        let y = (i as f64 - k as f64) * dy;
+                        sum += love_pixel_displacement(x, y, dx, dy, e) * p[k * cols + l];
                     }
                 }
                 u[i * cols + j] = sum;
@@ -511,7 +397,13 @@ mod tests {
 
     /// Direct periodic oracle: kernel by a naive inverse DFT of 2/(E*|q|), then a cyclic
     /// direct sum.
-    fn direct_periodic(p: &[f64], rows: usize, cols: usize, dx: f64, e: f64) -> Vec<f64> {
+    fn direct_periodic(
+        p: &[f64],
+        rows: usize,
+        cols: usize,
+        (dx, dy): (f64, f64),
+        e: f64,
+    ) -> Vec<f64> {
         let mut kernel = vec![0.0; rows * cols];
         for (idx, value) in kernel.iter_mut().enumerate() {
             let (y, x) = (idx / cols, idx % cols);
@@ -529,7 +421,7 @@ mod tests {
                         ky as f64 - rows as f64
                     };
                     let q = (2.0 * PI * sx / (cols as f64 * dx))
-                        .hypot(2.0 * PI * sy / (rows as f64 * dx));
+                        .hypot(2.0 * PI * sy / (rows as f64 * dy));
                     if q > 0.0 {
                         let phase = 2.0
                             * PI
@@ -575,7 +467,7 @@ mod tests {
             // Twice, with dirty buffers in between: apply must not depend on leftovers.
             for _ in 0..2 {
                 op.apply(&p, &mut u);
-                assert_close(&u, &direct_free(&p, rows, cols, dx, e), 1e-13, "free");
+                assert_close(&u, &direct_free(&p, rows, cols, (dx, dx), e), 1e-13, "free");
             }
         }
     }
@@ -591,12 +483,103 @@ mod tests {
                 op.apply(&p, &mut u);
                 assert_close(
                     &u,
-                    &direct_periodic(&p, rows, cols, dx, e),
+                    &direct_periodic(&p, rows, cols, (dx, dx), e),
                     1e-12,
                     "periodic",
                 );
             }
         }
+    }
+
+    #[test]
+    fn rectangular_pixels_match_direct_summation_free_and_periodic() {
+        // Δx ≠ Δy, both orientations, even, odd and non-square grids: the FFT operator
+        // equals the direct sums with Love's rectangle coefficients (free) and with the
+        // q-grid 2π(kx/(cols Δx), ky/(rows Δy)) (periodic).
+        for (rows, cols) in [(8, 8), (7, 9), (10, 5)] {
+            for spacings in [(0.3, 0.15), (0.2, 0.5), (1.0, 2.0 / 3.0)] {
+                let (dx, dy) = spacings;
+                let p = pseudo_random(rows * cols, rows * cols);
+                let mut u = vec![f64::NAN; rows * cols];
+                let mut free =
+                    ElasticOperator::with_spacings(rows, cols, dx, dy, 1.7, Boundary::Free)
+                        .unwrap();
+                free.apply(&p, &mut u);
+                let direct = direct_free(&p, rows, cols, spacings, 1.7);
+                assert_close(&u, &direct, 1e-13, "free, rectangular pixels");
+                let mut periodic =
+                    ElasticOperator::with_spacings(rows, cols, dx, dy, 1.7, Boundary::Periodic)
+                        .unwrap();
+                periodic.apply(&p, &mut u);
+                let direct = direct_periodic(&p, rows, cols, spacings, 1.7);
+                assert_close(&u, &direct, 1e-12, "periodic, rectangular pixels");
+            }
+        }
+    }
+
+    #[test]
+    fn equal_spacings_are_the_square_pixel_operator() {
+        // `with_spacings(Δ, Δ)` and `new(Δ)` give identical bits, and a rectangular pixel
+        // 1e-9 away from square changes u by O(1e-9) only (no special case hides a jump).
+        let (rows, cols, dx) = (9, 14, 0.37);
+        let p = pseudo_random(rows * cols, 2);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let mut square = ElasticOperator::new(rows, cols, dx, 1.1, boundary).unwrap();
+            let mut same =
+                ElasticOperator::with_spacings(rows, cols, dx, dx, 1.1, boundary).unwrap();
+            let mut near =
+                ElasticOperator::with_spacings(rows, cols, dx, dx * (1.0 + 1e-9), 1.1, boundary)
+                    .unwrap();
+            let (mut a, mut b, mut c) =
+                (vec![0.0; p.len()], vec![0.0; p.len()], vec![0.0; p.len()]);
+            square.apply(&p, &mut a);
+            same.apply(&p, &mut b);
+            near.apply(&p, &mut c);
+            assert_eq!(a, b);
+            assert_close(&c, &a, 1e-8, "nearly square");
+            assert!((near.self_influence() / square.self_influence() - 1.0).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn periodic_rectangular_pixels_reproduce_a_sinusoid_along_y() {
+        // p = cos(q y), q = 2π·2/(rows Δy): u = 2 cos(q y)/(E* q) whatever Δx is.
+        let (rows, cols, dx, dy, e) = (16, 6, 0.7, 0.25, 2.0);
+        let mut op =
+            ElasticOperator::with_spacings(rows, cols, dx, dy, e, Boundary::Periodic).unwrap();
+        let q = 2.0 * PI * 2.0 / (rows as f64 * dy);
+        let p: Vec<f64> = (0..rows * cols)
+            .map(|i| (q * (i / cols) as f64 * dy).cos())
+            .collect();
+        let mut u = vec![0.0; rows * cols];
+        op.apply(&p, &mut u);
+        for (ui, pi) in u.iter().zip(&p) {
+            assert!((ui - 2.0 * pi / (e * q)).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn free_point_load_on_a_rectangular_pixel_decays_as_one_over_pi_e_r() {
+        // F = p Δx Δy; far pixels see F/(π E* r) up to the pixel's quadrupole correction
+        // (3 cos²θ Δx² + 3 sin²θ Δy² − Δx² − Δy²)/(24 r²), at most (2 max² − min²)/(24 r²)
+        // in size (Δ²/(24 r²) for a square); bound: that times 1.1.
+        let (n, dx, dy, e) = (64, 0.1, 0.05, 3.0);
+        let mut op = ElasticOperator::with_spacings(n, n, dx, dy, e, Boundary::Free).unwrap();
+        let mut p = vec![0.0; n * n];
+        p[0] = 2.0;
+        let mut u = vec![0.0; n * n];
+        op.apply(&p, &mut u);
+        let force = 2.0 * dx * dy;
+        for &(i, j) in &[(0, 20), (30, 40), (63, 63), (50, 0)] {
+            let r = (i as f64 * dy).hypot(j as f64 * dx);
+            let expected = force / (PI * e * r);
+            let rel = u[i * n + j] / expected - 1.0;
+            let bound = 1.1 / 24.0 * (2.0 * dx.max(dy).powi(2) - dx.min(dy).powi(2)) / (r * r);
+            assert!(rel.abs() <= bound, "({i},{j}): rel {rel:e} > {bound:e}");
+        }
+        let expected = 2.0 * love_pixel_displacement(0.0, 0.0, dx, dy, e);
+        assert!((u[0] / expected - 1.0).abs() < 1e-13);
+        assert!((op.self_influence() / (expected / 2.0) - 1.0).abs() < 1e-14);
     }
 
     #[test]
@@ -714,6 +697,11 @@ mod tests {
         assert!(ElasticOperator::new(0, 4, 1.0, 1.0, Boundary::Free).is_err());
         assert!(ElasticOperator::new(4, 4, -1.0, 1.0, Boundary::Free).is_err());
         assert!(ElasticOperator::new(4, 4, 1.0, f64::NAN, Boundary::Free).is_err());
+        assert!(ElasticOperator::with_spacings(4, 4, 1.0, 0.0, 1.0, Boundary::Free).is_err());
+        assert!(
+            ElasticOperator::with_spacings(4, 4, 1.0, f64::INFINITY, 1.0, Boundary::Periodic)
+                .is_err()
+        );
         let err = ElasticOperator::new(1 << 20, 1 << 20, 1.0, 1.0, Boundary::Free)
             .err()
             .unwrap();

@@ -1,0 +1,139 @@
+//! `asperity bench fft-pair` (the unit of the BEM benchmark's per-iteration cost) and
+//! `asperity bench bem-estimate`. Drives the real binary: `key=value` fields with finite
+//! values that add up; bad input is one line on stderr and exit status 2.
+
+use std::collections::HashMap;
+use std::process::{Command, Output};
+
+fn asperity(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn fields(output: &Output) -> HashMap<String, String> {
+    String::from_utf8_lossy(&output.stdout)
+        .split_whitespace()
+        .filter_map(|item| item.split_once('='))
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+#[test]
+fn fft_pair_reports_the_padded_grid_and_positive_timings() {
+    for (boundary, grid) in [("free", "24x24"), ("periodic", "12x12")] {
+        let out = asperity(&[
+            "bench",
+            "fft-pair",
+            "--n",
+            "12",
+            "--boundary",
+            boundary,
+            "--repeat",
+            "3",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let f = fields(&out);
+        assert_eq!(f["kernel"], "FftPair");
+        assert_eq!(f["boundary"], boundary);
+        assert_eq!(f["grid"], grid);
+        for key in [
+            "pair_min_s",
+            "pair_median_s",
+            "apply_min_s",
+            "apply_median_s",
+        ] {
+            let value: f64 = f[key].parse().unwrap();
+            assert!(value.is_finite() && value >= 0.0, "{key} = {value}");
+        }
+        let min: f64 = f["pair_min_s"].parse().unwrap();
+        let median: f64 = f["pair_median_s"].parse().unwrap();
+        assert!(min <= median);
+    }
+}
+
+#[test]
+fn fft_pair_refuses_bad_input_with_one_line() {
+    for args in [
+        &["bench", "fft-pair", "--n", "0"][..],
+        &["bench", "fft-pair", "--n", "8", "--boundary", "open"][..],
+        &["bench", "fft-pair", "--n", "8", "--repeat", "0"][..],
+        &["bench", "fft-pair", "--n", "100000000"][..],
+    ] {
+        let out = asperity(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn bem_estimate_sums_its_sizes_into_the_total() {
+    let out = asperity(&[
+        "bench",
+        "bem-estimate",
+        "--sizes",
+        "16,24",
+        "--samples",
+        "3",
+        "--hursts",
+        "0.5:0.8:0.3",
+        "--probes",
+        "8,16",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<HashMap<String, String>> = stdout
+        .lines()
+        .map(|line| {
+            line.split_whitespace()
+                .filter_map(|item| item.split_once('='))
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect();
+    assert_eq!(lines.len(), 3, "{stdout}");
+    let mut sum = 0.0;
+    for (line, n) in lines[..2].iter().zip(["16", "24"]) {
+        assert_eq!(line["n"], n);
+        assert_eq!(line["hursts"], "2");
+        for key in [
+            "solve_iterations",
+            "cg_iterations",
+            "solve_iteration_s",
+            "cg_iteration_s",
+        ] {
+            let value: f64 = line[key].parse().unwrap();
+            assert!(value.is_finite() && value > 0.0, "{key} = {value}");
+        }
+        sum += line["seconds"].parse::<f64>().unwrap();
+    }
+    let total: f64 = lines[2]["total_seconds"].parse().unwrap();
+    assert!((total - sum).abs() <= 2e-3, "{total} vs {sum}");
+}
+
+#[test]
+fn bem_estimate_refuses_bad_input_with_one_line() {
+    for args in [
+        &["bench", "bem-estimate", "--sizes", "4"][..],
+        &["bench", "bem-estimate", "--sizes", "16", "--probes", "16,8"][..],
+        &["bench", "bem-estimate", "--sizes", "16", "--probes", "16"][..],
+        &["bench", "bem-estimate", "--sizes", "16", "--samples", "0"][..],
+        &["bench", "bem-estimate", "--sizes", "16", "--hursts", "x"][..],
+    ] {
+        let out = asperity(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+    }
+}
