@@ -37,12 +37,21 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
-    /// A `.npy` file could not be read as the array that was expected.
+    /// A `.npy` or topography file could not be read as the array that was expected.
     #[error("{path}: {reason}")]
     BadArrayFile {
         /// The file concerned.
         path: PathBuf,
         /// What was wrong (dtype, shape, ...).
+        reason: String,
+    },
+    /// The bytes of a topography file do not hold what its format prescribes (a reader's
+    /// error, before the file's path is known; [`crate::topography::read_file`] adds it).
+    #[error("{format} file: {reason}")]
+    BadTopography {
+        /// The format's short name (e.g. `x3p`).
+        format: &'static str,
+        /// What is wrong (truncated, wrong magic, impossible size, ...).
         reason: String,
     },
     /// An input array holds NaN or infinity.
