@@ -25,6 +25,7 @@ use crate::{Error, Result};
 
 pub mod inpaint;
 pub mod level;
+pub mod patches;
 pub(crate) mod sdf;
 pub mod stats;
 pub(crate) mod text;

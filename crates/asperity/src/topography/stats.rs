@@ -188,6 +188,35 @@ pub fn profile(z: ArrayView1<f64>, dx: f64) -> Result<ProfileParameters> {
     })
 }
 
+/// rms slope from forward differences, `sqrt(mean((Δz/Δx)²) + mean((Δz/Δy)²))` over the
+/// neighbouring pairs inside the grid (the crate's definition, see
+/// [`crate::surface::stats`]), with separate spacings for rectangular pixels.
+pub fn rms_slope_forward(h: ArrayView2<f64>, dx: f64, dy: f64) -> f64 {
+    let (ny, nx) = h.dim();
+    let mean_square = |pairs: usize, sum: f64| if pairs == 0 { 0.0 } else { sum / pairs as f64 };
+    let sx: f64 = h
+        .rows()
+        .into_iter()
+        .map(|r| {
+            r.windows(2)
+                .into_iter()
+                .map(|w| ((w[1] - w[0]) / dx).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    let sy: f64 = h
+        .columns()
+        .into_iter()
+        .map(|c| {
+            c.windows(2)
+                .into_iter()
+                .map(|w| ((w[1] - w[0]) / dy).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (mean_square(ny * (nx - 1), sx) + mean_square(nx * (ny - 1), sy)).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -284,6 +313,22 @@ mod tests {
         let sdr = 2.0 / PI * (1.0 + g2).sqrt() * elliptic_e(g2 / (1.0 + g2)) - 1.0;
         close(s.sdr, sdr, 1e-11, "Sdr");
         assert!(g2 > 0.5, "a test with slopes of order one: G² = {g2}");
+    }
+
+    #[test]
+    fn forward_rms_slope_matches_the_square_pixel_definition() {
+        let h = Array2::from_shape_fn((9, 13), |(r, c)| ((r * 5 + c * 3) as f64 * 0.7).sin());
+        let ours = rms_slope_forward(h.view(), 0.25, 0.25);
+        let crate_wide = crate::surface::stats::rms_slope_2d(h.view(), 0.25);
+        close(ours, crate_wide, 1e-13, "rms slope");
+        // Along x only, Δy does not matter.
+        let wave = Array2::from_shape_fn((4, 9), |(_, c)| c as f64 * 2.0);
+        close(
+            rms_slope_forward(wave.view(), 0.5, 3.0),
+            4.0,
+            1e-15,
+            "slope 4",
+        );
     }
 
     #[test]
