@@ -341,13 +341,13 @@ fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
         let a = (3.0 * f * radius / (4.0 * e_star)).cbrt();
         let area = row[col("contact_area_m2")];
         assert!(
-            (area / (std::f64::consts::PI * a * a) - 1.0).abs() < 0.06,
+            (area / (std::f64::consts::PI * a * a) - 1.0).abs() < 0.03,
             "area {area} vs {}",
             std::f64::consts::PI * a * a
         );
         let k = row[col("stiffness_n_per_m")];
         assert!(
-            (k / (2.0 * a * e_star) - 1.0).abs() < 0.06,
+            (k / (2.0 * a * e_star) - 1.0).abs() < 0.03,
             "stiffness {k} vs {}",
             2.0 * a * e_star
         );
