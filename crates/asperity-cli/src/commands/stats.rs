@@ -250,8 +250,7 @@ fn psd_chart(
     }
 }
 
-/// What the statistics are computed from: the summary, PSD bins (empty for rectangular
-/// pixels), shape, PSD slope offset (1 for a line, 2 for a surface), side length along x,
+/// What the statistics are computed from: the summary, PSD bins, shape, PSD slope offset (1 for a line, 2 for a surface), side length along x,
 /// the ISO parameters (measured files) and the measured file's record.
 struct Inputs {
     summary: Summary,
@@ -309,7 +308,7 @@ fn npy_inputs(args: &StatsArgs, hints: &SidecarHints, size_x: Option<f64>) -> Re
 }
 
 /// A measured file (or an imported `.npy`): read, cleaned as asked, with the ISO
-/// parameters; the PSD in physical units (metres) where the pixels are square.
+/// parameters; the PSD in physical units (metres), rectangular pixels included.
 fn measured_inputs(args: &StatsArgs) -> Result<Inputs> {
     let t = load(&args.file, &args.measured, args.size.as_deref())?;
     let record = Some(measured_record(&t));
@@ -347,7 +346,12 @@ fn measured_inputs(args: &StatsArgs) -> Result<Inputs> {
                     ),
                     rms_curvature: None,
                 };
-                (summary, Vec::new())
+                let bins = topo_stats::radial_psd(
+                    surface.heights().view(),
+                    surface.size(),
+                    surface.size_y(),
+                )?;
+                (summary, bins)
             };
             Ok(Inputs {
                 summary,
@@ -430,12 +434,6 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         iso,
         record,
     } = inputs;
-    if bins.is_empty() && (args.psd.is_some() || args.plot.is_some()) {
-        bail!(
-            "{}: the PSD of a map with rectangular pixels is not computed yet; drop --psd and --plot",
-            args.file.display()
-        );
-    }
     let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
     let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
     let plan = fit_range(args, &hints, nyquist)?;
@@ -509,9 +507,6 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
     print_iso(&iso);
     match (fit, plan.range) {
-        _ if bins.is_empty() => println!(
-            "psd_slope: n/a (the PSD of a map with rectangular pixels is not computed yet)"
-        ),
         (Some(f), Some((from, to))) => {
             let end = match &plan.note {
                 Some(_) => format!(

@@ -188,6 +188,74 @@ pub fn profile(z: ArrayView1<f64>, dx: f64) -> Result<ProfileParameters> {
     })
 }
 
+/// Radially averaged 2D PSD `C2D(q)` of a map with sizes `size_x`, `size_y` (pixels may be
+/// rectangular), in physical units: `q` in radians per unit length, `C2D` in length⁴,
+/// normalised so that `Σ_q C2D(q) (2π)²/A = rms²` over all modes. Rings of width `2π/L_x`
+/// centred on integer `κ = q L_x/2π`, from 1 up to the smaller of the two Nyquist
+/// wavenumbers — the binning of [`crate::surface::stats::radial_psd_2d`], which this equals
+/// for square pixels, with `q_y = 2π k_y / L_y`.
+pub fn radial_psd(
+    h: ArrayView2<f64>,
+    size_x: f64,
+    size_y: f64,
+) -> Result<Vec<crate::surface::stats::PsdBin>> {
+    use num_complex::Complex64;
+    let (rows, cols) = h.dim();
+    ensure_usable(h.iter().copied(), &[size_x, size_y], 4)?;
+    let mean = h.mean().unwrap_or(0.0);
+    let mut centred = crate::memory::try_vec("the PSD's copy of the map", rows * cols, 0.0)?;
+    for (c, v) in centred.iter_mut().zip(h.iter()) {
+        *c = v - mean;
+    }
+    let mut fft = crate::fft::RealFft2::new(rows, cols)?;
+    let mut spectrum = crate::memory::try_vec(
+        "the PSD's spectrum",
+        fft.spectrum_len(),
+        Complex64::default(),
+    )?;
+    fft.forward(&centred, &mut spectrum);
+    // κ_y in units of 2π/L_x.
+    let aspect = size_x / size_y;
+    let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
+    let norm = size_x * size_y / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
+    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+    let last = cols / 2;
+    for (kx, column) in spectrum.chunks(rows).enumerate() {
+        // Columns 0 < kx < cols/2 stand for ±kx.
+        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
+            1
+        } else {
+            2
+        };
+        for (index, value) in column.iter().enumerate() {
+            let ky = if index <= rows / 2 {
+                index as f64
+            } else {
+                index as f64 - rows as f64
+            };
+            let kappa = (kx as f64).hypot(ky * aspect);
+            let bin = kappa.round() as usize;
+            if bin == 0 || bin > kappa_max {
+                continue;
+            }
+            let s = &mut sums[bin];
+            s.0 += weight as f64 * kappa;
+            s.1 += weight as f64 * value.norm_sqr() * norm;
+            s.2 += weight;
+        }
+    }
+    Ok(sums
+        .into_iter()
+        .skip(1)
+        .filter(|s| s.2 > 0)
+        .map(|(k, p, m)| crate::surface::stats::PsdBin {
+            q: std::f64::consts::TAU / size_x * k / m as f64,
+            psd: p / m as f64,
+            modes: m,
+        })
+        .collect())
+}
+
 /// rms slope from forward differences, `sqrt(mean((Δz/Δx)²) + mean((Δz/Δy)²))` over the
 /// neighbouring pairs inside the grid (the crate's definition, see
 /// [`crate::surface::stats`]), with separate spacings for rectangular pixels.
@@ -329,6 +397,48 @@ mod tests {
             1e-15,
             "slope 4",
         );
+    }
+
+    #[test]
+    fn psd_equals_the_square_pixel_one_and_holds_a_plane_wave_on_rectangular_pixels() {
+        let h = Array2::from_shape_fn((24, 32), |(r, c)| {
+            ((r * 7 + c * 3) as f64 * 0.37).sin() + (c as f64 * 0.11).cos()
+        });
+        let surface = crate::surface::Surface::new(h.clone(), 3.2).unwrap();
+        let theirs = crate::surface::stats::radial_psd_2d(&surface).unwrap();
+        let ours = radial_psd(h.view(), 3.2, 2.4).unwrap();
+        assert_eq!(ours.len(), theirs.len());
+        for (a, b) in ours.iter().zip(&theirs) {
+            close(a.q, b.q, 1e-14, "q");
+            close(a.psd, b.psd, 1e-12, "psd");
+        }
+        // A plane wave A cos(2π(3x/Lx + 2y/Ly)) with Lx = 2e-5 m, Ly = 1e-5 m on 40 x 30
+        // pixels: all its power A²/2 in the ring κ = round(hypot(3, 2 Lx/Ly)) = 5, at
+        // in m⁴: Σ C (2π)²/A_nominal over the ring's modes = A²/2.
+        let (lx, ly, amp) = (2e-5, 1e-5, 3e-8);
+        let (ny, nx) = (30, 40);
+        let wave = Array2::from_shape_fn((ny, nx), |(r, c)| {
+            let (x, y) = (c as f64 * lx / nx as f64, r as f64 * ly / ny as f64);
+            amp * (2.0 * PI * (3.0 * x / lx + 2.0 * y / ly)).cos()
+        });
+        let bins = radial_psd(wave.view(), lx, ly).unwrap();
+        let power = |b: &crate::surface::stats::PsdBin| {
+            b.psd * b.modes as f64 * (2.0 * PI).powi(2) / (lx * ly)
+        };
+        // The ring holding the power is κ = 5 (its q is the mean over all the ring's modes,
+        // within half a ring of 5).
+        let ring = bins
+            .iter()
+            .max_by(|a, b| power(a).total_cmp(&power(b)))
+            .unwrap();
+        assert!(
+            (ring.q * lx / (2.0 * PI) - 5.0).abs() < 0.5,
+            "ring at {}",
+            ring.q
+        );
+        close(power(ring), amp * amp / 2.0, 1e-12, "ring power");
+        let rest: f64 = bins.iter().map(power).sum::<f64>() - power(ring);
+        assert!(rest.abs() < 1e-12 * amp * amp, "other rings hold {rest}");
     }
 
     #[test]
