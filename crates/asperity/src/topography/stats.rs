@@ -413,7 +413,7 @@ mod tests {
             close(a.psd, b.psd, 1e-12, "psd");
         }
         // A plane wave A cos(2π(3x/Lx + 2y/Ly)) with Lx = 2e-5 m, Ly = 1e-5 m on 40 x 30
-        // pixels: all its power A²/2 in the ring κ = round(hypot(3, 2 Lx/Ly)) = 5, at
+        // pixels: all its power A²/2 in the ring κ = round(hypot(3, 2 Lx/Ly)) = 5,
         // in m⁴: Σ C (2π)²/A_nominal over the ring's modes = A²/2.
         let (lx, ly, amp) = (2e-5, 1e-5, 3e-8);
         let (ny, nx) = (30, 40);
