@@ -105,7 +105,7 @@ fn import_reads_the_shared_files_to_their_references() {
             assert!((a - b).abs() <= 1e-12 * b, "{name} size {axis}: {a} vs {b}");
         }
         assert_eq!(sidecar["unit"], "m");
-        assert_eq!(sidecar["cleaning"][0], "no levelling (--detrend none)");
+        assert_eq!(sidecar["cleaning"][0], "no levelling");
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use asperity::topography::level::Detrend;
-use asperity::topography::{self, ChannelChoice, Fill, ReadOptions, Topography};
+use asperity::topography::{self, ChannelChoice, Fill, Levelling, ReadOptions, Topography};
 
 /// Options for reading a measured file (ignored for `.npy` made by asperity, except
 /// `--size`).
@@ -97,19 +97,12 @@ pub fn load(path: &Path, args: &MeasuredArgs, size: Option<&str>) -> Result<Topo
         Some(_) => Some(Fill::Refuse),
         None => None,
     };
-    let warnings = match detrend(args) {
-        Some(choice) => {
-            let warnings = topography::clean(&mut topography, choice, fill)?;
-            if choice.is_none() {
-                topography
-                    .provenance
-                    .cleaning
-                    .push("no levelling (--detrend none)".into());
-            }
-            warnings
-        }
-        None => topography::clean(&mut topography, None, fill)?,
+    let levelling = match detrend(args) {
+        Some(Some(d)) => Levelling::By(d),
+        Some(None) => Levelling::None,
+        None => Levelling::Unchosen,
     };
+    let warnings = topography::clean(&mut topography, levelling, fill)?;
     for w in warnings {
         eprintln!("warning: {}: {w} (choose --detrend)", path.display());
     }

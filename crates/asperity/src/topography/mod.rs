@@ -329,14 +329,25 @@ pub enum Fill {
     Refuse,
 }
 
-/// Levels (`detrend`, recorded even when `None`-like choices change nothing) and fills
-/// undefined points (`fill`), recording each step in the provenance. Returns warnings for
-/// what was not asked for: a surface that looks tilted when no levelling was chosen
-/// (`detrend = None`). Undefined points with no `fill` chosen are refused with their count,
-/// as with [`Fill::Refuse`]: nothing is changed silently.
+/// The levelling [`clean`] applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Levelling {
+    /// None chosen: the heights are kept, with a warning when they look tilted.
+    Unchosen,
+    /// Explicitly none (recorded; no tilt check).
+    None,
+    /// This levelling.
+    By(level::Detrend),
+}
+
+/// Levels and fills undefined points (`fill`), recording each step in the provenance,
+/// including an explicit "no levelling". Returns warnings for what was not asked for: a
+/// surface that looks tilted when no levelling was chosen ([`Levelling::Unchosen`]).
+/// Undefined points with no `fill` chosen are refused with their count, as with
+/// [`Fill::Refuse`]: nothing is changed silently.
 pub fn clean(
     topography: &mut Topography,
-    detrend: Option<level::Detrend>,
+    levelling: Levelling,
     fill: Option<Fill>,
 ) -> Result<Vec<String>> {
     let mut warnings = Vec::new();
@@ -366,12 +377,13 @@ pub fn clean(
         ));
     }
     let spacings = topography.spacings();
-    match detrend {
-        Some(d) => {
+    match levelling {
+        Levelling::By(d) => {
             level::detrend(&mut topography.heights, d)?;
             topography.provenance.cleaning.push(d.describe());
         }
-        None => {
+        Levelling::None => topography.provenance.cleaning.push("no levelling".into()),
+        Levelling::Unchosen => {
             if let Some(w) = level::tilt_warning(&topography.heights) {
                 warnings.push(w);
             }
@@ -831,6 +843,54 @@ mod tests {
         let err = read_file(&path, &ReadOptions::default()).unwrap_err();
         assert!(err.to_string().contains("unknown format"), "{err}");
         assert_eq!(err.to_string().lines().count(), 1);
+    }
+
+    #[test]
+    fn cleaning_is_explicit_and_recorded() {
+        let tilted = Array2::from_shape_fn((16, 16), |(r, c)| {
+            1e-7 * c as f64 + 1e-9 * ((r * 5 + c * 3) as f64).sin()
+        });
+        let topography = |h: Array2<f64>| Topography {
+            heights: Heights::Areal(h),
+            sizes: vec![1e-6, 1e-6],
+            provenance: Provenance {
+                source: "t".into(),
+                format: "test".into(),
+                channel: "h".into(),
+                channel_index: 0,
+                channels: vec!["h".into()],
+                file_unit: Some("m".into()),
+                unit: Some("m".into()),
+                size_source: "file".into(),
+                cleaning: Vec::new(),
+            },
+        };
+        let mut t = topography(tilted.clone());
+        assert_eq!(clean(&mut t, Levelling::Unchosen, None).unwrap().len(), 1);
+        assert!(t.provenance.cleaning.is_empty());
+        let mut t = topography(tilted.clone());
+        assert!(clean(&mut t, Levelling::None, None).unwrap().is_empty());
+        assert_eq!(t.provenance.cleaning, ["no levelling"]);
+        let mut holed = tilted;
+        holed[(3, 4)] = f64::NAN;
+        holed[(9, 9)] = f64::NAN;
+        let mut t = topography(holed.clone());
+        let err = clean(&mut t, Levelling::By(level::Detrend::Polynomial(1)), None).unwrap_err();
+        assert!(
+            err.to_string().contains("2 of 256 points are undefined"),
+            "{err}"
+        );
+        assert!(clean(&mut t, Levelling::None, Some(Fill::Refuse)).is_err());
+        let by = Levelling::By(level::Detrend::Polynomial(1));
+        let warnings = clean(&mut t, by, Some(Fill::Harmonic)).unwrap();
+        assert!(warnings.is_empty());
+        assert_eq!(
+            t.provenance.cleaning.len(),
+            2,
+            "{:?}",
+            t.provenance.cleaning
+        );
+        assert_eq!(t.heights.undefined_count(), 0);
     }
 
     #[test]
