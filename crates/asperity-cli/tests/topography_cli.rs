@@ -20,9 +20,14 @@ fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-/// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it).
+/// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it; a git
+/// worktree elsewhere sets `ASPERITY_TOPOGRAPHIES`), or `None` with a printed notice.
 fn shared() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies");
+    let dir = std::env::var_os("ASPERITY_TOPOGRAPHIES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies")
+        });
     if dir.is_dir() {
         Some(dir)
     } else {

@@ -694,10 +694,15 @@ pub(crate) mod test_files {
     use ndarray::ArrayD;
     use ndarray_npy::ReadNpyExt;
 
-    /// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it), or
-    /// `None` with a printed notice when it is absent.
+    /// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it; a git
+    /// worktree elsewhere sets `ASPERITY_TOPOGRAPHIES`), or `None` with a printed notice
+    /// when it is absent.
     pub fn folder() -> Option<PathBuf> {
-        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies");
+        let dir = std::env::var_os("ASPERITY_TOPOGRAPHIES")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| {
+                PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies")
+            });
         if dir.is_dir() {
             Some(dir)
         } else {
