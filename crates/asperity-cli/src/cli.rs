@@ -29,6 +29,10 @@ pub enum Command {
     Mdr(commands::mdr::MdrArgs),
     /// Ensemble studies: α(H, N) sweeps and mean k(F) curves, checkpointed and resumable.
     Study(commands::study::StudyArgs),
+    /// Read a measured topography (X3P, SDF, text, x y z, profiles, ...) into .npy + sidecar or X3P.
+    Import(commands::import::ImportArgs),
+    /// Contact area, mean gap, stiffness and patches of a measured surface against load (SI units).
+    Contact(commands::contact::ContactArgs),
     /// Time a library kernel (for comparisons with other tools; see bench/).
     Bench(commands::bench::BenchArgs),
     /// Regenerate a figure of the paper or the book chapter.

@@ -18,6 +18,7 @@ use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
 use serde_json::json;
 
+use super::measured::{has_import_sidecar, is_npy, load, MeasuredArgs};
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
 use crate::progress::Progress;
@@ -31,7 +32,8 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --boundary periodic --forces 0.02 --tol 1e-10\n  \
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --out reference.csv\n  \
-    asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n\n\
+    asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n  \
+    asperity bem --surface scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
 (stiffness by the frozen contact set; indentation from the highest point, or with\n\
 periodic boundaries relative to the mean elastic displacement); then\n\
@@ -41,12 +43,17 @@ E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused 
 any solve.")]
 #[command(group(clap::ArgGroup::new("loads").required(true).args(["forces", "pressures", "indentations", "nloads"])))]
 pub struct BemArgs {
-    /// Surface heights (.npy, float64, 2D), positive up.
-    #[arg(long, value_name = "FILE.npy")]
+    /// Surface heights, positive up: a .npy (float64, 2D), or a measured file (X3P, SDF,
+    /// text matrix, x y z, ...; sizes and units from the file, see --channel, --detrend,
+    /// --fill).
+    #[arg(long, value_name = "FILE")]
     pub surface: PathBuf,
-    /// Side length L along x; defaults to the surface's sidecar, else 1.
+    /// Side length L along x (square pixels); defaults to the surface's sidecar or the
+    /// measured file's size, else 1 for a .npy (a measured file without size is refused).
     #[arg(long, allow_negative_numbers = true)]
     pub size: Option<f64>,
+    #[command(flatten)]
+    pub measured: MeasuredArgs,
     /// Effective modulus E*.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub modulus: f64,
@@ -353,6 +360,7 @@ fn check_full_contact(
 enum SizeSource {
     Flag,
     Sidecar,
+    File,
     Default,
 }
 
@@ -361,6 +369,7 @@ impl SizeSource {
         match self {
             SizeSource::Flag => "--size",
             SizeSource::Sidecar => "sidecar",
+            SizeSource::File => "file",
             SizeSource::Default => "default",
         }
     }
@@ -370,6 +379,7 @@ impl SizeSource {
         match self {
             SizeSource::Flag => "from --size",
             SizeSource::Sidecar => "from sidecar",
+            SizeSource::File => "from the measured file",
             SizeSource::Default => "default",
         }
     }
@@ -519,7 +529,12 @@ pub fn run(args: &BemArgs) -> Result<()> {
     // Memory, from the file's header before its data is read: the solver plus the heights,
     // alive while the solver is built (the fields go to files as they are solved), plus the
     // per-load bookkeeping.
-    let shape = read_npy_shape(&args.surface)?;
+    let measured = !is_npy(&args.surface) || has_import_sidecar(&args.surface);
+    let shape = if measured {
+        Vec::new() // read, bounded, by the topography reader; checked below
+    } else {
+        read_npy_shape(&args.surface)?
+    };
     if let [rows, cols] = shape[..] {
         let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
             .zip(array_bytes(&[rows, cols], 8))
@@ -534,20 +549,44 @@ pub fn run(args: &BemArgs) -> Result<()> {
             bytes,
         )?;
     }
-    let (size, size_source) = match (args.size, asperity::io::sidecar_size(&args.surface)) {
-        (Some(size), _) => (size, SizeSource::Flag),
-        (None, Some(size)) => (size, SizeSource::Sidecar),
-        (None, None) => (1.0, SizeSource::Default),
+    let (surface, size_source) = if measured {
+        let size = args.size.map(|x| x.to_string());
+        let t = load(&args.surface, &args.measured, size.as_deref())?;
+        let surface = t
+            .to_surface()
+            .with_context(|| format!("{}", args.surface.display()))?;
+        let (rows, cols) = surface.dim();
+        ensure_fits(
+            &format!(
+                "asperity bem on a {rows}x{cols} surface ({} boundaries)",
+                boundary.name()
+            ),
+            ContactSolver::memory_bytes(rows, cols, boundary),
+        )?;
+        let source = if args.size.is_some() {
+            SizeSource::Flag
+        } else {
+            SizeSource::File
+        };
+        (surface, source)
+    } else {
+        let (size, size_source) = match (args.size, asperity::io::sidecar_size(&args.surface)) {
+            (Some(size), _) => (size, SizeSource::Flag),
+            (None, Some(size)) => (size, SizeSource::Sidecar),
+            (None, None) => (1.0, SizeSource::Default),
+        };
+        let heights = read_npy_2d(&args.surface)?;
+        let surface = Surface::new(heights, size).with_context(|| match size_source {
+            SizeSource::Sidecar => format!(
+                "{} (L = {size} from its sidecar {})",
+                args.surface.display(),
+                sidecar_path(&args.surface).display()
+            ),
+            _ => format!("{}", args.surface.display()),
+        })?;
+        (surface, size_source)
     };
-    let heights = read_npy_2d(&args.surface)?;
-    let surface = Surface::new(heights, size).with_context(|| match size_source {
-        SizeSource::Sidecar => format!(
-            "{} (L = {size} from its sidecar {})",
-            args.surface.display(),
-            sidecar_path(&args.surface).display()
-        ),
-        _ => format!("{}", args.surface.display()),
-    })?;
+    let size = surface.size();
     let grid = surface.dim();
     let half_space = HalfSpace {
         modulus: args.modulus,

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use asperity::io::{read_npy_1d, StagedOutputs};
+
+use super::measured::{has_import_sidecar, is_npy, load, MeasuredArgs};
 use asperity::mdr::{
     log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
@@ -49,13 +51,18 @@ pub enum SpringKind {
     asperity mdr --profile hertz --radius 1 --n 2001 --dx 0.01 --spring hertz --indentations 1e-8,1e-6,1e-4\n  \
     asperity mdr --profile cone --slope 0.2 --n 4001 --dx 1e-3 --nloads 20 --out cone.csv\n  \
     asperity mdr --radial tip.npy --radial-step 1e-3 --n 1001 --dx 1e-3 --nloads 30\n  \
-    asperity mdr --line line.npy --nloads 40 --out curve.csv --plot curve.svg\n\n\
+    asperity mdr --line line.npy --nloads 40 --out curve.csv --plot curve.svg\n  \
+    asperity mdr --line profile.csv --detrend mean --modulus 1e9 --nloads 20 --out curve.csv\n\n\
     Output columns: indentation, force, stiffness, contacts. Indentation is measured from \
     first contact (the highest point of a line, the tip of an indenter).")]
 pub struct MdrArgs {
-    /// A rough line (1D .npy, float64), heights positive up; spacing = size / n.
-    #[arg(long, value_name = "FILE.npy", group = "indenter")]
+    /// A rough line, heights positive up: a 1D .npy (float64; spacing = size / n), or a
+    /// measured profile (x z text, Dektak CSV, ...; length and units from the file, see
+    /// --detrend, --fill).
+    #[arg(long, value_name = "FILE", group = "indenter")]
     pub line: Option<PathBuf>,
+    #[command(flatten)]
+    pub measured: MeasuredArgs,
     /// A closed-form axisymmetric indenter, mapped to 1D by the MDR transform.
     #[arg(long, value_enum, group = "indenter")]
     pub profile: Option<ProfileKind>,
@@ -196,6 +203,28 @@ fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
 }
 
 fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
+    if let Some(path) = args
+        .line
+        .as_ref()
+        .filter(|p| !is_npy(p) || has_import_sidecar(p))
+    {
+        let size = args.size.map(|x| x.to_string());
+        let t = load(path, &args.measured, size.as_deref())?;
+        let line = t.to_line().with_context(|| format!("{}", path.display()))?;
+        let size = line.size();
+        return Ok(Indenter {
+            description: format!(
+                "measured line {} ({} points, L = {size} m, {})",
+                path.display(),
+                line.len(),
+                t.provenance.format
+            ),
+            spacing: line.spacing(),
+            values: line.into_heights().to_vec(),
+            is_line: true,
+            size,
+        });
+    }
     if let Some(path) = &args.line {
         let heights = read_npy_1d(path)?.to_vec();
         let size = args

@@ -2,9 +2,12 @@
 
 pub mod bem;
 pub mod bench;
+pub mod contact;
 mod fig15;
 pub mod figures;
+pub mod import;
 pub mod mdr;
+pub mod measured;
 pub mod reproduce;
 pub mod stats;
 pub mod study;
@@ -21,6 +24,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bem(args) => bem::run(&args),
         Command::Mdr(args) => mdr::run(&args),
         Command::Study(args) => study::run(&args),
+        Command::Import(args) => import::run(&args),
+        Command::Contact(args) => contact::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     }

@@ -12,22 +12,32 @@ use asperity::surface::stats::{
 use asperity::surface::{Line, Surface};
 use ndarray::{Ix1, Ix2};
 
+use super::measured::{
+    has_import_sidecar, is_npy, load, parse_size, record as measured_record, MeasuredArgs,
+};
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
+use asperity::topography::stats as topo_stats;
+use asperity::topography::Heights;
 
 /// Arguments of `asperity stats`.
 #[derive(Debug, clap::Args)]
 #[command(
     allow_negative_numbers = true,
     after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6\n  \
-    asperity stats s.npy --plot psd.png"
+    asperity stats s.npy --plot psd.png\n  asperity stats scan.x3p --detrend plane\n  \
+    asperity stats profile.csv --detrend mean --json"
 )]
 pub struct StatsArgs {
-    /// A surface (2D) or line (1D) `.npy` file, float64.
+    /// A surface (2D) or line (1D): `.npy` (float64), or a measured file (X3P, SDF, text,
+    /// x y z, profiles, ...), which adds the ISO 25178 / ISO 4287 parameters.
     pub file: PathBuf,
-    /// Side length L; defaults to the sidecar's, else 1.
-    #[arg(long)]
-    pub size: Option<f64>,
+    /// Side length L (.npy: defaults to the sidecar's, else 1); for a measured file its
+    /// physical size X[,Y] in metres where the file has none or to override it.
+    #[arg(long, value_name = "X[,Y]")]
+    pub size: Option<String>,
+    #[command(flatten)]
+    pub measured: MeasuredArgs,
     /// Write the (radially averaged) PSD as CSV with columns q (the wavenumber, radians
     /// per unit length), psd (C2D(q) in length⁴ for a surface, C1D(q) in length³ for a
     /// line) and q_l_2pi (q·L/2π: wavelengths per side, the unit of --fit-from, --fit-to
@@ -240,14 +250,155 @@ fn psd_chart(
     }
 }
 
+/// What the statistics are computed from: the summary, PSD bins, shape, PSD slope offset (1 for a line, 2 for a surface), side length along x,
+/// the ISO parameters (measured files) and the measured file's record.
+struct Inputs {
+    summary: Summary,
+    bins: Vec<PsdBin>,
+    dims: Vec<usize>,
+    psd_offset: f64,
+    size: f64,
+    iso: Option<serde_json::Value>,
+    record: Option<serde_json::Value>,
+}
+
+/// A `.npy` array, its side length from --size, the sidecar, else 1.
+fn npy_inputs(args: &StatsArgs, hints: &SidecarHints, size_x: Option<f64>) -> Result<Inputs> {
+    // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
+    // the file, checked from the header before the data are read.
+    let shape = read_npy_shape(&args.file)?;
+    ensure_fits(
+        &format!(
+            "computing the statistics of {} (shape {shape:?})",
+            args.file.display()
+        ),
+        array_bytes(&shape, 4 * 8),
+    )?;
+    let size = size_x.or(hints.size).unwrap_or(1.0);
+    let array = read_npy(&args.file)?;
+    let (summary, bins, dims, psd_offset) = match array.ndim() {
+        1 => {
+            let line = Line::new(array.into_dimensionality::<Ix1>()?, size)?;
+            (line_summary(&line), line_psd(&line), vec![line.len()], 1.0)
+        }
+        2 => {
+            let surface = Surface::new(array.into_dimensionality::<Ix2>()?, size)?;
+            let (r, c) = surface.dim();
+            (
+                surface_summary(&surface),
+                radial_psd_2d(&surface)?,
+                vec![r, c],
+                2.0,
+            )
+        }
+        d => bail!(
+            "{}: expected a 1D line or 2D surface, found {d} dimensions",
+            args.file.display()
+        ),
+    };
+    Ok(Inputs {
+        summary,
+        bins,
+        dims,
+        psd_offset,
+        size,
+        iso: None,
+        record: None,
+    })
+}
+
+/// A measured file (or an imported `.npy`): read, cleaned as asked, with the ISO
+/// parameters; the PSD in physical units (metres), rectangular pixels included.
+fn measured_inputs(args: &StatsArgs) -> Result<Inputs> {
+    let t = load(&args.file, &args.measured, args.size.as_deref())?;
+    let record = Some(measured_record(&t));
+    let dims = t.heights.shape();
+    match &t.heights {
+        Heights::Profile(_) => {
+            let line = t.to_line()?;
+            let iso = topo_stats::profile(line.heights().view(), line.spacing())?;
+            Ok(Inputs {
+                summary: line_summary(&line),
+                bins: line_psd(&line),
+                dims,
+                psd_offset: 1.0,
+                size: line.size(),
+                iso: Some(serde_json::to_value(iso)?),
+                record,
+            })
+        }
+        Heights::Areal(_) => {
+            let surface = t.to_surface()?;
+            let iso = topo_stats::areal(
+                surface.heights().view(),
+                surface.spacing(),
+                surface.spacing_y(),
+            )?;
+            let (summary, bins) = if surface.has_square_pixels() {
+                (surface_summary(&surface), radial_psd_2d(&surface)?)
+            } else {
+                let summary = Summary {
+                    rms_height: iso.sq,
+                    rms_slope: topo_stats::rms_slope_forward(
+                        surface.heights().view(),
+                        surface.spacing(),
+                        surface.spacing_y(),
+                    ),
+                    rms_curvature: None,
+                };
+                let bins = topo_stats::radial_psd(
+                    surface.heights().view(),
+                    surface.size(),
+                    surface.size_y(),
+                )?;
+                (summary, bins)
+            };
+            Ok(Inputs {
+                summary,
+                bins,
+                dims,
+                psd_offset: 2.0,
+                size: surface.size(),
+                iso: Some(serde_json::to_value(iso)?),
+                record,
+            })
+        }
+    }
+}
+
+/// Prints the ISO parameters, if any, one per line with their units.
+fn print_iso(iso: &Option<serde_json::Value>) {
+    let Some(serde_json::Value::Object(map)) = iso else {
+        return;
+    };
+    let order = [
+        "sq", "sa", "sz", "ssk", "sku", "sdq", "sdr", "rq", "ra", "rz", "rsk", "rku", "rdq",
+    ];
+    for name in order {
+        let Some(value) = map.get(name) else { continue };
+        let v = value.as_f64().unwrap_or(f64::NAN);
+        let (label, unit) = match name {
+            "sdr" => ("Sdr".to_string(), format!(" ({:.4} %)", 100.0 * v)),
+            "sdq" | "rdq" | "ssk" | "sku" | "rsk" | "rku" => (capitalised(name), String::new()),
+            _ => (capitalised(name), " m".to_string()),
+        };
+        println!("{label}: {}{unit}", format_number(v));
+    }
+}
+
+fn capitalised(name: &str) -> String {
+    let mut c = name.chars();
+    c.next()
+        .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+        .unwrap_or_default()
+}
+
 /// Runs `asperity stats`.
 pub fn run(args: &StatsArgs) -> Result<()> {
-    if let Some(size) = args.size {
-        ensure!(
-            size.is_finite() && size > 0.0,
-            "invalid --size: must be positive and finite, got {size}"
-        );
-    }
+    let size_x = match &args.size {
+        Some(text) => parse_size(text)?[0],
+        None => None,
+    };
     fit_bound("--fit-from", args.fit_from)?;
     fit_bound("--fit-to", args.fit_to)?;
     if let (Some(from), Some(to)) = (args.fit_from, args.fit_to) {
@@ -262,40 +413,27 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
     let staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
     staged.ensure_not_input(&args.file)?;
-    // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
-    // the file, checked from the header before the data are read.
-    let shape = read_npy_shape(&args.file)?;
-    ensure_fits(
-        &format!(
-            "computing the statistics of {} (shape {shape:?})",
-            args.file.display()
-        ),
-        array_bytes(&shape, 4 * 8),
-    )?;
-    let hints = sidecar_hints(&args.file);
-    let size = args.size.or(hints.size).unwrap_or(1.0);
-    let array = read_npy(&args.file)?;
-    let (summary, bins, dims, psd_offset): (Summary, Vec<PsdBin>, Vec<usize>, f64) =
-        match array.ndim() {
-            1 => {
-                let line = Line::new(array.into_dimensionality::<Ix1>()?, size)?;
-                (line_summary(&line), line_psd(&line), vec![line.len()], 1.0)
-            }
-            2 => {
-                let surface = Surface::new(array.into_dimensionality::<Ix2>()?, size)?;
-                let (r, c) = surface.dim();
-                (
-                    surface_summary(&surface),
-                    radial_psd_2d(&surface)?,
-                    vec![r, c],
-                    2.0,
-                )
-            }
-            d => bail!(
-                "{}: expected a 1D line or 2D surface, found {d} dimensions",
-                args.file.display()
-            ),
-        };
+    let measured = !is_npy(&args.file) || has_import_sidecar(&args.file);
+    // A measured file's sidecar (if any) is its import record, not a generator's spec.
+    let hints = if measured {
+        SidecarHints::default()
+    } else {
+        sidecar_hints(&args.file)
+    };
+    let inputs = if measured {
+        measured_inputs(args)?
+    } else {
+        npy_inputs(args, &hints, size_x)?
+    };
+    let Inputs {
+        summary,
+        bins,
+        dims,
+        psd_offset,
+        size,
+        iso,
+        record,
+    } = inputs;
     let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
     let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
     let plan = fit_range(args, &hints, nyquist)?;
@@ -332,22 +470,42 @@ pub fn run(args: &StatsArgs) -> Result<()> {
             "psd_slope": fit.map(|f| f.exponent), "psd_slope_low": fit.map(|f| f.low),
             "psd_slope_high": fit.map(|f| f.high), "fit_from": plan.range.map(|r| r.0),
             "fit_to": plan.range.map(|r| r.1), "fit_note": plan.note, "hurst_estimate": hurst,
+            "iso": iso, "measured": record,
         });
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
     let shape: Vec<String> = dims.iter().map(|d| d.to_string()).collect();
-    println!(
-        "file: {} ({}, size {size})",
-        args.file.display(),
-        shape.join(" x ")
-    );
+    match &record {
+        Some(r) => println!(
+            "file: {} ({}, {}, channel {}, sizes {} m; cleaning: {})",
+            args.file.display(),
+            r["format"].as_str().unwrap_or("?"),
+            shape.join(" x "),
+            r["channel"],
+            r["sizes"],
+            match r["cleaning"].as_array() {
+                Some(c) if !c.is_empty() => c
+                    .iter()
+                    .filter_map(|v| v.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+                _ => "none".to_string(),
+            }
+        ),
+        None => println!(
+            "file: {} ({}, size {size})",
+            args.file.display(),
+            shape.join(" x ")
+        ),
+    }
     println!("rms_height: {}", format_number(summary.rms_height));
     println!("rms_slope: {}", format_number(summary.rms_slope));
     match summary.rms_curvature {
         Some(c) => println!("rms_curvature: {}", format_number(c)),
-        None => println!("rms_curvature: n/a (grid too small)"),
+        None => println!("rms_curvature: n/a (grid too small or rectangular pixels)"),
     }
+    print_iso(&iso);
     match (fit, plan.range) {
         (Some(f), Some((from, to))) => {
             let end = match &plan.note {

@@ -1,0 +1,433 @@
+//! Measured topographies through the real binary: `import`, `stats`, `bem`, `mdr` and
+//! `contact` on the shared instrument files and on synthesised surfaces; bad files give one
+//! line and exit status 2, and leave nothing behind.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use ndarray::{ArrayD, Ix2};
+use ndarray_npy::ReadNpyExt;
+
+fn asperity(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it; a git
+/// worktree elsewhere sets `ASPERITY_TOPOGRAPHIES`), or `None` with a printed notice.
+fn shared() -> Option<PathBuf> {
+    let dir = std::env::var_os("ASPERITY_TOPOGRAPHIES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies")
+        });
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "skipped: {} is absent (the shared test files)",
+            dir.display()
+        );
+        None
+    }
+}
+
+fn npy(path: &Path) -> ArrayD<f64> {
+    ArrayD::<f64>::read_npy(std::fs::File::open(path).unwrap()).unwrap()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Refused: status 2, one line on stderr containing `needle`, no files left in `dir`
+/// besides `keep`.
+fn assert_refused(out: &Output, dir: &Path, keep: &[&str], needle: &str) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.contains(needle), "{needle:?} in {err}");
+    let mut left: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !keep.contains(&n.as_str()))
+        .collect();
+    left.sort();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+#[test]
+fn import_reads_the_shared_files_to_their_references() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    for name in [
+        "x3p-2.x3p",
+        "sdf-1.sdf",
+        "gwyddion-export-english.txt",
+        "txt_example.txt",
+        "matrix-3.txt",
+    ] {
+        let out_path = dir.path().join(format!("{name}.npy"));
+        let file = shared.join(name);
+        let out = asperity(
+            &[
+                "import",
+                file.to_str().unwrap(),
+                "--out",
+                out_path.to_str().unwrap(),
+                "--detrend",
+                "none",
+            ],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        // Ours is (row y, col x), the reference [x, y]: transposed.
+        let ours = npy(&out_path).into_dimensionality::<Ix2>().unwrap();
+        let reference = npy(&shared.join(format!("{name}.reference.npy")))
+            .into_dimensionality::<Ix2>()
+            .unwrap();
+        assert_eq!(ours.t().dim(), reference.dim(), "{name}");
+        for (a, b) in ours.t().iter().zip(reference.iter()) {
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(b.abs()),
+                "{name}: {a} vs {b}"
+            );
+        }
+        let sidecar = json(&dir.path().join(format!("{name}.npy.json")));
+        let record = json(&shared.join(format!("{name}.reference.json")));
+        for axis in 0..2 {
+            let (a, b) = (
+                sidecar["sizes"][axis].as_f64().unwrap(),
+                record["physical_sizes_m"][axis].as_f64().unwrap(),
+            );
+            assert!((a - b).abs() <= 1e-12 * b, "{name} size {axis}: {a} vs {b}");
+        }
+        assert_eq!(sidecar["unit"], "m");
+        assert_eq!(sidecar["cleaning"][0], "no levelling");
+    }
+}
+
+#[test]
+fn stats_of_a_measured_file_prints_iso_parameters() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = shared.join("x3p-2.x3p");
+    let out = asperity(&["stats", file.to_str().unwrap(), "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let record = json(&shared.join("x3p-2.x3p.reference.json"));
+    // Sq is the rms height about the mean: the reference's rms height.
+    let (sq, want) = (
+        v["iso"]["sq"].as_f64().unwrap(),
+        record["rms_height_m"].as_f64().unwrap(),
+    );
+    assert!((sq / want - 1.0).abs() < 1e-12, "{sq} vs {want}");
+    let sz = v["iso"]["sz"].as_f64().unwrap();
+    let range = record["max_m"].as_f64().unwrap() - record["min_m"].as_f64().unwrap();
+    assert!((sz / range - 1.0).abs() < 1e-12);
+    assert_eq!(v["measured"]["format"], "x3p");
+    // A profile gives the R parameters; text output names them with units.
+    let file = shared.join("dektak-1.csv");
+    let out = asperity(
+        &["stats", file.to_str().unwrap(), "--detrend", "mean"],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for p in ["Rq: ", "Ra: ", "Rz: ", "Rsk: ", "Rku: ", "Rdq: "] {
+        assert!(text.contains(p), "{p} in {text}");
+    }
+}
+
+#[test]
+fn bad_files_give_one_line_and_exit_2() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let x3p = std::fs::read(shared.join("x3p-2.x3p")).unwrap();
+    std::fs::write(d.join("cut.x3p"), &x3p[..x3p.len() / 2]).unwrap();
+    std::fs::write(d.join("junk.sur"), [0u8, 1, 2, 3, 4, 255, 0, 9]).unwrap();
+    std::fs::write(d.join("nosize.txt"), "1 2 3 4\n5 6 7 8\n9 10 11 12\n").unwrap();
+    std::fs::write(d.join("empty.txt"), "").unwrap();
+    std::fs::write(d.join("ragged.txt"), "1 2 3 4\n5 6 7\n").unwrap();
+    std::fs::write(
+        d.join("nan.txt"),
+        "# Width: 1 um\n# Height: 1 um\n# Value units: m\n1 nan 3 4\n5 6 7 8\n",
+    )
+    .unwrap();
+    std::fs::create_dir(d.join("folder.x3p")).unwrap();
+    let inputs = [
+        "cut.x3p",
+        "junk.sur",
+        "nosize.txt",
+        "empty.txt",
+        "ragged.txt",
+        "nan.txt",
+        "folder.x3p",
+    ];
+    let cases = [
+        ("cut.x3p", "x3p"),
+        ("junk.sur", "junk.sur"),
+        ("nosize.txt", "no physical size"),
+        ("empty.txt", "empty.txt"),
+        ("ragged.txt", "line 2"),
+        ("nan.txt", "1 of 8 points are undefined"),
+        ("folder.x3p", "not a regular file"),
+        ("missing.x3p", "missing.x3p"),
+    ];
+    for (file, needle) in cases {
+        let out = asperity(&["import", file, "--out", "s.npy", "--detrend", "mean"], d);
+        assert_refused(&out, d, &inputs, needle);
+        let out = asperity(&["stats", file], d);
+        assert_refused(&out, d, &inputs, needle);
+        let out = asperity(
+            &[
+                "contact",
+                file,
+                "--modulus",
+                "1e9",
+                "--pressures",
+                "1e5",
+                "--out",
+                "c.csv",
+            ],
+            d,
+        );
+        assert_refused(&out, d, &inputs, needle);
+    }
+    // Truncations of a real file: never a panic, always one line and status 2.
+    for cut in [0, 10, 100, 1000, 5000, x3p.len() - 100] {
+        std::fs::write(d.join("t.x3p"), &x3p[..cut]).unwrap();
+        let out = asperity(&["stats", "t.x3p"], d);
+        assert_refused(&out, d, &[&inputs[..], &["t.x3p"]].concat(), "t.x3p");
+    }
+    // Filling the undefined point lets it through.
+    let out = asperity(
+        &[
+            "import",
+            "nan.txt",
+            "--out",
+            "s.npy",
+            "--fill",
+            "harmonic",
+            "--detrend",
+            "none",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(json(&d.join("s.npy.json"))["cleaning"][1]
+        .as_str()
+        .unwrap()
+        .contains("harmonic"));
+}
+
+#[test]
+fn rectangular_pixels_are_refused_by_the_bem_until_it_takes_them() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = shared.join("x3p-2.x3p");
+    let out = asperity(
+        &[
+            "bem",
+            "--surface",
+            file.to_str().unwrap(),
+            "--modulus",
+            "1e9",
+            "--pressures",
+            "1e5",
+            "--out",
+            "b.csv",
+        ],
+        dir.path(),
+    );
+    assert_refused(&out, dir.path(), &[], "square pixels");
+}
+
+#[test]
+fn mdr_takes_a_measured_profile() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = shared.join("dektak-1.csv");
+    let out = asperity(
+        &[
+            "mdr",
+            "--line",
+            file.to_str().unwrap(),
+            "--detrend",
+            "mean",
+            "--modulus",
+            "1e9",
+            "--nloads",
+            "5",
+            "--out",
+            "m.csv",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(dir.path().join("m.csv")).unwrap();
+    assert_eq!(text.lines().count(), 6);
+}
+
+/// A paraboloid z = −(x² + y²)/(2R) in metres (Gwyddion text export with its header),
+/// pressed with a force F: Hertz gives the contact radius a = (3FR/(4E*))^(1/3), area πa²,
+/// stiffness 2aE*, one patch. On 96² pixels with a ≈ 8 and 17 pixels the pixelated
+/// circle's area and stiffness come within 1.5 % (boundary pixels; measured 1.5 % and
+/// 0.8 % at the smaller load): tolerance 3 %.
+#[test]
+fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, e_star) = (96usize, 20e-6, 1e-3, 1e9);
+    let dx = side / n as f64;
+    let mut text = format!(
+        "# Channel: Height\n# Width: {} um\n# Height: {} um\n# Value units: m\n",
+        side * 1e6,
+        side * 1e6
+    );
+    for r in 0..n {
+        let row: Vec<String> = (0..n)
+            .map(|c| {
+                let (x, y) = (
+                    (c as f64 - n as f64 / 2.0) * dx,
+                    (r as f64 - n as f64 / 2.0) * dx,
+                );
+                format!("{:e}", -(x * x + y * y) / (2.0 * radius))
+            })
+            .collect();
+        text += &row.join(" ");
+        text += "\n";
+    }
+    std::fs::write(d.join("sphere.txt"), text).unwrap();
+    let a_target: f64 = 3.5e-6;
+    let force = 4.0 * e_star * a_target.powi(3) / (3.0 * radius);
+    let pressure = force / (side * side);
+    let pressures = format!("{},{}", pressure / 8.0, pressure);
+    let out = asperity(
+        &[
+            "contact",
+            "sphere.txt",
+            "--young",
+            &format!("{}", e_star * (1.0 - 0.09)),
+            "--poisson",
+            "0.3",
+            "--pressures",
+            &pressures,
+            "--detrend",
+            "none",
+            "--out",
+            "c.csv",
+            "--plot",
+            "c.png",
+            "--map",
+            "m.png",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(d.join("c.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for row in &rows {
+        let f = row[col("force_n")];
+        assert!((f / (row[col("mean_pressure_pa")] * side * side) - 1.0).abs() < 1e-9);
+        let a = (3.0 * f * radius / (4.0 * e_star)).cbrt();
+        let area = row[col("contact_area_m2")];
+        assert!(
+            (area / (std::f64::consts::PI * a * a) - 1.0).abs() < 0.03,
+            "area {area} vs {}",
+            std::f64::consts::PI * a * a
+        );
+        let k = row[col("stiffness_n_per_m")];
+        assert!(
+            (k / (2.0 * a * e_star) - 1.0).abs() < 0.03,
+            "stiffness {k} vs {}",
+            2.0 * a * e_star
+        );
+        assert_eq!(row[col("patches")], 1.0);
+        assert!(row[col("mean_gap_m")] > 0.0);
+    }
+    let record = json(&d.join("c.csv.json"));
+    assert!((record["effective_modulus_pa"].as_f64().unwrap() / e_star - 1.0).abs() < 1e-12);
+    assert!(d.join("c.png").is_file() && d.join("m.png").is_file());
+}
+
+#[test]
+fn x3p_written_by_import_reads_back_bit_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = asperity(
+        &[
+            "surface",
+            "--n",
+            "32",
+            "--hurst",
+            "0.8",
+            "--rolloff",
+            "4",
+            "--rms-height",
+            "1e-7",
+            "--seed",
+            "2",
+            "--out",
+            "s.npy",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = asperity(
+        &[
+            "import",
+            "s.npy",
+            "--size",
+            "1e-5",
+            "--out",
+            "s.x3p",
+            "--detrend",
+            "none",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = asperity(
+        &["import", "s.x3p", "--out", "back.npy", "--detrend", "none"],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (npy(&d.join("s.npy")), npy(&d.join("back.npy")));
+    assert_eq!(a.shape(), b.shape());
+    assert!(a
+        .iter()
+        .zip(b.iter())
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
+    let sizes = &json(&d.join("back.npy.json"))["sizes"];
+    assert!((sizes[0].as_f64().unwrap() / 1e-5 - 1.0).abs() < 1e-15);
+    // The square-pixel X3P goes straight into the contact command.
+    let out = asperity(
+        &[
+            "contact",
+            "s.x3p",
+            "--modulus",
+            "1e9",
+            "--pressures",
+            "1e4,1e5",
+            "--detrend",
+            "plane",
+        ],
+        d,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 3);
+}

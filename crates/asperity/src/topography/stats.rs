@@ -1,0 +1,455 @@
+//! ISO 25178-2 areal and ISO 4287 profile parameters of a (levelled, filled) topography,
+//! in the units of its heights (metres for a file with a length unit).
+//!
+//! Heights are taken about their mean (the reference after the chosen levelling); no
+//! λs/λc filtering is applied (primary-surface / primary-profile parameters).
+//! * `Sq`, `Rq`: rms height; `Sa`, `Ra`: mean absolute height; `Ssk`, `Rsk`: skewness
+//!   `mean(z³)/Sq³`; `Sku`, `Rku`: kurtosis `mean(z⁴)/Sq⁴`.
+//! * `Sz`: maximum height, highest peak plus deepest pit (`max − min`). `Rz`: the mean over
+//!   five sampling lengths (the profile cut into five equal sections, ISO 4288's default)
+//!   of each section's highest peak plus deepest valley; profiles of fewer than 10 points
+//!   are one section.
+//! * `Sdq`: rms gradient, and `Sdr`: developed interfacial area ratio
+//!   `mean(sqrt(1 + |∇z|²)) − 1` (a fraction; × 100 for per cent), both from the gradient
+//!   at the centre of each grid cell, `∂z/∂x` the mean of the cell's two x-differences over
+//!   `Δx`, `∂z/∂y` likewise over `Δy` (pixels may be rectangular). For a plane wave this
+//!   gradient is the exact continuous one times a known factor, which is what the tests
+//!   check. `Rdq`: rms of the forward differences `Δz/Δx`.
+
+use ndarray::{ArrayView1, ArrayView2};
+use serde::Serialize;
+
+use crate::{Error, Result};
+
+/// ISO 25178-2 areal parameters (heights' unit; `sdq`, `sdr` dimensionless).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ArealParameters {
+    /// Root mean square height.
+    pub sq: f64,
+    /// Arithmetic mean height.
+    pub sa: f64,
+    /// Maximum height (peak to pit).
+    pub sz: f64,
+    /// Skewness.
+    pub ssk: f64,
+    /// Kurtosis.
+    pub sku: f64,
+    /// Root mean square gradient.
+    pub sdq: f64,
+    /// Developed interfacial area ratio, as a fraction.
+    pub sdr: f64,
+}
+
+/// ISO 4287 profile parameters (heights' unit; `rdq` dimensionless).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ProfileParameters {
+    /// Root mean square height.
+    pub rq: f64,
+    /// Arithmetic mean height.
+    pub ra: f64,
+    /// Mean over five sampling lengths of the maximum height (peak plus valley).
+    pub rz: f64,
+    /// Skewness.
+    pub rsk: f64,
+    /// Kurtosis.
+    pub rku: f64,
+    /// Root mean square slope.
+    pub rdq: f64,
+}
+
+/// Mean, and the central moments 2–4 with the mean absolute deviation.
+struct Moments {
+    rms: f64,
+    abs: f64,
+    skew: f64,
+    kurt: f64,
+}
+
+fn moments(values: impl Iterator<Item = f64> + Clone) -> Moments {
+    let (sum, n) = values
+        .clone()
+        .fold((0.0, 0.0), |(s, n), v| (s + v, n + 1.0));
+    let mean = sum / n;
+    let (mut a, mut m2, mut m3, mut m4) = (0.0, 0.0, 0.0, 0.0);
+    for v in values {
+        let d = v - mean;
+        a += d.abs();
+        m2 += d * d;
+        m3 += d * d * d;
+        m4 += d * d * d * d;
+    }
+    let (a, m2, m3, m4) = (a / n, m2 / n, m3 / n, m4 / n);
+    let rms = m2.sqrt();
+    // A flat surface has no defined skewness or kurtosis: report 0 and 0, never NaN.
+    let (skew, kurt) = if m2 > 0.0 {
+        (m3 / (rms * m2), m4 / (m2 * m2))
+    } else {
+        (0.0, 0.0)
+    };
+    Moments {
+        rms,
+        abs: a,
+        skew,
+        kurt,
+    }
+}
+
+fn ensure_usable(values: impl Iterator<Item = f64>, spacings: &[f64], min: usize) -> Result<()> {
+    let mut n = 0;
+    for v in values {
+        if !v.is_finite() {
+            return Err(Error::invalid(
+                "heights",
+                "undefined or non-finite points: fill them before computing parameters",
+            ));
+        }
+        n += 1;
+    }
+    if n < min {
+        return Err(Error::invalid(
+            "heights",
+            format!("at least {min} points are needed, got {n}"),
+        ));
+    }
+    if let Some(s) = spacings.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(Error::invalid(
+            "spacing",
+            format!("must be positive and finite, got {s}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The areal parameters of a map, rows along y, pixel spacings `dx`, `dy`.
+pub fn areal(h: ArrayView2<f64>, dx: f64, dy: f64) -> Result<ArealParameters> {
+    let (ny, nx) = h.dim();
+    if ny < 2 || nx < 2 {
+        return Err(Error::invalid(
+            "heights",
+            format!("a map of at least 2 x 2 points is needed, got {ny} x {nx}"),
+        ));
+    }
+    ensure_usable(h.iter().copied(), &[dx, dy], 4)?;
+    let m = moments(h.iter().copied());
+    let (min, max) = h
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let (mut g2, mut area) = (0.0, 0.0);
+    for r in 0..ny - 1 {
+        for c in 0..nx - 1 {
+            let gx = (h[(r, c + 1)] - h[(r, c)] + h[(r + 1, c + 1)] - h[(r + 1, c)]) / (2.0 * dx);
+            let gy = (h[(r + 1, c)] - h[(r, c)] + h[(r + 1, c + 1)] - h[(r, c + 1)]) / (2.0 * dy);
+            let s = gx * gx + gy * gy;
+            g2 += s;
+            // sqrt(1 + s) − 1 without cancellation for small slopes.
+            area += s / ((1.0 + s).sqrt() + 1.0);
+        }
+    }
+    let cells = ((ny - 1) * (nx - 1)) as f64;
+    Ok(ArealParameters {
+        sq: m.rms,
+        sa: m.abs,
+        sz: max - min,
+        ssk: m.skew,
+        sku: m.kurt,
+        sdq: (g2 / cells).sqrt(),
+        sdr: area / cells,
+    })
+}
+
+/// The profile parameters of a line profile with spacing `dx`.
+pub fn profile(z: ArrayView1<f64>, dx: f64) -> Result<ProfileParameters> {
+    ensure_usable(z.iter().copied(), &[dx], 2)?;
+    let n = z.len();
+    let m = moments(z.iter().copied());
+    let sections = if n >= 10 { 5 } else { 1 };
+    let mut rz = 0.0;
+    for s in 0..sections {
+        let part = z.slice(ndarray::s![s * n / sections..(s + 1) * n / sections]);
+        let (lo, hi) = part
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        rz += hi - lo;
+    }
+    let slopes = (1..n)
+        .map(|i| ((z[i] - z[i - 1]) / dx).powi(2))
+        .sum::<f64>();
+    Ok(ProfileParameters {
+        rq: m.rms,
+        ra: m.abs,
+        rz: rz / sections as f64,
+        rsk: m.skew,
+        rku: m.kurt,
+        rdq: (slopes / (n - 1) as f64).sqrt(),
+    })
+}
+
+/// Radially averaged 2D PSD `C2D(q)` of a map with sizes `size_x`, `size_y` (pixels may be
+/// rectangular), in physical units: `q` in radians per unit length, `C2D` in length⁴,
+/// normalised so that `Σ_q C2D(q) (2π)²/A = rms²` over all modes. Rings of width `2π/L_x`
+/// centred on integer `κ = q L_x/2π`, from 1 up to the smaller of the two Nyquist
+/// wavenumbers — the binning of [`crate::surface::stats::radial_psd_2d`], which this equals
+/// for square pixels, with `q_y = 2π k_y / L_y`.
+pub fn radial_psd(
+    h: ArrayView2<f64>,
+    size_x: f64,
+    size_y: f64,
+) -> Result<Vec<crate::surface::stats::PsdBin>> {
+    use num_complex::Complex64;
+    let (rows, cols) = h.dim();
+    ensure_usable(h.iter().copied(), &[size_x, size_y], 4)?;
+    let mean = h.mean().unwrap_or(0.0);
+    let mut centred = crate::memory::try_vec("the PSD's copy of the map", rows * cols, 0.0)?;
+    for (c, v) in centred.iter_mut().zip(h.iter()) {
+        *c = v - mean;
+    }
+    let mut fft = crate::fft::RealFft2::new(rows, cols)?;
+    let mut spectrum = crate::memory::try_vec(
+        "the PSD's spectrum",
+        fft.spectrum_len(),
+        Complex64::default(),
+    )?;
+    fft.forward(&centred, &mut spectrum);
+    // κ_y in units of 2π/L_x.
+    let aspect = size_x / size_y;
+    let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
+    let norm = size_x * size_y / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
+    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+    let last = cols / 2;
+    for (kx, column) in spectrum.chunks(rows).enumerate() {
+        // Columns 0 < kx < cols/2 stand for ±kx.
+        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
+            1
+        } else {
+            2
+        };
+        for (index, value) in column.iter().enumerate() {
+            let ky = if index <= rows / 2 {
+                index as f64
+            } else {
+                index as f64 - rows as f64
+            };
+            let kappa = (kx as f64).hypot(ky * aspect);
+            let bin = kappa.round() as usize;
+            if bin == 0 || bin > kappa_max {
+                continue;
+            }
+            let s = &mut sums[bin];
+            s.0 += weight as f64 * kappa;
+            s.1 += weight as f64 * value.norm_sqr() * norm;
+            s.2 += weight;
+        }
+    }
+    Ok(sums
+        .into_iter()
+        .skip(1)
+        .filter(|s| s.2 > 0)
+        .map(|(k, p, m)| crate::surface::stats::PsdBin {
+            q: std::f64::consts::TAU / size_x * k / m as f64,
+            psd: p / m as f64,
+            modes: m,
+        })
+        .collect())
+}
+
+/// rms slope from forward differences, `sqrt(mean((Δz/Δx)²) + mean((Δz/Δy)²))` over the
+/// neighbouring pairs inside the grid (the crate's definition, see
+/// [`crate::surface::stats`]), with separate spacings for rectangular pixels.
+pub fn rms_slope_forward(h: ArrayView2<f64>, dx: f64, dy: f64) -> f64 {
+    let (ny, nx) = h.dim();
+    let mean_square = |pairs: usize, sum: f64| if pairs == 0 { 0.0 } else { sum / pairs as f64 };
+    let sx: f64 = h
+        .rows()
+        .into_iter()
+        .map(|r| {
+            r.windows(2)
+                .into_iter()
+                .map(|w| ((w[1] - w[0]) / dx).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    let sy: f64 = h
+        .columns()
+        .into_iter()
+        .map(|c| {
+            c.windows(2)
+                .into_iter()
+                .map(|w| ((w[1] - w[0]) / dy).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (mean_square(ny * (nx - 1), sx) + mean_square(nx * (ny - 1), sy)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ndarray::{Array1, Array2};
+    use std::f64::consts::PI;
+
+    fn close(a: f64, b: f64, rel: f64, what: &str) {
+        assert!(
+            (a - b).abs() <= rel * b.abs().max(1e-300),
+            "{what}: {a} vs {b}"
+        );
+    }
+
+    /// Complete elliptic integral of the second kind E(m) by the arithmetic–geometric mean.
+    fn elliptic_e(m: f64) -> f64 {
+        let (mut a, mut b) = (1.0f64, (1.0 - m).sqrt());
+        let mut sum = m / 2.0; // 2^(n−1) c_n² for n = 0, c_0² = m
+        let mut power = 0.5;
+        for _ in 0..40 {
+            let c = (a - b) / 2.0;
+            let (a1, b1) = ((a + b) / 2.0, (a * b).sqrt());
+            power *= 2.0;
+            sum += power * c * c;
+            a = a1;
+            b = b1;
+        }
+        PI / (2.0 * a) * (1.0 - sum)
+    }
+
+    #[test]
+    fn elliptic_e_known_values() {
+        close(elliptic_e(0.0), PI / 2.0, 1e-15, "E(0)");
+        close(elliptic_e(0.5), 1.350_643_881_047_675_5, 1e-14, "E(1/2)");
+    }
+
+    /// z = A sin(2π x/λ), λ = M Δx, on j whole periods plus one point (a non-periodic
+    /// grid: N = jM + 1 samples, the last at phase 2πj where sin = 0). Closed forms of the
+    /// sampled sinusoid: Σ sin² = jM/2, Σ |sin| = 2j cot(π/M) (M even), Σ sin³ = 0,
+    /// Σ sin⁴ = 3jM/8 (M ≥ 5); max − min = 2A when M is a multiple of 4; forward
+    /// differences are (2A sin(π/M)/Δx) cos(phase + π/M), whose mean square over whole
+    /// periods is half the square amplitude.
+    #[test]
+    fn sinusoid_profile_and_map_match_closed_forms() {
+        let (a, m, j, dx, dy) = (2.5e-7, 64usize, 5usize, 0.3e-6, 0.7e-6);
+        let n = j * m + 1;
+        let wave = |i: usize| a * (2.0 * PI * i as f64 / m as f64).sin();
+        let nf = n as f64;
+        let jm = (j * m) as f64;
+        let sq = a * (jm / 2.0 / nf).sqrt();
+        let sa = a * 2.0 * j as f64 / (PI / m as f64).tan() / nf;
+        let sku = (3.0 * jm / 8.0 / nf) / (jm / 2.0 / nf).powi(2);
+        let slope = 2.0 * a * (PI / m as f64).sin() / dx / 2f64.sqrt();
+        // Profile (five sections of 64 points, each with a whole period).
+        let z = Array1::from_shape_fn(n, wave);
+        let p = profile(z.view(), dx).unwrap();
+        close(p.rq, sq, 1e-13, "Rq");
+        close(p.ra, sa, 1e-13, "Ra");
+        close(p.rz, 2.0 * a, 1e-13, "Rz");
+        assert!(p.rsk.abs() < 1e-12, "Rsk {}", p.rsk);
+        close(p.rku, sku, 1e-12, "Rku");
+        close(p.rdq, slope, 1e-12, "Rdq");
+        // The same wave along x of a map (rows identical, Δy ≠ Δx).
+        let h = Array2::from_shape_fn((7, n), |(_, c)| wave(c));
+        let s = areal(h.view(), dx, dy).unwrap();
+        close(s.sq, sq, 1e-13, "Sq");
+        close(s.sa, sa, 1e-13, "Sa");
+        close(s.sz, 2.0 * a, 1e-13, "Sz");
+        assert!(s.ssk.abs() < 1e-12);
+        close(s.sku, sku, 1e-12, "Sku");
+        close(s.sdq, slope, 1e-12, "Sdq");
+    }
+
+    /// A plane wave z = A sin(a x + b y) on rectangular pixels: the cell-centre gradient is
+    /// G cos(θ_c) with G² = (2A sin(aΔx/2) cos(bΔy/2)/Δx)² + (2A sin(bΔy/2) cos(aΔx/2)/Δy)²,
+    /// so Sdq = G/√2 and Sdr = (2/π) sqrt(1 + G²) E(G²/(1 + G²)) − 1 (the mean of
+    /// sqrt(1 + G² cos² θ) over whole periods; the sampled mean equals it to rounding, the
+    /// integrand's Fourier coefficients decaying geometrically).
+    #[test]
+    fn plane_wave_on_rectangular_pixels_sdq_sdr() {
+        let (amp, dx, dy) = (0.6e-6, 0.5e-6, 1.25e-6);
+        let (cx, cy, mx, my) = (48usize, 40usize, 5.0, 3.0); // cells per axis, periods
+        let (a, b) = (
+            2.0 * PI * mx / (cx as f64 * dx),
+            2.0 * PI * my / (cy as f64 * dy),
+        );
+        let h = Array2::from_shape_fn((cy + 1, cx + 1), |(r, c)| {
+            amp * (a * c as f64 * dx + b * r as f64 * dy).sin()
+        });
+        let s = areal(h.view(), dx, dy).unwrap();
+        let gx = 2.0 * amp * (a * dx / 2.0).sin() * (b * dy / 2.0).cos() / dx;
+        let gy = 2.0 * amp * (b * dy / 2.0).sin() * (a * dx / 2.0).cos() / dy;
+        let g2 = gx * gx + gy * gy;
+        close(s.sdq, (g2 / 2.0).sqrt(), 1e-12, "Sdq");
+        let sdr = 2.0 / PI * (1.0 + g2).sqrt() * elliptic_e(g2 / (1.0 + g2)) - 1.0;
+        close(s.sdr, sdr, 1e-11, "Sdr");
+        assert!(g2 > 0.5, "a test with slopes of order one: G² = {g2}");
+    }
+
+    #[test]
+    fn forward_rms_slope_matches_the_square_pixel_definition() {
+        let h = Array2::from_shape_fn((9, 13), |(r, c)| ((r * 5 + c * 3) as f64 * 0.7).sin());
+        let ours = rms_slope_forward(h.view(), 0.25, 0.25);
+        let crate_wide = crate::surface::stats::rms_slope_2d(h.view(), 0.25);
+        close(ours, crate_wide, 1e-13, "rms slope");
+        // Along x only, Δy does not matter.
+        let wave = Array2::from_shape_fn((4, 9), |(_, c)| c as f64 * 2.0);
+        close(
+            rms_slope_forward(wave.view(), 0.5, 3.0),
+            4.0,
+            1e-15,
+            "slope 4",
+        );
+    }
+
+    #[test]
+    fn psd_equals_the_square_pixel_one_and_holds_a_plane_wave_on_rectangular_pixels() {
+        let h = Array2::from_shape_fn((24, 32), |(r, c)| {
+            ((r * 7 + c * 3) as f64 * 0.37).sin() + (c as f64 * 0.11).cos()
+        });
+        let surface = crate::surface::Surface::new(h.clone(), 3.2).unwrap();
+        let theirs = crate::surface::stats::radial_psd_2d(&surface).unwrap();
+        let ours = radial_psd(h.view(), 3.2, 2.4).unwrap();
+        assert_eq!(ours.len(), theirs.len());
+        for (a, b) in ours.iter().zip(&theirs) {
+            close(a.q, b.q, 1e-14, "q");
+            close(a.psd, b.psd, 1e-12, "psd");
+        }
+        // A plane wave A cos(2π(3x/Lx + 2y/Ly)) with Lx = 2e-5 m, Ly = 1e-5 m on 40 x 30
+        // pixels: all its power A²/2 in the ring κ = round(hypot(3, 2 Lx/Ly)) = 5,
+        // in m⁴: Σ C (2π)²/A_nominal over the ring's modes = A²/2.
+        let (lx, ly, amp) = (2e-5, 1e-5, 3e-8);
+        let (ny, nx) = (30, 40);
+        let wave = Array2::from_shape_fn((ny, nx), |(r, c)| {
+            let (x, y) = (c as f64 * lx / nx as f64, r as f64 * ly / ny as f64);
+            amp * (2.0 * PI * (3.0 * x / lx + 2.0 * y / ly)).cos()
+        });
+        let bins = radial_psd(wave.view(), lx, ly).unwrap();
+        let power = |b: &crate::surface::stats::PsdBin| {
+            b.psd * b.modes as f64 * (2.0 * PI).powi(2) / (lx * ly)
+        };
+        // The ring holding the power is κ = 5 (its q is the mean over all the ring's modes,
+        // within half a ring of 5).
+        let ring = bins
+            .iter()
+            .max_by(|a, b| power(a).total_cmp(&power(b)))
+            .unwrap();
+        assert!(
+            (ring.q * lx / (2.0 * PI) - 5.0).abs() < 0.5,
+            "ring at {}",
+            ring.q
+        );
+        close(power(ring), amp * amp / 2.0, 1e-12, "ring power");
+        let rest: f64 = bins.iter().map(power).sum::<f64>() - power(ring);
+        assert!(rest.abs() < 1e-12 * amp * amp, "other rings hold {rest}");
+    }
+
+    #[test]
+    fn undefined_points_are_refused() {
+        let mut h = Array2::<f64>::zeros((3, 3));
+        h[(1, 1)] = f64::NAN;
+        assert!(areal(h.view(), 1.0, 1.0).is_err());
+        let flat = areal(Array2::<f64>::zeros((3, 3)).view(), 1.0, 1.0).unwrap();
+        assert_eq!(
+            (flat.sq, flat.ssk, flat.sku, flat.sdr),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+    }
+}
