@@ -142,32 +142,7 @@ pub fn radial_psd_2d(surface: &Surface) -> Result<Vec<PsdBin>> {
     let aspect = cols as f64 / rows as f64;
     let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
     let norm = area / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
-    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
-    let half = cols / 2 + 1;
-    for (kx, column) in spectrum.chunks(rows).enumerate() {
-        // Columns 0 < kx < cols/2 stand for ±kx: weight 2 keeps the average over the ring.
-        let weight = if kx == 0 || (cols % 2 == 0 && kx == half - 1) {
-            1
-        } else {
-            2
-        };
-        for (ky_index, value) in column.iter().enumerate() {
-            let ky = if ky_index <= rows / 2 {
-                ky_index as f64
-            } else {
-                ky_index as f64 - rows as f64
-            };
-            let kappa = (kx as f64).hypot(ky * aspect);
-            let bin = kappa.round() as usize;
-            if bin == 0 || bin > kappa_max {
-                continue;
-            }
-            let s = &mut sums[bin];
-            s.0 += weight as f64 * kappa;
-            s.1 += weight as f64 * value.norm_sqr() * norm;
-            s.2 += weight;
-        }
-    }
+    let sums = ring_sums(&spectrum, rows, cols, aspect, kappa_max, norm);
     Ok(sums
         .into_iter()
         .skip(1)
@@ -232,6 +207,46 @@ pub fn line_summary(line: &Line) -> Summary {
         rms_slope: rms_slope_1d(h, line.spacing()),
         rms_curvature: rms_curvature_1d(h, line.spacing()),
     }
+}
+
+/// Sums over the rings `round(|(kx, ky·aspect)|) = κ` of a half spectrum in transposed
+/// layout (`cols/2+1` columns of `rows`): per ring `(Σ w κ, Σ w |c|² norm, Σ w)`, where
+/// `w = 2` for the columns `0 < kx < cols/2` that stand for ±kx; index 0 of the result
+/// is unused (the mean is no ring).
+pub(crate) fn ring_sums(
+    spectrum: &[num_complex::Complex64],
+    rows: usize,
+    cols: usize,
+    aspect: f64,
+    kappa_max: usize,
+    norm: f64,
+) -> Vec<(f64, f64, usize)> {
+    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+    let last = cols / 2;
+    for (kx, column) in spectrum.chunks(rows).enumerate() {
+        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
+            1
+        } else {
+            2
+        };
+        for (index, value) in column.iter().enumerate() {
+            let ky = if index <= rows / 2 {
+                index as f64
+            } else {
+                index as f64 - rows as f64
+            };
+            let kappa = (kx as f64).hypot(ky * aspect);
+            let bin = kappa.round() as usize;
+            if bin == 0 || bin > kappa_max {
+                continue;
+            }
+            let s = &mut sums[bin];
+            s.0 += weight as f64 * kappa;
+            s.1 += weight as f64 * value.norm_sqr() * norm;
+            s.2 += weight;
+        }
+    }
+    sums
 }
 
 #[cfg(test)]

@@ -218,32 +218,7 @@ pub fn radial_psd(
     let aspect = size_x / size_y;
     let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
     let norm = size_x * size_y / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
-    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
-    let last = cols / 2;
-    for (kx, column) in spectrum.chunks(rows).enumerate() {
-        // Columns 0 < kx < cols/2 stand for ±kx.
-        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
-            1
-        } else {
-            2
-        };
-        for (index, value) in column.iter().enumerate() {
-            let ky = if index <= rows / 2 {
-                index as f64
-            } else {
-                index as f64 - rows as f64
-            };
-            let kappa = (kx as f64).hypot(ky * aspect);
-            let bin = kappa.round() as usize;
-            if bin == 0 || bin > kappa_max {
-                continue;
-            }
-            let s = &mut sums[bin];
-            s.0 += weight as f64 * kappa;
-            s.1 += weight as f64 * value.norm_sqr() * norm;
-            s.2 += weight;
-        }
-    }
+    let sums = crate::surface::stats::ring_sums(&spectrum, rows, cols, aspect, kappa_max, norm);
     Ok(sums
         .into_iter()
         .skip(1)
