@@ -9,6 +9,7 @@ mod output;
 mod plot;
 #[allow(dead_code)]
 mod progress;
+mod rerun;
 
 use clap::Parser;
 

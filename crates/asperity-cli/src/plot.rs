@@ -147,9 +147,17 @@ fn tick_label(v: f64) -> String {
 impl Chart {
     /// Writes the chart as PNG and SVG, both or neither.
     pub fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()> {
-        register_fonts();
         let mut staged = StagedOutputs::new([png, svg], force)?;
-        stage_png(&mut staged, png, SIZE, |root| self.render(root))?;
+        self.stage(&mut staged, png, svg)?;
+        staged.commit()?;
+        Ok(())
+    }
+
+    /// Stages the chart as the outputs `png` and `svg` of `staged` (renamed into place
+    /// with the others on commit).
+    pub fn stage(&self, staged: &mut StagedOutputs, png: &Path, svg: &Path) -> Result<()> {
+        register_fonts();
+        stage_png(staged, png, SIZE, |root| self.render(root))?;
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
@@ -158,7 +166,6 @@ impl Chart {
                 .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
         }
         staged.write_bytes(svg, text.as_bytes())?;
-        staged.commit()?;
         Ok(())
     }
 

@@ -54,6 +54,14 @@ pub enum Error {
         /// What is wrong (truncated, wrong magic, impossible size, ...).
         reason: String,
     },
+    /// An input file cannot be read as given: not a regular file, too large, corrupt.
+    #[error("{path}: {reason}")]
+    BadInput {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An input array holds NaN or infinity.
     #[error("{what} holds a non-finite value ({value}) at index {index}")]
     NonFinite {
@@ -84,6 +92,14 @@ pub enum Error {
         dir: PathBuf,
         /// What differs.
         reason: String,
+    },
+    /// Another process holds the lock of an output folder ([`crate::lock::FolderLock`]).
+    #[error("{dir}: in use by another asperity process ({holder}); wait for it to finish, or use another folder")]
+    FolderInUse {
+        /// The folder.
+        dir: PathBuf,
+        /// Who holds it, e.g. `PID 1234`.
+        holder: String,
     },
     /// A contact solve inside a larger computation (a study sample) failed.
     #[error("{context}: {source}")]

@@ -10,20 +10,30 @@
 //! The temporary files (and folders made for outputs) of unfinished outputs are also listed
 //! process-wide, so that a program interrupted by a signal can remove them before it exits
 //! ([`abandon_unfinished_outputs`]).
-//! Inputs are validated on reading: `.npy` must hold float64 (C or Fortran order), have the
-//! expected number of dimensions, and contain finite values only.
+//! Inputs are validated on reading: `.npy` files are read by the bounded parser of
+//! [`crate::npy`] (regular files only, any real dtype converted to float64 losslessly, C or
+//! Fortran order), must have the expected number of dimensions, and contain finite values
+//! only.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard};
 
 use ndarray::{Array1, Array2, ArrayBase, ArrayD, Data, Ix1, Ix2};
-use ndarray_npy::npy::header::Header;
-use ndarray_npy::{ReadNpyError, ReadNpyExt, WriteNpyExt};
+use ndarray_npy::WriteNpyExt;
 use serde::Serialize;
 
 use crate::{ensure_finite, Error, Result};
+
+/// FNV-1a, 64 bits (Fowler–Noll–Vo: offset basis `0xcbf29ce484222325`, prime
+/// `0x100000001b3`): a checksum that detects accidental changes (edits, truncation,
+/// corruption), not forgery.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |hash, &b| {
+        (hash ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 
 /// Fails with [`Error::OutputExists`] when `path` exists and `force` is false.
 ///
@@ -81,12 +91,12 @@ pub fn sidecar_path(path: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
-/// The side length `spec.size` recorded in the JSON sidecar of `path`, if there is a
-/// readable one (surfaces and lines written by asperity have it).
-pub fn sidecar_size(path: &Path) -> Option<f64> {
-    let text = std::fs::read_to_string(sidecar_path(path)).ok()?;
-    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
-    value["spec"]["size"].as_f64()
+/// The side length `spec.size` recorded in the JSON sidecar of `path`, if it has a
+/// sidecar that records one; a sidecar that is corrupt, not a regular file, too large, or
+/// gives a size that is not a positive finite number is an error (see
+/// [`crate::input::read_sidecar`], the one set of rules for every command).
+pub fn sidecar_size(path: &Path) -> Result<Option<f64>> {
+    crate::input::sidecar_size(path)
 }
 
 fn bad_output(path: &Path, reason: impl Into<String>) -> Error {
@@ -103,6 +113,15 @@ fn checked_output_key(path: &Path, force: bool) -> Result<PathBuf> {
     let Some(name) = path.file_name() else {
         return Err(bad_output(path, "is not a file name"));
     };
+    if name.len() > 255 {
+        return Err(bad_output(
+            path,
+            format!(
+                "its name is {} bytes long; a file name may have at most 255",
+                name.len()
+            ),
+        ));
+    }
     let parent = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -138,7 +157,15 @@ fn temp_path(path: &Path, index: usize, extension: Option<&str>) -> PathBuf {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "output".into());
     let ext = extension.map(|e| format!(".{e}")).unwrap_or_default();
-    let tmp = format!(".{file_name}.{}.{index}.tmp{ext}", std::process::id());
+    // A long name is shortened (on a character boundary) so that the temporary name stays
+    // within the 255 bytes a file name may have: the output's own name may use them all.
+    let suffix = format!(".{}.{index}.tmp{ext}", std::process::id());
+    let room = 255usize.saturating_sub(suffix.len() + 1);
+    let mut cut = file_name.len().min(room);
+    while !file_name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    let tmp = format!(".{}{suffix}", &file_name[..cut]);
     path.with_file_name(tmp)
 }
 
@@ -350,6 +377,20 @@ impl StagedOutputs {
         self.write_npy(target, array)
     }
 
+    /// The FNV-1a-64 hash ([`fnv1a64`]) of every output staged so far, by target, read
+    /// back from its temporary file: for a record of what a command wrote, staged last and
+    /// committed with the outputs it describes.
+    pub fn fingerprints(&self) -> Result<Vec<(PathBuf, u64)>> {
+        let mut out = Vec::new();
+        for e in &self.entries {
+            if let Some(tmp) = &e.tmp {
+                let bytes = std::fs::read(tmp).map_err(|err| Error::io(tmp, err))?;
+                out.push((e.target.clone(), fnv1a64(&bytes)));
+            }
+        }
+        Ok(out)
+    }
+
     /// Renames every staged file into place. Fails, touching no target, if an output was
     /// not written or (without `force`) appeared meanwhile. Should a rename itself fail,
     /// the outputs already renamed that did not exist before are removed again.
@@ -473,33 +514,16 @@ pub fn write_npy_1d(path: &Path, force: bool, array: &Array1<f64>) -> Result<()>
 }
 
 /// The shape recorded in the header of a `.npy` file, read without loading the data (to
-/// size the work before reading a large file). Only the header is checked here; the data
-/// are validated by [`read_npy`].
+/// size the work before reading a large file). Only the header is checked here (by the
+/// bounded parser of [`crate::npy`]); the data are validated by [`read_npy`].
 pub fn read_npy_shape(path: &Path) -> Result<Vec<usize>> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let header =
-        Header::from_reader(&mut BufReader::new(file)).map_err(|e| Error::BadArrayFile {
-            path: path.to_path_buf(),
-            reason: format!("not a readable .npy array ({e})"),
-        })?;
-    Ok(header.shape)
+    Ok(crate::npy::read_header(path)?.0.shape)
 }
 
-/// Reads a float64 `.npy` of any dimension and checks that all values are finite.
+/// Reads a `.npy` of any real dtype and dimension as float64 (losslessly, see
+/// [`crate::npy`]) and checks that it is not empty and all values are finite.
 pub fn read_npy(path: &Path) -> Result<ArrayD<f64>> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let array = ArrayD::<f64>::read_npy(BufReader::new(file)).map_err(|e| {
-        let reason = match e {
-            ReadNpyError::WrongDescriptor(d) => {
-                format!("expected a float64 array, found dtype {d}")
-            }
-            other => format!("not a readable .npy array ({other})"),
-        };
-        Error::BadArrayFile {
-            path: path.to_path_buf(),
-            reason,
-        }
-    })?;
+    let array = crate::npy::read(path)?;
     if array.is_empty() {
         return Err(Error::BadArrayFile {
             path: path.to_path_buf(),
@@ -582,13 +606,12 @@ mod tests {
     }
 
     #[test]
-    fn float32_is_refused() {
+    fn float32_is_read_exactly() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("f32.npy");
-        let a = array![[1.0f32, 2.0], [3.0, 4.0]];
+        let a = array![[1.0f32, 0.1], [3.0, 4.0]];
         a.write_npy(File::create(&path).unwrap()).unwrap();
-        let err = read_npy_2d(&path).unwrap_err().to_string();
-        assert!(err.contains("float64"), "{err}");
+        assert_eq!(read_npy_2d(&path).unwrap(), a.mapv(f64::from));
     }
 
     #[test]
@@ -730,6 +753,6 @@ mod tests {
         let junk = dir.path().join("junk.npy");
         std::fs::write(&junk, b"hello world, not an array").unwrap();
         let err = read_npy_shape(&junk).unwrap_err().to_string();
-        assert!(err.contains("not a readable .npy"), "{err}");
+        assert!(err.contains("not a .npy array"), "{err}");
     }
 }

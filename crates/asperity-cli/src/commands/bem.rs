@@ -50,12 +50,12 @@ pub struct BemArgs {
     pub surface: PathBuf,
     /// Side length L along x (square pixels); defaults to the surface's sidecar or the
     /// measured file's size, else 1 for a .npy (a measured file without size is refused).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub size: Option<f64>,
     #[command(flatten)]
     pub measured: MeasuredArgs,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Boundary conditions: free (zero-padded, no periodic images; the paper's) or periodic.
     #[arg(long, default_value = "free", value_parser = ["free", "periodic"])]
@@ -64,7 +64,7 @@ pub struct BemArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         value_name = "F1,F2,…"
     )]
     pub forces: Option<Vec<f64>>,
@@ -72,7 +72,7 @@ pub struct BemArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         value_name = "P1,P2,…"
     )]
     pub pressures: Option<Vec<f64>>,
@@ -83,18 +83,18 @@ pub struct BemArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         value_name = "D1,D2,…"
     )]
     pub indentations: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
-    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"], allow_negative_numbers = true)]
+    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"], allow_hyphen_values = true)]
     pub nloads: Option<usize>,
     /// Smallest mean pressure for --nloads.
     #[arg(
         long,
         value_name = "P",
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         requires = "nloads"
     )]
     pub pmin: Option<f64>,
@@ -102,12 +102,12 @@ pub struct BemArgs {
     #[arg(
         long,
         value_name = "P",
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         requires = "nloads"
     )]
     pub pmax: Option<f64>,
     /// Convergence tolerance: rms gap violation on the contact set over the rms height.
-    #[arg(long, default_value_t = SolverParams::default().tolerance, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SolverParams::default().tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// The solver: bccg (default; Fourier-preconditioned bound-constrained conjugate
     /// gradients without restart, tens of iterations) or pk (Polonsky & Keer 1999, the
@@ -116,7 +116,7 @@ pub struct BemArgs {
     #[arg(long, default_value = "bccg", value_parser = ["bccg", "pk"])]
     pub solver: String,
     /// Maximum solver iterations per load.
-    #[arg(long, default_value_t = SolverParams::default().max_iterations, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SolverParams::default().max_iterations, allow_hyphen_values = true)]
     pub max_iter: usize,
     /// Output table (CSV); printed to stdout when absent. Its inputs go to OUT.csv.json
     /// beside it (surface, L and its source, E*, boundary, tolerance, loads, columns).
@@ -467,6 +467,22 @@ fn sweep_charts(
     [stiffness, area]
 }
 
+/// The largest `--tol`: a relative residual of 1e-2 (gaps on the contact set of 1 % of the
+/// rms height) is already far coarser than any use of the results; at 1 and above the
+/// criterion means nothing.
+const MAX_TOL: f64 = 1e-2;
+
+/// `--tol` in (0, [`MAX_TOL`]].
+fn check_tolerance(tol: f64) -> Result<()> {
+    if !(tol > 0.0 && tol <= MAX_TOL) {
+        bail!(
+            "--tol must be positive and at most {MAX_TOL:e} (a relative residual), got {}",
+            asperity::input::short_number(tol)
+        );
+    }
+    Ok(())
+}
+
 /// Runs `asperity bem`.
 pub fn run(args: &BemArgs) -> Result<()> {
     // 1. Everything that can be checked before solving.
@@ -483,9 +499,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
             bail!("--size must be positive and finite, got {size}");
         }
     }
-    if !(args.tol.is_finite() && args.tol > 0.0) {
-        bail!("--tol must be positive and finite, got {}", args.tol);
-    }
+    check_tolerance(args.tol)?;
     let solver: SolverKind = args.solver.parse()?;
     let params = SolverParams {
         solver,
@@ -570,7 +584,11 @@ pub fn run(args: &BemArgs) -> Result<()> {
         };
         (surface, source)
     } else {
-        let (size, size_source) = match (args.size, asperity::io::sidecar_size(&args.surface)) {
+        let sidecar_size = match args.size {
+            Some(_) => None,
+            None => asperity::io::sidecar_size(&args.surface)?,
+        };
+        let (size, size_source) = match (args.size, sidecar_size) {
             (Some(size), _) => (size, SizeSource::Flag),
             (None, Some(size)) => (size, SizeSource::Sidecar),
             (None, None) => (1.0, SizeSource::Default),

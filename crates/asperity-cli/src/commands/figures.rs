@@ -171,7 +171,8 @@ fn setting(quick: bool) -> &'static str {
     }
 }
 
-/// Runs one study of a figure in `dir/<name>/` (its own checkpoint) and returns results.
+/// Runs one study of a figure in `dir/<name>/` (its own checkpoint, lock and record of
+/// outputs) and returns results; `discard` is the user's --force.
 fn figure_study(
     dir: &Path,
     name: &str,
@@ -180,18 +181,12 @@ fn figure_study(
     force: bool,
 ) -> Result<Vec<TaskResult>> {
     let sub = dir.join(name);
-    let outputs = super::study::outputs(kind, &sub);
     let options = RunOptions {
         force,
         quiet: false,
         checkpoint_every: asperity::study::CHECKPOINT_INTERVAL,
     };
-    let results = execute(spec, &sub, options, &outputs)?;
-    match kind {
-        Kind::Alpha => write_alpha(&sub, &results, force)?,
-        Kind::Curve => write_curves(&sub, &results, force, "curve")?,
-    }
-    Ok(results)
+    execute(spec, &sub, options, kind)
 }
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {
@@ -214,7 +209,7 @@ fn alpha_rows_md(results: &[TaskResult]) -> String {
 }
 
 /// Paper Fig. 1: α(H) from MDR (N = 2^9, 2^11, 2^15) and BEM (N = 2^7 … 2^10).
-pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
+pub fn fig1(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
     let hursts = parse_range("-1:3:0.25")?;
     // MDR is cheap (the paper's 25 500 lines take seconds): --quick keeps its setting.
     let mdr = study_spec(
@@ -230,17 +225,14 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
         (vec![1 << 7, 1 << 8, 1 << 9, 1 << 10], 60, hursts)
     };
     let bem = study_spec(Method::Bem, bem_sizes, bem_hursts, bem_samples, None);
-    let start = std::time::Instant::now();
-    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, force)?;
-    let mdr_seconds = start.elapsed().as_secs_f64();
-    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, force)?;
-    let bem_seconds = start.elapsed().as_secs_f64() - mdr_seconds;
+    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
+    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();
     write_alpha(dir, &all, force)?;
     let report = format!(
         "# Fig. 1: exponent α of k ∝ F^α versus H\n\n{}\n\n\
-         - MDR: N = {:?}, {} samples per (N, H), H = {}; {:.1} s in this run.\n\
-         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {}; {:.1} s in this run.\n\
+         - MDR: N = {:?}, {} samples per (N, H), H = {}.\n\
+         - BEM: free boundaries, N = {:?}, {} samples per (N, H), H = {}.\n\
          - α window: {}; α is fitted on the ensemble-mean k(F) (column `alpha`), and per sample\n  \
            (`alpha_low`, `alpha_high`: 2.5 % and 97.5 % of the per-sample values).\n\n\
          Files: `alpha.csv`, `alpha.png`, `alpha.svg` (both methods with the theory curves);\n\
@@ -254,11 +246,9 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
         mdr.sizes,
         mdr.samples,
         describe_hursts(&mdr.hursts),
-        mdr_seconds,
         bem.sizes,
         bem.samples,
         describe_hursts(&bem.hursts),
-        bem_seconds,
         mdr.window.describe(),
         alpha_rows_md(&all)
     );
@@ -266,14 +256,14 @@ pub fn fig1(dir: &Path, quick: bool, force: bool) -> Result<()> {
 }
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
-pub fn fig2(dir: &Path, quick: bool, force: bool) -> Result<()> {
+pub fn fig2(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
     let (n, samples, hursts) = if quick {
         (128, 20, vec![-1.0, 0.0, 1.0, 2.0, 3.0])
     } else {
         (1024, 60, parse_range("-1:3:0.5")?)
     };
     let spec = study_spec(Method::Bem, vec![n], hursts, samples, Some(6.0));
-    let results = figure_study(dir, "bem", &spec, Kind::Curve, force)?;
+    let results = figure_study(dir, "bem", &spec, Kind::Curve, discard)?;
     write_curves(dir, &results, force, "fig2")?;
     let mut md = String::from(
         "| H | low-force α (window) | steepest slope over a decade of F (paper: ≈ 1) | contact fraction there |\n\
@@ -333,7 +323,7 @@ pub fn fig2(dir: &Path, quick: bool, force: bool) -> Result<()> {
 }
 
 /// Paper Fig. 5: α versus N for H < 0 against eq. (24).
-pub fn fig5(dir: &Path, quick: bool, force: bool) -> Result<()> {
+pub fn fig5(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
     let mdr_sizes: Vec<usize> = (6..=16).map(|m| 1usize << m).collect();
     let mdr = study_spec(Method::Mdr, mdr_sizes, vec![-0.5], 500, None);
     let bem_sizes = if quick {
@@ -348,8 +338,8 @@ pub fn fig5(dir: &Path, quick: bool, force: bool) -> Result<()> {
         if quick { 20 } else { 60 },
         None,
     );
-    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, force)?;
-    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, force)?;
+    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
+    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
     let mut table = Table::new(&[
         "method",
         "n_interpretation",

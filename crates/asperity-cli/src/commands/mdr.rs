@@ -94,23 +94,23 @@ pub struct MdrArgs {
     #[arg(long, conflicts_with = "line")]
     pub n: Option<usize>,
     /// Spring spacing Δx for --profile / --radial (a line's is size / n).
-    #[arg(long, allow_negative_numbers = true, conflicts_with = "line")]
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "line")]
     pub dx: Option<f64>,
     /// Line length L (--line: default the sidecar's, else 1; fractal law with a profile:
     /// default n·Δx).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub size: Option<f64>,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Spring law.
     #[arg(long, value_enum, default_value_t = SpringKind::Linear)]
     pub spring: SpringKind,
     /// Hurst exponent H of the fractal law (15.7), 0 < H < 2.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub hurst: Option<f64>,
     /// rms height h of the fractal law (default: the line's own rms height).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub rms_height: Option<f64>,
     /// Asperity radius R of the Hertz law (15.2) (default --radius with --profile hertz).
     #[arg(long)]
@@ -122,10 +122,10 @@ pub struct MdrArgs {
     #[arg(long, conflicts_with = "breakpoints")]
     pub nloads: Option<usize>,
     /// Smallest indentation for --nloads (default --dmax · 1e-6).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub dmin: Option<f64>,
     /// Largest indentation for --nloads (default: full contact, the largest finite gap).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub dmax: Option<f64>,
     /// Linear springs on a line: write the exact curve, one row per contact count j = 1..N
     /// (the breakpoints d_j where the j-th spring first touches). Here `stiffness` and
@@ -227,10 +227,10 @@ fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
     }
     if let Some(path) = &args.line {
         let heights = read_npy_1d(path)?.to_vec();
-        let size = args
-            .size
-            .or_else(|| asperity::io::sidecar_size(path))
-            .unwrap_or(1.0);
+        let size = match args.size {
+            Some(size) => size,
+            None => asperity::io::sidecar_size(path)?.unwrap_or(1.0),
+        };
         if !(size.is_finite() && size > 0.0) {
             bail!("invalid size: the line length must be positive and finite, got {size}");
         }

@@ -1,6 +1,8 @@
 //! `asperity reproduce FIGURE`: regenerate a figure of the paper or the book chapter.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use crate::rerun::{checksum, Written};
 
 /// Which figure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -31,8 +33,10 @@ pub enum Figure {
 /// Arguments of `asperity reproduce`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours). Studies checkpoint: an interrupted run resumes when the same command runs
-again (each folder's reproduce.json records the figure and setting that made it).\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
+    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours); timings.json holds the run's wall time. Studies checkpoint: an interrupted
+run resumes when the same command runs again (each folder's reproduce.json records the
+figure and setting that made it, and the checksum of every file it wrote: a file edited
+since is never overwritten without --force).\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.
@@ -63,68 +67,184 @@ impl Figure {
     }
 }
 
-/// What a figure folder was made by: `DIR/<figure>/reproduce.json`. The same command run
-/// again on the same folder resumes there (study checkpoints are kept, and the figure's own
-/// outputs, deterministic, are written anew); a folder holding anything else is refused
-/// before any work unless `--force`.
+/// What a figure folder was made by: `DIR/<figure>/reproduce.json`, with the checksum of
+/// every file the figure wrote there once it is complete (see [`crate::rerun`]). The same
+/// command run again on the same folder resumes there (study checkpoints are kept, and
+/// the figure's own outputs, deterministic, are written anew) as long as no output was
+/// edited since; a folder holding anything else is refused before any work unless
+/// `--force`.
 #[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct FolderStamp {
     figure: String,
     quick: bool,
+    /// Whether the figure finished (an interrupted one is resumed, its partial outputs
+    /// rewritten).
+    #[serde(default)]
+    complete: bool,
+    /// Checksums of the files of a complete figure.
+    #[serde(default)]
+    written: Written,
+}
+
+/// Files in a figure folder that are not outputs: the stamp, the lock, the timings.
+fn is_bookkeeping(name: &str) -> bool {
+    name == STAMP || name == TIMINGS || name == asperity::lock::LOCK_FILE || name.starts_with('.')
+}
+
+/// The figure's own files in `dir` (top level; study sub-folders keep their own record).
+fn figure_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<_> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_type().is_ok_and(|t| !t.is_dir()))
+        .filter(|e| !is_bookkeeping(&e.file_name().to_string_lossy()))
+        .map(|e| e.path())
+        .collect();
+    files.sort();
+    files
 }
 
 /// Whether the figure may write over files in `dir`: yes when it is empty or new, when it
-/// was made by this same figure and setting, or with `--force`; else a one-line refusal.
-fn may_overwrite(dir: &std::path::Path, stamp: &FolderStamp, force: bool) -> anyhow::Result<bool> {
-    let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
-    if !holds_files {
+/// was made by this same figure and setting and none of its outputs was edited since, or
+/// with `--force`; else a one-line refusal naming the folder or the edited file.
+fn may_overwrite(dir: &Path, stamp: &FolderStamp, force: bool) -> anyhow::Result<bool> {
+    let holds_files = std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries
+            .filter_map(|e| e.ok())
+            .any(|e| !is_bookkeeping(&e.file_name().to_string_lossy()))
+    });
+    if !holds_files || force {
         return Ok(force);
     }
-    let same = std::fs::read_to_string(dir.join(STAMP))
+    let found = asperity::input::read_text(&dir.join(STAMP), asperity::input::TEXT_MAX_BYTES)
         .ok()
-        .and_then(|text| serde_json::from_str::<FolderStamp>(&text).ok())
-        .is_some_and(|found| &found == stamp);
-    if same || force {
-        return Ok(true);
-    }
-    anyhow::bail!(
-        "{} holds files not made by `asperity reproduce {}{}`: use another --out, or --force to \
-         overwrite them",
-        dir.display(),
+        .and_then(|text| serde_json::from_str::<FolderStamp>(&text).ok());
+    let command = format!(
+        "`asperity reproduce {}{}`",
         stamp.figure,
         if stamp.quick { " --quick" } else { "" }
-    )
+    );
+    let Some(found) = found.filter(|f| f.figure == stamp.figure && f.quick == stamp.quick) else {
+        anyhow::bail!(
+            "{} holds files not made by {command}: use another --out, or --force to overwrite \
+             them",
+            dir.display()
+        );
+    };
+    if found.complete {
+        if let Some(edited) = figure_files(dir)
+            .iter()
+            .find(|f| !found.written.unchanged(f))
+        {
+            anyhow::bail!(
+                "{}: changed since {command} wrote it (or not written by it): use another \
+                 --out, or --force to overwrite it",
+                edited.display()
+            );
+        }
+    }
+    Ok(true)
 }
 
 const STAMP: &str = "reproduce.json";
 
-/// Runs one figure; `force` lets it write over files in its folder ([`may_overwrite`]).
-fn run_one(figure: Figure, out: &std::path::Path, quick: bool, force: bool) -> anyhow::Result<()> {
+/// Wall-clock times of a figure's last run (kept apart, so that every result file of a
+/// rerun is byte-identical).
+const TIMINGS: &str = "timings.json";
+
+/// Runs one figure in its folder, holding the folder's lock: `force` lets it write over
+/// files there ([`may_overwrite`]); `discard` (the user's --force) lets its studies discard
+/// another study's checkpoints. A refusal before any output leaves no folder behind.
+fn run_one(
+    figure: Figure,
+    out: &Path,
+    quick: bool,
+    force: bool,
+    discard: bool,
+) -> anyhow::Result<()> {
     let dir = out.join(figure.folder());
-    let stamp = FolderStamp {
+    let existed = dir.exists();
+    std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    let lock = asperity::lock::FolderLock::acquire(&dir)?;
+    let mut stamp = FolderStamp {
         figure: figure.folder().to_string(),
         quick,
+        complete: false,
+        written: Written::default(),
     };
-    std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     let start = std::time::Instant::now();
-    match figure {
-        Figure::Fig1 => super::figures::fig1(&dir, quick, force)?,
-        Figure::Fig2 => super::figures::fig2(&dir, quick, force)?,
-        Figure::Fig5 => super::figures::fig5(&dir, quick, force)?,
-        Figure::Fig6 => super::figures::fig6(&dir, quick, force)?,
-        // The book's figures name their own folder under `out`.
-        Figure::Fig15_1 => super::fig15::fig15_1(out, quick, force)?,
-        Figure::Fig15_2 => super::fig15::fig15_2(out, quick, force)?,
-        Figure::All => unreachable!("expanded by run"),
+    if let Err(err) = run_figure(figure, &dir, out, quick, force, discard) {
+        if !existed {
+            remove_if_untouched(&dir, lock);
+        }
+        return Err(err);
     }
+    let seconds = start.elapsed().as_secs_f64();
+    for file in figure_files(&dir) {
+        let bytes = std::fs::read(&file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+        let name = file
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        stamp
+            .written
+            .outputs
+            .insert(name, checksum(asperity::io::fnv1a64(&bytes)));
+    }
+    stamp.complete = true;
+    asperity::io::write_json(
+        &dir.join(TIMINGS),
+        true,
+        &serde_json::json!({ "seconds": seconds }),
+    )?;
+    asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     eprintln!(
-        "{}: done in {:.1} s -> {}",
+        "{}: done in {seconds:.1} s -> {}",
         figure.folder(),
-        start.elapsed().as_secs_f64(),
         dir.display()
     );
     Ok(())
+}
+
+fn run_figure(
+    figure: Figure,
+    dir: &Path,
+    out: &Path,
+    quick: bool,
+    force: bool,
+    discard: bool,
+) -> anyhow::Result<()> {
+    match figure {
+        Figure::Fig1 => super::figures::fig1(dir, quick, force, discard),
+        Figure::Fig2 => super::figures::fig2(dir, quick, force, discard),
+        Figure::Fig5 => super::figures::fig5(dir, quick, force, discard),
+        Figure::Fig6 => super::figures::fig6(dir, quick, force),
+        // The book's figures name their own folder under `out`.
+        Figure::Fig15_1 => super::fig15::fig15_1(out, quick, force),
+        Figure::Fig15_2 => super::fig15::fig15_2(out, quick, force),
+        Figure::All => unreachable!("expanded by run"),
+    }
+}
+
+/// Removes a figure folder made by this run if it holds nothing but bookkeeping (the
+/// figure was refused before writing anything, e.g. for memory).
+fn remove_if_untouched(dir: &Path, lock: asperity::lock::FolderLock) {
+    let only_ours = std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.filter_map(|e| e.ok()).all(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name == STAMP || name == asperity::lock::LOCK_FILE
+        })
+    });
+    if only_ours {
+        let _ = std::fs::remove_file(dir.join(STAMP));
+        let _ = std::fs::remove_file(dir.join(asperity::lock::LOCK_FILE));
+        drop(lock);
+        let _ = std::fs::remove_dir(dir);
+    }
 }
 
 /// Runs `asperity reproduce`.
@@ -147,12 +267,14 @@ pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
             let stamp = FolderStamp {
                 figure: figure.folder().to_string(),
                 quick: args.quick,
+                complete: false,
+                written: Written::default(),
             };
             may_overwrite(&args.out.join(figure.folder()), &stamp, args.force)
         })
         .collect::<anyhow::Result<Vec<bool>>>()?;
     for (figure, force) in figures.into_iter().zip(overwrite) {
-        run_one(figure, &args.out, args.quick, force)?;
+        run_one(figure, &args.out, args.quick, force, args.force)?;
     }
     Ok(())
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, ensure, Context, Result};
 use asperity::fit::{power_law_fit, PowerLawFit};
-use asperity::io::{read_npy, read_npy_shape, sidecar_path, StagedOutputs};
+use asperity::io::{read_npy, read_npy_shape, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::{
     line_psd, line_summary, radial_psd_2d, surface_summary, PsdBin, Summary,
@@ -65,7 +65,9 @@ pub struct StatsArgs {
 }
 
 /// What a sidecar records that shapes the statistics: the side length and the spectrum's
-/// limits (as q·L/2π). Missing or unreadable sidecars give no hints.
+/// limits (as q·L/2π). A missing sidecar gives no hints; one that is corrupt, not a regular
+/// file or too large is an error ([`asperity::input::read_sidecar`], the rules of every
+/// command).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct SidecarHints {
     size: Option<f64>,
@@ -74,17 +76,14 @@ struct SidecarHints {
     short_cutoff: Option<f64>,
 }
 
-fn sidecar_hints(file: &Path) -> SidecarHints {
-    let Ok(text) = std::fs::read_to_string(sidecar_path(file)) else {
-        return SidecarHints::default();
-    };
-    let Ok(value) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return SidecarHints::default();
+fn sidecar_hints(file: &Path) -> Result<SidecarHints> {
+    let Some(value) = asperity::input::read_sidecar(file)? else {
+        return Ok(SidecarHints::default());
     };
     let spec = &value["spec"];
     let long = &spec["psd"]["long_wavelength"];
     let positive = |v: &serde_json::Value| v.as_f64().filter(|x| x.is_finite() && *x > 0.0);
-    SidecarHints {
+    Ok(SidecarHints {
         size: positive(&spec["size"]),
         long_wavelength: match (long["kind"].as_str(), positive(&long["q0"])) {
             (Some("roll_off"), Some(q0)) => Some((true, q0)),
@@ -92,7 +91,7 @@ fn sidecar_hints(file: &Path) -> SidecarHints {
             _ => None,
         },
         short_cutoff: positive(&spec["psd"]["short_cutoff"]),
-    }
+    })
 }
 
 /// Checks a user-given end of the fit range: a positive, finite q·L/2π.
@@ -418,7 +417,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     let hints = if measured {
         SidecarHints::default()
     } else {
-        sidecar_hints(&args.file)
+        sidecar_hints(&args.file)?
     };
     let inputs = if measured {
         measured_inputs(args)?

@@ -477,6 +477,9 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
     }
 }
 
+/// The longest `--checkpoint-every`, in seconds (about 11 days).
+const MAX_CHECKPOINT_EVERY: f64 = 1e6;
+
 /// How a study runs (not part of what it computes).
 #[derive(Debug, Clone, Copy)]
 pub struct RunOptions {
@@ -491,9 +494,9 @@ pub struct RunOptions {
 impl RunOptions {
     fn from_args(run: &RunArgs) -> Result<Self> {
         anyhow::ensure!(
-            run.checkpoint_every.is_finite() && run.checkpoint_every >= 0.0,
-            "--checkpoint-every must be a number of seconds >= 0, got {}",
-            run.checkpoint_every
+            (0.0..=MAX_CHECKPOINT_EVERY).contains(&run.checkpoint_every),
+            "--checkpoint-every must be between 0 and {MAX_CHECKPOINT_EVERY:e} seconds, got {}",
+            asperity::input::short_number(run.checkpoint_every)
         );
         Ok(RunOptions {
             force: run.force,
@@ -525,34 +528,30 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::File(f) => {
-            let text = std::fs::read_to_string(&f.file)
-                .with_context(|| format!("reading {}", f.file.display()))?;
+            let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
             let (kind, spec) = parse_study_file(&f.file, &text)?;
             (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
-    let results = execute(&spec, out, options, &outputs(kind, out))?;
-    match kind {
-        Kind::Alpha => write_alpha(out, &results, options.force),
-        Kind::Curve => write_curves(out, &results, options.force, "curve"),
-    }
+    execute(&spec, out, options, kind)?;
+    Ok(())
 }
 
 /// The files a study of `kind` writes into `dir`.
 pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
-    let stem = match kind {
-        Kind::Alpha => "alpha",
-        Kind::Curve => "curve",
-    };
+    let stem = outputs_stem(kind);
     ["csv", "png", "svg"]
         .iter()
         .map(|ext| dir.join(format!("{stem}.{ext}")))
         .collect()
 }
 
-/// Validates (the spec, then whether its largest task fits in memory), checks outputs,
-/// opens (or resumes) the study folder and runs every task with a progress bar. Nothing
-/// is created before every check has passed. Returns the task results in task order.
+/// Validates (the spec, then whether its largest task fits in memory), checks outputs
+/// (see [`crate::rerun`]: existing ones only if this study wrote them unchanged, or with
+/// `--force`), locks the folder against other processes, opens (or resumes) the study and
+/// runs every task with a progress bar, then writes its outputs of `kind` together (all or
+/// none). Nothing is created before every check has passed. Returns the task results in
+/// task order.
 ///
 /// The progress bar counts samples; its ETA weighs each sample by
 /// [`sample_cost`] and leaves out samples read back from checkpoints (see
@@ -561,7 +560,7 @@ pub fn execute(
     spec: &StudySpec,
     dir: &Path,
     options: RunOptions,
-    outputs: &[PathBuf],
+    kind: Kind,
 ) -> Result<Vec<TaskResult>> {
     let RunOptions {
         force,
@@ -571,9 +570,8 @@ pub fn execute(
     spec.validate()?;
     spec.ensure_fits()?;
     StudyDir::check(dir, spec, force)?;
-    for path in outputs {
-        asperity::io::ensure_new_output(path, force)?;
-    }
+    let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
+    let _lock = StudyDir::lock(dir)?;
     let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
     let tasks = spec.tasks();
     let segments: Vec<(u64, f64)> = tasks
@@ -597,15 +595,68 @@ pub fn execute(
         results.push(result);
     }
     progress.finish();
+    let (table, chart) = match kind {
+        Kind::Alpha => (alpha_table(&results), alpha_chart(&results, ALPHA_TITLE)),
+        Kind::Curve => (curve_table(&results), curve_chart(&results, CURVE_TITLE)),
+    };
+    let stem = outputs_stem(kind);
+    write_together(dir, stem, &table, &chart, rewrite, true)?;
     Ok(results)
+}
+
+/// Writes `<stem>.csv`, `.png` and `.svg` (and, with `record`, the record of what was
+/// written, [`crate::rerun::RECORD`]) into `dir`, all or none.
+pub fn write_together(
+    dir: &Path,
+    stem: &str,
+    table: &Table,
+    chart: &Chart,
+    force: bool,
+    record: bool,
+) -> Result<()> {
+    let (csv, png, svg) = (
+        dir.join(format!("{stem}.csv")),
+        dir.join(format!("{stem}.png")),
+        dir.join(format!("{stem}.svg")),
+    );
+    let record_path = dir.join(crate::rerun::RECORD);
+    let mut paths = vec![&csv, &png, &svg];
+    if record {
+        paths.push(&record_path);
+    }
+    let mut staged = asperity::io::StagedOutputs::new(paths, force)?;
+    table.stage(&mut staged, &csv)?;
+    chart.stage(&mut staged, &png, &svg)?;
+    if record {
+        crate::rerun::stage_record(&mut staged, &record_path)?;
+    }
+    staged.commit()?;
+    Ok(())
+}
+
+const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
+const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
+
+fn outputs_stem(kind: Kind) -> &'static str {
+    match kind {
+        Kind::Alpha => "alpha",
+        Kind::Curve => "curve",
+    }
 }
 
 fn opt(v: Option<f64>) -> String {
     v.map(format_number).unwrap_or_default()
 }
 
-/// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves.
+/// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
+/// written together.
 pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()> {
+    let chart = alpha_chart(results, ALPHA_TITLE);
+    write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
+}
+
+/// The rows of `alpha.csv`.
+fn alpha_table(results: &[TaskResult]) -> Table {
     let mut table = Table::new(&[
         "method",
         "n",
@@ -640,12 +691,7 @@ pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()
             )),
         ]);
     }
-    table.write(&dir.join("alpha.csv"), force)?;
-    alpha_chart(results, "α of k ∝ F^α vs H").save(
-        &dir.join("alpha.png"),
-        &dir.join("alpha.svg"),
-        force,
-    )
+    table
 }
 
 /// The α(H) chart: one series per (method, N) and the theory curves (6), 1/3 and (24).
@@ -709,8 +755,14 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
     }
 }
 
-/// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F).
+/// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
 pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str) -> Result<()> {
+    let chart = curve_chart(results, CURVE_TITLE);
+    write_together(dir, stem, &curve_table(results), &chart, force, false)
+}
+
+/// The rows of `curve.csv`.
+fn curve_table(results: &[TaskResult]) -> Table {
     let mut table = Table::new(&[
         "method",
         "n",
@@ -737,12 +789,7 @@ pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str)
             ]);
         }
     }
-    table.write(&dir.join(format!("{stem}.csv")), force)?;
-    curve_chart(results, "Contact stiffness vs force (ensemble mean)").save(
-        &dir.join(format!("{stem}.png")),
-        &dir.join(format!("{stem}.svg")),
-        force,
-    )
+    table
 }
 
 /// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean

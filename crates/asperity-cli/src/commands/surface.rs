@@ -13,7 +13,7 @@ use serde_json::json;
 #[derive(Debug, Clone, clap::Args)]
 pub struct SpectrumArgs {
     /// Hurst exponent H in [-1, 3]: C2D(q) ∝ q^(-2H-2).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub hurst: f64,
     /// Long-wavelength roll-off q0·L/2π: C2D flat below q0 (paper eq. 7).
     #[arg(long, value_name = "Q", conflicts_with = "cutoff")]

@@ -12,17 +12,22 @@
 //! (atomically). Run again with
 //! the same spec, it resumes where it stopped and — since samples are deterministic and
 //! stored with round-trip precision — gives bit-identical results. A folder holding a
-//! different study is refused ([`Error::ForeignCheckpoint`]) unless `discard` is set; a
-//! folder whose `study.json` names another study but whose checkpoints hold no sample (a
-//! study that stopped before its first checkpoint) is free and reused. Every checkpoint
-//! names its task, and a checkpoint whose task is not the one requested (bit for bit) is
-//! refused rather than silently reused.
+//! different study is refused ([`Error::ForeignCheckpoint`], naming the parameters that
+//! differ) unless `discard` is set; a folder whose `study.json` names another study but
+//! whose checkpoints hold no sample (a study that stopped before its first checkpoint) is
+//! free and reused.
+//!
+//! Every checkpoint is sealed with the full identity of what produced it and a checksum
+//! of its content ([`identity`]): one copied from another study, left behind by a study
+//! whose `study.json` was deleted, written by an older asperity, edited by hand or damaged
+//! is refused with the fields that differ, never merged. Two processes never share a
+//! folder: a front end holds [`StudyDir::lock`] while it runs.
 //!
 //! `study.json` also records the scales of the samples (`normalisation`, see
-//! [`samplers::Scales`]); it is informative only and not compared on resume, so folders
-//! written before it existed resume as before.
+//! [`samplers::Scales`]), which every checkpoint's identity holds as well.
 
 pub mod curve;
+pub mod identity;
 pub mod samplers;
 pub mod theory;
 
@@ -37,8 +42,11 @@ pub use curve::{
 pub use samplers::{run_any_task, Scales};
 
 use crate::fit::PowerLawFit;
+use crate::lock::FolderLock;
+use crate::memory::array_bytes;
 use crate::spectrum::HURST_RANGE;
 use crate::{io, Error, Result};
+use identity::{TaskIdentity, Unsealed};
 
 /// Which solver produces the force–stiffness curve of a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -97,10 +105,9 @@ impl StudySpec {
                 format!("N = {n} is below the smallest useful size {min_n}"),
             ));
         }
-        for (i, n) in self.sizes.iter().enumerate() {
-            if self.sizes[..i].contains(n) {
-                return Err(Error::invalid("n", format!("N = {n} is given twice")));
-            }
+        let mut seen = std::collections::HashSet::with_capacity(self.sizes.len());
+        if let Some(n) = self.sizes.iter().find(|&&n| !seen.insert(n)) {
+            return Err(Error::invalid("n", format!("N = {n} is given twice")));
         }
         if self.hursts.is_empty() {
             return Err(Error::invalid("hurst", "the range of H is empty"));
@@ -112,23 +119,7 @@ impl StudySpec {
                 format!("H = {h} is outside [{lo}, {hi}]"),
             ));
         }
-        for (i, &h) in self.hursts.iter().enumerate() {
-            for &earlier in &self.hursts[..i] {
-                if earlier == h {
-                    return Err(Error::invalid("hurst", format!("H = {h} is given twice")));
-                }
-                if hurst_key(earlier) == hurst_key(h) {
-                    return Err(Error::invalid(
-                        "hurst",
-                        format!(
-                            "H = {earlier} and H = {h} would share one checkpoint (H is kept \
-                             to 6 decimals in its name, {}); give values at least 1e-6 apart",
-                            hurst_key(h)
-                        ),
-                    ));
-                }
-            }
-        }
+        check_distinct_hursts(&self.hursts)?;
         if self.samples == 0 {
             return Err(Error::invalid("samples", "need at least 1 sample"));
         }
@@ -140,10 +131,50 @@ impl StudySpec {
                 ));
             }
         }
-        if self.levels < 3 {
-            return Err(Error::invalid("levels", "need at least 3 force levels"));
+        if !(3..=MAX_LEVELS).contains(&self.levels) {
+            return Err(Error::invalid(
+                "levels",
+                format!("need 3 to {MAX_LEVELS} force levels, got {}", self.levels),
+            ));
         }
-        self.window.validate()
+        self.window.validate()?;
+        self.ensure_size()?;
+        self.ensure_samplers()
+    }
+
+    /// Refuses a study whose size (tasks × samples, and the results it keeps: tasks ×
+    /// levels) is beyond what can be run, before anything is created.
+    fn ensure_size(&self) -> Result<()> {
+        let tasks = self.sizes.len().checked_mul(self.hursts.len());
+        let samples = tasks.and_then(|t| t.checked_mul(self.samples));
+        match samples {
+            Some(total) if total <= MAX_STUDY_SAMPLES => {}
+            _ => {
+                return Err(Error::invalid(
+                    "samples",
+                    format!(
+                        "{} sizes x {} H values x {} samples is more than the {} samples a \
+                         study may hold",
+                        self.sizes.len(),
+                        self.hursts.len(),
+                        self.samples,
+                        crate::input::short_number(MAX_STUDY_SAMPLES as f64)
+                    ),
+                ))
+            }
+        }
+        // The results of every task stay in memory until the tables are written.
+        let per_task = array_bytes(&[self.levels], std::mem::size_of::<EnsemblePoint>())
+            .zip(array_bytes(&[self.samples], 8))
+            .and_then(|(a, b)| a.checked_add(b));
+        crate::memory::ensure_fits(
+            &format!(
+                "the results of a study of {} tasks with {} force levels",
+                tasks.unwrap_or(usize::MAX),
+                self.levels
+            ),
+            per_task.and_then(|b| b.checked_mul(tasks? as u64)),
+        )
     }
 
     /// All tasks, sizes outer, H inner.
@@ -153,6 +184,38 @@ impl StudySpec {
             .flat_map(|&n| self.hursts.iter().map(move |&hurst| Task { n, hurst }))
             .collect()
     }
+}
+
+/// The most force levels of an ensemble curve.
+pub const MAX_LEVELS: usize = 100_000;
+
+/// The most samples (over all tasks) a study may hold.
+pub const MAX_STUDY_SAMPLES: usize = 1_000_000_000;
+
+/// The most values one `A:B:STEP` range may give.
+pub const MAX_RANGE_VALUES: usize = 100_000;
+
+/// Refuses H values given twice (`0` and `-0` are one value) or sharing a checkpoint
+/// name (6 decimals), in one pass.
+fn check_distinct_hursts(hursts: &[f64]) -> Result<()> {
+    let mut values = std::collections::HashMap::with_capacity(hursts.len());
+    let mut keys = std::collections::HashMap::with_capacity(hursts.len());
+    for &h in hursts {
+        if values.insert((h + 0.0).to_bits(), h).is_some() {
+            return Err(Error::invalid("hurst", format!("H = {h} is given twice")));
+        }
+        if let Some(earlier) = keys.insert(hurst_key(h), h) {
+            return Err(Error::invalid(
+                "hurst",
+                format!(
+                    "H = {earlier} and H = {h} would share one checkpoint (H is kept to 6 \
+                     decimals in its name, {}); give values at least 1e-6 apart",
+                    hurst_key(h)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Parses Hurst exponents: comma-separated items, each a value or an inclusive range
@@ -170,7 +233,14 @@ fn parse_range_item(text: &str) -> Result<Vec<f64>> {
     let num = |s: &str| {
         s.trim()
             .parse::<f64>()
-            .map_err(|_| Error::invalid("hurst", format!("'{s}' is not a number in '{text}'")))
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                Error::invalid(
+                    "hurst",
+                    format!("'{}' is not a finite number in '{}'", clip(s), clip(text)),
+                )
+            })
     };
     match parts.as_slice() {
         [single] => Ok(vec![num(single)?]),
@@ -179,10 +249,21 @@ fn parse_range_item(text: &str) -> Result<Vec<f64>> {
             if step.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || b < a {
                 return Err(Error::invalid(
                     "hurst",
-                    format!("empty range '{text}' (need A <= B and STEP > 0)"),
+                    format!("empty range '{}' (need A <= B and STEP > 0)", clip(text)),
                 ));
             }
-            let count = ((b - a) / step + 1e-9).floor() as usize + 1;
+            let count = ((b - a) / step + 1e-9).floor() + 1.0;
+            if !(count <= MAX_RANGE_VALUES as f64) {
+                return Err(Error::invalid(
+                    "hurst",
+                    format!(
+                        "the range '{}' gives {} values, more than {MAX_RANGE_VALUES}",
+                        clip(text),
+                        crate::input::short_number(count)
+                    ),
+                ));
+            }
+            let count = count as usize;
             // Round to 1e-12 so that 0.1-steps print and key cleanly.
             Ok((0..count)
                 .map(|i| ((a + step * i as f64) * 1e12).round() / 1e12)
@@ -190,8 +271,17 @@ fn parse_range_item(text: &str) -> Result<Vec<f64>> {
         }
         _ => Err(Error::invalid(
             "hurst",
-            format!("'{text}' is neither a value nor A:B:STEP"),
+            format!("'{}' is neither a value nor A:B:STEP", clip(text)),
         )),
+    }
+}
+
+/// At most 40 characters of user text, on one line.
+fn clip(text: &str) -> String {
+    let line = crate::input::one_line(text);
+    match line.char_indices().nth(40) {
+        Some((i, _)) => format!("{}…", &line[..i]),
+        None => line,
     }
 }
 
@@ -316,52 +406,20 @@ impl TaskResult {
 struct Manifest {
     format: String,
     spec: StudySpec,
-    /// Scales of the samples; informative, not compared on resume (absent in folders
-    /// written before it was recorded).
+    /// Scales of the samples; informative here (each checkpoint's identity holds them
+    /// too, and is compared).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     normalisation: Option<Scales>,
 }
 
-/// What `checkpoint/<task>.json` holds: the samples of a task in progress, or the result
-/// of a finished one (its sample curves are then no longer kept).
+/// What `checkpoint/<task>.json` holds, sealed with the task's [`TaskIdentity`]: the
+/// samples of a task in progress, or the result of a finished one (its sample curves are
+/// then no longer kept).
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(tag = "state", rename_all = "snake_case")]
 enum Checkpoint {
-    InProgress {
-        key: String,
-        /// The task (absent in checkpoints written before it was recorded).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        task: Option<Task>,
-        samples: Vec<SampleCurve>,
-    },
-    Done {
-        key: String,
-        result: TaskResult,
-    },
-}
-
-impl Checkpoint {
-    fn key(&self) -> &str {
-        match self {
-            Checkpoint::InProgress { key, .. } | Checkpoint::Done { key, .. } => key,
-        }
-    }
-
-    /// The task it holds, where recorded.
-    fn task(&self) -> Option<Task> {
-        match self {
-            Checkpoint::InProgress { task, .. } => *task,
-            Checkpoint::Done { result, .. } => Some(result.task),
-        }
-    }
-
-    /// Whether it holds anything worth keeping: a finished task or at least one sample.
-    fn holds_samples(&self) -> bool {
-        match self {
-            Checkpoint::InProgress { samples, .. } => !samples.is_empty(),
-            Checkpoint::Done { .. } => true,
-        }
-    }
+    InProgress { samples: Vec<SampleCurve> },
+    Done { result: TaskResult },
 }
 
 /// A task in progress saves its samples at most this often (and always when it ends), so
@@ -370,42 +428,85 @@ pub const CHECKPOINT_INTERVAL: std::time::Duration = std::time::Duration::from_s
 
 const MANIFEST_FORMAT: &str = "asperity-study/1";
 
+/// The largest checkpoint file read (2^34 bytes); the memory guard checks it first.
+const CHECKPOINT_MAX_BYTES: u64 = 1 << 34;
+
 /// Where a study keeps its spec and checkpoints.
 #[derive(Debug, Clone)]
 pub struct StudyDir {
     dir: PathBuf,
-    method: Method,
+    spec: StudySpec,
     interval: std::time::Duration,
 }
 
+/// What a folder's `study.json` says, as [`StudyDir::check`] sees it.
+enum Stored {
+    None,
+    Same,
+    Other(String),
+    Corrupt(String),
+}
+
 impl StudyDir {
+    /// Locks the study folder `dir` (made if missing) against other processes for as long
+    /// as the returned lock lives (see [`FolderLock`]); a folder in use is refused at once.
+    pub fn lock(dir: &Path) -> Result<FolderLock> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        FolderLock::acquire(dir)
+    }
+
+    fn stored_spec(dir: &Path, spec: &StudySpec) -> Result<Stored> {
+        let path = dir.join("study.json");
+        if std::fs::symlink_metadata(&path).is_err() {
+            return Ok(Stored::None);
+        }
+        let text = crate::input::read_text(&path, crate::input::TEXT_MAX_BYTES)?;
+        let manifest = match serde_json::from_str::<Manifest>(&text) {
+            Ok(m) if m.format == MANIFEST_FORMAT => m,
+            Ok(m) => return Ok(Stored::Corrupt(format!("unknown format {:?}", m.format))),
+            Err(e) => return Ok(Stored::Corrupt(crate::input::one_line(&e.to_string()))),
+        };
+        if &manifest.spec == spec {
+            return Ok(Stored::Same);
+        }
+        Ok(Stored::Other(spec_differences(&manifest.spec, spec)))
+    }
+
     /// Checks, without writing, whether `dir` can hold `spec`:
     ///
-    /// * `Ok(false)` when it is new or holds the same study (which then resumes);
+    /// * `Ok(false)` when it is new or holds the same study (which then resumes; each
+    ///   checkpoint is still checked against its task's identity when read);
     /// * `Ok(true)` when its checkpoints are to be cleared first: it holds another study
-    ///   and `discard` is set, or its `study.json` names another study but no checkpoint
-    ///   holds a sample (that study stopped before its first checkpoint: nothing is lost);
-    /// * [`Error::ForeignCheckpoint`] when it holds samples of another study.
+    ///   (or a corrupt `study.json`, or checkpoints without one) and `discard` is set, or
+    ///   its `study.json` names another study but no checkpoint holds a sample (that study
+    ///   stopped before its first checkpoint: nothing is lost);
+    /// * [`Error::ForeignCheckpoint`] when it holds samples of another study, and
+    ///   [`Error::Metadata`] when its `study.json` is corrupt and checkpoints hold samples.
     pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
-        let manifest_path = dir.join("study.json");
-        if !manifest_path.exists() {
+        let stored = Self::stored_spec(dir, spec)?;
+        if matches!(stored, Stored::Same) {
             return Ok(false);
         }
-        let text =
-            std::fs::read_to_string(&manifest_path).map_err(|e| Error::io(&manifest_path, e))?;
-        let same = serde_json::from_str::<Manifest>(&text)
-            .map(|m| m.format == MANIFEST_FORMAT && &m.spec == spec)
-            .unwrap_or(false);
-        if same {
-            return Ok(false);
+        if !Self::holds_samples(dir)? {
+            return Ok(!matches!(stored, Stored::None));
         }
-        if discard || !Self::holds_samples(dir)? {
+        if discard {
             return Ok(true);
         }
-        Err(Error::ForeignCheckpoint {
-            dir: dir.to_path_buf(),
-            reason: "its study.json has other parameters".into(),
-        })
+        match stored {
+            Stored::None | Stored::Same => Ok(false),
+            Stored::Other(differences) => Err(Error::ForeignCheckpoint {
+                dir: dir.to_path_buf(),
+                reason: format!("its study.json has other parameters: {differences}"),
+            }),
+            Stored::Corrupt(why) => Err(Error::Metadata {
+                path: dir.join("study.json"),
+                reason: format!(
+                    "corrupt study file ({why}); restore it, or use --force to discard the \
+                     folder's checkpoints"
+                ),
+            }),
+        }
     }
 
     /// Whether any checkpoint in `dir` holds a finished task or a sample. A checkpoint that
@@ -424,11 +525,14 @@ impl StudyDir {
             if name.starts_with('.') || !name.ends_with(".json") {
                 continue;
             }
-            let holds = std::fs::read_to_string(&path)
+            let value = crate::input::read_text(&path, CHECKPOINT_MAX_BYTES)
                 .ok()
-                .and_then(|text| serde_json::from_str::<Checkpoint>(&text).ok())
-                .is_none_or(|c| c.holds_samples());
-            if holds {
+                .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok());
+            let content = value.as_ref().map(|v| &v["content"]);
+            let empty = content.is_some_and(|c| {
+                c["state"] == "in_progress" && c["samples"].as_array().is_some_and(Vec::is_empty)
+            });
+            if !empty {
                 return Ok(true);
             }
         }
@@ -437,7 +541,8 @@ impl StudyDir {
 
     /// Opens (creating) `dir` for `spec`: a folder with the same spec resumes, a folder with
     /// another study is refused unless `discard`, which deletes its checkpoints (see
-    /// [`StudyDir::check`]).
+    /// [`StudyDir::check`]). Another process must not work in the folder meanwhile: hold
+    /// its [`StudyDir::lock`] (as the command-line front end does).
     pub fn open(dir: &Path, spec: &StudySpec, discard: bool) -> Result<Self> {
         if Self::check(dir, spec, discard)? {
             let checkpoints = dir.join("checkpoint");
@@ -458,7 +563,7 @@ impl StudyDir {
         io::write_json(&manifest_path, true, &manifest)?;
         Ok(StudyDir {
             dir: dir.to_path_buf(),
-            method: spec.method,
+            spec: spec.clone(),
             interval: CHECKPOINT_INTERVAL,
         })
     }
@@ -475,62 +580,97 @@ impl StudyDir {
         &self.dir
     }
 
-    fn checkpoint_path(&self, key: &str) -> PathBuf {
+    fn checkpoint_path(&self, task: Task) -> PathBuf {
+        let key = task.key(self.spec.method);
         self.dir.join("checkpoint").join(format!("{key}.json"))
     }
 
-    /// The checkpoint of `task`, if any; refused when the file holds another task (its
-    /// name or, where recorded, its N and H bit for bit).
+    /// The checkpoint of `task`, if any: refused unless intact (its checksum) and made by
+    /// this task with this study's settings (its identity).
     fn load(&self, task: Task) -> Result<Option<Checkpoint>> {
-        let key = task.key(self.method);
-        let path = self.checkpoint_path(&key);
-        if !path.exists() {
-            return Ok(None);
-        }
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-        let checkpoint: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::Metadata {
+        let path = self.checkpoint_path(task);
+        let length = match std::fs::metadata(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(Error::io(&path, e)),
+            Ok(meta) => meta.len(),
+        };
+        // The text and its parsed samples (about as large again).
+        crate::memory::ensure_fits(
+            &format!("reading the checkpoint {}", path.display()),
+            length.checked_mul(3),
+        )?;
+        let text = crate::input::read_text(&path, CHECKPOINT_MAX_BYTES)?;
+        let wanted = TaskIdentity::of(&self.spec, task);
+        let refuse = |what: String| Error::Metadata {
             path: path.clone(),
-            reason: format!("unreadable checkpoint: {e}"),
-        })?;
-        if checkpoint.key() != key {
-            return Err(Error::ForeignCheckpoint {
-                dir: self.dir.clone(),
-                reason: format!("{} is not {key}", path.display()),
-            });
-        }
-        if let Some(stored) = checkpoint.task().filter(|stored| !stored.same_as(&task)) {
-            return Err(Error::ForeignCheckpoint {
+            reason: format!(
+                "{what}; delete it to recompute its task, or use --force to discard the \
+                 folder's checkpoints"
+            ),
+        };
+        match identity::unseal::<Checkpoint>(text.as_bytes(), &wanted) {
+            Ok(checkpoint) => Ok(Some(checkpoint)),
+            Err(Unsealed::Corrupt(why)) => Err(refuse(format!("corrupt checkpoint ({why})"))),
+            Err(Unsealed::Checksum) => Err(refuse(
+                "the checkpoint does not match its checksum (edited or damaged)".into(),
+            )),
+            Err(Unsealed::Foreign(differences)) => Err(Error::ForeignCheckpoint {
                 dir: self.dir.clone(),
                 reason: format!(
-                    "{} holds N = {}, H = {}, not the requested N = {}, H = {}",
+                    "{} was made with other settings: {}",
                     path.display(),
-                    stored.n,
-                    stored.hurst,
-                    task.n,
-                    task.hurst
+                    differences.join(", ")
                 ),
-            });
+            }),
         }
-        Ok(Some(checkpoint))
     }
 
-    fn save(&self, checkpoint: &Checkpoint) -> Result<()> {
-        let path = self.checkpoint_path(checkpoint.key());
-        let text = serde_json::to_vec(checkpoint).map_err(|e| Error::Metadata {
-            path: path.clone(),
-            reason: e.to_string(),
-        })?;
-        io::write_bytes(&path, true, &text)
+    fn save(&self, task: Task, checkpoint: &Checkpoint) -> Result<()> {
+        let path = self.checkpoint_path(task);
+        let bytes =
+            identity::seal(&TaskIdentity::of(&self.spec, task), checkpoint).map_err(|reason| {
+                Error::Metadata {
+                    path: path.clone(),
+                    reason,
+                }
+            })?;
+        io::write_bytes(&path, true, &bytes)
     }
 
     /// Saves the first samples of `task`, in progress.
     pub fn save_in_progress(&self, task: Task, samples: &[SampleCurve]) -> Result<()> {
-        self.save(&Checkpoint::InProgress {
-            key: task.key(self.method),
-            task: Some(task),
-            samples: samples.to_vec(),
-        })
+        self.save(
+            task,
+            &Checkpoint::InProgress {
+                samples: samples.to_vec(),
+            },
+        )
     }
+}
+
+/// The fields of two specs that differ, as `name: stored X, wanted Y`.
+fn spec_differences(stored: &StudySpec, wanted: &StudySpec) -> String {
+    let map = |s: &StudySpec| match serde_json::to_value(s) {
+        Ok(serde_json::Value::Object(m)) => m,
+        _ => serde_json::Map::new(),
+    };
+    let (a, b) = (map(stored), map(wanted));
+    let clip = |v: &serde_json::Value| {
+        let t = v.to_string();
+        match t.char_indices().nth(40) {
+            Some((i, _)) => format!("{}…", &t[..i]),
+            None => t,
+        }
+    };
+    let items: Vec<String> = a
+        .iter()
+        .filter(|(k, v)| b.get(*k) != Some(*v))
+        .map(|(k, v)| {
+            let w = b.get(k).unwrap_or(&serde_json::Value::Null);
+            format!("{k}: stored {}, wanted {}", clip(v), clip(w))
+        })
+        .collect();
+    items.join(", ")
 }
 
 /// Progress of a task: `progress(done, total)` with the samples done so far and the
@@ -551,7 +691,12 @@ pub fn run_task<S: Sampler>(
     store: &StudyDir,
     progress: &ProgressFn,
 ) -> Result<TaskResult> {
-    let key = task.key(spec.method);
+    if &store.spec != spec {
+        return Err(Error::invalid(
+            "spec",
+            "the study folder was opened for another study",
+        ));
+    }
     let mut samples = match store.load(task)? {
         Some(Checkpoint::Done { result, .. }) if result.samples == spec.samples => {
             progress(spec.samples, spec.samples);
@@ -594,10 +739,12 @@ pub fn run_task<S: Sampler>(
         progress(samples.len(), spec.samples);
     }
     let result = TaskResult::from_samples(spec, task, samples)?;
-    store.save(&Checkpoint::Done {
-        key,
-        result: result.clone(),
-    })?;
+    store.save(
+        task,
+        &Checkpoint::Done {
+            result: result.clone(),
+        },
+    )?;
     Ok(result)
 }
 
@@ -751,35 +898,169 @@ mod tests {
         assert!(StudyDir::open(dir.path(), &spec(23), false).is_err());
     }
 
+    fn checkpoint_file(dir: &Path, task: Task) -> PathBuf {
+        dir.join("checkpoint")
+            .join(format!("{}.json", task.key(Method::Mdr)))
+    }
+
     #[test]
-    fn study_json_written_before_the_normalisation_was_recorded_resumes() {
+    fn checkpoints_of_older_versions_are_refused_not_merged() {
         let dir = tempfile::tempdir().unwrap();
         let task = Task { n: 64, hurst: 0.5 };
         let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
-        let first = vec![Synthetic.sample(&mut (), 1).unwrap()];
-        store.save_in_progress(task, &first).unwrap();
-        // The old format: no normalisation, no task in the checkpoint.
-        let old = serde_json::json!({"format": MANIFEST_FORMAT, "spec": spec(4)});
-        std::fs::write(dir.path().join("study.json"), old.to_string()).unwrap();
-        let path = dir
-            .path()
-            .join("checkpoint")
-            .join(format!("{}.json", task.key(Method::Mdr)));
-        let mut checkpoint: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-        checkpoint.as_object_mut().unwrap().remove("task");
-        std::fs::write(&path, checkpoint.to_string()).unwrap();
-        let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
-        let restored = std::sync::Mutex::new(Vec::new());
-        run_task(&spec(4), task, &Synthetic, &store, &|done, _| {
-            restored.lock().unwrap().push(done)
-        })
-        .unwrap();
-        assert_eq!(
-            restored.into_inner().unwrap()[0],
-            1,
-            "the sample was resumed"
+        // The format before identities: key, task and samples, no checksum.
+        let old = serde_json::json!({
+            "state": "in_progress",
+            "key": task.key(Method::Mdr),
+            "task": task,
+            "samples": [Synthetic.sample(&mut (), 1).unwrap()],
+        });
+        std::fs::write(checkpoint_file(dir.path(), task), old.to_string()).unwrap();
+        let err = run_task(&spec(4), task, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("older asperity") && text.contains("--force"),
+            "{text}"
         );
+        // --force (discard) clears it.
+        let mut other = spec(4);
+        other.seed = 9;
+        StudyDir::open(dir.path(), &other, true).unwrap();
+        assert!(!checkpoint_file(dir.path(), task).exists());
+    }
+
+    /// Item 1 of issue 9: a checkpoint copied from another study, or left by a study whose
+    /// study.json was deleted, is refused naming every field that differs; an edited or
+    /// damaged one is refused by its checksum.
+    #[test]
+    fn checkpoints_carry_their_identity_and_checksum() {
+        let task = Task { n: 64, hurst: 0.5 };
+        let first = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(first.path(), &spec(6), false).unwrap();
+        store
+            .save_in_progress(task, &[Synthetic.sample(&mut (), 1).unwrap()])
+            .unwrap();
+        let saved = std::fs::read(checkpoint_file(first.path(), task)).unwrap();
+        let variants: Vec<(&str, Box<dyn Fn(&mut StudySpec)>)> = vec![
+            ("seed", Box::new(|s| s.seed = 4)),
+            ("rolloff", Box::new(|s| s.rolloff = Some(6.0))),
+            ("levels", Box::new(|s| s.levels = 11)),
+            ("window", Box::new(|s| s.window.min_contacts = 2)),
+        ];
+        for (field, change) in variants {
+            let mut other = spec(6);
+            change(&mut other);
+            let dir = tempfile::tempdir().unwrap();
+            let store = StudyDir::open(dir.path(), &other, false).unwrap();
+            // No study.json from the first study: only the copied checkpoint.
+            std::fs::write(checkpoint_file(dir.path(), task), &saved).unwrap();
+            let err = run_task(&other, task, &Synthetic, &store, &|_, _| {}).unwrap_err();
+            assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+            let text = err.to_string();
+            assert!(
+                text.contains(&format!("{field}: stored")),
+                "{field}: {text}"
+            );
+            assert!(!text.contains('\n'));
+            // Refused, not merged: the copied file is left as it was.
+            assert_eq!(
+                std::fs::read(checkpoint_file(dir.path(), task)).unwrap(),
+                saved
+            );
+        }
+        // A hand edit that keeps valid JSON: a changed stiffness.
+        let text = String::from_utf8(saved.clone()).unwrap();
+        let at = text.find("\"stiffness\":").unwrap() + 12;
+        let mut edited = text.clone();
+        edited.insert(at, '9');
+        std::fs::write(checkpoint_file(first.path(), task), edited).unwrap();
+        let err = run_task(&spec(6), task, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        assert!(err.to_string().contains("checksum"), "{err}");
+        // Truncated: corrupt.
+        std::fs::write(
+            checkpoint_file(first.path(), task),
+            &saved[..saved.len() / 2],
+        )
+        .unwrap();
+        let err = run_task(&spec(6), task, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        assert!(err.to_string().contains("corrupt checkpoint"), "{err}");
+        // Intact: resumed.
+        std::fs::write(checkpoint_file(first.path(), task), &saved).unwrap();
+        run_task(&spec(6), task, &Synthetic, &store, &|_, _| {}).unwrap();
+    }
+
+    #[test]
+    fn a_corrupt_study_json_is_named_as_such() {
+        let dir = tempfile::tempdir().unwrap();
+        let task = Task { n: 64, hurst: 0.5 };
+        let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
+        store
+            .save_in_progress(task, &[Synthetic.sample(&mut (), 1).unwrap()])
+            .unwrap();
+        std::fs::write(dir.path().join("study.json"), "{\"format\": \"asp").unwrap();
+        let err = StudyDir::check(dir.path(), &spec(4), false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("corrupt study file") && !err.contains("other parameters"),
+            "{err}"
+        );
+        // Another study's parameters are named.
+        let mut other = spec(4);
+        other.seed = 77;
+        StudyDir::open(dir.path(), &spec(4), true).unwrap();
+        store
+            .save_in_progress(task, &[Synthetic.sample(&mut (), 1).unwrap()])
+            .unwrap();
+        let err = StudyDir::check(dir.path(), &other, false)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("seed: stored 3, wanted 77"), "{err}");
+    }
+
+    #[test]
+    fn sizes_and_ranges_are_bounded_up_front() {
+        // Item 7: a range of 4e9 values, 1e12 levels, an absurd sample count.
+        let err = parse_range("-1:3:1e-9").unwrap_err().to_string();
+        assert!(err.contains("more than 100000"), "{err}");
+        assert!(err.contains("4e9"), "{err}");
+        // Item 12: NaN and infinity are not H values.
+        for text in ["0:nan:0.1", "nan", "-inf", "0:1:inf"] {
+            let err = parse_range(text).unwrap_err().to_string();
+            assert!(err.contains("not a finite number"), "{text}: {err}");
+        }
+        assert_eq!(parse_range("-1e-300").unwrap(), vec![-1e-300]);
+        let mut s = spec(3);
+        s.levels = 1_000_000_000_000;
+        let err = s.validate().unwrap_err().to_string();
+        assert!(err.contains("force levels"), "{err}");
+        s.levels = 10;
+        s.samples = usize::MAX / 2;
+        s.hursts = vec![0.1, 0.2, 0.3];
+        let err = s.validate().unwrap_err().to_string();
+        assert!(err.contains("samples a study may hold"), "{err}");
+    }
+
+    #[test]
+    fn duplicate_h_checking_is_linear() {
+        // Item 9: 40 001 values (the quadratic check took minutes at this size).
+        let hursts = parse_range("-1:3:0.0001").unwrap();
+        assert_eq!(hursts.len(), 40_001);
+        let mut s = spec(1);
+        s.hursts = hursts;
+        let start = std::time::Instant::now();
+        s.validate().unwrap();
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(2),
+            "{:?}",
+            start.elapsed()
+        );
+        s.hursts.push(0.5);
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("given twice"));
     }
 
     #[test]

@@ -183,11 +183,50 @@ impl StudySpec {
     }
 }
 
+impl StudySpec {
+    /// Builds the sampler of every grid size (and the spectrum of every H) once, so that
+    /// a spec the samplers would refuse (e.g. a roll-off at or beyond Nyquist, N/2) is
+    /// refused before a study creates anything rather than at its first task.
+    pub(crate) fn ensure_samplers(&self) -> Result<()> {
+        let Some(&first) = self.hursts.first() else {
+            return Ok(());
+        };
+        for &hurst in &self.hursts {
+            psd_of(
+                self,
+                Task {
+                    n: self.sizes[0],
+                    hurst,
+                },
+            )?;
+        }
+        for &n in &self.sizes {
+            let task = Task { n, hurst: first };
+            match self.method {
+                Method::Bem => drop(BemSampler::new(self, task)?),
+                Method::Mdr => drop(LineSpec::new(
+                    n,
+                    SIZE,
+                    psd_of(self, task)?,
+                    Normalisation::RmsHeight(LINE_RMS_HEIGHT),
+                )?),
+            }
+        }
+        Ok(())
+    }
+}
+
 fn psd_of(spec: &StudySpec, task: Task) -> Result<Psd> {
     let long = spec
         .rolloff
         .map_or(LongWavelength::None, |q0| LongWavelength::RollOff { q0 });
     Psd::new(task.hurst, long, None)
+}
+
+/// The contact solver settings of every BEM sample (recorded in each checkpoint's
+/// identity, [`super::identity::SolverIdentity`]).
+pub(crate) fn bem_solver_params() -> SolverParams {
+    SolverParams::default()
 }
 
 /// BEM sampler: see the module docs.
@@ -218,7 +257,7 @@ impl BemSampler {
         Ok(BemSampler {
             surface,
             mean_pressures,
-            params: SolverParams::default(),
+            params: bem_solver_params(),
         })
     }
 }

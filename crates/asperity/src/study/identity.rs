@@ -1,0 +1,213 @@
+//! The identity of a checkpoint: everything that changes a number of a task's samples or
+//! result, and a checksum of the stored content.
+//!
+//! Every `checkpoint/<task>.json` is stored sealed ([`seal`]): the [`TaskIdentity`] of the
+//! task that produced it (method, N, H, seed, roll-off, force levels, fit window, the
+//! samplers' scales and solver settings, and the asperity version that defines the
+//! numerics), the checkpoint itself, and the FNV-1a-64 hash ([`fnv1a64`]) of the canonical
+//! bytes of both: their compact JSON serialisation by `serde_json` (fields in declaration
+//! order, floats in shortest round-trip form). [`unseal`] recomputes the hash from the
+//! parsed content, so any edit that changes a value (or a corrupted byte that still
+//! parses) is detected, and compares the identity field by field, naming what differs.
+//!
+//! FNV-1a (Fowler–Noll–Vo, 64-bit: offset basis `0xcbf29ce484222325`, prime
+//! `0x100000001b3`) is not cryptographic: it detects accidents (truncation, bit flips, hand
+//! edits), which is its purpose here, not deliberate forgery.
+
+use serde::{Deserialize, Serialize};
+
+use super::samplers::Scales;
+use super::{FitWindow, Method, StudySpec, Task};
+
+/// The format tag of sealed checkpoints.
+pub const CHECKPOINT_FORMAT: &str = "asperity-checkpoint/2";
+
+/// The solver settings of a BEM sample (`None` for MDR, which has no iterative solver).
+/// Extend it with any new setting that changes a number (e.g. a solver choice).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolverIdentity {
+    /// Residual tolerance of the contact solve.
+    pub tolerance: f64,
+    /// Iteration limit of the contact solve.
+    pub max_iterations: usize,
+    /// Relative residual of the frozen-set stiffness solve.
+    pub stiffness_tolerance: f64,
+    /// Iteration limit of the frozen-set stiffness solve.
+    pub stiffness_max_iterations: usize,
+}
+
+impl From<&crate::bem::SolverParams> for SolverIdentity {
+    fn from(p: &crate::bem::SolverParams) -> Self {
+        SolverIdentity {
+            tolerance: p.tolerance,
+            max_iterations: p.max_iterations,
+            stiffness_tolerance: p.stiffness_tolerance,
+            stiffness_max_iterations: p.stiffness_max_iterations,
+        }
+    }
+}
+
+/// Everything that changes a number of one task of a study (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TaskIdentity {
+    /// The asperity version whose numerics produced it.
+    pub numerics: String,
+    /// Solver.
+    pub method: Method,
+    /// Grid size.
+    pub n: usize,
+    /// Hurst exponent.
+    pub hurst: f64,
+    /// Study seed.
+    pub seed: u64,
+    /// Long-wavelength roll-off, if any.
+    pub rolloff: Option<f64>,
+    /// Common force levels of the ensemble curve.
+    pub levels: usize,
+    /// Fit window of α.
+    pub window: FitWindow,
+    /// Scales (normalisation, L, E*) of the samples.
+    pub scales: Scales,
+    /// Solver settings (BEM).
+    pub solver: Option<SolverIdentity>,
+}
+
+impl TaskIdentity {
+    /// The identity of `task` in `spec`, with this build's numerics.
+    pub fn of(spec: &StudySpec, task: Task) -> Self {
+        TaskIdentity {
+            numerics: format!("asperity {}", env!("CARGO_PKG_VERSION")),
+            method: spec.method,
+            n: task.n,
+            hurst: task.hurst,
+            seed: spec.seed,
+            rolloff: spec.rolloff,
+            levels: spec.levels,
+            window: spec.window,
+            scales: Scales::of(spec.method),
+            solver: match spec.method {
+                Method::Bem => Some(SolverIdentity::from(&super::samplers::bem_solver_params())),
+                Method::Mdr => None,
+            },
+        }
+    }
+
+    /// What differs from `other`, one `name: stored X, wanted Y` item per field (the field
+    /// names of the stored JSON), or an empty list when they are the same.
+    pub fn differences(&self, wanted: &TaskIdentity) -> Vec<String> {
+        let (a, b) = (to_map(self), to_map(wanted));
+        let mut out = Vec::new();
+        for (key, value) in &a {
+            let other = b.get(key).unwrap_or(&serde_json::Value::Null);
+            if value != other {
+                out.push(format!(
+                    "{key}: stored {}, wanted {}",
+                    short(value),
+                    short(other)
+                ));
+            }
+        }
+        out
+    }
+}
+
+fn to_map(id: &TaskIdentity) -> serde_json::Map<String, serde_json::Value> {
+    match serde_json::to_value(id) {
+        Ok(serde_json::Value::Object(map)) => map,
+        _ => serde_json::Map::new(),
+    }
+}
+
+/// A JSON value in at most 60 characters.
+fn short(value: &serde_json::Value) -> String {
+    let text = value.to_string();
+    if text.chars().count() <= 60 {
+        text
+    } else {
+        format!("{}…", text.chars().take(60).collect::<String>())
+    }
+}
+
+pub use crate::io::fnv1a64;
+
+/// The file: format tag, checksum, and the hashed part (identity and content).
+#[derive(Serialize, Deserialize)]
+struct Sealed<T> {
+    format: String,
+    checksum: String,
+    identity: TaskIdentity,
+    content: T,
+}
+
+/// The checksum of the canonical bytes: the compact JSON of `[identity, content]`.
+fn checksum_of<T: Serialize>(identity: &TaskIdentity, content: &T) -> Result<String, String> {
+    let bytes = serde_json::to_vec(&(identity, content)).map_err(|e| e.to_string())?;
+    Ok(format!("fnv1a64:{:016x}", fnv1a64(&bytes)))
+}
+
+/// The bytes of a sealed file holding `content` produced by `identity`.
+pub fn seal<T: Serialize>(identity: &TaskIdentity, content: T) -> Result<Vec<u8>, String> {
+    let checksum = checksum_of(identity, &content)?;
+    serde_json::to_vec(&Sealed {
+        format: CHECKPOINT_FORMAT.into(),
+        checksum,
+        identity: identity.clone(),
+        content,
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// Why a sealed file cannot be used.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Unsealed {
+    /// Not a sealed file of this format (unparseable, truncated, or an older format).
+    Corrupt(String),
+    /// The content does not match its checksum (edited or damaged).
+    Checksum,
+    /// Produced by another task or setting; the differences, one item per field.
+    Foreign(Vec<String>),
+}
+
+/// Reads a sealed file: its content if intact and produced by `wanted`.
+pub fn unseal<T>(bytes: &[u8], wanted: &TaskIdentity) -> Result<T, Unsealed>
+where
+    T: Serialize + for<'de> Deserialize<'de>,
+{
+    let format = serde_json::from_slice::<FormatOnly>(bytes)
+        .map_err(|e| Unsealed::Corrupt(crate::input::one_line(&e.to_string())))?
+        .format;
+    if format.as_deref() != Some(CHECKPOINT_FORMAT) {
+        return Err(Unsealed::Corrupt(
+            "written by an older asperity, without identity or checksum".into(),
+        ));
+    }
+    let sealed: Sealed<T> = serde_json::from_slice(bytes)
+        .map_err(|e| Unsealed::Corrupt(crate::input::one_line(&e.to_string())))?;
+    let checksum = checksum_of(&sealed.identity, &sealed.content).ok();
+    if checksum.as_deref() != Some(sealed.checksum.as_str()) {
+        return Err(Unsealed::Checksum);
+    }
+    let differences = sealed.identity.differences(wanted);
+    if !differences.is_empty() {
+        return Err(Unsealed::Foreign(differences));
+    }
+    Ok(sealed.content)
+}
+
+#[derive(Deserialize)]
+struct FormatOnly {
+    format: Option<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv1a64_matches_the_published_test_vectors() {
+        // From the FNV reference test suite (Landon Curt Noll's fnv test vectors).
+        assert_eq!(fnv1a64(b""), 0xcbf29ce484222325);
+        assert_eq!(fnv1a64(b"a"), 0xaf63dc4c8601ec8c);
+        assert_eq!(fnv1a64(b"foobar"), 0x85944171f73967e8);
+    }
+}
