@@ -345,7 +345,9 @@ fn indentation_levels(args: &MdrArgs, foundation: &Foundation) -> Result<Vec<f64
             let full = foundation.full_contact_indentation();
             if full <= 0.0 {
                 bail!(
-                    "every spring touches at once (a flat punch?): give --dmax or --indentations"
+                    "every spring touches at the first contact (all gaps are equal, e.g. a \
+                     flat punch, or a profile sampled by one or two springs), so there is no \
+                     range of indentations to sweep: give --dmax, or --indentations"
                 );
             }
             full

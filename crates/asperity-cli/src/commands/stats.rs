@@ -94,6 +94,23 @@ fn sidecar_hints(file: &Path) -> Result<SidecarHints> {
     })
 }
 
+/// Refuses statistics that overflow float64 (heights near 1e308 square to infinity),
+/// naming the file, before anything is written or printed.
+fn ensure_finite_statistics(file: &Path, summary: &Summary, bins: &[PsdBin]) -> Result<()> {
+    let values = [summary.rms_height, summary.rms_slope]
+        .into_iter()
+        .chain(summary.rms_curvature)
+        .chain(bins.iter().flat_map(|b| [b.q, b.psd]));
+    if values.into_iter().any(|v| !v.is_finite()) {
+        bail!(
+            "{}: its statistics overflow float64 (squares of its heights or slopes exceed \
+             1.8e308); rescale the heights",
+            file.display()
+        );
+    }
+    Ok(())
+}
+
 /// Checks a user-given end of the fit range: a positive, finite q·L/2π.
 fn fit_bound(flag: &str, value: Option<f64>) -> Result<Option<f64>> {
     match value {
@@ -433,6 +450,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         iso,
         record,
     } = inputs;
+    ensure_finite_statistics(&args.file, &summary, &bins)?;
     let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
     let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
     let plan = fit_range(args, &hints, nyquist)?;

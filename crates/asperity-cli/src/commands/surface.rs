@@ -104,6 +104,29 @@ fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> Normalisati
     }
 }
 
+/// Refuses a generated profile that float64 cannot represent: heights that underflow to
+/// zero (a tiny --rms-height) or slopes that overflow (a tiny --size), naming the inputs.
+fn ensure_usable(rms_height: f64, rms_slope: f64, s: &SpectrumArgs) -> Result<()> {
+    let short = asperity::input::short_number;
+    if !(rms_height.is_finite() && rms_height > 0.0) {
+        anyhow::bail!(
+            "the generated heights are not representable (rms height {}): --rms-height or \
+             --rms-slope with --size {} is beyond the range of float64",
+            short(rms_height),
+            short(s.size)
+        );
+    }
+    if !(rms_slope.is_finite() && rms_slope > 0.0) {
+        anyhow::bail!(
+            "the generated slopes are not representable (rms slope {}): --size {} is too \
+             small for float64 slopes",
+            short(rms_slope),
+            short(s.size)
+        );
+    }
+    Ok(())
+}
+
 /// Runs `asperity surface`.
 pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let s = &args.spectrum;
@@ -133,6 +156,7 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let surface = SurfaceGenerator::new(&spec)?.try_generate(s.seed)?;
     let elapsed = start.elapsed().as_secs_f64();
     let summary = surface_summary(&surface);
+    ensure_usable(summary.rms_height, summary.rms_slope, s)?;
     staged.write_npy_2d(&s.out, surface.heights())?;
     staged.write_json(
         &sidecar,
@@ -173,6 +197,7 @@ pub fn run_line(args: &LineArgs) -> Result<()> {
     let mut staged = StagedOutputs::new([&s.out, &sidecar], s.force)?;
     let line = LineGenerator::new(&spec)?.try_generate(s.seed)?;
     let summary = line_summary(&line);
+    ensure_usable(summary.rms_height, summary.rms_slope, s)?;
     staged.write_npy_1d(&s.out, line.heights())?;
     staged.write_json(
         &sidecar,

@@ -77,7 +77,12 @@ impl FitWindow {
         if self.min_contacts == 0 || !(self.max_fraction > 0.0 && self.max_fraction <= 1.0) {
             return Err(Error::invalid(
                 "fit window",
-                format!("need min_contacts ≥ 1 and 0 < max_fraction ≤ 1, got {self:?}"),
+                format!(
+                    "need min_contacts ≥ 1 and 0 < max_fraction ≤ 1, got min_contacts = {} and \
+                     max_fraction = {}",
+                    self.min_contacts,
+                    crate::input::short_number(self.max_fraction)
+                ),
             ));
         }
         Ok(())
