@@ -57,16 +57,18 @@ impl Written {
     }
 }
 
-/// Whether a study may write `outputs` into `dir`: `Ok(false)` when none exists (nothing
-/// to overwrite), `Ok(true)` when every existing one is unchanged since this study wrote
-/// it, or with `force`; else a one-line refusal naming the file.
+/// Whether a study may write `outputs` into `dir` over existing files: `Ok(false)` when
+/// none exists (nothing to overwrite), `Ok(true)` when every existing one is unchanged
+/// since this study wrote it (or only the record is left), or with `force`; else a
+/// one-line refusal naming the file.
 pub fn may_rewrite(dir: &Path, outputs: &[PathBuf], force: bool) -> Result<bool> {
     if force {
         return Ok(true);
     }
     let existing: Vec<&PathBuf> = outputs.iter().filter(|p| p.exists()).collect();
     if existing.is_empty() {
-        return Ok(false);
+        // Only the record may be left (its outputs removed by hand): it is rewritten.
+        return Ok(dir.join(RECORD).exists());
     }
     let record = Written::read(&dir.join(RECORD));
     if let Some(changed) = existing.iter().find(|p| !record.unchanged(p)) {

@@ -58,11 +58,24 @@ fn alpha_study_writes_table_and_plots() {
     for ext in ["png", "svg"] {
         assert!(dir.path().join(format!("a/alpha.{ext}")).exists());
     }
-    // Running the finished study again refuses to overwrite its outputs.
+    // Running the finished study again resumes (nothing to compute) and rewrites the
+    // same outputs; once one is edited, it is refused without --force.
+    let csv_path = dir.path().join("a/alpha.csv");
+    ok(&asperity(&[&ALPHA[..], &["a"]].concat(), dir.path()));
+    assert_eq!(std::fs::read_to_string(&csv_path).unwrap(), csv);
+    std::fs::write(&csv_path, format!("{csv}# my note\n")).unwrap();
     refused(
         &asperity(&[&ALPHA[..], &["a"]].concat(), dir.path()),
-        "already exists",
+        "was edited since",
     );
+    assert!(std::fs::read_to_string(&csv_path)
+        .unwrap()
+        .ends_with("# my note\n"));
+    ok(&asperity(
+        &[&ALPHA[..], &["a", "--force"]].concat(),
+        dir.path(),
+    ));
+    assert_eq!(std::fs::read_to_string(&csv_path).unwrap(), csv);
 }
 
 #[test]
@@ -80,7 +93,7 @@ fn truncated_checkpoint_resumes_to_identical_results() {
     checkpoints.sort();
     let done: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&checkpoints[0]).unwrap()).unwrap();
-    assert_eq!(done["state"], "done");
+    assert_eq!(done["content"]["state"], "done");
     std::fs::remove_file(&checkpoints[1]).unwrap();
     for ext in ["csv", "png", "svg"] {
         std::fs::remove_file(d.join(format!("s/alpha.{ext}"))).unwrap();

@@ -207,7 +207,17 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
     assert_refused(&out, d, 0, "rms-height");
 
     write_npy(d.join("nan.npy"), &array![[0.0, 1.0], [f64::NAN, 2.0]]).unwrap();
-    write_npy(d.join("f32.npy"), &array![[0.0f32, 1.0], [3.0, 2.0]]).unwrap();
+    // A complex64 array (dtype <c8): not a real dtype.
+    let mut complex = b"\x93NUMPY\x01\x00".to_vec();
+    let mut dict = "{'descr': '<c8', 'fortran_order': False, 'shape': (2, 2), }".to_string();
+    while (10 + dict.len() + 1) % 64 != 0 {
+        dict.push(' ');
+    }
+    dict.push('\n');
+    complex.extend((dict.len() as u16).to_le_bytes());
+    complex.extend(dict.as_bytes());
+    complex.extend([0u8; 32]);
+    std::fs::write(d.join("f32.npy"), complex).unwrap();
     write_npy(
         d.join("cube.npy"),
         &ndarray::Array3::<f64>::zeros((2, 2, 2)),
@@ -219,7 +229,12 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
     assert_refused(&asperity(&["stats", "nan.npy"], d), d, n, "non-finite");
     assert_refused(&asperity(&["stats", "inf.npy"], d), d, n, "inf");
     assert_refused(&asperity(&["stats", "ninf.npy"], d), d, n, "index 1");
-    assert_refused(&asperity(&["stats", "f32.npy"], d), d, n, "float64");
+    assert_refused(
+        &asperity(&["stats", "f32.npy"], d),
+        d,
+        n,
+        "unsupported .npy dtype '<c8'",
+    );
     assert_refused(&asperity(&["stats", "cube.npy"], d), d, n, "3 dimensions");
     assert_refused(&asperity(&["stats", "missing.npy"], d), d, n, "missing.npy");
 

@@ -553,19 +553,24 @@ impl StudyDir {
                 _ => {}
             }
         }
+        let store = StudyDir {
+            dir: dir.to_path_buf(),
+            spec: spec.clone(),
+            interval: CHECKPOINT_INTERVAL,
+        };
+        // Every checkpoint already there is verified before the folder is claimed, so that
+        // a refused run leaves it exactly as it was.
+        for task in spec.tasks() {
+            store.load(task)?;
+        }
         std::fs::create_dir_all(dir.join("checkpoint")).map_err(|e| Error::io(dir, e))?;
-        let manifest_path = dir.join("study.json");
         let manifest = Manifest {
             format: MANIFEST_FORMAT.into(),
             spec: spec.clone(),
             normalisation: Some(Scales::of(spec.method)),
         };
-        io::write_json(&manifest_path, true, &manifest)?;
-        Ok(StudyDir {
-            dir: dir.to_path_buf(),
-            spec: spec.clone(),
-            interval: CHECKPOINT_INTERVAL,
-        })
+        io::write_json(&dir.join("study.json"), true, &manifest)?;
+        Ok(store)
     }
 
     /// Saves tasks in progress at most every `interval` instead of [`CHECKPOINT_INTERVAL`]
