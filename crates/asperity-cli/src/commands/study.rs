@@ -947,6 +947,42 @@ mod tests {
         assert!(err.contains("line 3") || err.contains("line 4"), "{err}");
     }
 
+    /// Inputs tried by the property test below.
+    const FUZZ_CASES: u32 = 1000;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: FUZZ_CASES, failure_persistence: None, ..Default::default() })]
+
+        /// The example study file with bytes changed, cut or inserted: parsed or refused in
+        /// one line; a spec it accepts either validates or is refused by validation, in one
+        /// line too (never a panic, an abort or a huge allocation).
+        #[test]
+        fn mutated_study_files_never_panic(
+            at in 0usize..10_000,
+            byte in proptest::prelude::any::<u8>(),
+            mode in 0u8..4,
+            number in proptest::prelude::prop::sample::select(vec!["1e300", "-1", "nan", "1e-9", "18446744073709551616", "\"-1:3:1e-12\"", "[]"]),
+        ) {
+            let mut bytes = SWEEP_EXAMPLE.as_bytes().to_vec();
+            let i = at % bytes.len();
+            match mode {
+                0 => bytes[i] = byte,
+                1 => bytes.truncate(i),
+                2 => bytes.insert(i, byte),
+                _ => bytes.extend(format!("\nlevels = {number}\n").as_bytes()),
+            }
+            let text = String::from_utf8_lossy(&bytes);
+            match parse_study_file(Path::new("s.toml"), &text) {
+                Ok((_, spec)) => {
+                    if let Err(e) = spec.validate() {
+                        proptest::prop_assert!(!e.to_string().contains('\n'));
+                    }
+                }
+                Err(e) => proptest::prop_assert!(!e.to_string().contains('\n'), "{}", e),
+            }
+        }
+    }
+
     #[test]
     fn the_example_file_parses_and_help_and_readme_list_every_key() {
         let (kind, spec) = parse_study_file(Path::new("docs/sweep.toml"), SWEEP_EXAMPLE).unwrap();

@@ -210,4 +210,71 @@ mod tests {
         assert_eq!(fnv1a64(b"a"), 0xaf63dc4c8601ec8c);
         assert_eq!(fnv1a64(b"foobar"), 0x85944171f73967e8);
     }
+
+    fn identity() -> TaskIdentity {
+        let spec = StudySpec {
+            method: Method::Bem,
+            sizes: vec![16],
+            hursts: vec![0.5],
+            samples: 2,
+            rolloff: Some(2.0),
+            seed: 11,
+            window: FitWindow::default(),
+            levels: 10,
+        };
+        TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 })
+    }
+
+    /// Inputs tried by the property test below.
+    const FUZZ_CASES: u32 = 2000;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: FUZZ_CASES, failure_persistence: None, ..Default::default() })]
+
+        /// A sealed checkpoint with one byte changed, bytes cut off or inserted is either
+        /// refused (one line) or, where the change left its content intact (whitespace),
+        /// read back as the very values sealed.
+        #[test]
+        fn mutated_checkpoints_are_refused_or_intact(
+            values in proptest::collection::vec(-1e6f64..1e6, 1..20),
+            at in 0usize..100_000,
+            byte in proptest::prelude::any::<u8>(),
+            mode in 0u8..3,
+        ) {
+            let id = identity();
+            let mut bytes = seal(&id, &values).unwrap();
+            let i = at % bytes.len();
+            match mode {
+                0 => bytes[i] = byte,
+                1 => bytes.truncate(i),
+                _ => bytes.insert(i, byte),
+            }
+            match unseal::<Vec<f64>>(&bytes, &id) {
+                Ok(read) => proptest::prop_assert_eq!(read, values),
+                Err(Unsealed::Corrupt(why)) => proptest::prop_assert!(!why.contains('\n')),
+                Err(_) => {}
+            }
+        }
+    }
+
+    #[test]
+    fn other_identities_are_named_field_by_field() {
+        let id = identity();
+        let bytes = seal(&id, 1.5f64).unwrap();
+        let mut other = id.clone();
+        other.seed = 12;
+        other.numerics = "asperity 9.9.9".into();
+        match unseal::<f64>(&bytes, &other) {
+            Err(Unsealed::Foreign(d)) => {
+                assert_eq!(d.len(), 2, "{d:?}");
+                assert!(
+                    d.contains(&"seed: stored 11, wanted 12".to_string()),
+                    "{d:?}"
+                );
+                assert!(d[0].starts_with("numerics: stored \"asperity "), "{d:?}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(unseal::<f64>(&bytes, &id).unwrap(), 1.5);
+    }
 }
