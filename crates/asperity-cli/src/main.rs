@@ -52,9 +52,34 @@ fn main() {
                 line = format!("{line}: {cause}");
             }
         }
-        eprintln!("error: {line}");
+        eprintln!(
+            "error: {}",
+            shorten_numbers(&asperity::input::one_line(&line))
+        );
         std::process::exit(2);
     }
+}
+
+/// Numbers of more than 20 characters (Rust prints `1e-300` as 300 digits) in short
+/// scientific form; everything else as it is.
+fn shorten_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let tail = &rest[start..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(tail.len());
+        let number = tail[..len].trim_end_matches('.');
+        out.push_str(&rest[..start]);
+        match number.parse::<f64>() {
+            Ok(v) if number.len() > 20 => out.push_str(&asperity::input::short_number(v)),
+            _ => out.push_str(number),
+        }
+        rest = &tail[number.len()..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// clap's message in one line. It is several lines (tip, usage); the first is kept, as for
@@ -97,6 +122,20 @@ mod tests {
             one_line(text),
             "the following required arguments were not provided: --radial-step <DR>, --out <FILE>"
         );
+    }
+
+    #[test]
+    fn long_numbers_are_shortened() {
+        let tiny = format!("H = {} is outside [-1, 3]", 1e-300f64);
+        assert!(tiny.len() > 300);
+        assert_eq!(
+            super::shorten_numbers(&tiny),
+            "H = 1e-300 is outside [-1, 3]"
+        );
+        let huge = format!("got {} and -{}", 1e300f64, 4.5e25f64);
+        assert_eq!(super::shorten_numbers(&huge), "got 1e300 and -4.5e25");
+        let plain = "a/b1.npy: needs 32000000000000 bytes, v0.1.0";
+        assert_eq!(super::shorten_numbers(plain), plain);
     }
 
     #[test]

@@ -162,8 +162,9 @@ impl Chart {
         {
             let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
             self.render(&root)?;
-            root.present()
-                .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
+            root.present().map_err(|e| {
+                anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string()))
+            })?;
         }
         staged.write_bytes(svg, text.as_bytes())?;
         Ok(())
@@ -418,8 +419,9 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
             {
                 let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
                 draw(&root, charts)?;
-                root.present()
-                    .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+                root.present().map_err(|e| {
+                    anyhow!("rendering {}: {}", path.display(), in_words(&e.to_string()))
+                })?;
             }
             staged.write_bytes(path, text.as_bytes())?;
             Ok(())
@@ -455,6 +457,27 @@ pub fn thin_log(points: impl Iterator<Item = (f64, f64)>, keep: usize) -> Vec<(f
     kept
 }
 
+/// A drawing error in words. Plotters prints its bitmap errors with `{:?}` (e.g.
+/// `ImageError(IoError(Os { code: 28, kind: StorageFull, message: "No space left on
+/// device" }))`): the message inside is kept, not the Debug text.
+fn in_words(text: &str) -> String {
+    for key in ["message: \"", "error: \""] {
+        if let Some(rest) = text.find(key).map(|i| &text[i + key.len()..]) {
+            if let Some(end) = rest.find('"') {
+                return rest[..end].to_string();
+            }
+        }
+    }
+    if let Some(rest) = text.find("kind: ").map(|i| &text[i + 6..]) {
+        let end = rest.find([',', ' ', '}']).unwrap_or(rest.len());
+        return format!("input/output error ({})", &rest[..end]);
+    }
+    if text.contains('{') || text.contains("Error(") {
+        return "the image could not be encoded or written".into();
+    }
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 /// Renders a `size` PNG with `draw` into the staged output `path` (a temporary file until
 /// the outputs are committed).
 fn stage_png<F>(staged: &mut StagedOutputs, path: &Path, size: (u32, u32), draw: F) -> Result<()>
@@ -465,7 +488,7 @@ where
         let root = BitMapBackend::new(tmp, size).into_drawing_area();
         draw(&root)?;
         root.present()
-            .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+            .map_err(|e| anyhow!("rendering {}: {}", path.display(), in_words(&e.to_string())))?;
         Ok(())
     })
 }
@@ -489,7 +512,9 @@ pub fn greyscale_png(
             for c in 0..w as usize {
                 let v = ((heights[[r * step, c * step]] - lo) / range * 255.0).round() as u8;
                 root.draw_pixel((c as i32, r as i32), &RGBColor(v, v, v))
-                    .map_err(|e| anyhow!("rendering {}: {e}", path.display()))?;
+                    .map_err(|e| {
+                        anyhow!("rendering {}: {}", path.display(), in_words(&e.to_string()))
+                    })?;
             }
         }
         Ok(())
@@ -561,11 +586,29 @@ pub fn greyscale_panel(
         // One SVG rectangle per 4x4 block keeps the file small.
         draw(&root, maps, tile, caption_height, 4)?;
         root.present()
-            .map_err(|e| anyhow!("rendering {}: {e}", svg.display()))?;
+            .map_err(|e| anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string())))?;
     }
     staged.write_bytes(svg, text.as_bytes())?;
     staged.commit()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod words_tests {
+    use super::in_words;
+
+    #[test]
+    fn debug_formatted_backend_errors_become_words() {
+        let full = r#"Drawing backend error: ImageError(IoError(Os { code: 28, kind: StorageFull, message: "No space left on device" }))"#;
+        assert_eq!(in_words(full), "No space left on device");
+        let custom = r#"ImageError(IoError(Custom { kind: Other, error: "disk quota exceeded" }))"#;
+        assert_eq!(in_words(custom), "disk quota exceeded");
+        assert_eq!(
+            in_words("InvalidBuffer { x: 1 }"),
+            "the image could not be encoded or written"
+        );
+        assert_eq!(in_words("plain words"), "plain words");
+    }
 }
 
 #[cfg(test)]
