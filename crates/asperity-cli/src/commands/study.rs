@@ -99,7 +99,9 @@ E* = 1 and linear springs at spacing dx = L/N; BEM surfaces have unit rms slope,
 E* = 1 and free boundaries. Forces and stiffnesses of the two methods are therefore on
 different scales; compare exponents, not values.
 
-The folder also holds the checkpoint: run the same command again to resume."
+The folder also holds the checkpoint: run the same command again to resume (no --force
+needed; it rewrites only outputs it wrote that nobody edited since). While a study runs, its
+folder is locked: a second process on it is refused, naming the holder's PID."
     };
 }
 

@@ -120,12 +120,14 @@ fn random_sign(rng: &mut ChaCha8Rng) -> f64 {
 /// of the `rows × (cols/2 + 1)` half grid, so a narrow grid costs up to 32 B per point), and
 /// the plans and scratch of the transforms along each axis, which grow with the length of
 /// that axis (measured with rustfft on 4 000 000 × 2 and 2 × 4 000 000 grids: about 75 B
-/// per row and 42 B per column; 96 and 64 are taken).
+/// per row and 42 B per column; 96 and 64 are taken), and never less than 32 B per point.
 pub fn surface_generation_bytes(rows: usize, cols: usize) -> Option<u64> {
     let heights = array_bytes(&[rows, cols], 8)?;
     let half = array_bytes(&[rows, cols / 2 + 1], 2 * 16)?;
     let plans = array_bytes(&[rows], 96)?.checked_add(array_bytes(&[cols], 64)?)?;
-    heights.checked_add(half)?.checked_add(plans)
+    let estimate = heights.checked_add(half)?.checked_add(plans)?;
+    // Never below the flat 32 B per point that square grids have always been sized with.
+    Some(estimate.max(array_bytes(&[rows, cols], 32)?))
 }
 
 impl SurfaceGenerator {
