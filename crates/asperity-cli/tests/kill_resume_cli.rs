@@ -122,7 +122,7 @@ fn a_bem_study_killed_anywhere_resumes_byte_identical() {
     let straight: Vec<&str> = straight.iter().map(String::as_str).collect();
     let full = run(&straight, d);
     let reference = results(&d.join("straight"));
-    let fractions = kill_fractions(9, 8);
+    let fractions = kill_fractions(9, 12);
     let mut landed = 0;
     for (i, f) in fractions.iter().enumerate() {
         let name = format!("cut{i}");
