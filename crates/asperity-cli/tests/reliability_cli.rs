@@ -53,7 +53,7 @@ fn refused(out: &Output, needle: &str) -> String {
 /// A `.npy` file (version 1) with this header dict and data.
 fn npy(dict: &str, data: &[u8]) -> Vec<u8> {
     let mut header = dict.to_string();
-    while (10 + header.len() + 1) % 64 != 0 {
+    while !(10 + header.len() + 1).is_multiple_of(64) {
         header.push(' ');
     }
     header.push('\n');
@@ -541,7 +541,7 @@ fn non_finite_results_are_refused_naming_the_input() {
     );
     assert!(!d.join("a.npy").exists() && !d.join("b.npy").exists());
     let data: Vec<u8> = (0..64)
-        .flat_map(|i| (if i % 2 == 0 { 1e308 } else { -1e308 } as f64).to_le_bytes())
+        .flat_map(|i| (if i % 2 == 0 { 1e308f64 } else { -1e308 }).to_le_bytes())
         .collect();
     let dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (8, 8), }";
     std::fs::write(d.join("big.npy"), npy(dict, &data)).unwrap();

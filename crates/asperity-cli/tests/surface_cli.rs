@@ -210,7 +210,7 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
     // A complex64 array (dtype <c8): not a real dtype.
     let mut complex = b"\x93NUMPY\x01\x00".to_vec();
     let mut dict = "{'descr': '<c8', 'fortran_order': False, 'shape': (2, 2), }".to_string();
-    while (10 + dict.len() + 1) % 64 != 0 {
+    while !(10 + dict.len() + 1).is_multiple_of(64) {
         dict.push(' ');
     }
     dict.push('\n');

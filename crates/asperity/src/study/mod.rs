@@ -253,7 +253,7 @@ fn parse_range_item(text: &str) -> Result<Vec<f64>> {
                 ));
             }
             let count = ((b - a) / step + 1e-9).floor() + 1.0;
-            if !(count <= MAX_RANGE_VALUES as f64) {
+            if count.is_nan() || count > MAX_RANGE_VALUES as f64 {
                 return Err(Error::invalid(
                     "hurst",
                     format!(
@@ -946,7 +946,8 @@ mod tests {
             .save_in_progress(task, &[Synthetic.sample(&mut (), 1).unwrap()])
             .unwrap();
         let saved = std::fs::read(checkpoint_file(first.path(), task)).unwrap();
-        let variants: Vec<(&str, Box<dyn Fn(&mut StudySpec)>)> = vec![
+        type Change = Box<dyn Fn(&mut StudySpec)>;
+        let variants: Vec<(&str, Change)> = vec![
             ("seed", Box::new(|s| s.seed = 4)),
             ("rolloff", Box::new(|s| s.rolloff = Some(6.0))),
             ("levels", Box::new(|s| s.levels = 11)),
