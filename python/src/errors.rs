@@ -9,11 +9,12 @@
 //! * [`SolveError::BeyondFullContact`] → `asperity.BeyondFullContactError` (a
 //!   `ValueError`) with `.threshold` (the full-contact value in the quantity asked for, or
 //!   `None`), `.quantity` and `.requested`;
-//! * I/O errors → `OSError`.
+//! * I/O errors → `OSError`; a study folder locked by another process
+//!   ([`Error::FolderInUse`]) → `BlockingIOError`, naming the holder's PID.
 
 use asperity::bem::SolveError;
 use asperity::Error;
-use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyBlockingIOError, PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
@@ -37,6 +38,7 @@ pub fn from_error(error: Error) -> PyErr {
     match error {
         Error::OutOfMemory { .. } => PyMemoryError::new_err(error.to_string()),
         Error::Io { .. } => PyOSError::new_err(error.to_string()),
+        Error::FolderInUse { .. } => PyBlockingIOError::new_err(error.to_string()),
         Error::Solve { context, source } => {
             let err = from_solve(*source);
             Python::attach(|py| prefix(py, err, &context))

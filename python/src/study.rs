@@ -16,7 +16,7 @@ use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
     parse_range, run_task, FitWindow, Method, SampleCurve, Sampler, StudyDir, StudySpec, Task,
-    TaskResult,
+    TaskResult, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 use asperity::Error;
 use pyo3::prelude::*;
@@ -98,9 +98,10 @@ fn run_study(
     checkpoint_every: f64,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
-    if !(checkpoint_every.is_finite() && checkpoint_every >= 0.0) {
+    if !(0.0..=MAX_CHECKPOINT_INTERVAL_SECONDS).contains(&checkpoint_every) {
         return Err(invalid(format!(
-            "checkpoint_every must be a number of seconds >= 0, got {checkpoint_every}"
+            "checkpoint_every must be between 0 and {MAX_CHECKPOINT_INTERVAL_SECONDS:e} \
+             seconds, got {checkpoint_every}"
         )));
     }
     let spec = StudySpec {
@@ -119,6 +120,9 @@ fn run_study(
     spec.validate().map_err(from_error)?;
     spec.ensure_fits().map_err(from_error)?;
     StudyDir::check(&out, &spec, force).map_err(from_error)?;
+    // Held until the study returns: a second process (CLI or Python) on the folder is
+    // refused at once, naming this one's PID.
+    let _lock = StudyDir::lock(&out).map_err(from_error)?;
     let store = StudyDir::open(&out, &spec, force)
         .map_err(from_error)?
         .with_checkpoint_interval(Duration::from_secs_f64(checkpoint_every));

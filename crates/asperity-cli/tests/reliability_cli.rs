@@ -268,7 +268,10 @@ fn a_study_never_reports_another_studys_samples() {
         (&["--seed", "2"][..], "seed: stored 1, wanted 2"),
         (&["--rolloff", "2"][..], "rolloff: stored null, wanted 2"),
         (&["--levels", "20"][..], "levels: stored 48, wanted 20"),
-        (&["--max-fraction", "0.5"][..], "window: stored"),
+        (
+            &["--max-fraction", "0.5"][..],
+            "window.max_fraction: stored",
+        ),
     ] {
         let _ = std::fs::remove_dir_all(d.join("b"));
         std::fs::create_dir_all(d.join("b/checkpoint")).unwrap();

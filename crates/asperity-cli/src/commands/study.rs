@@ -480,7 +480,7 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
 }
 
 /// The longest `--checkpoint-every`, in seconds (about 11 days).
-const MAX_CHECKPOINT_EVERY: f64 = 1e6;
+const MAX_CHECKPOINT_EVERY: f64 = asperity::study::MAX_CHECKPOINT_INTERVAL_SECONDS;
 
 /// How a study runs (not part of what it computes).
 #[derive(Debug, Clone, Copy)]

@@ -23,9 +23,12 @@ use super::{FitWindow, Method, StudySpec, Task};
 pub const CHECKPOINT_FORMAT: &str = "asperity-checkpoint/2";
 
 /// The solver settings of a BEM sample (`None` for MDR, which has no iterative solver).
-/// Extend it with any new setting that changes a number (e.g. a solver choice).
+/// Extend it with any new setting that changes a number.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SolverIdentity {
+    /// The iteration that solved the contact problem, by its command-line name (`bccg`,
+    /// `pk`): both converge to the tolerance, but not to the same last digits.
+    pub solver: String,
     /// Residual tolerance of the contact solve.
     pub tolerance: f64,
     /// Iteration limit of the contact solve.
@@ -39,6 +42,7 @@ pub struct SolverIdentity {
 impl From<&crate::bem::SolverParams> for SolverIdentity {
     fn from(p: &crate::bem::SolverParams) -> Self {
         SolverIdentity {
+            solver: p.solver.name().to_owned(),
             tolerance: p.tolerance,
             max_iterations: p.max_iterations,
             stiffness_tolerance: p.stiffness_tolerance,
@@ -93,21 +97,38 @@ impl TaskIdentity {
     }
 
     /// What differs from `other`, one `name: stored X, wanted Y` item per field (the field
-    /// names of the stored JSON), or an empty list when they are the same.
+    /// names of the stored JSON, nested ones as `solver.tolerance`), or an empty list when
+    /// they are the same.
     pub fn differences(&self, wanted: &TaskIdentity) -> Vec<String> {
-        let (a, b) = (to_map(self), to_map(wanted));
         let mut out = Vec::new();
-        for (key, value) in &a {
-            let other = b.get(key).unwrap_or(&serde_json::Value::Null);
-            if value != other {
-                out.push(format!(
-                    "{key}: stored {}, wanted {}",
-                    short(value),
-                    short(other)
-                ));
-            }
-        }
+        push_differences("", &to_map(self), &to_map(wanted), &mut out);
         out
+    }
+}
+
+/// Compares two JSON objects key by key, descending into objects present on both sides.
+fn push_differences(
+    prefix: &str,
+    stored: &serde_json::Map<String, serde_json::Value>,
+    wanted: &serde_json::Map<String, serde_json::Value>,
+    out: &mut Vec<String>,
+) {
+    for (key, value) in stored {
+        let other = wanted.get(key).unwrap_or(&serde_json::Value::Null);
+        if value == other {
+            continue;
+        }
+        let name = format!("{prefix}{key}");
+        match (value, other) {
+            (serde_json::Value::Object(a), serde_json::Value::Object(b)) => {
+                push_differences(&format!("{name}."), a, b, out)
+            }
+            _ => out.push(format!(
+                "{name}: stored {}, wanted {}",
+                short(value),
+                short(other)
+            )),
+        }
     }
 }
 
@@ -276,5 +297,21 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert_eq!(unseal::<f64>(&bytes, &id).unwrap(), 1.5);
+    }
+
+    #[test]
+    fn a_checkpoint_of_another_solver_is_foreign() {
+        let id = identity();
+        assert_eq!(id.solver.as_ref().unwrap().solver, "bccg");
+        let bytes = seal(&id, 1.5f64).unwrap();
+        let mut other = id.clone();
+        other.solver.as_mut().unwrap().solver = "pk".into();
+        match unseal::<f64>(&bytes, &other) {
+            Err(Unsealed::Foreign(d)) => {
+                assert_eq!(d.len(), 1, "{d:?}");
+                assert_eq!(d[0], "solver.solver: stored \"bccg\", wanted \"pk\"");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

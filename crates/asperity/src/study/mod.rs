@@ -426,6 +426,10 @@ enum Checkpoint {
 /// that fast tasks (MDR) do not spend their time rewriting checkpoints.
 pub const CHECKPOINT_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
 
+/// The longest checkpoint interval a caller may ask for, in seconds (about 11 days): longer
+/// is no checkpoint at all, and `Duration::from_secs_f64` panics past its range.
+pub const MAX_CHECKPOINT_INTERVAL_SECONDS: f64 = 1e6;
+
 const MANIFEST_FORMAT: &str = "asperity-study/1";
 
 /// The largest checkpoint file read (2^34 bytes); the memory guard checks it first.
@@ -951,7 +955,10 @@ mod tests {
             ("seed", Box::new(|s| s.seed = 4)),
             ("rolloff", Box::new(|s| s.rolloff = Some(6.0))),
             ("levels", Box::new(|s| s.levels = 11)),
-            ("window", Box::new(|s| s.window.min_contacts = 2)),
+            (
+                "window.min_contacts",
+                Box::new(|s| s.window.min_contacts = 2),
+            ),
         ];
         for (field, change) in variants {
             let mut other = spec(6);
