@@ -1074,11 +1074,11 @@ fn bad_numbers_name_their_flag() {
         ),
         (
             &["--size", "-1"][..],
-            "--size must be positive and finite, got -1",
+            "invalid --size -1: sizes must be positive and finite",
         ),
         (
             &["--size", "0"][..],
-            "--size must be positive and finite, got 0",
+            "invalid --size 0: sizes must be positive and finite",
         ),
         (&["--size", "nan"][..], "--size"),
         (&["--max-iter", "-1"][..], "--max-iter"),
@@ -1237,4 +1237,46 @@ fn both_solvers_give_the_same_contact_and_the_record_names_the_solver() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--solver"), "{}", stderr(&out));
+}
+
+/// `--size X,Y`: Y equal to the square-pixel default (L·rows/cols) gives the very numbers
+/// of `--size X`; another Y (rectangular pixels) changes them and is recorded.
+#[test]
+fn size_takes_both_sides() {
+    let dir = tempfile::tempdir().unwrap();
+    let square: Array2<f64> = read_npy(surface(dir.path())).unwrap();
+    // 64 rows × 32 columns: with L = 1 along x, square pixels make the y side 2.
+    let tall = square.slice(ndarray::s![.., ..32]).to_owned();
+    let s = dir.path().join("tall.npy");
+    write_npy(&s, &tall).unwrap();
+    let run = |size: &str, name: &str| {
+        let out = dir.path().join(name);
+        let o = asperity(&[
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--size",
+            size,
+            "--pressures",
+            "0.01,0.03",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let record: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join(format!("{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        (
+            std::fs::read(&out).unwrap(),
+            record["size_y"].as_f64().unwrap(),
+        )
+    };
+    let (default_y, y1) = run("1", "a.csv");
+    let (explicit_y, y2) = run("1,2", "b.csv");
+    let (other_y, y3) = run("1,1", "c.csv");
+    assert_eq!((y1, y2, y3), (2.0, 2.0, 1.0));
+    assert_eq!(default_y, explicit_y);
+    assert_ne!(default_y, other_y);
 }

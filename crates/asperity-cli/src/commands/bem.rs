@@ -18,7 +18,7 @@ use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
 use serde_json::json;
 
-use super::measured::{has_import_sidecar, is_npy, load, MeasuredArgs};
+use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
 use crate::progress::Progress;
@@ -48,10 +48,11 @@ pub struct BemArgs {
     /// --fill).
     #[arg(long, value_name = "FILE")]
     pub surface: PathBuf,
-    /// Side length L along x (square pixels); defaults to the surface's sidecar or the
-    /// measured file's size, else 1 for a .npy (a measured file without size is refused).
-    #[arg(long, allow_hyphen_values = true)]
-    pub size: Option<f64>,
+    /// Side lengths: L along x, and along y after a comma for rectangular pixels (else
+    /// square pixels, L·rows/cols along y); default: the surface's sidecar or the measured
+    /// file's sizes, else 1 for a .npy (a measured file without sizes is refused).
+    #[arg(long, value_name = "X[,Y]", allow_hyphen_values = true)]
+    pub size: Option<String>,
     #[command(flatten)]
     pub measured: MeasuredArgs,
     /// Effective modulus E*.
@@ -494,11 +495,10 @@ pub fn run(args: &BemArgs) -> Result<()> {
             args.modulus
         );
     }
-    if let Some(size) = args.size {
-        if !(size.is_finite() && size > 0.0) {
-            bail!("--size must be positive and finite, got {size}");
-        }
-    }
+    let [size_x, size_y] = match &args.size {
+        Some(text) => parse_size(text)?,
+        None => [None, None],
+    };
     check_tolerance(args.tol)?;
     let solver: SolverKind = args.solver.parse()?;
     let params = SolverParams {
@@ -564,8 +564,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
         )?;
     }
     let (surface, size_source) = if measured {
-        let size = args.size.map(|x| x.to_string());
-        let t = load(&args.surface, &args.measured, size.as_deref())?;
+        let t = load(&args.surface, &args.measured, args.size.as_deref())?;
         let surface = t
             .to_surface()
             .with_context(|| format!("{}", args.surface.display()))?;
@@ -584,17 +583,21 @@ pub fn run(args: &BemArgs) -> Result<()> {
         };
         (surface, source)
     } else {
-        let sidecar_size = match args.size {
+        let sidecar_size = match size_x {
             Some(_) => None,
             None => asperity::io::sidecar_size(&args.surface)?,
         };
-        let (size, size_source) = match (args.size, sidecar_size) {
+        let (size, size_source) = match (size_x, sidecar_size) {
             (Some(size), _) => (size, SizeSource::Flag),
             (None, Some(size)) => (size, SizeSource::Sidecar),
             (None, None) => (1.0, SizeSource::Default),
         };
         let heights = read_npy_2d(&args.surface)?;
-        let surface = Surface::new(heights, size).with_context(|| match size_source {
+        let surface = match size_y {
+            Some(size_y) => Surface::with_sizes(heights, size, size_y),
+            None => Surface::new(heights, size),
+        };
+        let surface = surface.with_context(|| match size_source {
             SizeSource::Sidecar => format!(
                 "{} (L = {size} from its sidecar {})",
                 args.surface.display(),
@@ -604,7 +607,12 @@ pub fn run(args: &BemArgs) -> Result<()> {
         })?;
         (surface, size_source)
     };
-    let size = surface.size();
+    let (size, size_y) = (surface.size(), surface.size_y());
+    let sizes_shown = if surface.has_square_pixels() {
+        format!("{size}")
+    } else {
+        format!("{size} × {size_y}")
+    };
     let grid = surface.dim();
     let half_space = HalfSpace {
         modulus: args.modulus,
@@ -722,6 +730,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
             "surface": args.surface,
             "grid": [grid.0, grid.1],
             "size": size,
+            "size_y": size_y,
             "size_source": size_source.name(),
             "modulus": args.modulus,
             "boundary": boundary.name(),
@@ -746,7 +755,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     staged.commit()?;
     if !args.quiet {
-        eprintln!("L = {size} ({})", size_source.phrase());
+        eprintln!("L = {sizes_shown} ({})", size_source.phrase());
     }
     match &args.out {
         Some(out) => {

@@ -67,8 +67,7 @@ pub fn is_npy(path: &Path) -> bool {
     let mut head = [0u8; 6];
     // Only a regular file is opened (a FIFO would block): anything else is not an array,
     // and the reader it is handed to refuses it in one line.
-    asperity::input::open_regular(path)
-        .is_ok_and(|(mut f, _)| f.read_exact(&mut head).is_ok())
+    asperity::input::open_regular(path).is_ok_and(|(mut f, _)| f.read_exact(&mut head).is_ok())
         && &head == b"\x93NUMPY"
 }
 
