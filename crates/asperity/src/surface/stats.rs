@@ -213,6 +213,9 @@ pub fn line_summary(line: &Line) -> Summary {
 /// layout (`cols/2+1` columns of `rows`): per ring `(Σ w κ, Σ w |c|² norm, Σ w)`, where
 /// `w = 2` for the columns `0 < kx < cols/2` that stand for ±kx; index 0 of the result
 /// is unused (the mean is no ring).
+///
+/// Blocks of [`RING_BLOCK`] columns are summed in parallel and their sums added in block
+/// order: the result does not depend on the thread count.
 pub(crate) fn ring_sums(
     spectrum: &[num_complex::Complex64],
     rows: usize,
@@ -221,32 +224,68 @@ pub(crate) fn ring_sums(
     kappa_max: usize,
     norm: f64,
 ) -> Vec<(f64, f64, usize)> {
-    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
-    let last = cols / 2;
-    for (kx, column) in spectrum.chunks(rows).enumerate() {
-        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
-            1
-        } else {
-            2
-        };
-        for (index, value) in column.iter().enumerate() {
-            let ky = if index <= rows / 2 {
-                index as f64
-            } else {
-                index as f64 - rows as f64
-            };
-            let kappa = (kx as f64).hypot(ky * aspect);
-            let bin = kappa.round() as usize;
-            if bin == 0 || bin > kappa_max {
-                continue;
+    use rayon::prelude::*;
+    let blocks: Vec<Vec<(f64, f64, usize)>> = spectrum
+        .par_chunks(rows * RING_BLOCK)
+        .enumerate()
+        .map(|(block, columns)| {
+            let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+            let first = block * RING_BLOCK;
+            for (dk, column) in columns.chunks(rows).enumerate() {
+                add_column_rings(&mut sums, column, first + dk, cols, aspect, norm);
             }
-            let s = &mut sums[bin];
-            s.0 += weight as f64 * kappa;
-            s.1 += weight as f64 * value.norm_sqr() * norm;
-            s.2 += weight;
+            sums
+        })
+        .collect();
+    let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
+    for block in blocks {
+        for (total, part) in sums.iter_mut().zip(block) {
+            total.0 += part.0;
+            total.1 += part.1;
+            total.2 += part.2;
         }
     }
     sums
+}
+
+/// Columns of the half spectrum per parallel block of [`ring_sums`].
+const RING_BLOCK: usize = 64;
+
+/// Adds column `kx` (its `rows` values over ky) to the ring sums.
+fn add_column_rings(
+    sums: &mut [(f64, f64, usize)],
+    column: &[num_complex::Complex64],
+    kx: usize,
+    cols: usize,
+    aspect: f64,
+    norm: f64,
+) {
+    let rows = column.len();
+    let kappa_max = sums.len() - 1;
+    let weight = if kx == 0 || (cols % 2 == 0 && kx == cols / 2) {
+        1
+    } else {
+        2
+    };
+    let kx2 = (kx * kx) as f64;
+    for (index, value) in column.iter().enumerate() {
+        let ky = if index <= rows / 2 {
+            index as f64
+        } else {
+            index as f64 - rows as f64
+        };
+        // Wavenumbers are far from overflow: the plain root is exact enough and much
+        // cheaper than `hypot`.
+        let kappa = (kx2 + (ky * aspect) * (ky * aspect)).sqrt();
+        let bin = kappa.round() as usize;
+        if bin == 0 || bin > kappa_max {
+            continue;
+        }
+        let s = &mut sums[bin];
+        s.0 += weight as f64 * kappa;
+        s.1 += weight as f64 * value.norm_sqr() * norm;
+        s.2 += weight;
+    }
 }
 
 #[cfg(test)]
