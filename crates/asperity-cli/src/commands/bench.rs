@@ -343,7 +343,70 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         _ => anyhow::bail!("--probes takes two increasing sizes, got {:?}", args.probes),
     };
     let hursts = asperity::study::parse_range(&args.hursts)?;
-    for n in sizes.iter().copied().chain([probes.0, probes.1]) {
+    let study = BemStudy {
+        sizes: &sizes,
+        samples: args.samples,
+        hursts: &hursts,
+        rolloff: args.rolloff,
+    };
+    let estimate = estimate_bem_seconds(&study, probes)?;
+    let lanes = estimate.lanes;
+    for row in &estimate.per_size {
+        println!(
+            "n={} samples={} hursts={} lanes={lanes} solve_iterations={:.0} \
+             cg_iterations={:.0} solve_iteration_s={:.3e} cg_iteration_s={:.3e} \
+             seconds={:.3}",
+            row.n,
+            args.samples,
+            hursts.len(),
+            row.solve_iterations,
+            row.cg_iterations,
+            row.solve_iteration_s,
+            row.cg_iteration_s,
+            row.seconds,
+        );
+    }
+    println!(
+        "total_seconds={:.3} total_hours={:.2} lanes={lanes}",
+        estimate.seconds,
+        estimate.seconds / 3600.0
+    );
+    Ok(())
+}
+
+/// A BEM study to estimate: grids, samples per (N, H), H values and roll-off.
+pub struct BemStudy<'a> {
+    /// Grid sizes N.
+    pub sizes: &'a [usize],
+    /// Samples per (N, H).
+    pub samples: usize,
+    /// Hurst exponents.
+    pub hursts: &'a [f64],
+    /// Roll-off wavenumber q0 L/2π, if any.
+    pub rolloff: Option<f64>,
+}
+
+/// The estimate of one grid size (see [`estimate_bem_study`]).
+pub struct SizeEstimate {
+    pub n: usize,
+    pub solve_iterations: f64,
+    pub cg_iterations: f64,
+    pub solve_iteration_s: f64,
+    pub cg_iteration_s: f64,
+    pub seconds: f64,
+}
+
+/// The estimated wall time of a BEM study on this machine, per N and in all.
+pub struct StudyEstimate {
+    pub per_size: Vec<SizeEstimate>,
+    pub seconds: f64,
+    pub lanes: usize,
+}
+
+/// The up-front estimate of [`estimate_bem_study`] for `study`, iteration counts measured
+/// at the two `probes` sizes.
+pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<StudyEstimate> {
+    for n in study.sizes.iter().copied().chain([probes.0, probes.1]) {
         memory::ensure_fits(
             &format!("a BEM solver for a {n}x{n} grid"),
             ContactSolver::memory_bytes(n, n, Boundary::Free),
@@ -351,15 +414,15 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
     }
     let lanes = rayon::current_num_threads().max(1);
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let mut counts = Vec::with_capacity(hursts.len());
-    for &hurst in &hursts {
-        let small = sample_iterations(probes.0, hurst, args.rolloff)?;
-        let large = sample_iterations(probes.1, hurst, args.rolloff)?;
+    let mut counts = Vec::with_capacity(study.hursts.len());
+    for &hurst in study.hursts {
+        let small = sample_iterations(probes.0, hurst, study.rolloff)?;
+        let large = sample_iterations(probes.1, hurst, study.rolloff)?;
         counts.push(((small.0, large.0), (small.1, large.1)));
     }
-    let samples_per_lane = args.samples.div_ceil(lanes) as f64;
-    let mut total = 0.0;
-    for &n in &sizes {
+    let samples_per_lane = study.samples.div_ceil(lanes) as f64;
+    let mut per_size = Vec::with_capacity(study.sizes.len());
+    for &n in study.sizes {
         let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
         // Iterations of one sample per H, summed over H.
         let (solve, cg) = counts.iter().fold((0.0, 0.0), |(s, c), (solve, cg)| {
@@ -368,21 +431,21 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
                 c + extrapolate(*cg, probes, n),
             )
         });
-        let seconds = samples_per_lane * (solve * c_solve + cg * c_cg);
-        total += seconds;
-        println!(
-            "n={n} samples={} hursts={} lanes={lanes} solve_iterations={solve:.0} \
-             cg_iterations={cg:.0} solve_iteration_s={c_solve:.3e} cg_iteration_s={c_cg:.3e} \
-             seconds={seconds:.3}",
-            args.samples,
-            hursts.len(),
-        );
+        per_size.push(SizeEstimate {
+            n,
+            solve_iterations: solve,
+            cg_iterations: cg,
+            solve_iteration_s: c_solve,
+            cg_iteration_s: c_cg,
+            seconds: samples_per_lane * (solve * c_solve + cg * c_cg),
+        });
     }
-    println!(
-        "total_seconds={total:.3} total_hours={:.2} lanes={lanes}",
-        total / 3600.0
-    );
-    Ok(())
+    let seconds = per_size.iter().map(|s| s.seconds).sum();
+    Ok(StudyEstimate {
+        per_size,
+        seconds,
+        lanes,
+    })
 }
 
 #[cfg(test)]

@@ -30,7 +30,8 @@ fn psd_exponent(bins: &[asperity::surface::stats::PsdBin], size: f64) -> Option<
 }
 
 /// Paper Fig. 6: grey-scale surfaces and their rough lines for several H, no roll-off.
-pub fn fig6(dir: &Path, quick: bool, force: bool) -> Result<()> {
+pub fn fig6(dir: &Path, setting: Setting, force: bool) -> Result<()> {
+    let quick = setting.is_quick();
     let hursts = [-0.5, 0.0, 0.5, 1.0, 2.0, 3.0];
     let n = if quick { 256 } else { 512 };
     let line_n = 4 * n;
@@ -132,6 +133,7 @@ pub fn fig6(dir: &Path, quick: bool, force: bool) -> Result<()> {
 use asperity::study::theory::{alpha_theory, alpha_white_noise};
 use asperity::study::{parse_range, FitWindow, Method, StudySpec, TaskResult};
 
+use super::setting::Setting;
 use super::study::{execute, write_alpha, write_curves, Kind, RunOptions};
 
 fn study_spec(
@@ -162,13 +164,39 @@ fn describe_hursts(hursts: &[f64]) -> String {
     }
 }
 
-fn setting(quick: bool) -> &'static str {
-    if quick {
-        "**--quick**: BEM on smaller grids (N ≤ 128) with 20 samples instead of the paper's N up to 1024 with 60; \
-         MDR as in the paper. Run without --quick for the paper's setting (BEM: days on 2 cores, checkpointed)."
-    } else {
-        "Full setting, as in the paper."
+/// States a figure's BEM studies before they start: grids, samples and, for the settings
+/// that take hours, the estimated run time measured on this machine
+/// ([`super::bench::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
+fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)]) -> Result<()> {
+    if setting == Setting::Quick {
+        // Minutes: the report states the setting; stderr stays for errors.
+        return Ok(());
     }
+    for (spec, rolloff) in studies {
+        eprintln!(
+            "{figure} ({} setting): BEM on N = {:?}, {} samples per (N, H), H = {}",
+            setting.name(),
+            spec.sizes,
+            spec.samples,
+            describe_hursts(&spec.hursts)
+        );
+        if matches!(setting, Setting::Medium | Setting::Paper) {
+            let study = super::bench::BemStudy {
+                sizes: &spec.sizes,
+                samples: spec.samples,
+                hursts: &spec.hursts,
+                rolloff: *rolloff,
+            };
+            let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+            eprintln!(
+                "{figure}: estimated BEM time on this machine {:.1} h ({} lanes; checkpointed: \
+                 an interrupted run resumes with the same command)",
+                estimate.seconds / 3600.0,
+                estimate.lanes
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Runs one study of a figure in `dir/<name>/` (its own checkpoint, lock and record of
@@ -209,22 +237,14 @@ fn alpha_rows_md(results: &[TaskResult]) -> String {
 }
 
 /// Paper Fig. 1: α(H) from MDR (N = 2^9, 2^11, 2^15) and BEM (N = 2^7 … 2^10).
-pub fn fig1(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
+pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {
     let hursts = parse_range("-1:3:0.25")?;
-    // MDR is cheap (the paper's 25 500 lines take seconds): --quick keeps its setting.
-    let mdr = study_spec(
-        Method::Mdr,
-        vec![1 << 9, 1 << 11, 1 << 15],
-        hursts.clone(),
-        500,
-        None,
-    );
-    let (bem_sizes, bem_samples, bem_hursts) = if quick {
-        (vec![64, 128], 20, parse_range("-1:3:0.5")?)
-    } else {
-        (vec![1 << 7, 1 << 8, 1 << 9, 1 << 10], 60, hursts)
-    };
-    let bem = study_spec(Method::Bem, bem_sizes, bem_hursts, bem_samples, None);
+    // MDR is cheap (the paper's 25 500 lines take seconds): every setting keeps it.
+    let (mdr_sizes, mdr_samples) = setting.fig1_mdr();
+    let mdr = study_spec(Method::Mdr, mdr_sizes, hursts, mdr_samples, None);
+    let plan = setting.fig1_bem()?;
+    let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
+    announce("fig1", setting, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();
@@ -242,7 +262,7 @@ pub fn fig1(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
          N-dependent α ≈ 0.9 given by eq. (24), α = (1 + log2 N)/(3 + log2 N), derived for H = 0 and\n\
          \"valid not only for H = 0, but also for smaller values\". Column *theory* is that value\n\
          for each row (eq. 24 at H = 0, not 1/(1+0) = 1).\n\n{}\n",
-        setting(quick),
+        setting.describe(),
         mdr.sizes,
         mdr.samples,
         describe_hursts(&mdr.hursts),
@@ -256,13 +276,11 @@ pub fn fig1(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
 }
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
-pub fn fig2(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
-    let (n, samples, hursts) = if quick {
-        (128, 20, vec![-1.0, 0.0, 1.0, 2.0, 3.0])
-    } else {
-        (1024, 60, parse_range("-1:3:0.5")?)
-    };
-    let spec = study_spec(Method::Bem, vec![n], hursts, samples, Some(6.0));
+pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {
+    let plan = setting.fig2()?;
+    let (n, samples) = (plan.sizes[0], plan.samples);
+    let spec = study_spec(Method::Bem, plan.sizes, plan.hursts, samples, Some(6.0));
+    announce("fig2", setting, &[(&spec, Some(6.0))])?;
     let results = figure_study(dir, "bem", &spec, Kind::Curve, discard)?;
     write_curves(dir, &results, force, "fig2")?;
     let mut md = String::from(
@@ -316,28 +334,19 @@ pub fn fig2(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
          `asperity study curve --method bem --rolloff 6` (3–6 samples each, so ±0.05) gave\n\
          for H = −1: 0.73 at N = 128 and 256, 0.87 at N = 512; the full setting (1024²)\n\
          measures how close to 1 the paper's grid comes.\n\n{md}\n",
-        setting(quick),
+        setting.describe(),
         min_contacts = spec.window.min_contacts,
     );
     write_report(dir, &report, force)
 }
 
 /// Paper Fig. 5: α versus N for H < 0 against eq. (24).
-pub fn fig5(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
-    let mdr_sizes: Vec<usize> = (6..=16).map(|m| 1usize << m).collect();
-    let mdr = study_spec(Method::Mdr, mdr_sizes, vec![-0.5], 500, None);
-    let bem_sizes = if quick {
-        vec![64, 128]
-    } else {
-        vec![1 << 7, 1 << 8, 1 << 9, 1 << 10]
-    };
-    let bem = study_spec(
-        Method::Bem,
-        bem_sizes,
-        vec![-0.5],
-        if quick { 20 } else { 60 },
-        None,
-    );
+pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {
+    let (mdr_sizes, mdr_samples) = setting.fig5_mdr();
+    let mdr = study_spec(Method::Mdr, mdr_sizes, vec![-0.5], mdr_samples, None);
+    let plan = setting.fig5_bem();
+    let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
+    announce("fig5", setting, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
     let mut table = Table::new(&[
@@ -421,7 +430,7 @@ pub fn fig5(dir: &Path, quick: bool, force: bool, discard: bool) -> Result<()> {
          ## The paper's values beside ours\n\
          The paper: MDR follows eq. (24), α = (1 + log2 N)/(3 + log2 N), closely; BEM follows a\n\
          similar dependence.\n\n{md}\n",
-        setting(quick),
+        setting.describe(),
         mdr.sizes,
         mdr.samples,
         bem.sizes,

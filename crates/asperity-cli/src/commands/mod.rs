@@ -9,6 +9,7 @@ pub mod import;
 pub mod mdr;
 pub mod measured;
 pub mod reproduce;
+pub mod setting;
 pub mod stats;
 pub mod study;
 pub mod surface;

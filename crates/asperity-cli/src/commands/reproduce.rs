@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::setting::Setting;
 use crate::rerun::{checksum, Written};
 
 /// Which figure.
@@ -33,15 +34,20 @@ pub enum Figure {
 /// Arguments of `asperity reproduce`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours); timings.json holds the run's wall time. Studies checkpoint: an interrupted
+    after_help = "Examples:\n  asperity reproduce all --quick --out figs     # every figure, about a minute on 2 cores\n  asperity reproduce fig1 --quick --out figs\n  asperity reproduce fig1 --setting medium --out figs   # BEM on 256² and 512²: hours\n  asperity reproduce fig15.2 --out figs\n\nEach figure writes DIR/<figure>/ with CSV, PNG, SVG and report.md (the paper's values\nbeside ours); timings.json holds the run's wall time. Studies checkpoint: an interrupted
 run resumes when the same command runs again (each folder's reproduce.json records the
 figure and setting that made it, and the checksum of every file it wrote: a file edited
-since is never overwritten without --force).\nWithout --quick the BEM parts follow the paper (grids up to 1024², 60 samples): days."
+since is never overwritten without --force).\nSettings: quick (minutes), medium (BEM on 256² and 512², 20 samples: hours, with an
+estimate printed before it starts), paper (the default: grids up to 1024², 60 samples: days)."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.
     pub figure: Figure,
-    /// Fewer samples and smaller grids (minutes instead of hours); stated in each report.
+    /// How closely to follow the paper's grids and samples: quick (minutes), medium (BEM on
+    /// 256² and 512², hours), paper (grids up to 1024², days); stated in each report.
+    #[arg(long, value_enum, default_value = "paper", conflicts_with = "quick")]
+    pub setting: Setting,
+    /// The quick setting: `--setting quick`.
     #[arg(long)]
     pub quick: bool,
     /// Output folder (one sub-folder per figure).
@@ -76,6 +82,12 @@ impl Figure {
 #[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct FolderStamp {
     figure: String,
+    /// The setting's name (`quick`, `medium`, `paper`).
+    #[serde(default)]
+    setting: String,
+    /// The stamp of asperity 0.1 before settings: `true` for `--quick` (read when
+    /// `setting` is absent).
+    #[serde(default, skip_serializing)]
     quick: bool,
     /// Whether the figure finished (an interrupted one is resumed, its partial outputs
     /// rewritten).
@@ -122,11 +134,11 @@ fn may_overwrite(dir: &Path, stamp: &FolderStamp, force: bool) -> anyhow::Result
         .ok()
         .and_then(|text| serde_json::from_str::<FolderStamp>(&text).ok());
     let command = format!(
-        "`asperity reproduce {}{}`",
-        stamp.figure,
-        if stamp.quick { " --quick" } else { "" }
+        "`asperity reproduce {} --setting {}`",
+        stamp.figure, stamp.setting
     );
-    let Some(found) = found.filter(|f| f.figure == stamp.figure && f.quick == stamp.quick) else {
+    let Some(found) = found.filter(|f| f.figure == stamp.figure && f.setting() == stamp.setting)
+    else {
         anyhow::bail!(
             "{} holds files not made by {command}: use another --out, or --force to overwrite \
              them",
@@ -148,10 +160,21 @@ fn may_overwrite(dir: &Path, stamp: &FolderStamp, force: bool) -> anyhow::Result
     Ok(true)
 }
 
+impl FolderStamp {
+    /// The setting that made the folder (a stamp without one: `quick` or `paper`).
+    fn setting(&self) -> &str {
+        match (self.setting.as_str(), self.quick) {
+            ("", true) => "quick",
+            ("", false) => "paper",
+            (name, _) => name,
+        }
+    }
+}
+
 const STAMP: &str = "reproduce.json";
 
-/// Wall-clock times of a figure's last run (kept apart, so that every result file of a
-/// rerun is byte-identical).
+/// The record of a figure's last run: wall time, setting, command line and asperity
+/// version (kept apart, so that every result file of a rerun is byte-identical).
 const TIMINGS: &str = "timings.json";
 
 /// Runs one figure in its folder, holding the folder's lock: `force` lets it write over
@@ -160,7 +183,7 @@ const TIMINGS: &str = "timings.json";
 fn run_one(
     figure: Figure,
     out: &Path,
-    quick: bool,
+    setting: Setting,
     force: bool,
     discard: bool,
 ) -> anyhow::Result<()> {
@@ -170,13 +193,14 @@ fn run_one(
     let lock = asperity::lock::FolderLock::acquire(&dir)?;
     let mut stamp = FolderStamp {
         figure: figure.folder().to_string(),
-        quick,
+        setting: setting.name().to_string(),
+        quick: false,
         complete: false,
         written: Written::default(),
     };
     asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     let start = std::time::Instant::now();
-    if let Err(err) = run_figure(figure, &dir, out, quick, force, discard) {
+    if let Err(err) = run_figure(figure, &dir, out, setting, force, discard) {
         if !existed {
             remove_if_untouched(&dir, lock);
         }
@@ -199,7 +223,12 @@ fn run_one(
     asperity::io::write_json(
         &dir.join(TIMINGS),
         true,
-        &serde_json::json!({ "seconds": seconds }),
+        &serde_json::json!({
+            "seconds": seconds,
+            "setting": setting.name(),
+            "command": std::env::args().collect::<Vec<_>>().join(" "),
+            "version": env!("CARGO_PKG_VERSION"),
+        }),
     )?;
     asperity::io::write_json(&dir.join(STAMP), true, &stamp)?;
     eprintln!(
@@ -214,18 +243,18 @@ fn run_figure(
     figure: Figure,
     dir: &Path,
     out: &Path,
-    quick: bool,
+    setting: Setting,
     force: bool,
     discard: bool,
 ) -> anyhow::Result<()> {
     match figure {
-        Figure::Fig1 => super::figures::fig1(dir, quick, force, discard),
-        Figure::Fig2 => super::figures::fig2(dir, quick, force, discard),
-        Figure::Fig5 => super::figures::fig5(dir, quick, force, discard),
-        Figure::Fig6 => super::figures::fig6(dir, quick, force),
+        Figure::Fig1 => super::figures::fig1(dir, setting, force, discard),
+        Figure::Fig2 => super::figures::fig2(dir, setting, force, discard),
+        Figure::Fig5 => super::figures::fig5(dir, setting, force, discard),
+        Figure::Fig6 => super::figures::fig6(dir, setting, force),
         // The book's figures name their own folder under `out`.
-        Figure::Fig15_1 => super::fig15::fig15_1(out, quick, force),
-        Figure::Fig15_2 => super::fig15::fig15_2(out, quick, force),
+        Figure::Fig15_1 => super::fig15::fig15_1(out, setting.is_quick(), force),
+        Figure::Fig15_2 => super::fig15::fig15_2(out, setting.is_quick(), force),
         Figure::All => unreachable!("expanded by run"),
     }
 }
@@ -249,6 +278,11 @@ fn remove_if_untouched(dir: &Path, lock: asperity::lock::FolderLock) {
 
 /// Runs `asperity reproduce`.
 pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
+    let setting = if args.quick {
+        Setting::Quick
+    } else {
+        args.setting
+    };
     let figures: Vec<Figure> = match args.figure {
         Figure::All => vec![
             Figure::Fig6,
@@ -266,7 +300,8 @@ pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
         .map(|figure| {
             let stamp = FolderStamp {
                 figure: figure.folder().to_string(),
-                quick: args.quick,
+                setting: setting.name().to_string(),
+                quick: false,
                 complete: false,
                 written: Written::default(),
             };
@@ -274,7 +309,7 @@ pub fn run(args: &ReproduceArgs) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<bool>>>()?;
     for (figure, force) in figures.into_iter().zip(overwrite) {
-        run_one(figure, &args.out, args.quick, force, args.force)?;
+        run_one(figure, &args.out, setting, force, args.force)?;
     }
     Ok(())
 }
