@@ -83,7 +83,7 @@ grep -Eq "3 ranks computed [1-9][0-9]* \+ [1-9][0-9]* \+ [1-9][0-9]* samples" "$
 echo "ok: identical outputs on 1, 2, 3 ranks (study alpha, curve, file)"
 
 # 2. Kill a rank, then resume. A longer study, checkpointing after every sample.
-long=(study alpha --method bem --n 96 --hurst 0.5,0.9 --samples 24 --seed 8 --quiet --checkpoint-every 0)
+long=(study alpha --method bem --n 96 --hurst 0.5,0.9 --samples 32 --seed 8 --quiet --checkpoint-every 0)
 "$serial" "${long[@]}" --out "$work/long-serial"
 
 # Samples in the checkpoints of a folder (each sample has one points_total).

@@ -25,6 +25,13 @@
 //!
 //! `study.json` also records the scales of the samples (`normalisation`, see
 //! [`samplers::Scales`]), which every checkpoint's identity holds as well.
+//!
+//! # Samples computed elsewhere
+//! A front end that spreads a study's samples over processes (the CLI's MPI build) keeps
+//! the folder on one process with [`StudyDir::restore`], [`StudyDir::save_in_progress`]
+//! and [`StudyDir::finish`], and computes chosen samples of a task anywhere with
+//! [`TaskSamples`]: assembled in index order, they give the serial run's checkpoints and
+//! results byte for byte.
 
 pub mod curve;
 pub mod identity;
