@@ -3,6 +3,8 @@
 
 mod cli;
 mod commands;
+#[cfg(feature = "mpi")]
+mod distributed;
 #[allow(dead_code)] // shared helpers, not all used by every command yet
 mod output;
 #[allow(dead_code)]
@@ -14,18 +16,35 @@ mod rerun;
 use clap::Parser;
 
 fn main() {
+    // Under MPI (the `mpi` feature), rank 0 runs the command and the other ranks compute
+    // samples for its studies (see `distributed`).
+    #[cfg(feature = "mpi")]
+    let code = distributed::main(run);
+    #[cfg(not(feature = "mpi"))]
+    let code = run();
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    let _ = std::io::stderr().flush();
+    std::process::exit(code);
+}
+
+/// Parses the command line and runs it; returns the exit status.
+fn run() -> i32 {
     let cli = match cli::Cli::try_parse() {
         Ok(cli) => cli,
-        Err(err) if !err.use_stderr() => err.exit(), // --help, --version
-        // `asperity` or `asperity study` alone: the help (on stderr, status 2) says what to give.
+        // --help, --version; and `asperity` or `asperity study` alone: the help (on
+        // stderr, status 2) says what to give.
         Err(err)
-            if err.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+            if !err.use_stderr()
+                || err.kind()
+                    == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
         {
-            err.exit()
+            let _ = err.print();
+            return err.exit_code();
         }
         Err(err) => {
             eprintln!("error: {} (see --help)", one_line(&err.to_string()));
-            std::process::exit(2);
+            return 2;
         }
     };
     // Ctrl-C, SIGTERM or SIGHUP: remove the temporary files of outputs not yet renamed into
@@ -56,8 +75,9 @@ fn main() {
             "error: {}",
             shorten_numbers(&asperity::input::one_line(&line))
         );
-        std::process::exit(2);
+        return 2;
     }
+    0
 }
 
 /// Numbers of more than 20 characters (Rust prints `1e-300` as 300 digits) in short

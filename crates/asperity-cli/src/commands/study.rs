@@ -581,12 +581,42 @@ pub fn execute(
         .map(|t| (spec.samples as u64, sample_cost(spec.method, t.n)))
         .collect();
     let progress = Progress::weighted(&format!("{} study", spec.method.name()), &segments, quiet);
+    let results = run_tasks(&store, &progress, quiet)?;
+    progress.finish();
+    let (table, chart) = match kind {
+        Kind::Alpha => (alpha_table(&results), alpha_chart(&results, ALPHA_TITLE)),
+        Kind::Curve => (curve_table(&results), curve_chart(&results, CURVE_TITLE)),
+    };
+    let stem = outputs_stem(kind);
+    write_together(dir, stem, &table, &chart, rewrite, true)?;
+    Ok(results)
+}
+
+/// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
+/// an MPI job of several ranks, over all ranks ([`crate::distributed`]): the same
+/// results either way.
+fn run_tasks(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<Vec<TaskResult>> {
+    #[cfg(feature = "mpi")]
+    if crate::distributed::active() {
+        let progress = |done, restored| {
+            if restored {
+                progress.restore(done)
+            } else {
+                progress.set(done)
+            }
+        };
+        return crate::distributed::run_study(store, &progress, quiet);
+    }
+    // Without MPI, `quiet` is the progress bar's alone.
+    let _ = quiet;
+    let spec = store.spec();
+    let tasks = spec.tasks();
     let mut results = Vec::with_capacity(tasks.len());
     for (i, task) in tasks.iter().enumerate() {
         let offset = (i * spec.samples) as u64;
         // The first report of a task is what its checkpoint held (run_task's contract).
         let first = AtomicBool::new(true);
-        let result = run_any_task(spec, *task, &store, &|done, _| {
+        let result = run_any_task(spec, *task, store, &|done, _| {
             if first.swap(false, Ordering::Relaxed) {
                 progress.restore(offset + done as u64)
             } else {
@@ -596,13 +626,6 @@ pub fn execute(
         .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
         results.push(result);
     }
-    progress.finish();
-    let (table, chart) = match kind {
-        Kind::Alpha => (alpha_table(&results), alpha_chart(&results, ALPHA_TITLE)),
-        Kind::Curve => (curve_table(&results), curve_chart(&results, CURVE_TITLE)),
-    };
-    let stem = outputs_stem(kind);
-    write_together(dir, stem, &table, &chart, rewrite, true)?;
     Ok(results)
 }
 

@@ -25,6 +25,13 @@
 //!
 //! `study.json` also records the scales of the samples (`normalisation`, see
 //! [`samplers::Scales`]), which every checkpoint's identity holds as well.
+//!
+//! # Samples computed elsewhere
+//! A front end that spreads a study's samples over processes (the CLI's MPI build) keeps
+//! the folder on one process with [`StudyDir::restore`], [`StudyDir::save_in_progress`]
+//! and [`StudyDir::finish`], and computes chosen samples of a task anywhere with
+//! [`TaskSamples`]: assembled in index order, they give the serial run's checkpoints and
+//! results byte for byte.
 
 pub mod curve;
 pub mod identity;
@@ -39,7 +46,7 @@ use serde::{Deserialize, Serialize};
 pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
-pub use samplers::{run_any_task, Scales};
+pub use samplers::{run_any_task, Scales, TaskSamples};
 
 use crate::fit::PowerLawFit;
 use crate::lock::FolderLock;
@@ -706,55 +713,132 @@ pub fn run_task<S: Sampler>(
             "the study folder was opened for another study",
         ));
     }
-    let mut samples = match store.load(task)? {
-        Some(Checkpoint::Done { result, .. }) if result.samples == spec.samples => {
+    let mut samples = match store.restore(task)? {
+        Restored::Done(result) => {
             progress(spec.samples, spec.samples);
             return Ok(result);
         }
-        Some(Checkpoint::InProgress { samples, .. }) => samples,
-        _ => Vec::new(),
+        Restored::Partial(samples) => samples,
     };
-    samples.truncate(spec.samples);
     progress(samples.len(), spec.samples);
-    let lanes = rayon::current_num_threads().max(1);
-    let mut workers = (0..lanes)
-        .map(|_| sampler.worker())
-        .collect::<Result<Vec<_>>>()?;
-    let batch = 4 * lanes;
+    let mut workers = lane_workers(sampler)?;
+    let batch = 4 * workers.len();
     let mut last_save = std::time::Instant::now();
     while samples.len() < spec.samples {
         let indices: Vec<usize> =
             (samples.len()..(samples.len() + batch).min(spec.samples)).collect();
-        let per_lane = indices.len().div_ceil(lanes);
-        let done: Vec<Vec<Result<SampleCurve>>> = workers
-            .par_iter_mut()
-            .zip(indices.par_chunks(per_lane))
-            .map(|(worker, chunk)| {
-                chunk
-                    .iter()
-                    .map(|&index| {
-                        sampler.sample(worker, sample_seed(spec.seed, spec.method, task, index))
-                    })
-                    .collect()
-            })
-            .collect();
-        for curve in done.into_iter().flatten() {
-            samples.push(curve?);
-        }
+        samples.extend(sample_on_lanes(
+            spec,
+            task,
+            sampler,
+            &mut workers,
+            &indices,
+        )?);
         if samples.len() < spec.samples && last_save.elapsed() >= store.interval {
             store.save_in_progress(task, &samples)?;
             last_save = std::time::Instant::now();
         }
         progress(samples.len(), spec.samples);
     }
-    let result = TaskResult::from_samples(spec, task, samples)?;
-    store.save(
-        task,
-        &Checkpoint::Done {
-            result: result.clone(),
-        },
-    )?;
-    Ok(result)
+    store.finish(task, samples)
+}
+
+/// One worker of `sampler` per thread of the current rayon pool.
+fn lane_workers<S: Sampler>(sampler: &S) -> Result<Vec<S::Worker>> {
+    let lanes = rayon::current_num_threads().max(1);
+    (0..lanes).map(|_| sampler.worker()).collect()
+}
+
+/// The samples `indices` of `task`, in that order, computed in parallel: consecutive
+/// chunks of `indices`, one per worker. Each sample depends on its seed only
+/// ([`sample_seed`]), not on the worker or on what that worker computed before, so the
+/// chunking changes the time, never the numbers.
+fn sample_on_lanes<S: Sampler>(
+    spec: &StudySpec,
+    task: Task,
+    sampler: &S,
+    workers: &mut [S::Worker],
+    indices: &[usize],
+) -> Result<Vec<SampleCurve>> {
+    if indices.is_empty() {
+        return Ok(Vec::new());
+    }
+    let per_lane = indices.len().div_ceil(workers.len().max(1));
+    let done: Vec<Vec<Result<SampleCurve>>> = workers
+        .par_iter_mut()
+        .zip(indices.par_chunks(per_lane))
+        .map(|(worker, chunk)| {
+            chunk
+                .iter()
+                .map(|&index| {
+                    sampler.sample(worker, sample_seed(spec.seed, spec.method, task, index))
+                })
+                .collect()
+        })
+        .collect();
+    done.into_iter().flatten().collect()
+}
+
+/// What a task's checkpoint holds, as [`StudyDir::restore`] reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Restored {
+    /// The task is finished: its result.
+    Done(TaskResult),
+    /// The task's first samples (none for a task not started), in index order.
+    Partial(Vec<SampleCurve>),
+}
+
+impl StudyDir {
+    /// The checkpoint of `task`, read and verified as [`run_task`] reads it: the result of
+    /// a finished task, or the samples saved so far (at most the study's sample count).
+    /// For front ends that compute a task's samples elsewhere (e.g. on other processes)
+    /// and keep its checkpoint with [`StudyDir::save_in_progress`] and
+    /// [`StudyDir::finish`].
+    pub fn restore(&self, task: Task) -> Result<Restored> {
+        match self.load(task)? {
+            Some(Checkpoint::Done { result }) if result.samples == self.spec.samples => {
+                Ok(Restored::Done(result))
+            }
+            Some(Checkpoint::InProgress { mut samples }) => {
+                samples.truncate(self.spec.samples);
+                Ok(Restored::Partial(samples))
+            }
+            _ => Ok(Restored::Partial(Vec::new())),
+        }
+    }
+
+    /// Ends `task` with all its `samples` (in index order): its result, saved as
+    /// [`run_task`] saves it, so that the checkpoint is the same file byte for byte.
+    pub fn finish(&self, task: Task, samples: Vec<SampleCurve>) -> Result<TaskResult> {
+        if samples.len() != self.spec.samples {
+            return Err(Error::invalid(
+                "samples",
+                format!(
+                    "a task ends with its {} samples, got {}",
+                    self.spec.samples,
+                    samples.len()
+                ),
+            ));
+        }
+        let result = TaskResult::from_samples(&self.spec, task, samples)?;
+        self.save(
+            task,
+            &Checkpoint::Done {
+                result: result.clone(),
+            },
+        )?;
+        Ok(result)
+    }
+
+    /// The longest time between two checkpoints of a task in progress.
+    pub fn checkpoint_interval(&self) -> std::time::Duration {
+        self.interval
+    }
+
+    /// The study this folder was opened for.
+    pub fn spec(&self) -> &StudySpec {
+        &self.spec
+    }
 }
 
 #[cfg(test)]

@@ -390,6 +390,79 @@ impl Sampler for MdrSampler {
     }
 }
 
+/// The samplers of both methods, with one worker per thread.
+enum Lanes {
+    Bem(BemSampler, Vec<BemWorker>),
+    Mdr(MdrSampler, Vec<MdrWorker>),
+}
+
+/// Computes chosen samples of one task on this process's threads, with the sampler of the
+/// study's method: what a process needs to take part in a study whose checkpoints and
+/// outputs another process keeps (e.g. a rank of an MPI job). Sample `i` is the same
+/// curve, bit for bit, as sample `i` of [`run_any_task`], whichever samples were computed
+/// before it and on however many threads.
+pub struct TaskSamples {
+    spec: StudySpec,
+    task: Task,
+    lanes: Lanes,
+}
+
+impl TaskSamples {
+    /// The sampler of `task` of `spec` (validated first) and one worker per thread of the
+    /// current rayon pool.
+    pub fn new(spec: &StudySpec, task: Task) -> Result<Self> {
+        spec.validate()?;
+        let lanes = match spec.method {
+            Method::Bem => {
+                let sampler = BemSampler::new(spec, task)?;
+                let workers = super::lane_workers(&sampler)?;
+                Lanes::Bem(sampler, workers)
+            }
+            Method::Mdr => {
+                let sampler = MdrSampler::new(spec, task)?;
+                let workers = super::lane_workers(&sampler)?;
+                Lanes::Mdr(sampler, workers)
+            }
+        };
+        Ok(TaskSamples {
+            spec: spec.clone(),
+            task,
+            lanes,
+        })
+    }
+
+    /// The task.
+    pub fn task(&self) -> Task {
+        self.task
+    }
+
+    /// The number of samples computed at once (one per thread).
+    pub fn lanes(&self) -> usize {
+        match &self.lanes {
+            Lanes::Bem(_, w) => w.len(),
+            Lanes::Mdr(_, w) => w.len(),
+        }
+    }
+
+    /// The samples `indices` (each below the study's sample count), in that order.
+    pub fn compute(&mut self, indices: &[usize]) -> Result<Vec<SampleCurve>> {
+        if let Some(&i) = indices.iter().find(|&&i| i >= self.spec.samples) {
+            return Err(Error::invalid(
+                "samples",
+                format!(
+                    "sample {i} asked of a task of {} samples",
+                    self.spec.samples
+                ),
+            ));
+        }
+        let (spec, task) = (&self.spec, self.task);
+        match &mut self.lanes {
+            Lanes::Bem(s, w) => super::sample_on_lanes(spec, task, s, w, indices),
+            Lanes::Mdr(s, w) => super::sample_on_lanes(spec, task, s, w, indices),
+        }
+    }
+}
+
 /// Runs (or resumes) `task` with the sampler of `spec.method`.
 pub fn run_any_task(
     spec: &StudySpec,
@@ -500,6 +573,56 @@ mod tests {
         );
         let mdr = spec_mdr_curve(1);
         assert_eq!(mdr, spec_mdr_curve(4));
+    }
+
+    /// Issue 15: samples computed elsewhere, in another order, on reused workers and
+    /// another number of threads, assembled in index order, give the finished checkpoint
+    /// of the serial run byte for byte (and its result).
+    #[test]
+    fn samples_computed_out_of_order_finish_as_the_serial_run() {
+        for method in [Method::Bem, Method::Mdr] {
+            let n = if method == Method::Bem { 32 } else { 1024 };
+            let spec = spec(method, n, vec![0.7], 5);
+            let task = spec.tasks()[0];
+            let (serial_dir, other_dir) =
+                (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+            let serial = {
+                let store = StudyDir::open(serial_dir.path(), &spec, false).unwrap();
+                crate::test_support::with_threads(2, || {
+                    run_any_task(&spec, task, &store, &|_, _| {}).unwrap()
+                })
+            };
+            let store = StudyDir::open(other_dir.path(), &spec, false).unwrap();
+            let mut slots: Vec<Option<SampleCurve>> = vec![None; 5];
+            crate::test_support::with_threads(1, || {
+                let mut samples = TaskSamples::new(&spec, task).unwrap();
+                assert_eq!(samples.lanes(), 1);
+                for group in [&[4usize, 1][..], &[0, 3, 2]] {
+                    for (&i, curve) in group.iter().zip(samples.compute(group).unwrap()) {
+                        slots[i] = Some(curve);
+                    }
+                }
+                assert!(samples.compute(&[5]).is_err(), "beyond the sample count");
+            });
+            let assembled = slots.into_iter().map(Option::unwrap).collect();
+            assert_eq!(store.finish(task, assembled).unwrap(), serial);
+            let file = |dir: &std::path::Path| {
+                std::fs::read(
+                    dir.join("checkpoint")
+                        .join(format!("{}.json", task.key(method))),
+                )
+                .unwrap()
+            };
+            assert_eq!(
+                file(serial_dir.path()),
+                file(other_dir.path()),
+                "{method:?}"
+            );
+            assert_eq!(
+                store.restore(task).unwrap(),
+                super::super::Restored::Done(serial)
+            );
+        }
     }
 
     fn spec_mdr_curve(threads: usize) -> String {

@@ -1,0 +1,571 @@
+//! Studies spread over the ranks of an MPI job (issue 15; built with the `mpi` feature).
+//!
+//! `mpirun -n K asperity study …` (or `srun`, or `asperity reproduce …`) runs the same
+//! command on K processes. This module makes them one study:
+//!
+//! * **Rank 0 is the coordinator and the only writer.** It alone parses the command line,
+//!   checks and locks the output folder ([`asperity::study::StudyDir::lock`], a `flock`),
+//!   reads and writes checkpoints and writes the outputs; every other rank only computes
+//!   samples and never opens the folder. A command that runs no study (e.g. `surface`)
+//!   runs on rank 0 while the others wait for the end.
+//! * **Samples are the unit of work, handed out dynamically.** A rank that is idle gets
+//!   the next samples not yet given out (in task order, then index order; as many as it
+//!   has threads, all of one task), computes them with
+//!   [`asperity::study::TaskSamples`] and sends back their curves; BEM samples differ in
+//!   cost, so a fast rank simply asks more often. Rank 0 computes too, on a thread of its
+//!   own, while its main thread coordinates.
+//! * **The same numbers.** Every sample is seeded by (study seed, method, N, H, index)
+//!   ([`asperity::study::sample_seed`]) and depends on nothing else (not the rank, thread,
+//!   or the samples a worker computed before: tested in the library), and rank 0
+//!   assembles each task's samples in index order and ends it with
+//!   [`asperity::study::StudyDir::finish`], as the serial run does. The CSV files and the
+//!   finished checkpoints are therefore byte-identical to a single-process run, for any K,
+//!   and either kind of run resumes the other's checkpoints. With K = 1 the serial code
+//!   runs unchanged.
+//! * **Checkpoints.** A task in progress saves its first samples (the run of consecutive
+//!   indices received) at most every `--checkpoint-every` seconds, as the serial run does.
+//!
+//! # Faults
+//! MPI (Open MPI, MPICH, Slurm) ends the whole job when a rank dies; the launcher names
+//! the rank that died (e.g. "mpirun noticed that process rank 1 … exited on signal 9").
+//! What rank 0 had checkpointed stays, and running the same command again resumes from it.
+//! A sample that fails on a worker (a solver error) ends the study with an error naming
+//! the rank. An error on rank 0 while samples are in flight aborts the job
+//! (`MPI_Abort`) after printing it, so that no rank is left waiting.
+//!
+//! # Messages
+//! One tag; JSON bodies (floats round-trip exactly, as in checkpoints). Worker → rank 0:
+//! `Ready` once (its thread count), then `Done` or `Failed` per assignment. Rank 0 →
+//! worker: `Assign` (the study's spec the first time a worker sees that study) or `Stop`.
+//! Ranks that wait poll with short sleeps instead of blocking in MPI, whose blocking
+//! receives spin and would take a core from the threads computing samples.
+
+use std::collections::HashMap;
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
+use asperity::study::{Restored, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples};
+use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
+use mpi::topology::{Communicator, SimpleCommunicator};
+use serde::{Deserialize, Serialize};
+
+/// The longest pause between two polls of a waiting rank; short against any sample.
+const MAX_POLL: Duration = Duration::from_millis(20);
+
+/// A message between ranks.
+#[derive(Debug, Serialize, Deserialize)]
+enum Message {
+    /// Worker → rank 0, once: it is ready and computes this many samples at once.
+    Ready { lanes: usize },
+    /// Worker → rank 0: the curves of the samples assigned last, in the order asked.
+    Done { curves: Vec<SampleCurve> },
+    /// Worker → rank 0: the assignment failed.
+    Failed { reason: String },
+    /// Rank 0 → worker: compute samples `indices` of `task` of study number `study`
+    /// (`spec` is sent the first time a worker meets a study).
+    Assign {
+        study: u64,
+        spec: Option<StudySpec>,
+        task: Task,
+        indices: Vec<usize>,
+    },
+    /// Rank 0 → worker: the job is over.
+    Stop,
+}
+
+fn encode(message: &Message) -> Vec<u8> {
+    serde_json::to_vec(message).expect("messages serialise")
+}
+
+fn decode(bytes: &[u8], from: i32) -> Result<Message> {
+    serde_json::from_slice(bytes).with_context(|| format!("a garbled message from rank {from}"))
+}
+
+/// Waits for the next message from `source` (any rank if `None`), polling.
+fn receive(world: &SimpleCommunicator, source: Option<i32>) -> Result<(i32, Message)> {
+    let mut pause = Duration::from_micros(100);
+    loop {
+        if let Some(got) = try_receive(world, source)? {
+            return Ok(got);
+        }
+        std::thread::sleep(pause);
+        pause = (pause * 2).min(MAX_POLL);
+    }
+}
+
+fn try_receive(world: &SimpleCommunicator, source: Option<i32>) -> Result<Option<(i32, Message)>> {
+    let probed = match source {
+        Some(rank) => world.process_at_rank(rank).immediate_matched_probe(),
+        None => world.any_process().immediate_matched_probe(),
+    };
+    let Some(probed) = probed else {
+        return Ok(None);
+    };
+    let (bytes, status) = probed.matched_receive_vec::<u8>();
+    let from = status.source_rank();
+    Ok(Some((from, decode(&bytes, from)?)))
+}
+
+fn send(world: &SimpleCommunicator, rank: i32, message: &Message) {
+    world.process_at_rank(rank).send(&encode(message)[..]);
+}
+
+/// Runs the command line under MPI: initialises MPI, runs `cli` on rank 0 and the worker
+/// loop on the others, and returns the process's exit status.
+pub fn main(cli: impl FnOnce() -> i32) -> i32 {
+    let Some((universe, _)) = mpi::initialize_with_threading(mpi::Threading::Funneled) else {
+        eprintln!("error: MPI could not be initialised");
+        return 2;
+    };
+    let world = universe.world();
+    if world.size() <= 1 {
+        return cli();
+    }
+    if world.rank() != 0 {
+        return match serve(&world) {
+            Ok(()) => 0,
+            Err(err) => {
+                eprintln!("error: rank {}: {err:#}", world.rank());
+                world.abort(2)
+            }
+        };
+    }
+    *coordinator() = Some(Coordinator::new(world.size()));
+    let code = cli();
+    let Some(mut state) = coordinator().take() else {
+        return code;
+    };
+    if let Err(err) = state.stop(&world) {
+        eprintln!("error: {err:#}");
+        world.abort(if code == 0 { 2 } else { code });
+    }
+    drop(universe);
+    code
+}
+
+/// The worker loop of ranks other than 0.
+fn serve(world: &SimpleCommunicator) -> Result<()> {
+    let lanes = rayon::current_num_threads().max(1);
+    send(world, 0, &Message::Ready { lanes });
+    let mut specs: HashMap<u64, StudySpec> = HashMap::new();
+    let mut current: Option<(u64, TaskSamples)> = None;
+    loop {
+        match receive(world, Some(0))?.1 {
+            Message::Stop => return Ok(()),
+            Message::Assign {
+                study,
+                spec,
+                task,
+                indices,
+            } => {
+                if let Some(spec) = spec {
+                    specs.insert(study, spec);
+                }
+                let reply = match compute(&specs, &mut current, study, task, &indices) {
+                    Ok(curves) => Message::Done { curves },
+                    Err(err) => Message::Failed {
+                        reason: format!("{err:#}"),
+                    },
+                };
+                send(world, 0, &reply);
+            }
+            other => bail!("unexpected message from rank 0: {other:?}"),
+        }
+    }
+}
+
+/// The samples `indices` of `task` of study `study`, with the workers of the last task
+/// kept when the task is the same.
+fn compute(
+    specs: &HashMap<u64, StudySpec>,
+    current: &mut Option<(u64, TaskSamples)>,
+    study: u64,
+    task: Task,
+    indices: &[usize],
+) -> Result<Vec<SampleCurve>> {
+    let same = matches!(current, Some((s, t)) if *s == study && t.task().same_as(&task));
+    if !same {
+        let spec = specs
+            .get(&study)
+            .ok_or_else(|| anyhow!("no spec for study {study}"))?;
+        *current = Some((study, TaskSamples::new(spec, task)?));
+    }
+    let (_, samples) = current.as_mut().expect("set above");
+    Ok(samples.compute(indices)?)
+}
+
+/// The coordinator of rank 0, while the job runs with more than one rank.
+fn coordinator() -> std::sync::MutexGuard<'static, Option<Coordinator>> {
+    static STATE: Mutex<Option<Coordinator>> = Mutex::new(None);
+    STATE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Whether studies run distributed (rank 0 of a job of several ranks).
+pub fn active() -> bool {
+    coordinator().is_some()
+}
+
+/// What rank 0 knows of a worker rank.
+#[derive(Debug, Default)]
+struct Worker {
+    /// Samples computed at once; `None` until its `Ready` arrived.
+    lanes: Option<usize>,
+    /// The last study whose spec it was sent.
+    study: Option<u64>,
+    /// What it is computing: `(task number, indices)`.
+    busy: Option<(usize, Vec<usize>)>,
+}
+
+/// Rank 0's own worker: a thread computing samples while the main thread coordinates.
+struct Local {
+    jobs: Sender<(Arc<StudySpec>, u64, Task, Vec<usize>)>,
+    results: Receiver<Result<Vec<SampleCurve>>>,
+    thread: JoinHandle<()>,
+    busy: Option<(usize, Vec<usize>)>,
+}
+
+impl Local {
+    fn start() -> Local {
+        let (jobs, job_rx) = mpsc::channel::<(Arc<StudySpec>, u64, Task, Vec<usize>)>();
+        let (result_tx, results) = mpsc::channel();
+        let thread = std::thread::spawn(move || {
+            let mut current: Option<(u64, TaskSamples)> = None;
+            let mut specs = HashMap::new();
+            for (spec, study, task, indices) in job_rx {
+                specs
+                    .entry(study)
+                    .or_insert_with(|| StudySpec::clone(&spec));
+                let done = compute(&specs, &mut current, study, task, &indices);
+                if result_tx.send(done).is_err() {
+                    return;
+                }
+            }
+        });
+        Local {
+            jobs,
+            results,
+            thread,
+            busy: None,
+        }
+    }
+}
+
+/// Rank 0's view of the job: its workers and the number of studies run so far.
+struct Coordinator {
+    workers: Vec<Worker>,
+    local: Option<Local>,
+    studies: u64,
+    /// Samples computed by each rank in the current study.
+    computed: Vec<u64>,
+}
+
+impl Coordinator {
+    fn new(size: i32) -> Coordinator {
+        Coordinator {
+            workers: (0..size).map(|_| Worker::default()).collect(),
+            local: None,
+            studies: 0,
+            computed: Vec::new(),
+        }
+    }
+
+    /// Ends the job: every worker is told to stop once it is idle and registered. Fails if
+    /// samples are still in flight (a study ended by an error), which the caller turns
+    /// into an abort.
+    fn stop(&mut self, world: &SimpleCommunicator) -> Result<()> {
+        let in_flight = self.workers.iter().any(|w| w.busy.is_some())
+            || self.local.as_ref().is_some_and(|l| l.busy.is_some());
+        if in_flight {
+            bail!("the study stopped with samples in flight: ending every rank");
+        }
+        if let Some(local) = self.local.take() {
+            drop(local.jobs);
+            let _ = local.thread.join();
+        }
+        for rank in 1..self.workers.len() {
+            if self.workers[rank].lanes.is_none() {
+                match receive(world, Some(rank as i32))?.1 {
+                    Message::Ready { .. } => {}
+                    other => bail!("unexpected message from rank {rank}: {other:?}"),
+                }
+            }
+            send(world, rank as i32, &Message::Stop);
+        }
+        Ok(())
+    }
+}
+
+/// Progress of a distributed study: `(samples done over all tasks, whether the samples
+/// since the last call were read back from checkpoints rather than computed)`.
+pub type Progress<'a> = dyn Fn(u64, bool) + 'a;
+
+/// Runs every task of the study in `store` over the ranks of the job (module docs) and
+/// returns the results in task order. Rank 0 must be the coordinator ([`active`]).
+/// Unless `quiet`, says at the end how many samples each rank computed.
+pub fn run_study(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<Vec<TaskResult>> {
+    let mut guard = coordinator();
+    let state = guard
+        .as_mut()
+        .ok_or_else(|| anyhow!("not the coordinator of an MPI job"))?;
+    let world = SimpleCommunicator::world();
+    let mut study = Study::restore(store)?;
+    progress(study.done(), true);
+    state.studies += 1;
+    let number = state.studies;
+    let spec = Arc::new(store.spec().clone());
+    if state.local.is_none() {
+        state.local = Some(Local::start());
+    }
+    state.computed = vec![0; state.workers.len()];
+    let mut pause = Duration::from_micros(100);
+    while !study.finished() {
+        state.assign(&world, &mut study, number, &spec)?;
+        if state.collect(&world, &mut study, store)? {
+            progress(study.done(), false);
+            pause = Duration::from_micros(100);
+        } else {
+            std::thread::sleep(pause);
+            pause = (pause * 2).min(MAX_POLL);
+        }
+    }
+    if !quiet {
+        let counts: Vec<String> = state.computed.iter().map(u64::to_string).collect();
+        eprintln!(
+            "{} ranks computed {} samples (rank 0 first)",
+            counts.len(),
+            counts.join(" + ")
+        );
+    }
+    Ok(study.results())
+}
+
+impl Coordinator {
+    /// Gives work to every idle worker (rank 0's own thread included) while there is work.
+    fn assign(
+        &mut self,
+        world: &SimpleCommunicator,
+        study: &mut Study,
+        number: u64,
+        spec: &Arc<StudySpec>,
+    ) -> Result<()> {
+        if let Some(local) = self.local.as_mut().filter(|l| l.busy.is_none()) {
+            let lanes = rayon::current_num_threads().max(1);
+            if let Some((t, indices)) = study.next_work(lanes) {
+                let task = study.tasks[t].task;
+                local
+                    .jobs
+                    .send((spec.clone(), number, task, indices.clone()))
+                    .map_err(|_| anyhow!("rank 0's sample thread ended"))?;
+                local.busy = Some((t, indices));
+            }
+        }
+        for (rank, worker) in self.workers.iter_mut().enumerate().skip(1) {
+            let Some(lanes) = worker.lanes.filter(|_| worker.busy.is_none()) else {
+                continue;
+            };
+            let Some((t, indices)) = study.next_work(lanes) else {
+                break;
+            };
+            let first = worker.study != Some(number);
+            let message = Message::Assign {
+                study: number,
+                spec: first.then(|| (**spec).clone()),
+                task: study.tasks[t].task,
+                indices: indices.clone(),
+            };
+            send(world, rank as i32, &message);
+            worker.study = Some(number);
+            worker.busy = Some((t, indices));
+        }
+        Ok(())
+    }
+
+    /// Takes in one finished assignment, if any: whether one was.
+    fn collect(
+        &mut self,
+        world: &SimpleCommunicator,
+        study: &mut Study,
+        store: &StudyDir,
+    ) -> Result<bool> {
+        if let Some(local) = self.local.as_mut() {
+            if let Ok(done) = local.results.try_recv() {
+                let (t, indices) = local.busy.take().expect("an answer follows a job");
+                let curves = done.context("rank 0")?;
+                self.computed[0] += indices.len() as u64;
+                study.receive(store, t, &indices, curves)?;
+                return Ok(true);
+            }
+        }
+        let Some((rank, message)) = try_receive(world, None)? else {
+            return Ok(false);
+        };
+        let worker = &mut self.workers[rank as usize];
+        match message {
+            Message::Ready { lanes } => worker.lanes = Some(lanes.max(1)),
+            Message::Done { curves } => {
+                let (t, indices) = worker
+                    .busy
+                    .take()
+                    .ok_or_else(|| anyhow!("rank {rank} sent samples it was not asked for"))?;
+                self.computed[rank as usize] += indices.len() as u64;
+                study.receive(store, t, &indices, curves)?;
+            }
+            Message::Failed { reason } => {
+                worker.busy = None;
+                bail!("rank {rank}: {reason}");
+            }
+            other => bail!("unexpected message from rank {rank}: {other:?}"),
+        }
+        Ok(true)
+    }
+}
+
+/// One task of a distributed study, as rank 0 keeps it.
+struct TaskState {
+    task: Task,
+    /// Its result, once finished (or read back).
+    result: Option<TaskResult>,
+    /// The samples received, by index (empty until the task is started).
+    slots: Vec<Option<SampleCurve>>,
+    /// Samples `0..prefix` are all received.
+    prefix: usize,
+    /// Samples `0..next` are given out or received.
+    next: usize,
+    /// Samples received (read back or computed).
+    received: usize,
+    /// The prefix in the last checkpoint, and when it was written.
+    saved: (usize, Instant),
+}
+
+/// The tasks of a distributed study.
+struct Study {
+    tasks: Vec<TaskState>,
+    samples: usize,
+    interval: Duration,
+}
+
+impl Study {
+    /// Every task as its checkpoint left it.
+    fn restore(store: &StudyDir) -> Result<Study> {
+        let samples = store.spec().samples;
+        let mut tasks = Vec::new();
+        for task in store.spec().tasks() {
+            let restored = store
+                .restore(task)
+                .with_context(|| task_name(store, task))?;
+            let mut state = TaskState {
+                task,
+                result: None,
+                slots: Vec::new(),
+                prefix: 0,
+                next: 0,
+                received: 0,
+                saved: (0, Instant::now()),
+            };
+            match restored {
+                Restored::Done(result) => {
+                    state.result = Some(result);
+                    (state.prefix, state.next, state.received) = (samples, samples, samples);
+                }
+                Restored::Partial(first) => {
+                    let k = first.len();
+                    (state.prefix, state.next, state.received, state.saved.0) = (k, k, k, k);
+                    state.slots = first.into_iter().map(Some).collect();
+                }
+            }
+            tasks.push(state);
+        }
+        Ok(Study {
+            tasks,
+            samples,
+            interval: store.checkpoint_interval(),
+        })
+    }
+
+    fn done(&self) -> u64 {
+        self.tasks.iter().map(|t| t.received as u64).sum()
+    }
+
+    fn finished(&self) -> bool {
+        self.tasks.iter().all(|t| t.result.is_some())
+    }
+
+    /// The next samples to give out: up to `lanes` of the first task with samples left.
+    fn next_work(&mut self, lanes: usize) -> Option<(usize, Vec<usize>)> {
+        let samples = self.samples;
+        let (t, state) = self
+            .tasks
+            .iter_mut()
+            .enumerate()
+            .find(|(_, s)| s.next < samples)?;
+        let end = (state.next + lanes).min(samples);
+        let indices: Vec<usize> = (state.next..end).collect();
+        state.next = end;
+        Some((t, indices))
+    }
+
+    /// Takes in the curves of samples `indices` of task `t`; checkpoints the task when due
+    /// and ends it when complete.
+    fn receive(
+        &mut self,
+        store: &StudyDir,
+        t: usize,
+        indices: &[usize],
+        curves: Vec<SampleCurve>,
+    ) -> Result<()> {
+        let samples = self.samples;
+        let state = &mut self.tasks[t];
+        if curves.len() != indices.len() {
+            bail!(
+                "{}: {} curves for {} samples",
+                task_name(store, state.task),
+                curves.len(),
+                indices.len()
+            );
+        }
+        state.slots.resize(samples, None);
+        for (&i, curve) in indices.iter().zip(curves) {
+            state.slots[i] = Some(curve);
+        }
+        state.received += indices.len();
+        while state.prefix < samples && state.slots[state.prefix].is_some() {
+            state.prefix += 1;
+        }
+        let name = || task_name(store, state.task);
+        if state.prefix == samples {
+            let all = std::mem::take(&mut state.slots)
+                .into_iter()
+                .flatten()
+                .collect();
+            state.result = Some(store.finish(state.task, all).with_context(name)?);
+        } else if state.prefix > state.saved.0 && state.saved.1.elapsed() >= self.interval {
+            let first: Vec<SampleCurve> = state.slots[..state.prefix]
+                .iter()
+                .flatten()
+                .cloned()
+                .collect();
+            store
+                .save_in_progress(state.task, &first)
+                .with_context(name)?;
+            state.saved = (state.prefix, Instant::now());
+        }
+        Ok(())
+    }
+
+    fn results(self) -> Vec<TaskResult> {
+        self.tasks.into_iter().filter_map(|t| t.result).collect()
+    }
+}
+
+/// `bem N = 64 H = 0.5`, as errors of the serial run name a task.
+fn task_name(store: &StudyDir, task: Task) -> String {
+    format!(
+        "{} N = {} H = {}",
+        store.spec().method.name(),
+        task.n,
+        task.hurst
+    )
+}
