@@ -224,7 +224,7 @@ pub(crate) fn ring_sums(
     let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
     let last = cols / 2;
     for (kx, column) in spectrum.chunks(rows).enumerate() {
-        let weight = if kx == 0 || (cols % 2 == 0 && kx == last) {
+        let weight = if kx == 0 || (cols.is_multiple_of(2) && kx == last) {
             1
         } else {
             2
