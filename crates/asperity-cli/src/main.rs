@@ -3,11 +3,8 @@
 
 mod cli;
 mod commands;
-#[allow(dead_code)] // shared helpers, not all used by every command yet
 mod output;
-#[allow(dead_code)]
 mod plot;
-#[allow(dead_code)]
 mod progress;
 mod rerun;
 

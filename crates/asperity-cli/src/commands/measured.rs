@@ -65,16 +65,17 @@ pub fn parse_size(text: &str) -> Result<[Option<f64>; 2]> {
 pub fn is_npy(path: &Path) -> bool {
     use std::io::Read;
     let mut head = [0u8; 6];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok()
+    // Opened as every input is (a FIFO or device is no `.npy`, and opening one must not
+    // block); the reader that follows refuses it in words.
+    asperity::input::open_regular(path).is_ok_and(|(mut f, _)| f.read_exact(&mut head).is_ok())
         && &head == b"\x93NUMPY"
 }
 
 /// Whether the `.npy` at `path` has an import sidecar (with `sizes` per axis): such arrays
 /// go through the measured path, which reads both sizes.
 pub fn has_import_sidecar(path: &Path) -> bool {
-    std::fs::read_to_string(asperity::io::sidecar_path(path))
+    let sidecar = asperity::io::sidecar_path(path);
+    asperity::input::read_text(&sidecar, asperity::input::TEXT_MAX_BYTES)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .is_some_and(|v| v["sizes"].is_array())
