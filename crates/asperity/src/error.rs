@@ -25,8 +25,9 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
-    /// A file exists where an output should go and overwriting was not allowed.
-    #[error("{0}: output already exists (use --force to overwrite)")]
+    /// A file exists where an output should go and overwriting was not allowed (the
+    /// `force` argument of the writers).
+    #[error("{0}: output already exists (allow overwriting to replace it)")]
     OutputExists(PathBuf),
     /// An output path cannot be written: its folder is missing, it is a folder, it is
     /// named twice among one command's outputs, or it is the command's input.
@@ -86,11 +87,22 @@ pub enum Error {
         limited_by: String,
     },
     /// A study folder already holds the checkpoint of a different study.
-    #[error("{dir}: holds the checkpoint of another study ({reason}); use another --out, or --force to discard it")]
+    #[error("{dir}: holds the checkpoint of another study ({reason}); use another folder, or discard it (force)")]
     ForeignCheckpoint {
         /// The study folder.
         dir: PathBuf,
         /// What differs.
+        reason: String,
+    },
+    /// A study file or checkpoint in a study folder is damaged or from an older version: the
+    /// study goes on once it is repaired or removed, or once the folder's checkpoints are
+    /// discarded (`force`).
+    #[error("{path}: {reason}, or discard the folder's checkpoints (force)")]
+    DamagedStudy {
+        /// The study file or checkpoint.
+        path: PathBuf,
+        /// What is wrong and how to repair it (e.g. `corrupt checkpoint (...); delete it to
+        /// recompute its task`).
         reason: String,
     },
     /// Another process holds the lock of an output folder ([`crate::lock::FolderLock`]).

@@ -74,14 +74,14 @@ impl Psd {
         if let Some(q1) = short_cutoff {
             if !(q1.is_finite() && q1 > 0.0) {
                 return Err(Error::invalid(
-                    "short-cutoff",
+                    "short_cutoff",
                     format!("must be a positive number of wavelengths per side, got {q1}"),
                 ));
             }
             if let Some(q0) = q0 {
                 if q1 <= q0 {
                     return Err(Error::invalid(
-                        "short-cutoff",
+                        "short_cutoff",
                         format!("q1 = {q1} must be above the long-wavelength q0 = {q0}"),
                     ));
                 }

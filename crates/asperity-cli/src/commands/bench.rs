@@ -218,9 +218,7 @@ fn fft_pair_times(n: usize, boundary: Boundary, repeat: usize) -> Result<Vec<f64
 fn study_pressures(n: usize) -> Vec<f64> {
     const LOADS: usize = 24;
     let (lo, hi) = (0.05 / (n * n) as f64, 0.2f64);
-    (0..LOADS)
-        .map(|i| (lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (LOADS - 1) as f64).exp())
-        .collect()
+    asperity::fit::log_levels(lo, hi, LOADS).collect()
 }
 
 /// The study's surface of size `n` and Hurst exponent `hurst` (unit rms slope, L = 1).

@@ -201,7 +201,7 @@ impl RadialProfile {
         crate::ensure_finite("radial profile", values)?;
         if !(step.is_finite() && step > 0.0) {
             return Err(Error::invalid(
-                "radial-step",
+                "radial_step",
                 format!("the radial sample step must be positive and finite, got {step}"),
             ));
         }

@@ -135,7 +135,7 @@ impl Spring {
                         ),
                     ));
                 }
-                positive_finite("rms-height", rms_height, "the rms height h")?;
+                positive_finite("rms_height", rms_height, "the rms height h")?;
                 positive_finite("size", size, "the line length L")?;
                 let h1 = hurst + 1.0;
                 let exponent = h1 / hurst;

@@ -37,11 +37,11 @@ impl Default for Normalisation {
 }
 
 impl Normalisation {
-    /// The flag that sets it and the requested value.
+    /// The parameter that sets it and the requested value.
     pub(crate) fn name_and_value(&self) -> (&'static str, f64) {
         match *self {
-            Normalisation::RmsHeight(v) => ("rms-height", v),
-            Normalisation::RmsSlope(v) => ("rms-slope", v),
+            Normalisation::RmsHeight(v) => ("rms_height", v),
+            Normalisation::RmsSlope(v) => ("rms_slope", v),
         }
     }
 
@@ -93,7 +93,7 @@ pub(crate) fn validate_spectrum_on_grid(psd: &crate::spectrum::Psd, nyquist: f64
     }
     if let Some(q1) = psd.short_cutoff().filter(|&q1| q1 < 1.0) {
         return Err(Error::invalid(
-            "short-cutoff",
+            "short_cutoff",
             format!("q1 = {q1} removes every mode: the longest wavelength is the side (q1 ≥ 1)"),
         ));
     }
