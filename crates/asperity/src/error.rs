@@ -170,6 +170,29 @@ fn out_of_memory_message(
 /// `Result` with the library's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
 
+/// Whether `value` is a positive, finite number (NaN is not): the check behind every
+/// length, modulus, load and tolerance of the library.
+pub(crate) fn is_positive_finite(value: f64) -> bool {
+    value.is_finite() && value > 0.0
+}
+
+/// `value` if it is positive and finite, else [`Error::InvalidParameter`] naming `name`:
+/// "`{what} `must be positive and finite, got {value}" (`what` may be empty).
+pub(crate) fn positive_finite(name: &'static str, value: f64, what: &str) -> Result<f64> {
+    if is_positive_finite(value) {
+        return Ok(value);
+    }
+    let what = if what.is_empty() {
+        String::new()
+    } else {
+        format!("{what} ")
+    };
+    Err(Error::invalid(
+        name,
+        format!("{what}must be positive and finite, got {value}"),
+    ))
+}
+
 /// Checks that every value is finite; the error names `what` and the first bad index.
 pub fn ensure_finite<'a>(what: &str, values: impl IntoIterator<Item = &'a f64>) -> Result<()> {
     match values.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {

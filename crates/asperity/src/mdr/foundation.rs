@@ -121,7 +121,7 @@ impl Foundation {
         self.gaps
             .iter()
             .copied()
-            .find(|&g| g > 0.0 && g.is_finite())
+            .find(|&g| crate::is_positive_finite(g))
     }
 
     /// Force, stiffness and contacts at indentation `d` (exact; `d ≤ 0` gives zeros).

@@ -135,7 +135,7 @@ pub fn low_force_sample(
 ) -> Result<LowForceSample> {
     let n = curve.len();
     let (low, high) = window.contact_range(n)?;
-    if !(rms_height.is_finite() && rms_height > 0.0) {
+    if !crate::is_positive_finite(rms_height) {
         return Err(Error::invalid(
             "rms_height",
             format!("the line's rms height must be positive and finite, got {rms_height}"),

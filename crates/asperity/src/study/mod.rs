@@ -124,7 +124,7 @@ impl StudySpec {
             return Err(Error::invalid("samples", "need at least 1 sample"));
         }
         if let Some(q0) = self.rolloff {
-            if !(q0.is_finite() && q0 > 0.0) {
+            if !crate::is_positive_finite(q0) {
                 return Err(Error::invalid(
                     "rolloff",
                     format!("must be positive, got {q0}"),

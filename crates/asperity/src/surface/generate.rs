@@ -228,7 +228,7 @@ fn scale_to(heights: &mut [f64], realised: f64, target: Normalisation) -> Result
     let want = match target {
         Normalisation::RmsHeight(v) | Normalisation::RmsSlope(v) => v,
     };
-    if !(realised.is_finite() && realised > 0.0) {
+    if !crate::is_positive_finite(realised) {
         return Err(Error::invalid(
             "spectrum",
             "no power on this grid (is the cut-off above the grid's Nyquist wavenumber?)",

@@ -48,27 +48,13 @@ impl Normalisation {
     /// Checks that the target is positive and finite.
     pub fn validate(&self) -> Result<()> {
         let (name, value) = self.name_and_value();
-        if value.is_finite() && value > 0.0 {
-            Ok(())
-        } else {
-            Err(Error::invalid(
-                name,
-                format!("must be positive and finite, got {value}"),
-            ))
-        }
+        crate::positive_finite(name, value, "").map(drop)
     }
 }
 
 /// Checks a physical side length.
 pub(crate) fn validate_size(size: f64) -> Result<()> {
-    if size.is_finite() && size > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            "size",
-            format!("side length must be positive and finite, got {size}"),
-        ))
-    }
+    crate::positive_finite("size", size, "side length").map(drop)
 }
 
 /// Checks that the spectrum's wavenumbers fit the grid: a roll-off or cut-off `q0` must lie

@@ -642,7 +642,7 @@ fn sizes_for(
     given: Option<[Option<f64>; 2]>,
     profile: bool,
 ) -> std::result::Result<(Vec<f64>, &'static str), String> {
-    let valid = |v: f64| v.is_finite() && v > 0.0;
+    let valid = |v: f64| crate::is_positive_finite(v);
     let shape = channel.heights.shape();
     let (sizes, source) = match given {
         Some([Some(x), y]) => {
