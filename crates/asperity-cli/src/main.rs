@@ -5,11 +5,8 @@ mod cli;
 mod commands;
 #[cfg(feature = "mpi")]
 mod distributed;
-#[allow(dead_code)] // shared helpers, not all used by every command yet
 mod output;
-#[allow(dead_code)]
 mod plot;
-#[allow(dead_code)]
 mod progress;
 mod rerun;
 
@@ -64,7 +61,7 @@ fn run() -> i32 {
         // One line: the chain of causes joined, as a user reads it; a cause that its
         // parent's message already ends with (library errors print their source) is skipped.
         let mut line = String::new();
-        for cause in err.chain().map(|c| c.to_string()) {
+        for cause in err.chain().map(in_cli_words) {
             if line.is_empty() {
                 line = cause;
             } else if !line.ends_with(&cause) {
@@ -78,6 +75,58 @@ fn run() -> i32 {
         return 2;
     }
     0
+}
+
+/// One cause of an error as the CLI says it. The library names its parameters and
+/// arguments (`rms_height`, `force`); the CLI names the flags that set them (`rms-height`,
+/// `--force`, `--out`). Other causes are kept as they are.
+fn in_cli_words(cause: &(dyn std::error::Error + 'static)) -> String {
+    use asperity::bem::SolveError;
+    if let Some(error) = cause.downcast_ref::<asperity::Error>() {
+        return library_error(error);
+    }
+    match cause.downcast_ref::<SolveError>() {
+        Some(SolveError::Input(error)) => library_error(error),
+        _ => cause.to_string(),
+    }
+}
+
+/// The CLI flag (without `--`) of a library parameter whose name differs from it.
+fn flag(parameter: &str) -> &str {
+    const FLAGS: [(&str, &str); 4] = [
+        ("rms_height", "rms-height"),
+        ("rms_slope", "rms-slope"),
+        ("radial_step", "radial-step"),
+        ("short_cutoff", "short-cutoff"),
+    ];
+    FLAGS
+        .iter()
+        .find(|(name, _)| *name == parameter)
+        .map_or(parameter, |(_, flag)| flag)
+}
+
+fn library_error(error: &asperity::Error) -> String {
+    use asperity::Error as E;
+    match error {
+        E::InvalidParameter { name, reason } => format!("invalid {}: {reason}", flag(name)),
+        E::OutputExists(path) => format!(
+            "{}: output already exists (use --force to overwrite)",
+            path.display()
+        ),
+        E::ForeignCheckpoint { dir, reason } => format!(
+            "{}: holds the checkpoint of another study ({reason}); use another --out, or \
+             --force to discard it",
+            dir.display()
+        ),
+        E::DamagedStudy { path, reason } => format!(
+            "{}: {reason}, or use --force to discard the folder's checkpoints",
+            path.display()
+        ),
+        E::Solve { context, source } => {
+            format!("{context}: {}", in_cli_words(source.as_ref()))
+        }
+        other => other.to_string(),
+    }
 }
 
 /// Numbers of more than 20 characters (Rust prints `1e-300` as 300 digits) in short
@@ -132,6 +181,66 @@ fn one_line(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::one_line;
+
+    #[test]
+    fn library_errors_are_said_with_the_cli_flags() {
+        use asperity::Error;
+        use std::path::PathBuf;
+        let cases = [
+            (
+                Error::invalid("rms_height", "must be positive"),
+                "invalid rms_height: must be positive",
+                "invalid rms-height: must be positive",
+            ),
+            (
+                Error::OutputExists(PathBuf::from("a.csv")),
+                "a.csv: output already exists (allow overwriting to replace it)",
+                "a.csv: output already exists (use --force to overwrite)",
+            ),
+            (
+                Error::ForeignCheckpoint {
+                    dir: PathBuf::from("st"),
+                    reason: "seed 1 vs 2".into(),
+                },
+                "st: holds the checkpoint of another study (seed 1 vs 2); use another \
+                 folder, or discard it (force)",
+                "st: holds the checkpoint of another study (seed 1 vs 2); use another --out, \
+                 or --force to discard it",
+            ),
+            (
+                Error::DamagedStudy {
+                    path: PathBuf::from("st/study.json"),
+                    reason: "corrupt study file (eof); restore it".into(),
+                },
+                "st/study.json: corrupt study file (eof); restore it, or discard the \
+                 folder's checkpoints (force)",
+                "st/study.json: corrupt study file (eof); restore it, or use --force to \
+                 discard the folder's checkpoints",
+            ),
+        ];
+        for (error, library, cli) in cases {
+            assert_eq!(error.to_string(), library);
+            assert!(!library.contains("--"), "{library}");
+            assert_eq!(super::library_error(&error), cli);
+        }
+        // Names that are no flag stay as they are.
+        let env = Error::invalid("ASPERITY_MEMORY_LIMIT_MIB", "x");
+        assert_eq!(
+            super::library_error(&env),
+            "invalid ASPERITY_MEMORY_LIMIT_MIB: x"
+        );
+        // Inside a solver error, and inside a study sample's error.
+        let solve = asperity::bem::SolveError::from(Error::invalid("radial_step", "x"));
+        assert_eq!(super::in_cli_words(&solve), "invalid radial-step: x");
+        let sample = Error::Solve {
+            context: "seed 3".into(),
+            source: Box::new(solve),
+        };
+        assert_eq!(
+            super::in_cli_words(&sample),
+            "seed 3: invalid radial-step: x"
+        );
+    }
 
     #[test]
     fn missing_arguments_are_named() {

@@ -68,11 +68,6 @@ impl Table {
         self.rows.len()
     }
 
-    /// True when the table has no data rows.
-    pub fn is_empty(&self) -> bool {
-        self.rows.is_empty()
-    }
-
     /// Writes the table atomically.
     pub fn write(&self, path: &Path, force: bool) -> Result<()> {
         asperity::io::write_bytes(path, force, &self.to_csv()?)?;

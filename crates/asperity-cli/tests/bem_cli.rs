@@ -1,21 +1,12 @@
 //! `asperity bem` driven as a user would: through the real binary.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use ndarray::Array2;
 use ndarray_npy::{read_npy, write_npy};
 
-fn asperity(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{ok, png_size, refused, run_asperity as asperity, stderr};
 
 /// A 64² rough surface made by `asperity surface`.
 fn surface(dir: &Path) -> PathBuf {
@@ -35,7 +26,7 @@ fn surface(dir: &Path) -> PathBuf {
         "--out",
         path.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     path
 }
 
@@ -70,7 +61,7 @@ fn pressures_with_fields_write_the_documented_outputs() {
         "--fields",
         fields.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (header, rows) = read_csv(&csv);
     assert_eq!(
         header,
@@ -128,7 +119,7 @@ fn nloads_are_log_spaced_and_monotonic_and_forces_agree_with_pressures() {
         csv.to_str().unwrap(),
         "--timing",
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (header, rows) = read_csv(&csv);
     assert!(header.contains(&"solve_seconds".to_string()));
     let p: Vec<f64> = rows.iter().map(|r| r[1]).collect();
@@ -155,7 +146,7 @@ fn nloads_are_log_spaced_and_monotonic_and_forces_agree_with_pressures() {
         "--out",
         csv2.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (_, again) = read_csv(&csv2);
     assert!((again[0][2] / rows[1][2] - 1.0).abs() < 1e-6);
 }
@@ -171,7 +162,7 @@ fn stdout_table_without_out_and_indentation_control() {
         "--indentations",
         "0,0.01",
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     let mut lines = text.lines();
     assert!(lines.next().unwrap().contains("area_fraction"));
@@ -503,13 +494,6 @@ fn help_has_examples() {
     assert!(text.contains("--out sweep.csv --plot sweep.png"), "{text}");
 }
 
-/// Width and height of a PNG file, decoded.
-fn png_size(path: &Path) -> (u32, u32) {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let reader = decoder.read_info().unwrap();
-    (reader.info().width, reader.info().height)
-}
-
 #[test]
 fn plot_is_written_as_png_or_svg_beside_the_table() {
     let dir = tempfile::tempdir().unwrap();
@@ -533,7 +517,7 @@ fn plot_is_written_as_png_or_svg_beside_the_table() {
         png.to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(read_csv(&csv).1.len(), 3);
     let (w, h) = png_size(&png);
     assert!(w > 0 && h > 0, "{w}x{h}");
@@ -548,7 +532,7 @@ fn plot_is_written_as_png_or_svg_beside_the_table() {
         "--plot",
         svg.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert!(String::from_utf8_lossy(&out.stdout)
         .trim_start()
         .starts_with("force"));
@@ -672,17 +656,9 @@ fn bad_plots_are_refused_before_solving_and_nothing_is_written() {
         &path("old.png"),
         "--force",
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert!(png_size(&existing).0 > 0);
     assert!(dir.path().join("c.csv").exists());
-}
-
-/// Exit status 2 and a one-line error containing `expected`.
-fn assert_refused(out: &Output, expected: &str) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains(expected), "expected '{expected}' in: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
 
 #[test]
@@ -710,7 +686,7 @@ fn outputs_never_replace_the_surface_or_its_sidecar() {
             out,
             "--force",
         ]);
-        assert_refused(&out, expected);
+        refused(&out, expected);
         assert_eq!(tree(dir.path()), before);
     }
     assert_eq!(std::fs::read(&s).unwrap(), surface_bytes);
@@ -759,7 +735,7 @@ fn loads_beyond_full_contact_are_refused_before_any_solve() {
         let mut args = vec!["bem", "--surface", s, "--max-iter", "1", "--out", csv];
         args.extend(extra);
         let out = asperity(&args);
-        assert_refused(&out, expected);
+        refused(&out, expected);
         assert_eq!(tree(dir.path()), before, "{extra:?}");
     }
     // Loads below the threshold are solved (here: fail to converge in one iteration).
@@ -772,7 +748,7 @@ fn loads_beyond_full_contact_are_refused_before_any_solve() {
         "--pressures",
         "0.01,1",
     ]);
-    assert_refused(&out, "load 0 (mean pressure 0.01): no convergence");
+    refused(&out, "load 0 (mean pressure 0.01): no convergence");
     // Just below the threshold, --fd-stiffness's upper step would cross it: refused up
     // front too, naming the flag; without it the load is accepted.
     for boundary in ["free", "periodic"] {
@@ -797,14 +773,14 @@ fn loads_beyond_full_contact_are_refused_before_any_solve() {
             "1",
         ];
         let out = asperity(&[&base[..], &["--pressures", &near, "--fd-stiffness"]].concat());
-        assert_refused(&out, "--fd-stiffness: at load 0");
+        refused(&out, "--fd-stiffness: at load 0");
         assert!(
             stderr(&out).contains("beyond full contact"),
             "{}",
             stderr(&out)
         );
         let out = asperity(&[&base[..], &["--pressures", &near]].concat());
-        assert_refused(&out, "no convergence");
+        refused(&out, "no convergence");
     }
 }
 
@@ -824,7 +800,7 @@ fn fd_stiffness_agrees_with_the_frozen_set_and_changes_nothing_else() {
             "--quiet",
         ];
         let out = asperity(&[&base[..], extra].concat());
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         read_csv(&csv)
     };
     let loads = ["--pressures", "0.005,0.01,0.02,0.04"];
@@ -877,7 +853,7 @@ fn fd_stiffness_agrees_with_the_frozen_set_and_changes_nothing_else() {
         "--out",
         csv.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert!(lines[1].ends_with(','), "{text}");
@@ -907,7 +883,7 @@ fn stale_field_files_of_an_earlier_run_are_refused() {
         "--fields",
         f,
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let before = tree(dir.path());
     let old = std::fs::read(fields.join("gap_2.npy")).unwrap();
     // Two loads would leave pressure_2.npy and gap_2.npy beside the new files: refused,
@@ -928,7 +904,7 @@ fn stale_field_files_of_an_earlier_run_are_refused() {
             args.push("--force");
         }
         let out = asperity(&args);
-        assert_refused(&out, "gap_2.npy");
+        refused(&out, "gap_2.npy");
         assert!(stderr(&out).contains("another folder"), "{}", stderr(&out));
         assert_eq!(tree(dir.path()), before);
     }
@@ -945,11 +921,11 @@ fn stale_field_files_of_an_earlier_run_are_refused() {
         f,
         "--force",
     ];
-    assert_refused(&asperity(&args), "pressure_old.npy");
+    refused(&asperity(&args), "pressure_old.npy");
     std::fs::remove_file(dir.path().join("f/pressure_old.npy")).unwrap();
     // The same loads again replace exactly the files there.
     let out = asperity(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(std::fs::read(fields.join("gap_2.npy")).unwrap(), old);
 }
 
@@ -972,7 +948,7 @@ fn the_table_records_its_inputs_and_l_is_stated() {
             "--force",
         ];
         let out = asperity(&[&base[..], extra].concat());
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         stderr(&out)
     };
     let out_args = ["--out", csv.to_str().unwrap()];
@@ -1028,7 +1004,7 @@ fn the_table_records_its_inputs_and_l_is_stated() {
         "--out",
         csv.to_str().unwrap(),
     ]);
-    assert_refused(&out, "o.csv.json");
+    refused(&out, "o.csv.json");
     assert!(!csv.exists());
 }
 
@@ -1056,7 +1032,7 @@ fn impossible_load_counts_are_refused_without_aborting() {
             "--fields",
             fields.to_str().unwrap(),
         ]);
-        assert_refused(&out, expected);
+        refused(&out, expected);
         assert!(stderr(&out).contains("--nloads"), "{}", stderr(&out));
         assert_eq!(tree(dir.path()), before);
     }
@@ -1093,7 +1069,7 @@ fn bad_numbers_name_their_flag() {
             args.extend(["--pressures", "0.01"]);
         }
         let out = asperity(&args);
-        assert_refused(&out, expected);
+        refused(&out, expected);
         assert!(
             !stderr(&out).contains("unexpected argument"),
             "{}",
@@ -1122,7 +1098,7 @@ fn periodic_indentations_agree_with_load_control() {
         "--out",
         loads.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (header, by_load) = read_csv(&loads);
     let d = column(&header, "indentation");
     let indentations = by_load
@@ -1142,7 +1118,7 @@ fn periodic_indentations_agree_with_load_control() {
         "--out",
         displacements.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (header_d, by_indentation) = read_csv(&displacements);
     assert_eq!(header_d, header);
     assert_eq!(by_indentation.len(), 2);
@@ -1207,7 +1183,7 @@ fn both_solvers_give_the_same_contact_and_the_record_names_the_solver() {
             args.extend(["--solver", solver]);
         }
         let out = asperity(&args);
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         let record = csv.with_extension("csv.json");
         let value: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(record).unwrap()).unwrap();

@@ -3,14 +3,10 @@
 //! values that add up; bad input is one line on stderr and exit status 2.
 
 use std::collections::HashMap;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn asperity(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::{ok, run_asperity as asperity};
 
 fn fields(output: &Output) -> HashMap<String, String> {
     String::from_utf8_lossy(&output.stdout)
@@ -33,11 +29,7 @@ fn fft_pair_reports_the_padded_grid_and_positive_timings() {
             "--repeat",
             "3",
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        ok(&out);
         let f = fields(&out);
         assert_eq!(f["kernel"], "FftPair");
         assert_eq!(f["boundary"], boundary);
@@ -87,11 +79,7 @@ fn bem_estimate_sums_its_sizes_into_the_total() {
         "--probes",
         "8,16",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<HashMap<String, String>> = stdout
         .lines()

@@ -2,35 +2,13 @@
 //! real binary.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use asperity::reference::{FlatPunch, Hertz, PowerLaw};
 use ndarray::Array1;
 use ndarray_npy::WriteNpyExt;
 
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-/// Exit status 2 and a single `error: …` line mentioning `needle`.
-fn assert_refused(output: &Output, needle: &str) {
-    let text = stderr(output);
-    assert_eq!(output.status.code(), Some(2), "stderr: {text}");
-    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("error")).collect();
-    assert_eq!(errors.len(), 1, "one error line expected: {text}");
-    assert!(
-        errors[0].to_lowercase().contains(&needle.to_lowercase()),
-        "'{needle}' not in: {text}"
-    );
-}
+mod common;
+use common::{asperity, names, ok, png_size, refused, stderr};
 
 /// Rows of a CSV with header `indentation,force,stiffness,contacts`.
 fn read_curve(path: &Path) -> Vec<(f64, f64, f64, usize)> {
@@ -103,7 +81,7 @@ fn hertz_profile_reproduces_hertz_force_and_stiffness() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let hertz = Hertz {
         radius: 1.0,
         modulus: 2.0,
@@ -146,7 +124,7 @@ fn hertz_spring_law_holds_below_the_resolution() {
             ],
             dir.path(),
         );
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         read_curve(&dir.path().join(name))[0]
     };
     let hertz = Hertz {
@@ -168,12 +146,12 @@ fn line_breakpoints_and_log_spaced_loads() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let out = asperity(
         &["mdr", "--line", "l.npy", "--breakpoints", "--out", "b.csv"],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let rows = read_curve(&dir.path().join("b.csv"));
     assert_eq!(rows.len(), 1024);
     assert_eq!((rows[0].0, rows[0].1, rows[0].3), (0.0, 0.0, 1));
@@ -199,7 +177,7 @@ fn line_breakpoints_and_log_spaced_loads() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(
         read_curve(&dir.path().join("z.csv")),
         vec![(0.0, 0.0, 0.0, 0)]
@@ -208,7 +186,7 @@ fn line_breakpoints_and_log_spaced_loads() {
         &["mdr", "--line", "l.npy", "--nloads", "12", "--out", "n.csv"],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let loads = read_curve(&dir.path().join("n.csv"));
     assert_eq!(loads.len(), 12);
     assert!(loads
@@ -224,7 +202,7 @@ fn line_breakpoints_and_log_spaced_loads() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let fractal = read_curve(&dir.path().join("f.csv"));
     assert!((fractal[11].1 / loads[11].1 - 1.0).abs() < 0.05);
 }
@@ -259,7 +237,7 @@ fn sampled_radial_profile_is_transformed() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let hertz = Hertz {
         radius,
         modulus: 1.0,
@@ -286,7 +264,7 @@ fn sampled_radial_profile_is_transformed() {
         ],
         dir.path(),
     );
-    assert_refused(&out, "beyond the radial profile");
+    refused(&out, "beyond the radial profile");
 }
 
 #[test]
@@ -303,13 +281,13 @@ fn fractal_law_needs_a_valid_hurst_exponent() {
             ],
             dir.path(),
         );
-        assert_refused(&out, "hurst");
+        refused(&out, "hurst");
     }
     let out = asperity(
         &["mdr", "--line", "l.npy", "--spring", "fractal"],
         dir.path(),
     );
-    assert_refused(&out, "--hurst");
+    refused(&out, "--hurst");
 }
 
 #[test]
@@ -330,7 +308,7 @@ fn non_positive_spacing_is_refused() {
             ],
             dir.path(),
         );
-        assert_refused(&out, "dx");
+        refused(&out, "dx");
     }
     // A line that exists, so that the size (not a missing file) is what is refused.
     write_line(
@@ -339,7 +317,7 @@ fn non_positive_spacing_is_refused() {
     );
     for size in ["0", "-1"] {
         let out = asperity(&["mdr", "--line", "l.npy", "--size", size], dir.path());
-        assert_refused(&out, "size");
+        refused(&out, "size");
     }
 }
 
@@ -362,7 +340,7 @@ fn negative_indentation_range_is_refused_by_the_range_check() {
         let mut args = base.to_vec();
         args.extend([flag, "-1"]);
         let out = asperity(&args, dir.path());
-        assert_refused(&out, needle);
+        refused(&out, needle);
         assert!(
             stderr(&out).contains("-1") && !stderr(&out).contains("unexpected argument"),
             "{}",
@@ -379,12 +357,12 @@ fn missing_required_arguments_are_named() {
         &["mdr", "--radial", "tip.npy", "--n", "5", "--dx", "1e-3"],
         dir.path(),
     );
-    assert_refused(&out, "--radial-step");
-    assert_refused(&out, "not provided");
+    refused(&out, "--radial-step");
+    refused(&out, "not provided");
     // `bem` without any load flag names the load options it needs.
     let out = asperity(&["bem", "--surface", "s.npy"], dir.path());
-    assert_refused(&out, "not provided");
-    assert_refused(&out, "--forces");
+    refused(&out, "not provided");
+    refused(&out, "--forces");
 }
 
 #[test]
@@ -392,7 +370,7 @@ fn nan_in_the_profile_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     write_line(&dir.path().join("nan.npy"), vec![0.0, 1.0, f64::NAN, 0.5]);
     let out = asperity(&["mdr", "--line", "nan.npy", "--out", "x.csv"], dir.path());
-    assert_refused(&out, "non-finite");
+    refused(&out, "non-finite");
     assert!(!dir.path().join("x.csv").exists(), "nothing written");
     let out = asperity(
         &[
@@ -408,7 +386,7 @@ fn nan_in_the_profile_is_refused() {
         ],
         dir.path(),
     );
-    assert_refused(&out, "non-finite");
+    refused(&out, "non-finite");
 }
 
 #[test]
@@ -432,12 +410,12 @@ fn existing_output_is_kept_unless_forced() {
         "c.csv",
     ];
     let out = asperity(&args, dir.path());
-    assert_refused(&out, "already exists");
+    refused(&out, "already exists");
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
     let mut forced = args.to_vec();
     forced.push("--force");
     let out = asperity(&forced, dir.path());
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(read_curve(&target).len(), 5);
     assert_eq!(
         std::fs::read_dir(dir.path()).unwrap().count(),
@@ -501,7 +479,7 @@ fn reproduce_book_figures() {
         );
         assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
         let other = asperity(&["reproduce", figure, "--out", "figs"], dir.path());
-        assert_refused(&other, "not made by");
+        refused(&other, "not made by");
     }
     // Fig. 15.1 (sphere R = 1, Δx = 0.01, E* = 1; critical depth u0 = Δx²/R = 1e-4).
     let fig1 = read_columns(&dir.path().join("figs/fig15.1/fig15_1.csv"));
@@ -600,7 +578,7 @@ fn alpha_theory_column_uses_eq_24_at_h_zero() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let csv = std::fs::read_to_string(dir.path().join("a/alpha.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -645,7 +623,7 @@ fn flat_punch_profile_has_stiffness_two_modulus_radius() {
             ],
             dir.path(),
         );
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         read_curve(&dir.path().join(name))
     };
     for (radius, springs) in [(0.1, 201), (0.0375, 75), (0.0505, 101)] {
@@ -683,7 +661,7 @@ fn flat_punch_profile_has_stiffness_two_modulus_radius() {
         ],
         dir.path(),
     );
-    assert_refused(&out, "--indentations");
+    refused(&out, "--indentations");
 }
 
 #[test]
@@ -712,7 +690,7 @@ fn power_law_profile_matches_its_closed_form() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let power = PowerLaw {
         coefficient: 0.5,
         exponent: 3.0,
@@ -755,8 +733,8 @@ fn sizes_that_cannot_fit_in_memory_are_refused() {
             dir.path(),
         );
         // "needs about … MiB" or, where the byte count overflows, "exceeds addressable memory".
-        assert_refused(&out, if n.len() > 16 { "memory" } else { "MiB" });
-        assert_refused(&out, "--n");
+        refused(&out, if n.len() > 16 { "memory" } else { "MiB" });
+        refused(&out, "--n");
     }
     let out = asperity(
         &[
@@ -774,25 +752,8 @@ fn sizes_that_cannot_fit_in_memory_are_refused() {
         ],
         dir.path(),
     );
-    assert_refused(&out, "--nloads");
-    assert_refused(&out, "MiB");
-}
-
-/// Width and height of a PNG file, decoded.
-fn png_size(path: &Path) -> (u32, u32) {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let reader = decoder.read_info().unwrap();
-    (reader.info().width, reader.info().height)
-}
-
-/// The file names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
+    refused(&out, "--nloads");
+    refused(&out, "MiB");
 }
 
 #[test]
@@ -902,7 +863,7 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
     ];
     for (extra, needle) in cases {
         let out = asperity(&[&base[..], extra].concat(), d);
-        assert_refused(&out, needle);
+        refused(&out, needle);
         assert_eq!(names(d), ["old.svg"], "{extra:?} wrote files");
     }
     assert_eq!(
@@ -914,7 +875,7 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
         &[&base[..], &["--nloads", "5", "--plot", "k.png"]].concat(),
         d,
     );
-    assert_refused(&out, "--radius");
+    refused(&out, "--radius");
     assert_eq!(names(d), ["old.svg"]);
     // With --force the old plot is replaced, together with the table.
     let out = asperity(
@@ -927,7 +888,7 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
         .concat(),
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert!(std::fs::read_to_string(d.join("old.svg"))
         .unwrap()
         .contains("<svg"));

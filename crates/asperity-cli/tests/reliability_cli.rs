@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+use common::{files, ok, refused};
+
 fn asperity(args: &[&str], dir: &Path) -> Output {
     asperity_env(args, dir, &[])
 }
@@ -32,24 +35,6 @@ fn asperity_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
     child.wait_with_output().unwrap()
 }
 
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-/// Exit 2 with one line that contains `needle`, no NUL, no Debug formatting.
-fn refused(out: &Output, needle: &str) -> String {
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains(needle), "expected '{needle}' in: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
-    assert!(!err.contains('\0') && !err.contains(" { "), "{err:?}");
-    err
-}
-
 /// A `.npy` file (version 1) with this header dict and data.
 fn npy(dict: &str, data: &[u8]) -> Vec<u8> {
     let mut header = dict.to_string();
@@ -67,15 +52,6 @@ fn npy(dict: &str, data: &[u8]) -> Vec<u8> {
 fn mkfifo(path: &Path) {
     let status = Command::new("mkfifo").arg(path).status().unwrap();
     assert!(status.success());
-}
-
-fn files(dir: &Path) -> Vec<PathBuf> {
-    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    out.sort();
-    out
 }
 
 /// Items 5, 6: a 128-byte file whose header claims a huge shape, and a header of nested

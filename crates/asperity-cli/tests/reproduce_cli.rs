@@ -2,25 +2,11 @@
 //! (an interrupted run finishes with the numbers of an uninterrupted one), anything else is
 //! refused before any work.
 
-use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
+mod common;
+use common::{asperity, ok};
 
 #[test]
 fn the_same_command_runs_again_and_foreign_folders_are_refused_first() {

@@ -1,31 +1,11 @@
 //! Drives `asperity study` through the real binary: outputs, resume, bad input.
 
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run asperity")
-}
-
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-fn refused(out: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains(needle), "expected '{needle}' in: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
-}
+mod common;
+use common::{asperity, ok, refused};
 
 const ALPHA: [&str; 12] = [
     "study",

@@ -6,24 +6,12 @@ use std::process::{Command, Output};
 use ndarray::{array, Array2};
 use ndarray_npy::{read_npy, write_npy};
 
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run asperity")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{asperity, asperity_env, ok, refused, stderr};
 
 /// Exit status 2, a single `error:` line, and nothing new in the folder.
 fn assert_refused(out: &Output, dir: &Path, files_before: usize, needle: &str) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert!(err.contains(needle), "expected '{needle}' in: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "one-line error, got: {err}");
+    let err = refused(out, needle);
     assert_eq!(
         std::fs::read_dir(dir).unwrap().count(),
         files_before,
@@ -56,9 +44,9 @@ fn surface_writes_npy_sidecar_and_png_and_is_reproducible() {
         &[&args[..], &["--out", "a.npy", "--png", "a.png"]].concat(),
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let out = asperity(&[&args[..], &["--out", "b.npy"]].concat(), d);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let a: Array2<f64> = read_npy(d.join("a.npy")).unwrap();
     let b: Array2<f64> = read_npy(d.join("b.npy")).unwrap();
     assert_eq!(a.dim(), (48, 64));
@@ -140,7 +128,7 @@ fn stats_writes_psd_and_recovers_hurst_of_a_line() {
     .status
     .success());
     let out = asperity(&["stats", "l.npy", "--psd", "psd.csv"], d);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     let hurst: f64 = text
         .lines()
@@ -315,15 +303,6 @@ fn a_failing_output_leaves_no_other_output_behind() {
     assert_eq!(std::fs::read(d.join("a.npy.json")).unwrap(), sidecar);
 }
 
-fn asperity_env(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .envs(env.iter().copied())
-        .current_dir(dir)
-        .output()
-        .expect("run asperity")
-}
-
 #[test]
 fn memory_guard_refuses_before_writing_anything() {
     let dir = tempfile::tempdir().unwrap();
@@ -359,7 +338,7 @@ fn memory_guard_refuses_before_writing_anything() {
         d,
         &[("ASPERITY_MEMORY_LIMIT_MIB", "100000")],
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
 }
 
 #[test]
@@ -404,7 +383,7 @@ fn huge_grids_exceed_addressable_memory() {
 /// `asperity stats --json` of `file` with extra arguments, parsed.
 fn stats_json(d: &Path, file: &str, extra: &[&str]) -> serde_json::Value {
     let out = asperity(&[&["stats", file, "--json"], extra].concat(), d);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -415,7 +394,7 @@ fn stats_fit_range_follows_the_sidecar_spectrum() {
     let generate = |extra: &[&str], out: &str| {
         let base = ["surface", "--n", "512", "--hurst", "0.8", "--seed", "4"];
         let o = asperity(&[&base[..], extra, &["--out", out]].concat(), d);
-        assert!(o.status.success(), "{}", stderr(&o));
+        ok(&o);
     };
     let slope_ok = |v: &serde_json::Value| {
         let slope = v["psd_slope"].as_f64().unwrap();
@@ -531,7 +510,7 @@ fn an_existing_sidecar_or_png_alone_is_not_overwritten() {
     );
     // With --force all three are written.
     let out = asperity(&[&base[..], &["--png", "a.png", "--force"]].concat(), d);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(std::fs::read_dir(d).unwrap().count(), 3);
     assert_ne!(
         std::fs::read(d.join("a.png")).unwrap(),
@@ -563,14 +542,14 @@ fn stats_plots_the_psd_with_its_fit() {
         &["stats", "s.npy", "--psd", "psd.csv", "--plot", "s.png"],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert!(String::from_utf8_lossy(&out.stdout).contains("psd_slope: "));
     let decoder = png::Decoder::new(std::fs::File::open(d.join("s.png")).unwrap());
     let reader = decoder.read_info().unwrap();
     assert!(reader.info().width > 0 && reader.info().height > 0);
     assert!(d.join("psd.csv").exists());
     let out = asperity(&["stats", "l.npy", "--json", "--plot", "l.svg"], d);
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let slope = value["psd_slope"].as_f64().unwrap();
     let svg = std::fs::read_to_string(d.join("l.svg")).unwrap();
@@ -610,7 +589,7 @@ fn stats_refuses_bad_plots_before_any_work() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_ne!(std::fs::read(d.join("old.png")).unwrap(), b"keep me");
     assert_eq!(std::fs::read_dir(d).unwrap().count(), 3);
     // A flat surface has no power to show on log axes: one line, nothing written.
@@ -653,10 +632,10 @@ fn stats_psd_columns_state_their_units() {
         ),
     ] {
         let out = asperity(&[make, &["--out", file]].concat(), d);
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         let csv = format!("{file}.csv");
         let out = asperity(&["stats", file, "--psd", &csv], d);
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
         let text = std::fs::read_to_string(d.join(&csv)).unwrap();
         let mut lines = text.lines();
         // The contract's q,psd first; q_l_2pi appended.
@@ -689,7 +668,7 @@ fn stats_fit_range_is_clamped_and_an_empty_default_is_no_error() {
     let make = |extra: &[&str], out: &str| {
         let base = ["surface", "--n", "128", "--hurst", "0.8", "--seed", "5"];
         let o = asperity(&[&base[..], extra, &["--out", out]].concat(), d);
-        assert!(o.status.success(), "{}", stderr(&o));
+        ok(&o);
     };
     make(&["--rolloff", "6"], "s.npy");
     // --fit-to beyond Nyquist (64) is clamped, and said so.
@@ -741,7 +720,7 @@ fn stats_fit_range_is_clamped_and_an_empty_default_is_no_error() {
         assert!(v["fit_note"].as_str().unwrap().contains(cause), "{v}");
         // Outputs are still written (the PSD, its plot without a fit).
         let out = asperity(&["stats", file, "--psd", &format!("{file}.csv")], d);
-        assert!(out.status.success(), "{}", stderr(&out));
+        ok(&out);
     }
     // A given --fit-from beyond Nyquist is an error naming it.
     let out = asperity(&["stats", "s.npy", "--fit-from", "100"], d);

@@ -1,16 +1,8 @@
 //! `asperity surface` / `line` inputs that only make sense on some grids or scales:
 //! refused with one line, exit 2, nothing written.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::{asperity, ok};
 
 #[test]
 fn grid_and_scale_limits_are_refused_with_nothing_written() {
@@ -86,9 +78,5 @@ fn grid_and_scale_limits_are_refused_with_nothing_written() {
         ],
         d,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
 }

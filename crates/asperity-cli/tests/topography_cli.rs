@@ -3,22 +3,13 @@
 //! line and exit status 2, and leave nothing behind.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use ndarray::{ArrayD, Ix2};
 use ndarray_npy::ReadNpyExt;
 
-fn asperity(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{asperity, names, ok, refused, stderr};
 
 /// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it; a git
 /// worktree elsewhere sets `ASPERITY_TOPOGRAPHIES`), or `None` with a printed notice.
@@ -50,17 +41,12 @@ fn json(path: &Path) -> serde_json::Value {
 /// Refused: status 2, one line on stderr containing `needle`, no files left in `dir`
 /// besides `keep`.
 fn assert_refused(out: &Output, dir: &Path, keep: &[&str], needle: &str) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
-    assert!(err.contains(needle), "{needle:?} in {err}");
-    let mut left: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let err = refused(out, needle);
+    let left: Vec<String> = names(dir)
+        .into_iter()
         .filter(|n| !keep.contains(&n.as_str()))
         .collect();
-    left.sort();
-    assert!(left.is_empty(), "left behind: {left:?}");
+    assert!(left.is_empty(), "left behind: {left:?} after: {err}");
 }
 
 #[test]
@@ -120,7 +106,7 @@ fn stats_of_a_measured_file_prints_iso_parameters() {
     let dir = tempfile::tempdir().unwrap();
     let file = shared.join("x3p-2.x3p");
     let out = asperity(&["stats", file.to_str().unwrap(), "--json"], dir.path());
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let record = json(&shared.join("x3p-2.x3p.reference.json"));
     // Sq is the rms height about the mean: the reference's rms height.
@@ -139,7 +125,7 @@ fn stats_of_a_measured_file_prints_iso_parameters() {
         &["stats", file.to_str().unwrap(), "--detrend", "mean"],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     for p in ["Rq: ", "Ra: ", "Rz: ", "Rsk: ", "Rku: ", "Rdq: "] {
         assert!(text.contains(p), "{p} in {text}");
@@ -222,7 +208,7 @@ fn bad_files_give_one_line_and_exit_2() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert!(json(&d.join("s.npy.json"))["cleaning"][1]
         .as_str()
         .unwrap()
@@ -277,7 +263,7 @@ fn mdr_takes_a_measured_profile() {
         ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let text = std::fs::read_to_string(dir.path().join("m.csv")).unwrap();
     assert_eq!(text.lines().count(), 6);
 }
@@ -337,7 +323,7 @@ fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let csv = std::fs::read_to_string(d.join("c.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -391,7 +377,7 @@ fn x3p_written_by_import_reads_back_bit_exact() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let out = asperity(
         &[
             "import",
@@ -405,12 +391,12 @@ fn x3p_written_by_import_reads_back_bit_exact() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let out = asperity(
         &["import", "s.x3p", "--out", "back.npy", "--detrend", "none"],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     let (a, b) = (npy(&d.join("s.npy")), npy(&d.join("back.npy")));
     assert_eq!(a.shape(), b.shape());
     assert!(a
@@ -433,6 +419,6 @@ fn x3p_written_by_import_reads_back_bit_exact() {
         ],
         d,
     );
-    assert!(out.status.success(), "{}", stderr(&out));
+    ok(&out);
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 3);
 }

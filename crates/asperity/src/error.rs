@@ -25,8 +25,9 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
-    /// A file exists where an output should go and overwriting was not allowed.
-    #[error("{0}: output already exists (use --force to overwrite)")]
+    /// A file exists where an output should go and overwriting was not allowed (the
+    /// `force` argument of the writers).
+    #[error("{0}: output already exists (allow overwriting to replace it)")]
     OutputExists(PathBuf),
     /// An output path cannot be written: its folder is missing, it is a folder, it is
     /// named twice among one command's outputs, or it is the command's input.
@@ -86,11 +87,22 @@ pub enum Error {
         limited_by: String,
     },
     /// A study folder already holds the checkpoint of a different study.
-    #[error("{dir}: holds the checkpoint of another study ({reason}); use another --out, or --force to discard it")]
+    #[error("{dir}: holds the checkpoint of another study ({reason}); use another folder, or discard it (force)")]
     ForeignCheckpoint {
         /// The study folder.
         dir: PathBuf,
         /// What differs.
+        reason: String,
+    },
+    /// A study file or checkpoint in a study folder is damaged or from an older version: the
+    /// study goes on once it is repaired or removed, or once the folder's checkpoints are
+    /// discarded (`force`).
+    #[error("{path}: {reason}, or discard the folder's checkpoints (force)")]
+    DamagedStudy {
+        /// The study file or checkpoint.
+        path: PathBuf,
+        /// What is wrong and how to repair it (e.g. `corrupt checkpoint (...); delete it to
+        /// recompute its task`).
         reason: String,
     },
     /// Another process holds the lock of an output folder ([`crate::lock::FolderLock`]).
@@ -157,6 +169,29 @@ fn out_of_memory_message(
 
 /// `Result` with the library's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// Whether `value` is a positive, finite number (NaN is not): the check behind every
+/// length, modulus, load and tolerance of the library.
+pub(crate) fn is_positive_finite(value: f64) -> bool {
+    value.is_finite() && value > 0.0
+}
+
+/// `value` if it is positive and finite, else [`Error::InvalidParameter`] naming `name`:
+/// "`{what} `must be positive and finite, got {value}" (`what` may be empty).
+pub(crate) fn positive_finite(name: &'static str, value: f64, what: &str) -> Result<f64> {
+    if is_positive_finite(value) {
+        return Ok(value);
+    }
+    let what = if what.is_empty() {
+        String::new()
+    } else {
+        format!("{what} ")
+    };
+    Err(Error::invalid(
+        name,
+        format!("{what}must be positive and finite, got {value}"),
+    ))
+}
 
 /// Checks that every value is finite; the error names `what` and the first bad index.
 pub fn ensure_finite<'a>(what: &str, values: impl IntoIterator<Item = &'a f64>) -> Result<()> {

@@ -2,7 +2,9 @@
 //!
 //! Used for the PSD slope of [`crate::surface::stats`] and for the exponent α of
 //! `k ∝ F^α` (paper eq. 3). The fit is ordinary least squares of `ln y` on `ln x`; the
-//! interval is `p ± t(0.975, n−2) · se(p)` from the residuals (Student t).
+//! interval is `p ± t(0.975, n−2) · se(p)` from the residuals (Student t). The levels a
+//! power law is sampled at (loads, forces, indentations) are spaced evenly in log
+//! ([`log_levels`]), so that every decade weighs alike in the fit.
 
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +25,22 @@ pub struct PowerLawFit {
     pub high: f64,
     /// Number of points used.
     pub points: usize,
+}
+
+/// `count` values spaced evenly in log from `lo` to `hi`, both ends included exactly (the
+/// inner values clamped into `[lo, hi]`); `lo` alone for `count == 1`. The one log spacing
+/// of the crate: `0 < lo ≤ hi`, both finite, is the caller's to check.
+pub fn log_levels(lo: f64, hi: f64, count: usize) -> impl Iterator<Item = f64> {
+    let step = (hi / lo).ln() / (count.max(2) - 1) as f64;
+    (0..count).map(move |i| {
+        if i == 0 {
+            lo
+        } else if i + 1 == count {
+            hi
+        } else {
+            (lo.ln() + step * i as f64).exp().clamp(lo, hi)
+        }
+    })
 }
 
 /// Two-sided 97.5 % quantile of Student's t with `dof` degrees of freedom.
@@ -149,6 +167,23 @@ mod tests {
         assert!(x[last] / x[first] >= 10.0 - 1e-9);
         // No window spans a factor 1e5.
         assert!(steepest_power_law(&x, &y, 1e5).is_none());
+    }
+
+    #[test]
+    fn log_levels_have_exact_ends_and_one_ratio() {
+        for (lo, hi, count) in [(1e-6, 3.0, 64), (0.05 / 65536.0, 0.2, 24), (2.0, 2.0, 5)] {
+            let levels: Vec<f64> = log_levels(lo, hi, count).collect();
+            assert_eq!(levels.len(), count);
+            assert_eq!((levels[0], levels[count - 1]), (lo, hi));
+            // Every step is the same ratio (hi/lo)^(1/(count-1)), to rounding.
+            let ratio = (hi / lo).powf(1.0 / (count - 1) as f64);
+            for pair in levels.windows(2) {
+                assert!((pair[1] / pair[0] / ratio - 1.0).abs() < 1e-12, "{pair:?}");
+            }
+        }
+        assert_eq!(log_levels(0.5, 8.0, 1).collect::<Vec<_>>(), [0.5]);
+        assert_eq!(log_levels(0.5, 8.0, 2).collect::<Vec<_>>(), [0.5, 8.0]);
+        assert_eq!(log_levels(0.5, 8.0, 0).count(), 0);
     }
 
     #[test]

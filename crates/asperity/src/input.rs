@@ -102,7 +102,7 @@ pub fn read_sidecar(array: &Path) -> Result<Option<serde_json::Value>> {
         return Err(bad_input(&path, "is a corrupt sidecar (not a JSON object)"));
     }
     let size = &value["spec"]["size"];
-    if !size.is_null() && !size.as_f64().is_some_and(|s| s.is_finite() && s > 0.0) {
+    if !size.is_null() && !size.as_f64().is_some_and(crate::is_positive_finite) {
         return Err(bad_input(
             &path,
             format!(

@@ -100,6 +100,7 @@ pub mod surface;
 pub mod topography;
 
 pub use error::{ensure_finite, Error, Result};
+pub(crate) use error::{is_positive_finite, positive_finite};
 
 #[cfg(test)]
 pub(crate) mod test_support {

@@ -64,7 +64,7 @@ impl Psd {
             LongWavelength::RollOff { q0 } | LongWavelength::CutOff { q0 } => Some(q0),
         };
         if let Some(q0) = q0 {
-            if !(q0.is_finite() && q0 > 0.0) {
+            if !crate::is_positive_finite(q0) {
                 return Err(Error::invalid(
                     "q0",
                     format!("roll-off / cut-off must be a positive number of wavelengths per side, got {q0}"),
@@ -72,16 +72,16 @@ impl Psd {
             }
         }
         if let Some(q1) = short_cutoff {
-            if !(q1.is_finite() && q1 > 0.0) {
+            if !crate::is_positive_finite(q1) {
                 return Err(Error::invalid(
-                    "short-cutoff",
+                    "short_cutoff",
                     format!("must be a positive number of wavelengths per side, got {q1}"),
                 ));
             }
             if let Some(q0) = q0 {
                 if q1 <= q0 {
                     return Err(Error::invalid(
-                        "short-cutoff",
+                        "short_cutoff",
                         format!("q1 = {q1} must be above the long-wavelength q0 = {q0}"),
                     ));
                 }

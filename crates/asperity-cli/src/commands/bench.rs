@@ -218,9 +218,7 @@ fn fft_pair_times(n: usize, boundary: Boundary, repeat: usize) -> Result<Vec<f64
 fn study_pressures(n: usize) -> Vec<f64> {
     const LOADS: usize = 24;
     let (lo, hi) = (0.05 / (n * n) as f64, 0.2f64);
-    (0..LOADS)
-        .map(|i| (lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (LOADS - 1) as f64).exp())
-        .collect()
+    asperity::fit::log_levels(lo, hi, LOADS).collect()
 }
 
 /// The study's surface of size `n` and Hurst exponent `hurst` (unit rms slope, L = 1).
@@ -448,39 +446,6 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn extrapolation_is_the_power_law_through_the_probes() {
-        let probes = (64, 128);
-        // Doubling per doubling of N: exponent 1.
-        assert_eq!(extrapolate((10.0, 20.0), probes, 64), 10.0);
-        assert!((extrapolate((10.0, 20.0), probes, 128) - 20.0).abs() < 1e-12);
-        assert!((extrapolate((10.0, 20.0), probes, 1024) - 160.0).abs() < 1e-9);
-        // ×1.45 per doubling (Polonsky–Keer's growth): 1.45³ from 128 to 1024.
-        let grown = extrapolate((100.0, 145.0), probes, 1024);
-        assert!((grown - 145.0 * 1.45f64.powi(3)).abs() < 1e-9, "{grown}");
-        // Fewer iterations at the larger probe: held flat, never extrapolated down.
-        assert_eq!(extrapolate((30.0, 20.0), probes, 1024), 20.0);
-    }
-
-    #[test]
-    fn study_pressures_span_the_samplers_range() {
-        for n in [16, 256, 1024] {
-            let p = study_pressures(n);
-            assert_eq!(p.len(), 24);
-            assert!((p[0] / (0.05 / (n * n) as f64) - 1.0).abs() < 1e-12);
-            assert!((p[23] / 0.2 - 1.0).abs() < 1e-12);
-            let ratio = p[1] / p[0];
-            assert!(p
-                .windows(2)
-                .all(|w| (w[1] / w[0] / ratio - 1.0).abs() < 1e-9));
-        }
-    }
-}
-
 /// `asperity bench bem-solve`: one line per boundary, mean pressure and solver,
 /// `kernel n threads boundary solver mean_pressure iterations operator_applications
 /// area_fraction indentation solve_min_s solve_median_s fft_pair_s iteration_fft_pairs`.
@@ -546,4 +511,37 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extrapolation_is_the_power_law_through_the_probes() {
+        let probes = (64, 128);
+        // Doubling per doubling of N: exponent 1.
+        assert_eq!(extrapolate((10.0, 20.0), probes, 64), 10.0);
+        assert!((extrapolate((10.0, 20.0), probes, 128) - 20.0).abs() < 1e-12);
+        assert!((extrapolate((10.0, 20.0), probes, 1024) - 160.0).abs() < 1e-9);
+        // ×1.45 per doubling (Polonsky–Keer's growth): 1.45³ from 128 to 1024.
+        let grown = extrapolate((100.0, 145.0), probes, 1024);
+        assert!((grown - 145.0 * 1.45f64.powi(3)).abs() < 1e-9, "{grown}");
+        // Fewer iterations at the larger probe: held flat, never extrapolated down.
+        assert_eq!(extrapolate((30.0, 20.0), probes, 1024), 20.0);
+    }
+
+    #[test]
+    fn study_pressures_span_the_samplers_range() {
+        for n in [16, 256, 1024] {
+            let p = study_pressures(n);
+            assert_eq!(p.len(), 24);
+            assert!((p[0] / (0.05 / (n * n) as f64) - 1.0).abs() < 1e-12);
+            assert!((p[23] / 0.2 - 1.0).abs() < 1e-12);
+            let ratio = p[1] / p[0];
+            assert!(p
+                .windows(2)
+                .all(|w| (w[1] / w[0] / ratio - 1.0).abs() < 1e-9));
+        }
+    }
 }

@@ -278,6 +278,13 @@ struct Inputs {
     record: Option<serde_json::Value>,
 }
 
+impl Inputs {
+    /// The PSD ring `κ = round(q·L/2π)` of wavenumber `q`.
+    fn ring(&self, q: f64) -> f64 {
+        (q * self.size / std::f64::consts::TAU).round()
+    }
+}
+
 /// A `.npy` array, its side length from --size, the sidecar, else 1.
 fn npy_inputs(args: &StatsArgs, hints: &SidecarHints, size_x: Option<f64>) -> Result<Inputs> {
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
@@ -409,12 +416,46 @@ fn capitalised(name: &str) -> String {
         .unwrap_or_default()
 }
 
-/// Runs `asperity stats`.
+/// Runs `asperity stats`: the arguments and outputs are checked, the file read, the PSD
+/// fitted, the outputs written together, then the statistics printed.
 pub fn run(args: &StatsArgs) -> Result<()> {
     let size_x = match &args.size {
         Some(text) => parse_size(text)?[0],
         None => None,
     };
+    check_fit_bounds(args)?;
+    // The outputs are checked before the (possibly large) input is read.
+    if let Some(plot) = &args.plot {
+        ImageFormat::from_path(plot, "--plot")?;
+    }
+    let mut staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
+    staged.ensure_not_input(&args.file)?;
+    let measured = !is_npy(&args.file) || has_import_sidecar(&args.file);
+    // A measured file's sidecar (if any) is its import record, not a generator's spec.
+    let (hints, inputs) = if measured {
+        (SidecarHints::default(), measured_inputs(args)?)
+    } else {
+        let hints = sidecar_hints(&args.file)?;
+        let inputs = npy_inputs(args, &hints, size_x)?;
+        (hints, inputs)
+    };
+    ensure_finite_statistics(&args.file, &inputs.summary, &inputs.bins)?;
+    let nyquist = inputs.bins.last().map_or(0.0, |b| inputs.ring(b.q));
+    let plan = fit_range(args, &hints, nyquist)?;
+    let fit = psd_fit(&inputs, &plan);
+    stage_outputs(args, &mut staged, &inputs, &plan, fit)?;
+    staged.commit()?;
+    if args.json {
+        print_json(args, &inputs, &plan, fit)
+    } else {
+        print_text(args, &inputs, &plan, fit, nyquist);
+        Ok(())
+    }
+}
+
+/// Refuses a --fit-from or --fit-to that is no positive number, or a range they leave
+/// empty.
+fn check_fit_bounds(args: &StatsArgs) -> Result<()> {
     fit_bound("--fit-from", args.fit_from)?;
     fit_bound("--fit-to", args.fit_to)?;
     if let (Some(from), Some(to)) = (args.fit_from, args.fit_to) {
@@ -423,80 +464,118 @@ pub fn run(args: &StatsArgs) -> Result<()> {
             "invalid PSD fit range: --fit-from {from} must be below --fit-to {to}"
         );
     }
-    // The outputs are checked before the (possibly large) input is read.
-    if let Some(plot) = &args.plot {
-        ImageFormat::from_path(plot, "--plot")?;
-    }
-    let staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
-    staged.ensure_not_input(&args.file)?;
-    let measured = !is_npy(&args.file) || has_import_sidecar(&args.file);
-    // A measured file's sidecar (if any) is its import record, not a generator's spec.
-    let hints = if measured {
-        SidecarHints::default()
-    } else {
-        sidecar_hints(&args.file)?
-    };
-    let inputs = if measured {
-        measured_inputs(args)?
-    } else {
-        npy_inputs(args, &hints, size_x)?
-    };
-    let Inputs {
-        summary,
-        bins,
-        dims,
-        psd_offset,
-        size,
-        iso,
-        record,
-    } = inputs;
-    ensure_finite_statistics(&args.file, &summary, &bins)?;
-    let ring = |q: f64| (q * size / std::f64::consts::TAU).round();
-    let nyquist = bins.last().map_or(0.0, |b| ring(b.q));
-    let plan = fit_range(args, &hints, nyquist)?;
+    Ok(())
+}
+
+/// The PSD's power-law fit over the plan's rings and the Hurst exponent it gives.
+#[derive(Debug, Clone, Copy)]
+struct PsdFit {
+    fit: Option<PowerLawFit>,
+    hurst: Option<f64>,
+}
+
+fn psd_fit(inputs: &Inputs, plan: &FitPlan) -> PsdFit {
     let fit = plan.range.and_then(|(from, to)| {
-        let (q, c): (Vec<f64>, Vec<f64>) = bins
+        let (q, c): (Vec<f64>, Vec<f64>) = inputs
+            .bins
             .iter()
-            .filter(|b| (from..=to).contains(&ring(b.q)) && b.psd > 0.0)
+            .filter(|b| (from..=to).contains(&inputs.ring(b.q)) && b.psd > 0.0)
             .map(|b| (b.q, b.psd))
             .unzip();
         power_law_fit(&q, &c).ok()
     });
     // C2D ∝ q^(-2H-2), C1D ∝ q^(-2H-1): H = -(slope + offset)/2.
-    let hurst = fit.map(|f| -(f.exponent + psd_offset) / 2.0);
-    let mut staged = staged;
+    let hurst = fit.map(|f| -(f.exponent + inputs.psd_offset) / 2.0);
+    PsdFit { fit, hurst }
+}
+
+/// Stages the --psd table and the --plot chart (committed together by the caller).
+fn stage_outputs(
+    args: &StatsArgs,
+    staged: &mut StagedOutputs,
+    inputs: &Inputs,
+    plan: &FitPlan,
+    fit: PsdFit,
+) -> Result<()> {
+    let (bins, size) = (&inputs.bins, inputs.size);
     if let Some(path) = &args.psd {
         let mut table = Table::new(&["q", "psd", "q_l_2pi"]);
-        for b in &bins {
+        for b in bins {
             table.push_numbers(&[b.q, b.psd, b.q * size / std::f64::consts::TAU]);
         }
         table
-            .stage(&mut staged, path)
+            .stage(staged, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
         let range = plan.range.unwrap_or((0.0, 0.0));
-        let chart = psd_chart(&args.file, &bins, size, dims.len(), range, fit, hurst);
-        stage_charts(&mut staged, path, &[chart])
+        let dims = inputs.dims.len();
+        let chart = psd_chart(&args.file, bins, size, dims, range, fit.fit, fit.hurst);
+        stage_charts(staged, path, &[chart])
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    staged.commit()?;
-    if args.json {
-        let value = serde_json::json!({
-            "file": args.file, "shape": dims, "size": size, "stats": summary,
-            "psd_slope": fit.map(|f| f.exponent), "psd_slope_low": fit.map(|f| f.low),
-            "psd_slope_high": fit.map(|f| f.high), "fit_from": plan.range.map(|r| r.0),
-            "fit_to": plan.range.map(|r| r.1), "fit_note": plan.note, "hurst_estimate": hurst,
-            "iso": iso, "measured": record,
-        });
-        println!("{}", serde_json::to_string_pretty(&value)?);
-        return Ok(());
+    Ok(())
+}
+
+/// `--json`: everything in one JSON object.
+fn print_json(args: &StatsArgs, inputs: &Inputs, plan: &FitPlan, fit: PsdFit) -> Result<()> {
+    let (f, hurst) = (fit.fit, fit.hurst);
+    let value = serde_json::json!({
+        "file": args.file, "shape": inputs.dims, "size": inputs.size, "stats": inputs.summary,
+        "psd_slope": f.map(|f| f.exponent), "psd_slope_low": f.map(|f| f.low),
+        "psd_slope_high": f.map(|f| f.high), "fit_from": plan.range.map(|r| r.0),
+        "fit_to": plan.range.map(|r| r.1), "fit_note": plan.note, "hurst_estimate": hurst,
+        "iso": inputs.iso, "measured": inputs.record,
+    });
+    println!("{}", serde_json::to_string_pretty(&value)?);
+    Ok(())
+}
+
+/// The statistics as `name: value` lines.
+fn print_text(args: &StatsArgs, inputs: &Inputs, plan: &FitPlan, fit: PsdFit, nyquist: f64) {
+    print_file_line(&args.file, inputs);
+    let summary = &inputs.summary;
+    println!("rms_height: {}", format_number(summary.rms_height));
+    println!("rms_slope: {}", format_number(summary.rms_slope));
+    match summary.rms_curvature {
+        Some(c) => println!("rms_curvature: {}", format_number(c)),
+        None => println!("rms_curvature: n/a (grid too small or rectangular pixels)"),
     }
-    let shape: Vec<String> = dims.iter().map(|d| d.to_string()).collect();
-    match &record {
+    print_iso(&inputs.iso);
+    match (fit.fit, plan.range) {
+        (Some(f), Some((from, to))) => {
+            let end = match &plan.note {
+                Some(_) => format!(
+                    "{to} (Nyquist; --fit-to {} clamped to it)",
+                    args.fit_to.unwrap_or(to)
+                ),
+                None if to >= nyquist => format!("{to} (Nyquist)"),
+                None => to.to_string(),
+            };
+            println!(
+                "psd_slope: {:.4} (95% interval {:.4} .. {:.4}; fit over q·L/2π in [{from}, {end}], {} bins)",
+                f.exponent, f.low, f.high, f.points
+            );
+            println!("hurst_estimate: {:.4}", fit.hurst.unwrap_or(f64::NAN));
+        }
+        (_, None) => println!(
+            "psd_slope: n/a ({})",
+            plan.note.as_deref().unwrap_or("no PSD fit range")
+        ),
+        (None, Some((from, to))) => println!(
+            "psd_slope: n/a (fewer than 2 bins with power in the fit range [{from}, {to}], {})",
+            plan.origin
+        ),
+    }
+}
+
+/// The `file:` line: shape and size, or a measured file's format, channel and cleaning.
+fn print_file_line(file: &Path, inputs: &Inputs) {
+    let shape: Vec<String> = inputs.dims.iter().map(|d| d.to_string()).collect();
+    match &inputs.record {
         Some(r) => println!(
             "file: {} ({}, {}, channel {}, sizes {} m; cleaning: {})",
-            args.file.display(),
+            file.display(),
             r["format"].as_str().unwrap_or("?"),
             shape.join(" x "),
             r["channel"],
@@ -511,42 +590,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
             }
         ),
         None => println!(
-            "file: {} ({}, size {size})",
-            args.file.display(),
-            shape.join(" x ")
+            "file: {} ({}, size {})",
+            file.display(),
+            shape.join(" x "),
+            inputs.size
         ),
     }
-    println!("rms_height: {}", format_number(summary.rms_height));
-    println!("rms_slope: {}", format_number(summary.rms_slope));
-    match summary.rms_curvature {
-        Some(c) => println!("rms_curvature: {}", format_number(c)),
-        None => println!("rms_curvature: n/a (grid too small or rectangular pixels)"),
-    }
-    print_iso(&iso);
-    match (fit, plan.range) {
-        (Some(f), Some((from, to))) => {
-            let end = match &plan.note {
-                Some(_) => format!(
-                    "{to} (Nyquist; --fit-to {} clamped to it)",
-                    args.fit_to.unwrap_or(to)
-                ),
-                None if to >= nyquist => format!("{to} (Nyquist)"),
-                None => to.to_string(),
-            };
-            println!(
-                "psd_slope: {:.4} (95% interval {:.4} .. {:.4}; fit over q·L/2π in [{from}, {end}], {} bins)",
-                f.exponent, f.low, f.high, f.points
-            );
-            println!("hurst_estimate: {:.4}", hurst.unwrap_or(f64::NAN));
-        }
-        (_, None) => println!(
-            "psd_slope: n/a ({})",
-            plan.note.as_deref().unwrap_or("no PSD fit range")
-        ),
-        (None, Some((from, to))) => println!(
-            "psd_slope: n/a (fewer than 2 bins with power in the fit range [{from}, {to}], {})",
-            plan.origin
-        ),
-    }
-    Ok(())
 }

@@ -360,7 +360,7 @@ impl ContactSolver {
                 sw += si * wi;
             }
         }
-        if !(sw > 0.0 && sw.is_finite()) {
+        if !crate::is_positive_finite(sw) {
             // K is positive on every direction but the constant one of a periodic grid,
             // which the free set excludes short of full contact: rounding only.
             return Err(SolveError::NoConvergence {

@@ -179,7 +179,7 @@ impl SolverParams {
     /// it before any work.
     pub fn validate(&self) -> crate::Result<()> {
         let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
+            if crate::is_positive_finite(v) {
                 Ok(())
             } else {
                 Err(crate::Error::invalid(

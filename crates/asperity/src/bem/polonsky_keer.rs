@@ -614,11 +614,7 @@ fn update_pressure(
 }
 
 fn check_load(name: &'static str, value: f64) -> Result<f64, SolveError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(Error::invalid(name, format!("must be positive and finite, got {value}")).into())
-    }
+    Ok(crate::positive_finite(name, value, "")?)
 }
 
 fn validate_params(params: &SolverParams) -> Result<(), SolveError> {

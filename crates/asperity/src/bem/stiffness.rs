@@ -498,9 +498,41 @@ mod tests {
             SolverParams::default(),
         )
         .unwrap();
-        assert!(solver.frozen_set_stiffness().is_err());
-        assert!(solver
-            .finite_difference_stiffness(Control::MeanPressure(0.01), 1.5)
-            .is_err());
+        // Refused for the missing state (not for some other reason) ...
+        match solver.frozen_set_stiffness() {
+            Err(SolveError::Input(Error::InvalidParameter { name, reason })) => {
+                assert_eq!(name, "stiffness");
+                assert!(reason.contains("no solved contact state"), "{reason}");
+            }
+            other => panic!("expected the missing state to be named, got {other:?}"),
+        }
+        // ... and answered once a state is solved.
+        solver.solve(Control::MeanPressure(0.01)).unwrap();
+        let (stiffness, _) = solver.frozen_set_stiffness().unwrap();
+        assert!(stiffness > 0.0, "{stiffness}");
+    }
+
+    #[test]
+    fn finite_difference_step_must_lie_in_zero_one() {
+        let surface = rough(16, 13);
+        let mut solver = ContactSolver::new(
+            &surface,
+            half_space(Boundary::Free),
+            SolverParams::default(),
+        )
+        .unwrap();
+        for step in [0.0, 1.0, 1.5, -0.1, f64::NAN] {
+            match solver.finite_difference_stiffness(Control::MeanPressure(0.01), step) {
+                Err(SolveError::Input(Error::InvalidParameter { name, .. })) => {
+                    assert_eq!(name, "relative step", "{step}");
+                }
+                other => panic!("step {step}: expected a refused step, got {other:?}"),
+            }
+        }
+        // No solved state is needed: the two solves are its own.
+        let k = solver
+            .finite_difference_stiffness(Control::MeanPressure(0.01), 0.01)
+            .unwrap();
+        assert!(k.is_finite() && k > 0.0, "{k}");
     }
 }

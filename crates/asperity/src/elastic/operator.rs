@@ -97,14 +97,7 @@ pub struct ElasticOperator {
 }
 
 fn check_positive(name: &'static str, value: f64) -> Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            name,
-            format!("must be positive and finite, got {value}"),
-        ))
-    }
+    crate::positive_finite(name, value, "").map(drop)
 }
 
 impl ElasticOperator {

@@ -121,7 +121,7 @@ impl Foundation {
         self.gaps
             .iter()
             .copied()
-            .find(|&g| g > 0.0 && g.is_finite())
+            .find(|&g| crate::is_positive_finite(g))
     }
 
     /// Force, stiffness and contacts at indentation `d` (exact; `d ≤ 0` gives zeros).
@@ -162,20 +162,11 @@ pub fn log_spaced(low: f64, high: f64, count: usize) -> Result<Vec<f64>> {
     }
     if count < 2 {
         return Err(Error::invalid(
-            "nloads",
+            "count",
             format!("need at least 2 levels, got {count}"),
         ));
     }
-    let ratio = (high / low).ln() / (count - 1) as f64;
-    Ok((0..count)
-        .map(|i| {
-            if i + 1 == count {
-                high
-            } else {
-                low * (ratio * i as f64).exp()
-            }
-        })
-        .collect())
+    Ok(crate::fit::log_levels(low, high, count).collect())
 }
 
 #[cfg(test)]

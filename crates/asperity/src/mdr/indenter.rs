@@ -106,7 +106,7 @@ impl Axisymmetric {
             } => &[("coefficient", *coefficient), ("exponent", *exponent)],
         };
         for &(name, value) in checks {
-            if !(value.is_finite() && value > 0.0) {
+            if !crate::is_positive_finite(value) {
                 return Err(Error::invalid(
                     name,
                     format!("must be positive and finite, got {value}"),
@@ -158,7 +158,7 @@ fn check_grid(n: usize, spacing: f64) -> Result<()> {
     if n == 0 {
         return Err(Error::invalid("n", "need at least one spring"));
     }
-    if !(spacing.is_finite() && spacing > 0.0) {
+    if !crate::is_positive_finite(spacing) {
         return Err(Error::invalid(
             "dx",
             format!("the spring spacing Δx must be positive and finite, got {spacing}"),
@@ -199,9 +199,9 @@ impl RadialProfile {
             ));
         }
         crate::ensure_finite("radial profile", values)?;
-        if !(step.is_finite() && step > 0.0) {
+        if !crate::is_positive_finite(step) {
             return Err(Error::invalid(
-                "radial-step",
+                "radial_step",
                 format!("the radial sample step must be positive and finite, got {step}"),
             ));
         }

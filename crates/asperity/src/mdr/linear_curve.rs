@@ -105,7 +105,7 @@ impl LinearCurve {
             ("dx", spacing, "the spring spacing Δx"),
             ("modulus", modulus, "the effective modulus E*"),
         ] {
-            if !(value.is_finite() && value > 0.0) {
+            if !crate::is_positive_finite(value) {
                 return Err(Error::invalid(
                     name,
                     format!("{what} must be positive and finite, got {value}"),

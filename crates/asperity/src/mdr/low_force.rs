@@ -32,7 +32,7 @@
 use serde::Serialize;
 
 use super::linear_curve::LinearCurve;
-use crate::fit::{power_law_fit, student_t_975, PowerLawFit};
+use crate::fit::{log_levels, power_law_fit, student_t_975, PowerLawFit};
 use crate::{Error, Result};
 
 /// The window spans at least this factor in contact counts (`j_hi ≥ 4·j_lo`).
@@ -66,13 +66,13 @@ impl LowForceWindow {
     pub fn new(first_contacts: usize, max_contact_fraction: f64, levels: usize) -> Result<Self> {
         if first_contacts < 2 {
             return Err(Error::invalid(
-                "first-contacts",
+                "first_contacts",
                 format!("the window must start at 2 or more contacts, got {first_contacts}"),
             ));
         }
         if !(max_contact_fraction > 0.0 && max_contact_fraction < 1.0) {
             return Err(Error::invalid(
-                "contact-fraction",
+                "max_contact_fraction",
                 format!("must lie in (0, 1), got {max_contact_fraction}"),
             ));
         }
@@ -119,12 +119,6 @@ pub struct LowForceSample {
     pub fit: PowerLawFit,
 }
 
-/// `count` levels spaced evenly in log between `low` and `high`.
-fn log_levels(low: f64, high: f64, count: usize) -> impl Iterator<Item = f64> {
-    let step = (high / low).ln() / (count - 1) as f64;
-    (0..count).map(move |i| low * (step * i as f64).exp())
-}
-
 /// Stiffness `k̃ = #{j : F̃_j ≤ F̃}/N` at normalised force `F̃`, from the normalised
 /// breakpoint forces `F̃_j` of a line of `points` springs.
 fn normalised_stiffness(normalised_forces: &[f64], points: usize, force: f64) -> f64 {
@@ -141,9 +135,9 @@ pub fn low_force_sample(
 ) -> Result<LowForceSample> {
     let n = curve.len();
     let (low, high) = window.contact_range(n)?;
-    if !(rms_height.is_finite() && rms_height > 0.0) {
+    if !crate::is_positive_finite(rms_height) {
         return Err(Error::invalid(
-            "rms-height",
+            "rms_height",
             format!("the line's rms height must be positive and finite, got {rms_height}"),
         ));
     }

@@ -75,17 +75,6 @@ impl SpringLaw {
     }
 }
 
-fn positive_finite(name: &'static str, value: f64, what: &str) -> Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            name,
-            format!("{what} must be positive and finite, got {value}"),
-        ))
-    }
-}
-
 /// A validated spring: law, spacing `Δx` and modulus `E*`, with precomputed constants.
 ///
 /// Every law has the form `f(u) = E*·P·u^p` for `0 < u < u⁽⁰⁾` and `f(u) = E*·(C + Δx·u)`
@@ -107,12 +96,12 @@ impl Spring {
     /// constants. Errors name the offending parameter (`dx`, `modulus`, `radius`, `hurst`,
     /// `rms-height`, `size`).
     pub fn new(law: SpringLaw, spacing: f64, modulus: f64) -> Result<Self> {
-        positive_finite("dx", spacing, "the spring spacing Δx")?;
-        positive_finite("modulus", modulus, "the effective modulus E*")?;
+        crate::positive_finite("dx", spacing, "the spring spacing Δx")?;
+        crate::positive_finite("modulus", modulus, "the effective modulus E*")?;
         let (critical_depth, prefactor, exponent, offset) = match law {
             SpringLaw::Linear => (0.0, 0.0, 1.0, 0.0),
             SpringLaw::Hertz { radius } => {
-                positive_finite("radius", radius, "the asperity radius R")?;
+                crate::positive_finite("radius", radius, "the asperity radius R")?;
                 // (15.2): u0 = Δx²/R, P = 4/3 R^½, p = 3/2, C = Δx³/(3R).
                 (
                     spacing * spacing / radius,
@@ -126,7 +115,7 @@ impl Spring {
                 rms_height,
                 size,
             } => {
-                if !(hurst.is_finite() && hurst > 0.0 && hurst < 2.0) {
+                if !(crate::is_positive_finite(hurst) && hurst < 2.0) {
                     return Err(Error::invalid(
                         "hurst",
                         format!(
@@ -135,8 +124,8 @@ impl Spring {
                         ),
                     ));
                 }
-                positive_finite("rms-height", rms_height, "the rms height h")?;
-                positive_finite("size", size, "the line length L")?;
+                crate::positive_finite("rms_height", rms_height, "the rms height h")?;
+                crate::positive_finite("size", size, "the line length L")?;
                 let h1 = hurst + 1.0;
                 let exponent = h1 / hurst;
                 // (15.3): P = h^(-1/H) L (1.9412 H/(H+1)²)^((H+1)/H).

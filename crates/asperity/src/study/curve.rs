@@ -22,7 +22,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::fit::{power_law_fit, student_t_975, PowerLawFit};
+use crate::fit::{log_levels, power_law_fit, student_t_975, PowerLawFit};
 use crate::{Error, Result};
 
 /// One point of a force–stiffness curve.
@@ -155,18 +155,6 @@ impl SampleCurve {
             .unzip();
         (f.len() >= 3).then(|| power_law_fit(&f, &k).ok()).flatten()
     }
-}
-
-/// `count` forces evenly spaced in log from `lo` to `hi` (ends included exactly).
-fn log_levels(lo: f64, hi: f64, count: usize) -> impl Iterator<Item = f64> {
-    let step = (hi / lo).ln() / (count.max(2) - 1) as f64;
-    (0..count).map(move |i| {
-        if i + 1 == count {
-            hi
-        } else {
-            (lo.ln() + step * i as f64).exp().clamp(lo, hi)
-        }
-    })
 }
 
 /// One common force level of an ensemble: mean stiffness with its 95 % confidence

@@ -131,7 +131,7 @@ impl StudySpec {
             return Err(Error::invalid("samples", "need at least 1 sample"));
         }
         if let Some(q0) = self.rolloff {
-            if !(q0.is_finite() && q0 > 0.0) {
+            if !crate::is_positive_finite(q0) {
                 return Err(Error::invalid(
                     "rolloff",
                     format!("must be positive, got {q0}"),
@@ -510,12 +510,9 @@ impl StudyDir {
                 dir: dir.to_path_buf(),
                 reason: format!("its study.json has other parameters: {differences}"),
             }),
-            Stored::Corrupt(why) => Err(Error::Metadata {
+            Stored::Corrupt(why) => Err(Error::DamagedStudy {
                 path: dir.join("study.json"),
-                reason: format!(
-                    "corrupt study file ({why}); restore it, or use --force to discard the \
-                     folder's checkpoints"
-                ),
+                reason: format!("corrupt study file ({why}); restore it"),
             }),
         }
     }
@@ -617,12 +614,9 @@ impl StudyDir {
         )?;
         let text = crate::input::read_text(&path, CHECKPOINT_MAX_BYTES)?;
         let wanted = TaskIdentity::of(&self.spec, task);
-        let refuse = |what: String| Error::Metadata {
+        let refuse = |what: String| Error::DamagedStudy {
             path: path.clone(),
-            reason: format!(
-                "{what}; delete it to recompute its task, or use --force to discard the \
-                 folder's checkpoints"
-            ),
+            reason: format!("{what}; delete it to recompute its task"),
         };
         match identity::unseal::<Checkpoint>(text.as_bytes(), &wanted) {
             Ok(checkpoint) => Ok(Some(checkpoint)),
@@ -1012,10 +1006,10 @@ mod tests {
         let err = run_task(&spec(4), task, &Synthetic, &store, &|_, _| {}).unwrap_err();
         let text = err.to_string();
         assert!(
-            text.contains("older asperity") && text.contains("--force"),
+            matches!(err, Error::DamagedStudy { .. }) && text.contains("older asperity"),
             "{text}"
         );
-        // --force (discard) clears it.
+        // Discarding (force) clears it.
         let mut other = spec(4);
         other.seed = 9;
         StudyDir::open(dir.path(), &other, true).unwrap();

@@ -251,9 +251,7 @@ impl BemSampler {
             Normalisation::RmsSlope(SURFACE_RMS_SLOPE),
         )?;
         let (lo, hi) = (0.05 / (task.n * task.n) as f64, 0.2f64);
-        let mean_pressures = (0..Self::LOADS)
-            .map(|i| (lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (Self::LOADS - 1) as f64).exp())
-            .collect();
+        let mean_pressures = crate::fit::log_levels(lo, hi, Self::LOADS).collect();
         Ok(BemSampler {
             surface,
             mean_pressures,

@@ -228,7 +228,7 @@ fn scale_to(heights: &mut [f64], realised: f64, target: Normalisation) -> Result
     let want = match target {
         Normalisation::RmsHeight(v) | Normalisation::RmsSlope(v) => v,
     };
-    if !(realised.is_finite() && realised > 0.0) {
+    if !crate::is_positive_finite(realised) {
         return Err(Error::invalid(
             "spectrum",
             "no power on this grid (is the cut-off above the grid's Nyquist wavenumber?)",
@@ -719,7 +719,7 @@ mod tests {
             .unwrap()
             .try_generate(1)
             .unwrap_err();
-        assert!(err.to_string().contains("rms-height"), "{err}");
+        assert!(err.to_string().contains("rms_height"), "{err}");
         let spec = LineSpec::new(64, 1.0, psd, huge).unwrap();
         assert!(LineGenerator::new(&spec).unwrap().try_generate(1).is_err());
         let fine = SurfaceSpec::new(16, 16, 1.0, psd, Normalisation::RmsHeight(1e100)).unwrap();
@@ -752,7 +752,7 @@ mod tests {
         assert!(LineSpec::new(16, 1.0, just_below, height).is_ok());
         let no_modes = Psd::new(0.5, LongWavelength::None, Some(0.5)).unwrap();
         let err = SurfaceSpec::new(16, 16, 1.0, no_modes, height).unwrap_err();
-        assert!(err.to_string().contains("short-cutoff"), "{err}");
+        assert!(err.to_string().contains("short_cutoff"), "{err}");
         assert!(LineSpec::new(16, 1.0, no_modes, height).is_err());
     }
 }

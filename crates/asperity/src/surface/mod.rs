@@ -37,38 +37,24 @@ impl Default for Normalisation {
 }
 
 impl Normalisation {
-    /// The flag that sets it and the requested value.
+    /// The parameter that sets it and the requested value.
     pub(crate) fn name_and_value(&self) -> (&'static str, f64) {
         match *self {
-            Normalisation::RmsHeight(v) => ("rms-height", v),
-            Normalisation::RmsSlope(v) => ("rms-slope", v),
+            Normalisation::RmsHeight(v) => ("rms_height", v),
+            Normalisation::RmsSlope(v) => ("rms_slope", v),
         }
     }
 
     /// Checks that the target is positive and finite.
     pub fn validate(&self) -> Result<()> {
         let (name, value) = self.name_and_value();
-        if value.is_finite() && value > 0.0 {
-            Ok(())
-        } else {
-            Err(Error::invalid(
-                name,
-                format!("must be positive and finite, got {value}"),
-            ))
-        }
+        crate::positive_finite(name, value, "").map(drop)
     }
 }
 
 /// Checks a physical side length.
 pub(crate) fn validate_size(size: f64) -> Result<()> {
-    if size.is_finite() && size > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            "size",
-            format!("side length must be positive and finite, got {size}"),
-        ))
-    }
+    crate::positive_finite("size", size, "side length").map(drop)
 }
 
 /// Checks that the spectrum's wavenumbers fit the grid: a roll-off or cut-off `q0` must lie
@@ -93,7 +79,7 @@ pub(crate) fn validate_spectrum_on_grid(psd: &crate::spectrum::Psd, nyquist: f64
     }
     if let Some(q1) = psd.short_cutoff().filter(|&q1| q1 < 1.0) {
         return Err(Error::invalid(
-            "short-cutoff",
+            "short_cutoff",
             format!("q1 = {q1} removes every mode: the longest wavelength is the side (q1 ≥ 1)"),
         ));
     }

@@ -262,7 +262,7 @@ fn add_column_rings(
 ) {
     let rows = column.len();
     let kappa_max = sums.len() - 1;
-    let weight = if kx == 0 || (cols % 2 == 0 && kx == cols / 2) {
+    let weight = if kx == 0 || (cols.is_multiple_of(2) && kx == cols / 2) {
         1
     } else {
         2

@@ -76,7 +76,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     let invalid = number("InvalidPixelValue").unwrap_or(f64::NAN);
     let (dx, dy) = (number("PixelSizeXMeter")?, number("PixelSizeYMeter")?);
     for (key, d) in [("PixelSizeXMeter", dx), ("PixelSizeYMeter", dy)] {
-        if !(d.is_finite() && d > 0.0) {
+        if !crate::is_positive_finite(d) {
             return Err(bad(FORMAT, format!("{key} is {d}")));
         }
     }

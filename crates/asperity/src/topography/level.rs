@@ -76,8 +76,10 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
         b.swap(k, p);
         for i in k + 1..m {
             let f = a[i][k] / a[k][k];
-            for j in k..m {
-                a[i][j] -= f * a[k][j];
+            // Row k lies above row i (k < i): split so both rows can be borrowed at once.
+            let (above, below) = a.split_at_mut(i);
+            for (x, pivot) in below[0][k..m].iter_mut().zip(&above[k][k..m]) {
+                *x -= f * pivot;
             }
             b[i] -= f * b[k];
         }

@@ -149,13 +149,13 @@ pub(crate) fn unit_to_metres(unit: &str) -> Option<f64> {
 /// The one spelling used in provenance records for a unit [`unit_to_metres`] knows.
 pub(crate) fn canonical_unit(unit: &str) -> String {
     match unit_to_metres(unit) {
-        Some(f) if f == 1.0 => "m".into(),
-        Some(f) if f == 1e-2 => "cm".into(),
-        Some(f) if f == 1e-3 => "mm".into(),
-        Some(f) if f == 1e-6 => "µm".into(),
-        Some(f) if f == 1e-9 => "nm".into(),
-        Some(f) if f == 1e-10 => "Å".into(),
-        Some(f) if f == 1e-12 => "pm".into(),
+        Some(1.0) => "m".into(),
+        Some(1e-2) => "cm".into(),
+        Some(1e-3) => "mm".into(),
+        Some(1e-6) => "µm".into(),
+        Some(1e-9) => "nm".into(),
+        Some(1e-10) => "Å".into(),
+        Some(1e-12) => "pm".into(),
         _ => unit.trim().to_string(),
     }
 }
@@ -642,7 +642,7 @@ fn sizes_for(
     given: Option<[Option<f64>; 2]>,
     profile: bool,
 ) -> std::result::Result<(Vec<f64>, &'static str), String> {
-    let valid = |v: f64| v.is_finite() && v > 0.0;
+    let valid = |v: f64| crate::is_positive_finite(v);
     let shape = channel.heights.shape();
     let (sizes, source) = match given {
         Some([Some(x), y]) => {

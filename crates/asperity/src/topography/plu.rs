@@ -66,7 +66,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     c.seek(388 + 16)?;
     let (um_x, um_y) = (f64::from(c.f32(LE)?), f64::from(c.f32(LE)?));
     for (axis, d) in [("x", um_x), ("y", um_y)] {
-        if !(d.is_finite() && d > 0.0) {
+        if !crate::is_positive_finite(d) {
             return Err(bad(FORMAT, format!("pixel size along {axis} is {d} µm")));
         }
     }

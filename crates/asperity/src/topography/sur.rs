@@ -165,7 +165,7 @@ fn object(bytes: &[u8], start: usize, first: bool) -> Result<(Channel, usize, us
         let what = ["the x step", "the y step"][axis];
         let step = f64::from(h.steps[axis]) * metres_per(FORMAT, what, &h.units[axis])?;
         let s = step * [h.nx, h.ny][axis] as f64;
-        if !(s.is_finite() && s > 0.0) {
+        if !crate::is_positive_finite(s) {
             return Err(bad(FORMAT, format!("{what} gives a size of {s} m")));
         }
         size[axis] = Some(s);

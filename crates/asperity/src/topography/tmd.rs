@@ -48,7 +48,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     c.skip(8)?; // offsets of the map's origin, not needed for the heights
     let n = grid_points(FORMAT, nx.into(), ny.into())?;
     for (axis, l) in [("x", length_x), ("y", length_y)] {
-        if !(l.is_finite() && l > 0.0) {
+        if !crate::is_positive_finite(l) {
             return Err(bad(FORMAT, format!("length along {axis} is {l}")));
         }
     }

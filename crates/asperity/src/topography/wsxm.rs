@@ -151,7 +151,7 @@ fn amount(h: &Header, section: &str, key: &str) -> Result<(f64, String)> {
     let v = get(h, section, key).ok_or_else(|| bad(FORMAT, format!("`{key}` is missing")))?;
     let (number, unit) = v.split_once(' ').unwrap_or((v, ""));
     match number.trim().parse::<f64>() {
-        Ok(x) if x.is_finite() && x > 0.0 => Ok((x, unit.trim().to_string())),
+        Ok(x) if crate::is_positive_finite(x) => Ok((x, unit.trim().to_string())),
         _ => Err(bad(
             FORMAT,
             format!("`{key}` is `{v}`, not a positive amount"),
