@@ -8,7 +8,7 @@
 //! the CLI's numbers bit for bit. They are reimplemented here rather than moved into the
 //! library: the CLI's versions are interleaved with its output staging and messages.
 
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
@@ -74,14 +74,15 @@ fn log_pressures(nloads: usize, pmin: f64, pmax: f64) -> PyResult<Vec<f64>> {
         .collect())
 }
 
-/// The solver choice. `SolverParams` has no field for it yet: Polonsky–Keer is the only
-/// solver, and both names select it. When the library adds one, "default" maps onto its
-/// default and "pk" onto Polonsky–Keer.
-fn check_solver_name(name: &str) -> PyResult<()> {
+/// The solver choice as the library's [`SolverKind`]: `"bccg"` (the library's default) or
+/// `"pk"` (Polonsky–Keer), the CLI's `--solver` names; `"default"` is kept as an alias of
+/// the library's default (the name the first release of the package documented).
+fn solver_kind(name: &str) -> PyResult<SolverKind> {
     match name {
-        "default" | "pk" => Ok(()),
+        "bccg" | "default" => Ok(SolverKind::Bccg),
+        "pk" => Ok(SolverKind::PolonskyKeer),
         other => Err(invalid(format!(
-            "invalid solver: expected \"default\" or \"pk\" (Polonsky–Keer), got {other:?}"
+            "invalid solver: expected \"bccg\" (the default) or \"pk\" (Polonsky–Keer), got {other:?}"
         ))),
     }
 }
@@ -237,7 +238,7 @@ impl Solver {
         max_iterations: usize,
         solver: &str,
     ) -> PyResult<Self> {
-        check_solver_name(solver)?;
+        let solver = solver_kind(solver)?;
         let boundary: Boundary = boundary.parse().map_err(from_error)?;
         if !(modulus.is_finite() && modulus > 0.0) {
             return Err(invalid(format!(
@@ -257,6 +258,7 @@ impl Solver {
             )));
         }
         let params = SolverParams {
+            solver,
             tolerance,
             max_iterations,
             ..SolverParams::default()
@@ -331,6 +333,12 @@ impl Solver {
     #[getter]
     fn max_iterations(&self) -> usize {
         self.solver.params().max_iterations
+    }
+
+    /// `"bccg"` or `"pk"`.
+    #[getter]
+    fn solver(&self) -> &'static str {
+        self.solver.params().solver.name()
     }
 
     /// Forgets the last solution (the next solve starts cold).
