@@ -22,8 +22,9 @@ side L = 1 by default; arrays row-major ``(row, col) = (y, x)`` with square pixe
 ``L / cols``; wavenumbers as wavelengths per side ``q L / 2π``; heights positive up,
 pressure ≥ 0, gap ≥ 0; forces in ``E* · length²``.
 
-Long computations release the GIL (other Python threads run meanwhile) and stop on Ctrl-C
-between loads of a sweep or samples of a study (a single solve runs to its end).
+Long computations release the GIL (other Python threads run meanwhile) and stop on Ctrl-C:
+a solve, stiffness or sweep within a second (the solver checks every iteration), a study
+after the samples in flight.
 Errors: ``ValueError`` for bad input (the CLI's one-line message), ``MemoryError`` when a
 grid would not fit in memory, :class:`ConvergenceError` and
 :class:`BeyondFullContactError` from the solver.
@@ -569,7 +570,8 @@ class Solver:
         ``stiffness``: frozen-set stiffness per load; ``fd_stiffness``: also ``dF/dd``
         from two more solves at the load × (1 ± fd_step); ``fields``: keep pressure and
         gap of every load. ``progress``: a callable ``progress(done, total)``, or True for
-        a tqdm bar. Ctrl-C stops the sweep between loads (``KeyboardInterrupt``).
+        a tqdm bar. Ctrl-C stops the sweep within a second, inside a load's solve too
+        (``KeyboardInterrupt``).
 
         Example::
 

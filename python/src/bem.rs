@@ -18,7 +18,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::owned_2d;
 use crate::errors::{from_error, from_solve, invalid};
-use crate::interrupt::{run_detached, Cancel};
+use crate::interrupt::{run_detached, run_detached_with, Cancel};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Solver>()?;
@@ -349,8 +349,9 @@ impl Solver {
     /// `(mean_pressure, indentation)` of full contact (see the library's
     /// `full_contact_threshold`; on free boundaries it forgets the warm start).
     fn full_contact_threshold(&mut self, py: Python<'_>) -> PyResult<(f64, Option<f64>)> {
-        let solver = &mut self.solver;
-        let t = run_detached(py, |_| solver.full_contact_threshold())?.map_err(from_solve)?;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let t = run_detached_with(py, &stop, |_| solver.full_contact_threshold())?
+            .map_err(from_solve)?;
         Ok((t.mean_pressure, t.indentation))
     }
 
@@ -364,11 +365,11 @@ impl Solver {
         fields: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let control = control(quantity, value)?;
-        let solver = &mut self.solver;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         // No up-front full-contact check here (the CLI's is for sweeps): the library's
         // solve refuses such a load itself, with the same threshold, and a single solve
         // then costs exactly what the library's does.
-        let (summary, info, state) = run_detached(py, |_| {
+        let (summary, info, state) = run_detached_with(py, &stop, |_| {
             let (summary, info) = solver
                 .solve(control)
                 .map_err(|e| Stop::Solve(e, String::new()))?;
@@ -394,8 +395,9 @@ impl Solver {
 
     /// Frozen-set stiffness of the last solve: `(k, iterations, residual)`.
     fn stiffness(&mut self, py: Python<'_>) -> PyResult<(f64, usize, f64)> {
-        let solver = &mut self.solver;
-        let (k, info) = run_detached(py, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let (k, info) =
+            run_detached_with(py, &stop, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
         Ok((k, info.iterations, info.residual))
     }
 
@@ -408,8 +410,11 @@ impl Solver {
         step: f64,
     ) -> PyResult<f64> {
         let control = control(quantity, value)?;
-        let solver = &mut self.solver;
-        run_detached(py, |_| solver.finite_difference_stiffness(control, step))?.map_err(from_solve)
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        run_detached_with(py, &stop, |_| {
+            solver.finite_difference_stiffness(control, step)
+        })?
+        .map_err(from_solve)
     }
 
     /// A load sweep as `asperity bem` runs it (module docs); returns the columns.
@@ -429,8 +434,8 @@ impl Solver {
             .iter()
             .map(|&v| control(quantity, v))
             .collect::<PyResult<Vec<_>>>()?;
-        let solver = &mut self.solver;
-        let columns = run_detached(py, |cancel| {
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let columns = run_detached_with(py, &stop, |cancel| {
             sweep_loads(
                 solver,
                 &loads,

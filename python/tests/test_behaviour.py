@@ -300,6 +300,41 @@ print("finished")
     assert elapsed < 3.0, f"took {elapsed:.2f} s to stop"
 
 
+def test_ctrl_c_stops_a_single_long_solve_within_a_second(tmp_path):
+    """SIGINT during one solve (Polonsky–Keer, 512², a tolerance it never reaches: without
+    the stop it would run for hours) raises KeyboardInterrupt within a second: the library
+    solver polls the stop flag once per iteration. The solver stays usable: its next
+    computation is not stopped by the old request and equals a fresh solver's."""
+    script = """
+import sys, time, asperity, numpy as np
+s = asperity.surface(512, hurst=0.8, rolloff=4, rms_slope=1.0, seed=3)
+solver = asperity.Solver(s, solver="pk", tolerance=1e-300, max_iterations=10**9)
+print("running", flush=True)
+try:
+    solver.solve(pressure=0.01)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+    after = solver.full_contact_threshold()
+    fresh = asperity.Solver(s, solver="pk").full_contact_threshold()
+    print("usable" if after == fresh else f"differs {after} {fresh}", flush=True)
+    sys.exit(130)
+print("finished")
+"""
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    assert process.stdout.readline().strip() == "running", process.stderr.read()
+    time.sleep(1.0)  # well inside the solve
+    start = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    line = process.stdout.readline().strip()
+    elapsed = time.monotonic() - start
+    code = process.wait(timeout=120)
+    assert line == "KeyboardInterrupt", (line, process.stderr.read())
+    assert process.stdout.read().strip() == "usable" and code == 130
+    print(f"solve stopped {elapsed:.3f} s after SIGINT")
+    assert elapsed < 1.0, f"took {elapsed:.2f} s to stop"
+
+
 def test_progress_callbacks_and_their_exceptions(rough):
     seen = []
     asperity.Solver(rough).sweep(pressures=[0.001, 0.01], progress=lambda d, t: seen.append((d, t)))

@@ -25,6 +25,7 @@ use super::polonsky_keer::ContactSolver;
 use super::preconditioner::FourierPreconditioner;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
+use crate::stop::Stop;
 use crate::Error;
 
 /// Right-hand side of a CG on a set.
@@ -94,6 +95,7 @@ fn conjugate_gradient_on_set(
     work: &mut StiffnessWork,
     tolerance: f64,
     max_iterations: usize,
+    stop: &Stop,
 ) -> Result<SolveInfo, SolveError> {
     let StiffnessWork {
         x,
@@ -119,6 +121,9 @@ fn conjugate_gradient_on_set(
     direction.copy_from_slice(z);
     let mut iterations = 0;
     loop {
+        if stop.is_requested() {
+            return Err(SolveError::Interrupted { iterations });
+        }
         let relative = if b_norm > 0.0 {
             rr.sqrt() / b_norm
         } else {
@@ -211,6 +216,7 @@ impl ContactSolver {
             &mut work,
             tolerance,
             max_iterations,
+            &self.stop,
         );
         let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
@@ -264,6 +270,7 @@ impl ContactSolver {
             &mut work,
             tolerance,
             max_iterations,
+            &self.stop,
         )
         .and_then(|_| {
             std::mem::swap(&mut work.x, &mut work.profile_pressure);
@@ -275,6 +282,7 @@ impl ContactSolver {
                 &mut work,
                 tolerance,
                 max_iterations,
+                &self.stop,
             )
         })
         .map(|_| {
