@@ -452,7 +452,7 @@ class Solver:
     ``surface``: a 2D array of heights (rows × cols = y × x, positive up; any real dtype
     that converts to float64 without loss, any memory order), an :class:`asperity.Surface`,
     or any object with SurfaceTopography's ``heights()`` and ``physical_sizes`` (its
-    ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels must be square).
+    ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels may be rectangular).
     ``size``: side L along x (default: the object's, else 1). ``modulus`` E*;
     ``boundary`` ``"free"`` (zero-padded, the paper's) or ``"periodic"``; ``tolerance``
     (rms gap violation on the contact set over the rms height) and ``max_iterations``;

@@ -199,9 +199,10 @@ def test_a_topography_like_object_is_transposed_to_rows_y(rough):
     reference = asperity.Solver(rough.heights, 2.0).solve(pressure=0.01)
     r = asperity.Solver(FakeTopography(rough.heights.T, (2.0, 2.0))).solve(pressure=0.01)
     assert r.force == reference.force and np.array_equal(r.pressure, reference.pressure)
-    rect = FakeTopography(np.zeros((8, 4)), (1.0, 1.0))  # 8 x 4 points on a square: Δx ≠ Δy
-    with pytest.raises(ValueError, match="square pixels"):
-        asperity.Solver(rect)
+    # 8 x 4 points on a 1 x 2 rectangle: Δx = 1/8, Δy = 1/2 (the BEM takes rectangular
+    # pixels): 4 rows (y) of 8 columns (x), nominal area sx·sy.
+    rect = asperity.Solver(FakeTopography(np.zeros((8, 4)), (1.0, 2.0)))
+    assert rect.shape == (4, 8) and rect.nominal_area == 2.0 and rect.size == 1.0
 
 
 # ---------------------------------------------------------------- GIL and Ctrl-C

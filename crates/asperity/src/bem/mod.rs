@@ -48,6 +48,7 @@ mod periodic_indentation;
 mod polonsky_keer;
 mod preconditioner;
 mod stiffness;
+pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
 pub use polonsky_keer::ContactSolver;
