@@ -8,9 +8,9 @@ command line, so the same seed gives the same numbers bit for bit):
   slope), returned as numpy arrays with their metadata;
 * :func:`stats`, :func:`psd` -- rms height, slope, curvature and the (radially averaged)
   power spectrum with an optional power-law fit;
-* :class:`Solver` -- the boundary-element contact solver (Polonsky & Keer on FFTs, free or
-  periodic boundaries), reusable across loads, with frozen-set and finite-difference
-  stiffness and load sweeps;
+* :class:`Solver` -- the boundary-element contact solver (bound-constrained conjugate
+  gradients or Polonsky & Keer, on FFTs; free or periodic boundaries), reusable across
+  loads, with frozen-set and finite-difference stiffness and load sweeps;
 * :func:`mdr` -- the method of dimensionality reduction: rough lines and axisymmetric
   indenters on linear, Hertz (15.2) or fractal (15.7) spring foundations;
 * :func:`study_alpha`, :func:`study_curve` -- checkpointed ensemble studies of the exponent
@@ -22,8 +22,9 @@ side L = 1 by default; arrays row-major ``(row, col) = (y, x)`` with square pixe
 ``L / cols``; wavenumbers as wavelengths per side ``q L / 2π``; heights positive up,
 pressure ≥ 0, gap ≥ 0; forces in ``E* · length²``.
 
-Long computations release the GIL (other Python threads run meanwhile) and stop on Ctrl-C
-between loads of a sweep or samples of a study (a single solve runs to its end).
+Long computations release the GIL (other Python threads run meanwhile) and stop on Ctrl-C:
+a solve, stiffness or sweep within a second (the solver checks every iteration), a study
+after the samples in flight.
 Errors: ``ValueError`` for bad input (the CLI's one-line message), ``MemoryError`` when a
 grid would not fit in memory, :class:`ConvergenceError` and
 :class:`BeyondFullContactError` from the solver.
@@ -451,13 +452,14 @@ class Solver:
     ``surface``: a 2D array of heights (rows × cols = y × x, positive up; any real dtype
     that converts to float64 without loss, any memory order), an :class:`asperity.Surface`,
     or any object with SurfaceTopography's ``heights()`` and ``physical_sizes`` (its
-    ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels must be square).
+    ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels may be rectangular).
     ``size``: side L along x (default: the object's, else 1). ``modulus`` E*;
     ``boundary`` ``"free"`` (zero-padded, the paper's) or ``"periodic"``; ``tolerance``
     (rms gap violation on the contact set over the rms height) and ``max_iterations``;
-    ``solver``: ``"default"`` or ``"pk"`` (Polonsky–Keer). Today both select
-    Polonsky–Keer, the only solver of the library; ``"default"`` will follow the library's
-    default when another solver is added.
+    ``solver``: ``"bccg"`` (the default: Fourier-preconditioned bound-constrained conjugate
+    gradients, tens of iterations) or ``"pk"`` (Polonsky & Keer 1999, the reference), as
+    ``asperity bem --solver``; ``"default"`` is an alias of ``"bccg"``. Both converge to
+    the same contact to ``tolerance``.
 
     The solver plans its FFTs once and keeps its buffers: each solve starts from the last
     pressure (warm start), so a rising load sweep is cheap.
@@ -482,7 +484,7 @@ class Solver:
         boundary: str = "free",
         tolerance: float = 1e-8,
         max_iterations: int = 10_000,
-        solver: str = "default",
+        solver: str = "bccg",
     ):
         heights, size_x, size_y = _surface_input(surface, size)
         if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
@@ -500,6 +502,7 @@ class Solver:
     boundary = property(lambda self: self._core.boundary, doc="'free' or 'periodic'")
     tolerance = property(lambda self: self._core.tolerance)
     max_iterations = property(lambda self: self._core.max_iterations)
+    solver = property(lambda self: self._core.solver, doc="'bccg' or 'pk'")
     nominal_area = property(lambda self: self._core.nominal_area, doc="rows·cols·Δ²")
 
     def solve(
@@ -567,7 +570,8 @@ class Solver:
         ``stiffness``: frozen-set stiffness per load; ``fd_stiffness``: also ``dF/dd``
         from two more solves at the load × (1 ± fd_step); ``fields``: keep pressure and
         gap of every load. ``progress``: a callable ``progress(done, total)``, or True for
-        a tqdm bar. Ctrl-C stops the sweep between loads (``KeyboardInterrupt``).
+        a tqdm bar. Ctrl-C stops the sweep within a second, inside a load's solve too
+        (``KeyboardInterrupt``).
 
         Example::
 
@@ -595,7 +599,10 @@ class Solver:
 
     def __repr__(self) -> str:
         rows, cols = self.shape
-        return f"Solver({rows}x{cols}, size={self.size}, modulus={self.modulus}, boundary={self.boundary!r})"
+        return (
+            f"Solver({rows}x{cols}, size={self.size}, modulus={self.modulus}, "
+            f"boundary={self.boundary!r}, solver={self.solver!r})"
+        )
 
 
 def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, float, Optional[float]]:

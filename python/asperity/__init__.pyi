@@ -113,6 +113,7 @@ class Solver:
     boundary: str
     tolerance: float
     max_iterations: int
+    solver: str
     nominal_area: float
     def __init__(
         self, surface: Any, size: Optional[float] = ..., *, modulus: float = ...,

@@ -1,14 +1,16 @@
 //! The BEM contact solver (`asperity bem`): one planned [`ContactSolver`] per Python
 //! `Solver`, reused across loads (warm starts) as the CLI does.
 //!
-//! [`check_full_contact`] and the sweep loop in [`Solver::sweep`] follow
-//! `crates/asperity-cli/src/commands/bem.rs` step for step (the full-contact check of
-//! every load kind before any solve, then per load: solve, frozen-set stiffness, fields,
-//! finite-difference stiffness and the re-solve for the next warm start), so a sweep gives
-//! the CLI's numbers bit for bit. They are reimplemented here rather than moved into the
-//! library: the CLI's versions are interleaved with its output staging and messages.
+//! A sweep is the library's [`asperity::bem::sweep::sweep`], the loop `asperity bem` runs
+//! too (the full-contact check of every load kind before any solve, then per load: solve,
+//! frozen-set stiffness, fields, finite-difference stiffness and the re-solve for the next
+//! warm start), so a sweep gives the CLI's numbers bit for bit. The solver polls the stop
+//! flag that Ctrl-C sets ([`crate::interrupt`]), so one long solve stops too.
 
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
+use asperity::bem::sweep::{
+    describe, sweep, SweepError, SweepObserver, SweepParams, SweepRow, SweepStep,
+};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::Surface;
@@ -18,7 +20,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::owned_2d;
 use crate::errors::{from_error, from_solve, invalid};
-use crate::interrupt::{run_detached, Cancel};
+use crate::interrupt::{run_detached, run_detached_with, Cancel};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Solver>()?;
@@ -74,14 +76,15 @@ fn log_pressures(nloads: usize, pmin: f64, pmax: f64) -> PyResult<Vec<f64>> {
         .collect())
 }
 
-/// The solver choice. `SolverParams` has no field for it yet: Polonsky–Keer is the only
-/// solver, and both names select it. When the library adds one, "default" maps onto its
-/// default and "pk" onto Polonsky–Keer.
-fn check_solver_name(name: &str) -> PyResult<()> {
+/// The solver choice as the library's [`SolverKind`]: `"bccg"` (the library's default) or
+/// `"pk"` (Polonsky–Keer), the CLI's `--solver` names; `"default"` is kept as an alias of
+/// the library's default (the name the first release of the package documented).
+fn solver_kind(name: &str) -> PyResult<SolverKind> {
     match name {
-        "default" | "pk" => Ok(()),
+        "bccg" | "default" => Ok(SolverKind::Bccg),
+        "pk" => Ok(SolverKind::PolonskyKeer),
         other => Err(invalid(format!(
-            "invalid solver: expected \"default\" or \"pk\" (Polonsky–Keer), got {other:?}"
+            "invalid solver: expected \"bccg\" (the default) or \"pk\" (Polonsky–Keer), got {other:?}"
         ))),
     }
 }
@@ -98,11 +101,6 @@ fn control(quantity: &str, value: f64) -> PyResult<Control> {
     }
 }
 
-/// A load as messages name it: `load 3 (mean pressure 0.01)` (the CLI's wording).
-fn describe(k: usize, control: Control) -> String {
-    format!("load {k} ({} {})", control.quantity(), control.value())
-}
-
 /// `error` with `context: ` in front (a `SolveError` keeps its type and attributes).
 fn with_context(error: SolveError, context: &str) -> PyErr {
     let err = from_solve(error);
@@ -114,102 +112,66 @@ fn with_context(error: SolveError, context: &str) -> PyErr {
     err
 }
 
-/// Why a sweep stopped: a solver error with its context, or the cancel flag.
-enum Stop {
-    Solve(SolveError, String),
-    Message(String),
-    Cancelled,
-}
+/// Why a sweep stopped: the cancel flag (Ctrl-C or an exception of the progress
+/// callback, raised by `run_detached` instead of this).
+struct Cancelled;
 
-impl Stop {
-    fn into_py(self) -> PyErr {
-        match self {
-            Stop::Solve(e, context) if context.is_empty() => from_solve(e),
-            Stop::Solve(e, context) => with_context(e, &context),
-            Stop::Message(m) => invalid(m),
-            // The exception that cancelled is raised by `run_detached`.
-            Stop::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted"),
-        }
-    }
-}
-
-/// The CLI's up-front check: the largest load of each kind (and, with a finite-difference
-/// step, its upper step) must lie below full contact. The threshold itself is computed
-/// only where the cheap lower bound does not clear the loads.
-fn check_full_contact(
-    solver: &mut ContactSolver,
-    loads: &[Control],
-    fd_step: Option<f64>,
-) -> Result<(), Stop> {
-    let area = solver.nominal_area();
-    let same_kind =
-        |a: &Control, b: &Control| std::mem::discriminant(a) == std::mem::discriminant(b);
-    let mut kinds: Vec<Control> = Vec::new();
-    for c in loads {
-        if !kinds.iter().any(|k| same_kind(k, c)) {
-            kinds.push(*c);
-        }
-    }
-    let context = describe;
-    for kind in kinds {
-        let Some((k, &largest)) = loads
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| same_kind(c, &kind))
-            .max_by(|a, b| a.1.value().total_cmp(&b.1.value()))
-        else {
-            continue;
-        };
-        let top = largest.value() * (1.0 + fd_step.unwrap_or(0.0));
-        let bound = solver
-            .full_contact_lower_bound()
-            .map_err(|e| Stop::Solve(e, context(k, largest)))?;
-        match bound.in_units_of(largest, area) {
-            Some(b) if top < b => continue,
-            None => continue,
-            Some(_) => {}
-        }
-        let threshold = solver
-            .full_contact_threshold()
-            .map_err(|e| Stop::Solve(e, context(k, largest)))?;
-        let Some(full) = threshold.in_units_of(largest, area) else {
-            continue;
-        };
-        if largest.value() >= full {
-            let error = SolveError::BeyondFullContact {
-                requested: largest,
-                full_contact: Some(full),
+/// A sweep's error as a Python exception, with the load in the CLI's words.
+fn sweep_error(error: SweepError<Cancelled>) -> PyErr {
+    match error {
+        SweepError::Input(e) => from_error(e),
+        SweepError::Solve {
+            load,
+            control,
+            step,
+            source,
+        } => {
+            let load = describe(load, control);
+            let context = match step {
+                SweepStep::FullContactCheck | SweepStep::Solve => load,
+                SweepStep::Stiffness => format!("stiffness at {load}"),
+                SweepStep::FiniteDifference => format!("fd_stiffness at {load}"),
             };
-            return Err(Stop::Solve(error, context(k, largest)));
+            with_context(source, &context)
         }
-        if top >= full {
-            return Err(Stop::Message(format!(
-                "fd_stiffness: at {} the upper finite-difference step ({} {:.6e}, the load × (1 + {})) is beyond full contact (the gap closes everywhere from {:.6e}); lower the load or drop fd_stiffness",
-                describe(k, largest),
-                largest.quantity(),
-                top,
-                fd_step.unwrap_or(0.0),
-                full
-            )));
+        e @ SweepError::StepBeyondFullContact { .. } => invalid(format!(
+            "fd_stiffness: {e}; lower the load or drop fd_stiffness"
+        )),
+        SweepError::Stopped(Cancelled) => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted")
         }
     }
-    Ok(())
 }
 
-/// Columns of a sweep, one value per load.
-#[derive(Default)]
-struct Columns {
-    force: Vec<f64>,
-    mean_pressure: Vec<f64>,
-    indentation: Vec<f64>,
-    area_fraction: Vec<f64>,
-    contact_points: Vec<u64>,
-    stiffness: Vec<f64>,
-    iterations: Vec<u64>,
-    residual: Vec<f64>,
-    stiffness_fd: Vec<f64>,
+/// A sweep's Python side: the fields of every load (when asked for) and the progress
+/// callback, which may cancel the sweep between loads.
+struct PyObserver<'a> {
+    fields: bool,
     pressures: Vec<ndarray::Array2<f64>>,
     gaps: Vec<ndarray::Array2<f64>>,
+    progress: Option<&'a Py<PyAny>>,
+    cancel: &'a Cancel,
+    total: usize,
+}
+
+impl SweepObserver for PyObserver<'_> {
+    type Error = Cancelled;
+
+    fn solved(&mut self, _load: usize, solver: &ContactSolver) -> Result<(), Cancelled> {
+        if self.fields {
+            self.pressures.push(solver.pressure().to_owned());
+            self.gaps.push(solver.gap().to_owned());
+        }
+        Ok(())
+    }
+
+    fn finished(&mut self, load: usize, _row: &SweepRow) -> Result<(), Cancelled> {
+        self.cancel.call(self.progress, load + 1, self.total);
+        if self.cancel.is_set() {
+            return Err(Cancelled);
+        }
+        Ok(())
+    }
 }
 
 /// A reusable BEM contact solver (the compiled core of `asperity.Solver`).
@@ -237,7 +199,7 @@ impl Solver {
         max_iterations: usize,
         solver: &str,
     ) -> PyResult<Self> {
-        check_solver_name(solver)?;
+        let solver = solver_kind(solver)?;
         let boundary: Boundary = boundary.parse().map_err(from_error)?;
         if !(modulus.is_finite() && modulus > 0.0) {
             return Err(invalid(format!(
@@ -257,6 +219,7 @@ impl Solver {
             )));
         }
         let params = SolverParams {
+            solver,
             tolerance,
             max_iterations,
             ..SolverParams::default()
@@ -333,6 +296,12 @@ impl Solver {
         self.solver.params().max_iterations
     }
 
+    /// `"bccg"` or `"pk"`.
+    #[getter]
+    fn solver(&self) -> &'static str {
+        self.solver.params().solver.name()
+    }
+
     /// Forgets the last solution (the next solve starts cold).
     fn reset(&mut self) {
         self.solver.reset();
@@ -341,8 +310,9 @@ impl Solver {
     /// `(mean_pressure, indentation)` of full contact (see the library's
     /// `full_contact_threshold`; on free boundaries it forgets the warm start).
     fn full_contact_threshold(&mut self, py: Python<'_>) -> PyResult<(f64, Option<f64>)> {
-        let solver = &mut self.solver;
-        let t = run_detached(py, |_| solver.full_contact_threshold())?.map_err(from_solve)?;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let t = run_detached_with(py, &stop, |_| solver.full_contact_threshold())?
+            .map_err(from_solve)?;
         Ok((t.mean_pressure, t.indentation))
     }
 
@@ -356,18 +326,16 @@ impl Solver {
         fields: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let control = control(quantity, value)?;
-        let solver = &mut self.solver;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         // No up-front full-contact check here (the CLI's is for sweeps): the library's
         // solve refuses such a load itself, with the same threshold, and a single solve
         // then costs exactly what the library's does.
-        let (summary, info, state) = run_detached(py, |_| {
-            let (summary, info) = solver
-                .solve(control)
-                .map_err(|e| Stop::Solve(e, String::new()))?;
+        let (summary, info, state) = run_detached_with(py, &stop, |_| {
+            let (summary, info) = solver.solve(control)?;
             let state = if fields { solver.state() } else { None };
-            Ok((summary, info, state))
+            Ok::<_, SolveError>((summary, info, state))
         })?
-        .map_err(Stop::into_py)?;
+        .map_err(from_solve)?;
         let dict = PyDict::new(py);
         dict.set_item("force", summary.force)?;
         dict.set_item("mean_pressure", summary.mean_pressure)?;
@@ -386,8 +354,9 @@ impl Solver {
 
     /// Frozen-set stiffness of the last solve: `(k, iterations, residual)`.
     fn stiffness(&mut self, py: Python<'_>) -> PyResult<(f64, usize, f64)> {
-        let solver = &mut self.solver;
-        let (k, info) = run_detached(py, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let (k, info) =
+            run_detached_with(py, &stop, |_| solver.frozen_set_stiffness())?.map_err(from_solve)?;
         Ok((k, info.iterations, info.residual))
     }
 
@@ -400,8 +369,11 @@ impl Solver {
         step: f64,
     ) -> PyResult<f64> {
         let control = control(quantity, value)?;
-        let solver = &mut self.solver;
-        run_detached(py, |_| solver.finite_difference_stiffness(control, step))?.map_err(from_solve)
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        run_detached_with(py, &stop, |_| {
+            solver.finite_difference_stiffness(control, step)
+        })?
+        .map_err(from_solve)
     }
 
     /// A load sweep as `asperity bem` runs it (module docs); returns the columns.
@@ -421,114 +393,62 @@ impl Solver {
             .iter()
             .map(|&v| control(quantity, v))
             .collect::<PyResult<Vec<_>>>()?;
-        let solver = &mut self.solver;
-        let columns = run_detached(py, |cancel| {
-            sweep_loads(
-                solver,
-                &loads,
-                stiffness,
-                fd_step,
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let params = SweepParams { stiffness, fd_step };
+        let (rows, observer) = run_detached_with(py, &stop, |cancel| {
+            let mut observer = PyObserver {
                 fields,
-                progress.as_ref(),
+                pressures: Vec::new(),
+                gaps: Vec::new(),
+                progress: progress.as_ref(),
                 cancel,
-            )
-        })?
-        .map_err(Stop::into_py)?;
-        columns_dict(py, columns, stiffness, fd_step.is_some(), fields)
-    }
-}
-
-/// The CLI's loop over loads (step 2 of `asperity bem`), stopping between loads when
-/// cancelled.
-fn sweep_loads(
-    solver: &mut ContactSolver,
-    loads: &[Control],
-    stiffness: bool,
-    fd_step: Option<f64>,
-    fields: bool,
-    progress: Option<&Py<PyAny>>,
-    cancel: &Cancel,
-) -> Result<Columns, Stop> {
-    check_full_contact(solver, loads, fd_step)?;
-    let mut c = Columns::default();
-    cancel.call(progress, 0, loads.len());
-    for (k, &control) in loads.iter().enumerate() {
-        if cancel.is_set() {
-            return Err(Stop::Cancelled);
-        }
-        let (summary, info) = solver
-            .solve(control)
-            .map_err(|e| Stop::Solve(e, describe(k, control)))?;
-        let k_frozen = if stiffness {
-            solver
-                .frozen_set_stiffness()
-                .map_err(|e| Stop::Solve(e, format!("stiffness at {}", describe(k, control))))?
-                .0
-        } else {
-            f64::NAN
-        };
-        if fields {
-            c.pressures.push(solver.pressure().to_owned());
-            c.gaps.push(solver.gap().to_owned());
-        }
-        if let Some(step) = fd_step {
-            let fd = if control.value() > 0.0 {
-                let context = format!("fd_stiffness at {}", describe(k, control));
-                let fd = solver
-                    .finite_difference_stiffness(control, step)
-                    .map_err(|e| Stop::Solve(e, context.clone()))?;
-                if k + 1 < loads.len() {
-                    solver.solve(control).map_err(|e| Stop::Solve(e, context))?;
-                }
-                fd
-            } else {
-                f64::NAN // no central difference at indentation 0
+                total: loads.len(),
             };
-            c.stiffness_fd.push(fd);
-        }
-        c.force.push(summary.force);
-        c.mean_pressure.push(summary.mean_pressure);
-        c.indentation.push(summary.indentation);
-        c.area_fraction.push(summary.area_fraction);
-        c.contact_points.push(summary.contact_points as u64);
-        c.stiffness.push(k_frozen);
-        c.iterations.push(info.iterations as u64);
-        c.residual.push(info.residual);
-        cancel.call(progress, k + 1, loads.len());
+            cancel.call(observer.progress, 0, loads.len());
+            let rows = sweep(solver, &loads, params, &mut observer);
+            rows.map(|rows| (rows, (observer.pressures, observer.gaps)))
+        })?
+        .map_err(sweep_error)?;
+        columns_dict(py, &rows, params, observer)
     }
-    Ok(c)
 }
 
-fn columns_dict(
-    py: Python<'_>,
-    c: Columns,
-    stiffness: bool,
-    fd: bool,
-    fields: bool,
-) -> PyResult<Bound<'_, PyDict>> {
+/// The sweep's columns (as the CLI's CSV, plus `contact_points`) as numpy arrays.
+fn columns_dict<'py>(
+    py: Python<'py>,
+    rows: &[SweepRow],
+    params: SweepParams,
+    (pressures, gaps): (Vec<ndarray::Array2<f64>>, Vec<ndarray::Array2<f64>>),
+) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
-    let column = |v: Vec<f64>| PyArray1::from_vec(py, v);
-    dict.set_item("force", column(c.force))?;
-    dict.set_item("mean_pressure", column(c.mean_pressure))?;
-    dict.set_item("indentation", column(c.indentation))?;
-    dict.set_item("area_fraction", column(c.area_fraction))?;
-    if stiffness {
-        dict.set_item("stiffness", column(c.stiffness))?;
+    let column = |f: &dyn Fn(&SweepRow) -> f64| PyArray1::from_iter(py, rows.iter().map(f));
+    let count =
+        |f: &dyn Fn(&SweepRow) -> usize| PyArray1::from_iter(py, rows.iter().map(|r| f(r) as u64));
+    dict.set_item("force", column(&|r| r.summary.force))?;
+    dict.set_item("mean_pressure", column(&|r| r.summary.mean_pressure))?;
+    dict.set_item("indentation", column(&|r| r.summary.indentation))?;
+    dict.set_item("area_fraction", column(&|r| r.summary.area_fraction))?;
+    if params.stiffness {
+        dict.set_item("stiffness", column(&|r| r.stiffness.unwrap_or(f64::NAN)))?;
     }
-    dict.set_item("iterations", PyArray1::from_vec(py, c.iterations))?;
-    dict.set_item("residual", column(c.residual))?;
-    if fd {
-        dict.set_item("stiffness_fd", column(c.stiffness_fd))?;
+    dict.set_item("iterations", count(&|r| r.info.iterations))?;
+    dict.set_item("residual", column(&|r| r.info.residual))?;
+    if params.fd_step.is_some() {
+        // NaN at indentation 0 (no central difference there), as the CLI's empty cell.
+        dict.set_item(
+            "stiffness_fd",
+            column(&|r| r.stiffness_fd.unwrap_or(f64::NAN)),
+        )?;
     }
-    dict.set_item("contact_points", PyArray1::from_vec(py, c.contact_points))?;
-    if fields {
+    dict.set_item("contact_points", count(&|r| r.summary.contact_points))?;
+    if !pressures.is_empty() || !gaps.is_empty() {
         let list = |arrays: Vec<ndarray::Array2<f64>>| -> PyResult<Bound<'_, PyList>> {
             let items: Vec<Bound<'_, PyArray2<f64>>> =
                 arrays.into_iter().map(|a| a.into_pyarray(py)).collect();
             PyList::new(py, items)
         };
-        dict.set_item("pressure", list(c.pressures)?)?;
-        dict.set_item("gap", list(c.gaps)?)?;
+        dict.set_item("pressure", list(pressures)?)?;
+        dict.set_item("gap", list(gaps)?)?;
     }
     Ok(dict)
 }

@@ -9,12 +9,16 @@
 //! * [`SolveError::BeyondFullContact`] → `asperity.BeyondFullContactError` (a
 //!   `ValueError`) with `.threshold` (the full-contact value in the quantity asked for, or
 //!   `None`), `.quantity` and `.requested`;
+//! * [`SolveError::Interrupted`] → `KeyboardInterrupt` (normally the signal's own exception
+//!   is raised instead, see [`crate::interrupt`]);
 //! * I/O errors → `OSError`; a study folder locked by another process
 //!   ([`Error::FolderInUse`]) → `BlockingIOError`, naming the holder's PID.
 
 use asperity::bem::SolveError;
 use asperity::Error;
-use pyo3::exceptions::{PyBlockingIOError, PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyBlockingIOError, PyKeyboardInterrupt, PyMemoryError, PyOSError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
@@ -63,6 +67,9 @@ pub fn from_solve(error: SolveError) -> PyErr {
             let _ = value.setattr("residual", residual);
             err
         }),
+        // A stop requested through the solver's flag: Ctrl-C or an exception of a progress
+        // callback, which `run_detached` raises instead; this is the fallback.
+        SolveError::Interrupted { .. } => PyKeyboardInterrupt::new_err(message),
         SolveError::BeyondFullContact {
             requested,
             full_contact,

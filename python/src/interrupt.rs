@@ -5,38 +5,38 @@
 //! runs the work on a helper thread and keeps the calling thread waiting on it, waking
 //! every [`POLL`] to take the GIL for a moment and run the handlers
 //! (`Python::check_signals`). A raised signal (or an exception of the user's progress
-//! callback, see [`Cancel::call`]) sets the [`Cancel`] flag, which the work checks between
-//! its steps (loads of a sweep, samples of a study) and then stops; the exception is
-//! re-raised once the work has returned. A single contact solve has no such step inside:
-//! it runs to its end (the library's solver offers no cancellation point).
+//! callback, see [`Cancel::call`]) sets the [`Cancel`] flag, the library's [`Stop`], which
+//! the work checks between its steps (loads of a sweep, samples of a study) and which a
+//! contact solver given the same flag ([`run_detached_with`],
+//! `ContactSolver::with_stop`) polls once per iteration, so that even a single long solve
+//! ends within an iteration; the exception is re-raised once the work has returned.
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Mutex};
 use std::time::Duration;
 
+use asperity::stop::Stop;
 use pyo3::prelude::*;
 
 /// How often the waiting thread runs Python's signal handlers.
 pub const POLL: Duration = Duration::from_millis(50);
 
 /// Set when the work is to stop; holds the exception that stopped it.
-#[derive(Default)]
 pub struct Cancel {
-    flag: AtomicBool,
+    flag: Stop,
     error: Mutex<Option<PyErr>>,
 }
 
 impl Cancel {
     /// Whether the work should stop now.
     pub fn is_set(&self) -> bool {
-        self.flag.load(Ordering::Relaxed)
+        self.flag.is_requested()
     }
 
     /// Stops the work with `error` (the first error is kept).
     pub fn fail(&self, error: PyErr) {
         let mut slot = self.error.lock().unwrap_or_else(|e| e.into_inner());
         slot.get_or_insert(error);
-        self.flag.store(true, Ordering::Relaxed);
+        self.flag.request();
     }
 
     /// Calls the user's `progress(done, total)` (if any) with the GIL; an exception it
@@ -60,7 +60,21 @@ pub fn run_detached<R: Send>(
     py: Python<'_>,
     work: impl FnOnce(&Cancel) -> R + Send,
 ) -> PyResult<R> {
-    let cancel = Cancel::default();
+    run_detached_with(py, &Stop::new(), work)
+}
+
+/// [`run_detached`] with `stop` as the cancel flag: the flag a contact solver polls. A
+/// request left over from an earlier interrupted call is withdrawn first.
+pub fn run_detached_with<R: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    work: impl FnOnce(&Cancel) -> R + Send,
+) -> PyResult<R> {
+    stop.clear();
+    let cancel = Cancel {
+        flag: stop.clone(),
+        error: Mutex::new(None),
+    };
     let result = py.detach(|| {
         std::thread::scope(|scope| {
             let (sender, receiver) = mpsc::channel();

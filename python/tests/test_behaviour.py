@@ -199,9 +199,10 @@ def test_a_topography_like_object_is_transposed_to_rows_y(rough):
     reference = asperity.Solver(rough.heights, 2.0).solve(pressure=0.01)
     r = asperity.Solver(FakeTopography(rough.heights.T, (2.0, 2.0))).solve(pressure=0.01)
     assert r.force == reference.force and np.array_equal(r.pressure, reference.pressure)
-    rect = FakeTopography(np.zeros((8, 4)), (1.0, 1.0))  # 8 x 4 points on a square: Δx ≠ Δy
-    with pytest.raises(ValueError, match="square pixels"):
-        asperity.Solver(rect)
+    # 8 x 4 points on a 1 x 2 rectangle: Δx = 1/8, Δy = 1/2 (the BEM takes rectangular
+    # pixels): 4 rows (y) of 8 columns (x), nominal area sx·sy.
+    rect = asperity.Solver(FakeTopography(np.zeros((8, 4)), (1.0, 2.0)))
+    assert rect.shape == (4, 8) and rect.nominal_area == 2.0 and rect.size == 1.0
 
 
 # ---------------------------------------------------------------- GIL and Ctrl-C
@@ -298,6 +299,41 @@ print("finished")
     # One warm 256² load takes well under a second; allow for the loaded machine.
     print(f"sweep stopped {elapsed:.3f} s after SIGINT")
     assert elapsed < 3.0, f"took {elapsed:.2f} s to stop"
+
+
+def test_ctrl_c_stops_a_single_long_solve_within_a_second(tmp_path):
+    """SIGINT during one solve (Polonsky–Keer, 512², a tolerance it never reaches: without
+    the stop it would run for hours) raises KeyboardInterrupt within a second: the library
+    solver polls the stop flag once per iteration. The solver stays usable: its next
+    computation is not stopped by the old request and equals a fresh solver's."""
+    script = """
+import sys, time, asperity, numpy as np
+s = asperity.surface(512, hurst=0.8, rolloff=4, rms_slope=1.0, seed=3)
+solver = asperity.Solver(s, solver="pk", tolerance=1e-300, max_iterations=10**9)
+print("running", flush=True)
+try:
+    solver.solve(pressure=0.01)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+    after = solver.full_contact_threshold()
+    fresh = asperity.Solver(s, solver="pk").full_contact_threshold()
+    print("usable" if after == fresh else f"differs {after} {fresh}", flush=True)
+    sys.exit(130)
+print("finished")
+"""
+    process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    assert process.stdout.readline().strip() == "running", process.stderr.read()
+    time.sleep(1.0)  # well inside the solve
+    start = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    line = process.stdout.readline().strip()
+    elapsed = time.monotonic() - start
+    code = process.wait(timeout=120)
+    assert line == "KeyboardInterrupt", (line, process.stderr.read())
+    assert process.stdout.read().strip() == "usable" and code == 130
+    print(f"solve stopped {elapsed:.3f} s after SIGINT")
+    assert elapsed < 1.0, f"took {elapsed:.2f} s to stop"
 
 
 def test_progress_callbacks_and_their_exceptions(rough):

@@ -83,15 +83,19 @@ BEM_CASES = [
 ]
 
 
+@pytest.mark.parametrize("solver_name", ["bccg", "pk"])
 @pytest.mark.parametrize("boundary,flags,kwargs", BEM_CASES)
-def test_bem_sweep_and_fields_equal_the_cli(cli, tmp_path, boundary, flags, kwargs):
+def test_bem_sweep_and_fields_equal_the_cli(cli, tmp_path, boundary, flags, kwargs, solver_name):
     s = asperity.surface(48, m=40, hurst=0.8, rolloff=3, rms_slope=0.5, seed=7, size=2.0)
     s.save(tmp_path / "s.npy")
     cli("bem", "--surface", tmp_path / "s.npy", "--boundary", boundary, *flags, "--fd-stiffness",
-        "--tol", 1e-9, "--fields", tmp_path / "fields", "--out", tmp_path / "out.csv", "--quiet")
+        "--tol", 1e-9, "--solver", solver_name, "--fields", tmp_path / "fields",
+        "--out", tmp_path / "out.csv", "--quiet")
     table = read_csv(tmp_path / "out.csv")
     # The surface as a plain array with its size, as a user would load it.
-    solver = asperity.Solver(np.load(tmp_path / "s.npy"), 2.0, boundary=boundary, tolerance=1e-9)
+    solver = asperity.Solver(np.load(tmp_path / "s.npy"), 2.0, boundary=boundary, tolerance=1e-9,
+                             solver=solver_name)
+    assert solver.solver == solver_name
     sweep = solver.sweep(**kwargs, fd_stiffness=True, fields=True)
     for name in ("force", "mean_pressure", "indentation", "area_fraction", "stiffness",
                  "iterations", "residual"):
@@ -103,14 +107,18 @@ def test_bem_sweep_and_fields_equal_the_cli(cli, tmp_path, boundary, flags, kwar
         assert np.array_equal(sweep.gap[k], np.load(tmp_path / "fields" / f"gap_{k}.npy"))
 
 
+# The CLI's default solver (no --solver) against Python's default and both explicit names.
+@pytest.mark.parametrize("flags,kwargs", [
+    ([], {}), (["--solver", "bccg"], dict(solver="default")), (["--solver", "pk"], dict(solver="pk")),
+])
 @pytest.mark.parametrize("boundary", ["free", "periodic"])
-def test_a_single_solve_equals_the_cli(cli, tmp_path, boundary):
+def test_a_single_solve_equals_the_cli(cli, tmp_path, boundary, flags, kwargs):
     s = asperity.surface(64, hurst=0.6, rolloff=4, rms_slope=1.0, seed=2)
     s.save(tmp_path / "s.npy")
     cli("bem", "--surface", tmp_path / "s.npy", "--boundary", boundary, "--forces", 0.02,
-        "--fields", tmp_path / "f", "--out", tmp_path / "out.csv", "--quiet")
+        *flags, "--fields", tmp_path / "f", "--out", tmp_path / "out.csv", "--quiet")
     row = read_csv(tmp_path / "out.csv")
-    solver = asperity.Solver(s, boundary=boundary)
+    solver = asperity.Solver(s, boundary=boundary, **kwargs)
     r = solver.solve(force=0.02)
     assert [r.force] == row["force"] and [r.indentation] == row["indentation"]
     assert [r.area_fraction] == row["area_fraction"] and [r.iterations] == row["iterations"]

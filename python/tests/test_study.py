@@ -28,6 +28,8 @@ def checkpoint_samples(folder: Path) -> int:
             record = json.loads(path.read_text())
         except (OSError, ValueError):
             continue  # being replaced
+        # asperity-checkpoint/2 keeps the task's state under "content".
+        record = record.get("content", record)
         if record.get("state") == "in_progress":
             total += len(record["samples"])
     return total

@@ -95,6 +95,7 @@ pub mod memory;
 pub mod npy;
 pub mod reference;
 pub mod spectrum;
+pub mod stop;
 pub mod study;
 pub mod surface;
 pub mod topography;

@@ -8,9 +8,11 @@
 //! temporary files, so an error leaves nothing behind.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use asperity::bem::sweep::{
+    describe, sweep, SweepError, SweepObserver, SweepParams, SweepRow, SweepStep,
+};
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
@@ -291,69 +293,65 @@ fn ensure_no_stale_fields(dir: &Path, count: usize) -> Result<()> {
     Ok(())
 }
 
-/// A load as messages name it: `load 3 (mean pressure 0.01)`.
-fn describe(k: usize, control: Control) -> String {
-    format!("load {k} ({} {})", control.quantity(), control.value())
+/// What `asperity bem` does during the library's sweep: writes each load's fields to
+/// their staged files as soon as it is solved, counts progress and, with `--timing`, notes
+/// the peak memory after each load.
+struct CliObserver<'a> {
+    staged: &'a mut StagedOutputs,
+    fields: Option<&'a [(PathBuf, PathBuf)]>,
+    progress: Progress,
+    peak_rss: Option<Vec<f64>>,
 }
 
-/// Refuses, before any solve, the largest load of each kind if it is beyond full contact
-/// (and, with `--fd-stiffness`, its upper finite-difference step). The threshold is computed
-/// only where the cheap lower bound does not already clear the loads: periodic boundaries
-/// always (one FFT pair), free boundaries when a load reaches the bound (two CG solves on
-/// the full grid, about one solve's time; cached by the solver).
-fn check_full_contact(
-    solver: &mut ContactSolver,
-    loads: &[Control],
-    fd_step: Option<f64>,
-) -> Result<()> {
-    let area = solver.nominal_area();
-    let same_kind =
-        |a: &Control, b: &Control| std::mem::discriminant(a) == std::mem::discriminant(b);
-    let mut kinds: Vec<Control> = Vec::new();
-    for c in loads {
-        if !kinds.iter().any(|k| same_kind(k, c)) {
-            kinds.push(*c);
+impl SweepObserver for CliObserver<'_> {
+    type Error = anyhow::Error;
+
+    fn solved(&mut self, load: usize, solver: &ContactSolver) -> Result<()> {
+        if let Some((p_path, g_path)) = self.fields.map(|f| &f[load]) {
+            self.staged.write_npy_2d(p_path, &solver.pressure())?;
+            self.staged.write_npy_2d(g_path, &solver.gap())?;
         }
+        Ok(())
     }
-    for kind in kinds {
-        let Some((k, &largest)) = loads
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| same_kind(c, &kind))
-            .max_by(|a, b| a.1.value().total_cmp(&b.1.value()))
-        else {
-            continue;
-        };
-        let top = largest.value() * (1.0 + fd_step.unwrap_or(0.0));
-        let bound = solver.full_contact_lower_bound()?;
-        match bound.in_units_of(largest, area) {
-            Some(b) if top < b => continue,
-            None => continue, // no threshold in this quantity (left to the solver)
-            Some(_) => {}
+
+    fn finished(&mut self, _load: usize, _row: &SweepRow) -> Result<()> {
+        if let Some(peaks) = &mut self.peak_rss {
+            peaks.push(peak_rss_mib().unwrap_or(f64::NAN));
         }
-        let threshold = solver.full_contact_threshold()?;
-        let Some(full) = threshold.in_units_of(largest, area) else {
-            continue;
-        };
-        if largest.value() >= full {
-            let error = SolveError::BeyondFullContact {
-                requested: largest,
-                full_contact: Some(full),
+        self.progress.inc();
+        Ok(())
+    }
+}
+
+/// A sweep's error in the command line's words (its flags, the load as `load 3 (…)`).
+fn sweep_error(error: SweepError<anyhow::Error>) -> anyhow::Error {
+    match error {
+        SweepError::Input(e) => e.into(),
+        // The threshold computations before any solve fail without a load to name.
+        SweepError::Solve {
+            step: SweepStep::FullContactCheck,
+            source: source @ (SolveError::Input(_) | SolveError::NoConvergence { .. }),
+            ..
+        } => source.into(),
+        SweepError::Solve {
+            load,
+            control,
+            step,
+            source,
+        } => {
+            let load = describe(load, control);
+            let context = match step {
+                SweepStep::FullContactCheck | SweepStep::Solve => load,
+                SweepStep::Stiffness => format!("stiffness at {load}"),
+                SweepStep::FiniteDifference => format!("--fd-stiffness at {load}"),
             };
-            return Err(anyhow::Error::new(error).context(describe(k, largest)));
+            anyhow::Error::new(source).context(context)
         }
-        if top >= full {
-            bail!(
-                "--fd-stiffness: at {} the upper finite-difference step ({} {:.6e}, the load × (1 + {})) is beyond full contact (the gap closes everywhere from {:.6e}); lower the load or drop --fd-stiffness",
-                describe(k, largest),
-                largest.quantity(),
-                top,
-                fd_step.unwrap_or(0.0),
-                full
-            );
+        e @ SweepError::StepBeyondFullContact { .. } => {
+            anyhow::anyhow!("--fd-stiffness: {e}; lower the load or drop --fd-stiffness")
         }
+        SweepError::Stopped(e) => e,
     }
-    Ok(())
 }
 
 /// Where L came from.
@@ -622,9 +620,9 @@ pub fn run(args: &BemArgs) -> Result<()> {
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
     let fd_step = args.fd_stiffness.then_some(FD_STEP);
-    check_full_contact(&mut solver, &loads, fd_step)?;
 
-    // 2. Solve every load (warm starts in the given order).
+    // 2. Solve every load (warm starts in the given order), after the full-contact check of
+    // every load: the library's sweep.
     let mut header = vec![
         "force",
         "mean_pressure",
@@ -640,68 +638,45 @@ pub fn run(args: &BemArgs) -> Result<()> {
     if args.timing {
         header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
     }
-    let progress = Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2);
-    let mut rows = Vec::with_capacity(loads.len());
-    for (k, &control) in loads.iter().enumerate() {
-        let start = Instant::now();
-        let (summary, info) = solver
-            .solve(control)
-            .with_context(|| describe(k, control))?;
-        let solve_seconds = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let stiffness = if args.no_stiffness {
-            None
-        } else {
-            Some(
-                solver
-                    .frozen_set_stiffness()
-                    .with_context(|| format!("stiffness at {}", describe(k, control)))?
-                    .0,
-            )
-        };
-        let stiffness_seconds = start.elapsed().as_secs_f64();
-        if let Some((p_path, g_path)) = fields.as_ref().map(|f| &f[k]) {
-            staged.write_npy_2d(p_path, &solver.pressure())?;
-            staged.write_npy_2d(g_path, &solver.gap())?;
-        }
-        let mut values = vec![
-            Some(summary.force),
-            Some(summary.mean_pressure),
-            Some(summary.indentation),
-            Some(summary.area_fraction),
-            stiffness,
-            Some(info.iterations as f64),
-            Some(info.residual),
-        ];
-        // After everything taken from the state at this load: the two steps move the
-        // solver, so the load is solved again (warm, from the upper step) for the next
-        // load's warm start, except after the last one.
-        if let Some(step) = fd_step {
-            let fd = if control.value() > 0.0 {
-                let context = || format!("--fd-stiffness at {}", describe(k, control));
-                let fd = solver
-                    .finite_difference_stiffness(control, step)
-                    .with_context(context)?;
-                if k + 1 < loads.len() {
-                    solver.solve(control).with_context(context)?;
-                }
-                Some(fd)
-            } else {
-                None // no central difference at indentation 0
-            };
-            values.push(fd);
-        }
-        if args.timing {
-            values.extend([
-                Some(solve_seconds),
-                Some(stiffness_seconds),
-                Some(peak_rss_mib().unwrap_or(f64::NAN)),
-            ]);
-        }
-        rows.push(Row { values });
-        progress.inc();
-    }
-    progress.finish();
+    let mut observer = CliObserver {
+        staged: &mut staged,
+        fields: fields.as_deref(),
+        progress: Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2),
+        peak_rss: args.timing.then(Vec::new),
+    };
+    let params = SweepParams {
+        stiffness: !args.no_stiffness,
+        fd_step,
+    };
+    let solved = sweep(&mut solver, &loads, params, &mut observer).map_err(sweep_error)?;
+    observer.progress.finish();
+    let peak_rss = observer.peak_rss.take().unwrap_or_default();
+    let rows: Vec<Row> = solved
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let mut values = vec![
+                Some(r.summary.force),
+                Some(r.summary.mean_pressure),
+                Some(r.summary.indentation),
+                Some(r.summary.area_fraction),
+                r.stiffness,
+                Some(r.info.iterations as f64),
+                Some(r.info.residual),
+            ];
+            if args.fd_stiffness {
+                values.push(r.stiffness_fd);
+            }
+            if args.timing {
+                values.extend([
+                    Some(r.solve_seconds),
+                    Some(r.stiffness_seconds),
+                    Some(peak_rss[k]),
+                ]);
+            }
+            Row { values }
+        })
+        .collect();
 
     // 3. Write.
     let iterations = header.iter().position(|h| *h == "iterations");

@@ -167,6 +167,7 @@ impl ContactSolver {
         let mut previous_zg = 0.0;
         let mut iteration = 0;
         loop {
+            self.check_stop(iteration)?;
             let gradient = self.gradient_pass(target, indentation);
             indentation = gradient.indentation;
             if gradient.residual < tolerance && exact {

@@ -23,6 +23,10 @@
 //!   the previous pressure (warm start). Periodic displacement control: BCCG solves it
 //!   directly; Polonsky–Keer by a root find on the mean pressure over load-controlled solves
 //!   (`periodic_indentation.rs`).
+//! * **Stopping**: [`ContactSolver::with_stop`] hands the solver a [`crate::stop::Stop`]
+//!   flag, which every iteration (BCCG, Polonsky–Keer, the periodic root find, the
+//!   frozen-set and full-contact CGs) polls; a requested stop ends the solve with
+//!   [`SolveError::Interrupted`] within one iteration.
 //! * **Stiffness**: [`ContactSolver::frozen_set_stiffness`] — the paper's method: keep the
 //!   contact set, impose a uniform `Δd` on it, solve the linear SPD problem for the pressures
 //!   on the set (conjugate gradients with the Fourier preconditioner of the solver), `k = ΔF/Δd`; and
@@ -38,10 +42,13 @@
 
 mod bccg;
 mod full_contact;
+#[cfg(test)]
+mod interruption;
 mod periodic_indentation;
 mod polonsky_keer;
 mod preconditioner;
 mod stiffness;
+pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
 pub use polonsky_keer::ContactSolver;
@@ -256,6 +263,15 @@ pub enum SolveError {
         iterations: usize,
         /// Residual reached.
         residual: f64,
+    },
+    /// A stop was requested through the solver's [`crate::stop::Stop`] (checked once per
+    /// iteration of every solver loop). The solver forgets its unfinished state: the next
+    /// solve starts cold, as after [`ContactSolver::reset`].
+    #[error("interrupted after {iterations} iterations")]
+    Interrupted {
+        /// Iterations done before the stop (summed over the inner solves of a periodic
+        /// displacement-controlled root find).
+        iterations: usize,
     },
     /// The load or indentation closes the gap everywhere: no contact problem is left to
     /// solve. The message names the quantity that was given (force, mean pressure or

@@ -239,6 +239,7 @@ impl ContactSolver {
 
         let (mut used, mut applications) = (spent, 0);
         for _ in 0..MAX_EVALUATIONS {
+            self.check_stop(used)?;
             if root.hi.pressure - root.lo.pressure <= 4.0 * f64::EPSILON * root.hi.pressure {
                 break;
             }
@@ -260,6 +261,11 @@ impl ContactSolver {
                     used += iterations;
                     residual = self.residual_at(indentation).0;
                     break;
+                }
+                Err(SolveError::Interrupted { iterations }) => {
+                    return Err(SolveError::Interrupted {
+                        iterations: used + iterations,
+                    })
                 }
                 Err(other) => return Err(other),
             };

@@ -30,6 +30,7 @@ use super::{
     SolverParams,
 };
 use crate::elastic::{Boundary, ElasticOperator};
+use crate::stop::Stop;
 use crate::surface::Surface;
 use crate::{memory, Error};
 
@@ -70,6 +71,8 @@ pub struct ContactSolver {
     pub(super) preconditioner: FourierPreconditioner,
     /// The BCCG's own fields.
     pub(super) bccg_scratch: BccgScratch,
+    /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
+    pub(super) stop: Stop,
 }
 
 /// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
@@ -153,7 +156,40 @@ impl ContactSolver {
             stiffness_work: None,
             preconditioner,
             bccg_scratch,
+            stop: Stop::new(),
         })
+    }
+
+    /// The solver with `stop` as its stop flag (builder form of
+    /// [`ContactSolver::set_stop`]).
+    pub fn with_stop(mut self, stop: Stop) -> Self {
+        self.set_stop(stop);
+        self
+    }
+
+    /// Polls `stop` from now on: once it is requested, every solve, stiffness or threshold
+    /// computation ends within one iteration with [`SolveError::Interrupted`], and keeps
+    /// doing so until the flag is cleared. An interrupted solve leaves no state behind (the
+    /// next solve starts cold, exactly as a new solver's); an interrupted stiffness or
+    /// threshold keeps the solved state. A solver starts with a flag of its own that
+    /// nothing sets.
+    pub fn set_stop(&mut self, stop: Stop) {
+        self.stop = stop;
+    }
+
+    /// The stop flag polled by this solver (a clone shares it).
+    pub fn stop(&self) -> &Stop {
+        &self.stop
+    }
+
+    /// [`SolveError::Interrupted`] after `iterations` if a stop is requested.
+    #[inline]
+    pub(super) fn check_stop(&self, iterations: usize) -> Result<(), SolveError> {
+        if self.stop.is_requested() {
+            Err(SolveError::Interrupted { iterations })
+        } else {
+            Ok(())
+        }
     }
 
     /// Swaps in another surface with the same grid and spacing, keeping the operator (FFT
@@ -376,6 +412,7 @@ impl ContactSolver {
         let mut conjugate = false;
         let mut iteration = 0;
         loop {
+            self.check_stop(iteration)?;
             self.operator.apply(&self.pressure, &mut self.gap);
             let pass = gap_and_direction(
                 &self.pressure,

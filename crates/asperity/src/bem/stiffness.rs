@@ -25,6 +25,7 @@ use super::polonsky_keer::ContactSolver;
 use super::preconditioner::FourierPreconditioner;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
+use crate::stop::Stop;
 use crate::Error;
 
 /// Right-hand side of a CG on a set.
@@ -82,6 +83,15 @@ fn precondition_on_set(
     rz
 }
 
+/// When a CG stops: at `tolerance` relative residual, after `max_iterations`, or when `stop`
+/// is requested.
+#[derive(Clone, Copy)]
+struct Limits<'a> {
+    tolerance: f64,
+    max_iterations: usize,
+    stop: &'a Stop,
+}
+
 /// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
 /// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
 /// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
@@ -92,9 +102,13 @@ fn conjugate_gradient_on_set(
     in_set: impl Fn(usize) -> bool,
     rhs: RightHandSide<'_>,
     work: &mut StiffnessWork,
-    tolerance: f64,
-    max_iterations: usize,
+    limits: Limits<'_>,
 ) -> Result<SolveInfo, SolveError> {
+    let Limits {
+        tolerance,
+        max_iterations,
+        stop,
+    } = limits;
     let StiffnessWork {
         x,
         residual,
@@ -119,6 +133,9 @@ fn conjugate_gradient_on_set(
     direction.copy_from_slice(z);
     let mut iterations = 0;
     loop {
+        if stop.is_requested() {
+            return Err(SolveError::Interrupted { iterations });
+        }
         let relative = if b_norm > 0.0 {
             rr.sqrt() / b_norm
         } else {
@@ -202,6 +219,11 @@ impl ContactSolver {
         max_iterations: usize,
     ) -> Result<(f64, SolveInfo), SolveError> {
         let mut work = self.stiffness_work();
+        let limits = Limits {
+            tolerance,
+            max_iterations,
+            stop: &self.stop,
+        };
         let pressure = &self.pressure;
         let result = conjugate_gradient_on_set(
             &mut self.operator,
@@ -209,8 +231,7 @@ impl ContactSolver {
             |i| pressure[i] > 0.0,
             RightHandSide::Ones,
             &mut work,
-            tolerance,
-            max_iterations,
+            limits,
         );
         let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
@@ -255,6 +276,11 @@ impl ContactSolver {
             self.params.stiffness_tolerance,
             self.params.stiffness_max_iterations,
         );
+        let limits = Limits {
+            tolerance,
+            max_iterations,
+            stop: &self.stop,
+        };
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
             &mut self.operator,
@@ -262,8 +288,7 @@ impl ContactSolver {
             |_| true,
             RightHandSide::Values(&self.profile),
             &mut work,
-            tolerance,
-            max_iterations,
+            limits,
         )
         .and_then(|_| {
             std::mem::swap(&mut work.x, &mut work.profile_pressure);
@@ -273,8 +298,7 @@ impl ContactSolver {
                 |_| true,
                 RightHandSide::Ones,
                 &mut work,
-                tolerance,
-                max_iterations,
+                limits,
             )
         })
         .map(|_| {
