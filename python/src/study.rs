@@ -161,7 +161,8 @@ fn run_tasks(
             Method::Bem => run_one(
                 spec,
                 task,
-                BemSampler::new(spec, task)?,
+                // Stops inside a sample's solve, not only between samples.
+                BemSampler::new(spec, task)?.with_stop(cancel.stop().clone()),
                 store,
                 &report,
                 cancel,

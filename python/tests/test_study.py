@@ -111,7 +111,7 @@ def report(done, total):
     if done > 0:
         print("running", flush=True)
 try:
-    asperity.study_alpha(method="bem", n=[64], hurst=[0.5], samples=10000, seed=1,
+    asperity.study_alpha(method="bem", n=[256], hurst=[0.5], samples=10000, seed=1,
                          out={str(folder)!r}, checkpoint_every=0, progress=report)
 except KeyboardInterrupt:
     print("KeyboardInterrupt", flush=True)
@@ -129,10 +129,11 @@ print("finished", flush=True)
     elapsed = time.monotonic() - start
     out = process.stdout.read()
     assert code == 130 and "KeyboardInterrupt" in out, (code, out, process.stderr.read())
-    # One BEM sample of 64² (24 solves) takes about 0.1-0.3 s; the samples in flight finish
-    # first. A few seconds allow for the loaded test machine.
+    # One BEM sample of 256² (24 solves and stiffnesses) takes seconds; the samples in
+    # flight stop inside their solves (the sampler's solver polls the same stop flag), so
+    # the study ends within a second; 2 s allow for a loaded test machine.
     print(f"study stopped {elapsed:.3f} s after SIGINT")
-    assert elapsed < 5.0, f"took {elapsed:.2f} s to stop"
+    assert elapsed < 2.0, f"took {elapsed:.2f} s to stop"
     assert (folder / "study.json").exists() and checkpoint_samples(folder) > 0
 
 

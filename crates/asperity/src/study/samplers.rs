@@ -235,6 +235,7 @@ pub struct BemSampler {
     surface: SurfaceSpec,
     mean_pressures: Vec<f64>,
     params: SolverParams,
+    stop: crate::stop::Stop,
 }
 
 impl BemSampler {
@@ -256,7 +257,15 @@ impl BemSampler {
             surface,
             mean_pressures,
             params: bem_solver_params(),
+            stop: crate::stop::Stop::new(),
         })
+    }
+
+    /// Samples that stop within one solver iteration once `stop` is requested (their
+    /// error is [`crate::bem::SolveError::Interrupted`]; finished samples are unaffected).
+    pub fn with_stop(mut self, stop: crate::stop::Stop) -> Self {
+        self.stop = stop;
+        self
     }
 }
 
@@ -297,7 +306,8 @@ impl Sampler for BemSampler {
                     },
                     self.params,
                 )
-                .map_err(bem_error)?,
+                .map_err(bem_error)?
+                .with_stop(self.stop.clone()),
             ),
         };
         let points_total = self.surface.rows * self.surface.cols;
@@ -551,6 +561,27 @@ mod tests {
             panic!("one task")
         };
         assert!((alpha - 1.0 / 1.5).abs() < 0.06, "α = {alpha}");
+    }
+
+    #[test]
+    fn a_requested_stop_ends_a_bem_sample_inside_its_first_solve() {
+        let spec = spec(Method::Bem, 32, vec![0.8], 2);
+        let task = spec.tasks()[0];
+        let stop = crate::stop::Stop::new();
+        let sampler = BemSampler::new(&spec, task).unwrap().with_stop(stop.clone());
+        let mut worker = sampler.worker().unwrap();
+        let finished = sampler.sample(&mut worker, 1).unwrap();
+        stop.request();
+        match sampler.sample(&mut worker, 2) {
+            Err(Error::Solve { source, .. }) => assert!(
+                matches!(*source, crate::bem::SolveError::Interrupted { iterations: 0 }),
+                "{source}"
+            ),
+            other => panic!("{other:?}"),
+        }
+        // Withdrawn, the same worker computes the very sample an untouched one does.
+        stop.clear();
+        assert_eq!(sampler.sample(&mut worker, 1).unwrap(), finished);
     }
 
     #[test]
