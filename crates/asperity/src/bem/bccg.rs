@@ -229,7 +229,12 @@ fn contact_mean(
             *out = s;
         });
     let s = Sums::total(partials);
-    previous + if s.n[0] > 0 { s.x[0] / s.n[0] as f64 } else { 0.0 }
+    previous
+        + if s.n[0] > 0 {
+            s.x[0] / s.n[0] as f64
+        } else {
+            0.0
+        }
 }
 
 /// Writes `g = u + f − d` on the free set (zero elsewhere) into `z` and the free set into
@@ -248,8 +253,11 @@ fn gap_pass(
         .zip(partials.par_iter_mut())
         .for_each(|((((z, free), u), (f, p)), out)| {
             let mut s = Sums::default();
-            for (((zi, fr), &ui), (&fi, &pi)) in
-                z.iter_mut().zip(free.iter_mut()).zip(u).zip(f.iter().zip(p))
+            for (((zi, fr), &ui), (&fi, &pi)) in z
+                .iter_mut()
+                .zip(free.iter_mut())
+                .zip(u)
+                .zip(f.iter().zip(p))
             {
                 let (g, is_free) = gap_at(ui, fi, d, pi);
                 if pi > 0.0 {
@@ -367,8 +375,11 @@ fn step_pass(
         .enumerate()
         .for_each(|(chunk, ((((p, u), (s, w)), slots), out))| {
             let (mut cuts, mut total) = (0usize, 0.0);
-            for (index, ((pi, ui), (&si, &wi))) in
-                p.iter_mut().zip(u.iter_mut()).zip(s.iter().zip(w)).enumerate()
+            for (index, ((pi, ui), (&si, &wi))) in p
+                .iter_mut()
+                .zip(u.iter_mut())
+                .zip(s.iter().zip(w))
+                .enumerate()
             {
                 let next = *pi + alpha * si;
                 if next < 0.0 {
