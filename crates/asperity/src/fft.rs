@@ -228,6 +228,27 @@ impl RealFft2 {
         self.check_lengths(input, spectrum);
         self.check_lengths(output, spectrum);
         self.forward_rows(input);
+        self.filter_columns(spectrum, filter);
+        self.inverse_rows(output);
+    }
+
+    /// [`RealFft2::convolve`] with `data` both the input and the output (overwritten).
+    pub fn convolve_in_place<F>(&mut self, data: &mut [f64], spectrum: &mut [Complex64], filter: F)
+    where
+        F: Fn(usize, &mut [Complex64]) + Sync,
+    {
+        self.check_lengths(data, spectrum);
+        self.forward_rows(data);
+        self.filter_columns(spectrum, filter);
+        self.inverse_rows(data);
+    }
+
+    /// The column passes of [`RealFft2::convolve`]: from the rows' half spectra in `work`
+    /// through the fused forward, filter and inverse column transforms back to `work`.
+    fn filter_columns<F>(&mut self, spectrum: &mut [Complex64], filter: F)
+    where
+        F: Fn(usize, &mut [Complex64]) + Sync,
+    {
         transpose_into_columns(
             &self.work,
             spectrum,
@@ -248,7 +269,6 @@ impl RealFft2 {
         );
         let half = self.half_cols();
         transpose_from_columns(spectrum, &mut self.work, self.data_rows, half, self.rows);
-        self.inverse_rows(output);
     }
 
     /// Forward transform of a whole `rows × cols` grid (padding included) whose rows are

@@ -84,6 +84,12 @@ pub struct BenchArgs {
     /// Solver tolerance (bem-solve).
     #[arg(long, default_value_t = 1e-8)]
     pub tol: f64,
+    /// Solvers to time (bem-solve), comma separated: pk, bccg.
+    #[arg(long, value_delimiter = ',', default_value = "pk,bccg")]
+    pub solvers: Vec<SolverKind>,
+    /// Boundaries to time (bem-solve), comma separated: free, periodic.
+    #[arg(long, value_delimiter = ',', default_value = "free,periodic")]
+    pub boundaries: Vec<Boundary>,
 }
 
 /// Minimum and median of some timings (seconds).
@@ -467,14 +473,14 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
     let psd = Psd::new(args.hurst, LongWavelength::RollOff { q0: 6.0 }, None)?;
     let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
     let surface = SurfaceGenerator::new(&spec)?.try_generate(0)?;
-    for boundary in [Boundary::Free, Boundary::Periodic] {
+    for &boundary in &args.boundaries {
         let fft_pair = min_median(fft_pair_times(args.n, boundary, args.repeat.max(5))?).0;
         let half_space = HalfSpace {
             modulus: 1.0,
             boundary,
         };
         for &pressure in &args.pressures {
-            for solver in [SolverKind::PolonskyKeer, SolverKind::Bccg] {
+            for &solver in &args.solvers {
                 let params = SolverParams {
                     solver,
                     tolerance: args.tol,

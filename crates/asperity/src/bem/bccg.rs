@@ -37,8 +37,14 @@
 //! with them) and the iteration crawls; there a root find on the mean pressure over
 //! load-controlled solves takes over ([`ContactSolver::bccg_periodic_indentation`]).
 //!
-//! The elementwise passes run serially in a fixed order, so results are bit-identical for
-//! any thread count; they allocate nothing (the solver owns every buffer).
+//! The elementwise passes run in parallel over chunks of [`CHUNK`] points whose bounds do
+//! not depend on the thread count; each chunk sums in index order and the partial sums are
+//! added serially in chunk order, so results are bit-identical for any thread count. A
+//! pass reads the free set from a mask written once per iteration, and the sums of the new
+//! direction follow from those of the old one, so an iteration makes five passes besides
+//! the step's. They allocate nothing (the solver owns every buffer).
+
+use rayon::prelude::*;
 
 use super::polonsky_keer::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
@@ -60,17 +66,53 @@ const LOAD_ROUNDING: f64 = 1e-14;
 /// responses (each one pass over the grid); beyond this many `u` is recomputed.
 const CUT_LIMIT: usize = 16;
 
-/// The BCCG's own fields: the preconditioned gradient and the previous gradient, the
-/// operator's impulse response and the list of cut pressures.
+/// Elements per chunk of the parallel passes. Fixed, never derived from the thread count:
+/// each chunk is summed in index order and the chunks' partial sums are added in chunk
+/// order, so every sum is the same bits for any number of threads.
+const CHUNK: usize = 8192;
+
+/// Partial sums of one chunk of a pass (the meaning of each slot is the pass's).
+#[derive(Clone, Copy, Default)]
+pub(super) struct Sums {
+    x: [f64; 7],
+    n: [usize; 2],
+}
+
+impl Sums {
+    /// The sums of all chunks, added serially in chunk order.
+    fn total(partials: &[Sums]) -> Sums {
+        partials.iter().fold(Sums::default(), |mut a, b| {
+            a.x.iter_mut().zip(&b.x).for_each(|(x, y)| *x += y);
+            a.n[0] += b.n[0];
+            a.n[1] += b.n[1];
+            a
+        })
+    }
+}
+
+/// The BCCG's own fields: the preconditioned gradient, the current and the previous
+/// gradient, the free set, the operator's impulse response, the cut pressures and the
+/// partial sums of the parallel passes.
 pub(super) struct BccgScratch {
     /// `z = Π P_F M P_F Π g` (the preconditioner works in place here).
     pub(super) preconditioned: Vec<f64>,
+    /// `Π g` on the free set, zero elsewhere.
+    pub(super) gradient: Vec<f64>,
     /// `Π g` of the previous iteration on its free set, zero elsewhere.
     pub(super) previous_gradient: Vec<f64>,
+    /// The free set `F` of the current iteration.
+    pub(super) free: Vec<bool>,
     /// `K e_00`, the displacement under a unit pressure on pixel `(0, 0)`.
     pub(super) impulse: Vec<f64>,
     /// `(index, correction)` of the pressures cut in a step (capacity [`CUT_LIMIT`]).
     pub(super) cuts: Vec<(usize, f64)>,
+    /// The first [`CUT_LIMIT`] cuts of every chunk of the step pass.
+    chunk_cuts: Vec<(usize, f64)>,
+    /// One [`Sums`] per chunk.
+    partials: Vec<Sums>,
+    /// Factor of `p` and `u` that restores the load, not yet applied (1: none); applied by
+    /// the next pass that reads them.
+    pending_scale: f64,
 }
 
 impl BccgScratch {
@@ -81,11 +123,17 @@ impl BccgScratch {
         unit[0] = 1.0;
         let mut impulse = vec![0.0; len];
         operator.apply(&unit, &mut impulse);
+        let chunks = len.div_ceil(CHUNK);
         BccgScratch {
             preconditioned: unit,
+            gradient: vec![0.0; len],
             previous_gradient: vec![0.0; len],
+            free: vec![false; len],
             impulse,
             cuts: Vec::with_capacity(CUT_LIMIT),
+            chunk_cuts: vec![(0, 0.0); chunks * CUT_LIMIT],
+            partials: vec![Sums::default(); chunks],
+            pending_scale: 1.0,
         }
     }
 }
@@ -93,16 +141,17 @@ impl BccgScratch {
 /// Adds `c K e_t` to `u` for every `(t, c)` of `points`, from the operator's response to a
 /// unit pressure on pixel `(0, 0)`, `impulse`: free boundaries `K(Δi, Δj)` at
 /// `impulse[|Δi|][|Δj|]` (the kernel is even in both), periodic at the offsets modulo the
-/// grid. `grid` is `(rows, cols, periodic)`. `u` is row-major `rows × cols`.
+/// grid. `grid` is `(rows, cols, periodic)`. `u` is row-major `rows × cols`. One parallel
+/// pass over the rows with all points (each value sums them in their order).
 fn add_point_responses(
     u: &mut [f64],
     impulse: &[f64],
     (rows, cols, periodic): (usize, usize, bool),
     points: &[(usize, f64)],
 ) {
-    for &(t, c) in points {
-        let (ti, tj) = (t / cols, t % cols);
-        for (i, row) in u.chunks_exact_mut(cols).enumerate() {
+    u.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
+        for &(t, c) in points {
+            let (ti, tj) = (t / cols, t % cols);
             let di = if periodic {
                 (i + rows - ti) % rows
             } else {
@@ -124,19 +173,25 @@ fn add_point_responses(
                 }
             }
         }
-    }
+    });
 }
 
 /// What the gradient pass found.
 struct Gradient {
     /// Multiplier `d` (load control) or the given indentation.
     indentation: f64,
-    /// Mean of `g` on the free set (load control; zero otherwise): `Π g = g − mean`.
-    centre: f64,
     free_points: usize,
     contact_points: usize,
     /// The residual of the module docs.
     residual: f64,
+}
+
+/// What the direction passes found.
+struct Direction {
+    /// `zᵀ Π g`, the denominator of the next `β`.
+    zg: f64,
+    /// `sᵀ Π g` of the new direction (negative: downhill).
+    sg: f64,
 }
 
 /// `g = u + f − d` and whether the point is free (`p > 0` or `g < 0`).
@@ -144,6 +199,208 @@ struct Gradient {
 fn gap_at(u: f64, f: f64, d: f64, p: f64) -> (f64, bool) {
     let g = u + f - d;
     (g, p > 0.0 || g < 0.0)
+}
+
+/// Load control's `d`: the mean of `u + f` on the contact set, summed about `previous` so
+/// that the residual does not cancel; `p` and `u` are first multiplied by `scale` (the
+/// pending load restoration; 1: none).
+fn contact_mean(
+    (u, p, f): (&mut [f64], &mut [f64], &[f64]),
+    previous: f64,
+    scale: f64,
+    partials: &mut [Sums],
+) -> f64 {
+    u.par_chunks_mut(CHUNK)
+        .zip(p.par_chunks_mut(CHUNK))
+        .zip(f.par_chunks(CHUNK))
+        .zip(partials.par_iter_mut())
+        .for_each(|(((u, p), f), out)| {
+            let mut s = Sums::default();
+            for ((ui, pi), &fi) in u.iter_mut().zip(p.iter_mut()).zip(f) {
+                if scale != 1.0 {
+                    *ui *= scale;
+                    *pi *= scale;
+                }
+                if *pi > 0.0 {
+                    s.n[0] += 1;
+                    s.x[0] += *ui + fi - previous;
+                }
+            }
+            *out = s;
+        });
+    let s = Sums::total(partials);
+    previous
+        + if s.n[0] > 0 {
+            s.x[0] / s.n[0] as f64
+        } else {
+            0.0
+        }
+}
+
+/// Writes `g = u + f − d` on the free set (zero elsewhere) into `z` and the free set into
+/// `free`; sums `x[0] = Σ_{p>0} g²`, `x[1] = Σ_{p=0, g<0} g²`, `x[2] = Σ_F g`,
+/// `n[0] = |{p > 0}|`, `n[1] = |F|`.
+fn gap_pass(
+    (u, f, p): (&[f64], &[f64], &[f64]),
+    d: f64,
+    (z, free): (&mut [f64], &mut [bool]),
+    partials: &mut [Sums],
+) -> Sums {
+    z.par_chunks_mut(CHUNK)
+        .zip(free.par_chunks_mut(CHUNK))
+        .zip(u.par_chunks(CHUNK))
+        .zip(f.par_chunks(CHUNK).zip(p.par_chunks(CHUNK)))
+        .zip(partials.par_iter_mut())
+        .for_each(|((((z, free), u), (f, p)), out)| {
+            let mut s = Sums::default();
+            for (((zi, fr), &ui), (&fi, &pi)) in z
+                .iter_mut()
+                .zip(free.iter_mut())
+                .zip(u)
+                .zip(f.iter().zip(p))
+            {
+                let (g, is_free) = gap_at(ui, fi, d, pi);
+                if pi > 0.0 {
+                    s.n[0] += 1;
+                    s.x[0] += g * g;
+                } else if g < 0.0 {
+                    s.x[1] += g * g;
+                }
+                *zi = if is_free { g } else { 0.0 };
+                *fr = is_free;
+                s.n[1] += is_free as usize;
+                s.x[2] += if is_free { g } else { 0.0 };
+            }
+            *out = s;
+        });
+    Sums::total(partials)
+}
+
+/// `z ← z − centre` on the free set and `gradient ← z` (everywhere: zero off the set).
+fn centre_pass(z: &mut [f64], gradient: &mut [f64], free: &[bool], centre: f64) {
+    z.par_chunks_mut(CHUNK)
+        .zip(gradient.par_chunks_mut(CHUNK))
+        .zip(free.par_chunks(CHUNK))
+        .for_each(|((z, gradient), free)| {
+            for ((zi, gi), &fr) in z.iter_mut().zip(gradient.iter_mut()).zip(free) {
+                if fr {
+                    *zi -= centre;
+                }
+                *gi = *zi;
+            }
+        });
+}
+
+/// Sums on the free set for the new direction: `x = [Σz, Σz·Πg, Σz·g_old, Σg_old, Σs,
+/// Σs·Πg, ΣΠg]` (`s` the old direction).
+fn direction_sums(
+    (z, gradient, old): (&[f64], &[f64], &[f64]),
+    (s, free): (&[f64], &[bool]),
+    partials: &mut [Sums],
+) -> Sums {
+    z.par_chunks(CHUNK)
+        .zip(gradient.par_chunks(CHUNK))
+        .zip(old.par_chunks(CHUNK))
+        .zip(s.par_chunks(CHUNK).zip(free.par_chunks(CHUNK)))
+        .zip(partials.par_iter_mut())
+        .for_each(|((((z, g), old), (s, free)), out)| {
+            let mut a = [0.0; 7];
+            for ((((&zi, &gi), &oi), &si), &fr) in z.iter().zip(g).zip(old).zip(s).zip(free) {
+                if fr {
+                    a[0] += zi;
+                    a[1] += zi * gi;
+                    a[2] += zi * oi;
+                    a[3] += oi;
+                    a[4] += si;
+                    a[5] += si * gi;
+                    a[6] += gi;
+                }
+            }
+            *out = Sums { x: a, n: [0, 0] };
+        });
+    Sums::total(partials)
+}
+
+/// `s ← −(z − z̄) + β s − m` on the free set (`restart`: `−(z − z̄)`), zero elsewhere.
+fn direction_pass(
+    s: &mut [f64],
+    (z, free): (&[f64], &[bool]),
+    (z_mean, beta, s_mean): (f64, f64, f64),
+    restart: bool,
+) {
+    s.par_chunks_mut(CHUNK)
+        .zip(z.par_chunks(CHUNK))
+        .zip(free.par_chunks(CHUNK))
+        .for_each(|((s, z), free)| {
+            for ((si, &zi), &fr) in s.iter_mut().zip(z).zip(free) {
+                *si = if !fr {
+                    0.0
+                } else if restart {
+                    -(zi - z_mean)
+                } else {
+                    -(zi - z_mean) + beta * *si - s_mean
+                };
+            }
+        });
+}
+
+/// `Σ s·w`.
+fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
+    s.par_chunks(CHUNK)
+        .zip(w.par_chunks(CHUNK))
+        .zip(partials.par_iter_mut())
+        .for_each(|((s, w), out)| {
+            let sum = s.iter().zip(w).map(|(a, b)| a * b).fold(0.0, |a, b| a + b);
+            *out = Sums {
+                x: [sum, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                n: [0, 0],
+            };
+        });
+    Sums::total(partials).x[0]
+}
+
+/// `p ← max(p + α s, 0)`, `u ← u + α w`; sums `x[0] = Σ p`, `n[0]` = cuts; the first
+/// [`CUT_LIMIT`] cuts of each chunk go to its slots of `chunk_cuts`.
+fn step_pass(
+    (p, u): (&mut [f64], &mut [f64]),
+    (s, w): (&[f64], &[f64]),
+    alpha: f64,
+    (chunk_cuts, partials): (&mut [(usize, f64)], &mut [Sums]),
+) -> Sums {
+    p.par_chunks_mut(CHUNK)
+        .zip(u.par_chunks_mut(CHUNK))
+        .zip(s.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
+        .zip(chunk_cuts.par_chunks_mut(CUT_LIMIT))
+        .zip(partials.par_iter_mut())
+        .enumerate()
+        .for_each(|(chunk, ((((p, u), (s, w)), slots), out))| {
+            let (mut cuts, mut total) = (0usize, 0.0);
+            for (index, ((pi, ui), (&si, &wi))) in p
+                .iter_mut()
+                .zip(u.iter_mut())
+                .zip(s.iter().zip(w))
+                .enumerate()
+            {
+                let next = *pi + alpha * si;
+                if next < 0.0 {
+                    // The step wanted `next`, the bound allows 0: `u` misses `K e (−next)`.
+                    *pi = 0.0;
+                    if cuts < CUT_LIMIT {
+                        slots[cuts] = (chunk * CHUNK + index, -next);
+                    }
+                    cuts += 1;
+                } else {
+                    *pi = next;
+                }
+                *ui += alpha * wi;
+                total += *pi;
+            }
+            *out = Sums {
+                x: [total, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                n: [cuts, 0],
+            };
+        });
+    Sums::total(partials)
 }
 
 impl ContactSolver {
@@ -161,6 +418,7 @@ impl ContactSolver {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => self.solved.map_or(0.0, |s| s.indentation),
         };
+        self.bccg_scratch.pending_scale = 1.0;
         self.operator.apply(&self.pressure, &mut self.gap);
         let mut applications = 1;
         let (mut exact, mut since_refresh) = (true, 0);
@@ -192,11 +450,11 @@ impl ContactSolver {
                 });
             }
             iteration += 1;
-            let zg = self.direction(target, &gradient, previous_zg);
-            previous_zg = zg;
+            let direction = self.direction(target, &gradient, previous_zg);
+            previous_zg = direction.zg;
             self.operator.apply(&self.direction, &mut self.response);
             applications += 1;
-            let cut = self.step(target, &gradient, iteration)?;
+            let cut = self.step(target, &gradient, direction.sg, iteration)?;
             since_refresh += 1;
             exact = false;
             if cut || since_refresh >= REFRESH_INTERVAL {
@@ -206,58 +464,42 @@ impl ContactSolver {
         }
     }
 
-    /// Pass over the grid: `d` (load control, the mean of `u + f` on the contact set,
-    /// summed about its previous value so that the residual does not cancel), the residual,
-    /// the free set's size and mean gradient; writes `g` on the free set (zero elsewhere)
-    /// into the preconditioner's field.
+    /// Passes over the grid: `d` (load control, the mean of `u + f` on the contact set),
+    /// the residual, the free set and its mean gradient; writes `Π g` on the free set (zero
+    /// elsewhere) into the preconditioner's field and the gradient field.
     fn gradient_pass(&mut self, target: Target, previous: f64) -> Gradient {
-        let (u, f, p) = (&self.gap, &self.profile, &self.pressure);
+        let scratch = &mut self.bccg_scratch;
         let indentation = match target {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => {
-                let (mut count, mut sum) = (0usize, 0.0);
-                for ((&ui, &fi), &pi) in u.iter().zip(f).zip(p) {
-                    if pi > 0.0 {
-                        count += 1;
-                        sum += ui + fi - previous;
-                    }
-                }
-                previous + if count > 0 { sum / count as f64 } else { 0.0 }
+                let fields = (&mut self.gap[..], &mut self.pressure[..], &self.profile[..]);
+                let scale = std::mem::replace(&mut scratch.pending_scale, 1.0);
+                contact_mean(fields, previous, scale, &mut scratch.partials)
             }
         };
-        let z = &mut self.bccg_scratch.preconditioned;
-        let (mut contact_points, mut free_points) = (0usize, 0usize);
-        let (mut gap_squared, mut penetration_squared, mut free_sum) = (0.0, 0.0, 0.0);
-        for (((zi, &ui), &fi), &pi) in z.iter_mut().zip(u).zip(f).zip(p) {
-            let (g, free) = gap_at(ui, fi, indentation, pi);
-            if pi > 0.0 {
-                contact_points += 1;
-                gap_squared += g * g;
-            } else if g < 0.0 {
-                penetration_squared += g * g;
-            }
-            *zi = if free { g } else { 0.0 };
-            free_points += free as usize;
-            free_sum += if free { g } else { 0.0 };
-        }
+        let sums = gap_pass(
+            (&self.gap, &self.profile, &self.pressure),
+            indentation,
+            (&mut scratch.preconditioned, &mut scratch.free),
+            &mut scratch.partials,
+        );
+        let [contact_points, free_points] = sums.n;
         let load_control = matches!(target, Target::MeanPressure(_));
         let centre = if load_control && free_points > 0 {
-            free_sum / free_points as f64
+            sums.x[2] / free_points as f64
         } else {
             0.0
         };
-        if centre != 0.0 {
-            for ((zi, &ui), (&fi, &pi)) in z.iter_mut().zip(u).zip(f.iter().zip(p)) {
-                if gap_at(ui, fi, indentation, pi).1 {
-                    *zi -= centre;
-                }
-            }
-        }
-        let residual = ((gap_squared + penetration_squared) / contact_points.max(1) as f64).sqrt()
-            / self.height_scale;
+        centre_pass(
+            &mut scratch.preconditioned,
+            &mut scratch.gradient,
+            &scratch.free,
+            centre,
+        );
+        let residual =
+            ((sums.x[0] + sums.x[1]) / contact_points.max(1) as f64).sqrt() / self.height_scale;
         Gradient {
             indentation,
-            centre,
             free_points,
             contact_points,
             residual,
@@ -265,33 +507,21 @@ impl ContactSolver {
     }
 
     /// Preconditions the gradient and makes the new direction `s` (in the direction
-    /// buffer, zero off the free set); returns `zᵀg`, the denominator of the next `β`.
-    fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> f64 {
+    /// buffer, zero off the free set, centred on it under load control). The sums of the
+    /// new direction follow from those of the old one (one pass of sums, one of writes).
+    fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> Direction {
         let load_control = matches!(target, Target::MeanPressure(_));
-        self.preconditioner
-            .apply(&mut self.bccg_scratch.preconditioned);
-        let (u, f, p) = (&self.gap, &self.profile, &self.pressure);
-        let (d, centre) = (gradient.indentation, gradient.centre);
         let scratch = &mut self.bccg_scratch;
-        let (z, g_old) = (&scratch.preconditioned, &mut scratch.previous_gradient);
-        // zᵀΠg, zᵀg_old and the mean of z, all on the free set.
-        let (mut z_sum, mut zg, mut z_g_old, mut g_old_sum) = (0.0, 0.0, 0.0, 0.0);
-        for (((&zi, &go), &ui), (&fi, &pi)) in
-            z.iter().zip(g_old.iter()).zip(u).zip(f.iter().zip(p))
-        {
-            let (g, free) = gap_at(ui, fi, d, pi);
-            if free {
-                z_sum += zi;
-                zg += zi * (g - centre);
-                z_g_old += zi * go;
-                g_old_sum += go;
-            }
-        }
-        let z_mean = if load_control && gradient.free_points > 0 {
-            z_sum / gradient.free_points as f64
-        } else {
-            0.0
-        };
+        self.preconditioner.apply(&mut scratch.preconditioned);
+        let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
+        let [z_sum, zg, z_g_old, g_old_sum, s_sum, s_g, g_sum] = direction_sums(
+            (z, &scratch.gradient, &scratch.previous_gradient),
+            (&self.direction, free),
+            &mut scratch.partials,
+        )
+        .x;
+        let n_free = gradient.free_points.max(1) as f64;
+        let z_mean = if load_control { z_sum / n_free } else { 0.0 };
         // Polak–Ribière with the centred z: (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old.
         let numerator = zg - (z_g_old - z_mean * g_old_sum);
         let beta = if previous_zg > 0.0 {
@@ -299,68 +529,46 @@ impl ContactSolver {
         } else {
             0.0
         };
-        let s = &mut self.direction;
-        let (mut s_sum, mut sg) = (0.0, 0.0);
-        for ((((si, go), &zi), &ui), (&fi, &pi)) in s
-            .iter_mut()
-            .zip(g_old.iter_mut())
-            .zip(z)
-            .zip(u)
-            .zip(f.iter().zip(p))
-        {
-            let (g, free) = gap_at(ui, fi, d, pi);
-            if free {
-                *si = -(zi - z_mean) + beta * *si;
-                *go = g - centre;
-                s_sum += *si;
-                sg += *si * *go;
-            } else {
-                *si = 0.0;
-                *go = 0.0;
-            }
-        }
-        let s_mean = if load_control && gradient.free_points > 0 {
-            s_sum / gradient.free_points as f64
+        // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.
+        let steepest_g = -(zg - z_mean * g_sum);
+        let s_mean = if load_control {
+            (-(z_sum - z_mean * n_free) + beta * s_sum) / n_free
         } else {
             0.0
         };
+        let sg = steepest_g + beta * s_g;
         // Centring s on F leaves sᵀΠg unchanged (Σ_F Πg = 0); a direction that is not
         // downhill is replaced by steepest descent −z.
         let restart = sg >= 0.0 || sg.is_nan();
-        if s_mean != 0.0 || restart {
-            for ((si, &zi), (&ui, (&fi, &pi))) in
-                s.iter_mut().zip(z).zip(u.iter().zip(f.iter().zip(p)))
-            {
-                if gap_at(ui, fi, d, pi).1 {
-                    *si = if restart {
-                        -(zi - z_mean)
-                    } else {
-                        *si - s_mean
-                    };
-                }
-            }
+        direction_pass(
+            &mut self.direction,
+            (z, free),
+            (z_mean, beta, s_mean),
+            restart,
+        );
+        std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
+        Direction {
+            zg,
+            sg: if restart {
+                steepest_g
+            } else {
+                sg - s_mean * g_sum
+            },
         }
-        zg
     }
 
-    /// Pass over the grid: `α = −sᵀg / sᵀw`, `p ← max(p + α s, 0)`, `u ← u + α w`, and the
-    /// load restored by scaling `p` and `u`. Returns whether the projection cut a pressure
-    /// (then `u` is stale).
+    /// `α = −sᵀΠg / sᵀw`, `p ← max(p + α s, 0)`, `u ← u + α w`, and the load restored by
+    /// scaling `p` and `u` (in the next pass). Returns whether the projection cut a pressure
+    /// that the point responses did not correct (then `u` is stale).
     fn step(
         &mut self,
         target: Target,
         gradient: &Gradient,
+        sg: f64,
         iteration: usize,
     ) -> Result<bool, SolveError> {
-        let d = gradient.indentation;
-        let (s, w) = (&self.direction, &self.response);
-        let (mut sg, mut sw) = (0.0, 0.0);
-        for (((&si, &wi), &ui), &fi) in s.iter().zip(w).zip(&self.gap).zip(&self.profile) {
-            if si != 0.0 {
-                sg += si * (ui + fi - d - gradient.centre);
-                sw += si * wi;
-            }
-        }
+        let scratch = &mut self.bccg_scratch;
+        let sw = dot(&self.direction, &self.response, &mut scratch.partials);
         if !crate::is_positive_finite(sw) {
             // K is positive on every direction but the constant one of a periodic grid,
             // which the free set excludes short of full contact: rounding only.
@@ -370,46 +578,32 @@ impl ContactSolver {
             });
         }
         let alpha = -sg / sw;
-        let (mut cuts, mut total) = (0usize, 0.0);
-        let corrections = &mut self.bccg_scratch.cuts;
-        corrections.clear();
-        for (index, (((pi, ui), &si), &wi)) in self
-            .pressure
-            .iter_mut()
-            .zip(self.gap.iter_mut())
-            .zip(s)
-            .zip(w)
-            .enumerate()
-        {
-            let next = *pi + alpha * si;
-            if next < 0.0 {
-                // The step wanted `next`, the bound allows 0: `u` misses `K e (−next)`.
-                *pi = 0.0;
-                cuts += 1;
-                if corrections.len() < corrections.capacity() {
-                    corrections.push((index, -next));
-                }
-            } else {
-                *pi = next;
-            }
-            *ui += alpha * wi;
-            total += *pi;
-        }
-        // A few cuts are corrected by their point responses (a few grid passes, far
-        // cheaper than an operator application); more leave `u` stale.
-        let mut cut = cuts > corrections.len();
+        let sums = step_pass(
+            (&mut self.pressure, &mut self.gap),
+            (&self.direction, &self.response),
+            alpha,
+            (&mut scratch.chunk_cuts, &mut scratch.partials),
+        );
+        let (cuts, total) = (sums.n[0], sums.x[0]);
+        // A few cuts are corrected by their point responses (one grid pass, far cheaper
+        // than an operator application); more leave `u` stale.
+        let mut cut = cuts > CUT_LIMIT;
         if !cut && cuts > 0 {
+            let corrections = &mut scratch.cuts;
+            corrections.clear();
+            for (slots, partial) in scratch.chunk_cuts.chunks(CUT_LIMIT).zip(&scratch.partials) {
+                corrections.extend_from_slice(&slots[..partial.n[0]]);
+            }
             let periodic = self.operator.boundary() == Boundary::Periodic;
             let grid = (self.rows, self.cols, periodic);
-            add_point_responses(&mut self.gap, &self.bccg_scratch.impulse, grid, corrections);
+            add_point_responses(&mut self.gap, &scratch.impulse, grid, corrections);
         }
         if let Target::MeanPressure(mean_pressure) = target {
             let n = self.pressure.len() as f64;
             let scale = mean_pressure * n / total;
-            // A step that cut nothing keeps Σ p up to rounding: the two passes are saved.
+            // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
             if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
-                self.pressure.iter_mut().for_each(|v| *v *= scale);
-                self.gap.iter_mut().for_each(|v| *v *= scale);
+                scratch.pending_scale = scale;
             } else if total <= 0.0 {
                 self.pressure.fill(mean_pressure);
                 cut = true;
@@ -440,8 +634,15 @@ impl ContactSolver {
         }
     }
 
-    /// `u = K p` exactly (in the gap buffer).
+    /// `u = K p` exactly (in the gap buffer), after the pending load restoration of `p`
+    /// (that of `u` is moot).
     fn refresh_displacement(&mut self) {
+        let scale = std::mem::replace(&mut self.bccg_scratch.pending_scale, 1.0);
+        if scale != 1.0 {
+            self.pressure
+                .par_chunks_mut(CHUNK)
+                .for_each(|p| p.iter_mut().for_each(|v| *v *= scale));
+        }
         self.operator.apply(&self.pressure, &mut self.gap);
     }
 
@@ -610,12 +811,16 @@ mod tests {
 
     #[test]
     fn results_do_not_depend_on_the_thread_count() {
-        let surface = rough_grid(48, 56, 3);
-        for boundary in [Boundary::Free, Boundary::Periodic] {
+        // 150² spans three chunks of the parallel passes: their partial sums must add up
+        // to the same bits whichever threads computed them.
+        for (surface, boundary) in [rough_grid(48, 56, 3), rough_grid(150, 150, 3)]
+            .iter()
+            .flat_map(|s| [(s, Boundary::Free), (s, Boundary::Periodic)])
+        {
             let run = |threads: usize| {
                 crate::test_support::with_threads(threads, || {
                     let mut solver =
-                        ContactSolver::new(&surface, half_space(boundary), SolverParams::default())
+                        ContactSolver::new(surface, half_space(boundary), SolverParams::default())
                             .unwrap();
                     let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
                     let (k, _) = solver.frozen_set_stiffness().unwrap();

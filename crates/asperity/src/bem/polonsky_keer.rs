@@ -94,11 +94,11 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow): the operator, the preconditioner, five fields, the three BCCG fields and
-    /// the four stiffness and full-contact fields. The caller's [`Surface`] (one more
+    /// overflow): the operator, the preconditioner, five fields, the four BCCG fields and their
+    /// mask, the four stiffness and full-contact fields. The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let fields = memory::array_bytes(&[12, rows, cols], 8)?;
+        let fields = memory::array_bytes(&[14, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
             .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
             .checked_add(fields)

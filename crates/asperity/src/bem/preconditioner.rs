@@ -73,12 +73,14 @@ impl FourierPreconditioner {
     }
 
     /// `data ← M data` (a `rows × cols` row-major field, overwritten).
+    /// One fused convolution: each column of the spectrum is multiplied while in cache.
     pub(super) fn apply(&mut self, data: &mut [f64]) {
-        self.fft.forward(data, &mut self.spectrum);
-        for (c, &m) in self.spectrum.iter_mut().zip(&self.symbol) {
-            *c *= m;
-        }
-        self.fft.inverse(&mut self.spectrum, data);
+        let (symbol, rows) = (&self.symbol, self.fft.rows());
+        self.fft
+            .convolve_in_place(data, &mut self.spectrum, |kx, column| {
+                let m = &symbol[kx * rows..(kx + 1) * rows];
+                column.iter_mut().zip(m).for_each(|(c, &m)| *c *= m);
+            });
     }
 }
 
