@@ -568,13 +568,18 @@ mod tests {
         let spec = spec(Method::Bem, 32, vec![0.8], 2);
         let task = spec.tasks()[0];
         let stop = crate::stop::Stop::new();
-        let sampler = BemSampler::new(&spec, task).unwrap().with_stop(stop.clone());
+        let sampler = BemSampler::new(&spec, task)
+            .unwrap()
+            .with_stop(stop.clone());
         let mut worker = sampler.worker().unwrap();
         let finished = sampler.sample(&mut worker, 1).unwrap();
         stop.request();
         match sampler.sample(&mut worker, 2) {
             Err(Error::Solve { source, .. }) => assert!(
-                matches!(*source, crate::bem::SolveError::Interrupted { iterations: 0 }),
+                matches!(
+                    *source,
+                    crate::bem::SolveError::Interrupted { iterations: 0 }
+                ),
                 "{source}"
             ),
             other => panic!("{other:?}"),
