@@ -63,9 +63,11 @@ __all__ = [
     "StudyResult",
     "Surface",
     "Sweep",
+    "Topography",
     "line",
     "mdr",
     "psd",
+    "read_topography",
     "stats",
     "study_alpha",
     "study_curve",
@@ -349,6 +351,54 @@ class Psd:
     hurst: Optional[float] = None
 
 
+@dataclass
+class Topography:
+    """A measured topography read by asperity's own readers (:func:`read_topography`):
+    ``heights`` (rows × cols = y × x for a map, or a profile along x; metres where the file
+    gives a length unit; NaN where the instrument measured nothing), ``size`` along x,
+    ``size_y`` along y (``None`` for a profile; pixels may be rectangular) and the
+    ``provenance`` (source, format, channel, channels, units, where the sizes came from).
+    A map can go straight to :class:`Solver` (both sizes are used) once it has no NaN.
+
+    Example::
+
+        >>> t = asperity.read_topography("scan.x3p")                   # doctest: +SKIP
+        >>> t.heights.shape, t.size, t.size_y, t.provenance["format"]  # doctest: +SKIP
+    """
+
+    heights: np.ndarray
+    size: float
+    size_y: Optional[float]
+    provenance: Dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def physical_sizes(self) -> Tuple[float, ...]:
+        return (self.size,) if self.size_y is None else (self.size, self.size_y)
+
+
+def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None, str, int] = None,
+                    size: Union[None, float, Tuple[float, float]] = None) -> Topography:
+    """Reads a measured file with the library's readers, the ones ``asperity import`` and
+    ``asperity stats FILE`` use (format by content, then extension: X3P, SDF, text and
+    Gwyddion matrices, x y z lists, x z profiles, SUR, PLU, OPD, DI, AL3D, MetroPro DAT,
+    FRT, WSxM, TMD, ``.npy``). ``channel``: a name or 0-based index (default: the first
+    height channel); ``size``: ``x`` or ``(x, y)`` in metres where the file carries none,
+    or to override it. No cleaning is done (levelling, filling: the CLI's ``import``).
+    Bad files raise ``ValueError`` with the CLI's one line.
+    """
+    if isinstance(size, (tuple, list)):
+        if len(size) != 2:
+            raise ValueError(f"size: give x or (x, y), got {size!r}")
+        size_x, size_y = _positive(size[0], "size"), _positive(size[1], "size")
+    else:
+        size_x, size_y = _positive(size, "size"), None
+    heights, sizes, provenance = _core.read_topography(
+        os.fspath(path), None if channel is None else str(channel), size_x, size_y)
+    return Topography(heights=heights, size=float(sizes[0]),
+                      size_y=float(sizes[1]) if len(sizes) > 1 else None,
+                      provenance=json.loads(provenance))
+
+
 def psd(
     values: Any,
     *,
@@ -609,6 +659,12 @@ def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, flo
     """Heights (rows × cols), size along x and (for SurfaceTopography objects) along y."""
     if isinstance(surface, Surface):
         return surface.heights, surface.size if size is None else float(size), None
+    if isinstance(surface, Topography):
+        if surface.heights.ndim != 2:
+            raise ValueError("surface: a measured profile is no surface (use mdr for lines)")
+        if size is not None:
+            raise ValueError("size: the topography has its own sizes")
+        return surface.heights, surface.size, surface.size_y
     heights_of = getattr(surface, "heights", None)
     if callable(heights_of) and hasattr(surface, "physical_sizes"):
         # SurfaceTopography: heights()[x, y] with physical_sizes (sx, sy).

@@ -77,6 +77,20 @@ def psd(
 ) -> Psd: ...
 
 @dataclass
+class Topography:
+    heights: F64
+    size: float
+    size_y: Optional[float]
+    provenance: Dict[str, Any] = ...
+    @property
+    def physical_sizes(self) -> Tuple[float, ...]: ...
+
+def read_topography(
+    path: PathLike, *, channel: Union[None, str, int] = ...,
+    size: Union[None, float, Tuple[float, float]] = ...,
+) -> Topography: ...
+
+@dataclass
 class ContactResult:
     force: float
     mean_pressure: float

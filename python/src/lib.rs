@@ -14,6 +14,7 @@ mod interrupt;
 mod mdr;
 mod study;
 mod surface;
+mod topography;
 
 use pyo3::prelude::*;
 
@@ -34,5 +35,6 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bem::register(m)?;
     mdr::register(m)?;
     study::register(m)?;
+    topography::register(m)?;
     Ok(())
 }
