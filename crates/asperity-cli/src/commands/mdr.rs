@@ -264,20 +264,40 @@ fn radial_indenter(args: &MdrArgs, path: &Path) -> Result<Indenter> {
     let samples = read_npy_1d(path)?;
     let profile = RadialProfile::new(samples.as_slice().expect("contiguous"), step)?;
     let (n, dx) = spring_grid(args, "--radial")?;
-    Ok(Indenter {
-        values: profile.sample(n, dx)?,
+    let description = format!(
+        "radial profile {} ({} samples, Δr = {step}), n = {n}, Δx = {dx}",
+        path.display(),
+        samples.len()
+    );
+    let source = json!({
+        "kind": "radial profile", "file": path, "samples": samples.len(), "radial_step": step,
+    });
+    Ok(axisymmetric(
+        args,
+        profile.sample(n, dx)?,
+        dx,
+        description,
+        source,
+    ))
+}
+
+/// An axisymmetric indenter mapped to `values` on springs `dx` apart (L: `--size`, else
+/// the grid's n·Δx).
+fn axisymmetric(
+    args: &MdrArgs,
+    values: Vec<f64>,
+    dx: f64,
+    description: String,
+    source: serde_json::Value,
+) -> Indenter {
+    Indenter {
+        size: args.size.unwrap_or(values.len() as f64 * dx),
+        values,
         is_line: false,
         spacing: dx,
-        size: args.size.unwrap_or(n as f64 * dx),
-        description: format!(
-            "radial profile {} ({} samples, Δr = {step}), n = {n}, Δx = {dx}",
-            path.display(),
-            samples.len()
-        ),
-        source: json!({
-            "kind": "radial profile", "file": path, "samples": samples.len(), "radial_step": step,
-        }),
-    })
+        description,
+        source,
+    }
 }
 
 /// A closed-form axisymmetric indenter (`--profile`).
@@ -299,14 +319,15 @@ fn closed_form_indenter(args: &MdrArgs, kind: ProfileKind) -> Result<Indenter> {
     };
     shape.validate()?;
     let (n, dx) = spring_grid(args, "--profile")?;
-    Ok(Indenter {
-        values: shape.sample(n, dx)?,
-        is_line: false,
-        spacing: dx,
-        size: args.size.unwrap_or(n as f64 * dx),
-        description: format!("{shape}, n = {n}, Δx = {dx}"),
-        source: json!({ "kind": "profile", "shape": shape }),
-    })
+    let description = format!("{shape}, n = {n}, Δx = {dx}");
+    let source = json!({ "kind": "profile", "shape": shape });
+    Ok(axisymmetric(
+        args,
+        shape.sample(n, dx)?,
+        dx,
+        description,
+        source,
+    ))
 }
 
 fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
