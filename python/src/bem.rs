@@ -8,7 +8,7 @@
 //! flag that Ctrl-C sets ([`crate::interrupt`]), so one long solve stops too.
 
 use asperity::bem::sweep::{
-    describe, sweep, SweepError, SweepObserver, SweepParams, SweepRow, SweepStep,
+    sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow,
 };
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
@@ -116,28 +116,14 @@ fn with_context(error: SolveError, context: &str) -> PyErr {
 /// callback, raised by `run_detached` instead of this).
 struct Cancelled;
 
-/// A sweep's error as a Python exception, with the load in the CLI's words.
+/// A sweep's error as a Python exception, with the load as the library's
+/// [`SweepError::explain`] names it.
 fn sweep_error(error: SweepError<Cancelled>) -> PyErr {
-    match error {
-        SweepError::Input(e) => from_error(e),
-        SweepError::Solve {
-            load,
-            control,
-            step,
-            source,
-        } => {
-            let load = describe(load, control);
-            let context = match step {
-                SweepStep::FullContactCheck | SweepStep::Solve => load,
-                SweepStep::Stiffness => format!("stiffness at {load}"),
-                SweepStep::FiniteDifference => format!("fd_stiffness at {load}"),
-            };
-            with_context(source, &context)
-        }
-        e @ SweepError::StepBeyondFullContact { .. } => invalid(format!(
-            "fd_stiffness: {e}; lower the load or drop fd_stiffness"
-        )),
-        SweepError::Stopped(Cancelled) => {
+    match error.explain("fd_stiffness") {
+        SweepFailure::Input(source) => from_solve(source),
+        SweepFailure::AtLoad { context, source } => with_context(source, &context),
+        SweepFailure::StepBeyondFullContact(message) => invalid(message),
+        SweepFailure::Stopped(Cancelled) => {
             pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted")
         }
     }

@@ -44,7 +44,10 @@ pub fn from_error(error: Error) -> PyErr {
         Error::Io { .. } => PyOSError::new_err(error.to_string()),
         Error::FolderInUse { .. } => PyBlockingIOError::new_err(error.to_string()),
         Error::Solve { context, source } => {
-            let err = from_solve(*source);
+            let err = match source.downcast::<SolveError>() {
+                Ok(solve) => from_solve(*solve),
+                Err(other) => PyValueError::new_err(other.to_string()),
+            };
             Python::attach(|py| prefix(py, err, &context))
         }
         other => PyValueError::new_err(other.to_string()),

@@ -128,7 +128,8 @@ fn library_error(error: &asperity::Error) -> String {
             path.display()
         ),
         E::Solve { context, source } => {
-            format!("{context}: {}", in_cli_words(source.as_ref()))
+            let source: &(dyn std::error::Error + 'static) = source.as_ref();
+            format!("{context}: {}", in_cli_words(source))
         }
         other => other.to_string(),
     }

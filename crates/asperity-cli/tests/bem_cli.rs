@@ -167,6 +167,19 @@ fn stdout_table_without_out_and_indentation_control() {
     let mut lines = text.lines();
     assert!(lines.next().unwrap().contains("area_fraction"));
     assert_eq!(lines.count(), 2);
+    // The CSV that --out writes, byte for byte (the help promises a CSV either way).
+    let csv = dir.path().join("t.csv");
+    let written = asperity(&[
+        "bem",
+        "--surface",
+        s.to_str().unwrap(),
+        "--indentations",
+        "0,0.01",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    ok(&written);
+    assert_eq!(std::fs::read(&csv).unwrap(), out.stdout);
 }
 
 #[test]

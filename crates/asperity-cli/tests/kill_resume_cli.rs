@@ -8,7 +8,7 @@
 //! run ended.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -71,22 +71,10 @@ fn kill_after(args: &[&str], dir: &Path, delay: Duration, signal: &str) -> bool 
 /// Every result file under `dir` (relative path → bytes): all but the lock (it holds a
 /// PID), the wall times, and temporary files a SIGKILL can leave (hidden `.tmp` files,
 /// which no later run reads).
-fn results(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            if path.is_dir() {
-                stack.push(path);
-            } else if name != ".asperity.lock" && name != "timings.json" && !name.contains(".tmp") {
-                let rel = path.strip_prefix(dir).unwrap().to_path_buf();
-                out.insert(rel, std::fs::read(&path).unwrap());
-            }
-        }
-    }
-    out
+fn results(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    common::files_under(dir, |name| {
+        name == ".asperity.lock" || name == "timings.json" || name.contains(".tmp")
+    })
 }
 
 /// A small BEM study: for each kill point a fresh folder is killed once and resumed.

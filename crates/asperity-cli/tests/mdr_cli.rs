@@ -208,6 +208,56 @@ fn line_breakpoints_and_log_spaced_loads() {
 }
 
 #[test]
+fn out_records_the_inputs_beside_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let line = [
+        "line", "--n", "256", "--hurst", "0.5", "--size", "2", "--seed", "3",
+    ];
+    ok(&asperity(&[&line[..], &["--out", "l.npy"]].concat(), d));
+    let run = [
+        "mdr",
+        "--line",
+        "l.npy",
+        "--spring",
+        "fractal",
+        "--hurst",
+        "0.5",
+        "--nloads",
+        "7",
+        "--modulus",
+        "3",
+        "--out",
+        "c.csv",
+    ];
+    ok(&asperity(&run, d));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("c.csv.json")).unwrap()).unwrap();
+    assert_eq!(record["command"], "asperity mdr");
+    assert_eq!(record["indenter"]["kind"], "line");
+    assert_eq!(record["indenter"]["size_source"], "sidecar");
+    assert_eq!(record["springs"], 256);
+    assert_eq!(record["size"], 2.0);
+    assert_eq!(record["modulus"], 3.0);
+    assert_eq!(record["spring_law"]["kind"], "fractal");
+    assert_eq!(record["spring_law"]["hurst"], 0.5);
+    // The indentations recorded are those of the table, bit for bit.
+    let recorded: Vec<f64> = record["indentations"]["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let table: Vec<f64> = read_curve(&d.join("c.csv")).iter().map(|r| r.0).collect();
+    assert_eq!(recorded, table);
+    // Like every single command's outputs, the record is not overwritten without --force.
+    std::fs::remove_file(d.join("c.csv")).unwrap();
+    refused(&asperity(&run, d), "c.csv.json");
+    assert!(!d.join("c.csv").exists());
+    ok(&asperity(&[&run[..], &["--force"]].concat(), d));
+}
+
+#[test]
 fn sampled_radial_profile_is_transformed() {
     // f = r²/2R sampled on r = 0, 1e-3, …, 1: its MDR transform is x²/R, so the foundation
     // reproduces Hertz like the closed-form sphere (a ≥ 200 Δx: within 0.5 %).
@@ -417,9 +467,10 @@ fn existing_output_is_kept_unless_forced() {
     let out = asperity(&forced, dir.path());
     ok(&out);
     assert_eq!(read_curve(&target).len(), 5);
+    // The table and its record of inputs, no temporary files.
     assert_eq!(
         std::fs::read_dir(dir.path()).unwrap().count(),
-        1,
+        2,
         "no temporary files left"
     );
 }
@@ -822,7 +873,15 @@ fn plot_is_written_for_lines_and_profiles() {
     }
     assert_eq!(
         names(d),
-        ["a.csv", "a.png", "b.svg", "c.PNG", "d.svg", "line.npy"],
+        [
+            "a.csv",
+            "a.csv.json",
+            "a.png",
+            "b.svg",
+            "c.PNG",
+            "d.svg",
+            "line.npy"
+        ],
         "no temporary files left"
     );
 }
@@ -892,5 +951,5 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
     assert!(std::fs::read_to_string(d.join("old.svg"))
         .unwrap()
         .contains("<svg"));
-    assert_eq!(names(d), ["c.csv", "old.svg"]);
+    assert_eq!(names(d), ["c.csv", "c.csv.json", "old.svg"]);
 }

@@ -7,35 +7,14 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn asperity(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_asperity"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::run_asperity as asperity;
 
 /// Every result file under `dir` (bookkeeping left out: stamps, timings, locks, temp files).
 fn results(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            if path.is_dir() {
-                stack.push(path);
-            } else if !(name == "reproduce.json" || name == "timings.json" || name.starts_with('.'))
-            {
-                let key = path
-                    .strip_prefix(dir)
-                    .unwrap()
-                    .to_string_lossy()
-                    .into_owned();
-                out.insert(key, std::fs::read(&path).unwrap());
-            }
-        }
-    }
-    out
+    common::files_under(dir, |name| {
+        name == "reproduce.json" || name == "timings.json" || name.starts_with('.')
+    })
 }
 
 #[test]

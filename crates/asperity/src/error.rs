@@ -113,13 +113,18 @@ pub enum Error {
         /// Who holds it, e.g. `PID 1234`.
         holder: String,
     },
-    /// A contact solve inside a larger computation (a study sample) failed.
+    /// A contact solve inside a larger computation (a study sample) failed for a reason of
+    /// the solver's own: no convergence, a stop request, a load beyond full contact (bad
+    /// input to the solver is returned as the [`Error`] it is).
     #[error("{context}: {source}")]
     Solve {
         /// Which computation (e.g. the sample's seed).
         context: String,
-        /// The solver's error, with its residual where it did not converge.
-        source: Box<crate::bem::SolveError>,
+        /// The solver's error, a [`crate::bem::SolveError`] (downcast it to read its
+        /// residual or iterations). Held as a trait object so that the two error types do
+        /// not contain each other: a `SolveError` holds an `Error` (bad input), not the
+        /// other way round.
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A metadata (JSON / TOML) file could not be parsed or written.
     #[error("{path}: {reason}")]

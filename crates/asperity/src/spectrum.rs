@@ -36,12 +36,30 @@ pub enum LongWavelength {
     },
 }
 
-/// Shape of a self-affine power spectrum; construct with [`Psd::new`], which validates.
+/// Shape of a self-affine power spectrum; built only by [`Psd::new`], which validates (also
+/// when read back from JSON).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "PsdFields")]
 pub struct Psd {
     hurst: f64,
     long_wavelength: LongWavelength,
     short_cutoff: Option<f64>,
+}
+
+/// The fields of a [`Psd`] as stored, before [`Psd::new`] checks them.
+#[derive(Deserialize)]
+struct PsdFields {
+    hurst: f64,
+    long_wavelength: LongWavelength,
+    short_cutoff: Option<f64>,
+}
+
+impl TryFrom<PsdFields> for Psd {
+    type Error = Error;
+
+    fn try_from(f: PsdFields) -> Result<Self> {
+        Psd::new(f.hurst, f.long_wavelength, f.short_cutoff)
+    }
 }
 
 impl Psd {
@@ -160,6 +178,23 @@ impl Psd {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn json_is_read_back_through_the_same_checks() {
+        let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 4.0 }, Some(64.0)).unwrap();
+        let text = serde_json::to_string(&psd).unwrap();
+        assert_eq!(serde_json::from_str::<Psd>(&text).unwrap(), psd);
+        // The same fields with a Hurst exponent Psd::new refuses.
+        let bad = text.replace("0.8", "7.5");
+        assert_ne!(bad, text);
+        let err = serde_json::from_str::<Psd>(&bad).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            Psd::new(7.5, LongWavelength::RollOff { q0: 4.0 }, Some(64.0))
+                .unwrap_err()
+                .to_string()
+        );
+    }
 
     #[test]
     fn hurst_range_is_enforced() {

@@ -10,10 +10,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use asperity::bem::sweep::{
-    describe, sweep, SweepError, SweepObserver, SweepParams, SweepRow, SweepStep,
-};
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
+use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
@@ -323,34 +321,14 @@ impl SweepObserver for CliObserver<'_> {
     }
 }
 
-/// A sweep's error in the command line's words (its flags, the load as `load 3 (…)`).
+/// A sweep's error in the command line's words (its flags, the load as `load 3 (…)`), as
+/// the library's [`SweepError::explain`] puts it.
 fn sweep_error(error: SweepError<anyhow::Error>) -> anyhow::Error {
-    match error {
-        SweepError::Input(e) => e.into(),
-        // The threshold computations before any solve fail without a load to name.
-        SweepError::Solve {
-            step: SweepStep::FullContactCheck,
-            source: source @ (SolveError::Input(_) | SolveError::NoConvergence { .. }),
-            ..
-        } => source.into(),
-        SweepError::Solve {
-            load,
-            control,
-            step,
-            source,
-        } => {
-            let load = describe(load, control);
-            let context = match step {
-                SweepStep::FullContactCheck | SweepStep::Solve => load,
-                SweepStep::Stiffness => format!("stiffness at {load}"),
-                SweepStep::FiniteDifference => format!("--fd-stiffness at {load}"),
-            };
-            anyhow::Error::new(source).context(context)
-        }
-        e @ SweepError::StepBeyondFullContact { .. } => {
-            anyhow::anyhow!("--fd-stiffness: {e}; lower the load or drop --fd-stiffness")
-        }
-        SweepError::Stopped(e) => e,
+    match error.explain("--fd-stiffness") {
+        SweepFailure::Input(source) => source.into(),
+        SweepFailure::AtLoad { context, source } => anyhow::Error::new(source).context(context),
+        SweepFailure::StepBeyondFullContact(message) => anyhow::anyhow!(message),
+        SweepFailure::Stopped(e) => e,
     }
 }
 
@@ -400,15 +378,88 @@ fn loads_record(args: &BemArgs) -> serde_json::Value {
     }
 }
 
-/// One CSV row: a value per column, `None` where not computed (an empty CSV cell).
+/// The largest `--tol`: a relative residual of 1e-2 (gaps on the contact set of 1 % of the
+/// rms height) is already far coarser than any use of the results; at 1 and above the
+/// criterion means nothing.
+const MAX_TOL: f64 = 1e-2;
+
+/// `--tol` in (0, [`MAX_TOL`]].
+fn check_tolerance(tol: f64) -> Result<()> {
+    if !(tol > 0.0 && tol <= MAX_TOL) {
+        bail!(
+            "--tol must be positive and at most {MAX_TOL:e} (a relative residual), got {}",
+            asperity::input::short_number(tol)
+        );
+    }
+    Ok(())
+}
+
+/// The columns written: the fixed ones, then `stiffness_fd` with `--fd-stiffness` and the
+/// timing columns with `--timing`.
+#[derive(Debug, Clone, Copy)]
+struct Columns {
+    fd: bool,
+    timing: bool,
+}
+
+impl Columns {
+    fn header(self) -> Vec<&'static str> {
+        let mut header = vec![
+            "force",
+            "mean_pressure",
+            "indentation",
+            "area_fraction",
+            "stiffness",
+            "iterations",
+            "residual",
+        ];
+        if self.fd {
+            header.push("stiffness_fd");
+        }
+        if self.timing {
+            header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
+        }
+        header
+    }
+
+    /// One row's CSV cells: numbers in their shortest round-trip form, the iterations as an
+    /// integer, an empty cell where a value was not computed.
+    fn cells(self, row: &Row) -> Vec<String> {
+        let number = |v: Option<f64>| v.map_or_else(String::new, format_number);
+        let r = &row.sweep;
+        let mut cells = vec![
+            format_number(r.summary.force),
+            format_number(r.summary.mean_pressure),
+            format_number(r.summary.indentation),
+            format_number(r.summary.area_fraction),
+            number(r.stiffness),
+            r.info.iterations.to_string(),
+            format_number(r.info.residual),
+        ];
+        if self.fd {
+            cells.push(number(r.stiffness_fd));
+        }
+        if self.timing {
+            cells.extend([
+                format_number(r.solve_seconds),
+                format_number(r.stiffness_seconds),
+                format_number(row.peak_rss_mib),
+            ]);
+        }
+        cells
+    }
+}
+
+/// One load's results: the library's row, and the peak memory after it (`--timing`).
 struct Row {
-    values: Vec<Option<f64>>,
+    sweep: SweepRow,
+    peak_rss_mib: f64,
 }
 
 /// The `--plot` panels: k/E* vs F/E* and area fraction vs F/E*, log–log.
 fn sweep_charts(
     rows: &[Row],
-    header: &[&str],
+    fd: bool,
     modulus: f64,
     surface: &Path,
     boundary: &str,
@@ -417,29 +468,22 @@ fn sweep_charts(
         || surface.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
-    let col = |name: &str| header.iter().position(|h| *h == name);
-    let value = |row: &Row, i: Option<usize>| i.and_then(|i| row.values[i]).unwrap_or(f64::NAN);
-    let (force, stiffness, fd, area) = (
-        col("force"),
-        col("stiffness"),
-        col("stiffness_fd"),
-        col("area_fraction"),
-    );
-    let points = |y: &dyn Fn(&Row) -> f64| {
+    let points = |y: &dyn Fn(&SweepRow) -> f64| {
         rows.iter()
-            .map(|r| (value(r, force) / modulus, y(r)))
+            .map(|r| (r.sweep.summary.force / modulus, y(&r.sweep)))
             .collect()
     };
     let x_label = "normal force F / E*  [length²]".to_string();
+    let per_modulus = |k: Option<f64>| k.unwrap_or(f64::NAN) / modulus;
     let mut series = vec![Series::new(
         "frozen contact set",
-        points(&|r| value(r, stiffness) / modulus),
+        points(&|r| per_modulus(r.stiffness)),
         Style::LinePoints,
     )];
-    if fd.is_some() {
+    if fd {
         series.push(Series::new(
             "finite difference dF/dd",
-            points(&|r| value(r, fd) / modulus),
+            points(&|r| per_modulus(r.stiffness_fd)),
             Style::Dashed,
         ));
     }
@@ -459,32 +503,24 @@ fn sweep_charts(
         log_y: true,
         series: vec![Series::new(
             "",
-            points(&|r| value(r, area)),
+            points(&|r| r.summary.area_fraction),
             Style::LinePoints,
         )],
     };
     [stiffness, area]
 }
 
-/// The largest `--tol`: a relative residual of 1e-2 (gaps on the contact set of 1 % of the
-/// rms height) is already far coarser than any use of the results; at 1 and above the
-/// criterion means nothing.
-const MAX_TOL: f64 = 1e-2;
-
-/// `--tol` in (0, [`MAX_TOL`]].
-fn check_tolerance(tol: f64) -> Result<()> {
-    if !(tol > 0.0 && tol <= MAX_TOL) {
-        bail!(
-            "--tol must be positive and at most {MAX_TOL:e} (a relative residual), got {}",
-            asperity::input::short_number(tol)
-        );
-    }
-    Ok(())
+/// The checked arguments: everything a solve needs besides the surface.
+struct Plan {
+    boundary: Boundary,
+    loads: Vec<Control>,
+    params: SolverParams,
+    size: [Option<f64>; 2],
+    columns: Columns,
 }
 
-/// Runs `asperity bem`.
-pub fn run(args: &BemArgs) -> Result<()> {
-    // 1. Everything that can be checked before solving.
+/// Step 1a: every argument that can be checked without touching a file.
+fn plan(args: &BemArgs) -> Result<Plan> {
     let boundary: Boundary = args.boundary.parse()?;
     let loads = controls(args)?;
     if !(args.modulus.is_finite() && args.modulus > 0.0) {
@@ -493,14 +529,13 @@ pub fn run(args: &BemArgs) -> Result<()> {
             args.modulus
         );
     }
-    let [size_x, size_y] = match &args.size {
+    let size = match &args.size {
         Some(text) => parse_size(text)?,
         None => [None, None],
     };
     check_tolerance(args.tol)?;
-    let solver: SolverKind = args.solver.parse()?;
     let params = SolverParams {
-        solver,
+        solver: args.solver.parse::<SolverKind>()?,
         tolerance: args.tol,
         max_iterations: args.max_iter,
         ..SolverParams::default()
@@ -517,18 +552,35 @@ pub fn run(args: &BemArgs) -> Result<()> {
             bail!("--plot draws the stiffness: drop --no-stiffness");
         }
     }
-    // Outputs, checked before any work: each folder exists (--fields DIR and its missing
-    // parents are made here, and removed again on any error), no output is named twice or
-    // exists without --force, none is the surface or its sidecar, and --fields DIR holds no
-    // field files of another run. They are written to temporary files as each load is
-    // solved and renamed into place together at the end.
+    let columns = Columns {
+        fd: args.fd_stiffness,
+        timing: args.timing,
+    };
+    Ok(Plan {
+        boundary,
+        loads,
+        params,
+        size,
+        columns,
+    })
+}
+
+/// The declared outputs: staged, with the field paths of every load (`--fields`).
+struct Outputs {
+    staged: StagedOutputs,
+    fields: Option<Vec<(PathBuf, PathBuf)>>,
+}
+
+/// Step 1b: the outputs, checked before any work. Each folder exists (`--fields DIR` and its
+/// missing parents are made here, and removed again on any error), no output is named twice
+/// or exists without `--force`, none is the surface or its sidecar, and `--fields DIR` holds
+/// no field files of another run. They are written to temporary files as each load is solved
+/// and renamed into place together at the end.
+fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
     if let Some(dir) = &args.fields {
-        ensure_no_stale_fields(dir, loads.len())?;
+        ensure_no_stale_fields(dir, loads)?;
     }
-    let fields = args
-        .fields
-        .as_ref()
-        .map(|dir| field_paths(dir, loads.len()));
+    let fields = args.fields.as_ref().map(|dir| field_paths(dir, loads));
     let record_path = args.out.as_deref().map(sidecar_path);
     let output_paths = args
         .out
@@ -536,243 +588,234 @@ pub fn run(args: &BemArgs) -> Result<()> {
         .chain(&record_path)
         .chain(&args.plot)
         .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
-    let mut staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
+    let staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
-    // Memory, from the file's header before its data is read: the solver plus the heights,
-    // alive while the solver is built (the fields go to files as they are solved), plus the
-    // per-load bookkeeping.
+    Ok(Outputs { staged, fields })
+}
+
+/// Refuses a solve of a `rows`×`cols` surface that does not fit in memory (`extra`: bytes
+/// needed besides the solver).
+fn ensure_solver_fits(
+    rows: usize,
+    cols: usize,
+    boundary: Boundary,
+    extra: Option<u64>,
+) -> Result<()> {
+    let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
+        .zip(extra)
+        .and_then(|(solver, extra)| solver.checked_add(extra));
+    ensure_fits(
+        &format!(
+            "asperity bem on a {rows}x{cols} surface ({} boundaries)",
+            boundary.name()
+        ),
+        bytes,
+    )?;
+    Ok(())
+}
+
+/// Step 1c: the surface, with where its side length came from. A `.npy`'s memory is checked
+/// from its header before its data is read (the solver plus the heights, alive while the
+/// solver is built, plus the per-load bookkeeping); a measured file is read, bounded, by
+/// the topography reader and checked after.
+fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, SizeSource)> {
     let measured = !is_npy(&args.surface) || has_import_sidecar(&args.surface);
-    let shape = if measured {
-        Vec::new() // read, bounded, by the topography reader; checked below
-    } else {
-        read_npy_shape(&args.surface)?
-    };
-    if let [rows, cols] = shape[..] {
-        let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
-            .zip(array_bytes(&[rows, cols], 8))
-            .and_then(|(solver, heights)| solver.checked_add(heights))
-            .zip(bookkeeping_bytes(loads.len(), fields.is_some()))
-            .and_then(|(solver, loads)| solver.checked_add(loads));
-        ensure_fits(
-            &format!(
-                "asperity bem on a {rows}x{cols} surface ({} boundaries)",
-                boundary.name()
-            ),
-            bytes,
-        )?;
-    }
-    let (surface, size_source) = if measured {
+    if measured {
         let t = load(&args.surface, &args.measured, args.size.as_deref())?;
         let surface = t
             .to_surface()
             .with_context(|| format!("{}", args.surface.display()))?;
         let (rows, cols) = surface.dim();
-        ensure_fits(
-            &format!(
-                "asperity bem on a {rows}x{cols} surface ({} boundaries)",
-                boundary.name()
-            ),
-            ContactSolver::memory_bytes(rows, cols, boundary),
-        )?;
-        let source = if args.size.is_some() {
-            SizeSource::Flag
-        } else {
-            SizeSource::File
+        ensure_solver_fits(rows, cols, plan.boundary, Some(0))?;
+        let source = match args.size {
+            Some(_) => SizeSource::Flag,
+            None => SizeSource::File,
         };
-        (surface, source)
-    } else {
-        let sidecar_size = match size_x {
-            Some(_) => None,
-            None => asperity::io::sidecar_size(&args.surface)?,
-        };
-        let (size, size_source) = match (size_x, sidecar_size) {
-            (Some(size), _) => (size, SizeSource::Flag),
-            (None, Some(size)) => (size, SizeSource::Sidecar),
-            (None, None) => (1.0, SizeSource::Default),
-        };
-        let heights = read_npy_2d(&args.surface)?;
-        let surface = match size_y {
-            Some(size_y) => Surface::with_sizes(heights, size, size_y),
-            None => Surface::new(heights, size),
-        };
-        let surface = surface.with_context(|| match size_source {
-            SizeSource::Sidecar => format!(
-                "{} (L = {size} from its sidecar {})",
-                args.surface.display(),
-                sidecar_path(&args.surface).display()
-            ),
-            _ => format!("{}", args.surface.display()),
-        })?;
-        (surface, size_source)
+        return Ok((surface, source));
+    }
+    if let [rows, cols] = read_npy_shape(&args.surface)?[..] {
+        let extra = array_bytes(&[rows, cols], 8)
+            .zip(bookkeeping_bytes(plan.loads.len(), fields))
+            .and_then(|(heights, loads)| heights.checked_add(loads));
+        ensure_solver_fits(rows, cols, plan.boundary, extra)?;
+    }
+    let [size_x, size_y] = plan.size;
+    let sidecar_size = match size_x {
+        Some(_) => None,
+        None => asperity::io::sidecar_size(&args.surface)?,
     };
-    let (size, size_y) = (surface.size(), surface.size_y());
-    let sizes_shown = if surface.has_square_pixels() {
-        format!("{size}")
-    } else {
-        format!("{size} × {size_y}")
+    let (size, size_source) = match (size_x, sidecar_size) {
+        (Some(size), _) => (size, SizeSource::Flag),
+        (None, Some(size)) => (size, SizeSource::Sidecar),
+        (None, None) => (1.0, SizeSource::Default),
     };
-    let grid = surface.dim();
-    let half_space = HalfSpace {
-        modulus: args.modulus,
-        boundary,
+    let heights = read_npy_2d(&args.surface)?;
+    let surface = match size_y {
+        Some(size_y) => Surface::with_sizes(heights, size, size_y),
+        None => Surface::new(heights, size),
     };
-    let mut solver = ContactSolver::new(&surface, half_space, params)?;
-    // The solver keeps its own copy of the profile: free the heights (peak memory).
-    drop(surface);
-    let fd_step = args.fd_stiffness.then_some(FD_STEP);
+    let surface = surface.with_context(|| match size_source {
+        SizeSource::Sidecar => format!(
+            "{} (L = {size} from its sidecar {})",
+            args.surface.display(),
+            sidecar_path(&args.surface).display()
+        ),
+        _ => format!("{}", args.surface.display()),
+    })?;
+    Ok((surface, size_source))
+}
 
-    // 2. Solve every load (warm starts in the given order), after the full-contact check of
-    // every load: the library's sweep.
-    let mut header = vec![
-        "force",
-        "mean_pressure",
-        "indentation",
-        "area_fraction",
-        "stiffness",
-        "iterations",
-        "residual",
-    ];
-    if args.fd_stiffness {
-        header.push("stiffness_fd");
+/// The surface as the record and the stderr line state it.
+struct SurfaceInfo {
+    grid: (usize, usize),
+    size: f64,
+    size_y: f64,
+    square_pixels: bool,
+    source: SizeSource,
+}
+
+impl SurfaceInfo {
+    fn sizes_shown(&self) -> String {
+        if self.square_pixels {
+            format!("{}", self.size)
+        } else {
+            format!("{} × {}", self.size, self.size_y)
+        }
     }
-    if args.timing {
-        header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
-    }
+}
+
+/// Step 2: every load solved (warm starts in the given order) after the full-contact check
+/// of every load: the library's sweep, the fields staged as each load is solved.
+fn solve(
+    args: &BemArgs,
+    plan: &Plan,
+    solver: &mut ContactSolver,
+    outputs: &mut Outputs,
+) -> Result<Vec<Row>> {
+    let loads = &plan.loads;
     let mut observer = CliObserver {
-        staged: &mut staged,
-        fields: fields.as_deref(),
+        staged: &mut outputs.staged,
+        fields: outputs.fields.as_deref(),
         progress: Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2),
         peak_rss: args.timing.then(Vec::new),
     };
     let params = SweepParams {
         stiffness: !args.no_stiffness,
-        fd_step,
+        fd_step: args.fd_stiffness.then_some(FD_STEP),
     };
-    let solved = sweep(&mut solver, &loads, params, &mut observer).map_err(sweep_error)?;
+    let solved = sweep(solver, loads, params, &mut observer).map_err(sweep_error)?;
     observer.progress.finish();
     let peak_rss = observer.peak_rss.take().unwrap_or_default();
-    let rows: Vec<Row> = solved
-        .iter()
+    Ok(solved
+        .into_iter()
         .enumerate()
-        .map(|(k, r)| {
-            let mut values = vec![
-                Some(r.summary.force),
-                Some(r.summary.mean_pressure),
-                Some(r.summary.indentation),
-                Some(r.summary.area_fraction),
-                r.stiffness,
-                Some(r.info.iterations as f64),
-                Some(r.info.residual),
-            ];
-            if args.fd_stiffness {
-                values.push(r.stiffness_fd);
-            }
-            if args.timing {
-                values.extend([
-                    Some(r.solve_seconds),
-                    Some(r.stiffness_seconds),
-                    Some(peak_rss[k]),
-                ]);
-            }
-            Row { values }
+        .map(|(k, sweep)| Row {
+            sweep,
+            peak_rss_mib: peak_rss.get(k).copied().unwrap_or(f64::NAN),
         })
-        .collect();
+        .collect())
+}
 
-    // 3. Write.
-    let iterations = header.iter().position(|h| *h == "iterations");
-    let format_row = |row: &Row, empty: &str, number: &dyn Fn(f64) -> String| -> Vec<String> {
-        row.values
-            .iter()
-            .enumerate()
-            .map(|(i, v)| match v {
-                None => empty.to_string(),
-                Some(v) if Some(i) == iterations => format!("{}", *v as u64),
-                Some(v) => number(*v),
-            })
-            .collect()
-    };
+/// The inputs of a run, for OUT.csv.json.
+fn record(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Value {
+    json!({
+        "command": "asperity bem",
+        "version": env!("CARGO_PKG_VERSION"),
+        "surface": args.surface,
+        "grid": [surface.grid.0, surface.grid.1],
+        "size": surface.size,
+        "size_y": surface.size_y,
+        "size_source": surface.source.name(),
+        "modulus": args.modulus,
+        "boundary": plan.boundary.name(),
+        "solver": args.solver,
+        "tolerance": args.tol,
+        "max_iterations": args.max_iter,
+        "loads": loads_record(args),
+        "stiffness": if args.no_stiffness { None } else { Some("frozen contact set") },
+        "fd_relative_step": args.fd_stiffness.then_some(FD_STEP),
+        "fields": args.fields,
+        "columns": plan.columns.header(),
+    })
+}
+
+/// Step 3: the table (to OUT.csv with its record, else to standard output after the
+/// commit) and the plot, renamed into place with the fields.
+fn write(
+    args: &BemArgs,
+    plan: &Plan,
+    surface: &SurfaceInfo,
+    rows: &[Row],
+    mut staged: StagedOutputs,
+) -> Result<()> {
+    let mut table = Table::new(&plan.columns.header());
+    for row in rows {
+        table.push(&plan.columns.cells(row));
+    }
     if let Some(out) = &args.out {
-        let mut table = Table::new(&header);
-        for row in &rows {
-            table.push(&format_row(row, "", &|v| format_number(v)));
-        }
         table
             .stage(&mut staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
-        let record = json!({
-            "command": "asperity bem",
-            "version": env!("CARGO_PKG_VERSION"),
-            "surface": args.surface,
-            "grid": [grid.0, grid.1],
-            "size": size,
-            "size_y": size_y,
-            "size_source": size_source.name(),
-            "modulus": args.modulus,
-            "boundary": boundary.name(),
-            "solver": args.solver,
-            "tolerance": args.tol,
-            "max_iterations": args.max_iter,
-            "loads": loads_record(args),
-            "stiffness": if args.no_stiffness { None } else { Some("frozen contact set") },
-            "fd_relative_step": fd_step,
-            "fields": args.fields,
-            "columns": header,
-        });
-        let record_path = record_path.as_deref().expect("set with --out");
+        let record_path = sidecar_path(out);
         staged
-            .write_json(record_path, &record)
+            .write_json(&record_path, &record(args, plan, surface))
             .with_context(|| format!("writing {}", record_path.display()))?;
     }
     if let Some(plot) = &args.plot {
-        let charts = sweep_charts(&rows, &header, args.modulus, &args.surface, boundary.name());
+        let boundary = plan.boundary.name();
+        let charts = sweep_charts(rows, plan.columns.fd, args.modulus, &args.surface, boundary);
         stage_charts(&mut staged, plot, &charts)
             .with_context(|| format!("writing {}", plot.display()))?;
     }
     staged.commit()?;
     if !args.quiet {
-        eprintln!("L = {sizes_shown} ({})", size_source.phrase());
+        eprintln!(
+            "L = {} ({})",
+            surface.sizes_shown(),
+            surface.source.phrase()
+        );
     }
     match &args.out {
-        Some(out) => {
-            if !args.quiet {
-                eprintln!(
-                    "wrote {} and {} ({} loads)",
-                    out.display(),
-                    sidecar_path(out).display(),
-                    rows.len()
-                );
-            }
-        }
-        None => {
-            let cells: Vec<Vec<String>> = rows
-                .iter()
-                .map(|row| format_row(row, "-", &|v| format!("{v:.6e}")))
-                .collect();
-            let widths: Vec<usize> = header
-                .iter()
-                .enumerate()
-                .map(|(i, h)| {
-                    cells
-                        .iter()
-                        .map(|r| r[i].len())
-                        .chain([h.len()])
-                        .max()
-                        .unwrap_or(0)
-                })
-                .collect();
-            let line = |fields: Vec<&str>| {
-                fields
-                    .iter()
-                    .zip(&widths)
-                    .map(|(f, w)| format!("{f:>w$}"))
-                    .collect::<Vec<_>>()
-                    .join("  ")
-            };
-            println!("{}", line(header.clone()));
-            for row in &cells {
-                println!("{}", line(row.iter().map(|s| s.as_str()).collect()));
-            }
-        }
+        Some(out) if !args.quiet => eprintln!(
+            "wrote {} and {} ({} loads)",
+            out.display(),
+            sidecar_path(out).display(),
+            rows.len()
+        ),
+        Some(_) => {}
+        None => print_stdout(&table.to_csv()?)?,
     }
     Ok(())
+}
+
+/// Writes `bytes` to standard output; a closed pipe (`| head`) is not an error of ours.
+fn print_stdout(bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().write_all(bytes) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
+}
+
+/// Runs `asperity bem`: plan (every check before the first solve), solve, write.
+pub fn run(args: &BemArgs) -> Result<()> {
+    let plan = plan(args)?;
+    let mut outputs = stage_outputs(args, plan.loads.len())?;
+    let (surface, source) = read_surface(args, &plan, outputs.fields.is_some())?;
+    let info = SurfaceInfo {
+        grid: surface.dim(),
+        size: surface.size(),
+        size_y: surface.size_y(),
+        square_pixels: surface.has_square_pixels(),
+        source,
+    };
+    let half_space = HalfSpace {
+        modulus: args.modulus,
+        boundary: plan.boundary,
+    };
+    let mut solver = ContactSolver::new(&surface, half_space, plan.params)?;
+    // The solver keeps its own copy of the profile: free the heights (peak memory).
+    drop(surface);
+    let rows = solve(args, &plan, &mut solver, &mut outputs)?;
+    write(args, &plan, &info, &rows, outputs.staged)
 }

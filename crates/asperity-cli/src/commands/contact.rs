@@ -17,6 +17,7 @@ use asperity::elastic::Boundary;
 use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::memory::ensure_fits;
 use asperity::topography::patches::count_patches;
+use ndarray::Array2;
 use serde_json::json;
 
 use super::measured::{load, record, MeasuredArgs};
@@ -115,10 +116,8 @@ struct Row {
     residual: f64,
 }
 
-/// Runs `asperity contact`.
-pub fn run(args: &ContactArgs) -> Result<()> {
-    let e_star = effective_modulus(args)?;
-    let boundary: Boundary = args.boundary.parse()?;
+/// Step 1: the loads, the tolerance and the image outputs, checked before any file is read.
+fn check_args(args: &ContactArgs) -> Result<()> {
     if args.pressures.is_empty() {
         bail!("--pressures: give at least one value");
     }
@@ -146,6 +145,121 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             bail!("--map {}: the file name must end in .png", map.display());
         }
     }
+    Ok(())
+}
+
+/// The solves of step 2: one row per load, and the contact map of the last load (when
+/// `--map` asks for it: 0 in contact, 1 free).
+struct Solved {
+    rows: Vec<Row>,
+    map: Option<Array2<f64>>,
+}
+
+/// Step 2: every mean pressure solved in turn (each warm-starts from the previous), with
+/// the contact map of the last.
+fn solve(args: &ContactArgs, solver: &mut ContactSolver, pixel_area: f64) -> Result<Solved> {
+    let mut rows = Vec::with_capacity(args.pressures.len());
+    let mut map = None;
+    for (k, &p) in args.pressures.iter().enumerate() {
+        let (summary, info) = solver
+            .solve(Control::MeanPressure(p))
+            .with_context(|| format!("load {k} (mean pressure {p} Pa)"))?;
+        let contact = solver.pressure().mapv(|v| v > 0.0);
+        let patches = count_patches(contact.view());
+        let mean_gap = solver.gap().mean().unwrap_or(f64::NAN);
+        if k + 1 == args.pressures.len() && args.map.is_some() {
+            map = Some(contact.mapv(|c| if c { 0.0 } else { 1.0 }));
+        }
+        let (stiffness, _) = solver
+            .frozen_set_stiffness()
+            .with_context(|| format!("stiffness at load {k} (mean pressure {p} Pa)"))?;
+        rows.push(Row {
+            pressure: summary.mean_pressure,
+            force: summary.force,
+            area: summary.contact_points as f64 * pixel_area,
+            fraction: summary.area_fraction,
+            mean_gap,
+            stiffness,
+            patches,
+            indentation: summary.indentation,
+            iterations: info.iterations,
+            residual: info.residual,
+        });
+    }
+    Ok(Solved { rows, map })
+}
+
+/// The table of step 3, SI units.
+fn table(rows: &[Row]) -> Table {
+    let mut table = Table::new(&[
+        "mean_pressure_pa",
+        "force_n",
+        "contact_area_m2",
+        "area_fraction",
+        "mean_gap_m",
+        "stiffness_n_per_m",
+        "patches",
+        "indentation_m",
+        "iterations",
+        "residual",
+    ]);
+    let n = |v: f64| format_number(v);
+    for r in rows {
+        table.push(&[
+            n(r.pressure),
+            n(r.force),
+            n(r.area),
+            n(r.fraction),
+            n(r.mean_gap),
+            n(r.stiffness),
+            r.patches.to_string(),
+            n(r.indentation),
+            r.iterations.to_string(),
+            n(r.residual),
+        ]);
+    }
+    table
+}
+
+/// The `--plot` panels: stiffness, contact area and mean gap against force, log–log.
+fn charts(args: &ContactArgs, rows: &[Row], e_star: f64) -> [Chart; 3] {
+    let name = args
+        .file
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into());
+    let points = |y: &dyn Fn(&Row) -> f64| -> Vec<(f64, f64)> {
+        rows.iter().map(|r| (r.force, y(r))).collect()
+    };
+    let chart = |title: String, y_label: &str, y: &dyn Fn(&Row) -> f64| Chart {
+        title,
+        x_label: "normal force F  [N]".into(),
+        y_label: y_label.into(),
+        log_x: true,
+        log_y: true,
+        series: vec![Series::new("", points(y), Style::LinePoints)],
+    };
+    [
+        chart(
+            format!("{name}: contact stiffness (E* = {e_star:.3e} Pa)"),
+            "stiffness k  [N/m]",
+            &|r| r.stiffness,
+        ),
+        chart(
+            format!("{name}: true contact area"),
+            "contact area A  [m²]",
+            &|r| r.area,
+        ),
+        chart(format!("{name}: mean gap"), "mean gap  [m]", &|r| {
+            r.mean_gap
+        }),
+    ]
+}
+
+/// Runs `asperity contact`: check, read, solve, then write every output together.
+pub fn run(args: &ContactArgs) -> Result<()> {
+    let e_star = effective_modulus(args)?;
+    let boundary: Boundary = args.boundary.parse()?;
+    check_args(args)?;
     let record_path = args.out.as_deref().map(sidecar_path);
     let outputs = args
         .out
@@ -176,65 +290,11 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         .with_context(|| format!("{}", args.file.display()))?;
     let pixel_area = surface.spacing() * surface.spacing_y();
     drop(surface);
-    let mut rows_out = Vec::with_capacity(args.pressures.len());
-    let mut last_map = None;
-    for (k, &p) in args.pressures.iter().enumerate() {
-        let control = Control::MeanPressure(p);
-        let (summary, info) = solver
-            .solve(control)
-            .with_context(|| format!("load {k} (mean pressure {p} Pa)"))?;
-        let contact = solver.pressure().mapv(|v| v > 0.0);
-        let patches = count_patches(contact.view());
-        let mean_gap = solver.gap().mean().unwrap_or(f64::NAN);
-        if k + 1 == args.pressures.len() && args.map.is_some() {
-            last_map = Some(contact.mapv(|c| if c { 0.0 } else { 1.0 }));
-        }
-        let (stiffness, _) = solver
-            .frozen_set_stiffness()
-            .with_context(|| format!("stiffness at load {k} (mean pressure {p} Pa)"))?;
-        rows_out.push(Row {
-            pressure: summary.mean_pressure,
-            force: summary.force,
-            area: summary.contact_points as f64 * pixel_area,
-            fraction: summary.area_fraction,
-            mean_gap,
-            stiffness,
-            patches,
-            indentation: summary.indentation,
-            iterations: info.iterations,
-            residual: info.residual,
-        });
-    }
-    let mut table = Table::new(&[
-        "mean_pressure_pa",
-        "force_n",
-        "contact_area_m2",
-        "area_fraction",
-        "mean_gap_m",
-        "stiffness_n_per_m",
-        "patches",
-        "indentation_m",
-        "iterations",
-        "residual",
-    ]);
-    for r in &rows_out {
-        let n = |v: f64| format_number(v);
-        table.push(&[
-            n(r.pressure),
-            n(r.force),
-            n(r.area),
-            n(r.fraction),
-            n(r.mean_gap),
-            n(r.stiffness),
-            r.patches.to_string(),
-            n(r.indentation),
-            r.iterations.to_string(),
-            n(r.residual),
-        ]);
-    }
-    match &args.out {
-        Some(out) => {
-            table.stage(&mut staged, out)?;
+    let solved = solve(args, &mut solver, pixel_area)?;
+    let table = table(&solved.rows);
+    match &record_path {
+        Some(record_path) => {
+            table.stage(&mut staged, args.out.as_deref().expect("with its record"))?;
             let inputs = json!({
                 "surface": record(&topography),
                 "effective_modulus_pa": e_star,
@@ -245,44 +305,14 @@ pub fn run(args: &ContactArgs) -> Result<()> {
                 "pressures_pa": args.pressures,
                 "units": "SI: m, Pa, N, m², N/m",
             });
-            staged.write_json(record_path.as_ref().expect("with --out"), &inputs)?;
+            staged.write_json(record_path, &inputs)?;
         }
         None => print!("{}", String::from_utf8(table.to_csv()?)?),
     }
     if let Some(plot) = &args.plot {
-        let name = args
-            .file
-            .file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into());
-        let points = |y: &dyn Fn(&Row) -> f64| -> Vec<(f64, f64)> {
-            rows_out.iter().map(|r| (r.force, y(r))).collect()
-        };
-        let chart = |title: String, y_label: &str, y: &dyn Fn(&Row) -> f64| Chart {
-            title,
-            x_label: "normal force F  [N]".into(),
-            y_label: y_label.into(),
-            log_x: true,
-            log_y: true,
-            series: vec![Series::new("", points(y), Style::LinePoints)],
-        };
-        let charts = [
-            chart(
-                format!("{name}: contact stiffness (E* = {e_star:.3e} Pa)"),
-                "stiffness k  [N/m]",
-                &|r| r.stiffness,
-            ),
-            chart(
-                format!("{name}: true contact area"),
-                "contact area A  [m²]",
-                &|r| r.area,
-            ),
-            chart(format!("{name}: mean gap"), "mean gap  [m]", &|r| {
-                r.mean_gap
-            }),
-        ];
-        stage_charts(&mut staged, plot, &charts)?;
+        stage_charts(&mut staged, plot, &charts(args, &solved.rows, e_star))?;
     }
-    if let (Some(map), Some(values)) = (&args.map, &last_map) {
+    if let (Some(map), Some(values)) = (&args.map, &solved.map) {
         greyscale_png(&mut staged, map, values.view())?;
     }
     staged.commit()?;

@@ -2,12 +2,13 @@
 //! indenter on the MDR spring foundation (linear, Hertz 15.2 or fractal 15.7 springs).
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use asperity::io::{read_npy_1d, StagedOutputs};
+use asperity::io::{read_npy_1d, sidecar_path, StagedOutputs};
+use serde_json::json;
 
-use super::measured::{has_import_sidecar, is_npy, load, MeasuredArgs};
+use super::measured::{has_import_sidecar, is_npy, load, record, MeasuredArgs};
 use asperity::mdr::{
     log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
 };
@@ -54,7 +55,8 @@ pub enum SpringKind {
     asperity mdr --line line.npy --nloads 40 --out curve.csv --plot curve.svg\n  \
     asperity mdr --line profile.csv --detrend mean --modulus 1e9 --nloads 20 --out curve.csv\n\n\
     Output columns: indentation, force, stiffness, contacts. Indentation is measured from \
-    first contact (the highest point of a line, the tip of an indenter).")]
+    first contact (the highest point of a line, the tip of an indenter). With --out, \
+    OUT.csv.json records the inputs.")]
 pub struct MdrArgs {
     /// A rough line, heights positive up: a 1D .npy (float64; spacing = size / n), or a
     /// measured profile (x z text, Dektak CSV, ...; length and units from the file, see
@@ -135,7 +137,8 @@ pub struct MdrArgs {
     /// that is 0, and k = 0.
     #[arg(long)]
     pub breakpoints: bool,
-    /// Output CSV (default: standard output).
+    /// Output CSV (default: standard output). Its inputs go to OUT.csv.json beside it
+    /// (indenter and where it came from, springs, E*, spring law, indentations, columns).
     #[arg(long, value_name = "OUT.csv")]
     pub out: Option<PathBuf>,
     /// Also plot the curve (needs at least 2 indentations), .png or .svg by the extension:
@@ -164,6 +167,8 @@ struct Indenter {
     size: f64,
     /// One line for the summary printed after writing.
     description: String,
+    /// Where it came from, for the record OUT.csv.json.
+    source: serde_json::Value,
 }
 
 /// Estimated bytes of one output row while the table is built and written: the row's
@@ -202,71 +207,101 @@ fn spring_grid(args: &MdrArgs, what: &str) -> Result<(usize, f64)> {
     Ok((n, dx))
 }
 
-fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
-    if let Some(path) = args
-        .line
-        .as_ref()
-        .filter(|p| !is_npy(p) || has_import_sidecar(p))
-    {
-        let size = args.size.map(|x| x.to_string());
-        let t = load(path, &args.measured, size.as_deref())?;
-        let line = t.to_line().with_context(|| format!("{}", path.display()))?;
-        let size = line.size();
-        return Ok(Indenter {
-            description: format!(
-                "measured line {} ({} points, L = {size} m, {})",
-                path.display(),
-                line.len(),
-                t.provenance.format
-            ),
-            spacing: line.spacing(),
-            values: line.into_heights().to_vec(),
-            is_line: true,
-            size,
-        });
-    }
-    if let Some(path) = &args.line {
-        let heights = read_npy_1d(path)?.to_vec();
-        let size = match args.size {
-            Some(size) => size,
-            None => asperity::io::sidecar_size(path)?.unwrap_or(1.0),
-        };
-        if !(size.is_finite() && size > 0.0) {
-            bail!("invalid size: the line length must be positive and finite, got {size}");
-        }
-        let spacing = size / heights.len() as f64;
-        return Ok(Indenter {
-            description: format!(
-                "line {} ({} points, L = {size})",
-                path.display(),
-                heights.len()
-            ),
-            values: heights,
-            is_line: true,
-            spacing,
-            size,
-        });
-    }
-    if let Some(path) = &args.radial {
-        let step = need(args.radial_step, "--radial-step", "--radial")?;
-        let samples = read_npy_1d(path)?;
-        let profile = RadialProfile::new(samples.as_slice().expect("contiguous"), step)?;
-        let (n, dx) = spring_grid(args, "--radial")?;
-        return Ok(Indenter {
-            values: profile.sample(n, dx)?,
-            is_line: false,
-            spacing: dx,
-            size: args.size.unwrap_or(n as f64 * dx),
-            description: format!(
-                "radial profile {} ({} samples, Δr = {step}), n = {n}, Δx = {dx}",
-                path.display(),
-                samples.len()
-            ),
-        });
-    }
-    let Some(kind) = args.profile else {
-        bail!("give an indenter: --line FILE.npy, --profile hertz|cone|punch|power or --radial FILE.npy");
+/// A measured profile (any readable format, or a `.npy` with an import sidecar).
+fn measured_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
+    let size = args.size.map(|x| x.to_string());
+    let t = load(path, &args.measured, size.as_deref())?;
+    let line = t.to_line().with_context(|| format!("{}", path.display()))?;
+    let size = line.size();
+    Ok(Indenter {
+        description: format!(
+            "measured line {} ({} points, L = {size} m, {})",
+            path.display(),
+            line.len(),
+            t.provenance.format
+        ),
+        source: json!({ "kind": "measured line", "file": record(&t) }),
+        spacing: line.spacing(),
+        values: line.into_heights().to_vec(),
+        is_line: true,
+        size,
+    })
+}
+
+/// A line from a 1D `.npy`: L from `--size`, else its sidecar, else 1.
+fn npy_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
+    let heights = read_npy_1d(path)?.to_vec();
+    let (size, size_source) = match args.size {
+        Some(size) => (size, "--size"),
+        None => match asperity::io::sidecar_size(path)? {
+            Some(size) => (size, "sidecar"),
+            None => (1.0, "default"),
+        },
     };
+    if !(size.is_finite() && size > 0.0) {
+        bail!("invalid size: the line length must be positive and finite, got {size}");
+    }
+    let spacing = size / heights.len() as f64;
+    Ok(Indenter {
+        description: format!(
+            "line {} ({} points, L = {size})",
+            path.display(),
+            heights.len()
+        ),
+        source: json!({
+            "kind": "line", "file": path, "points": heights.len(), "size_source": size_source,
+        }),
+        values: heights,
+        is_line: true,
+        spacing,
+        size,
+    })
+}
+
+/// A user's axisymmetric profile f(r), mapped to 1D numerically.
+fn radial_indenter(args: &MdrArgs, path: &Path) -> Result<Indenter> {
+    let step = need(args.radial_step, "--radial-step", "--radial")?;
+    let samples = read_npy_1d(path)?;
+    let profile = RadialProfile::new(samples.as_slice().expect("contiguous"), step)?;
+    let (n, dx) = spring_grid(args, "--radial")?;
+    let description = format!(
+        "radial profile {} ({} samples, Δr = {step}), n = {n}, Δx = {dx}",
+        path.display(),
+        samples.len()
+    );
+    let source = json!({
+        "kind": "radial profile", "file": path, "samples": samples.len(), "radial_step": step,
+    });
+    Ok(axisymmetric(
+        args,
+        profile.sample(n, dx)?,
+        dx,
+        description,
+        source,
+    ))
+}
+
+/// An axisymmetric indenter mapped to `values` on springs `dx` apart (L: `--size`, else
+/// the grid's n·Δx).
+fn axisymmetric(
+    args: &MdrArgs,
+    values: Vec<f64>,
+    dx: f64,
+    description: String,
+    source: serde_json::Value,
+) -> Indenter {
+    Indenter {
+        size: args.size.unwrap_or(values.len() as f64 * dx),
+        values,
+        is_line: false,
+        spacing: dx,
+        description,
+        source,
+    }
+}
+
+/// A closed-form axisymmetric indenter (`--profile`).
+fn closed_form_indenter(args: &MdrArgs, kind: ProfileKind) -> Result<Indenter> {
     let shape = match kind {
         ProfileKind::Hertz => Axisymmetric::Sphere {
             radius: need(args.radius, "--radius", "--profile hertz")?,
@@ -284,13 +319,34 @@ fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
     };
     shape.validate()?;
     let (n, dx) = spring_grid(args, "--profile")?;
-    Ok(Indenter {
-        values: shape.sample(n, dx)?,
-        is_line: false,
-        spacing: dx,
-        size: args.size.unwrap_or(n as f64 * dx),
-        description: format!("{shape}, n = {n}, Δx = {dx}"),
-    })
+    let description = format!("{shape}, n = {n}, Δx = {dx}");
+    let source = json!({ "kind": "profile", "shape": shape });
+    Ok(axisymmetric(
+        args,
+        shape.sample(n, dx)?,
+        dx,
+        description,
+        source,
+    ))
+}
+
+fn load_indenter(args: &MdrArgs) -> Result<Indenter> {
+    if let Some(path) = &args.line {
+        return if !is_npy(path) || has_import_sidecar(path) {
+            measured_line(args, path)
+        } else {
+            npy_line(args, path)
+        };
+    }
+    if let Some(path) = &args.radial {
+        return radial_indenter(args, path);
+    }
+    match args.profile {
+        Some(kind) => closed_form_indenter(args, kind),
+        None => bail!(
+            "give an indenter: --line FILE.npy, --profile hertz|cone|punch|power or --radial FILE.npy"
+        ),
+    }
 }
 
 fn spring_law(args: &MdrArgs, indenter: &Indenter) -> Result<SpringLaw> {
@@ -408,37 +464,32 @@ fn curve_charts(points: &[CurvePoint], modulus: f64, description: &str, law: &st
     [force_chart, stiffness_chart]
 }
 
-/// Runs `asperity mdr`.
-pub fn run(args: &MdrArgs) -> Result<()> {
-    // Every output is checked before any work, and all are written together at the end.
-    if let Some(plot) = &args.plot {
-        ImageFormat::from_path(plot, "--plot")?;
-        let count = match (&args.indentations, args.nloads) {
-            (Some(list), _) => list.len(),
-            (None, Some(n)) if !args.breakpoints => n,
-            _ => 2,
-        };
-        if count < 2 {
-            bail!("--plot needs at least 2 indentations (a curve), got {count}");
-        }
-    }
-    let mut staged = StagedOutputs::new(args.out.iter().chain(&args.plot), args.force)?;
-    for input in args.line.iter().chain(&args.radial) {
-        staged.ensure_not_input(input)?;
-    }
-    let indenter = load_indenter(args)?;
-    let law = spring_law(args, &indenter)?;
-    let spring = Spring::new(law, indenter.spacing, args.modulus)?;
-    let mut table = Table::new(&["indentation", "force", "stiffness", "contacts"]);
-    let mut plotted: Option<Vec<CurvePoint>> = args.plot.as_ref().map(|_| Vec::new());
-    let push = |table: &mut Table, p: &CurvePoint| {
-        table.push(&[
-            format_number(p.indentation),
-            format_number(p.force),
-            format_number(p.stiffness),
-            p.contacts.to_string(),
-        ])
+/// Step 1: `--plot` needs a curve (at least 2 indentations); checked before any work.
+fn check_plot(args: &MdrArgs) -> Result<()> {
+    let Some(plot) = &args.plot else {
+        return Ok(());
     };
+    ImageFormat::from_path(plot, "--plot")?;
+    let count = match (&args.indentations, args.nloads) {
+        (Some(list), _) => list.len(),
+        (None, Some(n)) if !args.breakpoints => n,
+        _ => 2,
+    };
+    if count < 2 {
+        bail!("--plot needs at least 2 indentations (a curve), got {count}");
+    }
+    Ok(())
+}
+
+/// Step 2: the curve, one point at a time (`emit`): the exact breakpoints of linear springs
+/// on a line, or the foundation at every indentation asked for. Returns the indentations
+/// as evaluated (none for the breakpoints), for the record.
+fn compute(
+    args: &MdrArgs,
+    indenter: &Indenter,
+    spring: Spring,
+    emit: &mut dyn FnMut(CurvePoint),
+) -> Result<Option<Vec<f64>>> {
     if args.breakpoints {
         if !(spring.is_linear() && indenter.is_line) {
             bail!(
@@ -452,52 +503,107 @@ pub fn run(args: &MdrArgs) -> Result<()> {
             "--breakpoints",
         )?;
         let curve = LinearCurve::from_heights(&indenter.values, spring.spacing(), args.modulus)?;
-        for j in 1..=curve.len() {
-            let point = curve.breakpoint(j);
-            push(&mut table, &point);
-            if let Some(points) = plotted.as_mut() {
-                points.push(point);
-            }
-        }
-    } else {
-        let foundation = if indenter.is_line {
-            Foundation::from_heights(&indenter.values, spring)?
-        } else {
-            Foundation::from_profile(&indenter.values, spring)?
-        };
-        for d in indentation_levels(args, &foundation)? {
-            let point = foundation.evaluate(d);
-            push(&mut table, &point);
-            if let Some(points) = plotted.as_mut() {
-                points.push(point);
-            }
-        }
+        (1..=curve.len()).for_each(|j| emit(curve.breakpoint(j)));
+        return Ok(None);
     }
+    let foundation = if indenter.is_line {
+        Foundation::from_heights(&indenter.values, spring)?
+    } else {
+        Foundation::from_profile(&indenter.values, spring)?
+    };
+    let levels = indentation_levels(args, &foundation)?;
+    levels.iter().for_each(|&d| emit(foundation.evaluate(d)));
+    Ok(Some(levels))
+}
+
+/// The inputs of a run, for OUT.csv.json (the same style as `asperity bem`'s record).
+fn record_of(
+    args: &MdrArgs,
+    indenter: &Indenter,
+    law: SpringLaw,
+    levels: Option<&[f64]>,
+) -> serde_json::Value {
+    let indentations = match (levels, &args.indentations) {
+        (None, _) => json!({ "breakpoints": true }),
+        (Some(values), Some(_)) => json!({ "values": values }),
+        (Some(values), None) => json!({
+            "count": values.len(), "min": values.first(), "max": values.last(),
+            "spacing": "logarithmic", "values": values,
+        }),
+    };
+    json!({
+        "command": "asperity mdr",
+        "version": env!("CARGO_PKG_VERSION"),
+        "indenter": indenter.source,
+        "springs": indenter.values.len(),
+        "spacing": indenter.spacing,
+        "size": indenter.size,
+        "modulus": args.modulus,
+        "spring_law": law,
+        "indentations": indentations,
+        "columns": COLUMNS,
+    })
+}
+
+/// The CSV columns.
+const COLUMNS: [&str; 4] = ["indentation", "force", "stiffness", "contacts"];
+
+/// Runs `asperity mdr`: check, compute, then write every output together.
+pub fn run(args: &MdrArgs) -> Result<()> {
+    // Every output is checked before any work, and all are written together at the end.
+    check_plot(args)?;
+    let record_path = args.out.as_deref().map(sidecar_path);
+    let outputs = args.out.iter().chain(&record_path).chain(&args.plot);
+    let mut staged = StagedOutputs::new(outputs, args.force)?;
+    for input in args.line.iter().chain(&args.radial) {
+        staged.ensure_not_input(input)?;
+    }
+    let indenter = load_indenter(args)?;
+    let law = spring_law(args, &indenter)?;
+    let spring = Spring::new(law, indenter.spacing, args.modulus)?;
+    let mut table = Table::new(&COLUMNS);
+    let mut plotted: Option<Vec<CurvePoint>> = args.plot.as_ref().map(|_| Vec::new());
+    let levels = compute(args, &indenter, spring, &mut |p| {
+        table.push(&[
+            format_number(p.indentation),
+            format_number(p.force),
+            format_number(p.stiffness),
+            p.contacts.to_string(),
+        ]);
+        if let Some(points) = plotted.as_mut() {
+            points.push(p);
+        }
+    })?;
     if let (Some(plot), Some(points)) = (&args.plot, &plotted) {
         let charts = curve_charts(points, args.modulus, &indenter.description, law.name());
         stage_charts(&mut staged, plot, &charts)
             .with_context(|| format!("writing {}", plot.display()))?;
     }
-    if let Some(out) = &args.out {
+    if let (Some(out), Some(record_path)) = (&args.out, &record_path) {
         table
             .stage(&mut staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
+        staged
+            .write_json(
+                record_path,
+                &record_of(args, &indenter, law, levels.as_deref()),
+            )
+            .with_context(|| format!("writing {}", record_path.display()))?;
     }
     staged.commit()?;
     if let Some(plot) = &args.plot {
         eprintln!("wrote {}", plot.display());
     }
     match &args.out {
-        Some(out) => {
-            eprintln!(
-                "wrote {} ({} rows): {}, {} springs (u0 = {:.4e})",
-                out.display(),
-                table.len(),
-                indenter.description,
-                law.name(),
-                spring.critical_depth()
-            );
-        }
+        Some(out) => eprintln!(
+            "wrote {} and {} ({} rows): {}, {} springs (u0 = {:.4e})",
+            out.display(),
+            sidecar_path(out).display(),
+            table.len(),
+            indenter.description,
+            law.name(),
+            spring.critical_depth()
+        ),
         None => match std::io::stdout().write_all(&table.to_csv()?) {
             // A closed pipe (`| head`) is not an error of ours.
             Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}

@@ -128,11 +128,67 @@ pub fn describe(load: usize, control: Control) -> String {
 }
 
 fn step_context(step: SweepStep, load: usize, control: Control) -> String {
+    step_context_naming(step, load, control, "finite-difference stiffness")
+}
+
+/// [`step_context`] with the finite-difference stiffness called `fd_name`.
+fn step_context_naming(step: SweepStep, load: usize, control: Control, fd_name: &str) -> String {
     let load = describe(load, control);
     match step {
         SweepStep::FullContactCheck | SweepStep::Solve => load,
         SweepStep::Stiffness => format!("stiffness at {load}"),
-        SweepStep::FiniteDifference => format!("finite-difference stiffness at {load}"),
+        SweepStep::FiniteDifference => format!("{fd_name} at {load}"),
+    }
+}
+
+/// A [`SweepError`] taken apart for a front end, which names the finite-difference option
+/// its own way (`--fd-stiffness`, `fd_stiffness`) but should otherwise say the same.
+#[derive(Debug)]
+pub enum SweepFailure<E> {
+    /// Bad parameters, or a solver error with no load to name: the full-contact threshold
+    /// could not be computed (bad input, no convergence) before any solve.
+    Input(SolveError),
+    /// A solver error at a load, with where it happened: `load 3 (mean pressure 0.01)`,
+    /// `stiffness at load 3 (…)` or `<fd option> at load 3 (…)`.
+    AtLoad {
+        /// Where, as the prefix of the solver's message.
+        context: String,
+        /// The solver's error.
+        source: SolveError,
+    },
+    /// The upper finite-difference step of a load crosses full contact: the whole message,
+    /// with the advice to lower the load or drop the option.
+    StepBeyondFullContact(String),
+    /// An observer's hook stopped the sweep.
+    Stopped(E),
+}
+
+impl<E> SweepError<E> {
+    /// This error in the words of a front end whose finite-difference stiffness option is
+    /// called `fd_option`.
+    pub fn explain(self, fd_option: &str) -> SweepFailure<E> {
+        match self {
+            SweepError::Input(e) => SweepFailure::Input(SolveError::Input(e)),
+            // The threshold computations before any solve fail without a load to name.
+            SweepError::Solve {
+                step: SweepStep::FullContactCheck,
+                source: source @ (SolveError::Input(_) | SolveError::NoConvergence { .. }),
+                ..
+            } => SweepFailure::Input(source),
+            SweepError::Solve {
+                load,
+                control,
+                step,
+                source,
+            } => SweepFailure::AtLoad {
+                context: step_context_naming(step, load, control, fd_option),
+                source,
+            },
+            e @ SweepError::StepBeyondFullContact { .. } => SweepFailure::StepBeyondFullContact(
+                format!("{fd_option}: {e}; lower the load or drop {fd_option}"),
+            ),
+            SweepError::Stopped(e) => SweepFailure::Stopped(e),
+        }
     }
 }
 
@@ -378,7 +434,15 @@ mod tests {
         };
         match sweep(&mut s, &loads, SweepParams::default(), &mut count) {
             Err(e @ SweepError::Solve { load: 1, .. }) => {
-                assert!(e.to_string().starts_with("load 1 (mean pressure"), "{e}")
+                assert!(e.to_string().starts_with("load 1 (mean pressure"), "{e}");
+                // A front end names the same load, the solver's error kept as it is.
+                match e.explain("fd") {
+                    SweepFailure::AtLoad { context, source } => {
+                        assert!(context.starts_with("load 1 (mean pressure"), "{context}");
+                        assert!(matches!(source, SolveError::BeyondFullContact { .. }));
+                    }
+                    other => panic!("{other:?}"),
+                }
             }
             other => panic!("{other:?}"),
         }
@@ -394,5 +458,12 @@ mod tests {
             matches!(e, SweepError::StepBeyondFullContact { load: 0, .. }),
             "{e}"
         );
+        match e.explain("fd") {
+            SweepFailure::StepBeyondFullContact(text) => {
+                assert!(text.starts_with("fd: at load 0 (mean pressure"), "{text}");
+                assert!(text.ends_with("; lower the load or drop fd"), "{text}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -288,9 +288,12 @@ impl Sampler for BemSampler {
 
     fn sample(&self, worker: &mut BemWorker, seed: u64) -> Result<SampleCurve> {
         let surface = worker.generator.try_generate(seed)?;
-        let bem_error = |e: crate::bem::SolveError| Error::Solve {
-            context: format!("BEM sample with seed {seed}"),
-            source: Box::new(e),
+        let bem_error = |e: crate::bem::SolveError| match e {
+            crate::bem::SolveError::Input(e) => e,
+            e => Error::Solve {
+                context: format!("BEM sample with seed {seed}"),
+                source: Box::new(e),
+            },
         };
         let solver = match worker.solver.as_mut() {
             Some(solver) => {
@@ -310,7 +313,7 @@ impl Sampler for BemSampler {
                 .with_stop(self.stop.clone()),
             ),
         };
-        let points_total = self.surface.rows * self.surface.cols;
+        let points_total = self.surface.rows() * self.surface.cols();
         let mut points = Vec::with_capacity(self.mean_pressures.len());
         for &p in &self.mean_pressures {
             let (summary, _) = solver.solve(Control::MeanPressure(p)).map_err(bem_error)?;
@@ -577,8 +580,8 @@ mod tests {
         match sampler.sample(&mut worker, 2) {
             Err(Error::Solve { source, .. }) => assert!(
                 matches!(
-                    *source,
-                    crate::bem::SolveError::Interrupted { iterations: 0 }
+                    source.downcast_ref(),
+                    Some(crate::bem::SolveError::Interrupted { iterations: 0 })
                 ),
                 "{source}"
             ),

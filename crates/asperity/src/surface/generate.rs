@@ -39,23 +39,63 @@ use crate::memory::{array_bytes, ensure_fits, try_vec};
 use crate::spectrum::Psd;
 use crate::{Error, Result};
 
-/// What to generate: grid, side length, spectrum and normalisation. Validated by
-/// [`SurfaceSpec::new`].
+/// What to generate: grid, side length, spectrum and normalisation. Built only by
+/// [`SurfaceSpec::new`] (also when read back from JSON), so every value is a valid one:
+/// the generator relies on it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SurfaceSpecFields")]
 pub struct SurfaceSpec {
-    /// Grid rows (y).
-    pub rows: usize,
-    /// Grid columns (x).
-    pub cols: usize,
-    /// Side length along x.
-    pub size: f64,
-    /// Spectrum shape.
-    pub psd: Psd,
-    /// Scaling of each realisation.
-    pub normalisation: Normalisation,
+    rows: usize,
+    cols: usize,
+    size: f64,
+    psd: Psd,
+    normalisation: Normalisation,
+}
+
+/// The fields of a [`SurfaceSpec`] as stored, before [`SurfaceSpec::new`] checks them.
+#[derive(Deserialize)]
+struct SurfaceSpecFields {
+    rows: usize,
+    cols: usize,
+    size: f64,
+    psd: Psd,
+    normalisation: Normalisation,
+}
+
+impl TryFrom<SurfaceSpecFields> for SurfaceSpec {
+    type Error = Error;
+
+    fn try_from(f: SurfaceSpecFields) -> Result<Self> {
+        SurfaceSpec::new(f.rows, f.cols, f.size, f.psd, f.normalisation)
+    }
 }
 
 impl SurfaceSpec {
+    /// Grid rows (y).
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Grid columns (x).
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// Side length along x.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// Spectrum shape.
+    pub fn psd(&self) -> Psd {
+        self.psd
+    }
+
+    /// Scaling of each realisation.
+    pub fn normalisation(&self) -> Normalisation {
+        self.normalisation
+    }
+
     /// Checks the grid (at least 2×2), the size and the normalisation.
     pub fn new(
         rows: usize,
@@ -405,6 +445,22 @@ mod tests {
 
     fn surface_spec(rows: usize, cols: usize, hurst: f64, norm: Normalisation) -> SurfaceSpec {
         SurfaceSpec::new(rows, cols, 1.0, Psd::power_law(hurst).unwrap(), norm).unwrap()
+    }
+
+    #[test]
+    fn a_spec_read_from_json_is_checked_like_a_new_one() {
+        let spec = surface_spec(16, 32, 0.5, Normalisation::RmsSlope(1.0));
+        let text = serde_json::to_string(&spec).unwrap();
+        assert_eq!(serde_json::from_str::<SurfaceSpec>(&text).unwrap(), spec);
+        // A 1-row grid: refused by new, and so when read back (it would panic in generate).
+        let bad = text.replace("\"rows\":16", "\"rows\":1");
+        assert_ne!(bad, text);
+        let err = serde_json::from_str::<SurfaceSpec>(&bad).unwrap_err();
+        assert!(err.to_string().contains("at least 2x2"), "{err}");
+        let err =
+            serde_json::from_str::<SurfaceSpec>(&text.replace("\"size\":1.0", "\"size\":-1.0"))
+                .unwrap_err();
+        assert!(err.to_string().contains("size"), "{err}");
     }
 
     /// Slope of the ensemble-averaged radial PSD, fitted over κ ∈ [4, κ_max].
