@@ -24,7 +24,7 @@
 //!    load.
 //! 5. `u ← u + α w` (rescaled with `p`): no second operator application. Where the
 //!    projection cut a pressure to zero the recurrence misses `K e_t c_t` (`c_t` the part
-//!    of the step the bound refused): up to [`cut_limit`] cuts are added from the
+//!    of the step the bound refused): up to [`CUT_LIMIT`] cuts are added from the
 //!    operator's impulse response (one grid pass each); with more, and every
 //!    [`REFRESH_INTERVAL`] iterations against drift, `u = K p` is recomputed. Convergence (the residual of the module docs below the tolerance) is
 //!    accepted only on an exact `u`.
@@ -63,19 +63,8 @@ const DIRECT_BUDGET: usize = 150;
 const LOAD_ROUNDING: f64 = 1e-14;
 
 /// Pressures cut by the projection in one step that are corrected in `u` by their point
-/// responses (each costs about `N²` multiply-adds, a grid pass); beyond this many `u` is
-/// recomputed by an operator application. The break-even is the application's cost in
-/// point responses: about 16 for a periodic `N × N` pair (the limit's value before it
-/// depended on the boundary), about four times more for the padded `2N × 2N` pair of free
-/// boundaries, which therefore correct up to 64: the steps that cut 17–64 pressures,
-/// common at the end of the first iterations' cut phase, then cost grid passes instead of
-/// refreshes.
-fn cut_limit(boundary: Boundary) -> usize {
-    match boundary {
-        Boundary::Free => 64,
-        Boundary::Periodic => 16,
-    }
-}
+/// responses (each one pass over the grid); beyond this many `u` is recomputed.
+const CUT_LIMIT: usize = 16;
 
 /// Elements per chunk of the parallel passes. Fixed, never derived from the thread count:
 /// each chunk is summed in index order and the chunks' partial sums are added in chunk
@@ -115,14 +104,12 @@ pub(super) struct BccgScratch {
     pub(super) free: Vec<bool>,
     /// `K e_00`, the displacement under a unit pressure on pixel `(0, 0)`.
     pub(super) impulse: Vec<f64>,
-    /// `(index, correction)` of the pressures cut in a step (capacity `cut_limit`).
+    /// `(index, correction)` of the pressures cut in a step (capacity [`CUT_LIMIT`]).
     pub(super) cuts: Vec<(usize, f64)>,
-    /// The first `cut_limit` cuts of every chunk of the step pass.
+    /// The first [`CUT_LIMIT`] cuts of every chunk of the step pass.
     chunk_cuts: Vec<(usize, f64)>,
     /// One [`Sums`] per chunk.
     partials: Vec<Sums>,
-    /// Cuts of one step corrected by point responses ([`cut_limit`] of the boundary).
-    cut_limit: usize,
     /// Factor of `p` and `u` that restores the load, not yet applied (1: none); applied by
     /// the next pass that reads them.
     pending_scale: f64,
@@ -137,18 +124,16 @@ impl BccgScratch {
         let mut impulse = vec![0.0; len];
         operator.apply(&unit, &mut impulse);
         let chunks = len.div_ceil(CHUNK);
-        let cut_limit = cut_limit(operator.boundary());
         BccgScratch {
             preconditioned: unit,
             gradient: vec![0.0; len],
             previous_gradient: vec![0.0; len],
             free: vec![false; len],
             impulse,
-            cuts: Vec::with_capacity(cut_limit),
-            chunk_cuts: vec![(0, 0.0); chunks * cut_limit],
+            cuts: Vec::with_capacity(CUT_LIMIT),
+            chunk_cuts: vec![(0, 0.0); chunks * CUT_LIMIT],
             partials: vec![Sums::default(); chunks],
             pending_scale: 1.0,
-            cut_limit,
         }
     }
 }
@@ -375,18 +360,17 @@ fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
 }
 
 /// `p ← max(p + α s, 0)`, `u ← u + α w`; sums `x[0] = Σ p`, `n[0]` = cuts; the first
-/// `limit` cuts of each chunk go to its `limit` slots of `chunk_cuts`.
+/// [`CUT_LIMIT`] cuts of each chunk go to its slots of `chunk_cuts`.
 fn step_pass(
     (p, u): (&mut [f64], &mut [f64]),
     (s, w): (&[f64], &[f64]),
     alpha: f64,
     (chunk_cuts, partials): (&mut [(usize, f64)], &mut [Sums]),
 ) -> Sums {
-    let limit = chunk_cuts.len() / partials.len();
     p.par_chunks_mut(CHUNK)
         .zip(u.par_chunks_mut(CHUNK))
         .zip(s.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
-        .zip(chunk_cuts.par_chunks_mut(limit))
+        .zip(chunk_cuts.par_chunks_mut(CUT_LIMIT))
         .zip(partials.par_iter_mut())
         .enumerate()
         .for_each(|(chunk, ((((p, u), (s, w)), slots), out))| {
@@ -401,7 +385,7 @@ fn step_pass(
                 if next < 0.0 {
                     // The step wanted `next`, the bound allows 0: `u` misses `K e (−next)`.
                     *pi = 0.0;
-                    if cuts < limit {
+                    if cuts < CUT_LIMIT {
                         slots[cuts] = (chunk * CHUNK + index, -next);
                     }
                     cuts += 1;
@@ -603,12 +587,11 @@ impl ContactSolver {
         let (cuts, total) = (sums.n[0], sums.x[0]);
         // A few cuts are corrected by their point responses (one grid pass, far cheaper
         // than an operator application); more leave `u` stale.
-        let limit = scratch.cut_limit;
-        let mut cut = cuts > limit;
+        let mut cut = cuts > CUT_LIMIT;
         if !cut && cuts > 0 {
             let corrections = &mut scratch.cuts;
             corrections.clear();
-            for (slots, partial) in scratch.chunk_cuts.chunks(limit).zip(&scratch.partials) {
+            for (slots, partial) in scratch.chunk_cuts.chunks(CUT_LIMIT).zip(&scratch.partials) {
                 corrections.extend_from_slice(&slots[..partial.n[0]]);
             }
             let periodic = self.operator.boundary() == Boundary::Periodic;
