@@ -221,14 +221,15 @@ if [ "$python_tests" = 1 ]; then
         same_files "$1/checkpoint" "$2/checkpoint" "$3"
     }
     unset RAYON_NUM_THREADS
-    "${study_py[@]}" alpha "$work/py-serial" >"$work/py-serial.txt"
+    "${study_py[@]}" alpha "$work/py-serial" "$work/py-serial.json"
     same_checkpoints "$work/bem-serial" "$work/py-serial" "Python against the CLI"
     for k in 1 2 3; do
-        "${mpirun_cmd[@]}" -n $k "${study_py[@]}" alpha "$work/py-$k" >"$work/py-$k.txt"
+        "${mpirun_cmd[@]}" -n $k "${study_py[@]}" alpha "$work/py-$k" "$work/py-$k.json"
         same_checkpoints "$work/bem-serial" "$work/py-$k" "Python on $k ranks"
-        [ "$(wc -l <"$work/py-$k.txt")" -eq $k ] || fail "Python on $k ranks: $(wc -l <"$work/py-$k.txt") results"
-        [ "$(sort -u "$work/py-$k.txt")" = "$(cat "$work/py-serial.txt")" ] ||
-            fail "Python on $k ranks: a rank returned another result than the serial run"
+        for ((rank = 0; rank < k; rank++)); do
+            cmp -s "$work/py-serial.json.0" "$work/py-$k.json.$rank" ||
+                fail "Python on $k ranks: rank $rank returned another result than the serial run"
+        done
     done
     echo "ok: Python under mpirun: identical checkpoints and results on 1, 2, 3 ranks"
     export RAYON_NUM_THREADS=1

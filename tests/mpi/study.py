@@ -1,9 +1,11 @@
 """The Python side of tests/mpi/run.sh: a study through the package, run alone or under
-`mpirun -n K python tests/mpi/study.py ...`. Prints on every rank one line: the rank's
-result (rows and tasks as JSON), which must be the same on every rank and for every K.
+`mpirun -n K python tests/mpi/study.py ...`. Every rank writes its result (rows and
+tasks as JSON) to RESULT.<rank>, which must be the same on every rank and for every K (one
+file per rank: the launcher may interleave long lines of several ranks' stdout).
 
-Usage: study.py alpha|long OUT
+Usage: study.py alpha|long OUT [RESULT]
 """
+import os
 import json
 import sys
 
@@ -18,4 +20,7 @@ elif kind == "long":  # the same study as run.sh's long one
                                   out=out)
 else:
     raise SystemExit(f"unknown study {kind!r}")
-print(json.dumps({"rows": result.rows, "tasks": result.tasks}, sort_keys=True), flush=True)
+if len(sys.argv) > 3:
+    rank = os.environ.get("OMPI_COMM_WORLD_RANK", os.environ.get("PMI_RANK", "0"))
+    with open(f"{sys.argv[3]}.{rank}", "w") as f:
+        json.dump({"rows": result.rows, "tasks": result.tasks}, f, sort_keys=True)
