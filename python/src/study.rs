@@ -12,9 +12,9 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
+use asperity::lock::FolderLock;
 use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
-use asperity::lock::FolderLock;
 use asperity::study::{
     parse_range, run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec,
     Task, TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
@@ -296,7 +296,10 @@ impl StudyLedger {
 
     /// The results, as `run_study` returns them; the study must be finished.
     fn results(&mut self) -> PyResult<String> {
-        let ledger = self.ledger.take().ok_or_else(|| invalid("the study is closed"))?;
+        let ledger = self
+            .ledger
+            .take()
+            .ok_or_else(|| invalid("the study is closed"))?;
         if !ledger.finished() {
             return Err(invalid("the study is not finished"));
         }
