@@ -4,13 +4,19 @@
 #   1. `mpirun -n K` for K = 1, 2, 3 writes the same files, byte for byte, as the default
 #      build (CSV, plots, checkpoints, study.json), for `study alpha`, `study curve` and
 #      `study file`;
-#   2. a rank killed mid-study ends the job with a message naming it, and the same command
-#      run again resumes from the checkpoints (an MPI run resumes a killed serial run and
-#      the other way round) and ends with the same files;
+#   2. a rank killed mid-study ends the job with a message naming it, loses only its sample
+#      in flight (every sample the others computed is checkpointed, also beyond the lost
+#      one in index order), and the same command run again computes just that sample and
+#      ends with the uninterrupted run's files; an MPI run resumes a killed serial run;
 #   3. the folder lock holds across runs: a serial run and a second MPI job on a folder an
-#      MPI job is using are refused.
+#      MPI job is using are refused;
+#   4. the Python package's studies under `mpirun python` with mpi4py: the same checkpoints
+#      as the CLI's and the same result on every rank for 1, 2, 3 ranks, a killed rank and
+#      the lock (needs python/.venv with the package: python/ci.sh makes it; mpi4py's
+#      binary wheel is added to it).
 # Needs an MPI implementation with mpirun (Debian: libopenmpi-dev openmpi-bin) and libclang
-# (libclang-dev) for the build. Usage: tests/mpi/run.sh [--no-build]
+# (libclang-dev) for the build; without mpirun it fails at once, saying what to install.
+# Usage: tests/mpi/run.sh [--no-build] [--no-python]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if ! command -v mpirun >/dev/null 2>&1; then
