@@ -50,6 +50,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _asperity as _core
+from . import _mpi
 from ._asperity import BeyondFullContactError, ConvergenceError, __version__
 
 __all__ = [
@@ -825,14 +826,22 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
 def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
                levels, force, checkpoint_every, progress, description):
     window = _core.default_window()
+    args = (
+        str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
+        int(seed), window[0] if min_contacts is None else int(min_contacts),
+        window[1] if max_fraction is None else float(max_fraction), int(levels),
+        os.fspath(out), bool(force), float(checkpoint_every),
+    )
+    # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
+    comm = _mpi.world()
+    if comm is not None and comm.Get_rank() != 0:
+        progress = None  # one progress bar, rank 0's
     bar = _Progress(progress, description)
     try:
-        text = _core.run_study(
-            str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
-            int(seed), window[0] if min_contacts is None else int(min_contacts),
-            window[1] if max_fraction is None else float(max_fraction), int(levels),
-            os.fspath(out), bool(force), float(checkpoint_every), bar.callback,
-        )
+        if comm is None:
+            text = _core.run_study(*args, bar.callback)
+        else:
+            text = _mpi.run_study(comm, lambda: _core.StudyLedger(*args), bar.callback)
     finally:
         bar.close()
     return json.loads(text)

@@ -12,11 +12,12 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
+use asperity::lock::FolderLock;
 use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
-    parse_range, run_task, FitWindow, Method, SampleCurve, Sampler, StudyDir, StudySpec, Task,
-    TaskResult, MAX_CHECKPOINT_INTERVAL_SECONDS,
+    parse_range, run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec,
+    Task, TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 use asperity::Error;
 use pyo3::prelude::*;
@@ -29,6 +30,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(hurst_range, m)?)?;
     m.add_function(wrap_pyfunction!(default_window, m)?)?;
+    m.add_function(wrap_pyfunction!(thread_count, m)?)?;
+    m.add_class::<StudyLedger>()?;
+    m.add_class::<SampleComputer>()?;
     Ok(())
 }
 
@@ -98,6 +102,40 @@ fn run_study(
     checkpoint_every: f64,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
+    let spec = make_spec(
+        method_name,
+        sizes,
+        hursts,
+        samples,
+        rolloff,
+        seed,
+        min_contacts,
+        max_fraction,
+        levels,
+        checkpoint_every,
+    )?;
+    let (_lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
+    let results = run_detached(py, |cancel| {
+        run_tasks(&spec, &store, progress.as_ref(), cancel)
+    })?
+    .map_err(from_error)?;
+    Ok(records(&results))
+}
+
+/// A study's spec from `run_study`'s arguments, validated.
+#[allow(clippy::too_many_arguments)]
+fn make_spec(
+    method_name: &str,
+    sizes: Vec<usize>,
+    hursts: Vec<f64>,
+    samples: usize,
+    rolloff: Option<f64>,
+    seed: u64,
+    min_contacts: usize,
+    max_fraction: f64,
+    levels: usize,
+    checkpoint_every: f64,
+) -> PyResult<StudySpec> {
     if !(0.0..=MAX_CHECKPOINT_INTERVAL_SECONDS).contains(&checkpoint_every) {
         return Err(invalid(format!(
             "checkpoint_every must be between 0 and {MAX_CHECKPOINT_INTERVAL_SECONDS:e} \
@@ -119,17 +157,28 @@ fn run_study(
     };
     spec.validate().map_err(from_error)?;
     spec.ensure_fits().map_err(from_error)?;
-    StudyDir::check(&out, &spec, force).map_err(from_error)?;
+    Ok(spec)
+}
+
+/// Checks, locks and opens the study folder `out` as the CLI does.
+fn open_folder(
+    spec: &StudySpec,
+    out: PathBuf,
+    force: bool,
+    checkpoint_every: f64,
+) -> PyResult<(FolderLock, StudyDir)> {
+    StudyDir::check(&out, spec, force).map_err(from_error)?;
     // Held until the study returns: a second process (CLI or Python) on the folder is
     // refused at once, naming this one's PID.
-    let _lock = StudyDir::lock(&out).map_err(from_error)?;
-    let store = StudyDir::open(&out, &spec, force)
+    let lock = StudyDir::lock(&out).map_err(from_error)?;
+    let store = StudyDir::open(&out, spec, force)
         .map_err(from_error)?
         .with_checkpoint_interval(Duration::from_secs_f64(checkpoint_every));
-    let results = run_detached(py, |cancel| {
-        run_tasks(&spec, &store, progress.as_ref(), cancel)
-    })?
-    .map_err(from_error)?;
+    Ok((lock, store))
+}
+
+/// The task results as JSON text, each with the CLI's derived columns.
+fn records(results: &[TaskResult]) -> String {
     let records: Vec<serde_json::Value> = results
         .iter()
         .map(|r| {
@@ -141,7 +190,178 @@ fn run_study(
             })
         })
         .collect();
-    Ok(serde_json::Value::from(records).to_string())
+    serde_json::Value::from(records).to_string()
+}
+
+/// The threads of this process's rayon pool: the samples it computes at once.
+#[pyfunction]
+fn thread_count() -> usize {
+    rayon::current_num_threads().max(1)
+}
+
+/// Rank 0's side of a study spread over the ranks of an MPI job (`asperity/_mpi.py`): the
+/// folder checked, locked and opened as `run_study` does, and the library's
+/// [`Ledger`], which hands out samples, checkpoints those received and ends each task as
+/// the serial run does. The lock is held until [`StudyLedger::close`].
+#[pyclass(module = "asperity._asperity")]
+pub struct StudyLedger {
+    spec: StudySpec,
+    store: StudyDir,
+    ledger: Option<Ledger>,
+    lock: Option<FolderLock>,
+}
+
+#[pymethods]
+impl StudyLedger {
+    /// Opens the study as `run_study` (same arguments but the progress callback).
+    #[new]
+    #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
+        max_fraction, levels, out, force, checkpoint_every))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        method_name: &str,
+        sizes: Vec<usize>,
+        hursts: Vec<f64>,
+        samples: usize,
+        rolloff: Option<f64>,
+        seed: u64,
+        min_contacts: usize,
+        max_fraction: f64,
+        levels: usize,
+        out: PathBuf,
+        force: bool,
+        checkpoint_every: f64,
+    ) -> PyResult<Self> {
+        let spec = make_spec(
+            method_name,
+            sizes,
+            hursts,
+            samples,
+            rolloff,
+            seed,
+            min_contacts,
+            max_fraction,
+            levels,
+            checkpoint_every,
+        )?;
+        let (lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
+        let ledger = Ledger::restore(&store).map_err(from_error)?;
+        Ok(StudyLedger {
+            spec,
+            store,
+            ledger: Some(ledger),
+            lock: Some(lock),
+        })
+    }
+
+    /// The study's spec as JSON, for the other ranks' `SampleComputer`.
+    fn spec_json(&self) -> String {
+        serde_json::to_string(&self.spec).expect("specs serialise")
+    }
+
+    /// Up to `lanes` samples to compute next, `(task number, indices)`, or None.
+    fn next_work(&mut self, lanes: usize) -> PyResult<Option<(usize, Vec<usize>)>> {
+        Ok(self.ledger()?.next_work(lanes))
+    }
+
+    /// Takes in the curves (JSON, from `SampleComputer.compute`) of samples `indices` of
+    /// task `t`.
+    fn receive(&mut self, t: usize, indices: Vec<usize>, curves: &str) -> PyResult<()> {
+        let curves: Vec<SampleCurve> = serde_json::from_str(curves)
+            .map_err(|e| invalid(format!("garbled sample curves: {e}")))?;
+        let store = self.store.clone();
+        let ledger = self.ledger()?;
+        let task = ledger.task(t);
+        ledger
+            .receive(&store, t, &indices, curves)
+            .map_err(|e| from_error(with_task(store.spec(), task, e)))
+    }
+
+    /// Checkpoints the samples received, when due; the number of files written.
+    fn save_due(&mut self) -> PyResult<usize> {
+        let store = self.store.clone();
+        self.ledger()?.save_due(&store).map_err(from_error)
+    }
+
+    /// `(samples received, samples of the study)`.
+    fn progress(&mut self) -> PyResult<(u64, u64)> {
+        let ledger = self.ledger()?;
+        Ok((ledger.done(), ledger.total()))
+    }
+
+    /// Whether every task is finished.
+    fn finished(&mut self) -> PyResult<bool> {
+        Ok(self.ledger()?.finished())
+    }
+
+    /// The results, as `run_study` returns them; the study must be finished.
+    fn results(&mut self) -> PyResult<String> {
+        let ledger = self
+            .ledger
+            .take()
+            .ok_or_else(|| invalid("the study is closed"))?;
+        if !ledger.finished() {
+            return Err(invalid("the study is not finished"));
+        }
+        Ok(records(&ledger.results()))
+    }
+
+    /// Releases the folder's lock.
+    fn close(&mut self) {
+        self.ledger = None;
+        self.lock = None;
+    }
+}
+
+impl StudyLedger {
+    fn ledger(&mut self) -> PyResult<&mut Ledger> {
+        self.ledger
+            .as_mut()
+            .ok_or_else(|| invalid("the study is closed"))
+    }
+}
+
+/// A rank's side of a study spread over an MPI job: computes chosen samples of its tasks
+/// with the library's [`TaskSamples`] (the same curves, bit for bit, as the serial run's),
+/// keeping the workers of the last task.
+#[pyclass(module = "asperity._asperity")]
+pub struct SampleComputer {
+    spec: StudySpec,
+    tasks: Vec<Task>,
+    current: Option<(usize, TaskSamples)>,
+}
+
+#[pymethods]
+impl SampleComputer {
+    /// For the study of `spec_json` (`StudyLedger.spec_json`).
+    #[new]
+    fn new(spec_json: &str) -> PyResult<Self> {
+        let spec: StudySpec = serde_json::from_str(spec_json)
+            .map_err(|e| invalid(format!("garbled study spec: {e}")))?;
+        spec.validate().map_err(from_error)?;
+        Ok(SampleComputer {
+            tasks: spec.tasks(),
+            spec,
+            current: None,
+        })
+    }
+
+    /// The curves of samples `indices` of task number `t`, as JSON.
+    fn compute(&mut self, py: Python<'_>, t: usize, indices: Vec<usize>) -> PyResult<String> {
+        let task = *self
+            .tasks
+            .get(t)
+            .ok_or_else(|| invalid(format!("no task number {t}")))?;
+        if self.current.as_ref().is_none_or(|(c, _)| *c != t) {
+            self.current = None;
+            let samples = TaskSamples::new(&self.spec, task).map_err(from_error)?;
+            self.current = Some((t, samples));
+        }
+        let (_, samples) = self.current.as_mut().expect("set above");
+        let curves = run_detached(py, |_| samples.compute(&indices))?;
+        let curves = curves.map_err(|e| from_error(with_task(&self.spec, task, e)))?;
+        Ok(serde_json::to_string(&curves).expect("curves serialise"))
+    }
 }
 
 /// Every task in order, as the CLI's `execute`; progress counts samples over all tasks.
@@ -176,25 +396,29 @@ fn run_tasks(
                 cancel,
             ),
         };
-        let result = result.map_err(|e| match e {
-            // The CLI's context: `mdr N = 512 H = 0.5: ...`.
-            Error::Solve { context, source } => Error::Solve {
-                context: format!(
-                    "{} N = {} H = {}: {context}",
-                    spec.method.name(),
-                    task.n,
-                    task.hurst
-                ),
-                source,
-            },
-            other => other,
-        })?;
+        let result = result.map_err(|e| with_task(spec, task, e))?;
         results.push(result);
         if cancel.is_set() {
             break;
         }
     }
     Ok(results)
+}
+
+/// A solver error with the CLI's context: `mdr N = 512 H = 0.5: ...`.
+fn with_task(spec: &StudySpec, task: Task, error: Error) -> Error {
+    match error {
+        Error::Solve { context, source } => Error::Solve {
+            context: format!(
+                "{} N = {} H = {}: {context}",
+                spec.method.name(),
+                task.n,
+                task.hurst
+            ),
+            source,
+        },
+        other => other,
+    }
 }
 
 fn run_one<S: Sampler>(

@@ -22,13 +22,16 @@
 //!   finished checkpoints are therefore byte-identical to a single-process run, for any K,
 //!   and either kind of run resumes the other's checkpoints. With K = 1 the serial code
 //!   runs unchanged.
-//! * **Checkpoints.** A task in progress saves its first samples (the run of consecutive
-//!   indices received) at most every `--checkpoint-every` seconds, as the serial run does.
+//! * **Checkpoints.** Rank 0 keeps the study in an [`asperity::study::Ledger`], which
+//!   checkpoints every sample received soon after it arrives, including samples beyond
+//!   one still in flight (the checkpoint keeps them by index), so that a lost rank costs
+//!   only the samples then being computed (the ledger's docs say when it writes).
 //!
 //! # Faults
 //! MPI (Open MPI, MPICH, Slurm) ends the whole job when a rank dies; the launcher names
 //! the rank that died (e.g. "mpirun noticed that process rank 1 … exited on signal 9").
-//! What rank 0 had checkpointed stays, and running the same command again resumes from it.
+//! What rank 0 had received is checkpointed (all but the samples in flight when the job
+//! ended), and running the same command again resumes from it.
 //! A sample that fails on a worker (a solver error) ends the study with an error naming
 //! the rank. An error on rank 0 while samples are in flight aborts the job
 //! (`MPI_Abort`) after printing it, so that no rank is left waiting.
@@ -44,10 +47,10 @@ use std::collections::HashMap;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
-use asperity::study::{Restored, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples};
+use asperity::study::{Ledger, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples};
 use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
 use mpi::topology::{Communicator, SimpleCommunicator};
 use serde::{Deserialize, Serialize};
@@ -116,7 +119,9 @@ fn send(world: &SimpleCommunicator, rank: i32, message: &Message) {
 /// Runs the command line under MPI: initialises MPI, runs `cli` on rank 0 and the worker
 /// loop on the others, and returns the process's exit status.
 pub fn main(cli: impl FnOnce() -> i32) -> i32 {
-    let Some((universe, _)) = mpi::initialize_with_threading(mpi::Threading::Funneled) else {
+    // Serialized, not Funneled: one thread at a time calls MPI, but on rank 0 that is the
+    // thread of rayon's pool the command runs on (main.rs), not the main thread.
+    let Some((universe, _)) = mpi::initialize_with_threading(mpi::Threading::Serialized) else {
         eprintln!("error: MPI could not be initialised");
         return 2;
     };
@@ -164,7 +169,11 @@ fn serve(world: &SimpleCommunicator) -> Result<()> {
                 if let Some(spec) = spec {
                     specs.insert(study, spec);
                 }
-                let reply = match compute(&specs, &mut current, study, task, &indices) {
+                // On a thread of rayon's pool, so that the samples' parallel loops run
+                // there directly (as the CLI runs its command, main.rs).
+                let computed =
+                    rayon::scope(|_| compute(&specs, &mut current, study, task, &indices));
+                let reply = match computed {
                     Ok(curves) => Message::Done { curves },
                     Err(err) => Message::Failed {
                         reason: format!("{err:#}"),
@@ -228,7 +237,17 @@ struct Local {
 }
 
 impl Local {
-    fn start() -> Local {
+    /// Starts the thread, with a rayon pool of `lanes` threads of its own: the coordinator
+    /// runs on a thread of the global pool (the CLI runs its command there) and, polling,
+    /// never lends it to other work, so that samples computed in the global pool could
+    /// wait for it forever (a pool of one thread, as under `mpirun -n 2`, which binds each
+    /// rank to one core).
+    fn start(lanes: usize) -> Result<Local> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(lanes)
+            .thread_name(|i| format!("rank0-samples-{i}"))
+            .build()
+            .context("rank 0 could not start its sample threads")?;
         let (jobs, job_rx) = mpsc::channel::<(Arc<StudySpec>, u64, Task, Vec<usize>)>();
         let (result_tx, results) = mpsc::channel();
         let thread = std::thread::spawn(move || {
@@ -238,18 +257,18 @@ impl Local {
                 specs
                     .entry(study)
                     .or_insert_with(|| StudySpec::clone(&spec));
-                let done = compute(&specs, &mut current, study, task, &indices);
+                let done = pool.install(|| compute(&specs, &mut current, study, task, &indices));
                 if result_tx.send(done).is_err() {
                     return;
                 }
             }
         });
-        Local {
+        Ok(Local {
             jobs,
             results,
             thread,
             busy: None,
-        }
+        })
     }
 }
 
@@ -311,19 +330,21 @@ pub fn run_study(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<V
         .as_mut()
         .ok_or_else(|| anyhow!("not the coordinator of an MPI job"))?;
     let world = SimpleCommunicator::world();
-    let mut study = Study::restore(store)?;
+    let mut study = Ledger::restore(store)?;
     progress(study.done(), true);
     state.studies += 1;
     let number = state.studies;
     let spec = Arc::new(store.spec().clone());
     if state.local.is_none() {
-        state.local = Some(Local::start());
+        state.local = Some(Local::start(rayon::current_num_threads().max(1))?);
     }
     state.computed = vec![0; state.workers.len()];
     let mut pause = Duration::from_micros(100);
     while !study.finished() {
         state.assign(&world, &mut study, number, &spec)?;
-        if state.collect(&world, &mut study, store)? {
+        let collected = state.collect(&world, &mut study, store)?;
+        study.save_due(store)?;
+        if collected {
             progress(study.done(), false);
             pause = Duration::from_micros(100);
         } else {
@@ -347,14 +368,14 @@ impl Coordinator {
     fn assign(
         &mut self,
         world: &SimpleCommunicator,
-        study: &mut Study,
+        study: &mut Ledger,
         number: u64,
         spec: &Arc<StudySpec>,
     ) -> Result<()> {
         if let Some(local) = self.local.as_mut().filter(|l| l.busy.is_none()) {
             let lanes = rayon::current_num_threads().max(1);
             if let Some((t, indices)) = study.next_work(lanes) {
-                let task = study.tasks[t].task;
+                let task = study.task(t);
                 local
                     .jobs
                     .send((spec.clone(), number, task, indices.clone()))
@@ -373,7 +394,7 @@ impl Coordinator {
             let message = Message::Assign {
                 study: number,
                 spec: first.then(|| (**spec).clone()),
-                task: study.tasks[t].task,
+                task: study.task(t),
                 indices: indices.clone(),
             };
             send(world, rank as i32, &message);
@@ -387,7 +408,7 @@ impl Coordinator {
     fn collect(
         &mut self,
         world: &SimpleCommunicator,
-        study: &mut Study,
+        study: &mut Ledger,
         store: &StudyDir,
     ) -> Result<bool> {
         if let Some(local) = self.local.as_mut() {
@@ -395,7 +416,7 @@ impl Coordinator {
                 let (t, indices) = local.busy.take().expect("an answer follows a job");
                 let curves = done.context("rank 0")?;
                 self.computed[0] += indices.len() as u64;
-                study.receive(store, t, &indices, curves)?;
+                take_in(study, store, t, &indices, curves)?;
                 return Ok(true);
             }
         }
@@ -411,7 +432,7 @@ impl Coordinator {
                     .take()
                     .ok_or_else(|| anyhow!("rank {rank} sent samples it was not asked for"))?;
                 self.computed[rank as usize] += indices.len() as u64;
-                study.receive(store, t, &indices, curves)?;
+                take_in(study, store, t, &indices, curves)?;
             }
             Message::Failed { reason } => {
                 worker.busy = None;
@@ -423,141 +444,17 @@ impl Coordinator {
     }
 }
 
-/// One task of a distributed study, as rank 0 keeps it.
-struct TaskState {
-    task: Task,
-    /// Its result, once finished (or read back).
-    result: Option<TaskResult>,
-    /// The samples received, by index (empty until the task is started).
-    slots: Vec<Option<SampleCurve>>,
-    /// Samples `0..prefix` are all received.
-    prefix: usize,
-    /// Samples `0..next` are given out or received.
-    next: usize,
-    /// Samples received (read back or computed).
-    received: usize,
-    /// The prefix in the last checkpoint, and when it was written.
-    saved: (usize, Instant),
-}
-
-/// The tasks of a distributed study.
-struct Study {
-    tasks: Vec<TaskState>,
-    samples: usize,
-    interval: Duration,
-}
-
-impl Study {
-    /// Every task as its checkpoint left it.
-    fn restore(store: &StudyDir) -> Result<Study> {
-        let samples = store.spec().samples;
-        let mut tasks = Vec::new();
-        for task in store.spec().tasks() {
-            let restored = store
-                .restore(task)
-                .with_context(|| task_name(store, task))?;
-            let mut state = TaskState {
-                task,
-                result: None,
-                slots: Vec::new(),
-                prefix: 0,
-                next: 0,
-                received: 0,
-                saved: (0, Instant::now()),
-            };
-            match restored {
-                Restored::Done(result) => {
-                    state.result = Some(result);
-                    (state.prefix, state.next, state.received) = (samples, samples, samples);
-                }
-                Restored::Partial(first) => {
-                    let k = first.len();
-                    (state.prefix, state.next, state.received, state.saved.0) = (k, k, k, k);
-                    state.slots = first.into_iter().map(Some).collect();
-                }
-            }
-            tasks.push(state);
-        }
-        Ok(Study {
-            tasks,
-            samples,
-            interval: store.checkpoint_interval(),
-        })
-    }
-
-    fn done(&self) -> u64 {
-        self.tasks.iter().map(|t| t.received as u64).sum()
-    }
-
-    fn finished(&self) -> bool {
-        self.tasks.iter().all(|t| t.result.is_some())
-    }
-
-    /// The next samples to give out: up to `lanes` of the first task with samples left.
-    fn next_work(&mut self, lanes: usize) -> Option<(usize, Vec<usize>)> {
-        let samples = self.samples;
-        let (t, state) = self
-            .tasks
-            .iter_mut()
-            .enumerate()
-            .find(|(_, s)| s.next < samples)?;
-        let end = (state.next + lanes).min(samples);
-        let indices: Vec<usize> = (state.next..end).collect();
-        state.next = end;
-        Some((t, indices))
-    }
-
-    /// Takes in the curves of samples `indices` of task `t`; checkpoints the task when due
-    /// and ends it when complete.
-    fn receive(
-        &mut self,
-        store: &StudyDir,
-        t: usize,
-        indices: &[usize],
-        curves: Vec<SampleCurve>,
-    ) -> Result<()> {
-        let samples = self.samples;
-        let state = &mut self.tasks[t];
-        if curves.len() != indices.len() {
-            bail!(
-                "{}: {} curves for {} samples",
-                task_name(store, state.task),
-                curves.len(),
-                indices.len()
-            );
-        }
-        state.slots.resize(samples, None);
-        for (&i, curve) in indices.iter().zip(curves) {
-            state.slots[i] = Some(curve);
-        }
-        state.received += indices.len();
-        while state.prefix < samples && state.slots[state.prefix].is_some() {
-            state.prefix += 1;
-        }
-        let name = || task_name(store, state.task);
-        if state.prefix == samples {
-            let all = std::mem::take(&mut state.slots)
-                .into_iter()
-                .flatten()
-                .collect();
-            state.result = Some(store.finish(state.task, all).with_context(name)?);
-        } else if state.prefix > state.saved.0 && state.saved.1.elapsed() >= self.interval {
-            let first: Vec<SampleCurve> = state.slots[..state.prefix]
-                .iter()
-                .flatten()
-                .cloned()
-                .collect();
-            store
-                .save_in_progress(state.task, &first)
-                .with_context(name)?;
-            state.saved = (state.prefix, Instant::now());
-        }
-        Ok(())
-    }
-
-    fn results(self) -> Vec<TaskResult> {
-        self.tasks.into_iter().filter_map(|t| t.result).collect()
-    }
+/// [`Ledger::receive`], its errors named as the serial run names a task's.
+fn take_in(
+    study: &mut Ledger,
+    store: &StudyDir,
+    t: usize,
+    indices: &[usize],
+    curves: Vec<SampleCurve>,
+) -> Result<()> {
+    study
+        .receive(store, t, indices, curves)
+        .with_context(|| task_name(store, study.task(t)))
 }
 
 /// `bem N = 64 H = 0.5`, as errors of the serial run name a task.

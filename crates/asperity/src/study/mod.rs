@@ -31,10 +31,13 @@
 //! the folder on one process with [`StudyDir::restore`], [`StudyDir::save_in_progress`]
 //! and [`StudyDir::finish`], and computes chosen samples of a task anywhere with
 //! [`TaskSamples`]: assembled in index order, they give the serial run's checkpoints and
-//! results byte for byte.
+//! results byte for byte. [`Ledger`] does that bookkeeping: it hands out the samples not
+//! yet computed and checkpoints every sample received ([`StudyDir::save_received`]), in
+//! index order or not, so that a lost process costs only the samples it was computing.
 
 pub mod curve;
 pub mod identity;
+pub mod ledger;
 pub mod samplers;
 pub mod theory;
 
@@ -46,6 +49,7 @@ use serde::{Deserialize, Serialize};
 pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
+pub use ledger::Ledger;
 pub use samplers::{run_any_task, Scales, TaskSamples};
 
 use crate::fit::PowerLawFit;
@@ -425,8 +429,24 @@ struct Manifest {
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(tag = "state", rename_all = "snake_case")]
 enum Checkpoint {
-    InProgress { samples: Vec<SampleCurve> },
-    Done { result: TaskResult },
+    InProgress {
+        samples: Vec<SampleCurve>,
+        /// Samples received beyond the first missing index, by index: a front end that
+        /// computes samples out of order ([`StudyDir::save_received`], the MPI build)
+        /// keeps them too. Absent (and then not written) in serial runs.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        later: Vec<LaterSample>,
+    },
+    Done {
+        result: TaskResult,
+    },
+}
+
+/// A sample of a task in progress saved beyond the first missing index.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct LaterSample {
+    index: usize,
+    sample: SampleCurve,
 }
 
 /// A task in progress saves its samples at most this often (and always when it ends), so
@@ -537,8 +557,11 @@ impl StudyDir {
                 .ok()
                 .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok());
             let content = value.as_ref().map(|v| &v["content"]);
+            let none = |v: &serde_json::Value| v.as_array().is_none_or(Vec::is_empty);
             let empty = content.is_some_and(|c| {
-                c["state"] == "in_progress" && c["samples"].as_array().is_some_and(Vec::is_empty)
+                c["state"] == "in_progress"
+                    && c["samples"].as_array().is_some_and(Vec::is_empty)
+                    && none(&c["later"])
             });
             if !empty {
                 return Ok(true);
@@ -653,6 +676,32 @@ impl StudyDir {
             task,
             &Checkpoint::InProgress {
                 samples: samples.to_vec(),
+                later: Vec::new(),
+            },
+        )
+    }
+
+    /// Saves the samples of `task` received so far, in progress: `slots[i]` is sample `i`
+    /// if received. For front ends that receive samples out of index order (e.g. from
+    /// other processes), so that a sample beyond a missing one is kept too.
+    pub fn save_received(&self, task: Task, slots: &[Option<SampleCurve>]) -> Result<()> {
+        let first = slots.iter().take_while(|s| s.is_some()).count();
+        let later = slots
+            .iter()
+            .enumerate()
+            .skip(first)
+            .filter_map(|(index, s)| {
+                s.as_ref().map(|sample| LaterSample {
+                    index,
+                    sample: sample.clone(),
+                })
+            })
+            .collect();
+        self.save(
+            task,
+            &Checkpoint::InProgress {
+                samples: slots[..first].iter().flatten().cloned().collect(),
+                later,
             },
         )
     }
@@ -782,6 +831,16 @@ pub enum Restored {
     Partial(Vec<SampleCurve>),
 }
 
+/// What a task's checkpoint holds, sample by sample, as [`StudyDir::restore_received`]
+/// reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Received {
+    /// The task is finished: its result.
+    Done(TaskResult),
+    /// One slot per sample: those saved so far.
+    Partial(Vec<Option<SampleCurve>>),
+}
+
 impl StudyDir {
     /// The checkpoint of `task`, read and verified as [`run_task`] reads it: the result of
     /// a finished task, or the samples saved so far (at most the study's sample count).
@@ -793,12 +852,39 @@ impl StudyDir {
             Some(Checkpoint::Done { result }) if result.samples == self.spec.samples => {
                 Ok(Restored::Done(result))
             }
-            Some(Checkpoint::InProgress { mut samples }) => {
+            // Samples saved beyond a gap are left out: the serial run computes in index
+            // order (they are computed again, to the same bits).
+            Some(Checkpoint::InProgress { mut samples, .. }) => {
                 samples.truncate(self.spec.samples);
                 Ok(Restored::Partial(samples))
             }
             _ => Ok(Restored::Partial(Vec::new())),
         }
+    }
+
+    /// The checkpoint of `task` sample by sample: the result of a finished task, or one
+    /// slot per sample of the study holding the samples saved so far, in and out of index
+    /// order ([`StudyDir::save_received`]).
+    pub fn restore_received(&self, task: Task) -> Result<Received> {
+        let count = self.spec.samples;
+        let mut slots = vec![None; count];
+        match self.load(task)? {
+            Some(Checkpoint::Done { result }) if result.samples == count => {
+                return Ok(Received::Done(result))
+            }
+            Some(Checkpoint::InProgress { samples, later }) => {
+                for (slot, sample) in slots.iter_mut().zip(samples) {
+                    *slot = Some(sample);
+                }
+                for LaterSample { index, sample } in later {
+                    if let Some(slot) = slots.get_mut(index) {
+                        *slot = Some(sample);
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(Received::Partial(slots))
     }
 
     /// Ends `task` with all its `samples` (in index order): its result, saved as
