@@ -123,6 +123,8 @@ fn check_comparison(fig: &Path, report: &str) {
         let (ours, low, high, paper, tol) = (num(4), num(5), num(6), num(7), num(9));
         let verdict = if paper >= low - tol && paper <= high + tol {
             "agrees"
+        } else if (ours - paper).abs() <= 0.02 + tol {
+            "close"
         } else {
             "differs"
         };
