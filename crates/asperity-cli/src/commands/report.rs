@@ -260,7 +260,7 @@ fn reason(row: &Row) -> String {
         _ => format!("finite grid ({}²)", row.n),
     };
     if row.quantity == "steepest_slope" {
-        return format!("{grid}: the paper's curves are on 1024² (see the N trend)");
+        return format!("{grid}: the paper's curves are on 1024²");
     }
     if row.hurst > 0.0 && row.hurst <= 0.5 {
         return "crossover of eq. (24) and eq. (6) at H = 0: the theory's kink is sharp, \
