@@ -64,6 +64,8 @@ fn the_test_setting_writes_a_complete_recorded_folder_and_resumes_identically() 
     assert!(command.ends_with(&args_a.join(" ")), "{command}");
     let report = std::fs::read_to_string(fig.join("report.md")).unwrap();
     assert!(report.contains("**Setting: test**"), "{report}");
+    check_comparison(&fig, &report);
+    check_windows(&fig);
     // The same folder under another setting is refused, naming the one that made it.
     let o = asperity(&["reproduce", "fig1", "--quick", "--out", a.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
@@ -86,4 +88,68 @@ fn the_test_setting_writes_a_complete_recorded_folder_and_resumes_identically() 
         full < Duration::from_secs(120),
         "the test setting took {full:?}"
     );
+}
+
+/// Every row of `comparison.csv` appears in the report with a verdict that follows from
+/// its numbers (the paper's value inside the interval widened by the tolerance).
+fn check_comparison(fig: &Path, report: &str) {
+    let text = std::fs::read_to_string(fig.join("comparison.csv")).unwrap();
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let mut rows = 0;
+    for record in reader.records() {
+        let r = record.unwrap();
+        let num = |i: usize| r[i].parse::<f64>().unwrap();
+        let (ours, low, high, paper, tol) = (num(4), num(5), num(6), num(7), num(9));
+        let verdict = if paper >= low - tol && paper <= high + tol {
+            "agrees"
+        } else if (ours - paper).abs() <= 0.02 + tol {
+            "close"
+        } else {
+            "differs"
+        };
+        let line = format!(
+            "| {} | {} | {} | {} | {ours:.3} |",
+            &r[0],
+            num(1),
+            num(2),
+            &r[3]
+        );
+        let found = report
+            .lines()
+            .find(|l| l.starts_with(&line))
+            .unwrap_or_else(|| panic!("{line} not in the report:\n{report}"));
+        assert!(found.contains(&format!("| {verdict} |")), "{found}");
+        rows += 1;
+    }
+    // Fig. 1 of the test setting: MDR on one N and 17 H, BEM on 2 N and 3 H.
+    assert_eq!(rows, 17 + 6, "{text}");
+    assert!(
+        report.contains(&format!("of {rows} rows agree")),
+        "{report}"
+    );
+}
+
+/// `study windows` on the figure's BEM study: the default window (8 contacts to 1 %)
+/// gives the α of `alpha.csv` exactly, from the sample curves the checkpoints keep.
+fn check_windows(fig: &Path) {
+    let o = asperity(&["study", "windows", fig.join("bem").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let windows = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(fig.join("window_sensitivity.csv")).unwrap(),
+        windows
+    );
+    let alpha = std::fs::read_to_string(fig.join("bem").join("alpha.csv")).unwrap();
+    let mut checked = 0;
+    for line in alpha.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (n, h, a) = (f[1], f[2], f[3]);
+        let default = windows
+            .lines()
+            .find(|l| l.starts_with(&format!("{n}.0,{h},8.0,0.01,")))
+            .unwrap_or_else(|| panic!("no default window for N = {n}, H = {h}:\n{windows}"));
+        assert_eq!(default.split(',').nth(4).unwrap(), a, "{default} vs {line}");
+        checked += 1;
+    }
+    assert_eq!(checked, 6);
 }

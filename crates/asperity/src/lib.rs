@@ -56,24 +56,25 @@
 //!
 //! ## Rough lines and the exponent α (MDR, [`mdr`])
 //! A line of independent linear springs gives its whole force–stiffness curve from one
-//! sort; an ensemble of lines gives α of `k ∝ F^α` (paper eq. 3) in a stated low-force window.
+//! sort; an ensemble of lines gives α of `k ∝ F^α` (paper eq. 3) in a stated low-force
+//! window ([`study::FitWindow`]), the same estimator for lines (MDR) and surfaces (BEM).
 //! ```
-//! use asperity::mdr::{ensemble_exponent, low_force_sample, LinearCurve, LowForceWindow};
-//! use asperity::spectrum::Psd;
+//! use asperity::study::{ensemble_alpha, FitWindow, Method, StudySpec, Task, TaskSamples};
 //! use asperity::study::theory::alpha_theory;
-//! use asperity::surface::{LineGenerator, LineSpec, Normalisation};
 //! let n = 1 << 12;
-//! let spec = LineSpec::new(n, 1.0, Psd::power_law(1.0)?, Normalisation::RmsHeight(1.0))?;
-//! let mut generator = LineGenerator::new(&spec)?;
-//! let window = LowForceWindow::default(); // 8 contacts up to 1 % contact
-//! let samples = (0..100u64)
-//!     .map(|seed| {
-//!         let line = generator.generate(seed);
-//!         let curve = LinearCurve::from_heights(line.heights().as_slice().unwrap(), 1.0 / n as f64, 1.0)?;
-//!         low_force_sample(&curve, 1.0, &window)
-//!     })
-//!     .collect::<Result<Vec<_>, _>>()?;
-//! let alpha = ensemble_exponent(&samples, &window)?.mean_curve.exponent;
+//! let spec = StudySpec {
+//!     method: Method::Mdr,
+//!     sizes: vec![n],
+//!     hursts: vec![1.0],
+//!     samples: 100,
+//!     rolloff: None,
+//!     seed: 1,
+//!     window: FitWindow::default(), // 8 contacts up to 1 % contact
+//!     levels: 48,
+//! };
+//! let task = Task { n, hurst: 1.0 };
+//! let samples = TaskSamples::new(&spec, task)?.compute(&(0..100).collect::<Vec<_>>())?;
+//! let alpha = ensemble_alpha(&samples, &spec.window, spec.levels).unwrap().exponent;
 //! assert!((alpha - alpha_theory(1.0, n)).abs() < 0.05); // eq. (6): 1/(1+H) = 0.5
 //! # Ok::<(), asperity::Error>(())
 //! ```

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use asperity::fit::{power_law_fit, steepest_power_law};
+use asperity::fit::power_law_fit;
 use asperity::spectrum::Psd;
 use asperity::surface::stats::{line_psd, radial_psd_2d, surface_summary};
 use asperity::surface::{LineGenerator, LineSpec, Normalisation, SurfaceGenerator, SurfaceSpec};
@@ -272,7 +272,7 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         mdr.window.describe(),
         alpha_rows_md(&all)
     );
-    write_report(dir, &report, force)
+    super::report::write(dir, super::report::Results::Fig1(&all), &report, force)
 }
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
@@ -288,24 +288,10 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
          |---|---|---|---|\n",
     );
     for r in &results {
-        // The stretch a reader of the log–log plot calls "almost linear": the largest
-        // slope of the mean curve over any window spanning a factor 10 in force, past the
-        // first contacts (the α window's lower end), where single pixels dominate.
-        let first_contacts = spec.window.min_contacts as f64 / (n * n) as f64;
-        let curve: Vec<_> = r
-            .mean_curve
-            .iter()
-            .filter(|p| p.fraction >= first_contacts)
-            .collect();
-        let (f, k): (Vec<f64>, Vec<f64>) = curve.iter().map(|p| (p.force, p.stiffness)).unzip();
-        let (steepest, fractions) = match steepest_power_law(&f, &k, 10.0) {
-            Some((fit, first, last)) => (
-                format!("{:.3}", fit.exponent),
-                format!(
-                    "{:.2e} – {:.2e}",
-                    curve[first].fraction, curve[last].fraction
-                ),
-            ),
+        let (steepest, fractions) = match super::report::steepest_slope(r, &spec.window) {
+            Some((slope, first, last)) => {
+                (format!("{slope:.3}"), format!("{first:.2e} – {last:.2e}"))
+            }
             None => ("—".into(), "— (the curve spans less than a decade)".into()),
         };
         let low = r
@@ -337,7 +323,12 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         setting.describe(),
         min_contacts = spec.window.min_contacts,
     );
-    write_report(dir, &report, force)
+    super::report::write(
+        dir,
+        super::report::Results::Fig2(&results, spec.window),
+        &report,
+        force,
+    )
 }
 
 /// Paper Fig. 5: α versus N for H < 0 against eq. (24).
@@ -437,5 +428,6 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         bem.samples,
         mdr.window.describe()
     );
-    write_report(dir, &report, force)
+    let results = super::report::Results::Fig5(&mdr_results, &bem_results);
+    super::report::write(dir, results, &report, force)
 }

@@ -8,6 +8,7 @@ pub mod figures;
 pub mod import;
 pub mod mdr;
 pub mod measured;
+pub mod report;
 pub mod reproduce;
 pub mod setting;
 pub mod stats;

@@ -274,6 +274,41 @@ pub enum StudyCommand {
     Curve(CurveArgs),
     /// Run a study described by a TOML file (for larger sweeps).
     File(FileArgs),
+    /// α of a finished or running BEM study refitted with other windows (start 4, 8, 16
+    /// contacts; end 0.5, 1, 2 % contact), each with a bootstrap 95 % interval → CSV on
+    /// stdout.
+    #[command(
+        after_help = "Reads the sample curves that the study's checkpoints keep (finished BEM \
+tasks, and tasks in progress); writes nothing into the folder.\nColumns: n, hurst, \
+min_contacts, max_fraction, alpha (ensemble-mean fit), low, high (2.5 and 97.5 % of 400 \
+bootstrap resamples of the samples), samples.\n\nExample:\n  asperity study windows \
+docs/results/medium/fig2/bem > windows.csv"
+    )]
+    Windows(WindowsArgs),
+}
+
+/// Arguments of `asperity study windows`.
+#[derive(Debug, clap::Args)]
+pub struct WindowsArgs {
+    /// The study folder (holding study.json and checkpoint/).
+    pub dir: PathBuf,
+}
+
+/// `asperity study windows`: the window sensitivity as CSV on stdout.
+fn windows(args: &WindowsArgs) -> Result<()> {
+    use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity};
+    let found = study_sensitivity(&args.dir, &sensitivity_windows())?;
+    if found.is_empty() {
+        anyhow::bail!(
+            "{}: no task of this study has stored sample curves (MDR tasks and BEM tasks \
+             finished before asperity kept them have none)",
+            args.dir.display()
+        );
+    }
+    let table = super::report::window_table(&found);
+    use std::io::Write as _;
+    std::io::stdout().write_all(&table.to_csv()?)?;
+    Ok(())
 }
 
 /// Arguments of `asperity study`.
@@ -529,6 +564,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
                 RunOptions::from_args(&c.common.run)?,
             )
         }
+        StudyCommand::Windows(w) => return windows(w),
         StudyCommand::File(f) => {
             let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
             let (kind, spec) = parse_study_file(&f.file, &text)?;

@@ -14,8 +14,9 @@
 //! * [`linear_curve`]: the whole curve of a line on linear springs in `O(N log N)`, with a
 //!   reusable buffer for ensembles of thousands of lines.
 //! * [`radix_sort`]: the `O(N)` descending sort of doubles behind [`LinearCurve`].
-//! * [`low_force`]: the low-force exponent α of `k ∝ F^α` (3): the documented automatic
-//!   fit window, per-sample and ensemble-mean fits, and the theories (6) and (24).
+//!
+//! The low-force exponent α of `k ∝ F^α` (3) of an ensemble of lines is the study's
+//! ([`crate::study::curve`]: one fit window and estimator for MDR and BEM alike).
 //!
 //! # Example
 //! ```
@@ -36,14 +37,10 @@
 pub mod foundation;
 pub mod indenter;
 pub mod linear_curve;
-pub mod low_force;
 pub mod radix_sort;
 pub mod spring;
 
 pub use foundation::{log_spaced, CurvePoint, Foundation};
 pub use indenter::{spring_positions, Axisymmetric, RadialProfile, PUNCH_EDGE_TOLERANCE};
 pub use linear_curve::LinearCurve;
-pub use low_force::{
-    ensemble_exponent, low_force_sample, EnsembleExponent, LowForceSample, LowForceWindow,
-};
 pub use spring::{fractal_asymptote, Spring, SpringLaw, FRACTAL_CONSTANT};

@@ -8,8 +8,9 @@
 //! H and N, and stated in every report ([`FitWindow`]): it starts where `min_contacts`
 //! points touch and ends where a fraction `max_fraction` of all points touch, but spans at
 //! least a factor [`MIN_WINDOW_SPAN`] in contacts (so short lines and small grids keep
-//! about a decade in force). The default, 8 contacts to 1 %, is the MDR module's
-//! experimentally chosen window (`mdr::low_force`), within ±0.01 of theory for N = 2^15.
+//! about a decade in force). The default, 8 contacts to 1 %, was chosen by experiment on
+//! MDR lines of N = 2^15 (`samplers::tests::window_experiment`, `--ignored`; docs/mdr.md),
+//! within ±0.01 of theory there.
 //!
 //! Within the window the curve is sampled at `levels` log-spaced forces, so that every
 //! decade of force weighs alike, and `ln k` is fitted on `ln F`: per sample between that
@@ -235,6 +236,16 @@ pub fn ensemble_curve(samples: &[SampleCurve], levels: usize) -> Result<Vec<Ense
 /// window or fewer than 3 levels are covered.
 pub fn ensemble_alpha(
     samples: &[SampleCurve],
+    window: &FitWindow,
+    levels: usize,
+) -> Option<PowerLawFit> {
+    let refs: Vec<&SampleCurve> = samples.iter().collect();
+    ensemble_alpha_of(&refs, window, levels)
+}
+
+/// [`ensemble_alpha`] of samples held by reference (a bootstrap resample repeats some).
+pub fn ensemble_alpha_of(
+    samples: &[&SampleCurve],
     window: &FitWindow,
     levels: usize,
 ) -> Option<PowerLawFit> {

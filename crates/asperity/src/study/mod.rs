@@ -39,6 +39,7 @@ pub mod curve;
 pub mod identity;
 pub mod ledger;
 pub mod samplers;
+pub mod sensitivity;
 pub mod theory;
 
 use std::path::{Path, PathBuf};
@@ -335,7 +336,7 @@ pub fn sample_cost(method: Method, n: usize) -> f64 {
     }
 }
 
-fn splitmix64(mut x: u64) -> u64 {
+pub(crate) fn splitmix64(mut x: u64) -> u64 {
     x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
     x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -380,9 +381,9 @@ pub struct TaskResult {
 
 impl TaskResult {
     /// Builds the ensemble quantities from the samples.
-    pub fn from_samples(spec: &StudySpec, task: Task, samples: Vec<SampleCurve>) -> Result<Self> {
-        let mean_curve = ensemble_curve(&samples, spec.levels)?;
-        let alpha_ensemble = ensemble_alpha(&samples, &spec.window, spec.levels);
+    pub fn from_samples(spec: &StudySpec, task: Task, samples: &[SampleCurve]) -> Result<Self> {
+        let mean_curve = ensemble_curve(samples, spec.levels)?;
+        let alpha_ensemble = ensemble_alpha(samples, &spec.window, spec.levels);
         let alpha_samples = samples
             .iter()
             .filter_map(|s| s.alpha(&spec.window, spec.levels))
@@ -424,8 +425,11 @@ struct Manifest {
 }
 
 /// What `checkpoint/<task>.json` holds, sealed with the task's [`TaskIdentity`]: the
-/// samples of a task in progress, or the result of a finished one (its sample curves are
-/// then no longer kept).
+/// samples of a task in progress, or the result of a finished one. A finished BEM task
+/// keeps its sample curves too (24 loads a sample: tens of kB), so that its α can be
+/// refitted with other windows without solving again ([`StudyDir::stored_samples`]); a
+/// finished MDR task does not (up to a thousand points a line, 500 lines; recomputing
+/// them takes seconds).
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(tag = "state", rename_all = "snake_case")]
 enum Checkpoint {
@@ -439,6 +443,9 @@ enum Checkpoint {
     },
     Done {
         result: TaskResult,
+        /// The sample curves (BEM only; absent from checkpoints written before they were kept).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        samples: Vec<SampleCurve>,
     },
 }
 
@@ -602,6 +609,26 @@ impl StudyDir {
         };
         io::write_json(&dir.join("study.json"), true, &manifest)?;
         Ok(store)
+    }
+
+    /// The study already in `dir`, read without writing anything (to read its
+    /// checkpoints, e.g. [`StudyDir::stored_samples`]); an error when `dir` holds no study
+    /// or a corrupt `study.json`.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let path = dir.join("study.json");
+        let text = crate::input::read_text(&path, crate::input::TEXT_MAX_BYTES)?;
+        let manifest = serde_json::from_str::<Manifest>(&text)
+            .ok()
+            .filter(|m| m.format == MANIFEST_FORMAT)
+            .ok_or_else(|| Error::DamagedStudy {
+                path: path.clone(),
+                reason: "not a study file of this asperity".into(),
+            })?;
+        Ok(StudyDir {
+            dir: dir.to_path_buf(),
+            spec: manifest.spec,
+            interval: CHECKPOINT_INTERVAL,
+        })
     }
 
     /// Saves tasks in progress at most every `interval` instead of [`CHECKPOINT_INTERVAL`]
@@ -849,7 +876,7 @@ impl StudyDir {
     /// [`StudyDir::finish`].
     pub fn restore(&self, task: Task) -> Result<Restored> {
         match self.load(task)? {
-            Some(Checkpoint::Done { result }) if result.samples == self.spec.samples => {
+            Some(Checkpoint::Done { result, .. }) if result.samples == self.spec.samples => {
                 Ok(Restored::Done(result))
             }
             // Samples saved beyond a gap are left out: the serial run computes in index
@@ -869,7 +896,7 @@ impl StudyDir {
         let count = self.spec.samples;
         let mut slots = vec![None; count];
         match self.load(task)? {
-            Some(Checkpoint::Done { result }) if result.samples == count => {
+            Some(Checkpoint::Done { result, .. }) if result.samples == count => {
                 return Ok(Received::Done(result))
             }
             Some(Checkpoint::InProgress { samples, later }) => {
@@ -900,14 +927,31 @@ impl StudyDir {
                 ),
             ));
         }
-        let result = TaskResult::from_samples(&self.spec, task, samples)?;
+        let result = TaskResult::from_samples(&self.spec, task, &samples)?;
+        let samples = match self.spec.method {
+            Method::Bem => samples,
+            Method::Mdr => Vec::new(),
+        };
         self.save(
             task,
             &Checkpoint::Done {
                 result: result.clone(),
+                samples,
             },
         )?;
         Ok(result)
+    }
+
+    /// The sample curves of `task` stored in its checkpoint, in index order: those of a
+    /// finished BEM task, or those saved so far of a task in progress; empty when none
+    /// are stored (no checkpoint, a finished MDR task, or a checkpoint written before
+    /// finished tasks kept their samples).
+    pub fn stored_samples(&self, task: Task) -> Result<Vec<SampleCurve>> {
+        Ok(match self.load(task)? {
+            Some(Checkpoint::Done { samples, .. })
+            | Some(Checkpoint::InProgress { samples, .. }) => samples,
+            None => Vec::new(),
+        })
     }
 
     /// The longest time between two checkpoints of a task in progress.
@@ -924,6 +968,41 @@ impl StudyDir {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn finished_bem_tasks_keep_their_sample_curves_and_mdr_tasks_do_not() {
+        for (method, n, kept) in [(Method::Bem, 16, true), (Method::Mdr, 512, false)] {
+            let spec = StudySpec {
+                method,
+                sizes: vec![n],
+                hursts: vec![0.5],
+                samples: 3,
+                rolloff: None,
+                seed: 3,
+                window: FitWindow::default(),
+                levels: 16,
+            };
+            let dir = tempfile::tempdir().unwrap();
+            let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+            let task = spec.tasks()[0];
+            let result = run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
+            let stored = StudyDir::read(dir.path())
+                .unwrap()
+                .stored_samples(task)
+                .unwrap();
+            if kept {
+                // The stored curves give the finished result again, bit for bit.
+                assert_eq!(stored.len(), 3);
+                assert_eq!(
+                    TaskResult::from_samples(&spec, task, &stored).unwrap(),
+                    result
+                );
+            } else {
+                assert!(stored.is_empty());
+            }
+        }
+        assert!(StudyDir::read(tempfile::tempdir().unwrap().path()).is_err());
+    }
 
     #[test]
     fn ranges_are_inclusive_and_validated() {

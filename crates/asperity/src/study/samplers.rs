@@ -554,6 +554,38 @@ mod tests {
         }
     }
 
+    /// The experiment behind the default window (run with `--ignored --nocapture`): α of
+    /// the ensemble-mean curve of 200 MDR lines of 2^15 points for several windows, against
+    /// eq. (24) (H = −0.5) and eq. (6) (docs/mdr.md).
+    #[test]
+    #[ignore]
+    fn window_experiment() {
+        let n = 1 << 15;
+        for hurst in [-0.5, 0.5, 1.0] {
+            let s = spec(Method::Mdr, n, vec![hurst], 200);
+            let indices: Vec<usize> = (0..200).collect();
+            let samples = TaskSamples::new(&s, Task { n, hurst })
+                .unwrap()
+                .compute(&indices)
+                .unwrap();
+            for min_contacts in [2, 3, 5, 8, 10, 16] {
+                for max_fraction in [0.005, 0.01, 0.02, 0.05] {
+                    let window = FitWindow {
+                        min_contacts,
+                        max_fraction,
+                    };
+                    let alpha = crate::study::ensemble_alpha(&samples, &window, s.levels)
+                        .map_or(f64::NAN, |f| f.exponent);
+                    eprintln!(
+                        "H = {hurst:5}, from {min_contacts:2} contacts to {max_fraction:.3}: \
+                         α − theory = {:+.4}",
+                        alpha - alpha_theory(hurst, n)
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn bem_alpha_matches_pohrt_popov_for_h_one_half() {
         // 60 surfaces of 128² (the paper's sample count) with free boundaries. At this size

@@ -1,0 +1,538 @@
+//! The comparison with the paper in each `report.md` of `asperity reproduce` (Figs. 1, 2,
+//! 5): every result beside the paper's statement or equation, with its 95 % interval,
+//! whether the two agree within it, by how much, and the likely reason when they do not;
+//! how α moves with N; and how it moves with the fit window.
+//!
+//! The figure code hands its task results to [`write`]; the rows go to
+//! `comparison.csv`, and the tables of the report are rendered **from that CSV**
+//! ([`render`]), so that the text a reader sees is the file a script can check.
+//!
+//! # The interval of an α
+//! α is fitted on the ensemble-mean curve; its interval is that value ± `t·s/√m`, with `s`
+//! the spread of the `m` per-sample α (Student t, 95 %): the uncertainty of a mean over
+//! `m` samples, not the spread of single samples (the `alpha_low`, `alpha_high` columns
+//! of `alpha.csv`). A result **agrees** when the reference lies inside its interval
+//! widened by the reference's own looseness (`tolerance`: 0 for an equation, 0.1 for the
+//! paper's "≈ 1"). Outside it but within [`CLOSE`] of the reference a result is **close**:
+//! with hundreds of samples the interval shrinks below the estimator's own systematic
+//! accuracy (the default window is within ±0.02 of theory for MDR lines of 2^15 points,
+//! `docs/mdr.md`), so a difference that small says nothing about the paper.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use asperity::fit::{steepest_power_law, student_t_975};
+use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity, TaskSensitivity};
+use asperity::study::theory::{alpha_theory, alpha_white_noise};
+use asperity::study::{FitWindow, TaskResult};
+
+use crate::output::{format_number, Table};
+
+/// One result beside its reference: a row of `comparison.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// `mdr` or `bem`.
+    pub method: String,
+    /// Grid size as the reference reads it (Fig. 5: lines per side or grid points).
+    pub n: f64,
+    /// Hurst exponent.
+    pub hurst: f64,
+    /// What is compared (`alpha`, `steepest_slope`).
+    pub quantity: String,
+    /// Our value.
+    pub ours: f64,
+    /// 95 % interval of ours (module docs).
+    pub low: f64,
+    /// 95 % interval of ours, high end.
+    pub high: f64,
+    /// The paper's value.
+    pub reference: f64,
+    /// Where the paper's value comes from (`eq. (6)`, `eq. (24)`, `Hertz 1/3`, ...).
+    pub source: String,
+    /// How loosely the paper states its value (0 for an equation).
+    pub tolerance: f64,
+}
+
+const HEADER: [&str; 10] = [
+    "method",
+    "n",
+    "hurst",
+    "quantity",
+    "ours",
+    "low",
+    "high",
+    "reference",
+    "source",
+    "tolerance",
+];
+
+/// The results of one figure, as the figure code has them.
+pub enum Results<'a> {
+    /// Fig. 1: α(H) of both methods.
+    Fig1(&'a [TaskResult]),
+    /// Fig. 2: the mean curves of a roll-off study, its window and grid.
+    Fig2(&'a [TaskResult], FitWindow),
+    /// Fig. 5: MDR and BEM α at several N (H < 0).
+    Fig5(&'a [TaskResult], &'a [TaskResult]),
+}
+
+/// The ensemble α and its 95 % interval (module docs); `None` without a fit.
+pub fn alpha_interval(r: &TaskResult) -> Option<(f64, f64, f64)> {
+    let alpha = r.alpha_ensemble?.exponent;
+    let m = r.alpha_samples.len();
+    if m < 2 {
+        return Some((alpha, f64::NAN, f64::NAN));
+    }
+    let mean = r.alpha_samples.iter().sum::<f64>() / m as f64;
+    let var = r
+        .alpha_samples
+        .iter()
+        .map(|a| (a - mean).powi(2))
+        .sum::<f64>()
+        / (m - 1) as f64;
+    let half = student_t_975(m - 1) * (var / m as f64).sqrt();
+    Some((alpha, alpha - half, alpha + half))
+}
+
+/// Which theory the paper gives for α at `hurst` on `n` points (eq. 24 for H ≤ 0).
+fn alpha_source(hurst: f64) -> &'static str {
+    if hurst <= 0.0 {
+        "eq. (24)"
+    } else if hurst < 2.0 {
+        "eq. (6)"
+    } else {
+        "Hertz 1/3"
+    }
+}
+
+fn alpha_row(r: &TaskResult, n: f64, reference: f64, source: &str) -> Option<Row> {
+    let (ours, low, high) = alpha_interval(r)?;
+    Some(Row {
+        method: r.method.name().to_string(),
+        n,
+        hurst: r.task.hurst,
+        quantity: "alpha".into(),
+        ours,
+        low,
+        high,
+        reference,
+        source: source.into(),
+        tolerance: 0.0,
+    })
+}
+
+/// The steepest log–log slope of a mean curve over one decade of force, from the
+/// window's first contacts on, and the contact fractions where it lies (Fig. 2: the
+/// stretch a reader of the plot calls "almost linear"; single pixels dominate before).
+pub fn steepest_slope(r: &TaskResult, window: &FitWindow) -> Option<(f64, f64, f64)> {
+    let first_contacts = window.min_contacts as f64 / (r.task.n * r.task.n) as f64;
+    let curve: Vec<_> = r
+        .mean_curve
+        .iter()
+        .filter(|p| p.fraction >= first_contacts)
+        .collect();
+    let (f, k): (Vec<f64>, Vec<f64>) = curve.iter().map(|p| (p.force, p.stiffness)).unzip();
+    let (fit, first, last) = steepest_power_law(&f, &k, 10.0)?;
+    Some((fit.exponent, curve[first].fraction, curve[last].fraction))
+}
+
+/// The rows of a figure.
+pub fn rows(results: &Results) -> Vec<Row> {
+    match results {
+        Results::Fig1(all) => all
+            .iter()
+            .filter_map(|r| {
+                let theory = alpha_theory(r.task.hurst, r.task.n);
+                alpha_row(r, r.task.n as f64, theory, alpha_source(r.task.hurst))
+            })
+            .collect(),
+        Results::Fig2(all, window) => all
+            .iter()
+            .filter_map(|r| {
+                let (slope, _, _) = steepest_slope(r, window)?;
+                Some(Row {
+                    method: r.method.name().to_string(),
+                    n: r.task.n as f64,
+                    hurst: r.task.hurst,
+                    quantity: "steepest_slope".into(),
+                    ours: slope,
+                    low: slope,
+                    high: slope,
+                    reference: 1.0,
+                    source: "paper: slope ≈ 1".into(),
+                    tolerance: 0.1,
+                })
+            })
+            .collect(),
+        Results::Fig5(mdr, bem) => {
+            let mut rows: Vec<Row> = mdr
+                .iter()
+                .filter_map(|r| {
+                    let n = r.task.n as f64;
+                    alpha_row(r, n, alpha_white_noise(n), "eq. (24), N = modes")
+                })
+                .collect();
+            for r in bem.iter() {
+                for (n, how) in [(r.task.n, "lines"), (r.task.n * r.task.n, "points")] {
+                    let source = format!("eq. (24), N = {how}");
+                    rows.extend(alpha_row(r, n as f64, alpha_white_noise(n as f64), &source));
+                }
+            }
+            rows
+        }
+    }
+}
+
+/// `comparison.csv` of `rows`.
+pub fn table(rows: &[Row]) -> Table {
+    let mut table = Table::new(&HEADER);
+    for r in rows {
+        table.push(&[
+            r.method.clone(),
+            format_number(r.n),
+            format_number(r.hurst),
+            r.quantity.clone(),
+            format_number(r.ours),
+            format_number(r.low),
+            format_number(r.high),
+            format_number(r.reference),
+            r.source.clone(),
+            format_number(r.tolerance),
+        ]);
+    }
+    table
+}
+
+/// Reads the rows back from the text of a `comparison.csv`.
+pub fn parse(csv_text: &str) -> Result<Vec<Row>> {
+    let mut reader = csv::Reader::from_reader(csv_text.as_bytes());
+    let mut rows = Vec::new();
+    for record in reader.records() {
+        let rec = record?;
+        let num = |i: usize| -> Result<f64> {
+            let field = rec.get(i).context("short row in comparison.csv")?;
+            field
+                .parse::<f64>()
+                .with_context(|| format!("comparison.csv: `{field}` is not a number"))
+        };
+        rows.push(Row {
+            method: rec.get(0).unwrap_or_default().to_string(),
+            n: num(1)?,
+            hurst: num(2)?,
+            quantity: rec.get(3).unwrap_or_default().to_string(),
+            ours: num(4)?,
+            low: num(5)?,
+            high: num(6)?,
+            reference: num(7)?,
+            source: rec.get(8).unwrap_or_default().to_string(),
+            tolerance: num(9)?,
+        });
+    }
+    Ok(rows)
+}
+
+/// Below this difference a result outside its interval is still **close** (module docs).
+pub const CLOSE: f64 = 0.02;
+
+/// Whether `row` agrees with its reference (module docs).
+pub fn agrees(row: &Row) -> bool {
+    row.reference >= row.low - row.tolerance && row.reference <= row.high + row.tolerance
+}
+
+/// The verdict of a row: `agrees`, `close` or `differs` (module docs).
+pub fn verdict(row: &Row) -> &'static str {
+    if agrees(row) {
+        "agrees"
+    } else if (row.ours - row.reference).abs() <= CLOSE + row.tolerance {
+        "close"
+    } else {
+        "differs"
+    }
+}
+
+/// The likely reason of a disagreement, by where the row lies (the crossovers of the
+/// theory, the grid): a reading to check, not a measurement.
+fn reason(row: &Row) -> String {
+    let grid = match (row.method.as_str(), row.source.contains("N = points")) {
+        ("mdr", _) => format!("finite line ({} points)", row.n),
+        (_, true) => format!("finite grid ({} points)", row.n),
+        _ => format!("finite grid ({}²)", row.n),
+    };
+    if row.quantity == "steepest_slope" {
+        return format!("{grid}: the paper's curves are on 1024²");
+    }
+    if row.hurst > 0.0 && row.hurst <= 0.5 {
+        return "crossover of eq. (24) and eq. (6) at H = 0: the theory's kink is sharp, \
+                finite ensembles round it"
+            .into();
+    }
+    if (row.hurst - 2.0).abs() <= 0.5 {
+        return "crossover of eq. (6) and Hertz at H = 2: sharp in theory, rounded here".into();
+    }
+    grid
+}
+
+/// The comparison table of `rows` (rendered from `comparison.csv`), one verdict a row.
+pub fn render(rows: &[Row]) -> String {
+    let mut md = String::from(
+        "| method | N | H | quantity | ours | 95 % interval | paper | source | verdict | \
+         ours − paper | likely reason |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let interval = if r.low == r.high || r.low.is_nan() {
+            "—".to_string()
+        } else {
+            format!("{:.3} – {:.3}", r.low, r.high)
+        };
+        let verdict = verdict(r);
+        let why = match verdict {
+            "differs" => reason(r),
+            _ => "—".to_string(),
+        };
+        let half = 0.5 * (r.high - r.low);
+        let by = if half > 0.0 {
+            format!(
+                "{:+.3} ({:+.1} half-widths)",
+                r.ours - r.reference,
+                (r.ours - r.reference) / half
+            )
+        } else {
+            format!("{:+.3}", r.ours - r.reference)
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:.3} | {interval} | {:.3} | {} | {verdict} | {by} | {why} |",
+            r.method, r.n, r.hurst, r.quantity, r.ours, r.reference, r.source
+        );
+    }
+    let count = |v: &str| rows.iter().filter(|r| verdict(r) == v).count();
+    let _ = writeln!(
+        md,
+        "\n{} of {} rows agree with the paper within their 95 % interval, {} more are within \
+         {CLOSE} of it, {} differ.",
+        count("agrees"),
+        rows.len(),
+        count("close"),
+        count("differs")
+    );
+    md
+}
+
+/// How α moves with N: for every (method, H, source) measured at two or more N, the change
+/// of ours and of the paper's value between the smallest and the largest N, and whether
+/// ours changes by more than the paper's within the combined interval.
+pub fn trend(rows: &[Row]) -> String {
+    let mut md = String::from(
+        "| method | H | source | N | ours | Δ ours | Δ paper | Δ ours − Δ paper | reading |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut keys: Vec<(String, f64, String)> = Vec::new();
+    for r in rows.iter().filter(|r| r.quantity == "alpha") {
+        let key = (r.method.clone(), r.hurst, r.source.clone());
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+    }
+    let mut lines = 0;
+    for (method, hurst, source) in keys {
+        let group: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.method == method && r.hurst == hurst && r.source == source)
+            .collect();
+        let (Some(a), Some(b)) = (group.first(), group.last()) else {
+            continue;
+        };
+        if group.len() < 2 || a.n == b.n {
+            continue;
+        }
+        let (ours, paper) = (b.ours - a.ours, b.reference - a.reference);
+        let half = (0.25 * ((a.high - a.low).powi(2) + (b.high - b.low).powi(2))).sqrt();
+        let excess = ours - paper;
+        // Pastewka et al.'s reading concerns the elastic interaction of contact spots on
+        // a surface (BEM); an MDR line has none, its N trend is the window's.
+        let reading = match (excess.abs() <= half, excess > 0.0, method.as_str()) {
+            (true, _, _) => "as the paper (within the interval)",
+            (false, true, "bem") => "rises faster than the paper's: the finite-size reading",
+            (false, true, _) => {
+                "rises faster than the paper's (short lines: the window covers a large part)"
+            }
+            (false, false, _) => "rises slower than the paper's",
+        };
+        let sizes: Vec<String> = group.iter().map(|r| r.n.to_string()).collect();
+        let values: Vec<String> = group.iter().map(|r| format!("{:.3}", r.ours)).collect();
+        let _ = writeln!(
+            md,
+            "| {method} | {hurst} | {source} | {} | {} | {ours:+.3} | {paper:+.3} | {excess:+.3} ± {half:.3} | {reading} |",
+            sizes.join(", "),
+            values.join(", ")
+        );
+        lines += 1;
+    }
+    if lines == 0 {
+        return String::new();
+    }
+    md.push_str(
+        "\nΔ: from the smallest to the largest N. The paper's α depends on N only through \
+         eq. (24) (H ≤ 0); Pastewka et al. (PRE 87, 062809, 2013) read the sublinear k ∝ F^α \
+         at low load as a finite-size effect, which would make α rise with N towards 1 for \
+         every H, faster than eq. (24) and also where eq. (6) has no N at all.\n",
+    );
+    md
+}
+
+/// The window sensitivity of the study in `study_dir` (from the sample curves its
+/// checkpoints keep): `window_sensitivity.csv` in `dir` and a markdown table, or a
+/// sentence saying why there is none.
+fn sensitivity(dir: &Path, study_dir: &Path, force: bool) -> Result<String> {
+    let windows = sensitivity_windows();
+    let found = study_sensitivity(study_dir, &windows)?;
+    if found.is_empty() {
+        return Ok(
+            "No sample curves are stored for this figure's BEM study (its checkpoints \
+                   predate stored curves): rerun it to get the window sensitivity.\n"
+                .into(),
+        );
+    }
+    let mut md = String::from("| N | H | window start (contacts) | end (contact fraction) | α | bootstrap 95 % |\n|---|---|---|---|---|---|\n");
+    for t in &found {
+        for w in &t.windows {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {:.3} | {:.3} – {:.3} |",
+                t.task.n,
+                t.task.hurst,
+                w.window.min_contacts,
+                w.window.max_fraction,
+                w.alpha,
+                w.low,
+                w.high
+            );
+        }
+    }
+    let table = window_table(&found);
+    table.write(&dir.join("window_sensitivity.csv"), force)?;
+    Ok(md)
+}
+
+/// The window sensitivity as a table: one row per (task, window).
+pub fn window_table(found: &[TaskSensitivity]) -> Table {
+    let mut table = Table::new(&[
+        "n",
+        "hurst",
+        "min_contacts",
+        "max_fraction",
+        "alpha",
+        "low",
+        "high",
+        "samples",
+    ]);
+    for t in found {
+        for w in &t.windows {
+            table.push_numbers(&[
+                t.task.n as f64,
+                t.task.hurst,
+                w.window.min_contacts as f64,
+                w.window.max_fraction,
+                w.alpha,
+                w.low,
+                w.high,
+                w.samples as f64,
+            ]);
+        }
+    }
+    table
+}
+
+/// Writes `comparison.csv` and `report.md`: the figure's own `report` text, then the
+/// comparison rendered from the CSV, the N trend and the window sensitivity of its BEM
+/// study (folder `dir/bem`).
+pub fn write(dir: &Path, results: Results, report: &str, force: bool) -> Result<()> {
+    let path = dir.join("comparison.csv");
+    table(&rows(&results)).write(&path, force)?;
+    let text = asperity::input::read_text(&path, asperity::input::TEXT_MAX_BYTES)?;
+    let rows = parse(&text)?;
+    let mut md = format!(
+        "{report}\n## Verdicts (generated from `comparison.csv`)\n\
+         Interval: the ensemble α ± t·s/√m over the m per-sample α (95 %); *agrees* when the \
+         paper's value lies inside it (widened by 0.1 for the paper's \"≈ 1\"); *close* when \
+         outside it by at most {CLOSE} (the estimator's own accuracy, docs/mdr.md).\n\n{}",
+        render(&rows)
+    );
+    let trend = trend(&rows);
+    if !trend.is_empty() {
+        let _ = write!(md, "\n## How α moves with N\n\n{trend}");
+    }
+    let _ = write!(
+        md,
+        "\n## How α moves with the fit window (BEM)\n\n\
+         α refitted on the stored sample curves with windows starting at 4, 8, 16 contacts and \
+         ending at 0.5, 1, 2 % contact (`window_sensitivity.csv`; also `asperity study \
+         windows DIR/bem`); interval: bootstrap over samples.\n\n{}",
+        sensitivity(dir, &dir.join("bem"), force)?
+    );
+    super::figures::write_report(dir, &md, force)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(ours: f64, low: f64, high: f64, reference: f64, tolerance: f64) -> Row {
+        Row {
+            method: "bem".into(),
+            n: 512.0,
+            hurst: -1.0,
+            quantity: "alpha".into(),
+            ours,
+            low,
+            high,
+            reference,
+            source: "eq. (24)".into(),
+            tolerance,
+        }
+    }
+
+    #[test]
+    fn verdicts_follow_the_interval_and_the_tolerance() {
+        let rows = vec![
+            row(0.80, 0.78, 0.84, 0.833, 0.0),
+            row(0.72, 0.70, 0.74, 0.833, 0.0),
+            row(0.93, 0.93, 0.93, 1.0, 0.1),
+            row(0.85, 0.85, 0.85, 1.0, 0.1),
+            row(0.85, 0.84, 0.86, 0.833, 0.0),
+        ];
+        let csv = String::from_utf8(table(&rows).to_csv().unwrap()).unwrap();
+        let back = parse(&csv).unwrap();
+        assert_eq!(back, rows);
+        let verdicts: Vec<&str> = back.iter().map(verdict).collect();
+        assert_eq!(
+            verdicts,
+            ["agrees", "differs", "agrees", "differs", "close"]
+        );
+        let md = render(&back);
+        assert_eq!(md.matches("| agrees |").count(), 2, "{md}");
+        assert_eq!(md.matches("| differs |").count(), 2, "{md}");
+        assert_eq!(md.matches("| close |").count(), 1, "{md}");
+        // 0.72 − 0.833 in half-widths of 0.02.
+        assert!(md.contains("-0.113 (-5.6 half-widths)"), "{md}");
+        assert!(
+            md.contains("2 of 5 rows agree with the paper within their 95 % interval, 1 more"),
+            "{md}"
+        );
+    }
+
+    #[test]
+    fn the_trend_compares_the_change_with_n_against_the_papers() {
+        let mut small = row(0.70, 0.68, 0.72, 0.818, 0.0);
+        small.n = 256.0;
+        let large = row(0.80, 0.78, 0.82, 0.833, 0.0);
+        let md = trend(&[small.clone(), large.clone()]);
+        // Δ ours 0.10, Δ paper 0.015: 0.085 > 0.028 (the combined half-width).
+        assert!(md.contains("+0.100 | +0.015 | +0.085 ± 0.028"), "{md}");
+        assert!(md.contains("finite-size reading"), "{md}");
+        let flat = row(0.715, 0.695, 0.735, 0.833, 0.0);
+        assert!(trend(&[small, flat]).contains("as the paper"));
+        assert!(trend(&[large]).is_empty());
+    }
+}
