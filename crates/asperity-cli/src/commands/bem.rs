@@ -405,14 +405,17 @@ struct Row {
     values: Vec<Option<f64>>,
 }
 
-/// The `--plot` panels: k/E* vs F/E* and area fraction vs F/E*, log–log.
+/// The `--plot` panels, log–log: k vs F and area fraction vs F, in N and N/m as the CSV
+/// holds them when the surface came from a measured file (lengths in metres, E* in Pa:
+/// `physical`), else divided by E* (lengths in the surface's own unit).
 fn sweep_charts(
     rows: &[Row],
     header: &[&str],
-    modulus: f64,
+    (modulus, physical): (f64, bool),
     surface: &Path,
     boundary: &str,
 ) -> [Chart; 2] {
+    let per = if physical { 1.0 } else { modulus };
     let name = surface.file_name().map_or_else(
         || surface.display().to_string(),
         |n| n.to_string_lossy().into(),
@@ -425,35 +428,43 @@ fn sweep_charts(
         col("stiffness_fd"),
         col("area_fraction"),
     );
-    let points = |y: &dyn Fn(&Row) -> f64| {
-        rows.iter()
-            .map(|r| (value(r, force) / modulus, y(r)))
-            .collect()
+    let points =
+        |y: &dyn Fn(&Row) -> f64| rows.iter().map(|r| (value(r, force) / per, y(r))).collect();
+    let (x_label, y_label) = if physical {
+        ("normal force F [N]", "contact stiffness k [N/m]")
+    } else {
+        (
+            "normal force F / E*  [length²]",
+            "contact stiffness k / E*  [length]",
+        )
     };
-    let x_label = "normal force F / E*  [length²]".to_string();
     let mut series = vec![Series::new(
         "frozen contact set",
-        points(&|r| value(r, stiffness) / modulus),
+        points(&|r| value(r, stiffness) / per),
         Style::LinePoints,
     )];
     if fd.is_some() {
         series.push(Series::new(
             "finite difference dF/dd",
-            points(&|r| value(r, fd) / modulus),
+            points(&|r| value(r, fd) / per),
             Style::Dashed,
         ));
     }
     let stiffness = Chart {
-        title: format!("{name}: contact stiffness (E* = {modulus}, {boundary} boundaries)"),
-        x_label: x_label.clone(),
-        y_label: "contact stiffness k / E*  [length]".into(),
+        title: format!(
+            "{name}: contact stiffness (E* = {}{}, {boundary} boundaries)",
+            asperity::input::short_number(modulus),
+            if physical { " Pa" } else { "" }
+        ),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
         log_x: true,
         log_y: true,
         series,
     };
     let area = Chart {
         title: format!("{name}: true contact area"),
-        x_label,
+        x_label: x_label.into(),
         y_label: "area fraction A / A0".into(),
         log_x: true,
         log_y: true,
@@ -724,7 +735,14 @@ pub fn run(args: &BemArgs) -> Result<()> {
             .with_context(|| format!("writing {}", record_path.display()))?;
     }
     if let Some(plot) = &args.plot {
-        let charts = sweep_charts(&rows, &header, args.modulus, &args.surface, boundary.name());
+        let physical = matches!(size_source, SizeSource::File);
+        let charts = sweep_charts(
+            &rows,
+            &header,
+            (args.modulus, physical),
+            &args.surface,
+            boundary.name(),
+        );
         stage_charts(&mut staged, plot, &charts)
             .with_context(|| format!("writing {}", plot.display()))?;
     }

@@ -11,8 +11,8 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    parse_range, run_any_task, sample_cost, EnsemblePoint, FitWindow, Method, StudyDir, StudySpec,
-    TaskResult, CHECKPOINT_INTERVAL,
+    parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
+    CHECKPOINT_INTERVAL,
 };
 use serde::de::{self, Visitor};
 use serde::Deserialize;
@@ -491,6 +491,8 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Longest time between checkpoints of a task in progress.
     pub checkpoint_every: Duration,
+    /// The `reproduce` setting a figure's study runs under, marked on its plot.
+    pub setting: Option<&'static str>,
 }
 
 impl RunOptions {
@@ -504,6 +506,7 @@ impl RunOptions {
             force: run.force,
             quiet: run.quiet,
             checkpoint_every: Duration::from_secs_f64(run.checkpoint_every),
+            setting: None,
         })
     }
 }
@@ -568,6 +571,7 @@ pub fn execute(
         force,
         quiet,
         checkpoint_every,
+        setting,
     } = options;
     spec.validate()?;
     spec.ensure_fits()?;
@@ -584,8 +588,14 @@ pub fn execute(
     let results = run_tasks(&store, &progress, quiet)?;
     progress.finish();
     let (table, chart) = match kind {
-        Kind::Alpha => (alpha_table(&results), alpha_chart(&results, ALPHA_TITLE)),
-        Kind::Curve => (curve_table(&results), curve_chart(&results, CURVE_TITLE)),
+        Kind::Alpha => (
+            alpha_table(&results),
+            alpha_chart(&results, &titled(ALPHA_TITLE, setting)),
+        ),
+        Kind::Curve => (
+            curve_table(&results),
+            curve_chart(&results, &titled(CURVE_TITLE, setting)),
+        ),
     };
     let stem = outputs_stem(kind);
     write_together(dir, stem, &table, &chart, rewrite, true)?;
@@ -662,6 +672,14 @@ pub fn write_together(
 const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
 const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
 
+/// `title` marked with the `reproduce` setting, if any.
+fn titled(title: &str, setting: Option<&str>) -> String {
+    match setting {
+        Some(name) => format!("{title} ({name} setting)"),
+        None => title.to_string(),
+    }
+}
+
 fn outputs_stem(kind: Kind) -> &'static str {
     match kind {
         Kind::Alpha => "alpha",
@@ -675,8 +693,14 @@ fn opt(v: Option<f64>) -> String {
 
 /// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
 /// written together.
-pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()> {
-    let chart = alpha_chart(results, ALPHA_TITLE);
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_alpha(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = alpha_chart(results, &titled(ALPHA_TITLE, setting));
     write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
 }
 
@@ -719,29 +743,70 @@ fn alpha_table(results: &[TaskResult]) -> Table {
     table
 }
 
-/// The α(H) chart: one series per (method, N) and the theory curves (6), 1/3 and (24).
+/// The 95 % interval of each task's per-sample α (`alpha_low`, `alpha_high` of
+/// `alpha.csv`; NaN where there is none, which the plot leaves out).
+fn alpha_interval(r: &TaskResult) -> (f64, f64) {
+    r.alpha_sample_interval().unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// The (method, N) pairs of `results` in order of appearance.
+fn method_sizes(results: &[TaskResult]) -> Vec<(Method, usize)> {
+    let mut sizes: Vec<(Method, usize)> = Vec::new();
+    for r in results {
+        if !sizes.contains(&(r.method, r.task.n)) {
+            sizes.push((r.method, r.task.n));
+        }
+    }
+    sizes
+}
+
+fn family_color(k: usize, count: usize) -> plotters::style::RGBColor {
+    let t = if count > 1 {
+        k as f64 / (count - 1) as f64
+    } else {
+        0.5
+    };
+    ordered_color(t * 0.85)
+}
+
+/// The α(H) chart: one series per (method, N) with the 95 % interval of the samples as
+/// error bars, and the theory curves (6), 1/3 and (24), the last once per N in that
+/// series' colour. A study of a single H over several N is drawn as α(N) instead
+/// ([`alpha_n_chart`]).
 pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
+    let single_h = results
+        .windows(2)
+        .all(|w| w[0].task.hurst == w[1].task.hurst);
+    let sizes = method_sizes(results);
+    if single_h && sizes.len() > 1 {
+        return alpha_n_chart(results, title);
+    }
     let mut series = Vec::new();
-    let mut sizes: Vec<(Method, usize)> = results.iter().map(|r| (r.method, r.task.n)).collect();
-    sizes.dedup();
+    // Series at the same H are shifted apart so that their error bars do not overlap.
+    let shift = |k: usize| 0.03 * (k as f64 - (sizes.len() as f64 - 1.0) / 2.0);
     for (k, &(method, n)) in sizes.iter().enumerate() {
-        let points = results
+        let rows: Vec<&TaskResult> = results
             .iter()
             .filter(|r| r.method == method && r.task.n == n)
-            .filter_map(|r| r.alpha_ensemble.map(|f| (r.task.hurst, f.exponent)))
+            .filter(|r| r.alpha_ensemble.is_some())
             .collect();
-        let t = if sizes.len() > 1 {
-            k as f64 / (sizes.len() - 1) as f64
-        } else {
-            0.5
-        };
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    r.task.hurst + shift(k),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
         series.push(
             Series::new(
                 format!("{} N = {n}", method.name()),
                 points,
                 Style::LinePoints,
             )
-            .color(ordered_color(t * 0.85)),
+            .color(family_color(k, sizes.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
         );
     }
     // (6) on (0, 2]: H = 0 itself belongs to (24), drawn below on [-1, 0].
@@ -760,20 +825,73 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
     );
     for (k, &(_, n)) in sizes.iter().enumerate() {
         let a = alpha_white_noise(n as f64);
-        let label = if k == 0 {
-            "(1+log2 N)/(3+log2 N) (24)"
-        } else {
-            ""
-        };
         series.push(
-            Series::new(label, vec![(-1.0, a), (0.0, a)], Style::Dashed)
-                .color(plotters::style::BLUE),
+            Series::new(
+                format!("(24), N = {n}"),
+                vec![(-1.0, a), (0.0, a)],
+                Style::Dashed,
+            )
+            .color(family_color(k, sizes.len())),
         );
     }
     Chart {
         title: title.into(),
-        x_label: "Hurst exponent H".into(),
-        y_label: "α".into(),
+        x_label: "Hurst exponent H (series shifted apart by 0.03)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+/// α against log2 N for a study of one H: one series per method with the 95 % interval
+/// of the samples as error bars, beside eq. (24) (paper Fig. 5).
+fn alpha_n_chart(results: &[TaskResult], title: &str) -> Chart {
+    let mut methods: Vec<Method> = results.iter().map(|r| r.method).collect();
+    methods.dedup();
+    let mut series = Vec::new();
+    for (k, &method) in methods.iter().enumerate() {
+        let rows: Vec<&TaskResult> = results
+            .iter()
+            .filter(|r| r.method == method && r.alpha_ensemble.is_some())
+            .collect();
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    (r.task.n as f64).log2(),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
+        series.push(
+            Series::new(
+                format!("{} (H = {})", method.name(), results[0].task.hurst),
+                points,
+                Style::LinePoints,
+            )
+            .color(family_color(k, methods.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
+        );
+    }
+    let (lo, hi) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            let m = (r.task.n as f64).log2();
+            (a.min(m), b.max(m))
+        });
+    let theory = (0..=40)
+        .map(|i| lo - 0.5 + (hi - lo + 1.0) * i as f64 / 40.0)
+        .map(|m| (m, alpha_white_noise(2f64.powf(m))))
+        .collect();
+    series.push(
+        Series::new("(1+log2 N)/(3+log2 N) (24)", theory, Style::Dashed)
+            .color(plotters::style::BLUE),
+    );
+    Chart {
+        title: title.replace("vs H", "vs N"),
+        x_label: "log2 N (N: modes of a line, points a side of a surface)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
         log_x: false,
         log_y: false,
         series,
@@ -781,8 +899,15 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
 }
 
 /// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
-pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str) -> Result<()> {
-    let chart = curve_chart(results, CURVE_TITLE);
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_curves(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    stem: &str,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = curve_chart(results, &titled(CURVE_TITLE, setting));
     write_together(dir, stem, &curve_table(results), &chart, force, false)
 }
 
@@ -818,9 +943,8 @@ fn curve_table(results: &[TaskResult]) -> Table {
 }
 
 /// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
-/// dashed in the same colour. Interval ends that are not positive (a wide interval at few
-/// samples) cannot sit on a log axis: they are left out, not clamped, and the dashed line
-/// is broken there rather than drawn across the gap.
+/// as a band in the same colour (ends that a log axis cannot show are left out, see
+/// [`crate::plot::Series::interval`]), and a slope-1 reference line (k ∝ F).
 pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     let (hmin, hmax) = results
         .iter()
@@ -834,39 +958,27 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
         } else {
             0.5
         };
-        let color = ordered_color(t * 0.9);
         let points = r
             .mean_curve
             .iter()
             .map(|p| (p.force, p.stiffness))
             .collect();
-        series.push(
-            Series::new(
-                format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
-                points,
-                Style::Line,
-            )
-            .color(color),
-        );
+        let mut line = Series::new(
+            format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
+            points,
+            Style::Line,
+        )
+        .color(ordered_color(t * 0.9));
         if r.samples > 1 {
-            let ends: [fn(&EnsemblePoint) -> f64; 2] = [|p| p.stiffness_low, |p| p.stiffness_high];
-            for end in ends {
-                // Runs of drawable points; a gap is left open, not bridged.
-                let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-                for p in &r.mean_curve {
-                    let (f, k) = (p.force, end(p));
-                    if f > 0.0 && k > 0.0 && k.is_finite() {
-                        runs.last_mut().expect("one run").push((f, k));
-                    } else if !runs.last().expect("one run").is_empty() {
-                        runs.push(Vec::new());
-                    }
-                }
-                for run in runs.into_iter().filter(|run| run.len() >= 2) {
-                    series.push(Series::new("", run, Style::Dashed).color(color));
-                }
-            }
+            let interval = r
+                .mean_curve
+                .iter()
+                .map(|p| (p.stiffness_low, p.stiffness_high));
+            line = line.interval(interval.collect());
         }
+        series.push(line);
     }
+    series.extend(slope_one(results));
     let scale = match results.first().map(|r| r.method) {
         Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
         _ => "L = 1, E* = 1, unit rms height",
@@ -874,17 +986,41 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     Chart {
         title: title.into(),
         x_label: format!("normal force F ({scale})"),
-        y_label: "contact stiffness k".into(),
+        y_label: "contact stiffness k (band: 95 % interval of the mean)".into(),
         log_x: true,
         log_y: true,
         series,
     }
 }
 
+/// A k ∝ F line over the last two decades of force (fewer where the curves span less),
+/// from the smallest stiffness up: below the curves, whose slope is at most 1.
+fn slope_one(results: &[TaskResult]) -> Option<Series> {
+    let points = results.iter().flat_map(|r| &r.mean_curve);
+    let shown = points.filter(|p| p.force > 0.0 && p.stiffness > 0.0 && p.stiffness.is_finite());
+    let (f_lo, f_hi, k_lo) = shown.fold(
+        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY),
+        |(a, b, c), p| (a.min(p.force), b.max(p.force), c.min(p.stiffness)),
+    );
+    // No drawable point leaves f_lo infinite and f_hi below it.
+    if f_hi <= f_lo {
+        return None;
+    }
+    let span = (f_hi / f_lo).min(100.0);
+    Some(
+        Series::new(
+            "slope 1 (k ∝ F)",
+            vec![(f_hi / span, k_lo), (f_hi, k_lo * span)],
+            Style::Dashed,
+        )
+        .color(plotters::style::RGBColor(120, 120, 120)),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use asperity::study::Task;
+    use asperity::study::{EnsemblePoint, Task};
 
     fn result(lows: &[f64]) -> TaskResult {
         let point = |i: usize, &low: &f64| EnsemblePoint {
@@ -906,21 +1042,17 @@ mod tests {
     }
 
     #[test]
-    fn curve_plots_leave_out_non_positive_interval_ends() {
+    fn curve_plots_carry_the_interval_and_a_slope_one_line() {
         let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
-        let points = |i: usize| chart.series[i].points.clone();
-        assert_eq!(chart.series.len(), 4, "mean, low in two pieces, high");
-        assert_eq!(points(1), vec![(1.0, 0.5), (2.0, 0.6)]);
-        assert_eq!(points(2), vec![(5.0, 0.7), (6.0, 0.8)]);
-        assert_eq!(points(3).len(), 6, "the high end");
-        assert!(chart.series[1..].iter().all(|s| s.label.is_empty()));
-        // A lone positive point between gaps draws nothing; all positive: one line.
-        assert_eq!(
-            curve_chart(&[result(&[-1.0, 0.5, -1.0])], "t").series.len(),
-            2
-        );
-        let whole = curve_chart(&[result(&[0.1, 0.2, 0.3])], "t");
-        assert_eq!(whole.series[1].points.len(), 3);
+        assert_eq!(chart.series.len(), 2, "the mean and the reference");
+        let interval = chart.series[0].interval.clone().expect("an interval");
+        assert_eq!(interval.len(), 6);
+        assert_eq!(interval[2], (-0.3, 2.0), "kept: the plot leaves it out");
+        // The reference has slope 1 and ends at the largest force.
+        let line = &chart.series[1].points;
+        let (a, b) = (line[0], line[1]);
+        assert!(((b.1 / a.1).ln() / (b.0 / a.0).ln() - 1.0).abs() < 1e-12);
+        assert_eq!(b.0, 6.0);
     }
 
     #[test]

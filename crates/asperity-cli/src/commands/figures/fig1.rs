@@ -40,10 +40,10 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let plan = setting.fig1_bem()?;
     let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
     announce("fig1", setting, &[(&bem, None)])?;
-    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
-    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
+    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
+    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();
-    write_alpha(dir, &all, force)?;
+    write_alpha(dir, &all, force, Some(setting.name()))?;
     let report = format!(
         "# Fig. 1: exponent α of k ∝ F^α versus H\n\n{}\n\n\
          - MDR: N = {:?}, {} samples per (N, H), H = {}.\n\

@@ -9,6 +9,7 @@ use anyhow::Result;
 use asperity::mdr::{log_spaced, Axisymmetric, CurvePoint, Foundation, Spring, SpringLaw};
 use asperity::reference::Hertz;
 
+use super::super::setting::Setting;
 use super::{Outputs, BLACK, BLUE, GREEN, GREY};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};
@@ -68,7 +69,7 @@ struct Row {
 
 /// Book Fig. 15.1: a sphere on linear springs and on springs with the Hertz law (15.2),
 /// against Hertz, through the range where a single spring is in contact.
-pub fn fig15_1(out: &Path, _quick: bool, force: bool) -> Result<()> {
+pub fn fig15_1(out: &Path, setting: Setting, force: bool) -> Result<()> {
     let outputs = Outputs::new(
         out.join("fig15.1"),
         &[
@@ -84,7 +85,7 @@ pub fn fig15_1(out: &Path, _quick: bool, force: bool) -> Result<()> {
     let plan = Plan::new()?;
     let rows: Vec<Row> = plan.levels.iter().map(|&d| plan.row(d)).collect();
     write_table(&outputs, &plan, &rows)?;
-    write_charts(&outputs, &plan, &rows)?;
+    write_charts(&outputs, &plan, &rows, setting)?;
     outputs.write_report("fig15.1", &report(&plan, &rows)?)
 }
 
@@ -117,7 +118,8 @@ fn write_table(outputs: &Outputs, plan: &Plan, rows: &[Row]) -> Result<()> {
     table.write(&outputs.path("fig15_1.csv"), outputs.force)
 }
 
-fn write_charts(outputs: &Outputs, plan: &Plan, rows: &[Row]) -> Result<()> {
+fn write_charts(outputs: &Outputs, plan: &Plan, rows: &[Row], setting: Setting) -> Result<()> {
+    let mark = format!("({} setting)", setting.name());
     let series = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| (r.d, f(r))).collect::<Vec<_>>();
     let (levels, hertz, critical) = (&plan.levels, &plan.hertz, plan.critical);
     let f_range = (
@@ -126,7 +128,7 @@ fn write_charts(outputs: &Outputs, plan: &Plan, rows: &[Row]) -> Result<()> {
     );
     let (radius, dx) = (plan.radius, plan.dx);
     let chart = Chart {
-        title: format!("Fig. 15.1: sphere R = {radius}, Δx = {dx}: force"),
+        title: format!("Fig. 15.1: sphere R = {radius}, Δx = {dx}: force {mark}"),
         x_label: "indentation d".into(),
         y_label: "normal force F / E*".into(),
         log_x: true,
@@ -155,7 +157,7 @@ fn write_charts(outputs: &Outputs, plan: &Plan, rows: &[Row]) -> Result<()> {
     };
     outputs.save_chart(&chart, "fig15_1")?;
     let chart = Chart {
-        title: format!("Fig. 15.1: sphere R = {radius}, Δx = {dx}: stiffness"),
+        title: format!("Fig. 15.1: sphere R = {radius}, Δx = {dx}: stiffness {mark}"),
         y_label: "contact stiffness k / E*".into(),
         series: vec![
             Series::new(

@@ -12,6 +12,7 @@ use asperity::surface::stats::rms_height;
 use asperity::surface::{LineGenerator, LineSpec, Normalisation};
 use rayon::prelude::*;
 
+use super::super::setting::Setting;
 use super::{Outputs, BLACK, BLUE, GREEN};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};
@@ -26,13 +27,15 @@ struct Plan {
     modulus: f64,
     samples: u64,
     quick: bool,
+    setting: Setting,
     /// Critical depth (15.6) of the fractal law.
     critical: f64,
     levels: Vec<f64>,
 }
 
 impl Plan {
-    fn new(quick: bool) -> Result<Self> {
+    fn new(setting: Setting) -> Result<Self> {
+        let quick = setting.is_quick();
         let (n, hurst, size, h, modulus) = (2049usize, 1.0, 1.0, 1.0, 1.0);
         let law = SpringLaw::Fractal {
             hurst,
@@ -48,6 +51,7 @@ impl Plan {
             modulus,
             samples: if quick { 50 } else { 500 },
             quick,
+            setting,
             critical,
             levels: log_spaced(1e-6 * h, 3.0 * h, 64)?,
         })
@@ -85,13 +89,13 @@ impl Row {
 
 /// Book Fig. 15.2: the mean force of many fractal rough lines (N = 2049, H = 1) on linear
 /// springs and on springs with the fractal law (15.7), against the asymptote (15.3).
-pub fn fig15_2(out: &Path, quick: bool, force: bool) -> Result<()> {
+pub fn fig15_2(out: &Path, setting: Setting, force: bool) -> Result<()> {
     let outputs = Outputs::new(
         out.join("fig15.2"),
         &["fig15_2.csv", "fig15_2.png", "fig15_2.svg", "report.md"],
         force,
     )?;
-    let plan = Plan::new(quick)?;
+    let plan = Plan::new(setting)?;
     let mean = compute(&plan)?;
     write_table(&outputs, &plan, &mean)?;
     write_chart(&outputs, &plan, &mean)?;
@@ -198,7 +202,10 @@ fn write_chart(outputs: &Outputs, plan: &Plan, mean: &[Row]) -> Result<()> {
     };
     let (n, hurst, samples) = (plan.n, plan.hurst, plan.samples);
     let chart = Chart {
-        title: format!("Fig. 15.2: fractal lines N = {n}, H = {hurst}, mean of {samples}"),
+        title: format!(
+            "Fig. 15.2: fractal lines N = {n}, H = {hurst}, mean of {samples} ({} setting)",
+            plan.setting.name()
+        ),
         x_label: "indentation d / h".into(),
         y_label: "mean normal force F / (E* h L)".into(),
         log_x: true,

@@ -19,8 +19,8 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let (n, samples) = (plan.sizes[0], plan.samples);
     let spec = study_spec(Method::Bem, plan.sizes, plan.hursts, samples, Some(6.0));
     announce("fig2", setting, &[(&spec, Some(6.0))])?;
-    let results = figure_study(dir, "bem", &spec, Kind::Curve, discard)?;
-    write_curves(dir, &results, force, "fig2")?;
+    let results = figure_study(dir, "bem", &spec, Kind::Curve, setting, discard)?;
+    write_curves(dir, &results, force, "fig2", Some(setting.name()))?;
     let mut md = String::from(
         "| H | low-force α (window) | steepest slope over a decade of F (paper: ≈ 1) | contact fraction there |\n\
          |---|---|---|---|\n",

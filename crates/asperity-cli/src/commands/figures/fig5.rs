@@ -48,29 +48,35 @@ struct Row {
     n: f64,
     /// α of the ensemble fit (NaN where it failed).
     alpha: f64,
+    /// The 95 % interval of the per-sample α (NaN where there is none).
+    interval: (f64, f64),
 }
 
 fn rows(mdr: &[TaskResult], bem: &[TaskResult]) -> Vec<Row> {
     let alpha = |r: &TaskResult| r.alpha_ensemble.map_or(f64::NAN, |a| a.exponent);
+    let interval = |r: &TaskResult| r.alpha_sample_interval().unwrap_or((f64::NAN, f64::NAN));
     let mut rows: Vec<Row> = mdr
         .iter()
         .map(|r| Row {
             counting: Counting::Modes,
             n: r.task.n as f64,
             alpha: alpha(r),
+            interval: interval(r),
         })
         .collect();
     for r in bem {
-        let (n, a) = (r.task.n as f64, alpha(r));
+        let (n, a, interval) = (r.task.n as f64, alpha(r), interval(r));
         rows.push(Row {
             counting: Counting::Lines,
             n,
             alpha: a,
+            interval,
         });
         rows.push(Row {
             counting: Counting::Points,
             n: n * n,
             alpha: a,
+            interval,
         });
     }
     rows
@@ -83,11 +89,11 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let plan = setting.fig5_bem();
     let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
     announce("fig5", setting, &[(&bem, None)])?;
-    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, discard)?;
-    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, discard)?;
+    let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
+    let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let rows = rows(&mdr_results, &bem_results);
     write_table(dir, &rows, force)?;
-    write_chart(dir, &rows, force)?;
+    write_chart(dir, &rows, setting, force)?;
     let mut md = String::from(
         "| method | N as | N | log2 N | α (ours) | eq. (24) |\n|---|---|---|---|---|---|\n",
     );
@@ -129,6 +135,8 @@ fn write_table(dir: &Path, rows: &[Row], force: bool) -> Result<()> {
         "log2_n",
         "alpha",
         "alpha_eq24",
+        "alpha_low",
+        "alpha_high",
     ]);
     for r in rows {
         table.push(&[
@@ -138,43 +146,53 @@ fn write_table(dir: &Path, rows: &[Row], force: bool) -> Result<()> {
             format_number(r.n.log2()),
             format_number(r.alpha),
             format_number(alpha_white_noise(r.n)),
+            format_number(r.interval.0),
+            format_number(r.interval.1),
         ]);
     }
     table.write(&dir.join("fig5.csv"), force)
 }
 
-fn write_chart(dir: &Path, rows: &[Row], force: bool) -> Result<()> {
+fn write_chart(dir: &Path, rows: &[Row], setting: Setting, force: bool) -> Result<()> {
     let theory: Vec<(f64, f64)> = (4..=21)
         .map(|m| (m as f64, alpha_white_noise(2f64.powi(m))))
         .collect();
-    let pick = |counting: Counting| -> Vec<(f64, f64)> {
-        rows.iter()
-            .filter(|r| r.counting == counting)
-            .map(|r| (r.n.log2(), r.alpha))
-            .collect()
+    // Markers with the 95 % interval of the samples as error bars.
+    let pick = |label: &str, counting: Counting, color| {
+        let rows: Vec<&Row> = rows.iter().filter(|r| r.counting == counting).collect();
+        // MDR and BEM share some N: their bars are shifted apart by 0.2.
+        let shift = if counting == Counting::Modes {
+            -0.1
+        } else {
+            0.1
+        };
+        let points = rows.iter().map(|r| (r.n.log2() + shift, r.alpha)).collect();
+        Series::new(label, points, Style::Points)
+            .color(color)
+            .interval(rows.iter().map(|r| r.interval).collect())
     };
     Chart {
-        title: "Fig. 5: α vs grid size for H = -0.5".into(),
-        x_label: "log2 N".into(),
-        y_label: "α".into(),
+        title: format!(
+            "Fig. 5: α vs grid size for H = -0.5 ({} setting)",
+            setting.name()
+        ),
+        x_label: "log2 N (MDR shifted by -0.1, BEM by +0.1)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
         log_x: false,
         log_y: false,
         series: vec![
             Series::new("eq. (24)", theory, Style::Line).color(plotters::style::RED),
-            Series::new("MDR (N = modes)", pick(Counting::Modes), Style::Points)
-                .color(plotters::style::BLACK),
-            Series::new(
+            pick("MDR (N = modes)", Counting::Modes, plotters::style::BLACK),
+            pick(
                 "BEM (N = lines per side)",
-                pick(Counting::Lines),
-                Style::Points,
-            )
-            .color(plotters::style::GREEN),
-            Series::new(
+                Counting::Lines,
+                plotters::style::GREEN,
+            ),
+            pick(
                 "BEM (N = grid points)",
-                pick(Counting::Points),
-                Style::Points,
-            )
-            .color(plotters::style::MAGENTA),
+                Counting::Points,
+                plotters::style::MAGENTA,
+            ),
         ],
     }
     .save(&dir.join("fig5.png"), &dir.join("fig5.svg"), force)

@@ -24,6 +24,7 @@ struct Plan {
     line_n: usize,
     seed: u64,
     quick: bool,
+    setting: Setting,
 }
 
 impl Plan {
@@ -36,6 +37,7 @@ impl Plan {
             line_n: 4 * n,
             seed: 6,
             quick,
+            setting,
         }
     }
 }
@@ -107,7 +109,16 @@ pub fn fig6(dir: &Path, setting: Setting, force: bool) -> Result<()> {
 fn write_images(dir: &Path, plan: &Plan, rows: &[Row], force: bool) -> Result<()> {
     let views: Vec<(String, ndarray::ArrayView2<f64>)> = rows
         .iter()
-        .map(|r| (format!("H = {}", r.hurst), r.surface.view()))
+        .enumerate()
+        .map(|(i, r)| {
+            // The last caption also names the setting: the figure says how it was made.
+            let mark = if i + 1 == rows.len() {
+                format!(" ({} setting)", plan.setting.name())
+            } else {
+                String::new()
+            };
+            (format!("H = {}{mark}", r.hurst), r.surface.view())
+        })
         .collect();
     greyscale_panel(
         &dir.join("fig6_surfaces.png"),
@@ -130,12 +141,17 @@ fn write_images(dir: &Path, plan: &Plan, rows: &[Row], force: bool) -> Result<()
                 .enumerate()
                 .map(|(j, h)| (j as f64 * dx, h + offset))
                 .collect();
-            Series::new(format!("H = {}", r.hurst), points, Style::Line)
-                .color(ordered_color(i as f64 / last))
+            // Named at their right end: a legend would cover the stacked lines.
+            Series::new("", points, Style::Line)
+                .color(ordered_color(0.85 * i as f64 / last))
+                .tag(format!("H = {}", r.hurst))
         })
         .collect();
     Chart {
-        title: "Fig. 6: rough lines (C1D = π q C2D), offset for clarity".into(),
+        title: format!(
+            "Fig. 6: rough lines (C1D = π q C2D), offset for clarity ({} setting)",
+            plan.setting.name()
+        ),
         x_label: "x / L".into(),
         y_label: "h / h_rms (offset)".into(),
         log_x: false,

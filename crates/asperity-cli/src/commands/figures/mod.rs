@@ -144,6 +144,7 @@ fn figure_study(
     name: &str,
     spec: &StudySpec,
     kind: Kind,
+    setting: Setting,
     force: bool,
 ) -> Result<Vec<TaskResult>> {
     let sub = dir.join(name);
@@ -151,6 +152,7 @@ fn figure_study(
         force,
         quiet: false,
         checkpoint_every: asperity::study::CHECKPOINT_INTERVAL,
+        setting: Some(setting.name()),
     };
     execute(spec, &sub, options, kind)
 }
