@@ -520,3 +520,29 @@ fn the_example_study_file_runs() {
         "bad.toml, line 4, column 9 (key `hurst`)",
     );
 }
+
+#[test]
+fn curve_study_takes_a_list_of_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "study",
+        "curve",
+        "--method",
+        "mdr",
+        "--n",
+        "64,128",
+        "--hurst",
+        "0.5",
+        "--samples",
+        "2",
+        "--quiet",
+        "--out",
+        "c",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let csv = std::fs::read_to_string(dir.path().join("c/curve.csv")).unwrap();
+    for n in ["64", "128"] {
+        let prefix = format!("mdr,{n},0.5,");
+        assert!(csv.lines().any(|l| l.starts_with(&prefix)), "{n}: {csv}");
+    }
+}

@@ -140,9 +140,9 @@ pub struct AlphaArgs {
 #[command(
     allow_negative_numbers = true,
     after_help = concat!("\
-Output: DIR/curve.csv, one row per (H, force level): method, n, hurst, force, stiffness,
+Output: DIR/curve.csv, one row per (N, H, force level): method, n, hurst, force, stiffness,
 stiffness_low, stiffness_high, samples, area_fraction; and the plot DIR/curve.png,
-DIR/curve.svg (log-log, dashed: the interval).
+DIR/curve.svg (log-log, band: the interval; dashed: slope 1).
   stiffness                     mean stiffness over samples at that force
   stiffness_low/stiffness_high  95 % confidence interval of that mean (Student t over the
                                 samples), unlike alpha_low/alpha_high of study alpha, which
@@ -156,9 +156,9 @@ Examples:
   asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves")
 )]
 pub struct CurveArgs {
-    /// Grid size N.
-    #[arg(long)]
-    pub n: usize,
+    /// Grid sizes N (comma-separated), one curve per (N, H).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub n: Vec<usize>,
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
@@ -524,7 +524,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = spec_from(&c.common, vec![c.n], parse_range(&c.hurst)?);
+            let spec = spec_from(&c.common, c.n.clone(), parse_range(&c.hurst)?);
             (
                 Kind::Curve,
                 spec,
