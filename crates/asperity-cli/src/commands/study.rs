@@ -80,7 +80,9 @@ pub struct RunArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
-    /// Save tasks in progress at most every this many seconds (0: after every batch).
+    /// Save tasks in progress at most every this many seconds (0: after every batch of
+    /// samples: 4 per thread, 1 per thread for BEM from 256² on, so that a kill there loses
+    /// at most about one sample's time).
     #[arg(long, default_value_t = CHECKPOINT_INTERVAL.as_secs_f64(), value_name = "SECONDS")]
     pub checkpoint_every: f64,
 }
@@ -538,7 +540,47 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
+    if spec.method == Method::Bem && !options.quiet {
+        announce_bem(&spec)?;
+    }
     execute(&spec, out, options, kind)?;
+    Ok(())
+}
+
+/// The smallest grid whose BEM study gets an up-front time estimate (probes of a few
+/// seconds; smaller studies take about that long in all).
+const ESTIMATE_FROM_N: usize = 256;
+
+/// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
+/// ([`super::bench::estimate_bem_seconds`]), for the whole study: tasks already
+/// checkpointed in the folder take less.
+fn announce_bem(spec: &StudySpec) -> Result<()> {
+    if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
+        return Ok(());
+    }
+    let study = super::bench::BemStudy {
+        sizes: &spec.sizes,
+        samples: spec.samples,
+        hursts: &spec.hursts,
+        rolloff: spec.rolloff,
+    };
+    let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+    let minutes = estimate.seconds / 60.0;
+    eprintln!(
+        "bem study: N = {:?}, {} H, {} samples each: estimated {} on this machine ({} lanes; \
+         checkpointed: an interrupted run resumes with the same command)",
+        spec.sizes,
+        spec.hursts.len(),
+        spec.samples,
+        if estimate.seconds < 120.0 {
+            format!("{:.0} s", estimate.seconds)
+        } else if minutes < 120.0 {
+            format!("{minutes:.0} min")
+        } else {
+            format!("{:.1} h", minutes / 60.0)
+        },
+        estimate.lanes
+    );
     Ok(())
 }
 

@@ -736,7 +736,7 @@ pub fn run_task<S: Sampler>(
     };
     progress(samples.len(), spec.samples);
     let mut workers = lane_workers(sampler)?;
-    let batch = 4 * workers.len();
+    let batch = batch_size(spec.method, task.n, workers.len());
     let mut last_save = std::time::Instant::now();
     while samples.len() < spec.samples {
         let indices: Vec<usize> =
@@ -755,6 +755,20 @@ pub fn run_task<S: Sampler>(
         progress(samples.len(), spec.samples);
     }
     store.finish(task, samples)
+}
+
+/// Samples computed between two chances to checkpoint and report progress: four per
+/// lane for cheap samples (fewer pauses), one per lane from BEM on 256² on, where a
+/// sample takes seconds to minutes, so that an interrupted task loses at most about one
+/// sample's time per lane and the progress bar moves every sample. Samples depend on
+/// their seed only, so the batch size never changes a number.
+fn batch_size(method: Method, n: usize, lanes: usize) -> usize {
+    let per_lane = if sample_cost(method, n) >= sample_cost(Method::Bem, 256) {
+        1
+    } else {
+        4
+    };
+    per_lane * lanes.max(1)
 }
 
 /// One worker of `sampler` per thread of the current rayon pool.
@@ -1211,6 +1225,14 @@ mod tests {
                 piecewise_constant: false,
             })
         }
+    }
+
+    #[test]
+    fn costly_samples_checkpoint_after_one_per_lane() {
+        assert_eq!(batch_size(Method::Mdr, 1 << 15, 2), 8);
+        assert_eq!(batch_size(Method::Bem, 128, 2), 8);
+        assert_eq!(batch_size(Method::Bem, 256, 2), 2);
+        assert_eq!(batch_size(Method::Bem, 1024, 16), 16);
     }
 
     #[test]
