@@ -15,6 +15,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,6 +41,12 @@ pub struct Series {
     pub style: Style,
     /// Colour; `None` picks from a palette by position.
     pub color: Option<RGBColor>,
+    /// An interval `(low, high)` per point, drawn in a lighter shade of the colour: error
+    /// bars on markers, a band under a line. Ends a log axis cannot show are left out.
+    pub interval: Option<Vec<(f64, f64)>>,
+    /// Text written beside the last point, in the series' colour (names a line in place
+    /// of a legend entry).
+    pub tag: Option<String>,
 }
 
 impl Series {
@@ -50,7 +57,22 @@ impl Series {
             points,
             style,
             color: None,
+            interval: None,
+            tag: None,
         }
+    }
+
+    /// Sets the interval of each point (same length as the points).
+    pub fn interval(mut self, interval: Vec<(f64, f64)>) -> Self {
+        debug_assert_eq!(interval.len(), self.points.len());
+        self.interval = Some(interval);
+        self
+    }
+
+    /// Sets the text written beside the last point.
+    pub fn tag(mut self, tag: impl Into<String>) -> Self {
+        self.tag = Some(tag.into());
+        self
     }
 
     /// Sets the colour.
@@ -82,7 +104,16 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// The size of one chart in SVG units; a PNG is drawn at [`PNG_SCALE`] times that, with
+/// fonts, lines and markers scaled alike, so that it stays sharp in print.
 const SIZE: (u32, u32) = (900, 650);
+
+/// Pixels per SVG unit in PNG files.
+const PNG_SCALE: u32 = 2;
+
+fn scaled(size: (u32, u32), scale: u32) -> (u32, u32) {
+    (size.0 * scale, size.1 * scale)
+}
 
 fn register_fonts() {
     static ONCE: Once = Once::new();
@@ -157,11 +188,13 @@ impl Chart {
     /// with the others on commit).
     pub fn stage(&self, staged: &mut StagedOutputs, png: &Path, svg: &Path) -> Result<()> {
         register_fonts();
-        stage_png(staged, png, SIZE, |root| self.render(root))?;
+        stage_png(staged, png, scaled(SIZE, PNG_SCALE), |root| {
+            self.render(root, PNG_SCALE)
+        })?;
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-            self.render(&root)?;
+            self.render(&root, 1)?;
             root.present().map_err(|e| {
                 anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string()))
             })?;
@@ -170,22 +203,33 @@ impl Chart {
         Ok(())
     }
 
+    /// Whether a log axis can show `(x, y)`.
+    fn shows(&self, (x, y): (f64, f64)) -> bool {
+        x.is_finite() && y.is_finite() && (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0)
+    }
+
+    /// Every point the axes must hold: the series and the ends of their intervals.
+    fn extent(&self) -> Vec<(f64, f64)> {
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for s in &self.series {
+            pts.extend(s.points.iter().copied().filter(|&p| self.shows(p)));
+            for (&(x, _), &(lo, hi)) in s.points.iter().zip(s.interval.iter().flatten()) {
+                pts.extend([(x, lo), (x, hi)].into_iter().filter(|&p| self.shows(p)));
+            }
+        }
+        pts
+    }
+
     fn bounds(&self) -> Result<((f64, f64), (f64, f64))> {
-        let usable = |p: &&(f64, f64)| {
-            p.0.is_finite()
-                && p.1.is_finite()
-                && (!self.log_x || p.0 > 0.0)
-                && (!self.log_y || p.1 > 0.0)
-        };
-        let pts: Vec<(f64, f64)> = self
+        let pts = self.extent();
+        if self
             .series
             .iter()
-            .flat_map(|s| s.points.iter().filter(usable).copied())
-            .collect();
-        if pts.is_empty() {
+            .all(|s| !s.points.iter().any(|&p| self.shows(p)))
+        {
             return Err(anyhow!("nothing to plot in '{}'", self.title));
         }
-        let span = |vals: Vec<f64>, log: bool| {
+        let span = |vals: Vec<f64>, log: bool, right: f64| {
             let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             if log {
@@ -195,7 +239,7 @@ impl Chart {
                     (lo, hi)
                 };
                 let pad = (hi / lo).powf(0.04);
-                (lo / pad, hi * pad)
+                (lo / pad, hi * pad * (hi / lo).powf(right))
             } else {
                 let (lo, hi) = if hi <= lo {
                     (lo - 1.0, hi + 1.0)
@@ -203,44 +247,63 @@ impl Chart {
                     (lo, hi)
                 };
                 let pad = 0.04 * (hi - lo);
-                (lo - pad, hi + pad)
+                (lo - pad, hi + pad + right * (hi - lo))
             }
         };
+        // Room on the right for the tags written beside the last points.
+        let right = if self.series.iter().any(|s| s.tag.is_some()) {
+            0.12
+        } else {
+            0.0
+        };
         Ok((
-            span(pts.iter().map(|p| p.0).collect(), self.log_x),
-            span(pts.iter().map(|p| p.1).collect(), self.log_y),
+            span(pts.iter().map(|p| p.0).collect(), self.log_x, right),
+            span(pts.iter().map(|p| p.1).collect(), self.log_y, 0.0),
         ))
     }
 
-    /// The corner of the plot whose quarter holds the fewest data points, for the legend.
+    /// The corner of the plot whose quarter holds the least of the drawing (points, the
+    /// segments between them, interval ends), for the legend.
     fn emptiest_corner(&self) -> SeriesLabelPosition {
         let Ok(((x0, x1), (y0, y1))) = self.bounds() else {
             return SeriesLabelPosition::UpperLeft;
         };
-        let scale = |v: f64, lo: f64, hi: f64, log: bool| {
+        let unit = |v: f64, lo: f64, hi: f64, log: bool| {
             if log {
                 (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
             } else {
                 (v - lo) / (hi - lo)
             }
         };
-        let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
-        for s in &self.series {
-            for &(x, y) in &s.points {
-                if !(x.is_finite() && y.is_finite())
-                    || (self.log_x && x <= 0.0)
-                    || (self.log_y && y <= 0.0)
-                {
-                    continue;
-                }
-                let (u, v) = (scale(x, x0, x1, self.log_x), scale(y, y0, y1, self.log_y));
-                // The legend box covers about 40 % of the width and height.
-                let (left, right, top, bottom) = (u < 0.4, u > 0.6, v > 0.6, v < 0.4);
-                counts[0] += (left && top) as usize;
-                counts[1] += (right && top) as usize;
-                counts[2] += (left && bottom) as usize;
-                counts[3] += (right && bottom) as usize;
+        let place = |(x, y): (f64, f64)| (unit(x, x0, x1, self.log_x), unit(y, y0, y1, self.log_y));
+        let mut marks: Vec<(f64, f64)> = self.extent().into_iter().map(place).collect();
+        // A line of two points crosses the quarters between them: sample it.
+        for s in self.series.iter().filter(|s| s.style != Style::Points) {
+            let shown: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|&p| self.shows(p))
+                .map(place)
+                .collect();
+            for w in shown.windows(2) {
+                marks.extend((1..10).map(|i| {
+                    let t = i as f64 / 10.0;
+                    (
+                        w[0].0 + t * (w[1].0 - w[0].0),
+                        w[0].1 + t * (w[1].1 - w[0].1),
+                    )
+                }));
             }
+        }
+        let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
+        for (u, v) in marks {
+            // The legend box covers about 40 % of the width and height.
+            let (left, right, top, bottom) = (u < 0.4, u > 0.6, v > 0.6, v < 0.4);
+            counts[0] += (left && top) as usize;
+            counts[1] += (right && top) as usize;
+            counts[2] += (left && bottom) as usize;
+            counts[3] += (right && bottom) as usize;
         }
         let positions = [
             SeriesLabelPosition::UpperLeft,
@@ -252,7 +315,9 @@ impl Chart {
         positions[best].clone()
     }
 
-    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    /// Draws the chart on `root`; `scale` multiplies fonts, margins, lines and markers
+    /// (1 for SVG, [`PNG_SCALE`] for PNG).
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, scale: u32) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
@@ -267,14 +332,14 @@ impl Chart {
                 .with_light_points(ticks)
         };
         match (self.log_x, self.log_y) {
-            (true, true) => self.draw(root, log_axis(x0, x1), log_axis(y0, y1)),
-            (true, false) => self.draw(root, log_axis(x0, x1), y0..y1),
-            (false, true) => self.draw(root, x0..x1, log_axis(y0, y1)),
-            (false, false) => self.draw(root, x0..x1, y0..y1),
+            (true, true) => self.draw(root, scale, log_axis(x0, x1), log_axis(y0, y1)),
+            (true, false) => self.draw(root, scale, log_axis(x0, x1), y0..y1),
+            (false, true) => self.draw(root, scale, x0..x1, log_axis(y0, y1)),
+            (false, false) => self.draw(root, scale, x0..x1, y0..y1),
         }
     }
 
-    fn draw<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, x: X, y: Y) -> Result<()>
+    fn draw<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, scale: u32, x: X, y: Y) -> Result<()>
     where
         DB: DrawingBackend,
         DB::ErrorType: 'static,
@@ -285,11 +350,12 @@ impl Chart {
     {
         let err =
             |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("plotting '{}': {e}", self.title);
+        let px = |v: u32| v * scale;
         let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, ("sans-serif", 22))
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
+            .caption(&self.title, ("sans-serif", px(22)))
+            .margin(px(15))
+            .x_label_area_size(px(50))
+            .y_label_area_size(px(80))
             .build_cartesian_2d(x, y)
             .map_err(err)?;
         chart
@@ -298,65 +364,170 @@ impl Chart {
             .y_desc(&self.y_label)
             .x_label_formatter(&|v| tick_label(*v))
             .y_label_formatter(&|v| tick_label(*v))
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 18))
+            .label_style(("sans-serif", px(15)))
+            .axis_desc_style(("sans-serif", px(18)))
+            .bold_line_style(BLACK.mix(0.1).stroke_width(scale))
+            .axis_style(BLACK.stroke_width(scale))
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
-        let keep = |p: &&(f64, f64)| {
-            p.0.is_finite()
-                && p.1.is_finite()
-                && (!self.log_x || p.0 > 0.0)
-                && (!self.log_y || p.1 > 0.0)
-        };
-        for (i, s) in self.series.iter().enumerate() {
-            let color = s.color.unwrap_or_else(|| {
-                let c = Palette99::pick(i).to_rgba();
-                RGBColor(c.0, c.1, c.2)
-            });
-            let pts: Vec<(f64, f64)> = s.points.iter().filter(keep).copied().collect();
-            let line = color.stroke_width(2);
-            let anno = match s.style {
-                Style::Line => chart.draw_series(LineSeries::new(pts, line)).map_err(err)?,
-                Style::Dashed => chart
-                    .draw_series(DashedLineSeries::new(pts, 8, 6, line))
-                    .map_err(err)?,
-                Style::Points => chart
-                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
-                    .map_err(err)?,
-                Style::LinePoints => {
-                    chart
-                        .draw_series(LineSeries::new(pts.clone(), line))
-                        .map_err(err)?;
-                    chart
-                        .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))
-                        .map_err(err)?
-                }
-            };
-            if !s.label.is_empty() {
-                anno.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
-                });
-            }
+        let colors: Vec<RGBColor> = (0..self.series.len()).map(|i| self.color_of(i)).collect();
+        // Intervals first, so that every line and marker stays on top of every band.
+        for (s, &color) in self.series.iter().zip(&colors) {
+            self.draw_interval(&mut chart, s, color, scale)
+                .map_err(err)?;
+        }
+        for (s, &color) in self.series.iter().zip(&colors) {
+            self.draw_series(&mut chart, s, color, scale).map_err(err)?;
         }
         if self.series.iter().any(|s| !s.label.is_empty()) {
             chart
                 .configure_series_labels()
                 .position(self.emptiest_corner())
-                .label_font(("sans-serif", 14))
+                .margin(px(10))
+                .legend_area_size(px(30))
+                .label_font(("sans-serif", px(14)))
                 .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
+                .border_style(BLACK.stroke_width(scale))
                 .draw()
                 .map_err(err)?;
         }
         Ok(())
     }
+
+    fn color_of(&self, i: usize) -> RGBColor {
+        self.series[i].color.unwrap_or_else(|| {
+            let c = Palette99::pick(i).to_rgba();
+            RGBColor(c.0, c.1, c.2)
+        })
+    }
+
+    /// The interval of `s`: error bars with caps on markers, a translucent band (broken
+    /// where an end cannot be shown) under a line.
+    fn draw_interval<DB, X, Y>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+        s: &Series,
+        color: RGBColor,
+        scale: u32,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+    where
+        DB: DrawingBackend,
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        let Some(interval) = &s.interval else {
+            return Ok(());
+        };
+        let spans = s
+            .points
+            .iter()
+            .zip(interval)
+            .filter(|(&(x, _), &(lo, hi))| self.shows((x, lo)) && self.shows((x, hi)));
+        if matches!(s.style, Style::Points | Style::LinePoints) {
+            let bar = lighter(color).stroke_width(scale + scale / 2);
+            let cap = 4 * scale as i32;
+            for (&(x, _), &(lo, hi)) in spans {
+                chart.draw_series([PathElement::new(vec![(x, lo), (x, hi)], bar)])?;
+                for end in [lo, hi] {
+                    chart.draw_series([EmptyElement::at((x, end))
+                        + PathElement::new(vec![(-cap, 0), (cap, 0)], bar)])?;
+                }
+            }
+            return Ok(());
+        }
+        // Runs of drawable intervals; a gap is left open, not bridged.
+        let mut runs: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new()];
+        for (i, (&(x, _), &(lo, hi))) in s.points.iter().zip(interval).enumerate() {
+            if self.shows((x, lo)) && self.shows((x, hi)) {
+                runs.last_mut().expect("one run").push((x, lo, hi));
+            } else if i > 0 && !runs.last().expect("one run").is_empty() {
+                runs.push(Vec::new());
+            }
+        }
+        for run in runs.into_iter().filter(|r| r.len() >= 2) {
+            let outline: Vec<(f64, f64)> = run
+                .iter()
+                .map(|&(x, _, hi)| (x, hi))
+                .chain(run.iter().rev().map(|&(x, lo, _)| (x, lo)))
+                .collect();
+            chart.draw_series([Polygon::new(outline, color.mix(0.2).filled())])?;
+        }
+        Ok(())
+    }
+
+    /// The line or markers of `s`, its legend entry and its tag.
+    fn draw_series<'a, DB, X, Y>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+        s: &Series,
+        color: RGBColor,
+        scale: u32,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+    where
+        DB: DrawingBackend + 'a,
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|&p| self.shows(p))
+            .collect();
+        let line = color.stroke_width(2 * scale);
+        let radius = 3 * scale as i32;
+        let dots = |pts: Vec<(f64, f64)>| {
+            pts.into_iter()
+                .map(move |p| Circle::new(p, radius, color.filled()))
+        };
+        let (dash, gap) = (8 * scale, 6 * scale);
+        let anno = match s.style {
+            Style::Line => chart.draw_series(LineSeries::new(pts.clone(), line))?,
+            Style::Dashed => {
+                chart.draw_series(DashedLineSeries::new(pts.clone(), dash, gap, line))?
+            }
+            Style::Points => chart.draw_series(dots(pts.clone()))?,
+            Style::LinePoints => {
+                chart.draw_series(LineSeries::new(pts.clone(), line))?;
+                chart.draw_series(dots(pts.clone()))?
+            }
+        };
+        if !s.label.is_empty() {
+            let (width, dashed) = (24 * scale as i32, s.style == Style::Dashed);
+            anno.label(s.label.clone()).legend(move |(x, y)| {
+                // A dashed series shows two dashes, a solid one a line.
+                let gap = if dashed { width / 4 } else { 0 };
+                let stroke = color.stroke_width(2 * scale);
+                let half = (width - gap) / 2;
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (half, 0)], stroke)
+                    + PathElement::new(vec![(half + gap, 0), (width, 0)], stroke)
+            });
+        }
+        if let (Some(tag), Some(&last)) = (&s.tag, pts.last()) {
+            let font = ("sans-serif", 14 * scale)
+                .into_font()
+                .color(&color)
+                .pos(Pos::new(HPos::Left, VPos::Center));
+            chart.draw_series([
+                EmptyElement::at(last) + Text::new(tag.clone(), (6 * scale as i32, 0), font)
+            ])?;
+        }
+        Ok(())
+    }
+}
+
+/// `color` blended halfway to white: intervals drawn beside the line they belong to.
+fn lighter(color: RGBColor) -> RGBColor {
+    let mix = |c: u8| ((c as u16 + 255) / 2) as u8;
+    RGBColor(mix(color.0), mix(color.1), mix(color.2))
 }
 
 /// The image format of a plot file, chosen by its extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFormat {
-    /// `.png`: a 900×650 (per panel) bitmap.
+    /// `.png`: a 1800×1300 (per panel) bitmap: 900×650 at twice the scale.
     Png,
     /// `.svg`: vector graphics.
     Svg,
@@ -381,7 +552,7 @@ impl ImageFormat {
     }
 }
 
-/// Renders `charts` side by side (one 900×650 panel each) into the staged output `path`
+/// Renders `charts` side by side (one 900×650 panel each, twice that in pixels in a PNG) into the staged output `path`
 /// (declared there by the caller, who commits it with the other outputs), as PNG or SVG
 /// by its extension (see [`ImageFormat::from_path`]).
 pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -> Result<()> {
@@ -403,22 +574,28 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
     }
     register_fonts();
     let size = (SIZE.0 * charts.len() as u32, SIZE.1);
-    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, charts: &[Chart]) -> Result<()>
+    fn draw<DB: DrawingBackend>(
+        root: &DrawingArea<DB, Shift>,
+        charts: &[Chart],
+        scale: u32,
+    ) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
         for (chart, panel) in charts.iter().zip(root.split_evenly((1, charts.len()))) {
-            chart.render(&panel)?;
+            chart.render(&panel, scale)?;
         }
         Ok(())
     }
     match ImageFormat::from_path(path, "plot")? {
-        ImageFormat::Png => stage_png(staged, path, size, |root| draw(root, charts)),
+        ImageFormat::Png => stage_png(staged, path, scaled(size, PNG_SCALE), |root| {
+            draw(root, charts, PNG_SCALE)
+        }),
         ImageFormat::Svg => {
             let mut text = String::new();
             {
                 let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-                draw(&root, charts)?;
+                draw(&root, charts, 1)?;
                 root.present().map_err(|e| {
                     anyhow!("rendering {}: {}", path.display(), in_words(&e.to_string()))
                 })?;
@@ -522,7 +699,8 @@ pub fn greyscale_png(
 }
 
 /// A row of grey-scale height maps with captions (like the paper's Fig. 6), PNG and SVG.
-/// Each map is shown at `tile` pixels a side (nearest-neighbour sampling).
+/// Each map is shown at `tile` units a side (nearest-neighbour sampling; [`PNG_SCALE`]
+/// pixels a unit in the PNG).
 pub fn greyscale_panel(
     png: &Path,
     svg: &Path,
@@ -537,26 +715,67 @@ pub fn greyscale_panel(
         maps.len() as u32 * (tile + 10) + 10,
         tile + caption_height + 10,
     );
+    let (ps, panel) = (
+        PNG_SCALE,
+        Panel {
+            tile,
+            caption: caption_height,
+            block: 1,
+            scale: 1,
+        },
+    );
+    let png_panel = Panel {
+        tile: tile * ps,
+        caption: caption_height * ps,
+        scale: ps,
+        ..panel
+    };
+    stage_png(&mut staged, png, scaled(size, ps), |root| {
+        png_panel.draw(root, maps)
+    })?;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        // One SVG rectangle per 4x4 block keeps the file small.
+        Panel { block: 4, ..panel }.draw(&root, maps)?;
+        root.present()
+            .map_err(|e| anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string())))?;
+    }
+    staged.write_bytes(svg, text.as_bytes())?;
+    staged.commit()?;
+    Ok(())
+}
+
+/// The layout of [`greyscale_panel`] in one backend's units.
+#[derive(Debug, Clone, Copy)]
+struct Panel {
+    /// Side of one map.
+    tile: u32,
+    /// Height of the captions' row.
+    caption: u32,
+    /// Side of the squares the maps are drawn with.
+    block: u32,
+    /// Multiplies gaps and fonts.
+    scale: u32,
+}
+
+impl Panel {
     fn draw<DB: DrawingBackend>(
+        &self,
         root: &DrawingArea<DB, Shift>,
         maps: &[(String, ArrayView2<f64>)],
-        tile: u32,
-        caption: u32,
-        block: u32,
     ) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("drawing panel: {e}");
+        let (tile, block, gap) = (self.tile, self.block, 10 * self.scale as i32);
         root.fill(&WHITE).map_err(err)?;
         for (i, (title, heights)) in maps.iter().enumerate() {
-            let x0 = 10 + i as i32 * (tile as i32 + 10);
-            root.draw(&Text::new(
-                title.clone(),
-                (x0, 5),
-                ("sans-serif", 18).into_font(),
-            ))
-            .map_err(err)?;
+            let x0 = gap + i as i32 * (tile as i32 + gap);
+            let font = ("sans-serif", 18 * self.scale).into_font();
+            root.draw(&Text::new(title.clone(), (x0, gap / 2), font))
+                .map_err(err)?;
             let (rows, cols) = heights.dim();
             let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -566,7 +785,7 @@ pub fn greyscale_panel(
                     let r = (py as usize * rows / tile as usize).min(rows - 1);
                     let c = (px as usize * cols / tile as usize).min(cols - 1);
                     let v = ((heights[[r, c]] - lo) / range * 255.0).round() as u8;
-                    let (x, y) = (x0 + px as i32, caption as i32 + py as i32);
+                    let (x, y) = (x0 + px as i32, self.caption as i32 + py as i32);
                     root.draw(&Rectangle::new(
                         [(x, y), (x + block as i32, y + block as i32)],
                         RGBColor(v, v, v).filled(),
@@ -577,20 +796,6 @@ pub fn greyscale_panel(
         }
         Ok(())
     }
-    stage_png(&mut staged, png, size, |root| {
-        draw(root, maps, tile, caption_height, 1)
-    })?;
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-        // One SVG rectangle per 4x4 block keeps the file small.
-        draw(&root, maps, tile, caption_height, 4)?;
-        root.present()
-            .map_err(|e| anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string())))?;
-    }
-    staged.write_bytes(svg, text.as_bytes())?;
-    staged.commit()?;
-    Ok(())
 }
 
 #[cfg(test)]
@@ -675,9 +880,43 @@ mod tests {
         staged.commit().unwrap();
         let decoder = ::png::Decoder::new(std::fs::File::open(&png).unwrap());
         let info = decoder.read_info().unwrap().info().clone();
-        assert_eq!((info.width, info.height), (2 * SIZE.0, SIZE.1));
+        assert_eq!(
+            (info.width, info.height),
+            (2 * PNG_SCALE * SIZE.0, PNG_SCALE * SIZE.1)
+        );
         assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn intervals_widen_the_axes_except_where_a_log_axis_cannot_show_them() {
+        let chart = |style| Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![Series::new("s", vec![(1.0, 2.0), (10.0, 3.0)], style)
+                .interval(vec![(1.0, 4.0), (-1.0, 50.0)])],
+        };
+        for style in [Style::Points, Style::Line] {
+            let ((_, _), (y0, y1)) = chart(style).bounds().unwrap();
+            // The low end -1 cannot sit on a log axis; 1 and 50 widen it.
+            assert!(y0 < 1.0 && y0 > 0.5 && y1 > 50.0 && y1 < 100.0, "{y0} {y1}");
+            let dir = tempfile::tempdir().unwrap();
+            let (png, svg) = (dir.path().join("c.png"), dir.path().join("c.svg"));
+            chart(style).save(&png, &svg, false).unwrap();
+        }
+        // A tag leaves room on the right of the last point.
+        let tagged = Series::new("", vec![(0.0, 0.0), (1.0, 1.0)], Style::Line).tag("H = 1");
+        let chart = Chart {
+            log_x: false,
+            log_y: false,
+            series: vec![tagged],
+            ..chart(Style::Line)
+        };
+        let ((_, x1), _) = chart.bounds().unwrap();
+        assert!(x1 > 1.1, "{x1}");
     }
 
     #[test]

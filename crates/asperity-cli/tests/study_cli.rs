@@ -262,7 +262,16 @@ fn bad_studies_are_refused_and_lose_nothing() {
         &asperity(
             &[
                 &base[..],
-                &["--hurst", "0.5", "--samples", "4", "--out", "y"],
+                &[
+                    "--hurst",
+                    "0.5",
+                    "--samples",
+                    "3",
+                    "--seed",
+                    "9",
+                    "--out",
+                    "y",
+                ],
             ]
             .concat(),
             d,
@@ -277,7 +286,17 @@ fn bad_studies_are_refused_and_lose_nothing() {
     ok(&asperity(
         &[
             &base[..],
-            &["--hurst", "0.5", "--samples", "4", "--out", "y", "--force"],
+            &[
+                "--hurst",
+                "0.5",
+                "--samples",
+                "3",
+                "--seed",
+                "9",
+                "--out",
+                "y",
+                "--force",
+            ],
         ]
         .concat(),
         d,
@@ -519,4 +538,68 @@ fn the_example_study_file_runs() {
         &asperity(&["study", "file", "bad.toml", "--out", "bad"], d),
         "bad.toml, line 4, column 9 (key `hurst`)",
     );
+}
+
+#[test]
+fn curve_study_takes_a_list_of_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "study",
+        "curve",
+        "--method",
+        "mdr",
+        "--n",
+        "64,128",
+        "--hurst",
+        "0.5",
+        "--samples",
+        "2",
+        "--quiet",
+        "--out",
+        "c",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let csv = std::fs::read_to_string(dir.path().join("c/curve.csv")).unwrap();
+    for n in ["64", "128"] {
+        let prefix = format!("mdr,{n},0.5,");
+        assert!(csv.lines().any(|l| l.starts_with(&prefix)), "{n}: {csv}");
+    }
+}
+
+#[test]
+fn a_finished_study_grows_by_another_n_or_h_reusing_its_checkpoints() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let study = |n: &str, hurst: &str| {
+        let args = [
+            "study",
+            "alpha",
+            "--method",
+            "mdr",
+            "--n",
+            n,
+            "--hurst",
+            hurst,
+            "--samples",
+            "4",
+            "--quiet",
+            "--out",
+            "g",
+        ];
+        asperity(&args, d)
+    };
+    ok(&study("256", "0.5"));
+    let checkpoint = d.join("g/checkpoint/mdr_n256_h+0.500000.json");
+    let before = std::fs::read(&checkpoint).unwrap();
+    let modified = || std::fs::metadata(&checkpoint).unwrap().modified().unwrap();
+    let stamp = modified();
+    ok(&study("256,512", "0.5,1"));
+    assert_eq!(
+        modified(),
+        stamp,
+        "the finished task is read back, not rewritten"
+    );
+    assert_eq!(std::fs::read(&checkpoint).unwrap(), before);
+    let csv = std::fs::read_to_string(d.join("g/alpha.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5, "header and 4 tasks: {csv}");
 }

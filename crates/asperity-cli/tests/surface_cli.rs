@@ -152,6 +152,11 @@ fn bad_input_is_refused_with_one_line_and_nothing_written() {
         d,
     );
     assert_refused(&out, d, 0, "hurst");
+    // NumPy data is never written into a file named as an image.
+    for (command, name) in [("surface", "x.png"), ("line", "x.SVG")] {
+        let out = asperity(&[command, "--n", "32", "--hurst", "0.5", "--out", name], d);
+        assert_refused(&out, d, 0, "NumPy data");
+    }
     for hurst in ["-1.01", "-3"] {
         let out = asperity(
             &["surface", "--n", "32", "--hurst", hurst, "--out", "x.npy"],

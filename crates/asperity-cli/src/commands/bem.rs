@@ -456,48 +456,62 @@ struct Row {
     peak_rss_mib: f64,
 }
 
-/// The `--plot` panels: k/E* vs F/E* and area fraction vs F/E*, log–log.
+/// The `--plot` panels, log–log: k vs F and area fraction vs F, in N and N/m as the CSV
+/// holds them when the surface came from a measured file (lengths in metres, E* in Pa:
+/// `physical`), else divided by E* (lengths in the surface's own unit).
 fn sweep_charts(
     rows: &[Row],
     fd: bool,
-    modulus: f64,
+    (modulus, physical): (f64, bool),
     surface: &Path,
     boundary: &str,
 ) -> [Chart; 2] {
+    let per = if physical { 1.0 } else { modulus };
     let name = surface.file_name().map_or_else(
         || surface.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
     let points = |y: &dyn Fn(&SweepRow) -> f64| {
         rows.iter()
-            .map(|r| (r.sweep.summary.force / modulus, y(&r.sweep)))
+            .map(|r| (r.sweep.summary.force / per, y(&r.sweep)))
             .collect()
     };
-    let x_label = "normal force F / E*  [length²]".to_string();
-    let per_modulus = |k: Option<f64>| k.unwrap_or(f64::NAN) / modulus;
+    let (x_label, y_label) = if physical {
+        ("normal force F [N]", "contact stiffness k [N/m]")
+    } else {
+        (
+            "normal force F / E*  [length²]",
+            "contact stiffness k / E*  [length]",
+        )
+    };
+    let stiffness_per = |k: Option<f64>| k.unwrap_or(f64::NAN) / per;
     let mut series = vec![Series::new(
         "frozen contact set",
-        points(&|r| per_modulus(r.stiffness)),
+        points(&|r| stiffness_per(r.stiffness)),
         Style::LinePoints,
     )];
     if fd {
         series.push(Series::new(
             "finite difference dF/dd",
-            points(&|r| per_modulus(r.stiffness_fd)),
+            points(&|r| stiffness_per(r.stiffness_fd)),
             Style::Dashed,
         ));
     }
     let stiffness = Chart {
-        title: format!("{name}: contact stiffness (E* = {modulus}, {boundary} boundaries)"),
-        x_label: x_label.clone(),
-        y_label: "contact stiffness k / E*  [length]".into(),
+        title: format!(
+            "{name}: contact stiffness (E* = {}{}, {boundary} boundaries)",
+            asperity::input::short_number(modulus),
+            if physical { " Pa" } else { "" }
+        ),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
         log_x: true,
         log_y: true,
         series,
     };
     let area = Chart {
         title: format!("{name}: true contact area"),
-        x_label,
+        x_label: x_label.into(),
         y_label: "area fraction A / A0".into(),
         log_x: true,
         log_y: true,
@@ -762,8 +776,15 @@ fn write(
             .with_context(|| format!("writing {}", record_path.display()))?;
     }
     if let Some(plot) = &args.plot {
+        let physical = matches!(surface.source, SizeSource::File);
         let boundary = plan.boundary.name();
-        let charts = sweep_charts(rows, plan.columns.fd, args.modulus, &args.surface, boundary);
+        let charts = sweep_charts(
+            rows,
+            plan.columns.fd,
+            (args.modulus, physical),
+            &args.surface,
+            boundary,
+        );
         stage_charts(&mut staged, plot, &charts)
             .with_context(|| format!("writing {}", plot.display()))?;
     }

@@ -3,7 +3,6 @@
 pub mod bem;
 pub mod bench;
 pub mod contact;
-mod fig15;
 pub mod figures;
 pub mod import;
 pub mod mdr;

@@ -253,8 +253,8 @@ fn run_figure(
         Figure::Fig5 => super::figures::fig5(dir, setting, force, discard),
         Figure::Fig6 => super::figures::fig6(dir, setting, force),
         // The book's figures name their own folder under `out`.
-        Figure::Fig15_1 => super::fig15::fig15_1(out, setting.is_quick(), force),
-        Figure::Fig15_2 => super::fig15::fig15_2(out, setting.is_quick(), force),
+        Figure::Fig15_1 => super::figures::fig15_1(out, setting, force),
+        Figure::Fig15_2 => super::figures::fig15_2(out, setting, force),
         Figure::All => unreachable!("expanded by run"),
     }
 }

@@ -11,8 +11,8 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    parse_range, run_any_task, sample_cost, EnsemblePoint, FitWindow, Method, StudyDir, StudySpec,
-    TaskResult, CHECKPOINT_INTERVAL,
+    parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
+    CHECKPOINT_INTERVAL,
 };
 use serde::de::{self, Visitor};
 use serde::Deserialize;
@@ -80,7 +80,9 @@ pub struct RunArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
-    /// Save tasks in progress at most every this many seconds (0: after every batch).
+    /// Save tasks in progress at most every this many seconds (0: after every batch of
+    /// samples: 4 per thread, 1 per thread for BEM from 256² on, so that a kill there loses
+    /// at most about one sample's time).
     #[arg(long, default_value_t = CHECKPOINT_INTERVAL.as_secs_f64(), value_name = "SECONDS")]
     pub checkpoint_every: f64,
 }
@@ -140,9 +142,9 @@ pub struct AlphaArgs {
 #[command(
     allow_negative_numbers = true,
     after_help = concat!("\
-Output: DIR/curve.csv, one row per (H, force level): method, n, hurst, force, stiffness,
+Output: DIR/curve.csv, one row per (N, H, force level): method, n, hurst, force, stiffness,
 stiffness_low, stiffness_high, samples, area_fraction; and the plot DIR/curve.png,
-DIR/curve.svg (log-log, dashed: the interval).
+DIR/curve.svg (log-log, band: the interval; dashed: slope 1).
   stiffness                     mean stiffness over samples at that force
   stiffness_low/stiffness_high  95 % confidence interval of that mean (Student t over the
                                 samples), unlike alpha_low/alpha_high of study alpha, which
@@ -156,9 +158,9 @@ Examples:
   asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves")
 )]
 pub struct CurveArgs {
-    /// Grid size N.
-    #[arg(long)]
-    pub n: usize,
+    /// Grid sizes N (comma-separated), one curve per (N, H).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub n: Vec<usize>,
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
@@ -526,6 +528,8 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Longest time between checkpoints of a task in progress.
     pub checkpoint_every: Duration,
+    /// The `reproduce` setting a figure's study runs under, marked on its plot.
+    pub setting: Option<&'static str>,
 }
 
 impl RunOptions {
@@ -539,6 +543,7 @@ impl RunOptions {
             force: run.force,
             quiet: run.quiet,
             checkpoint_every: Duration::from_secs_f64(run.checkpoint_every),
+            setting: None,
         })
     }
 }
@@ -556,7 +561,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = spec_from(&c.common, vec![c.n], parse_range(&c.hurst)?);
+            let spec = spec_from(&c.common, c.n.clone(), parse_range(&c.hurst)?);
             (
                 Kind::Curve,
                 spec,
@@ -571,7 +576,47 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
+    if spec.method == Method::Bem && !options.quiet {
+        announce_bem(&spec)?;
+    }
     execute(&spec, out, options, kind)?;
+    Ok(())
+}
+
+/// The smallest grid whose BEM study gets an up-front time estimate (probes of a few
+/// seconds; smaller studies take about that long in all).
+const ESTIMATE_FROM_N: usize = 256;
+
+/// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
+/// ([`super::bench::estimate_bem_seconds`]), for the whole study: tasks already
+/// checkpointed in the folder take less.
+fn announce_bem(spec: &StudySpec) -> Result<()> {
+    if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
+        return Ok(());
+    }
+    let study = super::bench::BemStudy {
+        sizes: &spec.sizes,
+        samples: spec.samples,
+        hursts: &spec.hursts,
+        rolloff: spec.rolloff,
+    };
+    let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+    let minutes = estimate.seconds / 60.0;
+    eprintln!(
+        "bem study: N = {:?}, {} H, {} samples each: estimated {} on this machine ({} lanes; \
+         checkpointed: an interrupted run resumes with the same command)",
+        spec.sizes,
+        spec.hursts.len(),
+        spec.samples,
+        if estimate.seconds < 120.0 {
+            format!("{:.0} s", estimate.seconds)
+        } else if minutes < 120.0 {
+            format!("{minutes:.0} min")
+        } else {
+            format!("{:.1} h", minutes / 60.0)
+        },
+        estimate.lanes
+    );
     Ok(())
 }
 
@@ -604,6 +649,7 @@ pub fn execute(
         force,
         quiet,
         checkpoint_every,
+        setting,
     } = options;
     spec.validate()?;
     spec.ensure_fits()?;
@@ -620,8 +666,14 @@ pub fn execute(
     let results = run_tasks(&store, &progress, quiet)?;
     progress.finish();
     let (table, chart) = match kind {
-        Kind::Alpha => (alpha_table(&results), alpha_chart(&results, ALPHA_TITLE)),
-        Kind::Curve => (curve_table(&results), curve_chart(&results, CURVE_TITLE)),
+        Kind::Alpha => (
+            alpha_table(&results),
+            alpha_chart(&results, &titled(ALPHA_TITLE, setting)),
+        ),
+        Kind::Curve => (
+            curve_table(&results),
+            curve_chart(&results, &titled(CURVE_TITLE, setting)),
+        ),
     };
     let stem = outputs_stem(kind);
     write_together(dir, stem, &table, &chart, rewrite, true)?;
@@ -698,6 +750,14 @@ pub fn write_together(
 const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
 const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
 
+/// `title` marked with the `reproduce` setting, if any.
+fn titled(title: &str, setting: Option<&str>) -> String {
+    match setting {
+        Some(name) => format!("{title} ({name} setting)"),
+        None => title.to_string(),
+    }
+}
+
 fn outputs_stem(kind: Kind) -> &'static str {
     match kind {
         Kind::Alpha => "alpha",
@@ -711,8 +771,14 @@ fn opt(v: Option<f64>) -> String {
 
 /// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
 /// written together.
-pub fn write_alpha(dir: &Path, results: &[TaskResult], force: bool) -> Result<()> {
-    let chart = alpha_chart(results, ALPHA_TITLE);
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_alpha(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = alpha_chart(results, &titled(ALPHA_TITLE, setting));
     write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
 }
 
@@ -755,29 +821,70 @@ fn alpha_table(results: &[TaskResult]) -> Table {
     table
 }
 
-/// The α(H) chart: one series per (method, N) and the theory curves (6), 1/3 and (24).
+/// The 95 % interval of each task's per-sample α (`alpha_low`, `alpha_high` of
+/// `alpha.csv`; NaN where there is none, which the plot leaves out).
+fn alpha_interval(r: &TaskResult) -> (f64, f64) {
+    r.alpha_sample_interval().unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// The (method, N) pairs of `results` in order of appearance.
+fn method_sizes(results: &[TaskResult]) -> Vec<(Method, usize)> {
+    let mut sizes: Vec<(Method, usize)> = Vec::new();
+    for r in results {
+        if !sizes.contains(&(r.method, r.task.n)) {
+            sizes.push((r.method, r.task.n));
+        }
+    }
+    sizes
+}
+
+fn family_color(k: usize, count: usize) -> plotters::style::RGBColor {
+    let t = if count > 1 {
+        k as f64 / (count - 1) as f64
+    } else {
+        0.5
+    };
+    ordered_color(t * 0.85)
+}
+
+/// The α(H) chart: one series per (method, N) with the 95 % interval of the samples as
+/// error bars, and the theory curves (6), 1/3 and (24), the last once per N in that
+/// series' colour. A study of a single H over several N is drawn as α(N) instead
+/// ([`alpha_n_chart`]).
 pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
+    let single_h = results
+        .windows(2)
+        .all(|w| w[0].task.hurst == w[1].task.hurst);
+    let sizes = method_sizes(results);
+    if single_h && sizes.len() > 1 {
+        return alpha_n_chart(results, title);
+    }
     let mut series = Vec::new();
-    let mut sizes: Vec<(Method, usize)> = results.iter().map(|r| (r.method, r.task.n)).collect();
-    sizes.dedup();
+    // Series at the same H are shifted apart so that their error bars do not overlap.
+    let shift = |k: usize| 0.03 * (k as f64 - (sizes.len() as f64 - 1.0) / 2.0);
     for (k, &(method, n)) in sizes.iter().enumerate() {
-        let points = results
+        let rows: Vec<&TaskResult> = results
             .iter()
             .filter(|r| r.method == method && r.task.n == n)
-            .filter_map(|r| r.alpha_ensemble.map(|f| (r.task.hurst, f.exponent)))
+            .filter(|r| r.alpha_ensemble.is_some())
             .collect();
-        let t = if sizes.len() > 1 {
-            k as f64 / (sizes.len() - 1) as f64
-        } else {
-            0.5
-        };
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    r.task.hurst + shift(k),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
         series.push(
             Series::new(
                 format!("{} N = {n}", method.name()),
                 points,
                 Style::LinePoints,
             )
-            .color(ordered_color(t * 0.85)),
+            .color(family_color(k, sizes.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
         );
     }
     // (6) on (0, 2]: H = 0 itself belongs to (24), drawn below on [-1, 0].
@@ -796,20 +903,73 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
     );
     for (k, &(_, n)) in sizes.iter().enumerate() {
         let a = alpha_white_noise(n as f64);
-        let label = if k == 0 {
-            "(1+log2 N)/(3+log2 N) (24)"
-        } else {
-            ""
-        };
         series.push(
-            Series::new(label, vec![(-1.0, a), (0.0, a)], Style::Dashed)
-                .color(plotters::style::BLUE),
+            Series::new(
+                format!("(24), N = {n}"),
+                vec![(-1.0, a), (0.0, a)],
+                Style::Dashed,
+            )
+            .color(family_color(k, sizes.len())),
         );
     }
     Chart {
         title: title.into(),
-        x_label: "Hurst exponent H".into(),
-        y_label: "α".into(),
+        x_label: "Hurst exponent H (series shifted apart by 0.03)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+/// α against log2 N for a study of one H: one series per method with the 95 % interval
+/// of the samples as error bars, beside eq. (24) (paper Fig. 5).
+fn alpha_n_chart(results: &[TaskResult], title: &str) -> Chart {
+    let mut methods: Vec<Method> = results.iter().map(|r| r.method).collect();
+    methods.dedup();
+    let mut series = Vec::new();
+    for (k, &method) in methods.iter().enumerate() {
+        let rows: Vec<&TaskResult> = results
+            .iter()
+            .filter(|r| r.method == method && r.alpha_ensemble.is_some())
+            .collect();
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    (r.task.n as f64).log2(),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
+        series.push(
+            Series::new(
+                format!("{} (H = {})", method.name(), results[0].task.hurst),
+                points,
+                Style::LinePoints,
+            )
+            .color(family_color(k, methods.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
+        );
+    }
+    let (lo, hi) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            let m = (r.task.n as f64).log2();
+            (a.min(m), b.max(m))
+        });
+    let theory = (0..=40)
+        .map(|i| lo - 0.5 + (hi - lo + 1.0) * i as f64 / 40.0)
+        .map(|m| (m, alpha_white_noise(2f64.powf(m))))
+        .collect();
+    series.push(
+        Series::new("(1+log2 N)/(3+log2 N) (24)", theory, Style::Dashed)
+            .color(plotters::style::BLUE),
+    );
+    Chart {
+        title: title.replace("vs H", "vs N"),
+        x_label: "log2 N (N: modes of a line, points a side of a surface)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
         log_x: false,
         log_y: false,
         series,
@@ -817,8 +977,15 @@ pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
 }
 
 /// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
-pub fn write_curves(dir: &Path, results: &[TaskResult], force: bool, stem: &str) -> Result<()> {
-    let chart = curve_chart(results, CURVE_TITLE);
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_curves(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    stem: &str,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = curve_chart(results, &titled(CURVE_TITLE, setting));
     write_together(dir, stem, &curve_table(results), &chart, force, false)
 }
 
@@ -854,9 +1021,8 @@ fn curve_table(results: &[TaskResult]) -> Table {
 }
 
 /// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
-/// dashed in the same colour. Interval ends that are not positive (a wide interval at few
-/// samples) cannot sit on a log axis: they are left out, not clamped, and the dashed line
-/// is broken there rather than drawn across the gap.
+/// as a band in the same colour (ends that a log axis cannot show are left out, see
+/// [`crate::plot::Series::interval`]), and a slope-1 reference line (k ∝ F).
 pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     let (hmin, hmax) = results
         .iter()
@@ -870,39 +1036,27 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
         } else {
             0.5
         };
-        let color = ordered_color(t * 0.9);
         let points = r
             .mean_curve
             .iter()
             .map(|p| (p.force, p.stiffness))
             .collect();
-        series.push(
-            Series::new(
-                format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
-                points,
-                Style::Line,
-            )
-            .color(color),
-        );
+        let mut line = Series::new(
+            format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
+            points,
+            Style::Line,
+        )
+        .color(ordered_color(t * 0.9));
         if r.samples > 1 {
-            let ends: [fn(&EnsemblePoint) -> f64; 2] = [|p| p.stiffness_low, |p| p.stiffness_high];
-            for end in ends {
-                // Runs of drawable points; a gap is left open, not bridged.
-                let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-                for p in &r.mean_curve {
-                    let (f, k) = (p.force, end(p));
-                    if f > 0.0 && k > 0.0 && k.is_finite() {
-                        runs.last_mut().expect("one run").push((f, k));
-                    } else if !runs.last().expect("one run").is_empty() {
-                        runs.push(Vec::new());
-                    }
-                }
-                for run in runs.into_iter().filter(|run| run.len() >= 2) {
-                    series.push(Series::new("", run, Style::Dashed).color(color));
-                }
-            }
+            let interval = r
+                .mean_curve
+                .iter()
+                .map(|p| (p.stiffness_low, p.stiffness_high));
+            line = line.interval(interval.collect());
         }
+        series.push(line);
     }
+    series.extend(slope_one(results));
     let scale = match results.first().map(|r| r.method) {
         Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
         _ => "L = 1, E* = 1, unit rms height",
@@ -910,17 +1064,41 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
     Chart {
         title: title.into(),
         x_label: format!("normal force F ({scale})"),
-        y_label: "contact stiffness k".into(),
+        y_label: "contact stiffness k (band: 95 % interval of the mean)".into(),
         log_x: true,
         log_y: true,
         series,
     }
 }
 
+/// A k ∝ F line over the last two decades of force (fewer where the curves span less),
+/// from the smallest stiffness up: below the curves, whose slope is at most 1.
+fn slope_one(results: &[TaskResult]) -> Option<Series> {
+    let points = results.iter().flat_map(|r| &r.mean_curve);
+    let shown = points.filter(|p| p.force > 0.0 && p.stiffness > 0.0 && p.stiffness.is_finite());
+    let (f_lo, f_hi, k_lo) = shown.fold(
+        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY),
+        |(a, b, c), p| (a.min(p.force), b.max(p.force), c.min(p.stiffness)),
+    );
+    // No drawable point leaves f_lo infinite and f_hi below it.
+    if f_hi <= f_lo {
+        return None;
+    }
+    let span = (f_hi / f_lo).min(100.0);
+    Some(
+        Series::new(
+            "slope 1 (k ∝ F)",
+            vec![(f_hi / span, k_lo), (f_hi, k_lo * span)],
+            Style::Dashed,
+        )
+        .color(plotters::style::RGBColor(120, 120, 120)),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use asperity::study::Task;
+    use asperity::study::{EnsemblePoint, Task};
 
     fn result(lows: &[f64]) -> TaskResult {
         let point = |i: usize, &low: &f64| EnsemblePoint {
@@ -942,21 +1120,17 @@ mod tests {
     }
 
     #[test]
-    fn curve_plots_leave_out_non_positive_interval_ends() {
+    fn curve_plots_carry_the_interval_and_a_slope_one_line() {
         let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
-        let points = |i: usize| chart.series[i].points.clone();
-        assert_eq!(chart.series.len(), 4, "mean, low in two pieces, high");
-        assert_eq!(points(1), vec![(1.0, 0.5), (2.0, 0.6)]);
-        assert_eq!(points(2), vec![(5.0, 0.7), (6.0, 0.8)]);
-        assert_eq!(points(3).len(), 6, "the high end");
-        assert!(chart.series[1..].iter().all(|s| s.label.is_empty()));
-        // A lone positive point between gaps draws nothing; all positive: one line.
-        assert_eq!(
-            curve_chart(&[result(&[-1.0, 0.5, -1.0])], "t").series.len(),
-            2
-        );
-        let whole = curve_chart(&[result(&[0.1, 0.2, 0.3])], "t");
-        assert_eq!(whole.series[1].points.len(), 3);
+        assert_eq!(chart.series.len(), 2, "the mean and the reference");
+        let interval = chart.series[0].interval.clone().expect("an interval");
+        assert_eq!(interval.len(), 6);
+        assert_eq!(interval[2], (-0.3, 2.0), "kept: the plot leaves it out");
+        // The reference has slope 1 and ends at the largest force.
+        let line = &chart.series[1].points;
+        let (a, b) = (line[0], line[1]);
+        assert!(((b.1 / a.1).ln() / (b.0 / a.0).ln() - 1.0).abs() < 1e-12);
+        assert_eq!(b.0, 6.0);
     }
 
     #[test]

@@ -28,11 +28,30 @@ pub struct SpectrumArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Output file (.npy, float64); a JSON sidecar FILE.npy.json records every parameter.
-    #[arg(long)]
+    #[arg(long, value_parser = array_path)]
     pub out: PathBuf,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
+}
+
+/// `--out`: a path whose name does not promise an image (NumPy data written into
+/// `x.png` reads as a broken picture); the image of a surface is `--png`.
+fn array_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some(e @ ("png" | "svg" | "jpg" | "jpeg" | "tif" | "tiff" | "bmp" | "gif")) => {
+            Err(format!(
+                "--out writes NumPy data (.npy), not a .{e} image; for the image of a surface \
+             give --png FILE.png beside --out FILE.npy"
+            ))
+        }
+        _ => Ok(path),
+    }
 }
 
 impl SpectrumArgs {

@@ -13,7 +13,10 @@
 //! the same spec, it resumes where it stopped and — since samples are deterministic and
 //! stored with round-trip precision — gives bit-identical results. A folder holding a
 //! different study is refused ([`Error::ForeignCheckpoint`], naming the parameters that
-//! differ) unless `discard` is set; a folder whose `study.json` names another study but
+//! differ) unless `discard` is set. The same study over other grids, H values or sample
+//! counts is no different study: it is extended, every task it shares with the stored one
+//! keeping its checkpoint (a finished task whose sample count changed is computed again:
+//! its sample curves are not kept). A folder whose `study.json` names another study but
 //! whose checkpoints hold no sample (a study that stopped before its first checkpoint) is
 //! free and reused.
 //!
@@ -481,6 +484,9 @@ pub struct StudyDir {
 enum Stored {
     None,
     Same,
+    /// The same study over fewer or other N, H or samples: it is extended, each
+    /// checkpoint reused where its task's identity matches.
+    Extended,
     Other(String),
     Corrupt(String),
 }
@@ -507,13 +513,27 @@ impl StudyDir {
         if &manifest.spec == spec {
             return Ok(Stored::Same);
         }
+        // The grids, H values and sample count are not part of a task's identity: a task
+        // of the stored study is the same task in this one.
+        let extended = StudySpec {
+            sizes: spec.sizes.clone(),
+            hursts: spec.hursts.clone(),
+            samples: spec.samples,
+            ..manifest.spec.clone()
+        };
+        if &extended == spec {
+            return Ok(Stored::Extended);
+        }
         Ok(Stored::Other(spec_differences(&manifest.spec, spec)))
     }
 
     /// Checks, without writing, whether `dir` can hold `spec`:
     ///
     /// * `Ok(false)` when it is new or holds the same study (which then resumes; each
-    ///   checkpoint is still checked against its task's identity when read);
+    ///   checkpoint is still checked against its task's identity when read), or the same
+    ///   study over other grids N, H values or sample count (which is extended: the tasks
+    ///   in both keep their checkpoints; a finished task whose sample count changed is
+    ///   computed again, its sample curves not being kept);
     /// * `Ok(true)` when its checkpoints are to be cleared first: it holds another study
     ///   (or a corrupt `study.json`, or checkpoints without one) and `discard` is set, or
     ///   its `study.json` names another study but no checkpoint holds a sample (that study
@@ -522,7 +542,7 @@ impl StudyDir {
     ///   [`Error::Metadata`] when its `study.json` is corrupt and checkpoints hold samples.
     pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
         let stored = Self::stored_spec(dir, spec)?;
-        if matches!(stored, Stored::Same) {
+        if matches!(stored, Stored::Same | Stored::Extended) {
             return Ok(false);
         }
         if !Self::holds_samples(dir)? {
@@ -532,7 +552,7 @@ impl StudyDir {
             return Ok(true);
         }
         match stored {
-            Stored::None | Stored::Same => Ok(false),
+            Stored::None | Stored::Same | Stored::Extended => Ok(false),
             Stored::Other(differences) => Err(Error::ForeignCheckpoint {
                 dir: dir.to_path_buf(),
                 reason: format!("its study.json has other parameters: {differences}"),
@@ -792,7 +812,7 @@ pub fn run_task<S: Sampler>(
     };
     progress(samples.len(), spec.samples);
     let mut workers = lane_workers(sampler)?;
-    let batch = 4 * workers.len();
+    let batch = batch_size(spec.method, task.n, workers.len());
     let mut last_save = std::time::Instant::now();
     while samples.len() < spec.samples {
         let indices: Vec<usize> =
@@ -811,6 +831,20 @@ pub fn run_task<S: Sampler>(
         progress(samples.len(), spec.samples);
     }
     store.finish(task, samples)
+}
+
+/// Samples computed between two chances to checkpoint and report progress: four per
+/// lane for cheap samples (fewer pauses), one per lane from BEM on 256² on, where a
+/// sample takes seconds to minutes, so that an interrupted task loses at most about one
+/// sample's time per lane and the progress bar moves every sample. Samples depend on
+/// their seed only, so the batch size never changes a number.
+fn batch_size(method: Method, n: usize, lanes: usize) -> usize {
+    let per_lane = if sample_cost(method, n) >= sample_cost(Method::Bem, 256) {
+        1
+    } else {
+        4
+    };
+    per_lane * lanes.max(1)
 }
 
 /// One worker of `sampler` per thread of the current rayon pool.
@@ -1138,7 +1172,12 @@ mod tests {
         store
             .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
             .unwrap();
-        let err = StudyDir::open(dir.path(), &spec(23), false).unwrap_err();
+        // (Another seed: more samples alone would extend the study.)
+        let other = StudySpec {
+            seed: 7,
+            ..spec(23)
+        };
+        let err = StudyDir::open(dir.path(), &other, false).unwrap_err();
         assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
         // A file that cannot be read counts as holding samples.
         std::fs::write(dir.path().join("checkpoint/x.json"), "{").unwrap();
@@ -1147,7 +1186,7 @@ mod tests {
             Task { n: 64, hurst: 0.5 }.key(Method::Mdr)
         )))
         .unwrap();
-        assert!(StudyDir::open(dir.path(), &spec(23), false).is_err());
+        assert!(StudyDir::open(dir.path(), &other, false).is_err());
     }
 
     fn checkpoint_file(dir: &Path, task: Task) -> PathBuf {
@@ -1354,6 +1393,63 @@ mod tests {
     }
 
     #[test]
+    fn costly_samples_checkpoint_after_one_per_lane() {
+        assert_eq!(batch_size(Method::Mdr, 1 << 15, 2), 8);
+        assert_eq!(batch_size(Method::Bem, 128, 2), 8);
+        assert_eq!(batch_size(Method::Bem, 256, 2), 2);
+        assert_eq!(batch_size(Method::Bem, 1024, 16), 16);
+    }
+
+    #[test]
+    fn a_study_grows_by_grids_h_values_and_samples_reusing_its_checkpoints() {
+        let dir = tempfile::tempdir().unwrap();
+        let task = Task { n: 64, hurst: 0.5 };
+        let run = |spec: &StudySpec| -> Vec<TaskResult> {
+            let store = StudyDir::open(dir.path(), spec, false).unwrap();
+            spec.tasks()
+                .into_iter()
+                .map(|t| run_task(spec, t, &Synthetic, &store, &|_, _| {}).unwrap())
+                .collect()
+        };
+        let first = run(&spec(6));
+        let path = dir
+            .path()
+            .join("checkpoint")
+            .join(format!("{}.json", task.key(Method::Mdr)));
+        let modified = || std::fs::metadata(&path).unwrap().modified().unwrap();
+        let before = modified();
+        // Another N and another H: the finished task is read back, not recomputed.
+        let wider = StudySpec {
+            sizes: vec![64, 128],
+            hursts: vec![0.5, 1.0],
+            ..spec(6)
+        };
+        let grown = run(&wider);
+        assert_eq!(grown.len(), 4);
+        assert_eq!(grown[0], first[0], "the stored task, bit for bit");
+        assert_eq!(modified(), before, "its checkpoint untouched");
+        // More samples: that task again, now with 9, equal to a fresh study of 9.
+        let more = StudySpec {
+            samples: 9,
+            ..wider.clone()
+        };
+        let extended = run(&more);
+        let fresh = {
+            let other = tempfile::tempdir().unwrap();
+            let store = StudyDir::open(other.path(), &more, false).unwrap();
+            run_task(&more, task, &Synthetic, &store, &|_, _| {}).unwrap()
+        };
+        assert_eq!(extended[0], fresh);
+        // Anything else still makes another study.
+        let rolled = StudySpec {
+            rolloff: Some(2.0),
+            ..more
+        };
+        let err = StudyDir::open(dir.path(), &rolled, false).unwrap_err();
+        assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+    }
+
+    #[test]
     fn foreign_checkpoint_is_refused_and_resume_is_exact() {
         let dir = tempfile::tempdir().unwrap();
         let task = Task { n: 64, hurst: 0.5 };
@@ -1362,7 +1458,11 @@ mod tests {
             run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap()
         };
         // A different study in the same folder is refused and nothing is lost.
-        let err = StudyDir::open(dir.path(), &spec(21), false).unwrap_err();
+        let other_seed = StudySpec {
+            seed: 4,
+            ..spec(20)
+        };
+        let err = StudyDir::open(dir.path(), &other_seed, false).unwrap_err();
         assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
         assert!(dir
             .path()
