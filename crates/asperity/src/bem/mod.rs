@@ -44,6 +44,7 @@ mod bccg;
 mod full_contact;
 #[cfg(test)]
 mod interruption;
+mod mean_gap;
 mod periodic_indentation;
 mod polonsky_keer;
 mod preconditioner;
