@@ -3,9 +3,9 @@
 //! solving rough contact problems based on the multi-level multi-summation and conjugate
 //! gradient techniques*, Wear 231, 206–219, 1999), on the FFT half-space operator.
 //!
-//! One iteration (load control; displacement control on free boundaries skips the mean
-//! subtractions and the rescaling, with `d` fixed; periodic displacement control is a root
-//! find on the mean pressure over load-controlled solves, see [`super::periodic_indentation`]):
+//! One iteration (load control; displacement control skips the mean subtractions and the
+//! rescaling, with `d` fixed, on free and periodic boundaries alike: below full contact the
+//! periodic objective is bounded along the constant mode, see [`super::mean_gap`]):
 //! 1. `u = K p`; on the contact set `I_c = {p > 0}` the indentation is the mean of `u + f`,
 //!    `g = u + f − d`, `G = Σ_{I_c} g²`.
 //! 2. Direction `t = g + δ (G/G_old) t` on `I_c`, zero elsewhere (`δ = 0` after the contact
@@ -282,7 +282,11 @@ impl ContactSolver {
             let full = self.periodic_full_contact();
             let beyond = match target {
                 Target::MeanPressure(p) => p >= full.mean_pressure,
-                Target::Indentation(d) => full.indentation.is_some_and(|d_full| d >= d_full),
+                // The mean gap mean(f) − d within the rounding of the sum mean(f) (n ulps)
+                // is no gap: full contact.
+                Target::Indentation(d) => full.indentation.is_some_and(|d_full| {
+                    d >= d_full * (1.0 - self.profile.len() as f64 * f64::EPSILON)
+                }),
             };
             if beyond {
                 self.solved = None;
@@ -295,9 +299,6 @@ impl ContactSolver {
                 self.bccg_periodic_indentation(d)
             }
             (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
-            (SolverKind::PolonskyKeer, Target::Indentation(d)) if periodic => {
-                self.periodic_indentation(d, 0)
-            }
             (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
         };
         match result {
