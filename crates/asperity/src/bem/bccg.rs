@@ -46,7 +46,7 @@
 use rayon::prelude::*;
 
 use super::mean_gap::MeanGapScratch;
-use super::polonsky_keer::{ContactSolver, Target};
+use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 

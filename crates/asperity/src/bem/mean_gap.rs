@@ -110,7 +110,7 @@ impl MeanGapScratch {
 #[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::rough_grid;
-    use super::super::polonsky_keer::ContactSolver;
+    use super::super::solver::ContactSolver;
     use super::super::{Control, HalfSpace, SolveError, SolverParams};
     use crate::elastic::Boundary;
     use crate::reference::Westergaard;

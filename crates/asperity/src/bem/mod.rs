@@ -49,11 +49,12 @@ mod interruption;
 mod mean_gap;
 mod polonsky_keer;
 mod preconditioner;
+mod solver;
 mod stiffness;
 pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
-pub use polonsky_keer::ContactSolver;
+pub use solver::ContactSolver;
 
 use ndarray::Array2;
 
