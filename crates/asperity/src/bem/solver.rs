@@ -89,10 +89,17 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow): the operator, the preconditioner, five fields, the four BCCG fields and their
-    /// mask, the four stiffness and full-contact fields. The caller's [`Surface`] (one more
+    /// mask, the four stiffness and full-contact fields (periodic: three more for the
+    /// coarse correction of displacement control). The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let fields = memory::array_bytes(&[14, rows, cols], 8)?;
+        // Periodic grids add the coarse correction's two fields and its mask (`mean_gap.rs`).
+        let count = if boundary == Boundary::Periodic {
+            17
+        } else {
+            14
+        };
+        let fields = memory::array_bytes(&[count, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
             .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
             .checked_add(fields)
@@ -464,9 +471,17 @@ mod tests {
             assert!(before.0 > 0.0);
             let full = solver.full_contact_threshold().unwrap();
             assert!(full.mean_pressure > 0.02, "{boundary:?}");
-            assert_eq!(solver.frozen_set_stiffness().unwrap(), before, "{boundary:?}");
+            assert_eq!(
+                solver.frozen_set_stiffness().unwrap(),
+                before,
+                "{boundary:?}"
+            );
             solver.full_contact_lower_bound().unwrap();
-            assert_eq!(solver.frozen_set_stiffness().unwrap(), before, "{boundary:?}");
+            assert_eq!(
+                solver.frozen_set_stiffness().unwrap(),
+                before,
+                "{boundary:?}"
+            );
             assert_eq!(solver.pressure(), pressure);
             assert_eq!(solver.gap(), gap);
         }
