@@ -18,7 +18,7 @@
 //! set the pressure of full contact). On self-affine surfaces the bound is a few percent of
 //! the threshold (about 0.12 E*·h′ for an rms slope h′, measured: 512², H = 0.8, roll-off 6).
 
-use super::polonsky_keer::ContactSolver;
+use super::solver::ContactSolver;
 use super::{Control, SolveError};
 use crate::elastic::Boundary;
 

@@ -1,7 +1,6 @@
 //! Tests of stopping a solve through its [`Stop`] flag ([`ContactSolver::with_stop`]):
 //! every solver path (BCCG and Polonsky–Keer; load and displacement control; free and
-//! periodic boundaries, where periodic displacement control runs a root find) and the
-//! frozen-set CG end with [`SolveError::Interrupted`] when the flag is set before or during
+//! periodic boundaries) and the frozen-set CG end with [`SolveError::Interrupted`] when the flag is set before or during
 //! the computation, and the solver then gives exactly what an uninterrupted one gives.
 
 use std::time::{Duration, Instant};

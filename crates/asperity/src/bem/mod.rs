@@ -20,11 +20,13 @@
 //!   conjugate gradients (Wear 231, 206–219, 1999; [`SolverKind::PolonskyKeer`],
 //!   `polonsky_keer.rs`) stay selectable as the reference. The solver owns the operator, its
 //!   plans and every buffer, so one solver serves many loads, and it starts each solve from
-//!   the previous pressure (warm start). Periodic displacement control: BCCG solves it
-//!   directly; Polonsky–Keer by a root find on the mean pressure over load-controlled solves
-//!   (`periodic_indentation.rs`).
+//!   the previous pressure (warm start). Periodic displacement control is a direct solve
+//!   with the indentation (equivalently the mean gap `mean(f) − d`) fixed: the BCCG
+//!   preconditions the constant mode, which the periodic kernel does not see, by its exact
+//!   curvature on the free set (`mean_gap.rs`); Polonsky–Keer runs its own iteration with `d`
+//!   fixed (slow near full contact, but it converges: it is the reference).
 //! * **Stopping**: [`ContactSolver::with_stop`] hands the solver a [`crate::stop::Stop`]
-//!   flag, which every iteration (BCCG, Polonsky–Keer, the periodic root find, the
+//!   flag, which every iteration (BCCG, Polonsky–Keer, the
 //!   frozen-set and full-contact CGs) polls; a requested stop ends the solve with
 //!   [`SolveError::Interrupted`] within one iteration.
 //! * **Stiffness**: [`ContactSolver::frozen_set_stiffness`] — the paper's method: keep the
@@ -44,14 +46,15 @@ mod bccg;
 mod full_contact;
 #[cfg(test)]
 mod interruption;
-mod periodic_indentation;
+mod mean_gap;
 mod polonsky_keer;
 mod preconditioner;
+mod solver;
 mod stiffness;
 pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
-pub use polonsky_keer::ContactSolver;
+pub use solver::ContactSolver;
 
 use ndarray::Array2;
 
@@ -119,8 +122,8 @@ pub enum SolverKind {
     #[default]
     Bccg,
     /// Polonsky & Keer's constrained conjugate gradients (Wear 231, 1999): two operator
-    /// applications per iteration, a restart whenever the contact set grows; periodic
-    /// displacement control by a root find over load-controlled solves. The reference.
+    /// applications per iteration, a restart whenever the contact set grows; under
+    /// displacement control with `d` fixed on either boundary. The reference.
     PolonskyKeer,
 }
 
@@ -269,8 +272,7 @@ pub enum SolveError {
     /// solve starts cold, as after [`ContactSolver::reset`].
     #[error("interrupted after {iterations} iterations")]
     Interrupted {
-        /// Iterations done before the stop (summed over the inner solves of a periodic
-        /// displacement-controlled root find).
+        /// Iterations done before the stop.
         iterations: usize,
     },
     /// The load or indentation closes the gap everywhere: no contact problem is left to

@@ -21,8 +21,8 @@
 //! ([`StiffnessWork`]), so neither touches the solved state.
 
 use super::full_contact::FullContactThreshold;
-use super::polonsky_keer::ContactSolver;
 use super::preconditioner::FourierPreconditioner;
+use super::solver::ContactSolver;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::stop::Stop;
@@ -92,6 +92,88 @@ struct Limits<'a> {
     stop: &'a Stop,
 }
 
+/// `x = 0`, `r = b` on the set (zero off it); returns `‖b‖²`.
+fn start_on_set(
+    (x, residual): (&mut [f64], &mut [f64]),
+    in_set: &impl Fn(usize) -> bool,
+    rhs: RightHandSide<'_>,
+) -> f64 {
+    let mut rr = 0.0;
+    for i in 0..x.len() {
+        x[i] = 0.0;
+        let b = match rhs {
+            _ if !in_set(i) => 0.0,
+            RightHandSide::Ones => 1.0,
+            RightHandSide::Values(v) => v[i],
+        };
+        residual[i] = b;
+        rr += b * b;
+    }
+    rr
+}
+
+/// The end of a CG at relative residual `relative` after `iterations`, if it ends there:
+/// converged, out of iterations (or not finite), or stopped.
+fn finished(
+    relative: f64,
+    iterations: usize,
+    limits: Limits<'_>,
+) -> Option<Result<SolveInfo, SolveError>> {
+    if limits.stop.is_requested() {
+        return Some(Err(SolveError::Interrupted { iterations }));
+    }
+    if relative <= limits.tolerance {
+        return Some(Ok(SolveInfo {
+            iterations,
+            residual: relative,
+            operator_applications: iterations,
+        }));
+    }
+    if iterations >= limits.max_iterations || !relative.is_finite() {
+        return Some(Err(SolveError::NoConvergence {
+            iterations,
+            residual: relative,
+        }));
+    }
+    None
+}
+
+/// One CG step on the set: `w = K s`, `α = rz / sᵀw`, `x += α s`, `r −= α w`; returns the
+/// new `‖r‖²`, or `None` when the curvature `sᵀw` or `rz` is not positive (`K_SS` and
+/// `M_SS` are positive definite: round-off only).
+fn step_on_set(
+    operator: &mut ElasticOperator,
+    in_set: &impl Fn(usize) -> bool,
+    work: &mut StiffnessWork,
+    rz: f64,
+) -> Option<f64> {
+    let StiffnessWork {
+        x,
+        residual,
+        direction,
+        response,
+        ..
+    } = work;
+    operator.apply(direction, response);
+    let curvature: f64 = (0..x.len())
+        .filter(|&i| in_set(i))
+        .map(|i| direction[i] * response[i])
+        .sum();
+    if !(curvature > 0.0 && rz > 0.0) {
+        return None;
+    }
+    let alpha = rz / curvature;
+    let mut rr = 0.0;
+    for i in 0..x.len() {
+        if in_set(i) {
+            x[i] += alpha * direction[i];
+            residual[i] -= alpha * response[i];
+            rr += residual[i] * residual[i];
+        }
+    }
+    Some(rr)
+}
+
 /// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
 /// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
 /// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
@@ -104,86 +186,44 @@ fn conjugate_gradient_on_set(
     work: &mut StiffnessWork,
     limits: Limits<'_>,
 ) -> Result<SolveInfo, SolveError> {
-    let Limits {
-        tolerance,
-        max_iterations,
-        stop,
-    } = limits;
-    let StiffnessWork {
-        x,
-        residual,
-        preconditioned: z,
-        direction,
-        response,
-        ..
-    } = work;
-    let mut rr = 0.0;
-    for i in 0..x.len() {
-        x[i] = 0.0;
-        let b = match rhs {
-            _ if !in_set(i) => 0.0,
-            RightHandSide::Ones => 1.0,
-            RightHandSide::Values(v) => v[i],
-        };
-        residual[i] = b;
-        rr += b * b;
-    }
+    let mut rr = start_on_set((&mut work.x, &mut work.residual), &in_set, rhs);
     let b_norm = rr.sqrt();
-    let mut rz = precondition_on_set(preconditioner, &in_set, residual, z);
-    direction.copy_from_slice(z);
+    let mut rz = precondition_on_set(
+        preconditioner,
+        &in_set,
+        &work.residual,
+        &mut work.preconditioned,
+    );
+    work.direction.copy_from_slice(&work.preconditioned);
     let mut iterations = 0;
     loop {
-        if stop.is_requested() {
-            return Err(SolveError::Interrupted { iterations });
-        }
         let relative = if b_norm > 0.0 {
             rr.sqrt() / b_norm
         } else {
             0.0
         };
-        if relative <= tolerance {
-            return Ok(SolveInfo {
-                iterations,
-                residual: relative,
-                operator_applications: iterations,
-            });
-        }
-        if iterations >= max_iterations || !relative.is_finite() {
-            return Err(SolveError::NoConvergence {
-                iterations,
-                residual: relative,
-            });
+        if let Some(end) = finished(relative, iterations, limits) {
+            return end;
         }
         iterations += 1;
-        operator.apply(direction, response);
-        let curvature: f64 = (0..x.len())
-            .filter(|&i| in_set(i))
-            .map(|i| direction[i] * response[i])
-            .sum();
-        if !(curvature > 0.0 && rz > 0.0) {
-            // K_SS and M_SS are positive definite; this only happens at round-off level.
-            return Err(SolveError::NoConvergence {
-                iterations,
-                residual: relative,
-            });
-        }
-        let alpha = rz / curvature;
-        rr = 0.0;
-        for i in 0..x.len() {
-            if in_set(i) {
-                x[i] += alpha * direction[i];
-                residual[i] -= alpha * response[i];
-                rr += residual[i] * residual[i];
-            }
-        }
-        let rz_new = precondition_on_set(preconditioner, &in_set, residual, z);
+        rr = step_on_set(operator, &in_set, work, rz).ok_or(SolveError::NoConvergence {
+            iterations,
+            residual: relative,
+        })?;
+        let rz_new = precondition_on_set(
+            preconditioner,
+            &in_set,
+            &work.residual,
+            &mut work.preconditioned,
+        );
         let beta = rz_new / rz;
-        for i in 0..x.len() {
-            direction[i] = if in_set(i) {
-                z[i] + beta * direction[i]
-            } else {
-                0.0
-            };
+        for (i, (s, &z)) in work
+            .direction
+            .iter_mut()
+            .zip(&work.preconditioned)
+            .enumerate()
+        {
+            *s = if in_set(i) { z + beta * *s } else { 0.0 };
         }
         rz = rz_new;
     }

@@ -1,0 +1,489 @@
+//! [`ContactSolver`]: the solver core shared by the iterations of [`crate::bem`].
+//!
+//! It holds the problem — the indenter profile `f = max(h) − h` of one surface and its
+//! height scale, the half-space (the [`ElasticOperator`] with its boundary) and the
+//! parameters — and the state of the last solve (pressure, gap, summary, the cached
+//! full-contact threshold), with every scratch field owned by the part that uses it: the
+//! BCCG's ([`super::bccg`], with the coarse correction of [`super::mean_gap`]), the
+//! Polonsky–Keer iteration's two fields (`direction`, `response`), and the frozen-set and
+//! full-contact CGs' ([`super::stiffness`]). [`ContactSolver::solve`] validates the
+//! control, refuses a periodic load or indentation beyond full contact before solving, and
+//! dispatches to the chosen iteration ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`,
+//! each `(target, tolerance, max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed
+//! [`SolveError`] out. Shared by both: the initial pressure (warm or cold start) and the
+//! summary of a converged state.
+
+use ndarray::{Array2, ArrayView2};
+
+use super::bccg::BccgScratch;
+use super::full_contact::FullContactThreshold;
+use super::preconditioner::FourierPreconditioner;
+use super::stiffness::StiffnessWork;
+use super::{
+    ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
+    SolverParams,
+};
+use crate::elastic::{Boundary, ElasticOperator};
+use crate::stop::Stop;
+use crate::surface::Surface;
+use crate::{memory, Error};
+
+/// What an iteration holds fixed (a force is turned into its mean pressure).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Target {
+    MeanPressure(f64),
+    Indentation(f64),
+}
+
+/// A contact solver for one surface: owns the elastic operator (plans,
+/// kernel spectrum, buffers) and the fields, so successive solves allocate nothing and
+/// start from the previous pressure.
+pub struct ContactSolver {
+    pub(super) operator: ElasticOperator,
+    pub(super) rows: usize,
+    pub(super) cols: usize,
+    /// Indenter profile `f = max(h) − h ≥ 0`, row-major.
+    pub(super) profile: Vec<f64>,
+    /// rms height about the mean (1 for a flat surface), the residual's scale.
+    pub(super) height_scale: f64,
+    pub(super) params: SolverParams,
+    pub(super) pressure: Vec<f64>,
+    /// `u` during an iteration, the gap `g` after a solve.
+    pub(super) gap: Vec<f64>,
+    pub(super) direction: Vec<f64>,
+    pub(super) response: Vec<f64>,
+    /// The last solved state, if any (its pressure is in `pressure`).
+    pub(super) solved: Option<ContactSummary>,
+    /// Where the surface comes into full contact (computed once per surface, when first
+    /// needed).
+    pub(super) full_contact: Option<FullContactThreshold>,
+    /// The fields of the frozen-set CG and of the free-boundary full-contact threshold,
+    /// allocated on first use (their own: a stiffness or a threshold never touches the
+    /// solved state).
+    pub(super) stiffness_work: Option<StiffnessWork>,
+    /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG.
+    pub(super) preconditioner: FourierPreconditioner,
+    /// The BCCG's own fields.
+    pub(super) bccg_scratch: BccgScratch,
+    /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
+    pub(super) stop: Stop,
+}
+
+/// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
+/// `profile` and returns its rms, the scale of the solver's height tolerances.
+fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
+    let heights = surface.heights();
+    let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+    profile.clear();
+    profile.extend(heights.iter().map(|&h| top - h));
+    let n = profile.len() as f64;
+    let mean = profile.iter().sum::<f64>() / n;
+    let rms = (profile.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n).sqrt();
+    if rms > 0.0 {
+        rms
+    } else {
+        1.0
+    }
+}
+
+impl ContactSolver {
+    /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
+    /// overflow): the operator, the preconditioner, five fields, the four BCCG fields and their
+    /// mask, the four stiffness and full-contact fields (periodic: three more for the
+    /// coarse correction of displacement control). The caller's [`Surface`] (one more
+    /// `rows × cols` field while the solver is built) is not included.
+    pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
+        // Periodic grids add the coarse correction's two fields and its mask (`mean_gap.rs`).
+        let count = if boundary == Boundary::Periodic {
+            17
+        } else {
+            14
+        };
+        let fields = memory::array_bytes(&[count, rows, cols], 8)?;
+        ElasticOperator::memory_bytes(rows, cols, boundary)?
+            .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
+            .checked_add(fields)
+    }
+
+    /// Plans a solver for `surface` on `half_space`; validates `params`, refuses grids that
+    /// would not fit in memory.
+    pub fn new(
+        surface: &Surface,
+        half_space: HalfSpace,
+        params: SolverParams,
+    ) -> Result<Self, SolveError> {
+        validate_params(&params)?;
+        let (rows, cols) = surface.dim();
+        memory::ensure_fits(
+            &format!(
+                "a BEM solver for a {rows}x{cols} grid ({} boundaries)",
+                half_space.boundary.name()
+            ),
+            Self::memory_bytes(rows, cols, half_space.boundary),
+        )?;
+        let operator = ElasticOperator::with_spacings(
+            rows,
+            cols,
+            surface.spacing(),
+            surface.spacing_y(),
+            half_space.modulus,
+            half_space.boundary,
+        )?;
+        let preconditioner = FourierPreconditioner::new(
+            rows,
+            cols,
+            surface.spacing(),
+            surface.spacing_y(),
+            half_space.modulus,
+        )?;
+        let mut operator = operator;
+        let bccg_scratch = BccgScratch::new(&mut operator);
+        let mut profile = Vec::with_capacity(rows * cols);
+        let height_scale = fill_profile(surface, &mut profile);
+        let len = rows * cols;
+        Ok(ContactSolver {
+            operator,
+            rows,
+            cols,
+            profile,
+            height_scale,
+            params,
+            pressure: vec![0.0; len],
+            gap: vec![0.0; len],
+            direction: vec![0.0; len],
+            response: vec![0.0; len],
+            solved: None,
+            full_contact: None,
+            stiffness_work: None,
+            preconditioner,
+            bccg_scratch,
+            stop: Stop::new(),
+        })
+    }
+
+    /// The solver with `stop` as its stop flag (builder form of
+    /// [`ContactSolver::set_stop`]).
+    pub fn with_stop(mut self, stop: Stop) -> Self {
+        self.set_stop(stop);
+        self
+    }
+
+    /// Polls `stop` from now on: once it is requested, every solve, stiffness or threshold
+    /// computation ends within one iteration with [`SolveError::Interrupted`], and keeps
+    /// doing so until the flag is cleared. An interrupted solve leaves no state behind (the
+    /// next solve starts cold, exactly as a new solver's); an interrupted stiffness or
+    /// threshold keeps the solved state. A solver starts with a flag of its own that
+    /// nothing sets.
+    pub fn set_stop(&mut self, stop: Stop) {
+        self.stop = stop;
+    }
+
+    /// The stop flag polled by this solver (a clone shares it).
+    pub fn stop(&self) -> &Stop {
+        &self.stop
+    }
+
+    /// [`SolveError::Interrupted`] after `iterations` if a stop is requested.
+    #[inline]
+    pub(super) fn check_stop(&self, iterations: usize) -> Result<(), SolveError> {
+        if self.stop.is_requested() {
+            Err(SolveError::Interrupted { iterations })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Swaps in another surface with the same grid and spacing, keeping the operator (FFT
+    /// plans, kernel spectrum) and all buffers: how an ensemble solves many realisations.
+    /// The next solve starts cold, exactly as with a new solver.
+    pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
+        if surface.dim() != (self.rows, self.cols)
+            || surface.spacing() != self.operator.spacing()
+            || surface.spacing_y() != self.operator.spacing_y()
+        {
+            return Err(Error::invalid(
+                "surface",
+                format!(
+                    "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
+                    self.rows,
+                    self.cols,
+                    self.operator.spacing(),
+                    self.operator.spacing_y(),
+                    surface.dim(),
+                    surface.spacing(),
+                    surface.spacing_y()
+                ),
+            )
+            .into());
+        }
+        self.height_scale = fill_profile(surface, &mut self.profile);
+        self.pressure.fill(0.0);
+        self.solved = None;
+        self.full_contact = None;
+        Ok(())
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Replaces the parameters (validated).
+    pub fn set_params(&mut self, params: SolverParams) -> Result<(), SolveError> {
+        validate_params(&params)?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// `(rows, cols)` of the grid.
+    pub fn dim(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+
+    /// Nominal (projected) area `rows · cols · Δx · Δy`.
+    pub fn nominal_area(&self) -> f64 {
+        // Multiplied in this order so that square pixels give today's value bit for bit.
+        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
+    }
+
+    /// Forgets the previous solution: the next solve starts cold.
+    pub fn reset(&mut self) {
+        self.solved = None;
+    }
+
+    /// The last solved state's scalars, if any.
+    pub fn summary(&self) -> Option<ContactSummary> {
+        self.solved
+    }
+
+    /// Solves the contact under `control`, starting from the previous solution when there
+    /// is one (warm start). Fields of the result: [`ContactSolver::pressure`],
+    /// [`ContactSolver::gap`], [`ContactSolver::state`].
+    pub fn solve(&mut self, control: Control) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let target = match control {
+            Control::MeanPressure(p) => Target::MeanPressure(check_load("mean pressure", p)?),
+            Control::Force(f) => {
+                Target::MeanPressure(check_load("force", f)? / self.nominal_area())
+            }
+            Control::Indentation(d) => {
+                if !(d.is_finite() && d >= 0.0) {
+                    return Err(Error::invalid(
+                        "indentation",
+                        format!("must be finite and >= 0, got {d}"),
+                    )
+                    .into());
+                }
+                Target::Indentation(d)
+            }
+        };
+        let periodic = self.operator.boundary() == Boundary::Periodic;
+        if periodic {
+            // Exact thresholds, known before solving: the mean pressure max(K⁺f) and, with
+            // displacements of zero mean, the indentation mean(f).
+            let full = self.periodic_full_contact();
+            let beyond = match target {
+                Target::MeanPressure(p) => p >= full.mean_pressure,
+                // The mean gap mean(f) − d within the rounding of the sum mean(f) (n ulps)
+                // is no gap: full contact.
+                Target::Indentation(d) => full.indentation.is_some_and(|d_full| {
+                    d >= d_full * (1.0 - self.profile.len() as f64 * f64::EPSILON)
+                }),
+            };
+            if beyond {
+                self.solved = None;
+                return Err(self.beyond_full_contact(control));
+            }
+        }
+        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
+        let result = match (self.params.solver, target) {
+            (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
+                self.bccg_periodic_indentation(d)
+            }
+            (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
+            (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
+        };
+        match result {
+            // Every point in contact, under load or displacement control: no contact
+            // problem is left; refused with the threshold (free boundaries: only known
+            // from the solution, periodic: checked above, this is rounding at p ≈ p*).
+            Ok((summary, _)) if summary.contact_points == self.rows * self.cols => {
+                self.solved = None;
+                return Err(self.beyond_full_contact(control));
+            }
+            Ok((summary, _)) => self.solved = Some(summary),
+            Err(_) => self.solved = None,
+        }
+        result
+    }
+
+    /// The error for a `requested` load or indentation that closes the gap everywhere, with
+    /// the threshold in the same quantity where it is known.
+    fn beyond_full_contact(&mut self, requested: Control) -> SolveError {
+        let threshold = match self.operator.boundary() {
+            Boundary::Periodic => Some(self.periodic_full_contact()),
+            Boundary::Free => self.free_full_contact().ok(),
+        };
+        let full_contact = threshold.and_then(|t| match requested {
+            Control::MeanPressure(_) => Some(t.mean_pressure),
+            Control::Force(_) => Some(t.mean_pressure * self.nominal_area()),
+            Control::Indentation(_) => t.indentation,
+        });
+        SolveError::BeyondFullContact {
+            requested,
+            full_contact,
+        }
+    }
+
+    /// Pressure of the last solve, `rows × cols`.
+    pub fn pressure(&self) -> ArrayView2<'_, f64> {
+        ArrayView2::from_shape((self.rows, self.cols), &self.pressure)
+            .expect("buffer has the grid's shape")
+    }
+
+    /// Gap of the last solve, `rows × cols` (≥ 0, zero on the contact set).
+    pub fn gap(&self) -> ArrayView2<'_, f64> {
+        ArrayView2::from_shape((self.rows, self.cols), &self.gap)
+            .expect("buffer has the grid's shape")
+    }
+
+    /// The last solved state with owned copies of its fields; the displacement is computed
+    /// afresh (one operator application). `None` before a successful solve.
+    pub fn state(&mut self) -> Option<ContactState> {
+        let summary = self.solved?;
+        let mut displacement = Array2::zeros((self.rows, self.cols));
+        let out = displacement
+            .as_slice_mut()
+            .expect("a fresh array is contiguous");
+        self.operator.apply(&self.pressure, out);
+        Some(ContactState {
+            summary,
+            pressure: self.pressure().to_owned(),
+            gap: self.gap().to_owned(),
+            displacement,
+        })
+    }
+
+    /// Where a periodic surface comes into full contact. Mean pressure: with `K p = d − f`
+    /// everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)` (Westergaard's
+    /// `p* = π E* Δ / λ` for a sinusoid). Indentation: `K p` has zero mean, so
+    /// `d = mean(f) = max(h) − mean(h)`; below it some gap stays open (`d` is the mean of
+    /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface; uses
+    /// the direction buffer.
+    pub(super) fn periodic_full_contact(&mut self) -> FullContactThreshold {
+        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
+            return full;
+        }
+        if self
+            .operator
+            .apply_pseudo_inverse(&self.profile, &mut self.direction)
+            .is_err()
+        {
+            // Free boundaries have no spectral inverse (callers check the boundary).
+            return FullContactThreshold {
+                mean_pressure: f64::INFINITY,
+                indentation: None,
+            };
+        }
+        let mean_pressure = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
+        let indentation = self.profile.iter().sum::<f64>() / self.profile.len() as f64;
+        let full = FullContactThreshold {
+            mean_pressure,
+            indentation: Some(indentation),
+        };
+        self.full_contact = Some(full);
+        full
+    }
+
+    /// Initial pressure: the previous solution (rescaled to the new load) or a cold start
+    /// (uniform pressure under load control; local springs `max(d − f, 0)/K₀₀` under
+    /// displacement control).
+    pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
+        let n = (self.rows * self.cols) as f64;
+        let warm = self.solved.is_some();
+        match target {
+            Target::MeanPressure(mean_pressure) => {
+                let current = self.pressure.iter().sum::<f64>() / n;
+                if warm && current > 0.0 {
+                    let scale = mean_pressure / current;
+                    self.pressure.iter_mut().for_each(|p| *p *= scale);
+                } else {
+                    self.pressure.fill(mean_pressure);
+                }
+            }
+            Target::Indentation(d) => {
+                let any = self.pressure.iter().any(|&p| p > 0.0);
+                if !(warm && any) {
+                    for (p, f) in self.pressure.iter_mut().zip(&self.profile) {
+                        *p = (d - f).max(0.0) / self_influence;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Scalars of the converged state; the gap buffer is cleaned to `g ≥ 0`, zero on the
+    /// contact set (its residual there is below the tolerance).
+    pub(super) fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
+        for (g, p) in self.gap.iter_mut().zip(&self.pressure) {
+            *g = if *p > 0.0 { 0.0 } else { g.max(0.0) };
+        }
+        let n = self.rows * self.cols;
+        let mean_pressure = self.pressure.iter().sum::<f64>() / n as f64;
+        ContactSummary {
+            mean_pressure,
+            force: mean_pressure * self.nominal_area(),
+            indentation,
+            area_fraction: contact_points as f64 / n as f64,
+            contact_points,
+        }
+    }
+}
+
+fn check_load(name: &'static str, value: f64) -> Result<f64, SolveError> {
+    Ok(crate::positive_finite(name, value, "")?)
+}
+
+fn validate_params(params: &SolverParams) -> Result<(), SolveError> {
+    Ok(params.validate()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::polonsky_keer::tests::rough_grid;
+    use super::*;
+
+    #[test]
+    fn thresholds_keep_the_solved_state_and_its_stiffness() {
+        // The full-contact threshold and its lower bound work in their own fields: after
+        // them the frozen-set stiffness of the last solve is still there, bit for bit, and
+        // so are the pressure and gap.
+        let surface = rough_grid(40, 48, 4);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary,
+            };
+            let mut solver =
+                ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            solver.solve(Control::MeanPressure(0.02)).unwrap();
+            let (pressure, gap) = (solver.pressure().to_owned(), solver.gap().to_owned());
+            let before = solver.frozen_set_stiffness().unwrap();
+            assert!(before.0 > 0.0);
+            let full = solver.full_contact_threshold().unwrap();
+            assert!(full.mean_pressure > 0.02, "{boundary:?}");
+            assert_eq!(
+                solver.frozen_set_stiffness().unwrap(),
+                before,
+                "{boundary:?}"
+            );
+            solver.full_contact_lower_bound().unwrap();
+            assert_eq!(
+                solver.frozen_set_stiffness().unwrap(),
+                before,
+                "{boundary:?}"
+            );
+            assert_eq!(solver.pressure(), pressure);
+            assert_eq!(solver.gap(), gap);
+        }
+    }
+}
