@@ -1,5 +1,5 @@
 //! 3D boundary-element contact of a rigid rough indenter on an elastic half-space
-//! (the paper, *Methods*, "BEM calculations"; `shared/SCIENCE.md` §2).
+//! (the paper, *Methods*, "BEM calculations"; Pohrt & Popov, Sci. Rep. 3, 3293, 2013).
 //!
 //! * **Problem**: a [`Surface`](crate::surface::Surface) (heights positive up) is pressed
 //!   into a half-space of effective modulus E* with [`Boundary::Free`] or
