@@ -15,8 +15,9 @@
 //! different study is refused ([`Error::ForeignCheckpoint`], naming the parameters that
 //! differ) unless `discard` is set. The same study over other grids, H values or sample
 //! counts is no different study: it is extended, every task it shares with the stored one
-//! keeping its checkpoint (a finished task whose sample count changed is computed again:
-//! its sample curves are not kept). A folder whose `study.json` names another study but
+//! keeping its checkpoint (a finished BEM task whose sample count changed continues from
+//! its kept sample curves; a finished MDR task, whose curves are not kept, is computed
+//! again). A folder whose `study.json` names another study but
 //! whose checkpoints hold no sample (a study that stopped before its first checkpoint) is
 //! free and reused.
 //!
@@ -532,8 +533,8 @@ impl StudyDir {
     /// * `Ok(false)` when it is new or holds the same study (which then resumes; each
     ///   checkpoint is still checked against its task's identity when read), or the same
     ///   study over other grids N, H values or sample count (which is extended: the tasks
-    ///   in both keep their checkpoints; a finished task whose sample count changed is
-    ///   computed again, its sample curves not being kept);
+    ///   in both keep their checkpoints; a finished BEM task whose sample count changed
+    ///   continues from its kept sample curves, a finished MDR task is computed again);
     /// * `Ok(true)` when its checkpoints are to be cleared first: it holds another study
     ///   (or a corrupt `study.json`, or checkpoints without one) and `discard` is set, or
     ///   its `study.json` names another study but no checkpoint holds a sample (that study
@@ -914,12 +915,15 @@ impl StudyDir {
                 Ok(Restored::Done(result))
             }
             // Samples saved beyond a gap are left out: the serial run computes in index
-            // order (they are computed again, to the same bits).
-            Some(Checkpoint::InProgress { mut samples, .. }) => {
+            // order (they are computed again, to the same bits). A finished task that kept
+            // its sample curves (BEM) and now has another sample count continues from them:
+            // sample i depends only on the seed and i, so the result is that of a fresh run.
+            Some(Checkpoint::InProgress { mut samples, .. })
+            | Some(Checkpoint::Done { mut samples, .. }) => {
                 samples.truncate(self.spec.samples);
                 Ok(Restored::Partial(samples))
             }
-            _ => Ok(Restored::Partial(Vec::new())),
+            None => Ok(Restored::Partial(Vec::new())),
         }
     }
 
@@ -943,7 +947,14 @@ impl StudyDir {
                     }
                 }
             }
-            _ => {}
+            // A finished task kept with another sample count continues from its curves
+            // (as in [`StudyDir::restore`]).
+            Some(Checkpoint::Done { samples, .. }) => {
+                for (slot, sample) in slots.iter_mut().zip(samples) {
+                    *slot = Some(sample);
+                }
+            }
+            None => {}
         }
         Ok(Received::Partial(slots))
     }
@@ -1036,6 +1047,51 @@ mod tests {
             }
         }
         assert!(StudyDir::read(tempfile::tempdir().unwrap().path()).is_err());
+    }
+
+    #[test]
+    fn a_finished_bem_task_grows_from_its_kept_curves_to_a_fresh_runs_result() {
+        let spec = |samples| StudySpec {
+            method: Method::Bem,
+            sizes: vec![16],
+            hursts: vec![0.5],
+            samples,
+            rolloff: None,
+            seed: 5,
+            window: FitWindow::default(),
+            levels: 16,
+        };
+        let (small, grown) = (spec(3), spec(5));
+        let task = small.tasks()[0];
+        let dir = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(dir.path(), &small, false).unwrap();
+        run_any_task(&small, task, &store, &|_, _| {}).unwrap();
+        drop(store);
+        let kept = StudyDir::read(dir.path())
+            .unwrap()
+            .stored_samples(task)
+            .unwrap();
+        let store = StudyDir::open(dir.path(), &grown, false).unwrap();
+        match store.restore(task).unwrap() {
+            Restored::Partial(samples) => assert_eq!(samples, kept, "the 3 kept curves"),
+            Restored::Done(_) => panic!("a task of 3 samples is not done at 5"),
+        }
+        let grown_result = run_any_task(&grown, task, &store, &|_, _| {}).unwrap();
+        let fresh_dir = tempfile::tempdir().unwrap();
+        let fresh = StudyDir::open(fresh_dir.path(), &grown, false).unwrap();
+        assert_eq!(
+            run_any_task(&grown, task, &fresh, &|_, _| {}).unwrap(),
+            grown_result
+        );
+        // Shrinking takes the first samples: again a fresh run's result.
+        let store = StudyDir::open(dir.path(), &small, false).unwrap();
+        let shrunk = run_any_task(&small, task, &store, &|_, _| {}).unwrap();
+        let fresh_dir = tempfile::tempdir().unwrap();
+        let fresh = StudyDir::open(fresh_dir.path(), &small, false).unwrap();
+        assert_eq!(
+            run_any_task(&small, task, &fresh, &|_, _| {}).unwrap(),
+            shrunk
+        );
     }
 
     #[test]
