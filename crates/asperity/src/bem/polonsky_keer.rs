@@ -712,12 +712,22 @@ pub(super) mod tests {
             ..SolverParams::default()
         };
         let mut solver = ContactSolver::new(&surface, free(), params).unwrap();
-        match solver.solve(Control::MeanPressure(0.01)) {
+        assert_no_convergence(&mut solver, Control::MeanPressure(0.01), &params);
+    }
+
+    /// `control` stops at the iteration limit with `NoConvergence` (the iterations and a
+    /// finite residual above the tolerance) and leaves no solved state behind.
+    pub(crate) fn assert_no_convergence(
+        solver: &mut ContactSolver,
+        control: Control,
+        params: &SolverParams,
+    ) {
+        match solver.solve(control) {
             Err(SolveError::NoConvergence {
                 iterations,
                 residual,
             }) => {
-                assert_eq!(iterations, 3);
+                assert_eq!(iterations, params.max_iterations);
                 assert!(residual > params.tolerance && residual.is_finite());
             }
             other => panic!("expected NoConvergence, got {other:?}"),

@@ -286,11 +286,11 @@ pub fn quantile(values: &[f64], q: f64) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Synthetic curve k = c F^a with fraction ∝ F (like a GW-type law).
-    fn synthetic(a: f64, c: f64, points_total: usize) -> SampleCurve {
+    pub(crate) fn synthetic(a: f64, c: f64, points_total: usize) -> SampleCurve {
         let points = (0..200)
             .map(|i| {
                 let force = 10f64.powf(-6.0 + 6.0 * i as f64 / 199.0);

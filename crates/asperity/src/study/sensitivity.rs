@@ -130,26 +130,7 @@ pub fn study_sensitivity(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::curve::CurvePoint;
-
-    /// k = c F^a on a grid of `points_total`, contact fraction ∝ F (as in `curve`'s tests).
-    fn power_law(a: f64, c: f64, points_total: usize) -> SampleCurve {
-        let points = (0..120)
-            .map(|i| {
-                let force = 10f64.powf(-6.0 + 6.0 * i as f64 / 119.0);
-                CurvePoint {
-                    fraction: (force * 0.5).min(1.0),
-                    force,
-                    stiffness: c * force.powf(a),
-                }
-            })
-            .collect();
-        SampleCurve {
-            points_total,
-            points,
-            piecewise_constant: false,
-        }
-    }
+    use crate::study::curve::tests::synthetic as power_law;
 
     #[test]
     fn an_exact_power_law_gives_its_exponent_in_every_window_with_a_zero_width_interval() {
