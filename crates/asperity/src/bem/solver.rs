@@ -400,6 +400,9 @@ impl ContactSolver {
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
         let n = (self.rows * self.cols) as f64;
         let warm = self.solved.is_some();
+        if self.predict_from_tangent(target) {
+            return;
+        }
         match target {
             Target::MeanPressure(mean_pressure) => {
                 let current = self.pressure.iter().sum::<f64>() / n;

@@ -22,7 +22,7 @@
 
 use super::full_contact::FullContactThreshold;
 use super::preconditioner::FourierPreconditioner;
-use super::solver::ContactSolver;
+use super::solver::{ContactSolver, Target};
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::stop::Stop;
@@ -48,6 +48,11 @@ pub(super) struct StiffnessWork {
     response: Vec<f64>,
     /// `K⁻¹f` of the full-contact threshold.
     profile_pressure: Vec<f64>,
+    /// The indices of the set, ascending (capacity: the grid).
+    set: Vec<usize>,
+    /// Whether `x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
+    /// tangent `dp/dd` of its pressure), not yet used by a solve.
+    tangent: bool,
 }
 
 impl StiffnessWork {
@@ -59,28 +64,25 @@ impl StiffnessWork {
             direction: vec![0.0; len],
             response: vec![0.0; len],
             profile_pressure: vec![0.0; len],
+            set: Vec::with_capacity(len),
+            tangent: false,
         }
     }
 }
 
-/// `z = P_S M P_S r` (zero off the set).
+/// `z = M r` (read on the set only: the CG never uses `z` off it); returns `rᵀz` on the
+/// set, summed in index order.
 fn precondition_on_set(
     preconditioner: &mut FourierPreconditioner,
-    in_set: &impl Fn(usize) -> bool,
+    set: &[usize],
     residual: &[f64],
     z: &mut [f64],
 ) -> f64 {
     z.copy_from_slice(residual);
     preconditioner.apply(z);
-    let mut rz = 0.0;
-    for i in 0..z.len() {
-        if in_set(i) {
-            rz += residual[i] * z[i];
-        } else {
-            z[i] = 0.0;
-        }
-    }
-    rz
+    set.iter()
+        .map(|&i| residual[i] * z[i])
+        .fold(0.0, |a, b| a + b)
 }
 
 /// When a CG stops: at `tolerance` relative residual, after `max_iterations`, or when `stop`
@@ -95,14 +97,14 @@ struct Limits<'a> {
 /// `x = 0`, `r = b` on the set (zero off it); returns `‖b‖²`.
 fn start_on_set(
     (x, residual): (&mut [f64], &mut [f64]),
-    in_set: &impl Fn(usize) -> bool,
+    set: &[usize],
     rhs: RightHandSide<'_>,
 ) -> f64 {
+    x.fill(0.0);
+    residual.fill(0.0);
     let mut rr = 0.0;
-    for i in 0..x.len() {
-        x[i] = 0.0;
+    for &i in set {
         let b = match rhs {
-            _ if !in_set(i) => 0.0,
             RightHandSide::Ones => 1.0,
             RightHandSide::Values(v) => v[i],
         };
@@ -141,35 +143,29 @@ fn finished(
 /// One CG step on the set: `w = K s`, `α = rz / sᵀw`, `x += α s`, `r −= α w`; returns the
 /// new `‖r‖²`, or `None` when the curvature `sᵀw` or `rz` is not positive (`K_SS` and
 /// `M_SS` are positive definite: round-off only).
-fn step_on_set(
-    operator: &mut ElasticOperator,
-    in_set: &impl Fn(usize) -> bool,
-    work: &mut StiffnessWork,
-    rz: f64,
-) -> Option<f64> {
+fn step_on_set(operator: &mut ElasticOperator, work: &mut StiffnessWork, rz: f64) -> Option<f64> {
     let StiffnessWork {
         x,
         residual,
         direction,
         response,
+        set,
         ..
     } = work;
     operator.apply(direction, response);
-    let curvature: f64 = (0..x.len())
-        .filter(|&i| in_set(i))
-        .map(|i| direction[i] * response[i])
-        .sum();
+    let curvature = set
+        .iter()
+        .map(|&i| direction[i] * response[i])
+        .fold(0.0, |a, b| a + b);
     if !(curvature > 0.0 && rz > 0.0) {
         return None;
     }
     let alpha = rz / curvature;
     let mut rr = 0.0;
-    for i in 0..x.len() {
-        if in_set(i) {
-            x[i] += alpha * direction[i];
-            residual[i] -= alpha * response[i];
-            rr += residual[i] * residual[i];
-        }
+    for &i in set.iter() {
+        x[i] += alpha * direction[i];
+        residual[i] -= alpha * response[i];
+        rr += residual[i] * residual[i];
     }
     Some(rr)
 }
@@ -178,6 +174,8 @@ fn step_on_set(
 /// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
 /// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
 /// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual). The result is in `work.x`.
+/// Every pass but the two transforms visits the set's points only (listed once, in index
+/// order, so that every sum adds the same terms in the same order as a full pass would).
 fn conjugate_gradient_on_set(
     operator: &mut ElasticOperator,
     preconditioner: &mut FourierPreconditioner,
@@ -186,15 +184,22 @@ fn conjugate_gradient_on_set(
     work: &mut StiffnessWork,
     limits: Limits<'_>,
 ) -> Result<SolveInfo, SolveError> {
-    let mut rr = start_on_set((&mut work.x, &mut work.residual), &in_set, rhs);
+    let n = work.x.len();
+    work.set.clear();
+    work.set.extend((0..n).filter(|&i| in_set(i)));
+    let mut rr = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
     let b_norm = rr.sqrt();
     let mut rz = precondition_on_set(
         preconditioner,
-        &in_set,
+        &work.set,
         &work.residual,
         &mut work.preconditioned,
     );
-    work.direction.copy_from_slice(&work.preconditioned);
+    // The direction is zero off the set (the operator reads all of it).
+    work.direction.fill(0.0);
+    for &i in &work.set {
+        work.direction[i] = work.preconditioned[i];
+    }
     let mut iterations = 0;
     loop {
         let relative = if b_norm > 0.0 {
@@ -206,24 +211,20 @@ fn conjugate_gradient_on_set(
             return end;
         }
         iterations += 1;
-        rr = step_on_set(operator, &in_set, work, rz).ok_or(SolveError::NoConvergence {
+        rr = step_on_set(operator, work, rz).ok_or(SolveError::NoConvergence {
             iterations,
             residual: relative,
         })?;
         let rz_new = precondition_on_set(
             preconditioner,
-            &in_set,
+            &work.set,
             &work.residual,
             &mut work.preconditioned,
         );
         let beta = rz_new / rz;
-        for (i, (s, &z)) in work
-            .direction
-            .iter_mut()
-            .zip(&work.preconditioned)
-            .enumerate()
-        {
-            *s = if in_set(i) { z + beta * *s } else { 0.0 };
+        let (direction, z) = (&mut work.direction, &work.preconditioned);
+        for &i in &work.set {
+            direction[i] = z[i] + beta * direction[i];
         }
         rz = rz_new;
     }
@@ -275,8 +276,50 @@ impl ContactSolver {
         );
         let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
+        work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
         result.map(|info| (stiffness, info))
+    }
+
+    /// The continuation predictor of a warm start: if the last frozen-set stiffness left
+    /// the tangent `x = dp/dd = K_SS⁻¹ 1_S` of the solved state (and no solve used it
+    /// yet), `p ← max(p + Δd x, 0)` with `Δd` the step to `target` (load control: the
+    /// step that carries `Σ p` to the load, then `p` rescaled to it exactly). Exact for the
+    /// next state as long as the contact set does not change, far closer than the
+    /// previous pressure where it does. Returns whether it predicted; the tangent is used
+    /// up either way (the solve replaces the state it belongs to).
+    pub(super) fn predict_from_tangent(&mut self, target: Target) -> bool {
+        let Some(work) = self.stiffness_work.as_mut() else {
+            return false;
+        };
+        let (Some(solved), true) = (self.solved, std::mem::take(&mut work.tangent)) else {
+            return false;
+        };
+        let n = self.pressure.len() as f64;
+        let step = match target {
+            Target::MeanPressure(mean_pressure) => {
+                let x_sum: f64 = work.x.iter().sum();
+                let p_sum: f64 = self.pressure.iter().sum();
+                if !crate::is_positive_finite(x_sum) {
+                    return false;
+                }
+                (mean_pressure * n - p_sum) / x_sum
+            }
+            Target::Indentation(d) => d - solved.indentation,
+        };
+        let mut total = 0.0;
+        for (p, &x) in self.pressure.iter_mut().zip(&work.x) {
+            *p = (*p + step * x).max(0.0);
+            total += *p;
+        }
+        if let Target::MeanPressure(mean_pressure) = target {
+            if !crate::is_positive_finite(total) {
+                return false;
+            }
+            let scale = mean_pressure * n / total;
+            self.pressure.iter_mut().for_each(|p| *p *= scale);
+        }
+        true
     }
 
     /// `dF/dd` by central differences around `control`: two solves at `control·(1 ± step)`
@@ -312,6 +355,8 @@ impl ContactSolver {
         }
         let n = self.rows * self.cols;
         let mut work = self.stiffness_work();
+        // The threshold's CGs overwrite the frozen-set solution.
+        work.tangent = false;
         let (tolerance, max_iterations) = (
             self.params.stiffness_tolerance,
             self.params.stiffness_max_iterations,
