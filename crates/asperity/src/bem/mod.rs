@@ -20,7 +20,8 @@
 //!   conjugate gradients (Wear 231, 206–219, 1999; [`SolverKind::PolonskyKeer`],
 //!   `polonsky_keer.rs`) stay selectable as the reference. The solver owns the operator, its
 //!   plans and every buffer, so one solver serves many loads, and it starts each solve from
-//!   the previous pressure (warm start). Periodic displacement control is a direct solve
+//!   the previous pressure (warm start), moved along the tangent `dp/dd` to the new load
+//!   when the frozen-set stiffness of the previous state computed it (`stiffness.rs`). Periodic displacement control is a direct solve
 //!   with the indentation (equivalently the mean gap `mean(f) − d`) fixed: the BCCG
 //!   preconditions the constant mode, which the periodic kernel does not see, by its exact
 //!   curvature on the free set (`mean_gap.rs`); Polonsky–Keer runs its own iteration with `d`

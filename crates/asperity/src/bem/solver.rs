@@ -394,7 +394,9 @@ impl ContactSolver {
         full
     }
 
-    /// Initial pressure: the previous solution (rescaled to the new load) or a cold start
+    /// Initial pressure: the continuation predictor when the last solve's frozen-set
+    /// stiffness left its tangent (`stiffness.rs`), else the previous solution (rescaled to
+    /// the new load) or a cold start
     /// (uniform pressure under load control; local springs `max(d − f, 0)/K₀₀` under
     /// displacement control).
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {

@@ -17,8 +17,15 @@
 //!
 //! Both CGs are preconditioned with the Fourier approximate inverse of the operator
 //! restricted to the set (`P_S M P_S`, [`super::preconditioner`]). Neither allocates after
-//! the first call: the set is tested inline (`p > 0`), and the CG works in fields of its own
-//! ([`StiffnessWork`]), so neither touches the solved state.
+//! the first call: the set is listed once per CG (its indices, in a field of capacity the
+//! grid) and every pass but the two transforms visits only its points, in index order, so
+//! the sums are those of a full pass; the CG works in fields of its own ([`StiffnessWork`]),
+//! so neither touches the solved state.
+//!
+//! The frozen-set solution `x = K_SS⁻¹ 1_S` is also the tangent `dp/dd` of the solved state
+//! along its contact set: the next warm solve starts from `p + Δd x`
+//! ([`ContactSolver::predict_from_tangent`], a continuation predictor), which is the next
+//! state exactly as long as the set does not change.
 
 use super::full_contact::FullContactThreshold;
 use super::preconditioner::FourierPreconditioner;
