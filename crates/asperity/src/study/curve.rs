@@ -179,7 +179,17 @@ pub struct EnsemblePoint {
 /// Mean curve over `samples` at `levels` log-spaced forces spanning the range that every
 /// sample covers (from the largest first force to the smallest last force).
 pub fn ensemble_curve(samples: &[SampleCurve], levels: usize) -> Result<Vec<EnsemblePoint>> {
-    let usable: Vec<&SampleCurve> = samples.iter().filter(|s| !s.points.is_empty()).collect();
+    let refs: Vec<&SampleCurve> = samples.iter().collect();
+    ensemble_curve_of(&refs, levels)
+}
+
+/// [`ensemble_curve`] of samples held by reference (a bootstrap resample repeats some).
+pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<EnsemblePoint>> {
+    let usable: Vec<&SampleCurve> = samples
+        .iter()
+        .copied()
+        .filter(|s| !s.points.is_empty())
+        .collect();
     if usable.is_empty() || levels < 2 {
         return Err(Error::invalid(
             "ensemble",
