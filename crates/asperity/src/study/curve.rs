@@ -10,7 +10,7 @@
 //! least a factor [`MIN_WINDOW_SPAN`] in contacts (so short lines and small grids keep
 //! about a decade in force). The default, 8 contacts to 1 %, was chosen by experiment on
 //! MDR lines of N = 2^15 (`samplers::tests::window_experiment`, `--ignored`; docs/mdr.md),
-//! within ±0.01 of theory there.
+//! within ±0.012 of theory there (ensemble fit).
 //!
 //! Within the window the curve is sampled at `levels` log-spaced forces, so that every
 //! decade of force weighs alike, and `ln k` is fitted on `ln F`: per sample between that
