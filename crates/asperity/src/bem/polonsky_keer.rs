@@ -58,7 +58,6 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let n = self.problem.rows * self.problem.cols;
         let load_control = matches!(target, Target::MeanPressure(_));
         let self_influence = self.problem.operator.self_influence();
         self.initialise(target, self_influence);
@@ -120,18 +119,26 @@ impl ContactSolver {
                 tau,
                 entry_step,
             );
-            conjugate = !entered;
+            // Pass E: the prescribed load (a reset pressure restarts the directions).
+            let kept = self.restore_load(target, total);
+            conjugate = !entered && kept;
+        }
+    }
 
-            // Pass E: the prescribed load.
-            if let Target::MeanPressure(mean_pressure) = target {
-                if total > 0.0 {
-                    let scale = mean_pressure * n as f64 / total;
-                    self.state.pressure.iter_mut().for_each(|v| *v *= scale);
-                } else {
-                    self.state.pressure.fill(mean_pressure);
-                    conjugate = false;
-                }
-            }
+    /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
+    /// sum `total` (or reset to uniform if nothing is left). False after a reset.
+    fn restore_load(&mut self, target: Target, total: f64) -> bool {
+        let Target::MeanPressure(mean_pressure) = target else {
+            return true;
+        };
+        let pressure = &mut self.state.pressure;
+        if total > 0.0 {
+            let scale = mean_pressure * pressure.len() as f64 / total;
+            pressure.iter_mut().for_each(|v| *v *= scale);
+            true
+        } else {
+            pressure.fill(mean_pressure);
+            false
         }
     }
 }

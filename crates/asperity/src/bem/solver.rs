@@ -1,17 +1,38 @@
 //! [`ContactSolver`]: the solver core shared by the iterations of [`crate::bem`].
 //!
-//! It holds the problem — the indenter profile `f = max(h) − h` of one surface and its
-//! height scale, the half-space (the [`ElasticOperator`] with its boundary) and the
-//! parameters — and the state of the last solve (pressure, gap, summary, the cached
-//! full-contact threshold), with every scratch field owned by the part that uses it: the
-//! BCCG's ([`super::bccg`], with the coarse correction of [`super::mean_gap`]), the
-//! Polonsky–Keer iteration's two fields (`direction`, `response`), and the frozen-set and
-//! full-contact CGs' ([`super::stiffness`]). [`ContactSolver::solve`] validates the
-//! control, refuses a periodic load or indentation beyond full contact before solving, and
-//! dispatches to the chosen iteration ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`,
-//! each `(target, tolerance, max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed
-//! [`SolveError`] out. Shared by both: the initial pressure (warm or cold start) and the
-//! summary of a converged state.
+//! A solver is made of named parts, each owned by one piece of code:
+//! * [`ContactProblem`] — what is solved: the indenter profile `f = max(h) − h` of one
+//!   surface and its height scale, the half-space (the [`ElasticOperator`], with its
+//!   boundary, spacings and modulus) and the grid. Only [`ContactSolver::set_surface`]
+//!   changes it; every other piece of code reads it (and applies its operator).
+//! * `SolverState` — the state of the last solve: pressure, gap, the solved summary and
+//!   the cached full-contact threshold. Its fields are written by the iterations only; the
+//!   stiffness and threshold code reads them and keeps them intact (and caches the
+//!   threshold).
+//! * One scratch struct per algorithm, in its own file and used by no other:
+//!   `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs`), `PkScratch`
+//!   (`polonsky_keer.rs`), `StiffnessWork` (`stiffness.rs`: the frozen-set CG and the
+//!   free-boundary threshold's CG) and `FullContactScratch` (`full_contact.rs`: the
+//!   periodic threshold and the lower bound). Scratch that not every solver needs is
+//!   allocated on first use and kept, so warm solves allocate nothing.
+//! * The settings ([`SolverParams`]), the Fourier preconditioner shared read-only by the
+//!   BCCG and the CGs, and the stop flag.
+//!
+//! [`ContactSolver::solve`] validates the control, refuses a periodic load or indentation
+//! beyond full contact before solving, and dispatches to the chosen iteration
+//! ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`, each `(target, tolerance,
+//! max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed [`SolveError`] out. Shared
+//! by both: the initial pressure (warm or cold start, `initialise`) and
+//! the summary of a converged state (`finish`).
+//!
+//! **Extending the core** (an adhesive or a plasticity-capped contact, say): put the new
+//! iteration in a file of its own with its scratch struct (`struct AdhesionScratch`), add
+//! one `Option<AdhesionScratch>` field to [`ContactSolver`] allocated on the iteration's
+//! first use (as `pk_scratch` is), a [`SolverKind`] variant dispatched in
+//! [`ContactSolver::solve`], and the fields to [`ContactSolver::memory_bytes`]. The
+//! iteration reads [`ContactProblem`], writes `SolverState` through `initialise`, its own
+//! loop and `finish`, and works in its own scratch only: no other algorithm's fields change
+//! meaning, and the stiffness and threshold code applies to its solved state unchanged.
 
 use ndarray::{Array2, ArrayView2};
 
@@ -138,7 +159,8 @@ impl ContactProblem {
 
 /// The state of the last solve: its fields and scalars, and the full-contact threshold of
 /// the surface once known. Written by the iterations (through [`ContactSolver::initialise`]
-/// and [`ContactSolver::finish`]); read, never written, by the stiffness and threshold code.
+/// and [`ContactSolver::finish`]); the stiffness and threshold code reads the fields and
+/// only caches the threshold.
 pub(super) struct SolverState {
     pub(super) pressure: Vec<f64>,
     /// `u` during an iteration, the gap `g` after a solve.
@@ -540,6 +562,68 @@ mod tests {
             );
             assert_eq!(solver.pressure(), pressure);
             assert_eq!(solver.gap(), gap);
+        }
+    }
+
+    #[test]
+    fn the_problem_is_the_surface_on_the_half_space() {
+        let (a, b) = (rough_grid(24, 40, 1), rough_grid(24, 40, 2));
+        let half_space = HalfSpace {
+            modulus: 1.7,
+            boundary: Boundary::Periodic,
+        };
+        let mut solver = ContactSolver::new(&a, half_space, SolverParams::default()).unwrap();
+        let profile_of = |surface: &Surface| {
+            let top = surface.heights().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+            surface.heights().mapv(|h| top - h)
+        };
+        let problem = solver.problem();
+        assert_eq!(problem.dim(), (24, 40));
+        assert_eq!(problem.half_space(), half_space);
+        assert_eq!(problem.spacings(), (a.spacing(), a.spacing_y()));
+        assert_eq!(problem.nominal_area(), solver.nominal_area());
+        assert_eq!(problem.profile(), profile_of(&a));
+        let before = problem.height_scale();
+        assert!(before > 0.0);
+        solver.set_surface(&b).unwrap();
+        assert_eq!(solver.problem().profile(), profile_of(&b));
+        assert_ne!(solver.problem().height_scale(), before);
+        // A surface on another grid is refused and leaves the problem as it was.
+        assert!(solver.set_surface(&rough_grid(24, 41, 1)).is_err());
+        assert_eq!(solver.problem().profile(), profile_of(&b));
+    }
+
+    #[test]
+    fn each_iteration_works_in_its_own_fields() {
+        // A solver that ran the other iteration (and the thresholds) first gives, from a
+        // cold start, the same bits as a fresh solver: no iteration reads what another
+        // left in its fields.
+        let surface = rough_grid(40, 48, 6);
+        let load = Control::MeanPressure(0.02);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary,
+            };
+            for (first, then) in [
+                (SolverKind::Bccg, SolverKind::PolonskyKeer),
+                (SolverKind::PolonskyKeer, SolverKind::Bccg),
+            ] {
+                let params = |solver| SolverParams {
+                    solver,
+                    ..SolverParams::default()
+                };
+                let mut fresh = ContactSolver::new(&surface, half_space, params(then)).unwrap();
+                let want = (fresh.solve(load).unwrap(), fresh.pressure().to_owned());
+                let mut used = ContactSolver::new(&surface, half_space, params(first)).unwrap();
+                used.solve(Control::MeanPressure(0.03)).unwrap();
+                used.full_contact_lower_bound().unwrap();
+                used.full_contact_threshold().unwrap();
+                used.set_params(params(then)).unwrap();
+                used.reset();
+                let got = (used.solve(load).unwrap(), used.pressure().to_owned());
+                assert_eq!(got, want, "{boundary:?}: {first:?} then {then:?}");
+            }
         }
     }
 }
