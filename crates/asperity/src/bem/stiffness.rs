@@ -231,7 +231,7 @@ fn conjugate_gradient_on_set(
 
 impl ContactSolver {
     fn stiffness_work(&mut self) -> StiffnessWork {
-        let n = self.rows * self.cols;
+        let n = self.problem.rows * self.problem.cols;
         self.stiffness_work
             .take()
             .unwrap_or_else(|| StiffnessWork::new(n))
@@ -241,7 +241,7 @@ impl ContactSolver {
     /// (see the module docs), with the CG's iterations and relative residual. Zero when
     /// nothing is in contact.
     pub fn frozen_set_stiffness(&mut self) -> Result<(f64, SolveInfo), SolveError> {
-        if self.solved.is_none() {
+        if self.state.solved.is_none() {
             return Err(Error::invalid("stiffness", "no solved contact state yet").into());
         }
         let (tolerance, max_iterations) = (
@@ -264,16 +264,19 @@ impl ContactSolver {
             max_iterations,
             stop: &self.stop,
         };
-        let pressure = &self.pressure;
+        let pressure = &self.state.pressure;
         let result = conjugate_gradient_on_set(
-            &mut self.operator,
+            &mut self.problem.operator,
             &mut self.preconditioner,
             |i| pressure[i] > 0.0,
             RightHandSide::Ones,
             &mut work,
             limits,
         );
-        let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
+        let (dx, dy) = (
+            self.problem.operator.spacing(),
+            self.problem.operator.spacing_y(),
+        );
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
         self.stiffness_work = Some(work);
         result.map(|info| (stiffness, info))
@@ -307,10 +310,10 @@ impl ContactSolver {
     /// contact (two CG solves on the full grid, see the module docs); computed once per
     /// surface. Works in the CG's own fields: the solved state is kept.
     pub(super) fn free_full_contact(&mut self) -> Result<FullContactThreshold, SolveError> {
-        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
+        if let Some(full) = self.state.full_contact.filter(|f| f.indentation.is_some()) {
             return Ok(full);
         }
-        let n = self.rows * self.cols;
+        let n = self.problem.rows * self.problem.cols;
         let mut work = self.stiffness_work();
         let (tolerance, max_iterations) = (
             self.params.stiffness_tolerance,
@@ -323,17 +326,17 @@ impl ContactSolver {
         };
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
-            &mut self.operator,
+            &mut self.problem.operator,
             &mut self.preconditioner,
             |_| true,
-            RightHandSide::Values(&self.profile),
+            RightHandSide::Values(&self.problem.profile),
             &mut work,
             limits,
         )
         .and_then(|_| {
             std::mem::swap(&mut work.x, &mut work.profile_pressure);
             conjugate_gradient_on_set(
-                &mut self.operator,
+                &mut self.problem.operator,
                 &mut self.preconditioner,
                 |_| true,
                 RightHandSide::Ones,
@@ -354,7 +357,7 @@ impl ContactSolver {
         });
         self.stiffness_work = Some(work);
         if let Ok(full) = result {
-            self.full_contact = Some(full);
+            self.state.full_contact = Some(full);
         }
         result
     }
