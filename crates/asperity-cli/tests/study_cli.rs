@@ -603,3 +603,96 @@ fn a_finished_study_grows_by_another_n_or_h_reusing_its_checkpoints() {
     let csv = std::fs::read_to_string(d.join("g/alpha.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5, "header and 4 tasks: {csv}");
 }
+
+/// The steepest log–log slope over one decade of force of `curve.csv`'s mean curve for
+/// one H, from 8 contacts on: a least-squares fit of ln k on ln F over every run of rows
+/// spanning at least a decade, written here independently of the library.
+fn steepest_slope_of_curve_csv(csv: &str, hurst: &str, points_total: f64) -> f64 {
+    let rows: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f[2] == hurst && f[8].parse::<f64>().unwrap() >= 8.0 / points_total)
+        .map(|f| (f[3].parse().unwrap(), f[4].parse().unwrap()))
+        .collect();
+    let mut best = f64::NEG_INFINITY;
+    for first in 0..rows.len() {
+        let Some(last) = (first + 2..rows.len()).find(|&j| rows[j].0 >= 10.0 * rows[first].0)
+        else {
+            break;
+        };
+        let pts: Vec<(f64, f64)> = rows[first..=last]
+            .iter()
+            .map(|&(f, k)| (f.ln(), k.ln()))
+            .collect();
+        let m = pts.len() as f64;
+        let (mx, my) = pts
+            .iter()
+            .fold((0.0, 0.0), |(a, b), p| (a + p.0 / m, b + p.1 / m));
+        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        best = best.max(sxy / sxx);
+    }
+    best
+}
+
+#[test]
+fn compare_writes_slopes_with_intervals_and_verdicts_and_refuses_unfinished_studies() {
+    let dir = tempfile::tempdir().unwrap();
+    ok(&asperity(
+        &[
+            "study",
+            "curve",
+            "--method",
+            "bem",
+            "--n",
+            "16",
+            "--hurst",
+            "0,2",
+            "--rolloff",
+            "4",
+            "--samples",
+            "3",
+            "--seed",
+            "1",
+            "--quiet",
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    ));
+    ok(&asperity(&["study", "compare", "s"], dir.path()));
+    let s = dir.path().join("s");
+    let curve = std::fs::read_to_string(s.join("curve.csv")).unwrap();
+    let csv = std::fs::read_to_string(s.join("comparison.csv")).unwrap();
+    let report = std::fs::read_to_string(s.join("report.md")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for (row, hurst) in rows.iter().zip(["0.0", "2.0"]) {
+        assert_eq!((row[0], row[3], row[7]), ("bem", "steepest_slope", "1.0"));
+        let num = |i: usize| row[i].parse::<f64>().unwrap();
+        let expected = steepest_slope_of_curve_csv(&curve, hurst, 256.0);
+        assert!((num(4) - expected).abs() < 1e-9, "{} vs {expected}", num(4));
+        // A bootstrap interval over 3 samples: not empty, and around the slope.
+        assert!(num(5) < num(6) && num(5) <= num(4) + 0.05 && num(6) >= num(4) - 0.05);
+        let line = format!("| bem | 16 | {} | steepest_slope | {:.3} |", num(2), num(4));
+        assert!(report.contains(&line), "{line} not in:\n{report}");
+    }
+    assert!(report.contains("asperity study compare"), "{report}");
+    refused(&asperity(&["study", "compare", "s"], dir.path()), "exists");
+    // One more sample asked for: the tasks are no longer finished.
+    let spec = std::fs::read_to_string(s.join("study.json")).unwrap();
+    std::fs::write(
+        s.join("study.json"),
+        spec.replace("\"samples\": 3", "\"samples\": 4"),
+    )
+    .unwrap();
+    refused(
+        &asperity(&["study", "compare", "s", "--force"], dir.path()),
+        "not finished",
+    );
+}

@@ -22,8 +22,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use asperity::fit::{steepest_power_law, student_t_975};
-use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity, TaskSensitivity};
+use asperity::fit::student_t_975;
+use asperity::study::sensitivity::{
+    self, sensitivity_windows, study_sensitivity, study_slopes, TaskSensitivity, TaskSlope,
+};
 use asperity::study::theory::{alpha_theory, alpha_white_noise};
 use asperity::study::{FitWindow, TaskResult};
 
@@ -122,23 +124,16 @@ fn alpha_row(r: &TaskResult, n: f64, reference: f64, source: &str) -> Option<Row
     })
 }
 
-/// The steepest log–log slope of a mean curve over one decade of force, from the
-/// window's first contacts on, and the contact fractions where it lies (Fig. 2: the
-/// stretch a reader of the plot calls "almost linear"; single pixels dominate before).
+/// The steepest log–log slope of a task's mean curve over one decade of force and the
+/// contact fractions where it lies ([`asperity::study::sensitivity::steepest_slope`]).
 pub fn steepest_slope(r: &TaskResult, window: &FitWindow) -> Option<(f64, f64, f64)> {
-    let first_contacts = window.min_contacts as f64 / (r.task.n * r.task.n) as f64;
-    let curve: Vec<_> = r
-        .mean_curve
-        .iter()
-        .filter(|p| p.fraction >= first_contacts)
-        .collect();
-    let (f, k): (Vec<f64>, Vec<f64>) = curve.iter().map(|p| (p.force, p.stiffness)).unzip();
-    let (fit, first, last) = steepest_power_law(&f, &k, 10.0)?;
-    Some((fit.exponent, curve[first].fraction, curve[last].fraction))
+    let s = sensitivity::steepest_slope(&r.mean_curve, window, r.task.n * r.task.n)?;
+    Some((s.slope, s.from_fraction, s.to_fraction))
 }
 
-/// The rows of a figure.
-pub fn rows(results: &Results) -> Vec<Row> {
+/// The rows of a figure; a Fig. 2 slope takes its interval from `slopes` (the bootstrap
+/// over the study's stored sample curves) where that has its task.
+pub fn rows(results: &Results, slopes: &[TaskSlope]) -> Vec<Row> {
     match results {
         Results::Fig1(all) => all
             .iter()
@@ -151,14 +146,18 @@ pub fn rows(results: &Results) -> Vec<Row> {
             .iter()
             .filter_map(|r| {
                 let (slope, _, _) = steepest_slope(r, window)?;
+                let (low, high) = slopes
+                    .iter()
+                    .find(|s| s.task == r.task && s.samples == r.samples)
+                    .map_or((slope, slope), |s| (s.low, s.high));
                 Some(Row {
                     method: r.method.name().to_string(),
                     n: r.task.n as f64,
                     hurst: r.task.hurst,
                     quantity: "steepest_slope".into(),
                     ours: slope,
-                    low: slope,
-                    high: slope,
+                    low,
+                    high,
                     reference: 1.0,
                     source: "paper: slope ≈ 1".into(),
                     tolerance: 0.1,
@@ -260,7 +259,13 @@ fn reason(row: &Row) -> String {
         _ => format!("finite grid ({}²)", row.n),
     };
     if row.quantity == "steepest_slope" {
-        return format!("{grid}: the paper's curves are on 1024²");
+        return if row.n < 1024.0 {
+            format!("{grid}: the paper's curves are on 1024²")
+        } else {
+            "the paper's grid: the paper reads \"≈ 1\" off its plot, this is the steepest \
+             decade of the mean curve"
+                .into()
+        };
     }
     if row.hurst > 0.0 && row.hurst <= 0.5 {
         return "crossover of eq. (24) and eq. (6) at H = 0: the theory's kink is sharp, \
@@ -448,13 +453,30 @@ pub fn window_table(found: &[TaskSensitivity]) -> Table {
 /// comparison rendered from the CSV, the N trend and the window sensitivity of its BEM
 /// study (folder `dir/bem`).
 pub fn write(dir: &Path, results: Results, report: &str, force: bool) -> Result<()> {
+    write_for_study(dir, &dir.join("bem"), results, report, force)
+}
+
+/// [`write`] with the BEM study in `study_dir` (its stored sample curves give the window
+/// sensitivity and the slopes' intervals).
+fn write_for_study(
+    dir: &Path,
+    study_dir: &Path,
+    results: Results,
+    report: &str,
+    force: bool,
+) -> Result<()> {
+    let slopes = match results {
+        Results::Fig2(..) if study_dir.join("study.json").is_file() => study_slopes(study_dir)?,
+        _ => Vec::new(),
+    };
     let path = dir.join("comparison.csv");
-    table(&rows(&results)).write(&path, force)?;
+    table(&rows(&results, &slopes)).write(&path, force)?;
     let text = asperity::input::read_text(&path, asperity::input::TEXT_MAX_BYTES)?;
     let rows = parse(&text)?;
     let mut md = format!(
         "{report}\n## Verdicts (generated from `comparison.csv`)\n\
-         Interval: the ensemble α ± t·s/√m over the m per-sample α (95 %); *agrees* when the \
+         Interval: the ensemble α ± t·s/√m over the m per-sample α (95 %; a steepest slope: \
+         2.5 – 97.5 % of 400 bootstrap resamples of the samples); *agrees* when the \
          paper's value lies inside it (widened by 0.1 for the paper's \"≈ 1\"); *close* when \
          outside it by at most {CLOSE} (the estimator's own accuracy, docs/mdr.md).\n\n{}",
         render(&rows)
@@ -469,9 +491,54 @@ pub fn write(dir: &Path, results: Results, report: &str, force: bool) -> Result<
          α refitted on the stored sample curves with windows starting at 4, 8, 16 contacts and \
          ending at 0.5, 1, 2 % contact (`window_sensitivity.csv`; also `asperity study \
          windows DIR/bem`); interval: bootstrap over samples.\n\n{}",
-        sensitivity(dir, &dir.join("bem"), force)?
+        sensitivity(dir, study_dir, force)?
     );
     super::figures::write_report(dir, &md, force)
+}
+
+/// `asperity study compare DIR`: the finished study in `dir` beside the paper —
+/// `comparison.csv` and `report.md` in `dir`. A study with roll-off is compared like Fig. 2
+/// (steepest slope against "≈ 1"), one without like Fig. 1 (α against eqs. (6), (24)).
+pub fn compare_study(dir: &Path, force: bool) -> Result<()> {
+    use asperity::study::{Restored, StudyDir};
+    let store = StudyDir::read(dir)?;
+    let spec = store.spec().clone();
+    let mut results = Vec::new();
+    for task in spec.tasks() {
+        match store.restore(task)? {
+            Restored::Done(r) => results.push(r),
+            Restored::Partial(done) => anyhow::bail!(
+                "{}: task N = {}, H = {} is not finished ({} of {} samples): rerun the \
+                 study's command to finish it first",
+                dir.display(),
+                task.n,
+                task.hurst,
+                done.len(),
+                spec.samples
+            ),
+        }
+    }
+    let (kind, figure) = match spec.rolloff {
+        Some(_) => ("steepest slope", Results::Fig2(&results, spec.window)),
+        None => ("α", Results::Fig1(&results)),
+    };
+    let report = format!(
+        "# Comparison with the paper: {} study in `{}`\n\n{} of N = {:?}, H = {:?}, {} \
+         samples each, roll-off {}, seed {}, window {}; asperity {}. Regenerate with \
+         `asperity study compare {} --force`.\n",
+        spec.method.name(),
+        dir.display(),
+        kind,
+        spec.sizes,
+        spec.hursts,
+        spec.samples,
+        spec.rolloff.map_or("none".into(), |r| r.to_string()),
+        spec.seed,
+        spec.window.describe(),
+        env!("CARGO_PKG_VERSION"),
+        dir.display()
+    );
+    write_for_study(dir, dir, figure, &report, force)
 }
 
 #[cfg(test)]

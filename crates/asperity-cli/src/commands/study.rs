@@ -287,6 +287,21 @@ bootstrap resamples of the samples), samples.\n\nExample:\n  asperity study wind
 docs/results/medium/fig2/bem > windows.csv"
     )]
     Windows(WindowsArgs),
+    /// A finished study beside the paper → DIR/comparison.csv and DIR/report.md, with a
+    /// verdict per row (with roll-off: the steepest log–log slope against the paper's
+    /// "≈ 1", with a bootstrap interval; without: α against eqs. (6) and (24)).
+    #[command(after_help = "Example:\n  asperity study compare docs/results/fig2_1024 --force")]
+    Compare(CompareArgs),
+}
+
+/// Arguments of `asperity study compare`.
+#[derive(Debug, clap::Args)]
+pub struct CompareArgs {
+    /// The study folder (holding study.json and checkpoint/).
+    pub dir: PathBuf,
+    /// Overwrite an existing comparison.csv and report.md.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Arguments of `asperity study windows`.
@@ -570,6 +585,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Windows(w) => return windows(w),
+        StudyCommand::Compare(c) => return super::report::compare_study(&c.dir, c.force),
         StudyCommand::File(f) => {
             let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
             let (kind, spec) = parse_study_file(&f.file, &text)?;

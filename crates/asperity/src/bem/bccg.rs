@@ -85,10 +85,14 @@ impl Sums {
     }
 }
 
-/// The BCCG's own fields: the preconditioned gradient, the current and the previous
-/// gradient, the free set, the operator's impulse response, the cut pressures and the
-/// partial sums of the parallel passes.
+/// The BCCG's own fields: the search direction and its response, the preconditioned
+/// gradient, the current and the previous gradient, the free set, the operator's impulse
+/// response, the cut pressures and the partial sums of the parallel passes.
 pub(super) struct BccgScratch {
+    /// The search direction `s` (carried from one iteration to the next).
+    pub(super) direction: Vec<f64>,
+    /// `w = K s`.
+    pub(super) response: Vec<f64>,
     /// `z = Π P_F M P_F Π g` (the preconditioner works in place here).
     pub(super) preconditioned: Vec<f64>,
     /// `Π g` on the free set, zero elsewhere.
@@ -148,6 +152,8 @@ impl BccgScratch {
         operator.apply(&unit, &mut impulse);
         let chunks = len.div_ceil(CHUNK);
         BccgScratch {
+            direction: vec![0.0; len],
+            response: vec![0.0; len],
             preconditioned: unit,
             gradient: vec![0.0; len],
             previous_gradient: vec![0.0; len],
@@ -441,18 +447,20 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let self_influence = self.operator.self_influence();
+        let self_influence = self.problem.operator.self_influence();
         self.initialise(target, self_influence);
         let mut indentation = match target {
             Target::Indentation(d) => d,
-            Target::MeanPressure(_) => self.solved.map_or(0.0, |s| s.indentation),
+            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
         };
         self.bccg_scratch.pending_scale = 1.0;
         self.bccg_scratch.extra_applications = 0;
         if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
             mean_gap.reset();
         }
-        self.operator.apply(&self.pressure, &mut self.gap);
+        self.problem
+            .operator
+            .apply(&self.state.pressure, &mut self.state.gap);
         let mut applications = 1;
         let (mut exact, mut since_refresh) = (true, 0);
         let mut previous_zg = 0.0;
@@ -485,7 +493,10 @@ impl ContactSolver {
             iteration += 1;
             let direction = self.direction(target, &gradient, previous_zg);
             previous_zg = direction.zg;
-            self.operator.apply(&self.direction, &mut self.response);
+            self.problem.operator.apply(
+                &self.bccg_scratch.direction,
+                &mut self.bccg_scratch.response,
+            );
             applications += 1;
             let cut = self.step(target, &gradient, direction.sg, iteration)?;
             since_refresh += 1;
@@ -505,19 +516,23 @@ impl ContactSolver {
         let indentation = match target {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => {
-                let fields = (&mut self.gap[..], &mut self.pressure[..], &self.profile[..]);
+                let fields = (
+                    &mut self.state.gap[..],
+                    &mut self.state.pressure[..],
+                    &self.problem.profile[..],
+                );
                 let scale = std::mem::replace(&mut scratch.pending_scale, 1.0);
                 contact_mean(fields, previous, scale, &mut scratch.partials)
             }
         };
         let sums = gap_pass(
-            (&self.gap, &self.profile, &self.pressure),
+            (&self.state.gap, &self.problem.profile, &self.state.pressure),
             indentation,
             (&mut scratch.preconditioned, &mut scratch.free),
             &mut scratch.partials,
         );
         let [contact_points, free_points] = sums.n;
-        let periodic = self.operator.boundary() == Boundary::Periodic;
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         let mode = MeanMode::of(target, periodic);
         let centre = if mode != MeanMode::Plain && free_points > 0 {
             sums.x[2] / free_points as f64
@@ -536,8 +551,8 @@ impl ContactSolver {
             &scratch.free,
             (centre, restore),
         );
-        let residual =
-            ((sums.x[0] + sums.x[1]) / contact_points.max(1) as f64).sqrt() / self.height_scale;
+        let residual = ((sums.x[0] + sums.x[1]) / contact_points.max(1) as f64).sqrt()
+            / self.problem.height_scale;
         Gradient {
             indentation,
             free_points,
@@ -550,12 +565,13 @@ impl ContactSolver {
     /// buffer, zero off the free set, centred on it under load control). The sums of the
     /// new direction follow from those of the old one (one pass of sums, one of writes).
     fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> Direction {
-        let periodic = self.operator.boundary() == Boundary::Periodic;
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         let mode = MeanMode::of(target, periodic);
         let load_control = mode == MeanMode::Projected;
         let deflated = match (mode, self.bccg_scratch.mean_gap.as_mut()) {
             (MeanMode::Deflated, Some(mean_gap)) => {
-                let (_, applied) = mean_gap.curvature(&mut self.operator, &self.bccg_scratch.free);
+                let (_, applied) =
+                    mean_gap.curvature(&mut self.problem.operator, &self.bccg_scratch.free);
                 self.bccg_scratch.extra_applications += applied as usize;
                 true
             }
@@ -566,7 +582,7 @@ impl ContactSolver {
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
         let [z_sum, zg, z_g_old, g_old_sum, s_sum, s_g, g_sum] = direction_sums(
             (z, &scratch.gradient, &scratch.previous_gradient),
-            (&self.direction, free),
+            (&scratch.direction, free),
             &mut scratch.partials,
         )
         .x;
@@ -602,7 +618,7 @@ impl ContactSolver {
         // downhill is replaced by steepest descent −z.
         let restart = sg >= 0.0 || sg.is_nan();
         direction_pass(
-            &mut self.direction,
+            &mut scratch.direction,
             (z, free),
             (z_mean, beta, s_mean),
             restart,
@@ -629,7 +645,7 @@ impl ContactSolver {
         iteration: usize,
     ) -> Result<bool, SolveError> {
         let scratch = &mut self.bccg_scratch;
-        let sw = dot(&self.direction, &self.response, &mut scratch.partials);
+        let sw = dot(&scratch.direction, &scratch.response, &mut scratch.partials);
         if !crate::is_positive_finite(sw) {
             // K is positive on every direction but the constant one of a periodic grid,
             // which the free set excludes short of full contact: rounding only.
@@ -640,8 +656,8 @@ impl ContactSolver {
         }
         let alpha = -sg / sw;
         let sums = step_pass(
-            (&mut self.pressure, &mut self.gap),
-            (&self.direction, &self.response),
+            (&mut self.state.pressure, &mut self.state.gap),
+            (&scratch.direction, &scratch.response),
             alpha,
             (&mut scratch.chunk_cuts, &mut scratch.partials),
         );
@@ -655,18 +671,18 @@ impl ContactSolver {
             for (slots, partial) in scratch.chunk_cuts.chunks(CUT_LIMIT).zip(&scratch.partials) {
                 corrections.extend_from_slice(&slots[..partial.n[0]]);
             }
-            let periodic = self.operator.boundary() == Boundary::Periodic;
-            let grid = (self.rows, self.cols, periodic);
-            add_point_responses(&mut self.gap, &scratch.impulse, grid, corrections);
+            let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+            let grid = (self.problem.rows, self.problem.cols, periodic);
+            add_point_responses(&mut self.state.gap, &scratch.impulse, grid, corrections);
         }
         if let Target::MeanPressure(mean_pressure) = target {
-            let n = self.pressure.len() as f64;
+            let n = self.state.pressure.len() as f64;
             let scale = mean_pressure * n / total;
             // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
             if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
                 scratch.pending_scale = scale;
             } else if total <= 0.0 {
-                self.pressure.fill(mean_pressure);
+                self.state.pressure.fill(mean_pressure);
                 cut = true;
             }
         }
@@ -688,16 +704,19 @@ impl ContactSolver {
     fn refresh_displacement(&mut self) {
         let scale = std::mem::replace(&mut self.bccg_scratch.pending_scale, 1.0);
         if scale != 1.0 {
-            self.pressure
+            self.state
+                .pressure
                 .par_chunks_mut(CHUNK)
                 .for_each(|p| p.iter_mut().for_each(|v| *v *= scale));
         }
-        self.operator.apply(&self.pressure, &mut self.gap);
+        self.problem
+            .operator
+            .apply(&self.state.pressure, &mut self.state.gap);
     }
 
     /// Turns the displacement in the gap buffer into the gap `u + f − d`.
     fn write_gap(&mut self, indentation: f64) {
-        for (g, &f) in self.gap.iter_mut().zip(&self.profile) {
+        for (g, &f) in self.state.gap.iter_mut().zip(&self.problem.profile) {
             *g += f - indentation;
         }
     }

@@ -17,6 +17,11 @@
 //! Laplacian `v = ∇²f` (zero flux at the edges, so `Σ v = 0`; it weighs the slopes, which
 //! set the pressure of full contact). On self-affine surfaces the bound is a few percent of
 //! the threshold (about 0.12 E*·h′ for an rms slope h′, measured: 512², H = 0.8, roll-off 6).
+//!
+//! The periodic threshold and the bounds work in fields of their own
+//! ([`FullContactScratch`]); the free threshold in the stiffness CG's
+//! ([`super::stiffness`]). None of them touches the solved state or another iteration's
+//! fields.
 
 use super::solver::ContactSolver;
 use super::{Control, SolveError};
@@ -47,6 +52,23 @@ impl FullContactThreshold {
     }
 }
 
+/// The fields of the periodic threshold (`K⁺f`) and of the lower bound (the weights `v`
+/// and `K v`), owned by the solver and allocated on first use.
+pub(super) struct FullContactScratch {
+    weights: Vec<f64>,
+    response: Vec<f64>,
+}
+
+impl FullContactScratch {
+    /// The fields in `slot`, allocated there for `len` points on first use.
+    fn lend(slot: &mut Option<Self>, len: usize) -> &mut Self {
+        slot.get_or_insert_with(|| FullContactScratch {
+            weights: vec![0.0; len],
+            response: vec![0.0; len],
+        })
+    }
+}
+
 /// The weightings of the lower bound (module docs).
 #[derive(Debug, Clone, Copy)]
 enum Weights {
@@ -55,13 +77,48 @@ enum Weights {
 }
 
 impl ContactSolver {
+    /// Where a periodic surface comes into full contact. Mean pressure: with `K p = d − f`
+    /// everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)` (Westergaard's
+    /// `p* = π E* Δ / λ` for a sinusoid). Indentation: `K p` has zero mean, so
+    /// `d = mean(f) = max(h) − mean(h)`; below it some gap stays open (`d` is the mean of
+    /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface, in
+    /// the full-contact fields.
+    pub(super) fn periodic_full_contact(&mut self) -> FullContactThreshold {
+        if let Some(full) = self.state.full_contact.filter(|f| f.indentation.is_some()) {
+            return full;
+        }
+        let len = self.problem.profile.len();
+        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, len);
+        if self
+            .problem
+            .operator
+            .apply_pseudo_inverse(&self.problem.profile, &mut scratch.weights)
+            .is_err()
+        {
+            // Free boundaries have no spectral inverse (callers check the boundary).
+            return FullContactThreshold {
+                mean_pressure: f64::INFINITY,
+                indentation: None,
+            };
+        }
+        let mean_pressure = scratch.weights.iter().fold(0.0f64, |m, &v| m.max(v));
+        let indentation =
+            self.problem.profile.iter().sum::<f64>() / self.problem.profile.len() as f64;
+        let full = FullContactThreshold {
+            mean_pressure,
+            indentation: Some(indentation),
+        };
+        self.state.full_contact = Some(full);
+        full
+    }
+
     /// The full-contact threshold of the surface: the values that
     /// [`SolveError::BeyondFullContact`] states. Periodic boundaries: `max(K⁺f)`, one
     /// spectral pseudo-inverse, and the indentation `max(h) − mean(h)`. Free boundaries:
     /// two preconditioned conjugate-gradient solves on the full grid, computed once per
     /// surface. Either way the last solved state and its warm start are kept.
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
-        match self.operator.boundary() {
+        match self.problem.operator.boundary() {
             Boundary::Periodic => Ok(self.periodic_full_contact()),
             Boundary::Free => self.free_full_contact(),
         }
@@ -71,23 +128,34 @@ impl ContactSolver {
     /// full contact. Periodic boundaries: the threshold itself (one pseudo-inverse).
     /// Free boundaries: the mean-pressure bound of the module docs (two operator
     /// applications) and `max f` (the depth of the deepest point) for the indentation.
-    /// Uses scratch buffers only: the last solved state is kept.
+    /// Works in the full-contact fields only: the last solved state is kept.
     pub fn full_contact_lower_bound(&mut self) -> Result<FullContactThreshold, SolveError> {
-        if self.operator.boundary() == Boundary::Periodic {
+        if self.problem.operator.boundary() == Boundary::Periodic {
             return self.full_contact_threshold();
         }
-        let n = self.profile.len() as f64;
-        let deepest = self.profile.iter().fold(0.0f64, |m, &f| m.max(f));
+        let n = self.problem.profile.len() as f64;
+        let deepest = self.problem.profile.iter().fold(0.0f64, |m, &f| m.max(f));
+        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, n as usize);
+        let problem = &mut self.problem;
         let mut bound = 0.0f64;
         for weights in [Weights::Depth, Weights::Laplacian] {
-            self.fill_weights(weights, deepest);
-            let weighted = self.direction.iter().zip(&self.profile);
+            let grid = (problem.rows, problem.cols);
+            fill_weights(
+                weights,
+                deepest,
+                grid,
+                &problem.profile,
+                &mut scratch.weights,
+            );
+            let weighted = scratch.weights.iter().zip(&problem.profile);
             let numerator: f64 = match weights {
                 Weights::Depth => weighted.map(|(v, f)| v * (deepest - f)).sum(),
                 Weights::Laplacian => -weighted.map(|(v, f)| v * f).sum::<f64>(),
             };
-            self.operator.apply(&self.direction, &mut self.response);
-            let largest = self.response.iter().fold(0.0f64, |m, &v| m.max(v));
+            problem
+                .operator
+                .apply(&scratch.weights, &mut scratch.response);
+            let largest = scratch.response.iter().fold(0.0f64, |m, &v| m.max(v));
             let candidate = numerator / (n * largest);
             if largest > 0.0 && candidate.is_finite() {
                 bound = bound.max(candidate);
@@ -99,30 +167,34 @@ impl ContactSolver {
             indentation: Some(deepest),
         })
     }
+}
 
-    /// Writes the weights `v` of the lower bound into the direction buffer.
-    fn fill_weights(&mut self, weights: Weights, deepest: f64) {
-        let (rows, cols) = (self.rows, self.cols);
-        let (f, v) = (&self.profile, &mut self.direction);
-        match weights {
-            Weights::Depth => v.iter_mut().zip(f).for_each(|(v, f)| *v = deepest - f),
-            Weights::Laplacian => {
-                for r in 0..rows {
-                    for c in 0..cols {
-                        let i = r * cols + c;
-                        let neighbours = [
-                            (r > 0).then(|| i - cols),
-                            (r + 1 < rows).then(|| i + cols),
-                            (c > 0).then(|| i - 1),
-                            (c + 1 < cols).then(|| i + 1),
-                        ];
-                        v[i] = neighbours.iter().flatten().map(|&j| f[j] - f[i]).sum();
-                    }
+/// Writes the weights `v` of the lower bound for the profile `f` on a `(rows, cols)` grid.
+fn fill_weights(
+    weights: Weights,
+    deepest: f64,
+    (rows, cols): (usize, usize),
+    f: &[f64],
+    v: &mut [f64],
+) {
+    match weights {
+        Weights::Depth => v.iter_mut().zip(f).for_each(|(v, f)| *v = deepest - f),
+        Weights::Laplacian => {
+            for r in 0..rows {
+                for c in 0..cols {
+                    let i = r * cols + c;
+                    let neighbours = [
+                        (r > 0).then(|| i - cols),
+                        (r + 1 < rows).then(|| i + cols),
+                        (c > 0).then(|| i - 1),
+                        (c + 1 < cols).then(|| i + 1),
+                    ];
+                    v[i] = neighbours.iter().flatten().map(|&j| f[j] - f[i]).sum();
                 }
-                // Zero to rounding already (each pair cancels); exactly zero-sum now.
-                let mean = v.iter().sum::<f64>() / v.len() as f64;
-                v.iter_mut().for_each(|x| *x -= mean);
             }
+            // Zero to rounding already (each pair cancels); exactly zero-sum now.
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            v.iter_mut().for_each(|x| *x -= mean);
         }
     }
 }

@@ -55,7 +55,7 @@ mod stiffness;
 pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
-pub use solver::ContactSolver;
+pub use solver::{ContactProblem, ContactSolver};
 
 use ndarray::Array2;
 

@@ -22,39 +22,67 @@
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 
+/// The iteration's own fields: the conjugate direction `t` and its response `K t`. Owned
+/// by the solver, allocated on the first Polonsky–Keer solve; nothing is kept in them
+/// between solves.
+pub(super) struct PkScratch {
+    direction: Vec<f64>,
+    response: Vec<f64>,
+}
+
 impl ContactSolver {
     /// The Polonsky–Keer iteration for `target` to `tolerance` in at most `max_iterations`
-    /// iterations, from the current pressure (see [`ContactSolver::solve`]).
+    /// iterations, from the current pressure (see [`ContactSolver::solve`]), in its own
+    /// fields.
     pub(super) fn polonsky_keer(
         &mut self,
         target: Target,
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let n = self.rows * self.cols;
+        let len = self.problem.profile.len();
+        let mut pk = self.pk_scratch.take().unwrap_or_else(|| PkScratch {
+            direction: vec![0.0; len],
+            response: vec![0.0; len],
+        });
+        let result = self.polonsky_keer_in(&mut pk, target, tolerance, max_iterations);
+        self.pk_scratch = Some(pk);
+        result
+    }
+
+    /// [`ContactSolver::polonsky_keer`] in the fields `pk`.
+    fn polonsky_keer_in(
+        &mut self,
+        pk: &mut PkScratch,
+        target: Target,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let load_control = matches!(target, Target::MeanPressure(_));
-        let self_influence = self.operator.self_influence();
+        let self_influence = self.problem.operator.self_influence();
         self.initialise(target, self_influence);
         let mut indentation = match target {
             Target::Indentation(d) => d,
-            Target::MeanPressure(_) => self.solved.map_or(0.0, |s| s.indentation),
+            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
         };
         let mut g_old = 0.0;
         let mut conjugate = false;
         let mut iteration = 0;
         loop {
             self.check_stop(iteration)?;
-            self.operator.apply(&self.pressure, &mut self.gap);
+            self.problem
+                .operator
+                .apply(&self.state.pressure, &mut self.state.gap);
             let pass = gap_and_direction(
-                &self.pressure,
-                &mut self.gap,
-                &mut self.direction,
-                &self.profile,
+                &self.state.pressure,
+                &mut self.state.gap,
+                &mut pk.direction,
+                &self.problem.profile,
                 load_control,
                 &mut indentation,
                 if conjugate { g_old } else { 0.0 },
             );
-            let residual = pass.residual(self.height_scale);
+            let residual = pass.residual(self.problem.height_scale);
             if residual < tolerance {
                 let info = SolveInfo {
                     iterations: iteration,
@@ -72,12 +100,12 @@ impl ContactSolver {
             g_old = pass.gap_squared;
             iteration += 1;
 
-            self.operator.apply(&self.direction, &mut self.response);
+            self.problem.operator.apply(&pk.direction, &mut pk.response);
             let tau = step_length(
-                &self.pressure,
-                &self.gap,
-                &self.direction,
-                &self.response,
+                &self.state.pressure,
+                &self.state.gap,
+                &pk.direction,
+                &pk.response,
                 load_control,
                 pass.contact_points,
             );
@@ -85,24 +113,32 @@ impl ContactSolver {
             // set), a Jacobi step with the self-influence.
             let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
             let (total, entered) = update_pressure(
-                &mut self.pressure,
-                &self.gap,
-                &self.direction,
+                &mut self.state.pressure,
+                &self.state.gap,
+                &pk.direction,
                 tau,
                 entry_step,
             );
-            conjugate = !entered;
+            // Pass E: the prescribed load (a reset pressure restarts the directions).
+            let kept = self.restore_load(target, total);
+            conjugate = !entered && kept;
+        }
+    }
 
-            // Pass E: the prescribed load.
-            if let Target::MeanPressure(mean_pressure) = target {
-                if total > 0.0 {
-                    let scale = mean_pressure * n as f64 / total;
-                    self.pressure.iter_mut().for_each(|v| *v *= scale);
-                } else {
-                    self.pressure.fill(mean_pressure);
-                    conjugate = false;
-                }
-            }
+    /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
+    /// sum `total` (or reset to uniform if nothing is left). False after a reset.
+    fn restore_load(&mut self, target: Target, total: f64) -> bool {
+        let Target::MeanPressure(mean_pressure) = target else {
+            return true;
+        };
+        let pressure = &mut self.state.pressure;
+        if total > 0.0 {
+            let scale = mean_pressure * pressure.len() as f64 / total;
+            pressure.iter_mut().for_each(|v| *v *= scale);
+            true
+        } else {
+            pressure.fill(mean_pressure);
+            false
         }
     }
 }

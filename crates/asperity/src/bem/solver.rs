@@ -1,22 +1,44 @@
 //! [`ContactSolver`]: the solver core shared by the iterations of [`crate::bem`].
 //!
-//! It holds the problem — the indenter profile `f = max(h) − h` of one surface and its
-//! height scale, the half-space (the [`ElasticOperator`] with its boundary) and the
-//! parameters — and the state of the last solve (pressure, gap, summary, the cached
-//! full-contact threshold), with every scratch field owned by the part that uses it: the
-//! BCCG's ([`super::bccg`], with the coarse correction of [`super::mean_gap`]), the
-//! Polonsky–Keer iteration's two fields (`direction`, `response`), and the frozen-set and
-//! full-contact CGs' ([`super::stiffness`]). [`ContactSolver::solve`] validates the
-//! control, refuses a periodic load or indentation beyond full contact before solving, and
-//! dispatches to the chosen iteration ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`,
-//! each `(target, tolerance, max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed
-//! [`SolveError`] out. Shared by both: the initial pressure (warm or cold start) and the
-//! summary of a converged state.
+//! A solver is made of named parts, each owned by one piece of code:
+//! * [`ContactProblem`] — what is solved: the indenter profile `f = max(h) − h` of one
+//!   surface and its height scale, the half-space (the [`ElasticOperator`], with its
+//!   boundary, spacings and modulus) and the grid. Only [`ContactSolver::set_surface`]
+//!   changes it; every other piece of code reads it (and applies its operator).
+//! * `SolverState` — the state of the last solve: pressure, gap, the solved summary and
+//!   the cached full-contact threshold. Its fields are written by the iterations only; the
+//!   stiffness and threshold code reads them and keeps them intact (and caches the
+//!   threshold).
+//! * One scratch struct per algorithm, in its own file and used by no other:
+//!   `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs`), `PkScratch`
+//!   (`polonsky_keer.rs`), `StiffnessWork` (`stiffness.rs`: the frozen-set CG and the
+//!   free-boundary threshold's CG) and `FullContactScratch` (`full_contact.rs`: the
+//!   periodic threshold and the lower bound). Scratch that not every solver needs is
+//!   allocated on first use and kept, so warm solves allocate nothing.
+//! * The settings ([`SolverParams`]), the Fourier preconditioner shared read-only by the
+//!   BCCG and the CGs, and the stop flag.
+//!
+//! [`ContactSolver::solve`] validates the control, refuses a periodic load or indentation
+//! beyond full contact before solving, and dispatches to the chosen iteration
+//! ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`, each `(target, tolerance,
+//! max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed [`SolveError`] out. Shared
+//! by both: the initial pressure (warm or cold start, `initialise`) and
+//! the summary of a converged state (`finish`).
+//!
+//! **Extending the core** (an adhesive or a plasticity-capped contact, say): put the new
+//! iteration in a file of its own with its scratch struct (`struct AdhesionScratch`), add
+//! one `Option<AdhesionScratch>` field to [`ContactSolver`] allocated on the iteration's
+//! first use (as `pk_scratch` is), a [`SolverKind`] variant dispatched in
+//! [`ContactSolver::solve`], and the fields to [`ContactSolver::memory_bytes`]. The
+//! iteration reads [`ContactProblem`], writes `SolverState` through `initialise`, its own
+//! loop and `finish`, and works in its own scratch only: no other algorithm's fields change
+//! meaning, and the stiffness and threshold code applies to its solved state unchanged.
 
 use ndarray::{Array2, ArrayView2};
 
 use super::bccg::BccgScratch;
-use super::full_contact::FullContactThreshold;
+use super::full_contact::{FullContactScratch, FullContactThreshold};
+use super::polonsky_keer::PkScratch;
 use super::preconditioner::FourierPreconditioner;
 use super::stiffness::StiffnessWork;
 use super::{
@@ -35,10 +57,11 @@ pub(super) enum Target {
     Indentation(f64),
 }
 
-/// A contact solver for one surface: owns the elastic operator (plans,
-/// kernel spectrum, buffers) and the fields, so successive solves allocate nothing and
-/// start from the previous pressure.
-pub struct ContactSolver {
+/// What is solved: the indenter profile of one surface on a half-space, on a grid. Read by
+/// every iteration; changed only by [`ContactSolver::set_surface`] (a new profile on the same
+/// grid). The operator applies `K` in place of the half-space (its FFT buffers are its own).
+pub struct ContactProblem {
+    /// The half-space (modulus, boundary) on the grid and spacings of the surface.
     pub(super) operator: ElasticOperator,
     pub(super) rows: usize,
     pub(super) cols: usize,
@@ -46,25 +69,141 @@ pub struct ContactSolver {
     pub(super) profile: Vec<f64>,
     /// rms height about the mean (1 for a flat surface), the residual's scale.
     pub(super) height_scale: f64,
-    pub(super) params: SolverParams,
+}
+
+impl ContactProblem {
+    /// The problem of `surface` on `half_space` (plans the operator).
+    fn new(surface: &Surface, half_space: HalfSpace) -> Result<Self, SolveError> {
+        let (rows, cols) = surface.dim();
+        let operator = ElasticOperator::with_spacings(
+            rows,
+            cols,
+            surface.spacing(),
+            surface.spacing_y(),
+            half_space.modulus,
+            half_space.boundary,
+        )?;
+        let mut profile = Vec::with_capacity(rows * cols);
+        let height_scale = fill_profile(surface, &mut profile);
+        Ok(ContactProblem {
+            operator,
+            rows,
+            cols,
+            profile,
+            height_scale,
+        })
+    }
+
+    /// Swaps in the profile of `surface`, which must have the grid and spacings of the
+    /// problem (the operator is kept).
+    fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
+        if surface.dim() != (self.rows, self.cols)
+            || surface.spacing() != self.operator.spacing()
+            || surface.spacing_y() != self.operator.spacing_y()
+        {
+            return Err(Error::invalid(
+                "surface",
+                format!(
+                    "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
+                    self.rows,
+                    self.cols,
+                    self.operator.spacing(),
+                    self.operator.spacing_y(),
+                    surface.dim(),
+                    surface.spacing(),
+                    surface.spacing_y()
+                ),
+            )
+            .into());
+        }
+        self.height_scale = fill_profile(surface, &mut self.profile);
+        Ok(())
+    }
+
+    /// `(rows, cols)` of the grid.
+    pub fn dim(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+
+    /// Pixel spacings `(Δx, Δy)`.
+    pub fn spacings(&self) -> (f64, f64) {
+        (self.operator.spacing(), self.operator.spacing_y())
+    }
+
+    /// The half-space: effective modulus and boundary.
+    pub fn half_space(&self) -> HalfSpace {
+        HalfSpace {
+            modulus: self.operator.modulus(),
+            boundary: self.operator.boundary(),
+        }
+    }
+
+    /// Nominal (projected) area `rows · cols · Δx · Δy`.
+    pub fn nominal_area(&self) -> f64 {
+        // Multiplied in this order so that square pixels give today's value bit for bit.
+        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
+    }
+
+    /// The indenter profile `f = max(h) − h`, `rows × cols`.
+    pub fn profile(&self) -> ArrayView2<'_, f64> {
+        ArrayView2::from_shape((self.rows, self.cols), &self.profile)
+            .expect("buffer has the grid's shape")
+    }
+
+    /// rms of the profile about its mean (1 for a flat surface): the scale of the
+    /// residual.
+    pub fn height_scale(&self) -> f64 {
+        self.height_scale
+    }
+}
+
+/// The state of the last solve: its fields and scalars, and the full-contact threshold of
+/// the surface once known. Written by the iterations (through [`ContactSolver::initialise`]
+/// and [`ContactSolver::finish`]); the stiffness and threshold code reads the fields and
+/// only caches the threshold.
+pub(super) struct SolverState {
     pub(super) pressure: Vec<f64>,
     /// `u` during an iteration, the gap `g` after a solve.
     pub(super) gap: Vec<f64>,
-    pub(super) direction: Vec<f64>,
-    pub(super) response: Vec<f64>,
     /// The last solved state, if any (its pressure is in `pressure`).
     pub(super) solved: Option<ContactSummary>,
     /// Where the surface comes into full contact (computed once per surface, when first
     /// needed).
     pub(super) full_contact: Option<FullContactThreshold>,
-    /// The fields of the frozen-set CG and of the free-boundary full-contact threshold,
-    /// allocated on first use (their own: a stiffness or a threshold never touches the
-    /// solved state).
-    pub(super) stiffness_work: Option<StiffnessWork>,
-    /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG.
+}
+
+impl SolverState {
+    fn new(len: usize) -> Self {
+        SolverState {
+            pressure: vec![0.0; len],
+            gap: vec![0.0; len],
+            solved: None,
+            full_contact: None,
+        }
+    }
+}
+
+/// A contact solver for one surface: the problem, the state of the last solve, and the
+/// scratch of each algorithm, each its own (module docs); successive solves allocate
+/// nothing and start from the previous pressure.
+pub struct ContactSolver {
+    pub(super) problem: ContactProblem,
+    pub(super) params: SolverParams,
+    pub(super) state: SolverState,
+    /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG (read-only but for
+    /// its own FFT buffer).
     pub(super) preconditioner: FourierPreconditioner,
-    /// The BCCG's own fields.
+    /// The BCCG's own fields (`bccg.rs`, with the coarse correction of `mean_gap.rs`).
     pub(super) bccg_scratch: BccgScratch,
+    /// The Polonsky–Keer iteration's own fields (`polonsky_keer.rs`), allocated on its
+    /// first solve.
+    pub(super) pk_scratch: Option<PkScratch>,
+    /// The fields of the frozen-set and free-boundary threshold CGs (`stiffness.rs`),
+    /// allocated on first use.
+    pub(super) stiffness_work: Option<StiffnessWork>,
+    /// The fields of the periodic threshold and of the lower bound (`full_contact.rs`),
+    /// allocated on first use.
+    pub(super) full_contact_scratch: Option<FullContactScratch>,
     /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
     pub(super) stop: Stop,
 }
@@ -88,16 +227,19 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow): the operator, the preconditioner, five fields, the four BCCG fields and their
-    /// mask, the four stiffness and full-contact fields (periodic: three more for the
-    /// coarse correction of displacement control). The caller's [`Surface`] (one more
+    /// overflow), an upper bound on what its parts hold once all have been used: the
+    /// operator and the preconditioner; the profile, pressure and gap; the BCCG's six
+    /// fields and its mask; the Polonsky–Keer iteration's two; the six of the stiffness
+    /// CG and its set's index list; the two of the full-contact code (periodic: three more for the coarse
+    /// correction of displacement control). The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        // Periodic grids add the coarse correction's two fields and its mask (`mean_gap.rs`).
+        // The mask counts as a field (rounding up); periodic grids add the coarse
+        // correction's two fields and its mask (`mean_gap.rs`).
         let count = if boundary == Boundary::Periodic {
-            17
+            24
         } else {
-            14
+            21
         };
         let fields = memory::array_bytes(&[count, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
@@ -121,14 +263,7 @@ impl ContactSolver {
             ),
             Self::memory_bytes(rows, cols, half_space.boundary),
         )?;
-        let operator = ElasticOperator::with_spacings(
-            rows,
-            cols,
-            surface.spacing(),
-            surface.spacing_y(),
-            half_space.modulus,
-            half_space.boundary,
-        )?;
+        let mut problem = ContactProblem::new(surface, half_space)?;
         let preconditioner = FourierPreconditioner::new(
             rows,
             cols,
@@ -136,27 +271,16 @@ impl ContactSolver {
             surface.spacing_y(),
             half_space.modulus,
         )?;
-        let mut operator = operator;
-        let bccg_scratch = BccgScratch::new(&mut operator);
-        let mut profile = Vec::with_capacity(rows * cols);
-        let height_scale = fill_profile(surface, &mut profile);
-        let len = rows * cols;
+        let bccg_scratch = BccgScratch::new(&mut problem.operator);
         Ok(ContactSolver {
-            operator,
-            rows,
-            cols,
-            profile,
-            height_scale,
+            problem,
             params,
-            pressure: vec![0.0; len],
-            gap: vec![0.0; len],
-            direction: vec![0.0; len],
-            response: vec![0.0; len],
-            solved: None,
-            full_contact: None,
-            stiffness_work: None,
+            state: SolverState::new(rows * cols),
             preconditioner,
             bccg_scratch,
+            pk_scratch: None,
+            stiffness_work: None,
+            full_contact_scratch: None,
             stop: Stop::new(),
         })
     }
@@ -197,29 +321,10 @@ impl ContactSolver {
     /// plans, kernel spectrum) and all buffers: how an ensemble solves many realisations.
     /// The next solve starts cold, exactly as with a new solver.
     pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
-        if surface.dim() != (self.rows, self.cols)
-            || surface.spacing() != self.operator.spacing()
-            || surface.spacing_y() != self.operator.spacing_y()
-        {
-            return Err(Error::invalid(
-                "surface",
-                format!(
-                    "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
-                    self.rows,
-                    self.cols,
-                    self.operator.spacing(),
-                    self.operator.spacing_y(),
-                    surface.dim(),
-                    surface.spacing(),
-                    surface.spacing_y()
-                ),
-            )
-            .into());
-        }
-        self.height_scale = fill_profile(surface, &mut self.profile);
-        self.pressure.fill(0.0);
-        self.solved = None;
-        self.full_contact = None;
+        self.problem.set_surface(surface)?;
+        self.state.pressure.fill(0.0);
+        self.state.solved = None;
+        self.state.full_contact = None;
         Ok(())
     }
 
@@ -237,23 +342,27 @@ impl ContactSolver {
 
     /// `(rows, cols)` of the grid.
     pub fn dim(&self) -> (usize, usize) {
-        (self.rows, self.cols)
+        self.problem.dim()
     }
 
     /// Nominal (projected) area `rows · cols · Δx · Δy`.
     pub fn nominal_area(&self) -> f64 {
-        // Multiplied in this order so that square pixels give today's value bit for bit.
-        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
+        self.problem.nominal_area()
+    }
+
+    /// What is solved: the surface's profile on the half-space, on the grid.
+    pub fn problem(&self) -> &ContactProblem {
+        &self.problem
     }
 
     /// Forgets the previous solution: the next solve starts cold.
     pub fn reset(&mut self) {
-        self.solved = None;
+        self.state.solved = None;
     }
 
     /// The last solved state's scalars, if any.
     pub fn summary(&self) -> Option<ContactSummary> {
-        self.solved
+        self.state.solved
     }
 
     /// Solves the contact under `control`, starting from the previous solution when there
@@ -276,7 +385,7 @@ impl ContactSolver {
                 Target::Indentation(d)
             }
         };
-        let periodic = self.operator.boundary() == Boundary::Periodic;
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         if periodic {
             // Exact thresholds, known before solving: the mean pressure max(K⁺f) and, with
             // displacements of zero mean, the indentation mean(f).
@@ -286,11 +395,11 @@ impl ContactSolver {
                 // The mean gap mean(f) − d within the rounding of the sum mean(f) (n ulps)
                 // is no gap: full contact.
                 Target::Indentation(d) => full.indentation.is_some_and(|d_full| {
-                    d >= d_full * (1.0 - self.profile.len() as f64 * f64::EPSILON)
+                    d >= d_full * (1.0 - self.problem.profile.len() as f64 * f64::EPSILON)
                 }),
             };
             if beyond {
-                self.solved = None;
+                self.state.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
         }
@@ -306,12 +415,12 @@ impl ContactSolver {
             // Every point in contact, under load or displacement control: no contact
             // problem is left; refused with the threshold (free boundaries: only known
             // from the solution, periodic: checked above, this is rounding at p ≈ p*).
-            Ok((summary, _)) if summary.contact_points == self.rows * self.cols => {
-                self.solved = None;
+            Ok((summary, _)) if summary.contact_points == self.problem.rows * self.problem.cols => {
+                self.state.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
-            Ok((summary, _)) => self.solved = Some(summary),
-            Err(_) => self.solved = None,
+            Ok((summary, _)) => self.state.solved = Some(summary),
+            Err(_) => self.state.solved = None,
         }
         result
     }
@@ -319,7 +428,7 @@ impl ContactSolver {
     /// The error for a `requested` load or indentation that closes the gap everywhere, with
     /// the threshold in the same quantity where it is known.
     fn beyond_full_contact(&mut self, requested: Control) -> SolveError {
-        let threshold = match self.operator.boundary() {
+        let threshold = match self.problem.operator.boundary() {
             Boundary::Periodic => Some(self.periodic_full_contact()),
             Boundary::Free => self.free_full_contact().ok(),
         };
@@ -336,25 +445,25 @@ impl ContactSolver {
 
     /// Pressure of the last solve, `rows × cols`.
     pub fn pressure(&self) -> ArrayView2<'_, f64> {
-        ArrayView2::from_shape((self.rows, self.cols), &self.pressure)
+        ArrayView2::from_shape((self.problem.rows, self.problem.cols), &self.state.pressure)
             .expect("buffer has the grid's shape")
     }
 
     /// Gap of the last solve, `rows × cols` (≥ 0, zero on the contact set).
     pub fn gap(&self) -> ArrayView2<'_, f64> {
-        ArrayView2::from_shape((self.rows, self.cols), &self.gap)
+        ArrayView2::from_shape((self.problem.rows, self.problem.cols), &self.state.gap)
             .expect("buffer has the grid's shape")
     }
 
     /// The last solved state with owned copies of its fields; the displacement is computed
     /// afresh (one operator application). `None` before a successful solve.
     pub fn state(&mut self) -> Option<ContactState> {
-        let summary = self.solved?;
-        let mut displacement = Array2::zeros((self.rows, self.cols));
+        let summary = self.state.solved?;
+        let mut displacement = Array2::zeros((self.problem.rows, self.problem.cols));
         let out = displacement
             .as_slice_mut()
             .expect("a fresh array is contiguous");
-        self.operator.apply(&self.pressure, out);
+        self.problem.operator.apply(&self.state.pressure, out);
         Some(ContactState {
             summary,
             pressure: self.pressure().to_owned(),
@@ -363,62 +472,30 @@ impl ContactSolver {
         })
     }
 
-    /// Where a periodic surface comes into full contact. Mean pressure: with `K p = d − f`
-    /// everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)` (Westergaard's
-    /// `p* = π E* Δ / λ` for a sinusoid). Indentation: `K p` has zero mean, so
-    /// `d = mean(f) = max(h) − mean(h)`; below it some gap stays open (`d` is the mean of
-    /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface; uses
-    /// the direction buffer.
-    pub(super) fn periodic_full_contact(&mut self) -> FullContactThreshold {
-        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
-            return full;
-        }
-        if self
-            .operator
-            .apply_pseudo_inverse(&self.profile, &mut self.direction)
-            .is_err()
-        {
-            // Free boundaries have no spectral inverse (callers check the boundary).
-            return FullContactThreshold {
-                mean_pressure: f64::INFINITY,
-                indentation: None,
-            };
-        }
-        let mean_pressure = self.direction.iter().fold(0.0f64, |m, &v| m.max(v));
-        let indentation = self.profile.iter().sum::<f64>() / self.profile.len() as f64;
-        let full = FullContactThreshold {
-            mean_pressure,
-            indentation: Some(indentation),
-        };
-        self.full_contact = Some(full);
-        full
-    }
-
     /// Initial pressure: the continuation predictor when the last solve's frozen-set
     /// stiffness left its tangent (`stiffness.rs`), else the previous solution (rescaled to
-    /// the new load) or a cold start
-    /// (uniform pressure under load control; local springs `max(d − f, 0)/K₀₀` under
-    /// displacement control).
+    /// the new load) or a cold start (uniform pressure under load control; local springs
+    /// `max(d − f, 0)/K₀₀` under displacement control).
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
-        let n = (self.rows * self.cols) as f64;
-        let warm = self.solved.is_some();
+        let n = (self.problem.rows * self.problem.cols) as f64;
+        let warm = self.state.solved.is_some();
         if self.predict_from_tangent(target) {
             return;
         }
         match target {
             Target::MeanPressure(mean_pressure) => {
-                let current = self.pressure.iter().sum::<f64>() / n;
+                let current = self.state.pressure.iter().sum::<f64>() / n;
                 if warm && current > 0.0 {
                     let scale = mean_pressure / current;
-                    self.pressure.iter_mut().for_each(|p| *p *= scale);
+                    self.state.pressure.iter_mut().for_each(|p| *p *= scale);
                 } else {
-                    self.pressure.fill(mean_pressure);
+                    self.state.pressure.fill(mean_pressure);
                 }
             }
             Target::Indentation(d) => {
-                let any = self.pressure.iter().any(|&p| p > 0.0);
+                let any = self.state.pressure.iter().any(|&p| p > 0.0);
                 if !(warm && any) {
-                    for (p, f) in self.pressure.iter_mut().zip(&self.profile) {
+                    for (p, f) in self.state.pressure.iter_mut().zip(&self.problem.profile) {
                         *p = (d - f).max(0.0) / self_influence;
                     }
                 }
@@ -429,11 +506,11 @@ impl ContactSolver {
     /// Scalars of the converged state; the gap buffer is cleaned to `g ≥ 0`, zero on the
     /// contact set (its residual there is below the tolerance).
     pub(super) fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
-        for (g, p) in self.gap.iter_mut().zip(&self.pressure) {
+        for (g, p) in self.state.gap.iter_mut().zip(&self.state.pressure) {
             *g = if *p > 0.0 { 0.0 } else { g.max(0.0) };
         }
-        let n = self.rows * self.cols;
-        let mean_pressure = self.pressure.iter().sum::<f64>() / n as f64;
+        let n = self.problem.rows * self.problem.cols;
+        let mean_pressure = self.state.pressure.iter().sum::<f64>() / n as f64;
         ContactSummary {
             mean_pressure,
             force: mean_pressure * self.nominal_area(),
@@ -489,6 +566,68 @@ mod tests {
             );
             assert_eq!(solver.pressure(), pressure);
             assert_eq!(solver.gap(), gap);
+        }
+    }
+
+    #[test]
+    fn the_problem_is_the_surface_on_the_half_space() {
+        let (a, b) = (rough_grid(24, 40, 1), rough_grid(24, 40, 2));
+        let half_space = HalfSpace {
+            modulus: 1.7,
+            boundary: Boundary::Periodic,
+        };
+        let mut solver = ContactSolver::new(&a, half_space, SolverParams::default()).unwrap();
+        let profile_of = |surface: &Surface| {
+            let top = surface.heights().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
+            surface.heights().mapv(|h| top - h)
+        };
+        let problem = solver.problem();
+        assert_eq!(problem.dim(), (24, 40));
+        assert_eq!(problem.half_space(), half_space);
+        assert_eq!(problem.spacings(), (a.spacing(), a.spacing_y()));
+        assert_eq!(problem.nominal_area(), solver.nominal_area());
+        assert_eq!(problem.profile(), profile_of(&a));
+        let before = problem.height_scale();
+        assert!(before > 0.0);
+        solver.set_surface(&b).unwrap();
+        assert_eq!(solver.problem().profile(), profile_of(&b));
+        assert_ne!(solver.problem().height_scale(), before);
+        // A surface on another grid is refused and leaves the problem as it was.
+        assert!(solver.set_surface(&rough_grid(24, 41, 1)).is_err());
+        assert_eq!(solver.problem().profile(), profile_of(&b));
+    }
+
+    #[test]
+    fn each_iteration_works_in_its_own_fields() {
+        // A solver that ran the other iteration (and the thresholds) first gives, from a
+        // cold start, the same bits as a fresh solver: no iteration reads what another
+        // left in its fields.
+        let surface = rough_grid(40, 48, 6);
+        let load = Control::MeanPressure(0.02);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary,
+            };
+            for (first, then) in [
+                (SolverKind::Bccg, SolverKind::PolonskyKeer),
+                (SolverKind::PolonskyKeer, SolverKind::Bccg),
+            ] {
+                let params = |solver| SolverParams {
+                    solver,
+                    ..SolverParams::default()
+                };
+                let mut fresh = ContactSolver::new(&surface, half_space, params(then)).unwrap();
+                let want = (fresh.solve(load).unwrap(), fresh.pressure().to_owned());
+                let mut used = ContactSolver::new(&surface, half_space, params(first)).unwrap();
+                used.solve(Control::MeanPressure(0.03)).unwrap();
+                used.full_contact_lower_bound().unwrap();
+                used.full_contact_threshold().unwrap();
+                used.set_params(params(then)).unwrap();
+                used.reset();
+                let got = (used.solve(load).unwrap(), used.pressure().to_owned());
+                assert_eq!(got, want, "{boundary:?}: {first:?} then {then:?}");
+            }
         }
     }
 }

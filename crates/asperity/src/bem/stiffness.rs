@@ -239,7 +239,7 @@ fn conjugate_gradient_on_set(
 
 impl ContactSolver {
     fn stiffness_work(&mut self) -> StiffnessWork {
-        let n = self.rows * self.cols;
+        let n = self.problem.rows * self.problem.cols;
         self.stiffness_work
             .take()
             .unwrap_or_else(|| StiffnessWork::new(n))
@@ -249,7 +249,7 @@ impl ContactSolver {
     /// (see the module docs), with the CG's iterations and relative residual. Zero when
     /// nothing is in contact.
     pub fn frozen_set_stiffness(&mut self) -> Result<(f64, SolveInfo), SolveError> {
-        if self.solved.is_none() {
+        if self.state.solved.is_none() {
             return Err(Error::invalid("stiffness", "no solved contact state yet").into());
         }
         let (tolerance, max_iterations) = (
@@ -272,16 +272,19 @@ impl ContactSolver {
             max_iterations,
             stop: &self.stop,
         };
-        let pressure = &self.pressure;
+        let pressure = &self.state.pressure;
         let result = conjugate_gradient_on_set(
-            &mut self.operator,
+            &mut self.problem.operator,
             &mut self.preconditioner,
             |i| pressure[i] > 0.0,
             RightHandSide::Ones,
             &mut work,
             limits,
         );
-        let (dx, dy) = (self.operator.spacing(), self.operator.spacing_y());
+        let (dx, dy) = (
+            self.problem.operator.spacing(),
+            self.problem.operator.spacing_y(),
+        );
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
         work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
@@ -299,14 +302,14 @@ impl ContactSolver {
         let Some(work) = self.stiffness_work.as_mut() else {
             return false;
         };
-        let (Some(solved), true) = (self.solved, std::mem::take(&mut work.tangent)) else {
+        let (Some(solved), true) = (self.state.solved, std::mem::take(&mut work.tangent)) else {
             return false;
         };
-        let n = self.pressure.len() as f64;
+        let n = self.state.pressure.len() as f64;
         let step = match target {
             Target::MeanPressure(mean_pressure) => {
                 let x_sum: f64 = work.x.iter().sum();
-                let p_sum: f64 = self.pressure.iter().sum();
+                let p_sum: f64 = self.state.pressure.iter().sum();
                 if !crate::is_positive_finite(x_sum) {
                     return false;
                 }
@@ -315,7 +318,7 @@ impl ContactSolver {
             Target::Indentation(d) => d - solved.indentation,
         };
         let mut total = 0.0;
-        for (p, &x) in self.pressure.iter_mut().zip(&work.x) {
+        for (p, &x) in self.state.pressure.iter_mut().zip(&work.x) {
             *p = (*p + step * x).max(0.0);
             total += *p;
         }
@@ -324,7 +327,7 @@ impl ContactSolver {
                 return false;
             }
             let scale = mean_pressure * n / total;
-            self.pressure.iter_mut().for_each(|p| *p *= scale);
+            self.state.pressure.iter_mut().for_each(|p| *p *= scale);
         }
         true
     }
@@ -357,10 +360,10 @@ impl ContactSolver {
     /// contact (two CG solves on the full grid, see the module docs); computed once per
     /// surface. Works in the CG's own fields: the solved state is kept.
     pub(super) fn free_full_contact(&mut self) -> Result<FullContactThreshold, SolveError> {
-        if let Some(full) = self.full_contact.filter(|f| f.indentation.is_some()) {
+        if let Some(full) = self.state.full_contact.filter(|f| f.indentation.is_some()) {
             return Ok(full);
         }
-        let n = self.rows * self.cols;
+        let n = self.problem.rows * self.problem.cols;
         let mut work = self.stiffness_work();
         // The threshold's CGs overwrite the frozen-set solution.
         work.tangent = false;
@@ -375,17 +378,17 @@ impl ContactSolver {
         };
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
-            &mut self.operator,
+            &mut self.problem.operator,
             &mut self.preconditioner,
             |_| true,
-            RightHandSide::Values(&self.profile),
+            RightHandSide::Values(&self.problem.profile),
             &mut work,
             limits,
         )
         .and_then(|_| {
             std::mem::swap(&mut work.x, &mut work.profile_pressure);
             conjugate_gradient_on_set(
-                &mut self.operator,
+                &mut self.problem.operator,
                 &mut self.preconditioner,
                 |_| true,
                 RightHandSide::Ones,
@@ -406,7 +409,7 @@ impl ContactSolver {
         });
         self.stiffness_work = Some(work);
         if let Ok(full) = result {
-            self.full_contact = Some(full);
+            self.state.full_contact = Some(full);
         }
         result
     }
