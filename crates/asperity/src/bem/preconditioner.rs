@@ -72,15 +72,30 @@ impl FourierPreconditioner {
         })
     }
 
+    /// `output ← M input` (`rows × cols` row-major fields): [`FourierPreconditioner::apply`]
+    /// without first copying the input into the output.
+    pub(super) fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
+        let rows = self.fft.rows();
+        let multiply = multiplier(&self.symbol, rows);
+        self.fft
+            .convolve(input, &mut self.spectrum, output, multiply);
+    }
+
     /// `data ← M data` (a `rows × cols` row-major field, overwritten).
     /// One fused convolution: each column of the spectrum is multiplied while in cache.
     pub(super) fn apply(&mut self, data: &mut [f64]) {
-        let (symbol, rows) = (&self.symbol, self.fft.rows());
+        let rows = self.fft.rows();
+        let multiply = multiplier(&self.symbol, rows);
         self.fft
-            .convolve_in_place(data, &mut self.spectrum, |kx, column| {
-                let m = &symbol[kx * rows..(kx + 1) * rows];
-                column.iter_mut().zip(m).for_each(|(c, &m)| *c *= m);
-            });
+            .convolve_in_place(data, &mut self.spectrum, multiply);
+    }
+}
+
+/// The filter of the fused convolution: column `kx` of the spectrum times its symbol.
+fn multiplier(symbol: &[f64], rows: usize) -> impl Fn(usize, &mut [Complex64]) + Sync + '_ {
+    move |kx, column| {
+        let m = &symbol[kx * rows..(kx + 1) * rows];
+        column.iter_mut().zip(m).for_each(|(c, &m)| *c *= m);
     }
 }
 

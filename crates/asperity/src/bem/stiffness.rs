@@ -85,8 +85,7 @@ fn precondition_on_set(
     residual: &[f64],
     z: &mut [f64],
 ) -> f64 {
-    z.copy_from_slice(residual);
-    preconditioner.apply(z);
+    preconditioner.apply_into(residual, z);
     set.iter()
         .map(|&i| residual[i] * z[i])
         .fold(0.0, |a, b| a + b)
