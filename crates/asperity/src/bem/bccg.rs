@@ -379,13 +379,31 @@ fn direction_pass(
         });
 }
 
+/// `Σ term(k)` over `k < len` with four accumulators (`k mod 4`), added as
+/// `(a₀ + a₁) + (a₂ + a₃)` and then the remainder in order: a fixed order (the same bits for
+/// any thread count) whose four chains of additions do not wait on each other, where one
+/// chain would wait an addition's latency per term.
+#[inline]
+pub(super) fn sum4(len: usize, term: impl Fn(usize) -> f64) -> f64 {
+    let whole = len / 4 * 4;
+    let mut acc = [0.0; 4];
+    for k in (0..whole).step_by(4) {
+        acc[0] += term(k);
+        acc[1] += term(k + 1);
+        acc[2] += term(k + 2);
+        acc[3] += term(k + 3);
+    }
+    let tail = (whole..len).map(term).fold(0.0, |a, b| a + b);
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
 /// `Σ s·w`.
 fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
     s.par_chunks(CHUNK)
         .zip(w.par_chunks(CHUNK))
         .zip(partials.par_iter_mut())
         .for_each(|((s, w), out)| {
-            let sum = s.iter().zip(w).map(|(a, b)| a * b).fold(0.0, |a, b| a + b);
+            let sum = sum4(s.len().min(w.len()), |k| s[k] * w[k]);
             *out = Sums {
                 x: [sum, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
                 n: [0, 0],

@@ -27,6 +27,7 @@
 //! ([`ContactSolver::predict_from_tangent`], a continuation predictor), which is the next
 //! state exactly as long as the set does not change.
 
+use super::bccg::sum4;
 use super::full_contact::FullContactThreshold;
 use super::preconditioner::FourierPreconditioner;
 use super::solver::{ContactSolver, Target};
@@ -78,7 +79,7 @@ impl StiffnessWork {
 }
 
 /// `z = M r` (read on the set only: the CG never uses `z` off it); returns `rᵀz` on the
-/// set, summed in index order.
+/// set (summed by [`sum4`], in a fixed order).
 fn precondition_on_set(
     preconditioner: &mut FourierPreconditioner,
     set: &[usize],
@@ -86,9 +87,7 @@ fn precondition_on_set(
     z: &mut [f64],
 ) -> f64 {
     preconditioner.apply_into(residual, z);
-    set.iter()
-        .map(|&i| residual[i] * z[i])
-        .fold(0.0, |a, b| a + b)
+    sum4(set.len(), |k| residual[set[k]] * z[set[k]])
 }
 
 /// When a CG stops: at `tolerance` relative residual, after `max_iterations`, or when `stop`
@@ -159,21 +158,16 @@ fn step_on_set(operator: &mut ElasticOperator, work: &mut StiffnessWork, rz: f64
         ..
     } = work;
     operator.apply(direction, response);
-    let curvature = set
-        .iter()
-        .map(|&i| direction[i] * response[i])
-        .fold(0.0, |a, b| a + b);
+    let curvature = sum4(set.len(), |k| direction[set[k]] * response[set[k]]);
     if !(curvature > 0.0 && rz > 0.0) {
         return None;
     }
     let alpha = rz / curvature;
-    let mut rr = 0.0;
     for &i in set.iter() {
         x[i] += alpha * direction[i];
         residual[i] -= alpha * response[i];
-        rr += residual[i] * residual[i];
     }
-    Some(rr)
+    Some(sum4(set.len(), |k| residual[set[k]] * residual[set[k]]))
 }
 
 /// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
@@ -181,7 +175,7 @@ fn step_on_set(operator: &mut ElasticOperator, work: &mut StiffnessWork, rz: f64
 /// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
 /// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual). The result is in `work.x`.
 /// Every pass but the two transforms visits the set's points only (listed once, in index
-/// order, so that every sum adds the same terms in the same order as a full pass would).
+/// order; the sums in a fixed order, [`sum4`], whatever the thread count).
 fn conjugate_gradient_on_set(
     operator: &mut ElasticOperator,
     preconditioner: &mut FourierPreconditioner,
