@@ -346,7 +346,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         [a, b] if a < b => (a, b),
         _ => anyhow::bail!("--probes takes two increasing sizes, got {:?}", args.probes),
     };
-    let hursts = asperity::study::parse_range(&args.hursts)?;
+    let hursts = crate::range::parse_range(&args.hursts)?;
     let study = BemStudy {
         sizes: &sizes,
         samples: args.samples,

@@ -11,7 +11,7 @@
 //! A hidden `test` setting runs the medium setting's code path on tiny grids for the tests.
 
 use anyhow::Result;
-use asperity::study::parse_range;
+use crate::range::parse_range;
 
 /// How closely `reproduce` follows the paper (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -6,10 +6,11 @@ use std::path::Path;
 
 use anyhow::Result;
 use asperity::study::theory::alpha_theory;
-use asperity::study::{parse_range, Method, TaskResult};
+use asperity::study::{Method, TaskResult};
+use crate::range::parse_range;
 
 use super::super::setting::Setting;
-use super::super::study::{write_alpha, Kind};
+use crate::studies::{write_alpha, Kind};
 use super::{announce, describe_hursts, figure_study, study_spec};
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {

@@ -9,7 +9,7 @@ use anyhow::Result;
 use asperity::study::Method;
 
 use super::super::setting::Setting;
-use super::super::study::{write_curves, Kind};
+use crate::studies::{write_curves, Kind};
 use super::{announce, figure_study, study_spec};
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).

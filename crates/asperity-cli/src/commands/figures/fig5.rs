@@ -9,7 +9,7 @@ use asperity::study::theory::alpha_white_noise;
 use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use super::super::study::Kind;
+use crate::studies::Kind;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};

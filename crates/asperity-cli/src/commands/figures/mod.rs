@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use asperity::study::{FitWindow, Method, StudySpec, TaskResult};
 
 use super::setting::Setting;
-use super::study::{execute, Kind, RunOptions};
+use crate::studies::{execute, Kind, RunOptions};
 use crate::plot::Chart;
 
 mod fig1;
