@@ -1,6 +1,6 @@
 //! Ensemble studies (`asperity study alpha|curve`) in the CLI's checkpoint folders.
 //!
-//! [`run_study`] follows the CLI's `execute` (crates/asperity-cli/src/commands/study.rs):
+//! [`run_study`] follows the CLI's `execute` (crates/asperity-cli/src/studies.rs):
 //! validate the spec, check memory, open the folder (same `study.json`, same
 //! `checkpoint/<task>.json`, same checkpoint interval), run every task with the library's
 //! `run_task`. A study started here resumes from the CLI and the other way round. Two

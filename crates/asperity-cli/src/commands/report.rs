@@ -429,15 +429,16 @@ pub fn window_table(found: &[TaskSensitivity]) -> Table {
     ]);
     for t in found {
         for w in &t.windows {
-            table.push_numbers(&[
-                t.task.n as f64,
-                t.task.hurst,
-                w.window.min_contacts as f64,
-                w.window.max_fraction,
-                w.alpha,
-                w.low,
-                w.high,
-                w.samples as f64,
+            // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
+            table.push(&[
+                t.task.n.to_string(),
+                format_number(t.task.hurst),
+                w.window.min_contacts.to_string(),
+                format_number(w.window.max_fraction),
+                format_number(w.alpha),
+                format_number(w.low),
+                format_number(w.high),
+                w.samples.to_string(),
             ]);
         }
     }
