@@ -19,7 +19,9 @@ static UNFINISHED: Unfinished = Unfinished(Mutex::new(Vec::new()));
 impl Unfinished {
     fn lock(&self) -> MutexGuard<'_, Vec<PathBuf>> {
         // A panic while holding the lock leaves the list valid: keep using it.
-        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     /// Removes every listed path, newest first (so a file goes before its folder, and a

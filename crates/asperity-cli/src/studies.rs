@@ -5,11 +5,15 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
+use asperity::study::samplers::{BemSampler, OnLoad};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
-use asperity::study::{run_any_task, sample_cost, Method, StudyDir, StudySpec, TaskResult};
+use asperity::study::{
+    run_any_task_with_loads, sample_cost, Method, StudyDir, StudySpec, TaskResult,
+};
 use serde::Deserialize;
 
 use crate::output::{format_number, Table};
@@ -25,7 +29,6 @@ pub enum Kind {
     /// Mean curves table and plot.
     Curve,
 }
-
 
 /// How a study runs (not part of what it computes).
 #[derive(Debug, Clone, Copy)]
@@ -56,9 +59,9 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
 /// none). Nothing is created before every check has passed. Returns the task results in
 /// task order.
 ///
-/// The progress bar counts samples; its ETA weighs each sample by
-/// [`sample_cost`] and leaves out samples read back from checkpoints (see
-/// [`crate::progress`]).
+/// The progress bar counts samples (MDR) or solved loads (BEM, so that it moves within a
+/// sample); its ETA weighs each by [`sample_cost`] and leaves out samples read back from
+/// checkpoints (see [`crate::progress`]).
 pub fn execute(
     spec: &StudySpec,
     dir: &Path,
@@ -77,12 +80,7 @@ pub fn execute(
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
     let _lock = StudyDir::lock(dir)?;
     let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
-    let tasks = spec.tasks();
-    let segments: Vec<(u64, f64)> = tasks
-        .iter()
-        .map(|t| (spec.samples as u64, sample_cost(spec.method, t.n)))
-        .collect();
-    let progress = Progress::weighted(&format!("{} study", spec.method.name()), &segments, quiet);
+    let progress = Arc::new(study_progress(spec, quiet));
     let results = run_tasks(&store, &progress, quiet)?;
     progress.finish();
     let (table, chart) = match kind {
@@ -100,38 +98,76 @@ pub fn execute(
     Ok(results)
 }
 
+/// The progress steps of one sample: a BEM sample reports each of its loads (a 512²
+/// sample takes minutes), an MDR sample (milliseconds) only itself.
+fn steps_per_sample(method: Method) -> u64 {
+    match method {
+        Method::Bem => BemSampler::LOADS as u64,
+        Method::Mdr => 1,
+    }
+}
+
+/// The progress of a study: in samples, or in loads for BEM ([`steps_per_sample`]), each
+/// step weighed by its cost ([`sample_cost`] shared by a sample's steps).
+fn study_progress(spec: &StudySpec, quiet: bool) -> Progress {
+    let steps = steps_per_sample(spec.method);
+    let segments: Vec<(u64, f64)> = spec
+        .tasks()
+        .iter()
+        .map(|t| {
+            let cost = sample_cost(spec.method, t.n) / steps as f64;
+            (spec.samples as u64 * steps, cost)
+        })
+        .collect();
+    let name = match spec.method {
+        Method::Bem => "bem study (loads)",
+        Method::Mdr => "mdr study",
+    };
+    Progress::weighted(name, &segments, quiet)
+}
+
 /// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
 /// an MPI job of several ranks, over all ranks ([`crate::distributed`]): the same
-/// results either way.
-fn run_tasks(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<Vec<TaskResult>> {
+/// results either way. Progress moves per sample, and per solved load of the BEM samples
+/// computed here.
+fn run_tasks(store: &StudyDir, progress: &Arc<Progress>, quiet: bool) -> Result<Vec<TaskResult>> {
+    let spec = store.spec();
+    let steps = steps_per_sample(spec.method);
     #[cfg(feature = "mpi")]
     if crate::distributed::active() {
         let progress = |done, restored| {
             if restored {
-                progress.restore(done)
+                progress.restore(done * steps)
             } else {
-                progress.set(done)
+                progress.set(done * steps)
             }
         };
         return crate::distributed::run_study(store, &progress, quiet);
     }
     // Without MPI, `quiet` is the progress bar's alone.
     let _ = quiet;
-    let spec = store.spec();
     let tasks = spec.tasks();
+    // Every load solved in this run is one step; at the end of a batch of samples the
+    // count is set to what the finished samples hold, which all their loads reached.
+    let on_load = (steps > 1).then(|| {
+        let progress = Arc::clone(progress);
+        OnLoad::new(move || progress.inc())
+    });
     let mut results = Vec::with_capacity(tasks.len());
     for (i, task) in tasks.iter().enumerate() {
-        let offset = (i * spec.samples) as u64;
+        let offset = (i * spec.samples) as u64 * steps;
         // The first report of a task is what its checkpoint held (run_task's contract).
         let first = AtomicBool::new(true);
-        let result = run_any_task(spec, *task, store, &|done, _| {
+        let report = |done: usize, _| {
+            let done = offset + done as u64 * steps;
             if first.swap(false, Ordering::Relaxed) {
-                progress.restore(offset + done as u64)
+                progress.restore(done)
             } else {
-                progress.set(offset + done as u64)
+                progress.set(done)
             }
-        })
-        .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
+        };
+        let result = run_any_task_with_loads(spec, *task, store, &report, on_load.clone())
+            .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
         results.push(result);
     }
     Ok(results)
@@ -552,5 +588,4 @@ mod tests {
         assert!(((b.1 / a.1).ln() / (b.0 / a.0).ln() - 1.0).abs() < 1e-12);
         assert_eq!(b.0, 6.0);
     }
-
 }

@@ -603,3 +603,27 @@ fn a_finished_study_grows_by_another_n_or_h_reusing_its_checkpoints() {
     let csv = std::fs::read_to_string(d.join("g/alpha.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5, "header and 4 tasks: {csv}");
 }
+
+#[test]
+fn a_bem_study_reports_progress_per_solved_load() {
+    // 2 H × 3 samples × 24 loads: the log (stderr is no terminal here) counts loads.
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "study",
+        "alpha",
+        "--method",
+        "bem",
+        "--n",
+        "16",
+        "--hurst",
+        "0.5,1",
+        "--samples",
+        "3",
+        "--out",
+        "p",
+    ];
+    let out = asperity(&args, dir.path());
+    ok(&out);
+    let err = common::stderr(&out);
+    assert!(err.contains("bem study (loads): 144/144 ("), "{err}");
+}

@@ -59,7 +59,10 @@ fn the_watcher_sees_every_unfinished_path_until_it_is_finished() {
     assert_eq!(seen.len(), 3, "{seen:?}");
     assert!(seen.contains(&fields) && seen.contains(&deeper));
     assert!(seen.iter().all(|p| p.exists()));
-    let tmp = seen.iter().find(|p| p.to_string_lossy().ends_with(".tmp")).unwrap();
+    let tmp = seen
+        .iter()
+        .find(|p| p.to_string_lossy().ends_with(".tmp"))
+        .unwrap();
     assert_eq!(tmp.parent(), Some(deeper.as_path()));
 
     // Removing what is reported (what a signal handler does) leaves nothing behind.

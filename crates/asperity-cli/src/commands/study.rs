@@ -504,7 +504,6 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
 /// The longest `--checkpoint-every`, in seconds (about 11 days).
 const MAX_CHECKPOINT_EVERY: f64 = asperity::study::MAX_CHECKPOINT_INTERVAL_SECONDS;
 
-
 impl RunOptions {
     fn from_args(run: &RunArgs) -> Result<Self> {
         anyhow::ensure!(
@@ -592,7 +591,6 @@ fn announce_bem(spec: &StudySpec) -> Result<()> {
     );
     Ok(())
 }
-
 
 #[cfg(test)]
 mod tests {

@@ -55,7 +55,7 @@ pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
 pub use ledger::Ledger;
-pub use samplers::{run_any_task, Scales, TaskSamples};
+pub use samplers::{run_any_task, run_any_task_with_loads, Scales, TaskSamples};
 
 use crate::fit::PowerLawFit;
 use crate::lock::FolderLock;

@@ -4,14 +4,14 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::range::parse_range;
 use anyhow::Result;
 use asperity::study::theory::alpha_theory;
 use asperity::study::{Method, TaskResult};
-use crate::range::parse_range;
 
 use super::super::setting::Setting;
-use crate::studies::{write_alpha, Kind};
 use super::{announce, describe_hursts, figure_study, study_spec};
+use crate::studies::{write_alpha, Kind};
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {
     let mut md = String::from("| method | N | H | α (ensemble fit) | 95 % of samples | theory |\n|---|---|---|---|---|---|\n");

@@ -9,8 +9,8 @@ use anyhow::Result;
 use asperity::study::Method;
 
 use super::super::setting::Setting;
-use crate::studies::{write_curves, Kind};
 use super::{announce, figure_study, study_spec};
+use crate::studies::{write_curves, Kind};
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
 pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {

@@ -9,10 +9,10 @@ use asperity::study::theory::alpha_white_noise;
 use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use crate::studies::Kind;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};
+use crate::studies::Kind;
 
 /// How a row's N counts modes: the paper plots each BEM grid twice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

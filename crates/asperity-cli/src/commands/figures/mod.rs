@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use asperity::study::{FitWindow, Method, StudySpec, TaskResult};
 
 use super::setting::Setting;
-use crate::studies::{execute, Kind, RunOptions};
 use crate::plot::Chart;
+use crate::studies::{execute, Kind, RunOptions};
 
 mod fig1;
 mod fig15_1;
