@@ -5,6 +5,7 @@ mod cli;
 mod commands;
 #[cfg(feature = "mpi")]
 mod distributed;
+mod estimate;
 mod interrupt;
 mod output;
 mod plot;

@@ -560,19 +560,19 @@ pub fn run(args: &StudyArgs) -> Result<()> {
 const ESTIMATE_FROM_N: usize = 256;
 
 /// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
-/// ([`super::bench::estimate_bem_seconds`]), for the whole study: tasks already
+/// ([`crate::estimate::estimate_bem_seconds`]), for the whole study: tasks already
 /// checkpointed in the folder take less.
 fn announce_bem(spec: &StudySpec) -> Result<()> {
     if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
         return Ok(());
     }
-    let study = super::bench::BemStudy {
+    let study = crate::estimate::BemStudy {
         sizes: &spec.sizes,
         samples: spec.samples,
         hursts: &spec.hursts,
         rolloff: spec.rolloff,
     };
-    let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+    let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
     let minutes = estimate.seconds / 60.0;
     eprintln!(
         "bem study: N = {:?}, {} H, {} samples each: estimated {} on this machine ({} lanes; \

@@ -104,7 +104,7 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`super::bench::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
+/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
 fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)]) -> Result<()> {
     if setting == Setting::Quick {
         // Minutes: the report states the setting; stderr stays for errors.
@@ -119,13 +119,13 @@ fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)
             describe_hursts(&spec.hursts)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
-            let study = super::bench::BemStudy {
+            let study = crate::estimate::BemStudy {
                 sizes: &spec.sizes,
                 samples: spec.samples,
                 hursts: &spec.hursts,
                 rolloff: *rolloff,
             };
-            let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+            let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
             eprintln!(
                 "{figure}: estimated BEM time on this machine {:.1} h ({} lanes; checkpointed: \
                  an interrupted run resumes with the same command)",
