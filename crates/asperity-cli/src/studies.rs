@@ -240,20 +240,10 @@ pub fn write_alpha(
 
 /// The rows of `alpha.csv`.
 fn alpha_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::new(&[
-        "method",
-        "n",
-        "hurst",
-        "alpha",
-        "alpha_low",
-        "alpha_high",
-        "samples",
-        "alpha_fit_low",
-        "alpha_fit_high",
-        "alpha_sample_mean",
-        "samples_fitted",
-        "alpha_theory",
-    ]);
+    let mut table = Table::with_header(
+        "method,n,hurst,alpha,alpha_low,alpha_high,samples,alpha_fit_low,alpha_fit_high,\
+         alpha_sample_mean,samples_fitted,alpha_theory",
+    );
     for r in results {
         let (lo, hi) = r.alpha_sample_interval().unzip();
         table.push(&[
@@ -447,17 +437,9 @@ pub fn write_curves(
 
 /// The rows of `curve.csv`.
 fn curve_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::new(&[
-        "method",
-        "n",
-        "hurst",
-        "force",
-        "stiffness",
-        "stiffness_low",
-        "stiffness_high",
-        "samples",
-        "area_fraction",
-    ]);
+    let mut table = Table::with_header(
+        "method,n,hurst,force,stiffness,stiffness_low,stiffness_high,samples,area_fraction",
+    );
     for r in results {
         for p in &r.mean_curve {
             table.push(&[

@@ -608,20 +608,9 @@ fn a_finished_study_grows_by_another_n_or_h_reusing_its_checkpoints() {
 fn a_bem_study_reports_progress_per_solved_load() {
     // 2 H × 3 samples × 24 loads: the log (stderr is no terminal here) counts loads.
     let dir = tempfile::tempdir().unwrap();
-    let args = [
-        "study",
-        "alpha",
-        "--method",
-        "bem",
-        "--n",
-        "16",
-        "--hurst",
-        "0.5,1",
-        "--samples",
-        "3",
-        "--out",
-        "p",
-    ];
+    let args: Vec<&str> = "study alpha --method bem --n 16 --hurst 0.5,1 --samples 3 --out p"
+        .split(' ')
+        .collect();
     let out = asperity(&args, dir.path());
     ok(&out);
     let err = common::stderr(&out);

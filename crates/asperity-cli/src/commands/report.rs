@@ -428,18 +428,14 @@ pub fn window_table(found: &[TaskSensitivity]) -> Table {
         "samples",
     ]);
     for t in found {
+        let n = t.task.n.to_string();
         for w in &t.windows {
             // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
-            table.push(&[
-                t.task.n.to_string(),
-                format_number(t.task.hurst),
-                w.window.min_contacts.to_string(),
-                format_number(w.window.max_fraction),
-                format_number(w.alpha),
-                format_number(w.low),
-                format_number(w.high),
-                w.samples.to_string(),
-            ]);
+            let mut row = vec![n.clone(), format_number(t.task.hurst)];
+            row.push(w.window.min_contacts.to_string());
+            row.extend([w.window.max_fraction, w.alpha, w.low, w.high].map(format_number));
+            row.push(w.samples.to_string());
+            table.push(&row);
         }
     }
     table
