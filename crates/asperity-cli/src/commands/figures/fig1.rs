@@ -4,13 +4,14 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::range::parse_range;
 use anyhow::Result;
 use asperity::study::theory::alpha_theory;
-use asperity::study::{parse_range, Method, TaskResult};
+use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use super::super::study::{write_alpha, Kind};
 use super::{announce, describe_hursts, figure_study, study_spec};
+use crate::studies::{write_alpha, Kind};
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {
     let mut md = String::from("| method | N | H | α (ensemble fit) | 95 % of samples | theory |\n|---|---|---|---|---|---|\n");
@@ -67,10 +68,5 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         mdr.window.describe(),
         alpha_rows_md(&all)
     );
-    crate::commands::report::write(
-        dir,
-        crate::commands::report::Results::Fig1(&all),
-        &report,
-        force,
-    )
+    crate::report::write(dir, crate::report::Results::Fig1(&all), &report, force)
 }

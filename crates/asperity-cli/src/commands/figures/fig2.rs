@@ -9,8 +9,8 @@ use anyhow::Result;
 use asperity::study::Method;
 
 use super::super::setting::Setting;
-use super::super::study::{write_curves, Kind};
 use super::{announce, figure_study, study_spec};
+use crate::studies::{write_curves, Kind};
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
 pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {
@@ -25,7 +25,7 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
          |---|---|---|---|\n",
     );
     for r in &results {
-        let (steepest, fractions) = match crate::commands::report::steepest_slope(r, &spec.window) {
+        let (steepest, fractions) = match crate::report::steepest_slope(r, &spec.window) {
             Some((slope, first, last)) => {
                 (format!("{slope:.3}"), format!("{first:.2e} – {last:.2e}"))
             }
@@ -60,9 +60,9 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         setting.describe(),
         min_contacts = spec.window.min_contacts,
     );
-    crate::commands::report::write(
+    crate::report::write(
         dir,
-        crate::commands::report::Results::Fig2(&results, spec.window),
+        crate::report::Results::Fig2(&results, spec.window),
         &report,
         force,
     )

@@ -9,10 +9,10 @@ use asperity::study::theory::alpha_white_noise;
 use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use super::super::study::Kind;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};
+use crate::studies::Kind;
 
 /// How a row's N counts modes: the paper plots each BEM grid twice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -124,8 +124,8 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         bem.samples,
         mdr.window.describe()
     );
-    let results = crate::commands::report::Results::Fig5(&mdr_results, &bem_results);
-    crate::commands::report::write(dir, results, &report, force)
+    let results = crate::report::Results::Fig5(&mdr_results, &bem_results);
+    crate::report::write(dir, results, &report, force)
 }
 
 fn write_table(dir: &Path, rows: &[Row], force: bool) -> Result<()> {

@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use asperity::study::{FitWindow, Method, StudySpec, TaskResult};
 
 use super::setting::Setting;
-use super::study::{execute, Kind, RunOptions};
 use crate::plot::Chart;
+use crate::studies::{execute, Kind, RunOptions};
 
 mod fig1;
 mod fig15_1;
@@ -27,11 +27,7 @@ pub use fig2::fig2;
 pub use fig5::fig5;
 pub use fig6::fig6;
 
-/// Writes `report.md` atomically.
-pub fn write_report(dir: &Path, text: &str, force: bool) -> Result<()> {
-    asperity::io::write_bytes(&dir.join("report.md"), force, text.as_bytes())?;
-    Ok(())
-}
+pub use crate::report::write_report;
 
 /// Output files of one book figure, checked before any work.
 struct Outputs {
@@ -104,7 +100,7 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`super::bench::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
+/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
 fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)]) -> Result<()> {
     if setting == Setting::Quick {
         // Minutes: the report states the setting; stderr stays for errors.
@@ -119,13 +115,13 @@ fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)
             describe_hursts(&spec.hursts)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
-            let study = super::bench::BemStudy {
+            let study = crate::estimate::BemStudy {
                 sizes: &spec.sizes,
                 samples: spec.samples,
                 hursts: &spec.hursts,
                 rolloff: *rolloff,
             };
-            let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+            let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
             eprintln!(
                 "{figure}: estimated BEM time on this machine {:.1} h ({} lanes; checkpointed: \
                  an interrupted run resumes with the same command)",
