@@ -118,6 +118,54 @@ pub struct BemStudy<'a> {
     pub hursts: &'a [f64],
     /// Roll-off wavenumber q0 L/2π, if any.
     pub rolloff: Option<f64>,
+    /// Samples of `(N, H)` already checkpointed (not computed again), if any: see
+    /// [`stored_samples`].
+    pub stored: &'a [StoredSamples],
+}
+
+/// Samples of one task of a study already in its checkpoints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StoredSamples {
+    /// Grid size.
+    pub n: usize,
+    /// Hurst exponent.
+    pub hurst: f64,
+    /// Samples stored (at most the study's count).
+    pub samples: usize,
+}
+
+/// The samples of `spec`'s tasks already stored in the study folder `dir` (none when the
+/// folder holds no study or another one: the estimate is then for the whole study).
+pub fn stored_samples(
+    dir: &std::path::Path,
+    spec: &asperity::study::StudySpec,
+) -> Vec<StoredSamples> {
+    let Ok(store) = asperity::study::StudyDir::read(dir) else {
+        return Vec::new();
+    };
+    spec.tasks()
+        .into_iter()
+        .filter_map(|task| {
+            let samples = store.stored_samples(task).ok()?.len().min(spec.samples);
+            Some(StoredSamples {
+                n: task.n,
+                hurst: task.hurst,
+                samples,
+            })
+        })
+        .collect()
+}
+
+impl BemStudy<'_> {
+    /// Samples of `(n, hurst)` still to compute.
+    fn samples_left(&self, n: usize, hurst: f64) -> usize {
+        let stored = self
+            .stored
+            .iter()
+            .find(|s| s.n == n && s.hurst == hurst)
+            .map_or(0, |s| s.samples);
+        self.samples.saturating_sub(stored)
+    }
 }
 
 /// The estimate of one grid size (`asperity bench bem-estimate`).
@@ -154,24 +202,27 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
         let large = sample_iterations(probes.1, hurst, study.rolloff)?;
         counts.push(((small.0, large.0), (small.1, large.1)));
     }
-    let samples_per_lane = study.samples.div_ceil(lanes) as f64;
     let mut per_size = Vec::with_capacity(study.sizes.len());
     for &n in study.sizes {
         let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
-        // Iterations of one sample per H, summed over H.
-        let (solve, cg) = counts.iter().fold((0.0, 0.0), |(s, c), (solve, cg)| {
-            (
-                s + extrapolate(*solve, probes, n),
-                c + extrapolate(*cg, probes, n),
-            )
-        });
+        // Iterations of one sample, summed over H; and of the samples left per lane.
+        let (mut solve, mut cg, mut seconds) = (0.0, 0.0, 0.0);
+        for (&hurst, (solve_h, cg_h)) in study.hursts.iter().zip(&counts) {
+            let (solve_h, cg_h) = (
+                extrapolate(*solve_h, probes, n),
+                extrapolate(*cg_h, probes, n),
+            );
+            let per_lane = study.samples_left(n, hurst).div_ceil(lanes) as f64;
+            (solve, cg) = (solve + solve_h, cg + cg_h);
+            seconds += per_lane * (solve_h * c_solve + cg_h * c_cg);
+        }
         per_size.push(SizeEstimate {
             n,
             solve_iterations: solve,
             cg_iterations: cg,
             solve_iteration_s: c_solve,
             cg_iteration_s: c_cg,
-            seconds: samples_per_lane * (solve * c_solve + cg * c_cg),
+            seconds,
         });
     }
     let seconds = per_size.iter().map(|s| s.seconds).sum();

@@ -259,6 +259,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         samples: args.samples,
         hursts: &hursts,
         rolloff: args.rolloff,
+        stored: &[],
     };
     let estimate = estimate_bem_seconds(&study, probes)?;
     let lanes = estimate.lanes;

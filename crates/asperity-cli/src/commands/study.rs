@@ -565,7 +565,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         }
     };
     if spec.method == Method::Bem && !options.quiet {
-        announce_bem(&spec)?;
+        announce_bem(&spec, out)?;
     }
     execute(&spec, out, options, kind)?;
     Ok(())
@@ -576,26 +576,33 @@ pub fn run(args: &StudyArgs) -> Result<()> {
 const ESTIMATE_FROM_N: usize = 256;
 
 /// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
-/// ([`crate::estimate::estimate_bem_seconds`]), for the whole study: tasks already
-/// checkpointed in the folder take less.
-fn announce_bem(spec: &StudySpec) -> Result<()> {
+/// ([`crate::estimate::estimate_bem_seconds`]) for the samples not yet checkpointed in
+/// `out`.
+fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
     if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
         return Ok(());
     }
+    let stored = crate::estimate::stored_samples(out, spec);
     let study = crate::estimate::BemStudy {
         sizes: &spec.sizes,
         samples: spec.samples,
         hursts: &spec.hursts,
         rolloff: spec.rolloff,
+        stored: &stored,
     };
     let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
     let minutes = estimate.seconds / 60.0;
+    let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(
-        "bem study: N = {:?}, {} H, {} samples each: estimated {} on this machine ({} lanes; \
+        "bem study: N = {:?}, {} H, {} samples each{}: estimated {} on this machine ({} lanes; \
          checkpointed: an interrupted run resumes with the same command)",
         spec.sizes,
         spec.hursts.len(),
         spec.samples,
+        match stored {
+            0 => String::new(),
+            s => format!(" ({s} already checkpointed, not counted)"),
+        },
         if estimate.seconds < 120.0 {
             format!("{:.0} s", estimate.seconds)
         } else if minutes < 120.0 {

@@ -40,7 +40,7 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let mdr = study_spec(Method::Mdr, mdr_sizes, hursts, mdr_samples, None);
     let plan = setting.fig1_bem()?;
     let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
-    announce("fig1", setting, &[(&bem, None)])?;
+    announce("fig1", setting, dir, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();

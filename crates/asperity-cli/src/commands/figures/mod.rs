@@ -101,7 +101,12 @@ fn describe_hursts(hursts: &[f64]) -> String {
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
 /// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
-fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)]) -> Result<()> {
+fn announce(
+    figure: &str,
+    setting: Setting,
+    dir: &Path,
+    studies: &[(&StudySpec, Option<f64>)],
+) -> Result<()> {
     if setting == Setting::Quick {
         // Minutes: the report states the setting; stderr stays for errors.
         return Ok(());
@@ -115,17 +120,24 @@ fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)
             describe_hursts(&spec.hursts)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
+            let stored = crate::estimate::stored_samples(&dir.join("bem"), spec);
             let study = crate::estimate::BemStudy {
                 sizes: &spec.sizes,
                 samples: spec.samples,
                 hursts: &spec.hursts,
                 rolloff: *rolloff,
+                stored: &stored,
             };
             let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
+            let stored: usize = stored.iter().map(|s| s.samples).sum();
             eprintln!(
-                "{figure}: estimated BEM time on this machine {:.1} h ({} lanes; checkpointed: \
-                 an interrupted run resumes with the same command)",
+                "{figure}: estimated BEM time on this machine {:.1} h{} ({} lanes; \
+                 checkpointed: an interrupted run resumes with the same command)",
                 estimate.seconds / 3600.0,
+                match stored {
+                    0 => String::new(),
+                    s => format!(" for the samples left ({s} already checkpointed)"),
+                },
                 estimate.lanes
             );
         }
