@@ -4,7 +4,6 @@
 //! these from here, not from each other.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -12,7 +11,7 @@ use anyhow::{Context, Result};
 use asperity::study::samplers::{BemSampler, OnLoad};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    run_any_task_with_loads, sample_cost, Method, StudyDir, StudySpec, TaskResult,
+    run_any_task_with_loads, sample_cost, Method, Restored, StudyDir, StudySpec, TaskResult,
 };
 use serde::Deserialize;
 
@@ -80,8 +79,9 @@ pub fn execute(
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
     let _lock = StudyDir::lock(dir)?;
     let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
-    let progress = Arc::new(study_progress(spec, quiet));
-    let results = run_tasks(&store, &progress, quiet)?;
+    let stored = stored_per_task(&store)?;
+    let progress = Arc::new(study_progress(spec, &stored, quiet));
+    let results = run_tasks(&store, &stored, &progress, quiet)?;
     progress.finish();
     let (table, chart) = match kind {
         Kind::Alpha => (
@@ -107,34 +107,68 @@ fn steps_per_sample(method: Method) -> u64 {
     }
 }
 
-/// The progress of a study: in samples, or in loads for BEM ([`steps_per_sample`]), each
-/// step weighed by its cost ([`sample_cost`] shared by a sample's steps).
-fn study_progress(spec: &StudySpec, quiet: bool) -> Progress {
-    let steps = steps_per_sample(spec.method);
-    let segments: Vec<(u64, f64)> = spec
-        .tasks()
+/// The samples of each task of `store`'s study that its checkpoints hold, in task order:
+/// what [`run_any_task_with_loads`] will restore instead of computing.
+fn stored_per_task(store: &StudyDir) -> Result<Vec<usize>> {
+    let spec = store.spec();
+    spec.tasks()
         .iter()
-        .map(|t| {
-            let cost = sample_cost(spec.method, t.n) / steps as f64;
-            (spec.samples as u64 * steps, cost)
+        .map(|&task| {
+            Ok(match store.restore(task)? {
+                Restored::Done(_) => spec.samples,
+                Restored::Partial(samples) => samples.len().min(spec.samples),
+            })
         })
-        .collect();
+        .collect()
+}
+
+/// The progress of a study: in samples, or in loads for BEM ([`steps_per_sample`]), each
+/// step weighed by its cost ([`sample_cost`] shared by a sample's steps). The steps of the
+/// samples already `stored` (per task) come first and are counted as restored at once, so
+/// that a resumed study shows all it holds and its ETA covers only the samples left; then
+/// the samples left, task by task.
+fn study_progress(spec: &StudySpec, stored: &[usize], quiet: bool) -> Progress {
+    let steps = steps_per_sample(spec.method);
+    let segments = progress_segments(spec, stored);
     let name = match spec.method {
         Method::Bem => "bem study (loads)",
         Method::Mdr => "mdr study",
     };
-    Progress::weighted(name, &segments, quiet)
+    let progress = Progress::weighted(name, &segments, quiet);
+    progress.restore(stored.iter().sum::<usize>() as u64 * steps);
+    progress
+}
+
+/// The `(steps, cost of each)` runs of [`study_progress`]: the stored samples of every
+/// task, then the samples left of every task.
+fn progress_segments(spec: &StudySpec, stored: &[usize]) -> Vec<(u64, f64)> {
+    let steps = steps_per_sample(spec.method);
+    let tasks = spec.tasks();
+    let cost = |t: &asperity::study::Task| sample_cost(spec.method, t.n) / steps as f64;
+    let held = tasks
+        .iter()
+        .zip(stored)
+        .map(|(t, &s)| (s as u64 * steps, cost(t)));
+    let left =
+        (tasks.iter().zip(stored)).map(|(t, &s)| ((spec.samples - s) as u64 * steps, cost(t)));
+    held.chain(left).collect()
 }
 
 /// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
 /// an MPI job of several ranks, over all ranks ([`crate::distributed`]): the same
 /// results either way. Progress moves per sample, and per solved load of the BEM samples
 /// computed here.
-fn run_tasks(store: &StudyDir, progress: &Arc<Progress>, quiet: bool) -> Result<Vec<TaskResult>> {
+fn run_tasks(
+    store: &StudyDir,
+    stored: &[usize],
+    progress: &Arc<Progress>,
+    quiet: bool,
+) -> Result<Vec<TaskResult>> {
     let spec = store.spec();
     let steps = steps_per_sample(spec.method);
     #[cfg(feature = "mpi")]
     if crate::distributed::active() {
+        // The ledger counts samples held in all: the restored ones first, as the bar does.
         let progress = |done, restored| {
             if restored {
                 progress.restore(done * steps)
@@ -153,22 +187,18 @@ fn run_tasks(store: &StudyDir, progress: &Arc<Progress>, quiet: bool) -> Result<
         let progress = Arc::clone(progress);
         OnLoad::new(move || progress.inc())
     });
+    // Task i's computed samples follow every stored sample and the samples left of the
+    // tasks before it (`study_progress`).
+    let mut offset = stored.iter().sum::<usize>() as u64 * steps;
     let mut results = Vec::with_capacity(tasks.len());
-    for (i, task) in tasks.iter().enumerate() {
-        let offset = (i * spec.samples) as u64 * steps;
-        // The first report of a task is what its checkpoint held (run_task's contract).
-        let first = AtomicBool::new(true);
+    for (task, &held) in tasks.iter().zip(stored) {
         let report = |done: usize, _| {
-            let done = offset + done as u64 * steps;
-            if first.swap(false, Ordering::Relaxed) {
-                progress.restore(done)
-            } else {
-                progress.set(done)
-            }
+            progress.set(offset + done.saturating_sub(held) as u64 * steps);
         };
         let result = run_any_task_with_loads(spec, *task, store, &report, on_load.clone())
             .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
         results.push(result);
+        offset += (spec.samples - held) as u64 * steps;
     }
     Ok(results)
 }
@@ -537,6 +567,34 @@ fn slope_one(results: &[TaskResult]) -> Option<Series> {
 mod tests {
     use super::*;
     use asperity::study::{EnsemblePoint, Task};
+
+    #[test]
+    fn a_resumed_study_counts_what_its_checkpoints_hold_and_times_only_what_is_left() {
+        // Two tasks (N = 64, 128) of 4 samples; the second task's checkpoint holds 3, the
+        // first none: the bar starts at 3 samples' loads, and the cost left is that of the
+        // 4 + 1 samples to compute, whatever the task order.
+        let spec = StudySpec {
+            method: Method::Bem,
+            sizes: vec![64, 128],
+            hursts: vec![0.5],
+            samples: 4,
+            rolloff: None,
+            seed: 1,
+            window: asperity::study::FitWindow::default(),
+            levels: 48,
+        };
+        let segments = progress_segments(&spec, &[0, 3]);
+        let mut eta = crate::progress::Eta::weighted(&segments);
+        let loads = BemSampler::LOADS as u64;
+        assert_eq!(eta.total(), 8 * loads);
+        eta.restore(0, 3 * loads);
+        let (small, large) = (sample_cost(Method::Bem, 64), sample_cost(Method::Bem, 128));
+        let left = eta.cost_to(eta.total()) - eta.cost_to(3 * loads);
+        assert!((left - (4.0 * small + large)).abs() < 1e-6 * left, "{left}");
+        // One sample of N = 64 computed in 10 s: 10 s per `small`, the rest in proportion.
+        let eta_s = eta.remaining(4 * loads, 10.0).unwrap();
+        assert!((eta_s - 10.0 * (3.0 * small + large) / small).abs() < 1e-9 * eta_s);
+    }
 
     fn result(lows: &[f64]) -> TaskResult {
         let point = |i: usize, &low: &f64| EnsemblePoint {
