@@ -12,6 +12,9 @@ mod bem;
 mod errors;
 mod interrupt;
 mod mdr;
+/// The CLI's `--hurst` syntax, one parser for both front ends.
+#[path = "../../crates/asperity-cli/src/range.rs"]
+mod range;
 mod study;
 mod surface;
 mod topography;

@@ -1,6 +1,6 @@
 //! Ensemble studies (`asperity study alpha|curve`) in the CLI's checkpoint folders.
 //!
-//! [`run_study`] follows the CLI's `execute` (crates/asperity-cli/src/commands/study.rs):
+//! [`run_study`] follows the CLI's `execute` (crates/asperity-cli/src/studies.rs):
 //! validate the spec, check memory, open the folder (same `study.json`, same
 //! `checkpoint/<task>.json`, same checkpoint interval), run every task with the library's
 //! `run_task`. A study started here resumes from the CLI and the other way round. Two
@@ -16,7 +16,7 @@ use asperity::lock::FolderLock;
 use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
-    parse_range, run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec,
+    run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec,
     Task, TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 use asperity::Error;
@@ -25,6 +25,7 @@ use serde_json::json;
 
 use crate::errors::{from_error, invalid};
 use crate::interrupt::{run_detached, Cancel};
+use crate::range::parse_range;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_study, m)?)?;

@@ -5,10 +5,15 @@ mod cli;
 mod commands;
 #[cfg(feature = "mpi")]
 mod distributed;
+mod estimate;
+mod interrupt;
 mod output;
 mod plot;
 mod progress;
+mod range;
+mod report;
 mod rerun;
+mod studies;
 
 use clap::Parser;
 
@@ -44,19 +49,8 @@ fn run() -> i32 {
             return 2;
         }
     };
-    // Ctrl-C, SIGTERM or SIGHUP: remove the temporary files of outputs not yet renamed into
-    // place (finished outputs and study checkpoints stay; a study resumes from them), then
-    // exit with the conventional status 130.
-    let interrupted = ctrlc::set_handler(|| {
-        asperity::io::abandon_unfinished_outputs();
-        eprintln!("interrupted: unfinished outputs removed (a study resumes when run again)");
-        std::process::exit(130);
-    });
-    if let Err(err) = interrupted {
-        eprintln!(
-            "warning: no interrupt handler ({err}); an interrupted run may leave hidden .tmp files"
-        );
-    }
+    // Ctrl-C, SIGTERM or SIGHUP: unfinished outputs are removed, status 130.
+    interrupt::install();
     // The command runs on a thread of rayon's pool, so that its parallel loops (FFT
     // passes, the solvers' chunked passes, a study's lanes) run there directly: called from
     // the main thread, every one of them would be handed to the pool and waited for (two

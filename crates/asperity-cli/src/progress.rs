@@ -10,7 +10,8 @@
 //! * steps may weigh differently ([`Progress::weighted`]): a study weighs each sample by
 //!   its cost, `N² log₂ N` for BEM and `N log₂ N` for MDR
 //!   ([`asperity::study::sample_cost`]), so a sweep whose large grids come last does not
-//!   promise to end early.
+//!   promise to end early. A BEM study counts solved loads (24 a sample, each a 24th of
+//!   its sample's cost), so that the line and its ETA move while a large sample runs.
 //!
 //! Until a step is done in this run the ETA is unknown (`?` on the bar; no log line).
 

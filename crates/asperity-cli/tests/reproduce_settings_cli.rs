@@ -146,7 +146,7 @@ fn check_windows(fig: &Path) {
         let (n, h, a) = (f[1], f[2], f[3]);
         let default = windows
             .lines()
-            .find(|l| l.starts_with(&format!("{n}.0,{h},8.0,0.01,")))
+            .find(|l| l.starts_with(&format!("{n},{h},8,0.01,")))
             .unwrap_or_else(|| panic!("no default window for N = {n}, H = {h}:\n{windows}"));
         assert_eq!(default.split(',').nth(4).unwrap(), a, "{default} vs {line}");
         checked += 1;

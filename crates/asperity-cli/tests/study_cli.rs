@@ -696,3 +696,16 @@ fn compare_writes_slopes_with_intervals_and_verdicts_and_refuses_unfinished_stud
         "not finished",
     );
 }
+
+#[test]
+fn a_bem_study_reports_progress_per_solved_load() {
+    // 2 H × 3 samples × 24 loads: the log (stderr is no terminal here) counts loads.
+    let dir = tempfile::tempdir().unwrap();
+    let args: Vec<&str> = "study alpha --method bem --n 16 --hurst 0.5,1 --samples 3 --out p"
+        .split(' ')
+        .collect();
+    let out = asperity(&args, dir.path());
+    ok(&out);
+    let err = common::stderr(&out);
+    assert!(err.contains("bem study (loads): 144/144 ("), "{err}");
+}

@@ -149,8 +149,8 @@ pub fn short_number(v: f64) -> String {
     }
 }
 
-/// At most 40 characters of untrusted text on one line.
-fn clip(text: &str) -> String {
+/// At most 40 characters of untrusted text on one line (for messages that quote it).
+pub fn clip(text: &str) -> String {
     let line = one_line(text);
     if line.chars().count() <= 40 {
         line

@@ -7,9 +7,10 @@
 //! after every one was written, so a failure part-way leaves none of them. Outputs are
 //! checked before any work starts: each one's folder must exist, none may be a folder,
 //! none may be named twice, and none may already exist unless `force` is set.
-//! The temporary files (and folders made for outputs) of unfinished outputs are also listed
-//! process-wide, so that a program interrupted by a signal can remove them before it exits
-//! ([`abandon_unfinished_outputs`]).
+//! A program that exits on a signal (and so runs no destructor) can learn of every
+//! temporary file and folder of an unfinished output through an [`OutputWatcher`] it
+//! installs ([`watch_outputs`]) and remove them before it exits; the library keeps no list
+//! of its own.
 //! Inputs are validated on reading: `.npy` files are read by the bounded parser of
 //! [`crate::npy`] (regular files only, any real dtype converted to float64 losslessly, C or
 //! Fortran order), must have the expected number of dimensions, and contain finite values
@@ -18,7 +19,7 @@
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::OnceLock;
 
 use ndarray::{Array1, Array2, ArrayBase, ArrayD, Data, Ix1, Ix2};
 use ndarray_npy::WriteNpyExt;
@@ -45,43 +46,48 @@ pub fn ensure_new_output(path: &Path, force: bool) -> Result<()> {
     Ok(())
 }
 
-/// Temporary files and folders of this process's unfinished outputs (see the module docs).
-struct Unfinished {
-    files: Vec<PathBuf>,
-    folders: Vec<PathBuf>,
-}
-
-static UNFINISHED: Mutex<Unfinished> = Mutex::new(Unfinished {
-    files: Vec::new(),
-    folders: Vec::new(),
-});
-
-fn unfinished() -> MutexGuard<'static, Unfinished> {
-    // A panic while holding the lock leaves the lists valid: keep using them.
-    UNFINISHED
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-fn forget_path(list: &mut Vec<PathBuf>, path: &Path) {
-    if let Some(i) = list.iter().rposition(|p| p == path) {
-        list.swap_remove(i);
+/// Told of the temporary files and folders of unfinished outputs, so that a front end that
+/// exits on a signal (without running destructors) can remove them first: installed once
+/// per process with [`watch_outputs`]. Every path reported by
+/// [`unfinished`](OutputWatcher::unfinished) is later reported by
+/// [`finished`](OutputWatcher::finished) (renamed into place, or removed) unless the
+/// process ends first.
+pub trait OutputWatcher: Send + Sync {
+    /// `path`, a temporary file or a folder made for outputs, now exists for an output that
+    /// is not committed yet.
+    fn unfinished(&self, path: &Path);
+    /// `path` no longer needs removing: renamed into place, removed, or (a folder) kept
+    /// because its outputs were committed.
+    fn finished(&self, path: &Path);
+    /// Runs `renames`, the renames of one [`StagedOutputs::commit`]. A watcher that removes
+    /// unfinished outputs on a signal runs them under the same lock as that removal, so a
+    /// commit is never cut in half; the default just runs them. `renames` calls neither of
+    /// the other two methods (they may take the same lock).
+    fn commit(&self, renames: &mut dyn FnMut()) {
+        renames();
     }
 }
 
-/// Removes the temporary files of every unfinished output of this process, and the empty
-/// folders made for them, then keeps the list locked, so that no output is renamed into
-/// place afterwards (a commit in progress completes first: its renames hold the same
-/// lock). For a signal handler that exits right after; later commits would wait forever.
-pub fn abandon_unfinished_outputs() {
-    let mut list = unfinished();
-    for file in list.files.drain(..) {
-        let _ = std::fs::remove_file(file);
+static WATCHER: OnceLock<&'static dyn OutputWatcher> = OnceLock::new();
+
+/// Installs the process's [`OutputWatcher`]; outputs staged before are not reported. Fails
+/// (giving the watcher back) when one is installed already.
+pub fn watch_outputs(
+    watcher: &'static dyn OutputWatcher,
+) -> std::result::Result<(), &'static dyn OutputWatcher> {
+    WATCHER.set(watcher)
+}
+
+fn unfinished(path: &Path) {
+    if let Some(w) = WATCHER.get() {
+        w.unfinished(path);
     }
-    for folder in list.folders.drain(..).rev() {
-        let _ = std::fs::remove_dir(folder); // only if empty
+}
+
+fn finished(path: &Path) {
+    if let Some(w) = WATCHER.get() {
+        w.finished(path);
     }
-    std::mem::forget(list);
 }
 
 /// The sidecar path of an array file: `surface.npy` → `surface.npy.json`.
@@ -308,9 +314,9 @@ impl StagedOutputs {
         let tmp = temp_path(target, index, extension);
         if let Some(old) = self.entries[index].tmp.take() {
             let _ = std::fs::remove_file(&old);
-            forget_path(&mut unfinished().files, &old);
+            finished(&old);
         }
-        unfinished().files.push(tmp.clone());
+        unfinished(&tmp);
         match write(&tmp) {
             Ok(()) => {
                 self.entries[index].tmp = Some(tmp);
@@ -318,7 +324,7 @@ impl StagedOutputs {
             }
             Err(e) => {
                 let _ = std::fs::remove_file(&tmp);
-                forget_path(&mut unfinished().files, &tmp);
+                finished(&tmp);
                 Err(e)
             }
         }
@@ -401,16 +407,35 @@ impl StagedOutputs {
             }
             ensure_new_output(&e.target, self.force)?;
         }
+        let (mut result, mut renamed) = (Ok(()), Vec::new());
+        let mut renames = || result = self.rename_all(&mut renamed);
+        match WATCHER.get() {
+            Some(w) => w.commit(&mut renames),
+            None => renames(),
+        }
+        // Told after the renames (outside the watcher's lock): a signal in between removes
+        // paths that are gone, or folders that are no longer empty, which fails harmlessly.
+        for tmp in &renamed {
+            finished(tmp);
+        }
+        result?;
+        for folder in self.created_folders.drain(..) {
+            finished(&folder);
+        }
+        Ok(())
+    }
+
+    /// The renames of [`StagedOutputs::commit`]: on a failure, the outputs already renamed
+    /// that did not exist before are removed again, and the temporary files not yet renamed
+    /// stay staged (removed on drop).
+    /// `done` receives the temporary files renamed.
+    fn rename_all(&mut self, done: &mut Vec<PathBuf>) -> Result<()> {
         let mut renamed: Vec<(PathBuf, bool)> = Vec::new();
-        // Held through the renames: an interrupting signal waits until all are done.
-        let mut list = unfinished();
         for e in &mut self.entries {
             let existed = e.target.exists();
             let Some(tmp) = e.tmp.take() else { continue };
-            forget_path(&mut list.files, &tmp);
             if let Err(err) = std::fs::rename(&tmp, &e.target) {
-                list.files.push(tmp.clone());
-                e.tmp = Some(tmp); // removed on drop
+                e.tmp = Some(tmp);
                 for (path, existed) in renamed {
                     if !existed {
                         let _ = std::fs::remove_file(path);
@@ -418,10 +443,8 @@ impl StagedOutputs {
                 }
                 return Err(Error::io(&e.target, err));
             }
+            done.push(tmp);
             renamed.push((e.target.clone(), existed));
-        }
-        for folder in self.created_folders.drain(..) {
-            forget_path(&mut list.folders, &folder);
         }
         Ok(())
     }
@@ -432,7 +455,7 @@ impl Drop for StagedOutputs {
         for e in &mut self.entries {
             if let Some(tmp) = e.tmp.take() {
                 let _ = std::fs::remove_file(&tmp);
-                forget_path(&mut unfinished().files, &tmp);
+                finished(&tmp);
             }
         }
         drop(CreatedFolders(std::mem::take(&mut self.created_folders)));
@@ -453,7 +476,7 @@ impl CreatedFolders {
         }
         for d in missing.into_iter().rev() {
             std::fs::create_dir(&d).map_err(|e| Error::io(&d, e))?;
-            unfinished().folders.push(d.clone());
+            unfinished(&d);
             self.0.push(d);
         }
         if !dir.is_dir() {
@@ -465,10 +488,9 @@ impl CreatedFolders {
 
 impl Drop for CreatedFolders {
     fn drop(&mut self) {
-        let mut list = unfinished();
         for dir in self.0.iter().rev() {
             let _ = std::fs::remove_dir(dir); // only if empty
-            forget_path(&mut list.folders, dir);
+            finished(dir);
         }
     }
 }

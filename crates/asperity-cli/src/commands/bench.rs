@@ -4,12 +4,14 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
 use asperity::elastic::{Boundary, ElasticOperator};
 use asperity::fft::RealFft2;
 use asperity::memory::{self, try_vec};
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
+
+use crate::estimate::{estimate_bem_seconds, BemStudy};
 
 /// What to time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -219,101 +221,6 @@ fn fft_pair_times(n: usize, boundary: Boundary, repeat: usize) -> Result<Vec<f64
     Ok(pairs)
 }
 
-/// Loads per sample and their range, as the study's BEM sampler
-/// (`asperity::study::samplers`): 24 mean pressures log-spaced from `0.05/N²` to `0.2` E*.
-fn study_pressures(n: usize) -> Vec<f64> {
-    const LOADS: usize = 24;
-    let (lo, hi) = (0.05 / (n * n) as f64, 0.2f64);
-    asperity::fit::log_levels(lo, hi, LOADS).collect()
-}
-
-/// The study's surface of size `n` and Hurst exponent `hurst` (unit rms slope, L = 1).
-fn study_surface(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<asperity::surface::Surface> {
-    let long = rolloff.map_or(LongWavelength::None, |q0| LongWavelength::RollOff { q0 });
-    let psd = Psd::new(hurst, long, None)?;
-    let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
-    Ok(SurfaceGenerator::new(&spec)?.try_generate(1)?)
-}
-
-const FREE: HalfSpace = HalfSpace {
-    modulus: 1.0,
-    boundary: Boundary::Free,
-};
-
-/// Solver and frozen-set CG iterations of one study sample (seed 1): the 24 loads solved in
-/// turn with warm starts, the stiffness after each.
-fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<(f64, f64)> {
-    let surface = study_surface(n, hurst, rolloff)?;
-    let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
-    let (mut solve, mut cg) = (0usize, 0usize);
-    for p in study_pressures(n) {
-        let (_, info) = solver.solve(Control::MeanPressure(p))?;
-        let (_, stiffness) = solver.frozen_set_stiffness()?;
-        solve += info.iterations;
-        cg += stiffness.iterations;
-    }
-    Ok((solve as f64, cg as f64))
-}
-
-/// Seconds per solver iteration and per frozen-set CG iteration on an `n × n` grid: solves
-/// and stiffness CGs cut off after a few iterations (their `NoConvergence` carries the
-/// count; one that converges earlier counts its own iterations), timed; the minimum of three.
-/// The CG runs on the contact set of a loose solve at p̄ = 0.01 E* (a few percent contact).
-fn iteration_costs(n: usize) -> Result<(f64, f64)> {
-    const CUT: usize = 6;
-    let surface = study_surface(n, 0.8, None)?;
-    let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
-    let loose = SolverParams {
-        tolerance: 1e-4,
-        ..SolverParams::default()
-    };
-    let cut = SolverParams {
-        max_iterations: CUT,
-        stiffness_max_iterations: CUT,
-        ..SolverParams::default()
-    };
-    let per_iteration = |result: std::result::Result<usize, SolveError>, start: Instant| {
-        let iterations = match result {
-            Ok(iterations) | Err(SolveError::NoConvergence { iterations, .. }) => iterations,
-            Err(e) => return Err(anyhow::Error::from(e)),
-        };
-        anyhow::ensure!(
-            iterations > 0,
-            "the cost probe at N = {n} took no iteration"
-        );
-        Ok(start.elapsed().as_secs_f64() / iterations as f64)
-    };
-    let (mut solve, mut cg) = (f64::INFINITY, f64::INFINITY);
-    for _ in 0..3 {
-        solver.set_params(loose)?;
-        solver.reset();
-        solver.solve(Control::MeanPressure(0.01))?;
-        solver.set_params(cut)?;
-        let start = Instant::now();
-        let result = solver
-            .frozen_set_stiffness()
-            .map(|(_, info)| info.iterations);
-        cg = cg.min(per_iteration(result, start)?);
-        solver.reset();
-        let start = Instant::now();
-        let result = solver
-            .solve(Control::MeanPressure(0.05))
-            .map(|(_, info)| info.iterations);
-        solve = solve.min(per_iteration(result, start)?);
-    }
-    Ok((solve, cg))
-}
-
-/// `count(n)` from counts at two probe sizes by the power law through them (exponent
-/// clamped at ≥ 0); the measured count at a probe size itself.
-fn extrapolate(count: (f64, f64), probes: (usize, usize), n: usize) -> f64 {
-    if n == probes.0 {
-        return count.0;
-    }
-    let slope = ((count.1 / count.0).ln() / (probes.1 as f64 / probes.0 as f64).ln()).max(0.0);
-    count.1 * (n as f64 / probes.1 as f64).powf(slope)
-}
-
 fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
     text.split(',')
         .map(|s| {
@@ -330,10 +237,10 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 /// solve_iteration_s cg_iteration_s seconds`, then `total_seconds` and `total_hours`.
 ///
 /// Per (N, H) one sample costs `I_solve·c_solve(N) + I_cg·c_cg(N)`: the per-iteration costs
-/// `c` are measured at each N on one thread ([`iteration_costs`], so they include everything
+/// `c` are measured at each N on one thread ([`crate::estimate`], so they include everything
 /// an iteration does on this machine), the iteration counts `I` of a whole 24-load sample are
-/// measured at the two probe sizes for every H ([`sample_iterations`]) and carried to N by
-/// the power law through them ([`extrapolate`]). A study runs its samples side by side, one
+/// measured at the two probe sizes for every H  and carried to N by
+/// the power law through them . A study runs its samples side by side, one
 /// lane per thread (`study::run_task`), so a task of S samples takes `⌈S/lanes⌉` sample
 /// times; total = Σ_N Σ_H ⌈S/lanes⌉ · sample time. Left out: the lanes' competition for
 /// memory bandwidth (the estimate is low where it matters, at large N on many lanes),
@@ -346,12 +253,13 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         [a, b] if a < b => (a, b),
         _ => anyhow::bail!("--probes takes two increasing sizes, got {:?}", args.probes),
     };
-    let hursts = asperity::study::parse_range(&args.hursts)?;
+    let hursts = crate::range::parse_range(&args.hursts)?;
     let study = BemStudy {
         sizes: &sizes,
         samples: args.samples,
         hursts: &hursts,
         rolloff: args.rolloff,
+        stored: &[],
     };
     let estimate = estimate_bem_seconds(&study, probes)?;
     let lanes = estimate.lanes;
@@ -376,80 +284,6 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         estimate.seconds / 3600.0
     );
     Ok(())
-}
-
-/// A BEM study to estimate: grids, samples per (N, H), H values and roll-off.
-pub struct BemStudy<'a> {
-    /// Grid sizes N.
-    pub sizes: &'a [usize],
-    /// Samples per (N, H).
-    pub samples: usize,
-    /// Hurst exponents.
-    pub hursts: &'a [f64],
-    /// Roll-off wavenumber q0 L/2π, if any.
-    pub rolloff: Option<f64>,
-}
-
-/// The estimate of one grid size (see [`estimate_bem_study`]).
-pub struct SizeEstimate {
-    pub n: usize,
-    pub solve_iterations: f64,
-    pub cg_iterations: f64,
-    pub solve_iteration_s: f64,
-    pub cg_iteration_s: f64,
-    pub seconds: f64,
-}
-
-/// The estimated wall time of a BEM study on this machine, per N and in all.
-pub struct StudyEstimate {
-    pub per_size: Vec<SizeEstimate>,
-    pub seconds: f64,
-    pub lanes: usize,
-}
-
-/// The up-front estimate of [`estimate_bem_study`] for `study`, iteration counts measured
-/// at the two `probes` sizes.
-pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<StudyEstimate> {
-    for n in study.sizes.iter().copied().chain([probes.0, probes.1]) {
-        memory::ensure_fits(
-            &format!("a BEM solver for a {n}x{n} grid"),
-            ContactSolver::memory_bytes(n, n, Boundary::Free),
-        )?;
-    }
-    let lanes = rayon::current_num_threads().max(1);
-    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let mut counts = Vec::with_capacity(study.hursts.len());
-    for &hurst in study.hursts {
-        let small = sample_iterations(probes.0, hurst, study.rolloff)?;
-        let large = sample_iterations(probes.1, hurst, study.rolloff)?;
-        counts.push(((small.0, large.0), (small.1, large.1)));
-    }
-    let samples_per_lane = study.samples.div_ceil(lanes) as f64;
-    let mut per_size = Vec::with_capacity(study.sizes.len());
-    for &n in study.sizes {
-        let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
-        // Iterations of one sample per H, summed over H.
-        let (solve, cg) = counts.iter().fold((0.0, 0.0), |(s, c), (solve, cg)| {
-            (
-                s + extrapolate(*solve, probes, n),
-                c + extrapolate(*cg, probes, n),
-            )
-        });
-        per_size.push(SizeEstimate {
-            n,
-            solve_iterations: solve,
-            cg_iterations: cg,
-            solve_iteration_s: c_solve,
-            cg_iteration_s: c_cg,
-            seconds: samples_per_lane * (solve * c_solve + cg * c_cg),
-        });
-    }
-    let seconds = per_size.iter().map(|s| s.seconds).sum();
-    Ok(StudyEstimate {
-        per_size,
-        seconds,
-        lanes,
-    })
 }
 
 /// `asperity bench bem-solve`: one line per boundary, mean pressure and solver,
@@ -517,37 +351,4 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn extrapolation_is_the_power_law_through_the_probes() {
-        let probes = (64, 128);
-        // Doubling per doubling of N: exponent 1.
-        assert_eq!(extrapolate((10.0, 20.0), probes, 64), 10.0);
-        assert!((extrapolate((10.0, 20.0), probes, 128) - 20.0).abs() < 1e-12);
-        assert!((extrapolate((10.0, 20.0), probes, 1024) - 160.0).abs() < 1e-9);
-        // ×1.45 per doubling (Polonsky–Keer's growth): 1.45³ from 128 to 1024.
-        let grown = extrapolate((100.0, 145.0), probes, 1024);
-        assert!((grown - 145.0 * 1.45f64.powi(3)).abs() < 1e-9, "{grown}");
-        // Fewer iterations at the larger probe: held flat, never extrapolated down.
-        assert_eq!(extrapolate((30.0, 20.0), probes, 1024), 20.0);
-    }
-
-    #[test]
-    fn study_pressures_span_the_samplers_range() {
-        for n in [16, 256, 1024] {
-            let p = study_pressures(n);
-            assert_eq!(p.len(), 24);
-            assert!((p[0] / (0.05 / (n * n) as f64) - 1.0).abs() < 1e-12);
-            assert!((p[23] / 0.2 - 1.0).abs() < 1e-12);
-            let ratio = p[1] / p[0];
-            assert!(p
-                .windows(2)
-                .all(|w| (w[1] / w[0] / ratio - 1.0).abs() < 1e-9));
-        }
-    }
 }

@@ -7,7 +7,6 @@ pub mod figures;
 pub mod import;
 pub mod mdr;
 pub mod measured;
-pub mod report;
 pub mod reproduce;
 pub mod setting;
 pub mod stats;

@@ -2,24 +2,19 @@
 //!
 //! Studies checkpoint into their output folder after every batch of samples; running the
 //! same command again resumes (Ctrl-C loses at most one batch) and gives bit-identical
-//! results. A folder that holds a different study is refused unless `--force`.
+//! results. A folder that holds a different study is refused unless `--force`. Running a study
+//! and writing its tables and plots is shared with `reproduce` ([`crate::studies`]).
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use anyhow::{Context, Result};
-use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
-use asperity::study::{
-    parse_range, run_any_task, sample_cost, FitWindow, Method, StudyDir, StudySpec, TaskResult,
-    CHECKPOINT_INTERVAL,
-};
+use anyhow::Result;
+use asperity::study::{FitWindow, Method, StudySpec, CHECKPOINT_INTERVAL};
 use serde::de::{self, Visitor};
 use serde::Deserialize;
 
-use crate::output::{format_number, Table};
-use crate::plot::{ordered_color, Chart, Series, Style};
-use crate::progress::Progress;
+use crate::range::parse_range;
+use crate::studies::{execute, Kind, RunOptions};
 
 /// `--method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize)]
@@ -322,7 +317,7 @@ fn windows(args: &WindowsArgs) -> Result<()> {
             args.dir.display()
         );
     }
-    let table = super::report::window_table(&found);
+    let table = crate::report::window_table(&found);
     use std::io::Write as _;
     std::io::stdout().write_all(&table.to_csv()?)?;
     Ok(())
@@ -334,16 +329,6 @@ pub struct StudyArgs {
     /// Which study.
     #[command(subcommand)]
     pub command: StudyCommand,
-}
-
-/// What a study writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Kind {
-    /// α table and plot.
-    Alpha,
-    /// Mean curves table and plot.
-    Curve,
 }
 
 /// `n` of a study file: one size or a list.
@@ -534,19 +519,6 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
 /// The longest `--checkpoint-every`, in seconds (about 11 days).
 const MAX_CHECKPOINT_EVERY: f64 = asperity::study::MAX_CHECKPOINT_INTERVAL_SECONDS;
 
-/// How a study runs (not part of what it computes).
-#[derive(Debug, Clone, Copy)]
-pub struct RunOptions {
-    /// Overwrite outputs, discard another study's checkpoint.
-    pub force: bool,
-    /// No progress output.
-    pub quiet: bool,
-    /// Longest time between checkpoints of a task in progress.
-    pub checkpoint_every: Duration,
-    /// The `reproduce` setting a figure's study runs under, marked on its plot.
-    pub setting: Option<&'static str>,
-}
-
 impl RunOptions {
     fn from_args(run: &RunArgs) -> Result<Self> {
         anyhow::ensure!(
@@ -585,7 +557,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Windows(w) => return windows(w),
-        StudyCommand::Compare(c) => return super::report::compare_study(&c.dir, c.force),
+        StudyCommand::Compare(c) => return crate::report::compare_study(&c.dir, c.force),
         StudyCommand::File(f) => {
             let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
             let (kind, spec) = parse_study_file(&f.file, &text)?;
@@ -593,7 +565,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         }
     };
     if spec.method == Method::Bem && !options.quiet {
-        announce_bem(&spec)?;
+        announce_bem(&spec, out)?;
     }
     execute(&spec, out, options, kind)?;
     Ok(())
@@ -604,26 +576,33 @@ pub fn run(args: &StudyArgs) -> Result<()> {
 const ESTIMATE_FROM_N: usize = 256;
 
 /// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
-/// ([`super::bench::estimate_bem_seconds`]), for the whole study: tasks already
-/// checkpointed in the folder take less.
-fn announce_bem(spec: &StudySpec) -> Result<()> {
+/// ([`crate::estimate::estimate_bem_seconds`]) for the samples not yet checkpointed in
+/// `out`.
+fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
     if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
         return Ok(());
     }
-    let study = super::bench::BemStudy {
+    let stored = crate::estimate::stored_samples(out, spec);
+    let study = crate::estimate::BemStudy {
         sizes: &spec.sizes,
         samples: spec.samples,
         hursts: &spec.hursts,
         rolloff: spec.rolloff,
+        stored: &stored,
     };
-    let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+    let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
     let minutes = estimate.seconds / 60.0;
+    let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(
-        "bem study: N = {:?}, {} H, {} samples each: estimated {} on this machine ({} lanes; \
+        "bem study: N = {:?}, {} H, {} samples each{}: estimated {} on this machine ({} lanes; \
          checkpointed: an interrupted run resumes with the same command)",
         spec.sizes,
         spec.hursts.len(),
         spec.samples,
+        match stored {
+            0 => String::new(),
+            s => format!(" ({s} already checkpointed, not counted)"),
+        },
         if estimate.seconds < 120.0 {
             format!("{:.0} s", estimate.seconds)
         } else if minutes < 120.0 {
@@ -636,518 +615,9 @@ fn announce_bem(spec: &StudySpec) -> Result<()> {
     Ok(())
 }
 
-/// The files a study of `kind` writes into `dir`.
-pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
-    let stem = outputs_stem(kind);
-    ["csv", "png", "svg"]
-        .iter()
-        .map(|ext| dir.join(format!("{stem}.{ext}")))
-        .collect()
-}
-
-/// Validates (the spec, then whether its largest task fits in memory), checks outputs
-/// (see [`crate::rerun`]: existing ones only if this study wrote them unchanged, or with
-/// `--force`), locks the folder against other processes, opens (or resumes) the study and
-/// runs every task with a progress bar, then writes its outputs of `kind` together (all or
-/// none). Nothing is created before every check has passed. Returns the task results in
-/// task order.
-///
-/// The progress bar counts samples; its ETA weighs each sample by
-/// [`sample_cost`] and leaves out samples read back from checkpoints (see
-/// [`crate::progress`]).
-pub fn execute(
-    spec: &StudySpec,
-    dir: &Path,
-    options: RunOptions,
-    kind: Kind,
-) -> Result<Vec<TaskResult>> {
-    let RunOptions {
-        force,
-        quiet,
-        checkpoint_every,
-        setting,
-    } = options;
-    spec.validate()?;
-    spec.ensure_fits()?;
-    StudyDir::check(dir, spec, force)?;
-    let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
-    let _lock = StudyDir::lock(dir)?;
-    let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
-    let tasks = spec.tasks();
-    let segments: Vec<(u64, f64)> = tasks
-        .iter()
-        .map(|t| (spec.samples as u64, sample_cost(spec.method, t.n)))
-        .collect();
-    let progress = Progress::weighted(&format!("{} study", spec.method.name()), &segments, quiet);
-    let results = run_tasks(&store, &progress, quiet)?;
-    progress.finish();
-    let (table, chart) = match kind {
-        Kind::Alpha => (
-            alpha_table(&results),
-            alpha_chart(&results, &titled(ALPHA_TITLE, setting)),
-        ),
-        Kind::Curve => (
-            curve_table(&results),
-            curve_chart(&results, &titled(CURVE_TITLE, setting)),
-        ),
-    };
-    let stem = outputs_stem(kind);
-    write_together(dir, stem, &table, &chart, rewrite, true)?;
-    Ok(results)
-}
-
-/// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
-/// an MPI job of several ranks, over all ranks ([`crate::distributed`]): the same
-/// results either way.
-fn run_tasks(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<Vec<TaskResult>> {
-    #[cfg(feature = "mpi")]
-    if crate::distributed::active() {
-        let progress = |done, restored| {
-            if restored {
-                progress.restore(done)
-            } else {
-                progress.set(done)
-            }
-        };
-        return crate::distributed::run_study(store, &progress, quiet);
-    }
-    // Without MPI, `quiet` is the progress bar's alone.
-    let _ = quiet;
-    let spec = store.spec();
-    let tasks = spec.tasks();
-    let mut results = Vec::with_capacity(tasks.len());
-    for (i, task) in tasks.iter().enumerate() {
-        let offset = (i * spec.samples) as u64;
-        // The first report of a task is what its checkpoint held (run_task's contract).
-        let first = AtomicBool::new(true);
-        let result = run_any_task(spec, *task, store, &|done, _| {
-            if first.swap(false, Ordering::Relaxed) {
-                progress.restore(offset + done as u64)
-            } else {
-                progress.set(offset + done as u64)
-            }
-        })
-        .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
-        results.push(result);
-    }
-    Ok(results)
-}
-
-/// Writes `<stem>.csv`, `.png` and `.svg` (and, with `record`, the record of what was
-/// written, [`crate::rerun::RECORD`]) into `dir`, all or none.
-pub fn write_together(
-    dir: &Path,
-    stem: &str,
-    table: &Table,
-    chart: &Chart,
-    force: bool,
-    record: bool,
-) -> Result<()> {
-    let (csv, png, svg) = (
-        dir.join(format!("{stem}.csv")),
-        dir.join(format!("{stem}.png")),
-        dir.join(format!("{stem}.svg")),
-    );
-    let record_path = dir.join(crate::rerun::RECORD);
-    let mut paths = vec![&csv, &png, &svg];
-    if record {
-        paths.push(&record_path);
-    }
-    let mut staged = asperity::io::StagedOutputs::new(paths, force)?;
-    table.stage(&mut staged, &csv)?;
-    chart.stage(&mut staged, &png, &svg)?;
-    if record {
-        crate::rerun::stage_record(&mut staged, &record_path)?;
-    }
-    staged.commit()?;
-    Ok(())
-}
-
-const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
-const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
-
-/// `title` marked with the `reproduce` setting, if any.
-fn titled(title: &str, setting: Option<&str>) -> String {
-    match setting {
-        Some(name) => format!("{title} ({name} setting)"),
-        None => title.to_string(),
-    }
-}
-
-fn outputs_stem(kind: Kind) -> &'static str {
-    match kind {
-        Kind::Alpha => "alpha",
-        Kind::Curve => "curve",
-    }
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map(format_number).unwrap_or_default()
-}
-
-/// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
-/// written together.
-/// `setting`: the `reproduce` setting, marked on the plot.
-pub fn write_alpha(
-    dir: &Path,
-    results: &[TaskResult],
-    force: bool,
-    setting: Option<&str>,
-) -> Result<()> {
-    let chart = alpha_chart(results, &titled(ALPHA_TITLE, setting));
-    write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
-}
-
-/// The rows of `alpha.csv`.
-fn alpha_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::new(&[
-        "method",
-        "n",
-        "hurst",
-        "alpha",
-        "alpha_low",
-        "alpha_high",
-        "samples",
-        "alpha_fit_low",
-        "alpha_fit_high",
-        "alpha_sample_mean",
-        "samples_fitted",
-        "alpha_theory",
-    ]);
-    for r in results {
-        let (lo, hi) = r.alpha_sample_interval().unzip();
-        table.push(&[
-            r.method.name().to_string(),
-            r.task.n.to_string(),
-            format_number(r.task.hurst),
-            opt(r.alpha_ensemble.map(|f| f.exponent)),
-            opt(lo),
-            opt(hi),
-            r.samples.to_string(),
-            opt(r.alpha_ensemble.map(|f| f.low)),
-            opt(r.alpha_ensemble.map(|f| f.high)),
-            opt(r.alpha_sample_mean()),
-            r.alpha_samples.len().to_string(),
-            format_number(asperity::study::theory::alpha_theory(
-                r.task.hurst,
-                r.task.n,
-            )),
-        ]);
-    }
-    table
-}
-
-/// The 95 % interval of each task's per-sample α (`alpha_low`, `alpha_high` of
-/// `alpha.csv`; NaN where there is none, which the plot leaves out).
-fn alpha_interval(r: &TaskResult) -> (f64, f64) {
-    r.alpha_sample_interval().unwrap_or((f64::NAN, f64::NAN))
-}
-
-/// The (method, N) pairs of `results` in order of appearance.
-fn method_sizes(results: &[TaskResult]) -> Vec<(Method, usize)> {
-    let mut sizes: Vec<(Method, usize)> = Vec::new();
-    for r in results {
-        if !sizes.contains(&(r.method, r.task.n)) {
-            sizes.push((r.method, r.task.n));
-        }
-    }
-    sizes
-}
-
-fn family_color(k: usize, count: usize) -> plotters::style::RGBColor {
-    let t = if count > 1 {
-        k as f64 / (count - 1) as f64
-    } else {
-        0.5
-    };
-    ordered_color(t * 0.85)
-}
-
-/// The α(H) chart: one series per (method, N) with the 95 % interval of the samples as
-/// error bars, and the theory curves (6), 1/3 and (24), the last once per N in that
-/// series' colour. A study of a single H over several N is drawn as α(N) instead
-/// ([`alpha_n_chart`]).
-pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
-    let single_h = results
-        .windows(2)
-        .all(|w| w[0].task.hurst == w[1].task.hurst);
-    let sizes = method_sizes(results);
-    if single_h && sizes.len() > 1 {
-        return alpha_n_chart(results, title);
-    }
-    let mut series = Vec::new();
-    // Series at the same H are shifted apart so that their error bars do not overlap.
-    let shift = |k: usize| 0.03 * (k as f64 - (sizes.len() as f64 - 1.0) / 2.0);
-    for (k, &(method, n)) in sizes.iter().enumerate() {
-        let rows: Vec<&TaskResult> = results
-            .iter()
-            .filter(|r| r.method == method && r.task.n == n)
-            .filter(|r| r.alpha_ensemble.is_some())
-            .collect();
-        let points = rows
-            .iter()
-            .map(|r| {
-                (
-                    r.task.hurst + shift(k),
-                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
-                )
-            })
-            .collect();
-        series.push(
-            Series::new(
-                format!("{} N = {n}", method.name()),
-                points,
-                Style::LinePoints,
-            )
-            .color(family_color(k, sizes.len()))
-            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
-        );
-    }
-    // (6) on (0, 2]: H = 0 itself belongs to (24), drawn below on [-1, 0].
-    let pp: Vec<(f64, f64)> = (1..=40)
-        .map(|i| 0.05 * i as f64)
-        .map(|h| (h, alpha_pohrt_popov(h)))
-        .collect();
-    series.push(Series::new("1/(1+H) (6)", pp, Style::Dashed).color(plotters::style::BLACK));
-    series.push(
-        Series::new(
-            "1/3 (Hertz)",
-            vec![(2.0, ALPHA_HERTZ), (3.0, ALPHA_HERTZ)],
-            Style::Dashed,
-        )
-        .color(plotters::style::RED),
-    );
-    for (k, &(_, n)) in sizes.iter().enumerate() {
-        let a = alpha_white_noise(n as f64);
-        series.push(
-            Series::new(
-                format!("(24), N = {n}"),
-                vec![(-1.0, a), (0.0, a)],
-                Style::Dashed,
-            )
-            .color(family_color(k, sizes.len())),
-        );
-    }
-    Chart {
-        title: title.into(),
-        x_label: "Hurst exponent H (series shifted apart by 0.03)".into(),
-        y_label: "α (bars: 95 % of the single-sample α)".into(),
-        log_x: false,
-        log_y: false,
-        series,
-    }
-}
-
-/// α against log2 N for a study of one H: one series per method with the 95 % interval
-/// of the samples as error bars, beside eq. (24) (paper Fig. 5).
-fn alpha_n_chart(results: &[TaskResult], title: &str) -> Chart {
-    let mut methods: Vec<Method> = results.iter().map(|r| r.method).collect();
-    methods.dedup();
-    let mut series = Vec::new();
-    for (k, &method) in methods.iter().enumerate() {
-        let rows: Vec<&TaskResult> = results
-            .iter()
-            .filter(|r| r.method == method && r.alpha_ensemble.is_some())
-            .collect();
-        let points = rows
-            .iter()
-            .map(|r| {
-                (
-                    (r.task.n as f64).log2(),
-                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
-                )
-            })
-            .collect();
-        series.push(
-            Series::new(
-                format!("{} (H = {})", method.name(), results[0].task.hurst),
-                points,
-                Style::LinePoints,
-            )
-            .color(family_color(k, methods.len()))
-            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
-        );
-    }
-    let (lo, hi) = results
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
-            let m = (r.task.n as f64).log2();
-            (a.min(m), b.max(m))
-        });
-    let theory = (0..=40)
-        .map(|i| lo - 0.5 + (hi - lo + 1.0) * i as f64 / 40.0)
-        .map(|m| (m, alpha_white_noise(2f64.powf(m))))
-        .collect();
-    series.push(
-        Series::new("(1+log2 N)/(3+log2 N) (24)", theory, Style::Dashed)
-            .color(plotters::style::BLUE),
-    );
-    Chart {
-        title: title.replace("vs H", "vs N"),
-        x_label: "log2 N (N: modes of a line, points a side of a surface)".into(),
-        y_label: "α (bars: 95 % of the single-sample α)".into(),
-        log_x: false,
-        log_y: false,
-        series,
-    }
-}
-
-/// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
-/// `setting`: the `reproduce` setting, marked on the plot.
-pub fn write_curves(
-    dir: &Path,
-    results: &[TaskResult],
-    force: bool,
-    stem: &str,
-    setting: Option<&str>,
-) -> Result<()> {
-    let chart = curve_chart(results, &titled(CURVE_TITLE, setting));
-    write_together(dir, stem, &curve_table(results), &chart, force, false)
-}
-
-/// The rows of `curve.csv`.
-fn curve_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::new(&[
-        "method",
-        "n",
-        "hurst",
-        "force",
-        "stiffness",
-        "stiffness_low",
-        "stiffness_high",
-        "samples",
-        "area_fraction",
-    ]);
-    for r in results {
-        for p in &r.mean_curve {
-            table.push(&[
-                r.method.name().to_string(),
-                r.task.n.to_string(),
-                format_number(r.task.hurst),
-                format_number(p.force),
-                format_number(p.stiffness),
-                format_number(p.stiffness_low),
-                format_number(p.stiffness_high),
-                p.samples.to_string(),
-                format_number(p.fraction),
-            ]);
-        }
-    }
-    table
-}
-
-/// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
-/// as a band in the same colour (ends that a log axis cannot show are left out, see
-/// [`crate::plot::Series::interval`]), and a slope-1 reference line (k ∝ F).
-pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
-    let (hmin, hmax) = results
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
-            (a.min(r.task.hurst), b.max(r.task.hurst))
-        });
-    let mut series = Vec::new();
-    for r in results {
-        let t = if hmax > hmin {
-            (r.task.hurst - hmin) / (hmax - hmin)
-        } else {
-            0.5
-        };
-        let points = r
-            .mean_curve
-            .iter()
-            .map(|p| (p.force, p.stiffness))
-            .collect();
-        let mut line = Series::new(
-            format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
-            points,
-            Style::Line,
-        )
-        .color(ordered_color(t * 0.9));
-        if r.samples > 1 {
-            let interval = r
-                .mean_curve
-                .iter()
-                .map(|p| (p.stiffness_low, p.stiffness_high));
-            line = line.interval(interval.collect());
-        }
-        series.push(line);
-    }
-    series.extend(slope_one(results));
-    let scale = match results.first().map(|r| r.method) {
-        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
-        _ => "L = 1, E* = 1, unit rms height",
-    };
-    Chart {
-        title: title.into(),
-        x_label: format!("normal force F ({scale})"),
-        y_label: "contact stiffness k (band: 95 % interval of the mean)".into(),
-        log_x: true,
-        log_y: true,
-        series,
-    }
-}
-
-/// A k ∝ F line over the last two decades of force (fewer where the curves span less),
-/// from the smallest stiffness up: below the curves, whose slope is at most 1.
-fn slope_one(results: &[TaskResult]) -> Option<Series> {
-    let points = results.iter().flat_map(|r| &r.mean_curve);
-    let shown = points.filter(|p| p.force > 0.0 && p.stiffness > 0.0 && p.stiffness.is_finite());
-    let (f_lo, f_hi, k_lo) = shown.fold(
-        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY),
-        |(a, b, c), p| (a.min(p.force), b.max(p.force), c.min(p.stiffness)),
-    );
-    // No drawable point leaves f_lo infinite and f_hi below it.
-    if f_hi <= f_lo {
-        return None;
-    }
-    let span = (f_hi / f_lo).min(100.0);
-    Some(
-        Series::new(
-            "slope 1 (k ∝ F)",
-            vec![(f_hi / span, k_lo), (f_hi, k_lo * span)],
-            Style::Dashed,
-        )
-        .color(plotters::style::RGBColor(120, 120, 120)),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use asperity::study::{EnsemblePoint, Task};
-
-    fn result(lows: &[f64]) -> TaskResult {
-        let point = |i: usize, &low: &f64| EnsemblePoint {
-            force: (i + 1) as f64,
-            stiffness: 1.0,
-            stiffness_low: low,
-            stiffness_high: 2.0,
-            fraction: 0.1,
-            samples: 3,
-        };
-        TaskResult {
-            method: Method::Mdr,
-            task: Task { n: 64, hurst: 0.5 },
-            samples: 3,
-            mean_curve: lows.iter().enumerate().map(|(i, l)| point(i, l)).collect(),
-            alpha_ensemble: None,
-            alpha_samples: vec![],
-        }
-    }
-
-    #[test]
-    fn curve_plots_carry_the_interval_and_a_slope_one_line() {
-        let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
-        assert_eq!(chart.series.len(), 2, "the mean and the reference");
-        let interval = chart.series[0].interval.clone().expect("an interval");
-        assert_eq!(interval.len(), 6);
-        assert_eq!(interval[2], (-0.3, 2.0), "kept: the plot leaves it out");
-        // The reference has slope 1 and ends at the largest force.
-        let line = &chart.series[1].points;
-        let (a, b) = (line[0], line[1]);
-        assert!(((b.1 / a.1).ln() / (b.0 / a.0).ln() - 1.0).abs() < 1e-12);
-        assert_eq!(b.0, 6.0);
-    }
 
     #[test]
     fn study_files_take_single_values_and_lists() {

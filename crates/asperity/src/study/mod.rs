@@ -55,7 +55,7 @@ pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
 pub use ledger::Ledger;
-pub use samplers::{run_any_task, Scales, TaskSamples};
+pub use samplers::{run_any_task, run_any_task_with_loads, Scales, TaskSamples};
 
 use crate::fit::PowerLawFit;
 use crate::lock::FolderLock;
@@ -208,9 +208,6 @@ pub const MAX_LEVELS: usize = 100_000;
 /// The most samples (over all tasks) a study may hold.
 pub const MAX_STUDY_SAMPLES: usize = 1_000_000_000;
 
-/// The most values one `A:B:STEP` range may give.
-pub const MAX_RANGE_VALUES: usize = 100_000;
-
 /// Refuses H values given twice (`0` and `-0` are one value) or sharing a checkpoint
 /// name (6 decimals), in one pass.
 fn check_distinct_hursts(hursts: &[f64]) -> Result<()> {
@@ -232,73 +229,6 @@ fn check_distinct_hursts(hursts: &[f64]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Parses Hurst exponents: comma-separated items, each a value or an inclusive range
-/// `A:B:STEP` (e.g. `-1:0:0.5,0.8,2:3:1`).
-pub fn parse_range(text: &str) -> Result<Vec<f64>> {
-    let mut values = Vec::new();
-    for item in text.split(',') {
-        values.extend(parse_range_item(item)?);
-    }
-    Ok(values)
-}
-
-fn parse_range_item(text: &str) -> Result<Vec<f64>> {
-    let parts: Vec<&str> = text.split(':').collect();
-    let num = |s: &str| {
-        s.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                Error::invalid(
-                    "hurst",
-                    format!("'{}' is not a finite number in '{}'", clip(s), clip(text)),
-                )
-            })
-    };
-    match parts.as_slice() {
-        [single] => Ok(vec![num(single)?]),
-        [a, b, step] => {
-            let (a, b, step) = (num(a)?, num(b)?, num(step)?);
-            if step.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || b < a {
-                return Err(Error::invalid(
-                    "hurst",
-                    format!("empty range '{}' (need A <= B and STEP > 0)", clip(text)),
-                ));
-            }
-            let count = ((b - a) / step + 1e-9).floor() + 1.0;
-            if count.is_nan() || count > MAX_RANGE_VALUES as f64 {
-                return Err(Error::invalid(
-                    "hurst",
-                    format!(
-                        "the range '{}' gives {} values, more than {MAX_RANGE_VALUES}",
-                        clip(text),
-                        crate::input::short_number(count)
-                    ),
-                ));
-            }
-            let count = count as usize;
-            // Round to 1e-12 so that 0.1-steps print and key cleanly.
-            Ok((0..count)
-                .map(|i| ((a + step * i as f64) * 1e12).round() / 1e12)
-                .collect())
-        }
-        _ => Err(Error::invalid(
-            "hurst",
-            format!("'{}' is neither a value nor A:B:STEP", clip(text)),
-        )),
-    }
-}
-
-/// At most 40 characters of user text, on one line.
-fn clip(text: &str) -> String {
-    let line = crate::input::one_line(text);
-    match line.char_indices().nth(40) {
-        Some((i, _)) => format!("{}…", &line[..i]),
-        None => line,
-    }
 }
 
 /// One `(N, H)` ensemble of a study.
@@ -762,13 +692,7 @@ fn spec_differences(stored: &StudySpec, wanted: &StudySpec) -> String {
         _ => serde_json::Map::new(),
     };
     let (a, b) = (map(stored), map(wanted));
-    let clip = |v: &serde_json::Value| {
-        let t = v.to_string();
-        match t.char_indices().nth(40) {
-            Some((i, _)) => format!("{}…", &t[..i]),
-            None => t,
-        }
-    };
+    let clip = |v: &serde_json::Value| crate::input::clip(&v.to_string());
     let items: Vec<String> = a
         .iter()
         .filter(|(k, v)| b.get(*k) != Some(*v))
@@ -1095,21 +1019,6 @@ mod tests {
     }
 
     #[test]
-    fn ranges_are_inclusive_and_validated() {
-        assert_eq!(
-            parse_range("-1:3:0.5").unwrap(),
-            vec![-1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
-        );
-        assert_eq!(parse_range("0.1:0.3:0.1").unwrap(), vec![0.1, 0.2, 0.3]);
-        assert_eq!(parse_range("0.8").unwrap(), vec![0.8]);
-        assert_eq!(parse_range("-0.5,0.5:1:0.5").unwrap(), vec![-0.5, 0.5, 1.0]);
-        assert!(parse_range("").is_err());
-        assert!(parse_range("1:0:0.1").is_err(), "empty range");
-        assert!(parse_range("0:1:0").is_err());
-        assert!(parse_range("a:b").is_err());
-    }
-
-    #[test]
     fn seeds_differ_by_task_and_index_only() {
         let t = Task { n: 512, hurst: 0.5 };
         let a = sample_seed(1, Method::Mdr, t, 0);
@@ -1371,16 +1280,7 @@ mod tests {
 
     #[test]
     fn sizes_and_ranges_are_bounded_up_front() {
-        // Item 7: a range of 4e9 values, 1e12 levels, an absurd sample count.
-        let err = parse_range("-1:3:1e-9").unwrap_err().to_string();
-        assert!(err.contains("more than 100000"), "{err}");
-        assert!(err.contains("4e9"), "{err}");
-        // Item 12: NaN and infinity are not H values.
-        for text in ["0:nan:0.1", "nan", "-inf", "0:1:inf"] {
-            let err = parse_range(text).unwrap_err().to_string();
-            assert!(err.contains("not a finite number"), "{text}: {err}");
-        }
-        assert_eq!(parse_range("-1e-300").unwrap(), vec![-1e-300]);
+        // Item 7: 1e12 levels, an absurd sample count (ranges: the CLI's `range`).
         let mut s = spec(3);
         s.levels = 1_000_000_000_000;
         let err = s.validate().unwrap_err().to_string();
@@ -1395,7 +1295,10 @@ mod tests {
     #[test]
     fn duplicate_h_checking_is_linear() {
         // Item 9: 40 001 values (the quadratic check took minutes at this size).
-        let hursts = parse_range("-1:3:0.0001").unwrap();
+        // H = -1, -0.9999, ..., 3 (rounded as the CLI's ranges are, so that 0.5 is exact).
+        let hursts: Vec<f64> = (0..=40_000)
+            .map(|i| ((-1.0 + i as f64 * 1e-4) * 1e12).round() / 1e12)
+            .collect();
         assert_eq!(hursts.len(), 40_001);
         let mut s = spec(1);
         s.hursts = hursts;

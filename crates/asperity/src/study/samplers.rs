@@ -229,6 +229,24 @@ pub(crate) fn bem_solver_params() -> SolverParams {
     SolverParams::default()
 }
 
+/// Called after each solved load of a BEM sample, on the thread that solved it: progress
+/// within a sample, which on large grids takes minutes ([`BemSampler::with_progress`]).
+#[derive(Clone)]
+pub struct OnLoad(std::sync::Arc<dyn Fn() + Send + Sync>);
+
+impl OnLoad {
+    /// Wraps the callback.
+    pub fn new(on_load: impl Fn() + Send + Sync + 'static) -> Self {
+        OnLoad(std::sync::Arc::new(on_load))
+    }
+}
+
+impl std::fmt::Debug for OnLoad {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("OnLoad(..)")
+    }
+}
+
 /// BEM sampler: see the module docs.
 #[derive(Debug, Clone)]
 pub struct BemSampler {
@@ -236,6 +254,7 @@ pub struct BemSampler {
     mean_pressures: Vec<f64>,
     params: SolverParams,
     stop: crate::stop::Stop,
+    on_load: Option<OnLoad>,
 }
 
 impl BemSampler {
@@ -258,6 +277,7 @@ impl BemSampler {
             mean_pressures,
             params: bem_solver_params(),
             stop: crate::stop::Stop::new(),
+            on_load: None,
         })
     }
 
@@ -265,6 +285,14 @@ impl BemSampler {
     /// error is [`crate::bem::SolveError::Interrupted`]; finished samples are unaffected).
     pub fn with_stop(mut self, stop: crate::stop::Stop) -> Self {
         self.stop = stop;
+        self
+    }
+
+    /// Samples that call `on_load` after each of their [`Self::LOADS`] solves (from the
+    /// solving thread; it should be cheap, e.g. a counter), so that a front end can show
+    /// progress within a sample. The results are unaffected.
+    pub fn with_progress(mut self, on_load: OnLoad) -> Self {
+        self.on_load = Some(on_load);
         self
     }
 }
@@ -323,6 +351,9 @@ impl Sampler for BemSampler {
                 force: summary.force,
                 stiffness,
             });
+            if let Some(OnLoad(on_load)) = &self.on_load {
+                on_load();
+            }
         }
         Ok(SampleCurve {
             points_total,
@@ -481,8 +512,24 @@ pub fn run_any_task(
     store: &StudyDir,
     progress: &ProgressFn,
 ) -> Result<TaskResult> {
+    run_any_task_with_loads(spec, task, store, progress, None)
+}
+
+/// [`run_any_task`] whose BEM samples call `on_load` after each solved load
+/// ([`BemSampler::with_progress`]); MDR samples have no loads to report.
+pub fn run_any_task_with_loads(
+    spec: &StudySpec,
+    task: Task,
+    store: &StudyDir,
+    progress: &ProgressFn,
+    on_load: Option<OnLoad>,
+) -> Result<TaskResult> {
     match spec.method {
-        Method::Bem => run_task(spec, task, &BemSampler::new(spec, task)?, store, progress),
+        Method::Bem => {
+            let mut sampler = BemSampler::new(spec, task)?;
+            sampler.on_load = on_load;
+            run_task(spec, task, &sampler, store, progress)
+        }
         Method::Mdr => run_task(spec, task, &MdrSampler::new(spec, task)?, store, progress),
     }
 }
@@ -643,6 +690,36 @@ mod tests {
         // Withdrawn, the same worker computes the very sample an untouched one does.
         stop.clear();
         assert_eq!(sampler.sample(&mut worker, 1).unwrap(), finished);
+    }
+
+    #[test]
+    fn every_solved_load_is_reported() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        use std::sync::Arc;
+        let spec = spec(Method::Bem, 16, vec![0.8], 3);
+        let task = spec.tasks()[0];
+        let (loads, seen) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+        let counter = Arc::clone(&loads);
+        let on_load = OnLoad::new(move || {
+            counter.fetch_add(1, Ordering::Relaxed);
+        });
+        let dir = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        let samples_seen = Arc::clone(&seen);
+        let reported = move |done: usize, _: usize| {
+            samples_seen.fetch_max(done, Ordering::Relaxed);
+        };
+        let counted =
+            run_any_task_with_loads(&spec, task, &store, &reported, Some(on_load)).unwrap();
+        assert_eq!(seen.load(Ordering::Relaxed), 3);
+        assert_eq!(loads.load(Ordering::Relaxed), 3 * BemSampler::LOADS);
+        // Reporting changes nothing computed.
+        let plain = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(plain.path(), &spec, false).unwrap();
+        assert_eq!(
+            run_any_task(&spec, task, &store, &|_, _| {}).unwrap(),
+            counted
+        );
     }
 
     #[test]

@@ -4,13 +4,14 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::range::parse_range;
 use anyhow::Result;
 use asperity::study::theory::alpha_theory;
-use asperity::study::{parse_range, Method, TaskResult};
+use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use super::super::study::{write_alpha, Kind};
 use super::{announce, describe_hursts, figure_study, study_spec};
+use crate::studies::{write_alpha, Kind};
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {
     let mut md = String::from("| method | N | H | α (ensemble fit) | 95 % of samples | theory |\n|---|---|---|---|---|---|\n");
@@ -39,7 +40,7 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let mdr = study_spec(Method::Mdr, mdr_sizes, hursts, mdr_samples, None);
     let plan = setting.fig1_bem()?;
     let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
-    announce("fig1", setting, &[(&bem, None)])?;
+    announce("fig1", setting, dir, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();
@@ -67,10 +68,5 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         mdr.window.describe(),
         alpha_rows_md(&all)
     );
-    crate::commands::report::write(
-        dir,
-        crate::commands::report::Results::Fig1(&all),
-        &report,
-        force,
-    )
+    crate::report::write(dir, crate::report::Results::Fig1(&all), &report, force)
 }

@@ -9,15 +9,15 @@ use anyhow::Result;
 use asperity::study::Method;
 
 use super::super::setting::Setting;
-use super::super::study::{write_curves, Kind};
 use super::{announce, figure_study, study_spec};
+use crate::studies::{write_curves, Kind};
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
 pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<()> {
     let plan = setting.fig2()?;
     let (n, samples) = (plan.sizes[0], plan.samples);
     let spec = study_spec(Method::Bem, plan.sizes, plan.hursts, samples, Some(6.0));
-    announce("fig2", setting, &[(&spec, Some(6.0))])?;
+    announce("fig2", setting, dir, &[(&spec, Some(6.0))])?;
     let results = figure_study(dir, "bem", &spec, Kind::Curve, setting, discard)?;
     write_curves(dir, &results, force, "fig2", Some(setting.name()))?;
     let mut md = String::from(
@@ -25,7 +25,7 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
          |---|---|---|---|\n",
     );
     for r in &results {
-        let (steepest, fractions) = match crate::commands::report::steepest_slope(r, &spec.window) {
+        let (steepest, fractions) = match crate::report::steepest_slope(r, &spec.window) {
             Some((slope, first, last)) => {
                 (format!("{slope:.3}"), format!("{first:.2e} – {last:.2e}"))
             }
@@ -60,9 +60,9 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         setting.describe(),
         min_contacts = spec.window.min_contacts,
     );
-    crate::commands::report::write(
+    crate::report::write(
         dir,
-        crate::commands::report::Results::Fig2(&results, spec.window),
+        crate::report::Results::Fig2(&results, spec.window),
         &report,
         force,
     )

@@ -9,10 +9,10 @@ use asperity::study::theory::alpha_white_noise;
 use asperity::study::{Method, TaskResult};
 
 use super::super::setting::Setting;
-use super::super::study::Kind;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, Series, Style};
+use crate::studies::Kind;
 
 /// How a row's N counts modes: the paper plots each BEM grid twice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,7 +88,7 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let mdr = study_spec(Method::Mdr, mdr_sizes, vec![-0.5], mdr_samples, None);
     let plan = setting.fig5_bem();
     let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
-    announce("fig5", setting, &[(&bem, None)])?;
+    announce("fig5", setting, dir, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let rows = rows(&mdr_results, &bem_results);
@@ -124,8 +124,8 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         bem.samples,
         mdr.window.describe()
     );
-    let results = crate::commands::report::Results::Fig5(&mdr_results, &bem_results);
-    crate::commands::report::write(dir, results, &report, force)
+    let results = crate::report::Results::Fig5(&mdr_results, &bem_results);
+    crate::report::write(dir, results, &report, force)
 }
 
 fn write_table(dir: &Path, rows: &[Row], force: bool) -> Result<()> {

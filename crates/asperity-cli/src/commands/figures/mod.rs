@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use asperity::study::{FitWindow, Method, StudySpec, TaskResult};
 
 use super::setting::Setting;
-use super::study::{execute, Kind, RunOptions};
 use crate::plot::Chart;
+use crate::studies::{execute, Kind, RunOptions};
 
 mod fig1;
 mod fig15_1;
@@ -27,11 +27,7 @@ pub use fig2::fig2;
 pub use fig5::fig5;
 pub use fig6::fig6;
 
-/// Writes `report.md` atomically.
-pub fn write_report(dir: &Path, text: &str, force: bool) -> Result<()> {
-    asperity::io::write_bytes(&dir.join("report.md"), force, text.as_bytes())?;
-    Ok(())
-}
+pub use crate::report::write_report;
 
 /// Output files of one book figure, checked before any work.
 struct Outputs {
@@ -104,8 +100,13 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`super::bench::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
-fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)]) -> Result<()> {
+/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
+fn announce(
+    figure: &str,
+    setting: Setting,
+    dir: &Path,
+    studies: &[(&StudySpec, Option<f64>)],
+) -> Result<()> {
     if setting == Setting::Quick {
         // Minutes: the report states the setting; stderr stays for errors.
         return Ok(());
@@ -119,17 +120,24 @@ fn announce(figure: &str, setting: Setting, studies: &[(&StudySpec, Option<f64>)
             describe_hursts(&spec.hursts)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
-            let study = super::bench::BemStudy {
+            let stored = crate::estimate::stored_samples(&dir.join("bem"), spec);
+            let study = crate::estimate::BemStudy {
                 sizes: &spec.sizes,
                 samples: spec.samples,
                 hursts: &spec.hursts,
                 rolloff: *rolloff,
+                stored: &stored,
             };
-            let estimate = super::bench::estimate_bem_seconds(&study, (32, 64))?;
+            let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
+            let stored: usize = stored.iter().map(|s| s.samples).sum();
             eprintln!(
-                "{figure}: estimated BEM time on this machine {:.1} h ({} lanes; checkpointed: \
-                 an interrupted run resumes with the same command)",
+                "{figure}: estimated BEM time on this machine {:.1} h{} ({} lanes; \
+                 checkpointed: an interrupted run resumes with the same command)",
                 estimate.seconds / 3600.0,
+                match stored {
+                    0 => String::new(),
+                    s => format!(" for the samples left ({s} already checkpointed)"),
+                },
                 estimate.lanes
             );
         }

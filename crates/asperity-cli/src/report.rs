@@ -433,17 +433,14 @@ pub fn window_table(found: &[TaskSensitivity]) -> Table {
         "samples",
     ]);
     for t in found {
+        let n = t.task.n.to_string();
         for w in &t.windows {
-            table.push_numbers(&[
-                t.task.n as f64,
-                t.task.hurst,
-                w.window.min_contacts as f64,
-                w.window.max_fraction,
-                w.alpha,
-                w.low,
-                w.high,
-                w.samples as f64,
-            ]);
+            // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
+            let mut row = vec![n.clone(), format_number(t.task.hurst)];
+            row.push(w.window.min_contacts.to_string());
+            row.extend([w.window.max_fraction, w.alpha, w.low, w.high].map(format_number));
+            row.push(w.samples.to_string());
+            table.push(&row);
         }
     }
     table
@@ -493,7 +490,13 @@ fn write_for_study(
          windows DIR/bem`); interval: bootstrap over samples.\n\n{}",
         sensitivity(dir, study_dir, force)?
     );
-    super::figures::write_report(dir, &md, force)
+    write_report(dir, &md, force)
+}
+
+/// Writes `report.md` into `dir` atomically.
+pub fn write_report(dir: &Path, text: &str, force: bool) -> Result<()> {
+    asperity::io::write_bytes(&dir.join("report.md"), force, text.as_bytes())?;
+    Ok(())
 }
 
 /// `asperity study compare DIR`: the finished study in `dir` beside the paper —

@@ -1,0 +1,631 @@
+//! What `asperity study` and the figures of `asperity reproduce` share: running a study
+//! with progress into its folder ([`execute`]), and writing its results as `alpha.csv` or
+//! `curve.csv` with their plots ([`write_alpha`], [`write_curves`]). The commands import
+//! these from here, not from each other.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use asperity::study::samplers::{BemSampler, OnLoad};
+use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
+use asperity::study::{
+    run_any_task_with_loads, sample_cost, Method, Restored, StudyDir, StudySpec, TaskResult,
+};
+use serde::Deserialize;
+
+use crate::output::{format_number, Table};
+use crate::plot::{ordered_color, Chart, Series, Style};
+use crate::progress::Progress;
+
+/// What a study writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// α table and plot.
+    Alpha,
+    /// Mean curves table and plot.
+    Curve,
+}
+
+/// How a study runs (not part of what it computes).
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Overwrite outputs, discard another study's checkpoint.
+    pub force: bool,
+    /// No progress output.
+    pub quiet: bool,
+    /// Longest time between checkpoints of a task in progress.
+    pub checkpoint_every: Duration,
+    /// The `reproduce` setting a figure's study runs under, marked on its plot.
+    pub setting: Option<&'static str>,
+}
+
+/// The files a study of `kind` writes into `dir`.
+pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
+    let stem = outputs_stem(kind);
+    ["csv", "png", "svg"]
+        .iter()
+        .map(|ext| dir.join(format!("{stem}.{ext}")))
+        .collect()
+}
+
+/// Validates (the spec, then whether its largest task fits in memory), checks outputs
+/// (see [`crate::rerun`]: existing ones only if this study wrote them unchanged, or with
+/// `--force`), locks the folder against other processes, opens (or resumes) the study and
+/// runs every task with a progress bar, then writes its outputs of `kind` together (all or
+/// none). Nothing is created before every check has passed. Returns the task results in
+/// task order.
+///
+/// The progress bar counts samples (MDR) or solved loads (BEM, so that it moves within a
+/// sample); its ETA weighs each by [`sample_cost`] and leaves out samples read back from
+/// checkpoints (see [`crate::progress`]).
+pub fn execute(
+    spec: &StudySpec,
+    dir: &Path,
+    options: RunOptions,
+    kind: Kind,
+) -> Result<Vec<TaskResult>> {
+    let RunOptions {
+        force,
+        quiet,
+        checkpoint_every,
+        setting,
+    } = options;
+    spec.validate()?;
+    spec.ensure_fits()?;
+    StudyDir::check(dir, spec, force)?;
+    let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
+    let _lock = StudyDir::lock(dir)?;
+    let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
+    let stored = stored_per_task(&store)?;
+    let progress = Arc::new(study_progress(spec, &stored, quiet));
+    let results = run_tasks(&store, &stored, &progress, quiet)?;
+    progress.finish();
+    let (table, chart) = match kind {
+        Kind::Alpha => (
+            alpha_table(&results),
+            alpha_chart(&results, &titled(ALPHA_TITLE, setting)),
+        ),
+        Kind::Curve => (
+            curve_table(&results),
+            curve_chart(&results, &titled(CURVE_TITLE, setting)),
+        ),
+    };
+    let stem = outputs_stem(kind);
+    write_together(dir, stem, &table, &chart, rewrite, true)?;
+    Ok(results)
+}
+
+/// The progress steps of one sample: a BEM sample reports each of its loads (a 512²
+/// sample takes minutes), an MDR sample (milliseconds) only itself.
+fn steps_per_sample(method: Method) -> u64 {
+    match method {
+        Method::Bem => BemSampler::LOADS as u64,
+        Method::Mdr => 1,
+    }
+}
+
+/// The samples of each task of `store`'s study that its checkpoints hold, in task order:
+/// what [`run_any_task_with_loads`] will restore instead of computing.
+fn stored_per_task(store: &StudyDir) -> Result<Vec<usize>> {
+    let spec = store.spec();
+    spec.tasks()
+        .iter()
+        .map(|&task| {
+            Ok(match store.restore(task)? {
+                Restored::Done(_) => spec.samples,
+                Restored::Partial(samples) => samples.len().min(spec.samples),
+            })
+        })
+        .collect()
+}
+
+/// The progress of a study: in samples, or in loads for BEM ([`steps_per_sample`]), each
+/// step weighed by its cost ([`sample_cost`] shared by a sample's steps). The steps of the
+/// samples already `stored` (per task) come first and are counted as restored at once, so
+/// that a resumed study shows all it holds and its ETA covers only the samples left; then
+/// the samples left, task by task.
+fn study_progress(spec: &StudySpec, stored: &[usize], quiet: bool) -> Progress {
+    let steps = steps_per_sample(spec.method);
+    let segments = progress_segments(spec, stored);
+    let name = match spec.method {
+        Method::Bem => "bem study (loads)",
+        Method::Mdr => "mdr study",
+    };
+    let progress = Progress::weighted(name, &segments, quiet);
+    progress.restore(stored.iter().sum::<usize>() as u64 * steps);
+    progress
+}
+
+/// The `(steps, cost of each)` runs of [`study_progress`]: the stored samples of every
+/// task, then the samples left of every task.
+fn progress_segments(spec: &StudySpec, stored: &[usize]) -> Vec<(u64, f64)> {
+    let steps = steps_per_sample(spec.method);
+    let tasks = spec.tasks();
+    let cost = |t: &asperity::study::Task| sample_cost(spec.method, t.n) / steps as f64;
+    let held = tasks
+        .iter()
+        .zip(stored)
+        .map(|(t, &s)| (s as u64 * steps, cost(t)));
+    let left =
+        (tasks.iter().zip(stored)).map(|(t, &s)| ((spec.samples - s) as u64 * steps, cost(t)));
+    held.chain(left).collect()
+}
+
+/// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
+/// an MPI job of several ranks, over all ranks ([`crate::distributed`]): the same
+/// results either way. Progress moves per sample, and per solved load of the BEM samples
+/// computed here.
+fn run_tasks(
+    store: &StudyDir,
+    stored: &[usize],
+    progress: &Arc<Progress>,
+    quiet: bool,
+) -> Result<Vec<TaskResult>> {
+    let spec = store.spec();
+    let steps = steps_per_sample(spec.method);
+    #[cfg(feature = "mpi")]
+    if crate::distributed::active() {
+        // The ledger counts samples held in all: the restored ones first, as the bar does.
+        let progress = |done, restored| {
+            if restored {
+                progress.restore(done * steps)
+            } else {
+                progress.set(done * steps)
+            }
+        };
+        return crate::distributed::run_study(store, &progress, quiet);
+    }
+    // Without MPI, `quiet` is the progress bar's alone.
+    let _ = quiet;
+    let tasks = spec.tasks();
+    // Every load solved in this run is one step; at the end of a batch of samples the
+    // count is set to what the finished samples hold, which all their loads reached.
+    let on_load = (steps > 1).then(|| {
+        let progress = Arc::clone(progress);
+        OnLoad::new(move || progress.inc())
+    });
+    // Task i's computed samples follow every stored sample and the samples left of the
+    // tasks before it (`study_progress`).
+    let mut offset = stored.iter().sum::<usize>() as u64 * steps;
+    let mut results = Vec::with_capacity(tasks.len());
+    for (task, &held) in tasks.iter().zip(stored) {
+        let report = |done: usize, _| {
+            progress.set(offset + done.saturating_sub(held) as u64 * steps);
+        };
+        let result = run_any_task_with_loads(spec, *task, store, &report, on_load.clone())
+            .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
+        results.push(result);
+        offset += (spec.samples - held) as u64 * steps;
+    }
+    Ok(results)
+}
+
+/// Writes `<stem>.csv`, `.png` and `.svg` (and, with `record`, the record of what was
+/// written, [`crate::rerun::RECORD`]) into `dir`, all or none.
+pub fn write_together(
+    dir: &Path,
+    stem: &str,
+    table: &Table,
+    chart: &Chart,
+    force: bool,
+    record: bool,
+) -> Result<()> {
+    let (csv, png, svg) = (
+        dir.join(format!("{stem}.csv")),
+        dir.join(format!("{stem}.png")),
+        dir.join(format!("{stem}.svg")),
+    );
+    let record_path = dir.join(crate::rerun::RECORD);
+    let mut paths = vec![&csv, &png, &svg];
+    if record {
+        paths.push(&record_path);
+    }
+    let mut staged = asperity::io::StagedOutputs::new(paths, force)?;
+    table.stage(&mut staged, &csv)?;
+    chart.stage(&mut staged, &png, &svg)?;
+    if record {
+        crate::rerun::stage_record(&mut staged, &record_path)?;
+    }
+    staged.commit()?;
+    Ok(())
+}
+
+const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
+const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
+
+/// `title` marked with the `reproduce` setting, if any.
+fn titled(title: &str, setting: Option<&str>) -> String {
+    match setting {
+        Some(name) => format!("{title} ({name} setting)"),
+        None => title.to_string(),
+    }
+}
+
+fn outputs_stem(kind: Kind) -> &'static str {
+    match kind {
+        Kind::Alpha => "alpha",
+        Kind::Curve => "curve",
+    }
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map(format_number).unwrap_or_default()
+}
+
+/// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
+/// written together.
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_alpha(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = alpha_chart(results, &titled(ALPHA_TITLE, setting));
+    write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
+}
+
+/// The rows of `alpha.csv`.
+fn alpha_table(results: &[TaskResult]) -> Table {
+    let mut table = Table::with_header(
+        "method,n,hurst,alpha,alpha_low,alpha_high,samples,alpha_fit_low,alpha_fit_high,\
+         alpha_sample_mean,samples_fitted,alpha_theory",
+    );
+    for r in results {
+        let (lo, hi) = r.alpha_sample_interval().unzip();
+        table.push(&[
+            r.method.name().to_string(),
+            r.task.n.to_string(),
+            format_number(r.task.hurst),
+            opt(r.alpha_ensemble.map(|f| f.exponent)),
+            opt(lo),
+            opt(hi),
+            r.samples.to_string(),
+            opt(r.alpha_ensemble.map(|f| f.low)),
+            opt(r.alpha_ensemble.map(|f| f.high)),
+            opt(r.alpha_sample_mean()),
+            r.alpha_samples.len().to_string(),
+            format_number(asperity::study::theory::alpha_theory(
+                r.task.hurst,
+                r.task.n,
+            )),
+        ]);
+    }
+    table
+}
+
+/// The 95 % interval of each task's per-sample α (`alpha_low`, `alpha_high` of
+/// `alpha.csv`; NaN where there is none, which the plot leaves out).
+fn alpha_interval(r: &TaskResult) -> (f64, f64) {
+    r.alpha_sample_interval().unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// The (method, N) pairs of `results` in order of appearance.
+fn method_sizes(results: &[TaskResult]) -> Vec<(Method, usize)> {
+    let mut sizes: Vec<(Method, usize)> = Vec::new();
+    for r in results {
+        if !sizes.contains(&(r.method, r.task.n)) {
+            sizes.push((r.method, r.task.n));
+        }
+    }
+    sizes
+}
+
+fn family_color(k: usize, count: usize) -> plotters::style::RGBColor {
+    let t = if count > 1 {
+        k as f64 / (count - 1) as f64
+    } else {
+        0.5
+    };
+    ordered_color(t * 0.85)
+}
+
+/// The α(H) chart: one series per (method, N) with the 95 % interval of the samples as
+/// error bars, and the theory curves (6), 1/3 and (24), the last once per N in that
+/// series' colour. A study of a single H over several N is drawn as α(N) instead
+/// ([`alpha_n_chart`]).
+pub fn alpha_chart(results: &[TaskResult], title: &str) -> Chart {
+    let single_h = results
+        .windows(2)
+        .all(|w| w[0].task.hurst == w[1].task.hurst);
+    let sizes = method_sizes(results);
+    if single_h && sizes.len() > 1 {
+        return alpha_n_chart(results, title);
+    }
+    let mut series = Vec::new();
+    // Series at the same H are shifted apart so that their error bars do not overlap.
+    let shift = |k: usize| 0.03 * (k as f64 - (sizes.len() as f64 - 1.0) / 2.0);
+    for (k, &(method, n)) in sizes.iter().enumerate() {
+        let rows: Vec<&TaskResult> = results
+            .iter()
+            .filter(|r| r.method == method && r.task.n == n)
+            .filter(|r| r.alpha_ensemble.is_some())
+            .collect();
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    r.task.hurst + shift(k),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
+        series.push(
+            Series::new(
+                format!("{} N = {n}", method.name()),
+                points,
+                Style::LinePoints,
+            )
+            .color(family_color(k, sizes.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
+        );
+    }
+    // (6) on (0, 2]: H = 0 itself belongs to (24), drawn below on [-1, 0].
+    let pp: Vec<(f64, f64)> = (1..=40)
+        .map(|i| 0.05 * i as f64)
+        .map(|h| (h, alpha_pohrt_popov(h)))
+        .collect();
+    series.push(Series::new("1/(1+H) (6)", pp, Style::Dashed).color(plotters::style::BLACK));
+    series.push(
+        Series::new(
+            "1/3 (Hertz)",
+            vec![(2.0, ALPHA_HERTZ), (3.0, ALPHA_HERTZ)],
+            Style::Dashed,
+        )
+        .color(plotters::style::RED),
+    );
+    for (k, &(_, n)) in sizes.iter().enumerate() {
+        let a = alpha_white_noise(n as f64);
+        series.push(
+            Series::new(
+                format!("(24), N = {n}"),
+                vec![(-1.0, a), (0.0, a)],
+                Style::Dashed,
+            )
+            .color(family_color(k, sizes.len())),
+        );
+    }
+    Chart {
+        title: title.into(),
+        x_label: "Hurst exponent H (series shifted apart by 0.03)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+/// α against log2 N for a study of one H: one series per method with the 95 % interval
+/// of the samples as error bars, beside eq. (24) (paper Fig. 5).
+fn alpha_n_chart(results: &[TaskResult], title: &str) -> Chart {
+    let mut methods: Vec<Method> = results.iter().map(|r| r.method).collect();
+    methods.dedup();
+    let mut series = Vec::new();
+    for (k, &method) in methods.iter().enumerate() {
+        let rows: Vec<&TaskResult> = results
+            .iter()
+            .filter(|r| r.method == method && r.alpha_ensemble.is_some())
+            .collect();
+        let points = rows
+            .iter()
+            .map(|r| {
+                (
+                    (r.task.n as f64).log2(),
+                    r.alpha_ensemble.map_or(f64::NAN, |f| f.exponent),
+                )
+            })
+            .collect();
+        series.push(
+            Series::new(
+                format!("{} (H = {})", method.name(), results[0].task.hurst),
+                points,
+                Style::LinePoints,
+            )
+            .color(family_color(k, methods.len()))
+            .interval(rows.iter().map(|r| alpha_interval(r)).collect()),
+        );
+    }
+    let (lo, hi) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            let m = (r.task.n as f64).log2();
+            (a.min(m), b.max(m))
+        });
+    let theory = (0..=40)
+        .map(|i| lo - 0.5 + (hi - lo + 1.0) * i as f64 / 40.0)
+        .map(|m| (m, alpha_white_noise(2f64.powf(m))))
+        .collect();
+    series.push(
+        Series::new("(1+log2 N)/(3+log2 N) (24)", theory, Style::Dashed)
+            .color(plotters::style::BLUE),
+    );
+    Chart {
+        title: title.replace("vs H", "vs N"),
+        x_label: "log2 N (N: modes of a line, points a side of a surface)".into(),
+        y_label: "α (bars: 95 % of the single-sample α)".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+/// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
+/// `setting`: the `reproduce` setting, marked on the plot.
+pub fn write_curves(
+    dir: &Path,
+    results: &[TaskResult],
+    force: bool,
+    stem: &str,
+    setting: Option<&str>,
+) -> Result<()> {
+    let chart = curve_chart(results, &titled(CURVE_TITLE, setting));
+    write_together(dir, stem, &curve_table(results), &chart, force, false)
+}
+
+/// The rows of `curve.csv`.
+fn curve_table(results: &[TaskResult]) -> Table {
+    let mut table = Table::with_header(
+        "method,n,hurst,force,stiffness,stiffness_low,stiffness_high,samples,area_fraction",
+    );
+    for r in results {
+        for p in &r.mean_curve {
+            table.push(&[
+                r.method.name().to_string(),
+                r.task.n.to_string(),
+                format_number(r.task.hurst),
+                format_number(p.force),
+                format_number(p.stiffness),
+                format_number(p.stiffness_low),
+                format_number(p.stiffness_high),
+                p.samples.to_string(),
+                format_number(p.fraction),
+            ]);
+        }
+    }
+    table
+}
+
+/// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean
+/// as a band in the same colour (ends that a log axis cannot show are left out, see
+/// [`crate::plot::Series::interval`]), and a slope-1 reference line (k ∝ F).
+pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
+    let (hmin, hmax) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            (a.min(r.task.hurst), b.max(r.task.hurst))
+        });
+    let mut series = Vec::new();
+    for r in results {
+        let t = if hmax > hmin {
+            (r.task.hurst - hmin) / (hmax - hmin)
+        } else {
+            0.5
+        };
+        let points = r
+            .mean_curve
+            .iter()
+            .map(|p| (p.force, p.stiffness))
+            .collect();
+        let mut line = Series::new(
+            format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
+            points,
+            Style::Line,
+        )
+        .color(ordered_color(t * 0.9));
+        if r.samples > 1 {
+            let interval = r
+                .mean_curve
+                .iter()
+                .map(|p| (p.stiffness_low, p.stiffness_high));
+            line = line.interval(interval.collect());
+        }
+        series.push(line);
+    }
+    series.extend(slope_one(results));
+    let scale = match results.first().map(|r| r.method) {
+        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
+        _ => "L = 1, E* = 1, unit rms height",
+    };
+    Chart {
+        title: title.into(),
+        x_label: format!("normal force F ({scale})"),
+        y_label: "contact stiffness k (band: 95 % interval of the mean)".into(),
+        log_x: true,
+        log_y: true,
+        series,
+    }
+}
+
+/// A k ∝ F line over the last two decades of force (fewer where the curves span less),
+/// from the smallest stiffness up: below the curves, whose slope is at most 1.
+fn slope_one(results: &[TaskResult]) -> Option<Series> {
+    let points = results.iter().flat_map(|r| &r.mean_curve);
+    let shown = points.filter(|p| p.force > 0.0 && p.stiffness > 0.0 && p.stiffness.is_finite());
+    let (f_lo, f_hi, k_lo) = shown.fold(
+        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY),
+        |(a, b, c), p| (a.min(p.force), b.max(p.force), c.min(p.stiffness)),
+    );
+    // No drawable point leaves f_lo infinite and f_hi below it.
+    if f_hi <= f_lo {
+        return None;
+    }
+    let span = (f_hi / f_lo).min(100.0);
+    Some(
+        Series::new(
+            "slope 1 (k ∝ F)",
+            vec![(f_hi / span, k_lo), (f_hi, k_lo * span)],
+            Style::Dashed,
+        )
+        .color(plotters::style::RGBColor(120, 120, 120)),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asperity::study::{EnsemblePoint, Task};
+
+    #[test]
+    fn a_resumed_study_counts_what_its_checkpoints_hold_and_times_only_what_is_left() {
+        // Two tasks (N = 64, 128) of 4 samples; the second task's checkpoint holds 3, the
+        // first none: the bar starts at 3 samples' loads, and the cost left is that of the
+        // 4 + 1 samples to compute, whatever the task order.
+        let spec = StudySpec {
+            method: Method::Bem,
+            sizes: vec![64, 128],
+            hursts: vec![0.5],
+            samples: 4,
+            rolloff: None,
+            seed: 1,
+            window: asperity::study::FitWindow::default(),
+            levels: 48,
+        };
+        let segments = progress_segments(&spec, &[0, 3]);
+        let mut eta = crate::progress::Eta::weighted(&segments);
+        let loads = BemSampler::LOADS as u64;
+        assert_eq!(eta.total(), 8 * loads);
+        eta.restore(0, 3 * loads);
+        let (small, large) = (sample_cost(Method::Bem, 64), sample_cost(Method::Bem, 128));
+        let left = eta.cost_to(eta.total()) - eta.cost_to(3 * loads);
+        assert!((left - (4.0 * small + large)).abs() < 1e-6 * left, "{left}");
+        // One sample of N = 64 computed in 10 s: 10 s per `small`, the rest in proportion.
+        let eta_s = eta.remaining(4 * loads, 10.0).unwrap();
+        assert!((eta_s - 10.0 * (3.0 * small + large) / small).abs() < 1e-9 * eta_s);
+    }
+
+    fn result(lows: &[f64]) -> TaskResult {
+        let point = |i: usize, &low: &f64| EnsemblePoint {
+            force: (i + 1) as f64,
+            stiffness: 1.0,
+            stiffness_low: low,
+            stiffness_high: 2.0,
+            fraction: 0.1,
+            samples: 3,
+        };
+        TaskResult {
+            method: Method::Mdr,
+            task: Task { n: 64, hurst: 0.5 },
+            samples: 3,
+            mean_curve: lows.iter().enumerate().map(|(i, l)| point(i, l)).collect(),
+            alpha_ensemble: None,
+            alpha_samples: vec![],
+        }
+    }
+
+    #[test]
+    fn curve_plots_carry_the_interval_and_a_slope_one_line() {
+        let chart = curve_chart(&[result(&[0.5, 0.6, -0.3, 0.0, 0.7, 0.8])], "t");
+        assert_eq!(chart.series.len(), 2, "the mean and the reference");
+        let interval = chart.series[0].interval.clone().expect("an interval");
+        assert_eq!(interval.len(), 6);
+        assert_eq!(interval[2], (-0.3, 2.0), "kept: the plot leaves it out");
+        // The reference has slope 1 and ends at the largest force.
+        let line = &chart.series[1].points;
+        let (a, b) = (line[0], line[1]);
+        assert!(((b.1 / a.1).ln() / (b.0 / a.0).ln() - 1.0).abs() < 1e-12);
+        assert_eq!(b.0, 6.0);
+    }
+}
