@@ -3,7 +3,8 @@ per (N, boundary, p̄) asperity's BCCG on 2 and 1 threads, its Polonsky–Keer, 
 ContactMechanics' CCG without restart, with iterations, the cost of an iteration in padded
 FFT pairs (measured in the same run) and the ratios.
 
-    python3 bench/bccg_table.py bench/out/results.json
+    python3 bench/bccg_table.py bench/out/results.json            # docs/bem.md's table
+    python3 bench/bccg_table.py bench/out/results.json --readme   # the README's table
 """
 import json
 import sys
@@ -35,5 +36,28 @@ def main(path):
           f"start {env['loadavg'][0]:.2f}, {env['nproc']} cores; peers {env['peers']}.")
 
 
+def readme(path):
+    """The README's table: asperity's default solver against every peer, per case."""
+    data = json.load(open(path))
+    rows = {(r["n"], r["boundary"], r["pressure"], r["code"]): r for r in data["results"]}
+    keys = sorted({k[:3] for k in rows}, key=lambda k: (k[1], k[0], k[2]))
+    print("| N | boundary | p̄ | asperity 2 threads: s (iterations) | asperity 1 thread (s) "
+          "| tamaas PK (s) | ContactMechanics PK (s) | ContactMechanics CCG w/o restart: "
+          "s (iterations) | CCG ÷ asperity, 2 / 1 threads | tamaas ÷ asperity 2 threads |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for n, boundary, p in keys:
+        get = lambda code: rows.get((n, boundary, p, code))
+        b2, b1, tm, cm, ccg = (get(c) for c in ("asperity-bccg-2t", "asperity-bccg-1t",
+                                                  "tamaas", "contactmechanics", "cm-ccg"))
+        if not (b2 and b1 and tm and cm and ccg):
+            continue
+        print(f"| {n} | {boundary} | {p} | {b2['seconds']:.3f} ({b2['iterations']}) | "
+              f"{b1['seconds']:.3f} | {tm['seconds']:.2f} | {cm['seconds']:.2f} | "
+              f"{ccg['seconds']:.2f} ({ccg['iterations']}) | "
+              f"{ccg['seconds'] / b2['seconds']:.1f}× / {ccg['seconds'] / b1['seconds']:.1f}× | "
+              f"{tm['seconds'] / b2['seconds']:.0f}× |")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "bench/out/results.json")
+    path = sys.argv[1] if len(sys.argv) > 1 else "bench/out/results.json"
+    (readme if "--readme" in sys.argv[2:] else main)(path)
