@@ -189,7 +189,8 @@ pub fn table(rows: &[Row]) -> Table {
     for r in rows {
         table.push(&[
             r.method.clone(),
-            format_number(r.n),
+            // A grid size: lines per side or grid points, always a whole number.
+            format!("{}", r.n as u64),
             format_number(r.hurst),
             r.quantity.clone(),
             format_number(r.ours),
