@@ -119,13 +119,13 @@ pub struct BemStudy<'a> {
     /// Roll-off wavenumber q0 L/2π, if any.
     pub rolloff: Option<f64>,
     /// Samples of `(N, H)` already checkpointed (not computed again), if any: see
-    /// [`stored_samples`].
-    pub stored: &'a [StoredSamples],
+    /// [`held_samples`].
+    pub stored: &'a [HeldSamples],
 }
 
 /// Samples of one task of a study already in its checkpoints.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StoredSamples {
+pub struct HeldSamples {
     /// Grid size.
     pub n: usize,
     /// Hurst exponent.
@@ -136,18 +136,18 @@ pub struct StoredSamples {
 
 /// The samples of `spec`'s tasks already stored in the study folder `dir` (none when the
 /// folder holds no study or another one: the estimate is then for the whole study).
-pub fn stored_samples(
+pub fn held_samples(
     dir: &std::path::Path,
     spec: &asperity::study::StudySpec,
-) -> Vec<StoredSamples> {
+) -> Vec<HeldSamples> {
     let Ok(store) = asperity::study::StudyDir::read(dir) else {
         return Vec::new();
     };
     spec.tasks()
         .into_iter()
         .filter_map(|task| {
-            let samples = store.stored_samples(task).ok()?.len().min(spec.samples);
-            Some(StoredSamples {
+            let samples = store.samples_held(task, spec.samples).ok()?;
+            Some(HeldSamples {
                 n: task.n,
                 hurst: task.hurst,
                 samples,

@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use asperity::study::samplers::{BemSampler, OnLoad};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{
-    run_any_task_with_loads, sample_cost, Method, Restored, StudyDir, StudySpec, TaskResult,
+    run_any_task_with_loads, sample_cost, Method, StudyDir, StudySpec, TaskResult,
 };
 use serde::Deserialize;
 
@@ -113,12 +113,7 @@ fn stored_per_task(store: &StudyDir) -> Result<Vec<usize>> {
     let spec = store.spec();
     spec.tasks()
         .iter()
-        .map(|&task| {
-            Ok(match store.restore(task)? {
-                Restored::Done(_) => spec.samples,
-                Restored::Partial(samples) => samples.len().min(spec.samples),
-            })
-        })
+        .map(|&task| Ok(store.samples_held(task, spec.samples)?))
         .collect()
 }
 

@@ -582,7 +582,7 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
     if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
         return Ok(());
     }
-    let stored = crate::estimate::stored_samples(out, spec);
+    let stored = crate::estimate::held_samples(out, spec);
     let study = crate::estimate::BemStudy {
         sizes: &spec.sizes,
         samples: spec.samples,

@@ -834,8 +834,23 @@ impl StudyDir {
     /// and keep its checkpoint with [`StudyDir::save_in_progress`] and
     /// [`StudyDir::finish`].
     pub fn restore(&self, task: Task) -> Result<Restored> {
+        self.restore_as(task, self.spec.samples)
+    }
+
+    /// How many samples of `task` a run asking for `samples` of them reads back from its
+    /// checkpoint instead of computing ([`StudyDir::restore`] with that count): what a
+    /// progress bar or a run-time estimate leaves out before the run.
+    pub fn samples_held(&self, task: Task, samples: usize) -> Result<usize> {
+        Ok(match self.restore_as(task, samples)? {
+            Restored::Done(_) => samples,
+            Restored::Partial(held) => held.len(),
+        })
+    }
+
+    /// [`StudyDir::restore`] for a run asking for `count` samples of `task`.
+    fn restore_as(&self, task: Task, count: usize) -> Result<Restored> {
         match self.load(task)? {
-            Some(Checkpoint::Done { result, .. }) if result.samples == self.spec.samples => {
+            Some(Checkpoint::Done { result, .. }) if result.samples == count => {
                 Ok(Restored::Done(result))
             }
             // Samples saved beyond a gap are left out: the serial run computes in index
@@ -844,7 +859,7 @@ impl StudyDir {
             // sample i depends only on the seed and i, so the result is that of a fresh run.
             Some(Checkpoint::InProgress { mut samples, .. })
             | Some(Checkpoint::Done { mut samples, .. }) => {
-                samples.truncate(self.spec.samples);
+                samples.truncate(count);
                 Ok(Restored::Partial(samples))
             }
             None => Ok(Restored::Partial(Vec::new())),
@@ -937,6 +952,35 @@ impl StudyDir {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn samples_held_are_what_a_run_of_that_size_reads_back() {
+        // A finished task of 3 samples: a run of 3 reads back all 3; a run of 2 or 5
+        // continues from the kept curves (BEM: 2 and 3 of them) or, without kept curves
+        // (MDR), recomputes everything.
+        for (method, n, other) in [(Method::Bem, 16, [2, 3]), (Method::Mdr, 512, [0, 0])] {
+            let spec = StudySpec {
+                method,
+                sizes: vec![n],
+                hursts: vec![0.5],
+                samples: 3,
+                rolloff: None,
+                seed: 3,
+                window: FitWindow::default(),
+                levels: 16,
+            };
+            let dir = tempfile::tempdir().unwrap();
+            let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+            let task = spec.tasks()[0];
+            assert_eq!(store.samples_held(task, 3).unwrap(), 0);
+            run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
+            let held: Vec<usize> = [3, 2, 5]
+                .iter()
+                .map(|&wanted| store.samples_held(task, wanted).unwrap())
+                .collect();
+            assert_eq!(held, [3, other[0], other[1]], "{method:?}");
+        }
+    }
 
     #[test]
     fn finished_bem_tasks_keep_their_sample_curves_and_mdr_tasks_do_not() {

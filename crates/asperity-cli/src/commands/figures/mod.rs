@@ -120,7 +120,7 @@ fn announce(
             describe_hursts(&spec.hursts)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
-            let stored = crate::estimate::stored_samples(&dir.join("bem"), spec);
+            let stored = crate::estimate::held_samples(&dir.join("bem"), spec);
             let study = crate::estimate::BemStudy {
                 sizes: &spec.sizes,
                 samples: spec.samples,
