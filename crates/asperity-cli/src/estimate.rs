@@ -136,10 +136,7 @@ pub struct HeldSamples {
 
 /// The samples of `spec`'s tasks already stored in the study folder `dir` (none when the
 /// folder holds no study or another one: the estimate is then for the whole study).
-pub fn held_samples(
-    dir: &std::path::Path,
-    spec: &asperity::study::StudySpec,
-) -> Vec<HeldSamples> {
+pub fn held_samples(dir: &std::path::Path, spec: &asperity::study::StudySpec) -> Vec<HeldSamples> {
     let Ok(store) = asperity::study::StudyDir::read(dir) else {
         return Vec::new();
     };
