@@ -953,24 +953,30 @@ impl StudyDir {
 mod tests {
     use super::*;
 
+    /// A study of one task (N = `n`, H = 0.5, 3 samples) in a new folder, opened.
+    fn three_sample_study(method: Method, n: usize) -> (StudySpec, tempfile::TempDir, StudyDir) {
+        let spec = StudySpec {
+            method,
+            sizes: vec![n],
+            hursts: vec![0.5],
+            samples: 3,
+            rolloff: None,
+            seed: 3,
+            window: FitWindow::default(),
+            levels: 16,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        (spec, dir, store)
+    }
+
     #[test]
     fn samples_held_are_what_a_run_of_that_size_reads_back() {
         // A finished task of 3 samples: a run of 3 reads back all 3; a run of 2 or 5
         // continues from the kept curves (BEM: 2 and 3 of them) or, without kept curves
         // (MDR), recomputes everything.
         for (method, n, other) in [(Method::Bem, 16, [2, 3]), (Method::Mdr, 512, [0, 0])] {
-            let spec = StudySpec {
-                method,
-                sizes: vec![n],
-                hursts: vec![0.5],
-                samples: 3,
-                rolloff: None,
-                seed: 3,
-                window: FitWindow::default(),
-                levels: 16,
-            };
-            let dir = tempfile::tempdir().unwrap();
-            let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+            let (spec, _dir, store) = three_sample_study(method, n);
             let task = spec.tasks()[0];
             assert_eq!(store.samples_held(task, 3).unwrap(), 0);
             run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
@@ -985,18 +991,7 @@ mod tests {
     #[test]
     fn finished_bem_tasks_keep_their_sample_curves_and_mdr_tasks_do_not() {
         for (method, n, kept) in [(Method::Bem, 16, true), (Method::Mdr, 512, false)] {
-            let spec = StudySpec {
-                method,
-                sizes: vec![n],
-                hursts: vec![0.5],
-                samples: 3,
-                rolloff: None,
-                seed: 3,
-                window: FitWindow::default(),
-                levels: 16,
-            };
-            let dir = tempfile::tempdir().unwrap();
-            let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+            let (spec, dir, store) = three_sample_study(method, n);
             let task = spec.tasks()[0];
             let result = run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
             let stored = StudyDir::read(dir.path())
