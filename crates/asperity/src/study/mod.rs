@@ -778,10 +778,12 @@ fn lane_workers<S: Sampler>(sampler: &S) -> Result<Vec<S::Worker>> {
     (0..lanes).map(|_| sampler.worker()).collect()
 }
 
-/// The samples `indices` of `task`, in that order, computed in parallel: consecutive
-/// chunks of `indices`, one per worker. Each sample depends on its seed only
-/// ([`sample_seed`]), not on the worker or on what that worker computed before, so the
-/// chunking changes the time, never the numbers.
+/// The samples `indices` of `task`, in that order, computed in parallel by the workers,
+/// one task per worker that takes the next sample not yet taken until none is left
+/// (self-scheduling: samples of one task differ in cost by tens of per cent, and with fixed
+/// chunks a worker given the costlier samples, or slowed by another process, held the
+/// batch up while the other waited). Each sample depends on its seed only ([`sample_seed`]), not on the worker or on
+/// what that worker computed before, so the scheduling changes the time, never the numbers.
 fn sample_on_lanes<S: Sampler>(
     spec: &StudySpec,
     task: Task,
@@ -789,23 +791,23 @@ fn sample_on_lanes<S: Sampler>(
     workers: &mut [S::Worker],
     indices: &[usize],
 ) -> Result<Vec<SampleCurve>> {
-    if indices.is_empty() {
-        return Ok(Vec::new());
-    }
-    let per_lane = indices.len().div_ceil(workers.len().max(1));
-    let done: Vec<Vec<Result<SampleCurve>>> = workers
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let taken = || next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let done: Vec<Vec<(usize, Result<SampleCurve>)>> = workers
         .par_iter_mut()
-        .zip(indices.par_chunks(per_lane))
-        .map(|(worker, chunk)| {
-            chunk
-                .iter()
-                .map(|&index| {
-                    sampler.sample(worker, sample_seed(spec.seed, spec.method, task, index))
+        .map(|worker| {
+            std::iter::from_fn(|| Some(taken()))
+                .take_while(|&slot| slot < indices.len())
+                .map(|slot| {
+                    let seed = sample_seed(spec.seed, spec.method, task, indices[slot]);
+                    (slot, sampler.sample(worker, seed))
                 })
                 .collect()
         })
         .collect();
-    done.into_iter().flatten().collect()
+    let mut slots: Vec<(usize, Result<SampleCurve>)> = done.into_iter().flatten().collect();
+    slots.sort_unstable_by_key(|&(slot, _)| slot);
+    slots.into_iter().map(|(_, sample)| sample).collect()
 }
 
 /// What a task's checkpoint holds, as [`StudyDir::restore`] reads it.
