@@ -10,15 +10,32 @@ import json
 import sys
 
 
+def padded_pairs(data):
+    """The 2N×2N pair's seconds per (N, threads), from the run's `fft_pairs`."""
+    return {(f["n"], f["threads"]): f["pair_seconds"] for f in data.get("fft_pairs", [])
+            if f["boundary"] == "free"}
+
+
+def padded(r, pairs):
+    """The iteration in issue 10's unit, the 2N×2N pair measured in the same run, whatever
+    the boundary."""
+    pair = pairs.get((r["n"], r["threads"]))
+    if pair is None or not r.get("iterations"):
+        return "—"
+    return f"{r['seconds'] / r['iterations'] / pair:.2f}"
+
+
 def main(path):
     data = json.load(open(path))
+    pairs = padded_pairs(data)
     rows = {}
     for r in data["results"]:
         rows[(r["n"], r["boundary"], r["pressure"], r["code"])] = r
     keys = sorted({k[:3] for k in rows}, key=lambda k: (k[1], k[0], k[2]))
     print("| N | boundary | p̄ | BCCG 2 threads: s (it, pairs/it) | BCCG 1 thread: s (pairs/it) "
-          "| PK 2 threads: s (it) | CM CCG w/o restart: s (it) | CM ÷ BCCG 2t | CM ÷ BCCG 1t |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| PK 2 threads: s (it) | CM CCG w/o restart: s (it) | CM ÷ BCCG 2t | CM ÷ BCCG 1t "
+          "| BCCG iteration in 2N×2N pairs, 2t / 1t |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for n, boundary, p in keys:
         get = lambda code: rows.get((n, boundary, p, code))
         b2, b1, pk, cm = (get(c) for c in ("asperity-bccg-2t", "asperity-bccg-1t",
@@ -30,7 +47,7 @@ def main(path):
               f"{b2['iteration_in_pairs']:.2f}) | {b1['seconds']:.3f} "
               f"({b1['iteration_in_pairs']:.2f}) | {pk_text} | {cm['seconds']:.3f} "
               f"({cm['iterations']}) | {cm['seconds'] / b2['seconds']:.1f}× | "
-              f"{cm['seconds'] / b1['seconds']:.1f}× |")
+              f"{cm['seconds'] / b1['seconds']:.1f}× | {padded(b2, pairs)} / {padded(b1, pairs)} |")
     env = data["environment"]
     print(f"\nMeasured {env['date']}, commit {env['asperity_commit'][:7]}, load average at the "
           f"start {env['loadavg'][0]:.2f}, {env['nproc']} cores; peers {env['peers']}.")
