@@ -98,6 +98,18 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
     Ok((solve, cg))
 }
 
+/// The probe sizes for a study on grids up to `sizes`' largest: 32² and 64² (a second or
+/// two per H) up to 256², 64² and 128² above (a few seconds per H). Extrapolated from 32²
+/// and 64², the iteration counts of a 1024² sample came out 23 % high; from 64² and 128²,
+/// 6 % (solve) and 16 % (frozen-set CG) high (docs/bem.md, "Estimating a BEM study").
+pub fn probes_for(sizes: &[usize]) -> (usize, usize) {
+    if sizes.iter().all(|&n| n <= 256) {
+        (32, 64)
+    } else {
+        (64, 128)
+    }
+}
+
 /// `count(n)` from counts at two probe sizes by the power law through them (exponent
 /// clamped at ≥ 0); the measured count at a probe size itself.
 fn extrapolate(count: (f64, f64), probes: (usize, usize), n: usize) -> f64 {
@@ -246,6 +258,14 @@ mod tests {
         assert!((grown - 145.0 * 1.45f64.powi(3)).abs() < 1e-9, "{grown}");
         // Fewer iterations at the larger probe: held flat, never extrapolated down.
         assert_eq!(extrapolate((30.0, 20.0), probes, 1024), 20.0);
+    }
+
+    #[test]
+    fn larger_studies_probe_larger_grids() {
+        assert_eq!(probes_for(&[64, 128]), (32, 64));
+        assert_eq!(probes_for(&[256]), (32, 64));
+        assert_eq!(probes_for(&[256, 512]), (64, 128));
+        assert_eq!(probes_for(&[1024]), (64, 128));
     }
 
     #[test]

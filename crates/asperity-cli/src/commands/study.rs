@@ -590,7 +590,8 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
         rolloff: spec.rolloff,
         stored: &stored,
     };
-    let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
+    let estimate =
+        crate::estimate::estimate_bem_seconds(&study, crate::estimate::probes_for(&spec.sizes))?;
     let minutes = estimate.seconds / 60.0;
     let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(

@@ -100,7 +100,8 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², a few seconds).
+/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², or 64² and 128² for
+/// grids above 256²: seconds).
 fn announce(
     figure: &str,
     setting: Setting,
@@ -128,7 +129,10 @@ fn announce(
                 rolloff: *rolloff,
                 stored: &stored,
             };
-            let estimate = crate::estimate::estimate_bem_seconds(&study, (32, 64))?;
+            let estimate = crate::estimate::estimate_bem_seconds(
+                &study,
+                crate::estimate::probes_for(&spec.sizes),
+            )?;
             let stored: usize = stored.iter().map(|s| s.samples).sum();
             eprintln!(
                 "{figure}: estimated BEM time on this machine {:.1} h{} ({} lanes; \
