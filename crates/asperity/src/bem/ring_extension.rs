@@ -54,36 +54,33 @@ pub(super) struct RingExtension {
     share: [[f64; 32]; 2],
 }
 
-/// Calls `visit` with the index of each 4-neighbour of `(i, j)` on a `rows × cols` grid
-/// (periodic: wrapped; free: those inside the grid only). No division: this runs for
-/// every point of every pass.
+/// The 4-neighbours of `(i, j)` on a `rows × cols` grid and whether each exists (1 or 0):
+/// periodic grids wrap; on free boundaries a missing neighbour is the point itself with
+/// weight 0. Interior points take the fixed offsets, so the passes below run without
+/// data-dependent branches (the labels of a rough contact set are too irregular for the
+/// branch predictor).
 #[inline(always)]
 fn neighbours(
     (rows, cols, periodic): (usize, usize, bool),
     (i, j): (usize, usize),
-    mut visit: impl FnMut(usize),
-) {
-    let row = i * cols;
-    if i > 0 {
-        visit(row - cols + j);
-    } else if periodic {
-        visit((rows - 1) * cols + j);
+) -> ([usize; 4], [f64; 4]) {
+    let k = i * cols + j;
+    if i > 0 && i + 1 < rows && j > 0 && j + 1 < cols {
+        return ([k - cols, k + cols, k - 1, k + 1], [1.0; 4]);
     }
-    if i + 1 < rows {
-        visit(row + cols + j);
-    } else if periodic {
-        visit(j);
-    }
-    if j > 0 {
-        visit(row + j - 1);
-    } else if periodic {
-        visit(row + cols - 1);
-    }
-    if j + 1 < cols {
-        visit(row + j + 1);
-    } else if periodic {
-        visit(row);
-    }
+    let wrap = |inside: bool, index: usize, wrapped: usize| match (inside, periodic) {
+        (true, _) => (index, 1.0),
+        (false, true) => (wrapped, 1.0),
+        (false, false) => (k, 0.0),
+    };
+    let up = wrap(i > 0, k.wrapping_sub(cols), (rows - 1) * cols + j);
+    let down = wrap(i + 1 < rows, k + cols, j);
+    let left = wrap(j > 0, k.wrapping_sub(1), i * cols + cols - 1);
+    let right = wrap(j + 1 < cols, k + 1, i * cols);
+    (
+        [up.0, down.0, left.0, right.0],
+        [up.1, down.1, left.1, right.1],
+    )
 }
 
 impl RingExtension {
@@ -129,24 +126,16 @@ impl RingExtension {
             .for_each(|(i, (labels, values))| {
                 for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate() {
                     let k = i * cols + j;
+                    let (near, exists) = neighbours(grid, (i, j));
                     let (mut count, mut sum) = (0u8, 0.0);
-                    neighbours(grid, (i, j), |m| {
-                        count += free[m] as u8;
-                        sum += z_read[m];
-                    });
-                    let on_ring = !free[k] && count > 0;
-                    *label = if free[k] {
-                        0
-                    } else if on_ring {
-                        1 | count << 2
-                    } else {
-                        BEYOND
-                    };
-                    *value = if on_ring {
-                        gamma[0] * sum * RECIPROCAL[count as usize]
-                    } else {
-                        0.0
-                    };
+                    for (&m, &e) in near.iter().zip(&exists) {
+                        count += (free[m] && e > 0.0) as u8;
+                        sum += e * z_read[m];
+                    }
+                    let ring = if count > 0 { 1 | count << 2 } else { BEYOND };
+                    *label = if free[k] { 0 } else { ring };
+                    let on_ring = (*label & 3 == 1) as u8 as f64;
+                    *value = on_ring * gamma[0] * sum * RECIPROCAL[count.min(4) as usize];
                 }
             });
         // Second ring: γ₂ times the mean of the first-ring neighbours (`spare` is zero off
@@ -159,20 +148,16 @@ impl RingExtension {
             .for_each(|(i, (labels, values))| {
                 for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate() {
                     let k = i * cols + j;
-                    *label = first[k];
-                    if first[k] != BEYOND {
-                        *value += spare[k];
-                        continue;
-                    }
+                    let (near, exists) = neighbours(grid, (i, j));
                     let (mut count, mut sum) = (0u8, 0.0);
-                    neighbours(grid, (i, j), |m| {
-                        count += (first[m] & 3 == 1) as u8;
-                        sum += spare[m];
-                    });
-                    if count > 0 {
-                        *label = 2 | count << 2;
-                        *value = gamma[1] * sum * RECIPROCAL[count as usize];
+                    for (&m, &e) in near.iter().zip(&exists) {
+                        count += (first[m] & 3 == 1 && e > 0.0) as u8;
+                        sum += e * spare[m];
                     }
+                    let second = first[k] == BEYOND && count > 0;
+                    *label = if second { 2 | count << 2 } else { first[k] };
+                    let weight = second as u8 as f64 * gamma[1] * RECIPROCAL[count.min(4) as usize];
+                    *value += spare[k] + weight * sum;
                 }
             });
     }
@@ -190,15 +175,12 @@ impl RingExtension {
             .for_each(|(i, values)| {
                 for (j, value) in values.iter_mut().enumerate() {
                     let k = i * cols + j;
-                    *value = if ring[k] & 3 == 1 {
-                        let mut sum = z_read[k];
-                        neighbours(grid, (i, j), |m| {
-                            sum += share[1][ring[m] as usize] * z_read[m]
-                        });
-                        sum
-                    } else {
-                        0.0
-                    };
+                    let (near, exists) = neighbours(grid, (i, j));
+                    let mut sum = z_read[k];
+                    for (&m, &e) in near.iter().zip(&exists) {
+                        sum += e * share[1][ring[m] as usize & 31] * z_read[m];
+                    }
+                    *value = (ring[k] & 3 == 1) as u8 as f64 * sum;
                 }
             });
         // The free set: its own value plus the shares the first ring took from it.
@@ -206,15 +188,12 @@ impl RingExtension {
         z.par_chunks_mut(cols).enumerate().for_each(|(i, values)| {
             for (j, value) in values.iter_mut().enumerate() {
                 let k = i * cols + j;
-                *value = if ring[k] & 3 == 0 {
-                    let mut sum = *value;
-                    neighbours(grid, (i, j), |m| {
-                        sum += share[0][ring[m] as usize] * spare[m]
-                    });
-                    sum
-                } else {
-                    0.0
-                };
+                let (near, exists) = neighbours(grid, (i, j));
+                let mut sum = *value;
+                for (&m, &e) in near.iter().zip(&exists) {
+                    sum += e * share[0][ring[m] as usize & 31] * spare[m];
+                }
+                *value = (ring[k] & 3 == 0) as u8 as f64 * sum;
             }
         });
     }
