@@ -11,18 +11,18 @@
 //! 1. `d` (load control) is the mean of `u + f` on the contact set `{p > 0}`, `u = K p`;
 //!    `g = u + f − d`. The free set is `F = {p > 0} ∪ {g < 0}`: every point but the bounded
 //!    ones (`p = 0`, `g ≥ 0`), which the iteration leaves alone.
-//! 2. Preconditioned gradient `z = Π P_F (I + E)ᵀ M (I + E) P_F Π g`, with `M` the symbol
-//!    `E*|q|/2` ([`super::preconditioner`]), `E` the extension of a field on `F` over two
-//!    rings of bounded points around it ([`super::ring_extension`]: without it `M` sees
-//!    the gradient jump to zero at the edge of every contact patch and over-estimates the
-//!    inverse of `K` on `F` most where the patches are large) and, under load control, `Π`
-//!    the mean-centring on `F` (the projection onto `Σ_F = 0`, which keeps the load).
+//! 2. Preconditioned gradient `z = Π P_F M P_F Π g`, with `M` the symbol `E*|q|/2`
+//!    ([`super::preconditioner`]) and, under load control, `Π` the mean-centring on `F`
+//!    (the projection onto `Σ_F = 0`, which keeps the load). Measured and switched off
+//!    ([`EDGE_RINGS`]): `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of a field
+//!    on `F` over two rings of bounded points ([`super::ring_extension`]), fewer
+//!    iterations but dearer ones.
 //! 3. Direction `s = −z + β s` on `F`, zero off it (and centred again on `F` under load
-//!    control), with the Fletcher–Reeves `β = zᵀg/z_oldᵀg_old`: the direction carries
-//!    over when the set changes, and its conjugacy is never reset (Polak–Ribière+, which
-//!    resets it whenever the new gradient has little in common with the old one, took up
-//!    to 11 more iterations at 1024²). A direction that is not downhill is replaced by
-//!    `−z`.
+//!    control), with the Polak–Ribière `β = max(0, zᵀ(g − g_old)/z_oldᵀg_old)`: the
+//!    direction carries over when the set changes, and `β` falls to zero by itself when the
+//!    new gradient has nothing in common with the old one (with the rings: Fletcher–Reeves
+//!    `β = zᵀg/z_oldᵀg_old` but for periodic displacement control). A direction that is
+//!    not downhill is replaced by `−z`.
 //! 4. `w = K s` (the one operator application of an iteration), the exact line minimum
 //!    `α = −sᵀg / sᵀw`, `p ← max(p + α s, 0)`, and under load control `p` rescaled to the
 //!    load.
@@ -54,6 +54,14 @@ use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
+
+/// Whether the preconditioner extends the gradient over two rings around the free set
+/// (`ring_extension.rs`), with the Fletcher–Reeves `β` (Polak–Ribière+ without). Off: with
+/// the rings the cold solves of `asperity bench bem-solve` take 22–35 % fewer iterations
+/// (1024² free, p̄ = 0.05: 57 → 42), but the rings' four grid passes make an iteration
+/// cost 2.1–2.2 padded FFT pairs instead of 1.2–1.6 (no wall-time gain at 1024²), and the
+/// warm solves of a study sample at 128² take 1.4–1.9× the time (docs/bem.md).
+const EDGE_RINGS: bool = false;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -616,14 +624,19 @@ impl ContactSolver {
             _ => false,
         };
         let scratch = &mut self.bccg_scratch;
-        // z = P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`); the response is free until
-        // the operator writes it.
+        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`;
+        // the response is free until the operator writes it).
         let (z, spare) = (&mut scratch.preconditioned, &mut scratch.response);
-        scratch.rings.extend(&scratch.free, z, spare);
+        if EDGE_RINGS {
+            scratch.rings.extend(&scratch.free, z, spare);
+        }
         self.preconditioner.apply(z);
-        scratch.rings.gather(z, spare);
+        if EDGE_RINGS {
+            scratch.rings.gather(z, spare);
+        }
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
-        let old = deflated.then_some(&scratch.previous_gradient[..]);
+        let polak_ribiere = deflated || !EDGE_RINGS;
+        let old = polak_ribiere.then_some(&scratch.previous_gradient[..]);
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
             (z, &scratch.gradient, old),
             (&scratch.direction, free),
@@ -639,15 +652,16 @@ impl ContactSolver {
         };
         // Deflated: the gradient keeps its mean, so zᵀg needs the z̄ term.
         let zg = if deflated { zg - z_mean * g_sum } else { zg };
-        // Fletcher–Reeves with the centred z, (z − z̄)ᵀΠg / z_oldᵀ g_old: measured against
-        // Polak–Ribière+, Hestenes–Stiefel, Dai–Yuan and Powell's restart test (docs/bem.md),
-        // the one that never resets the conjugacy when the set changes does best. Periodic
-        // displacement control keeps Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old:
+        // With the rings, Fletcher–Reeves with the centred z, (z − z̄)ᵀΠg / z_oldᵀ g_old:
+        // measured against Polak–Ribière+, Hestenes–Stiefel, Dai–Yuan and Powell's restart
+        // test (docs/bem.md), the one that never resets the conjugacy when the set changes
+        // does best on cold solves (but worse on warm ones). Otherwise, and always for
+        // periodic displacement control, Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old:
         // with the coarse constant in z, Fletcher–Reeves crawls there (131 iterations
         // against 30 near full contact).
         let beta = match previous_zg > 0.0 {
             false => 0.0,
-            true if deflated => ((zg - (z_g_old - z_mean * g_old_sum)) / previous_zg).max(0.0),
+            true if polak_ribiere => ((zg - (z_g_old - z_mean * g_old_sum)) / previous_zg).max(0.0),
             true => zg / previous_zg,
         };
         // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.
@@ -671,7 +685,7 @@ impl ContactSolver {
             (z_mean, beta, s_mean),
             restart,
         );
-        if deflated {
+        if polak_ribiere {
             std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
         }
         Direction {

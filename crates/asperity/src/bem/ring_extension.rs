@@ -33,6 +33,9 @@ use rayon::prelude::*;
 /// Weights of the first and the second ring (measured, see the module docs).
 const GAMMA: [f64; 2] = [0.7, 0.5];
 
+/// Points per parallel task (rounded up to whole rows).
+const BLOCK_POINTS: usize = 8192;
+
 /// Label of a point: 0 on the free set, 1 and 2 on the rings, 3 beyond.
 const BEYOND: u8 = 3;
 
@@ -111,6 +114,13 @@ impl RingExtension {
         (self.rows, self.cols, self.periodic)
     }
 
+    /// Points and rows of one parallel task: whole rows, at least [`BLOCK_POINTS`] points
+    /// (fewer tasks on small grids, where one per row costs more than its work).
+    fn block(&self) -> (usize, usize) {
+        let rows_per_block = BLOCK_POINTS.div_ceil(self.cols).max(1);
+        (rows_per_block * self.cols, rows_per_block)
+    }
+
     /// `z ← (I + E) z` for the free set `free`: `z` (zero off the set) keeps its values on
     /// the set and gets the extension on the two rings; `spare` is overwritten. Labels the
     /// rings on the way (two parallel passes).
@@ -119,45 +129,57 @@ impl RingExtension {
         // First ring: γ₁ times the mean of the free neighbours (z is zero off the set, so
         // the sum of all four is the sum over the free ones).
         let z_read: &[f64] = z;
+        let (block, rows_per_block) = self.block();
         self.first
-            .par_chunks_mut(cols)
-            .zip(spare.par_chunks_mut(cols))
+            .par_chunks_mut(block)
+            .zip(spare.par_chunks_mut(block))
             .enumerate()
-            .for_each(|(i, (labels, values))| {
-                for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate() {
-                    let k = i * cols + j;
-                    let (near, exists) = neighbours(grid, (i, j));
-                    let (mut count, mut sum) = (0u8, 0.0);
-                    for (&m, &e) in near.iter().zip(&exists) {
-                        count += (free[m] && e > 0.0) as u8;
-                        sum += e * z_read[m];
+            .for_each(|(b, (labels, values))| {
+                let rows = labels.chunks_mut(cols).zip(values.chunks_mut(cols));
+                for (r, (labels, values)) in rows.enumerate() {
+                    let i = b * rows_per_block + r;
+                    for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate()
+                    {
+                        let k = i * cols + j;
+                        let (near, exists) = neighbours(grid, (i, j));
+                        let (mut count, mut sum) = (0u8, 0.0);
+                        for (&m, &e) in near.iter().zip(&exists) {
+                            count += (free[m] && e > 0.0) as u8;
+                            sum += e * z_read[m];
+                        }
+                        let ring = if count > 0 { 1 | count << 2 } else { BEYOND };
+                        *label = if free[k] { 0 } else { ring };
+                        let on_ring = (*label & 3 == 1) as u8 as f64;
+                        *value = on_ring * gamma[0] * sum * RECIPROCAL[count.min(4) as usize];
                     }
-                    let ring = if count > 0 { 1 | count << 2 } else { BEYOND };
-                    *label = if free[k] { 0 } else { ring };
-                    let on_ring = (*label & 3 == 1) as u8 as f64;
-                    *value = on_ring * gamma[0] * sum * RECIPROCAL[count.min(4) as usize];
                 }
             });
         // Second ring: γ₂ times the mean of the first-ring neighbours (`spare` is zero off
         // the first ring); every point adds its ring value to z.
         let (first, spare): (&[u8], &[f64]) = (&self.first, spare);
         self.ring
-            .par_chunks_mut(cols)
-            .zip(z.par_chunks_mut(cols))
+            .par_chunks_mut(block)
+            .zip(z.par_chunks_mut(block))
             .enumerate()
-            .for_each(|(i, (labels, values))| {
-                for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate() {
-                    let k = i * cols + j;
-                    let (near, exists) = neighbours(grid, (i, j));
-                    let (mut count, mut sum) = (0u8, 0.0);
-                    for (&m, &e) in near.iter().zip(&exists) {
-                        count += (first[m] & 3 == 1 && e > 0.0) as u8;
-                        sum += e * spare[m];
+            .for_each(|(b, (labels, values))| {
+                let rows = labels.chunks_mut(cols).zip(values.chunks_mut(cols));
+                for (r, (labels, values)) in rows.enumerate() {
+                    let i = b * rows_per_block + r;
+                    for (j, (label, value)) in labels.iter_mut().zip(values.iter_mut()).enumerate()
+                    {
+                        let k = i * cols + j;
+                        let (near, exists) = neighbours(grid, (i, j));
+                        let (mut count, mut sum) = (0u8, 0.0);
+                        for (&m, &e) in near.iter().zip(&exists) {
+                            count += (first[m] & 3 == 1 && e > 0.0) as u8;
+                            sum += e * spare[m];
+                        }
+                        let second = first[k] == BEYOND && count > 0;
+                        *label = if second { 2 | count << 2 } else { first[k] };
+                        let weight =
+                            second as u8 as f64 * gamma[1] * RECIPROCAL[count.min(4) as usize];
+                        *value += spare[k] + weight * sum;
                     }
-                    let second = first[k] == BEYOND && count > 0;
-                    *label = if second { 2 | count << 2 } else { first[k] };
-                    let weight = second as u8 as f64 * gamma[1] * RECIPROCAL[count.min(4) as usize];
-                    *value += spare[k] + weight * sum;
                 }
             });
     }
@@ -169,31 +191,38 @@ impl RingExtension {
         let (grid, cols, ring, share) = (self.grid(), self.cols, &self.ring[..], &self.share);
         // First ring: its own value plus the shares the second ring took from it.
         let z_read: &[f64] = z;
+        let (block, rows_per_block) = self.block();
         spare
-            .par_chunks_mut(cols)
+            .par_chunks_mut(block)
             .enumerate()
-            .for_each(|(i, values)| {
-                for (j, value) in values.iter_mut().enumerate() {
-                    let k = i * cols + j;
-                    let (near, exists) = neighbours(grid, (i, j));
-                    let mut sum = z_read[k];
-                    for (&m, &e) in near.iter().zip(&exists) {
-                        sum += e * share[1][ring[m] as usize & 31] * z_read[m];
+            .for_each(|(b, values)| {
+                for (r, values) in values.chunks_mut(cols).enumerate() {
+                    let i = b * rows_per_block + r;
+                    for (j, value) in values.iter_mut().enumerate() {
+                        let k = i * cols + j;
+                        let (near, exists) = neighbours(grid, (i, j));
+                        let mut sum = z_read[k];
+                        for (&m, &e) in near.iter().zip(&exists) {
+                            sum += e * share[1][ring[m] as usize & 31] * z_read[m];
+                        }
+                        *value = (ring[k] & 3 == 1) as u8 as f64 * sum;
                     }
-                    *value = (ring[k] & 3 == 1) as u8 as f64 * sum;
                 }
             });
         // The free set: its own value plus the shares the first ring took from it.
         let spare: &[f64] = spare;
-        z.par_chunks_mut(cols).enumerate().for_each(|(i, values)| {
-            for (j, value) in values.iter_mut().enumerate() {
-                let k = i * cols + j;
-                let (near, exists) = neighbours(grid, (i, j));
-                let mut sum = *value;
-                for (&m, &e) in near.iter().zip(&exists) {
-                    sum += e * share[0][ring[m] as usize & 31] * spare[m];
+        z.par_chunks_mut(block).enumerate().for_each(|(b, values)| {
+            for (r, values) in values.chunks_mut(cols).enumerate() {
+                let i = b * rows_per_block + r;
+                for (j, value) in values.iter_mut().enumerate() {
+                    let k = i * cols + j;
+                    let (near, exists) = neighbours(grid, (i, j));
+                    let mut sum = *value;
+                    for (&m, &e) in near.iter().zip(&exists) {
+                        sum += e * share[0][ring[m] as usize & 31] * spare[m];
+                    }
+                    *value = (ring[k] & 3 == 0) as u8 as f64 * sum;
                 }
-                *value = (ring[k] & 3 == 0) as u8 as f64 * sum;
             }
         });
     }
