@@ -13,12 +13,16 @@
 //!    ones (`p = 0`, `g ≥ 0`), which the iteration leaves alone.
 //! 2. Preconditioned gradient `z = Π P_F M P_F Π g`, with `M` the symbol `E*|q|/2`
 //!    ([`super::preconditioner`]) and, under load control, `Π` the mean-centring on `F`
-//!    (the projection onto `Σ_F = 0`, which keeps the load).
+//!    (the projection onto `Σ_F = 0`, which keeps the load). Measured and switched off
+//!    ([`EDGE_RINGS`]): `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of a field
+//!    on `F` over two rings of bounded points ([`super::ring_extension`]), fewer
+//!    iterations but dearer ones.
 //! 3. Direction `s = −z + β s` on `F`, zero off it (and centred again on `F` under load
 //!    control), with the Polak–Ribière `β = max(0, zᵀ(g − g_old)/z_oldᵀg_old)`: the
 //!    direction carries over when the set changes, and `β` falls to zero by itself when the
-//!    new gradient has nothing in common with the old one. A direction that is not downhill
-//!    is replaced by `−z`.
+//!    new gradient has nothing in common with the old one (with the rings: Fletcher–Reeves
+//!    `β = zᵀg/z_oldᵀg_old` but for periodic displacement control). A direction that is
+//!    not downhill is replaced by `−z`.
 //! 4. `w = K s` (the one operator application of an iteration), the exact line minimum
 //!    `α = −sᵀg / sᵀw`, `p ← max(p + α s, 0)`, and under load control `p` rescaled to the
 //!    load.
@@ -46,9 +50,18 @@
 use rayon::prelude::*;
 
 use super::mean_gap::MeanGapScratch;
+use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
+
+/// Whether the preconditioner extends the gradient over two rings around the free set
+/// (`ring_extension.rs`), with the Fletcher–Reeves `β` (Polak–Ribière+ without). Off: with
+/// the rings the cold solves of `asperity bench bem-solve` take 22–35 % fewer iterations
+/// (1024² free, p̄ = 0.05: 57 → 42), but the rings' four grid passes make an iteration
+/// cost 2.1–2.2 padded FFT pairs instead of 1.2–1.6 (no wall-time gain at 1024²), and the
+/// warm solves of a study sample at 128² take 1.4–1.9× the time (docs/bem.md).
+const EDGE_RINGS: bool = false;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -86,8 +99,8 @@ impl Sums {
 }
 
 /// The BCCG's own fields: the search direction and its response, the preconditioned
-/// gradient, the current and the previous gradient, the free set, the operator's impulse
-/// response, the cut pressures and the partial sums of the parallel passes.
+/// gradient, the gradient, the free set and its rings, the operator's impulse response,
+/// the cut pressures and the partial sums of the parallel passes.
 pub(super) struct BccgScratch {
     /// The search direction `s` (carried from one iteration to the next).
     pub(super) direction: Vec<f64>,
@@ -97,7 +110,8 @@ pub(super) struct BccgScratch {
     pub(super) preconditioned: Vec<f64>,
     /// `Π g` on the free set, zero elsewhere.
     pub(super) gradient: Vec<f64>,
-    /// `Π g` of the previous iteration on its free set, zero elsewhere.
+    /// `Π g` of the previous iteration on its free set, zero elsewhere (for the
+    /// Polak–Ribière `β` of periodic displacement control).
     pub(super) previous_gradient: Vec<f64>,
     /// The free set `F` of the current iteration.
     pub(super) free: Vec<bool>,
@@ -118,6 +132,8 @@ pub(super) struct BccgScratch {
     /// The coarse correction of periodic displacement control (`mean_gap.rs`); periodic
     /// grids only.
     pub(super) mean_gap: Option<MeanGapScratch>,
+    /// The rings around the free set that extend the gradient before the preconditioner.
+    rings: RingExtension,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -166,6 +182,11 @@ impl BccgScratch {
             extra_applications: 0,
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
+            rings: RingExtension::new(
+                operator.rows(),
+                operator.cols(),
+                operator.boundary() == Boundary::Periodic,
+            ),
         }
     }
 }
@@ -326,29 +347,36 @@ fn centre_pass(z: &mut [f64], gradient: &mut [f64], free: &[bool], (centre, rest
         });
 }
 
-/// Sums on the free set for the new direction: `x = [Σz, Σz·Πg, Σz·g_old, Σg_old, Σs,
-/// Σs·Πg, ΣΠg]` (`s` the old direction).
+/// Sums on the free set for the new direction: `x = [Σz, Σz·Πg, Σs, Σs·Πg, ΣΠg, Σz·g_old,
+/// Σg_old]` (`s` the old direction; the last two only where `old` is given).
 fn direction_sums(
-    (z, gradient, old): (&[f64], &[f64], &[f64]),
+    (z, gradient, old): (&[f64], &[f64], Option<&[f64]>),
     (s, free): (&[f64], &[bool]),
     partials: &mut [Sums],
 ) -> Sums {
     z.par_chunks(CHUNK)
         .zip(gradient.par_chunks(CHUNK))
-        .zip(old.par_chunks(CHUNK))
         .zip(s.par_chunks(CHUNK).zip(free.par_chunks(CHUNK)))
         .zip(partials.par_iter_mut())
-        .for_each(|((((z, g), old), (s, free)), out)| {
+        .enumerate()
+        .for_each(|(chunk, (((z, g), (s, free)), out))| {
             let mut a = [0.0; 7];
-            for ((((&zi, &gi), &oi), &si), &fr) in z.iter().zip(g).zip(old).zip(s).zip(free) {
+            for (((&zi, &gi), &si), &fr) in z.iter().zip(g).zip(s).zip(free) {
                 if fr {
                     a[0] += zi;
                     a[1] += zi * gi;
-                    a[2] += zi * oi;
-                    a[3] += oi;
-                    a[4] += si;
-                    a[5] += si * gi;
-                    a[6] += gi;
+                    a[2] += si;
+                    a[3] += si * gi;
+                    a[4] += gi;
+                }
+            }
+            if let Some(old) = old {
+                let old = &old[chunk * CHUNK..chunk * CHUNK + z.len()];
+                for ((&zi, &oi), &fr) in z.iter().zip(old).zip(free) {
+                    if fr {
+                        a[5] += zi * oi;
+                        a[6] += oi;
+                    }
                 }
             }
             *out = Sums { x: a, n: [0, 0] };
@@ -596,10 +624,21 @@ impl ContactSolver {
             _ => false,
         };
         let scratch = &mut self.bccg_scratch;
-        self.preconditioner.apply(&mut scratch.preconditioned);
+        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`;
+        // the response is free until the operator writes it).
+        let (z, spare) = (&mut scratch.preconditioned, &mut scratch.response);
+        if EDGE_RINGS {
+            scratch.rings.extend(&scratch.free, z, spare);
+        }
+        self.preconditioner.apply(z);
+        if EDGE_RINGS {
+            scratch.rings.gather(z, spare);
+        }
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
-        let [z_sum, zg, z_g_old, g_old_sum, s_sum, s_g, g_sum] = direction_sums(
-            (z, &scratch.gradient, &scratch.previous_gradient),
+        let polak_ribiere = deflated || !EDGE_RINGS;
+        let old = polak_ribiere.then_some(&scratch.previous_gradient[..]);
+        let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
+            (z, &scratch.gradient, old),
             (&scratch.direction, free),
             &mut scratch.partials,
         )
@@ -613,12 +652,17 @@ impl ContactSolver {
         };
         // Deflated: the gradient keeps its mean, so zᵀg needs the z̄ term.
         let zg = if deflated { zg - z_mean * g_sum } else { zg };
-        // Polak–Ribière with the centred z: (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old.
-        let numerator = zg - (z_g_old - z_mean * g_old_sum);
-        let beta = if previous_zg > 0.0 {
-            (numerator / previous_zg).max(0.0)
-        } else {
-            0.0
+        // With the rings, Fletcher–Reeves with the centred z, (z − z̄)ᵀΠg / z_oldᵀ g_old:
+        // measured against Polak–Ribière+, Hestenes–Stiefel, Dai–Yuan and Powell's restart
+        // test (docs/bem.md), the one that never resets the conjugacy when the set changes
+        // does best on cold solves (but worse on warm ones). Otherwise, and always for
+        // periodic displacement control, Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old:
+        // with the coarse constant in z, Fletcher–Reeves crawls there (131 iterations
+        // against 30 near full contact).
+        let beta = match previous_zg > 0.0 {
+            false => 0.0,
+            true if polak_ribiere => ((zg - (z_g_old - z_mean * g_old_sum)) / previous_zg).max(0.0),
+            true => zg / previous_zg,
         };
         // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.
         let steepest_g = if deflated {
@@ -641,7 +685,9 @@ impl ContactSolver {
             (z_mean, beta, s_mean),
             restart,
         );
-        std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
+        if polak_ribiere {
+            std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
+        }
         Direction {
             zg,
             sg: if restart {

@@ -50,6 +50,7 @@ mod interruption;
 mod mean_gap;
 mod polonsky_keer;
 mod preconditioner;
+mod ring_extension;
 mod solver;
 mod stiffness;
 pub mod sweep;

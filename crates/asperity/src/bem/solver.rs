@@ -228,18 +228,18 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow), an upper bound on what its parts hold once all have been used: the
-    /// operator and the preconditioner; the profile, pressure and gap; the BCCG's six
-    /// fields and its mask; the Polonsky–Keer iteration's two; the six of the stiffness
+    /// operator and the preconditioner; the profile, pressure and gap; the BCCG's five
+    /// fields, its mask and its two ring labels; the Polonsky–Keer iteration's two; the six of the stiffness
     /// CG and its set's index list; the two of the full-contact code (periodic: three more for the coarse
     /// correction of displacement control). The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        // The mask counts as a field (rounding up); periodic grids add the coarse
-        // correction's two fields and its mask (`mean_gap.rs`).
+        // The mask and the ring labels count as fields (rounding up); periodic grids add
+        // the coarse correction's two fields and its mask (`mean_gap.rs`).
         let count = if boundary == Boundary::Periodic {
-            24
+            25
         } else {
-            21
+            22
         };
         let fields = memory::array_bytes(&[count, rows, cols], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
