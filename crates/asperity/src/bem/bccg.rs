@@ -20,9 +20,9 @@
 //! 3. Direction `s = −z + β s` on `F`, zero off it (and centred again on `F` under load
 //!    control), with the Polak–Ribière `β = max(0, zᵀ(g − g_old)/z_oldᵀg_old)`: the
 //!    direction carries over when the set changes, and `β` falls to zero by itself when the
-//!    new gradient has nothing in common with the old one (with the rings: Fletcher–Reeves
-//!    `β = zᵀg/z_oldᵀg_old` but for periodic displacement control). A direction that is
-//!    not downhill is replaced by `−z`.
+//!    new gradient has nothing in common with the old one (with the rings: the hybrid
+//!    `max(0, min(β_PR, β_FR))` with Fletcher–Reeves' `β_FR = zᵀg/z_oldᵀg_old`, but for
+//!    periodic displacement control). A direction that is not downhill is replaced by `−z`.
 //! 4. `w = K s` (the one operator application of an iteration), the exact line minimum
 //!    `α = −sᵀg / sᵀw`, `p ← max(p + α s, 0)`, and under load control `p` rescaled to the
 //!    load.
@@ -56,11 +56,11 @@ use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 
 /// Whether the preconditioner extends the gradient over two rings around the free set
-/// (`ring_extension.rs`), with the Fletcher–Reeves `β` (Polak–Ribière+ without). Off: with
-/// the rings the cold solves of `asperity bench bem-solve` take 22–35 % fewer iterations
-/// (1024² free, p̄ = 0.05: 57 → 42), but the rings' four grid passes make an iteration
-/// cost 2.1–2.2 padded FFT pairs instead of 1.2–1.6 (no wall-time gain at 1024²), and the
-/// warm solves of a study sample at 128² take 1.4–1.9× the time (docs/bem.md).
+/// (`ring_extension.rs`), with the hybrid `β = max(0, min(β_PR, β_FR))` (Polak–Ribière+
+/// without). Off: with the rings the cold solves of `asperity bench bem-solve` take 10–36 %
+/// fewer iterations (1024² free, p̄ = 0.05: 57 → 44), but the ring work makes an iteration
+/// cost 1.7–2.0 padded FFT pairs instead of 1.4–1.6 (the same wall time at 1024²), and the
+/// warm solves of a study sample at 128², H = −1, take 1.3× the time (docs/bem.md).
 const EDGE_RINGS: bool = false;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
@@ -132,8 +132,10 @@ pub(super) struct BccgScratch {
     /// The coarse correction of periodic displacement control (`mean_gap.rs`); periodic
     /// grids only.
     pub(super) mean_gap: Option<MeanGapScratch>,
-    /// The rings around the free set that extend the gradient before the preconditioner.
-    rings: RingExtension,
+    /// The rings around the free set that extend the gradient before the preconditioner
+    /// (only with [`EDGE_RINGS`]: their lists hold up to a grid of points each, memory
+    /// the solver's estimate does not count while they are off).
+    rings: Option<RingExtension>,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -182,11 +184,13 @@ impl BccgScratch {
             extra_applications: 0,
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
-            rings: RingExtension::new(
-                operator.rows(),
-                operator.cols(),
-                operator.boundary() == Boundary::Periodic,
-            ),
+            rings: EDGE_RINGS.then(|| {
+                RingExtension::new(
+                    operator.rows(),
+                    operator.cols(),
+                    operator.boundary() == Boundary::Periodic,
+                )
+            }),
         }
     }
 }
@@ -624,19 +628,17 @@ impl ContactSolver {
             _ => false,
         };
         let scratch = &mut self.bccg_scratch;
-        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`;
-        // the response is free until the operator writes it).
-        let (z, spare) = (&mut scratch.preconditioned, &mut scratch.response);
-        if EDGE_RINGS {
-            scratch.rings.extend(&scratch.free, z, spare);
+        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`).
+        let z = &mut scratch.preconditioned;
+        if let Some(rings) = scratch.rings.as_mut() {
+            rings.extend(&scratch.free, z);
         }
         self.preconditioner.apply(z);
-        if EDGE_RINGS {
-            scratch.rings.gather(z, spare);
+        if let Some(rings) = scratch.rings.as_ref() {
+            rings.gather(&scratch.free, z);
         }
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
-        let polak_ribiere = deflated || !EDGE_RINGS;
-        let old = polak_ribiere.then_some(&scratch.previous_gradient[..]);
+        let old = Some(&scratch.previous_gradient[..]);
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
             (z, &scratch.gradient, old),
             (&scratch.direction, free),
@@ -652,17 +654,18 @@ impl ContactSolver {
         };
         // Deflated: the gradient keeps its mean, so zᵀg needs the z̄ term.
         let zg = if deflated { zg - z_mean * g_sum } else { zg };
-        // With the rings, Fletcher–Reeves with the centred z, (z − z̄)ᵀΠg / z_oldᵀ g_old:
-        // measured against Polak–Ribière+, Hestenes–Stiefel, Dai–Yuan and Powell's restart
-        // test (docs/bem.md), the one that never resets the conjugacy when the set changes
-        // does best on cold solves (but worse on warm ones). Otherwise, and always for
-        // periodic displacement control, Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old:
-        // with the coarse constant in z, Fletcher–Reeves crawls there (131 iterations
-        // against 30 near full contact).
+        // Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old. With the rings the hybrid
+        // max(0, min(PR, FR)), Fletcher–Reeves (z − z̄)ᵀΠg / z_oldᵀ g_old: Fletcher–Reeves
+        // never resets the conjugacy and does best on cold solves, Polak–Ribière+ on the
+        // warm ones of a study; the hybrid is within 2 of the better on both (docs/bem.md).
+        // Periodic displacement control keeps Polak–Ribière+: with the coarse constant in
+        // z, Fletcher–Reeves crawls there (131 iterations against 30 near full contact).
+        let polak_ribiere = (zg - (z_g_old - z_mean * g_old_sum)) / previous_zg;
+        let fletcher_reeves = zg / previous_zg;
         let beta = match previous_zg > 0.0 {
             false => 0.0,
-            true if polak_ribiere => ((zg - (z_g_old - z_mean * g_old_sum)) / previous_zg).max(0.0),
-            true => zg / previous_zg,
+            true if deflated || !EDGE_RINGS => polak_ribiere.max(0.0),
+            true => polak_ribiere.min(fletcher_reeves).max(0.0),
         };
         // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.
         let steepest_g = if deflated {
@@ -685,9 +688,7 @@ impl ContactSolver {
             (z_mean, beta, s_mean),
             restart,
         );
-        if polak_ribiere {
-            std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
-        }
+        std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
         Direction {
             zg,
             sg: if restart {
