@@ -25,21 +25,24 @@ def padded(r, pairs):
     return f"{r['seconds'] / r['iterations'] / pair:.2f}"
 
 
+def cases(data, codes):
+    """Per case (N, boundary, p̄), in table order (free first, then by N and p̄): the case
+    and the result of each of `codes` (None where that code has none)."""
+    rows = {(r["n"], r["boundary"], r["pressure"], r["code"]): r for r in data["results"]}
+    keys = sorted({k[:3] for k in rows}, key=lambda k: (k[1], k[0], k[2]))
+    for n, boundary, p in keys:
+        yield (n, boundary, p), [rows.get((n, boundary, p, code)) for code in codes]
+
+
 def main(path):
     data = json.load(open(path))
     pairs = padded_pairs(data)
-    rows = {}
-    for r in data["results"]:
-        rows[(r["n"], r["boundary"], r["pressure"], r["code"])] = r
-    keys = sorted({k[:3] for k in rows}, key=lambda k: (k[1], k[0], k[2]))
     print("| N | boundary | p̄ | BCCG 2 threads: s (it, pairs/it) | BCCG 1 thread: s (pairs/it) "
           "| PK 2 threads: s (it) | CM CCG w/o restart: s (it) | CM ÷ BCCG 2t | CM ÷ BCCG 1t "
           "| BCCG iteration in 2N×2N pairs, 2t / 1t |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for n, boundary, p in keys:
-        get = lambda code: rows.get((n, boundary, p, code))
-        b2, b1, pk, cm = (get(c) for c in ("asperity-bccg-2t", "asperity-bccg-1t",
-                                              "asperity-pk-2t", "cm-ccg"))
+    codes = ("asperity-bccg-2t", "asperity-bccg-1t", "asperity-pk-2t", "cm-ccg")
+    for (n, boundary, p), (b2, b1, pk, cm) in cases(data, codes):
         if not (b2 and b1 and cm):
             continue
         pk_text = f"{pk['seconds']:.3f} ({pk['iterations']})" if pk else "—"
@@ -56,16 +59,12 @@ def main(path):
 def readme(path):
     """The README's table: asperity's default solver against every peer, per case."""
     data = json.load(open(path))
-    rows = {(r["n"], r["boundary"], r["pressure"], r["code"]): r for r in data["results"]}
-    keys = sorted({k[:3] for k in rows}, key=lambda k: (k[1], k[0], k[2]))
     print("| N | boundary | p̄ | asperity 2 threads: s (iterations) | asperity 1 thread (s) "
           "| tamaas PK (s) | ContactMechanics PK (s) | ContactMechanics CCG w/o restart: "
           "s (iterations) | CCG ÷ asperity, 2 / 1 threads | tamaas ÷ asperity 2 threads |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for n, boundary, p in keys:
-        get = lambda code: rows.get((n, boundary, p, code))
-        b2, b1, tm, cm, ccg = (get(c) for c in ("asperity-bccg-2t", "asperity-bccg-1t",
-                                                  "tamaas", "contactmechanics", "cm-ccg"))
+    codes = ("asperity-bccg-2t", "asperity-bccg-1t", "tamaas", "contactmechanics", "cm-ccg")
+    for (n, boundary, p), (b2, b1, tm, cm, ccg) in cases(data, codes):
         if not (b2 and b1 and tm and cm and ccg):
             continue
         print(f"| {n} | {boundary} | {p} | {b2['seconds']:.3f} ({b2['iterations']}) | "
