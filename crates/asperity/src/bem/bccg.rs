@@ -111,7 +111,7 @@ pub(super) struct BccgScratch {
     /// `Π g` on the free set, zero elsewhere.
     pub(super) gradient: Vec<f64>,
     /// `Π g` of the previous iteration on its free set, zero elsewhere (for the
-    /// Polak–Ribière `β` of periodic displacement control).
+    /// Polak–Ribière `β`).
     pub(super) previous_gradient: Vec<f64>,
     /// The free set `F` of the current iteration.
     pub(super) free: Vec<bool>,
@@ -352,35 +352,28 @@ fn centre_pass(z: &mut [f64], gradient: &mut [f64], free: &[bool], (centre, rest
 }
 
 /// Sums on the free set for the new direction: `x = [Σz, Σz·Πg, Σs, Σs·Πg, ΣΠg, Σz·g_old,
-/// Σg_old]` (`s` the old direction; the last two only where `old` is given).
+/// Σg_old]` (`s` the old direction).
 fn direction_sums(
-    (z, gradient, old): (&[f64], &[f64], Option<&[f64]>),
+    (z, gradient, old): (&[f64], &[f64], &[f64]),
     (s, free): (&[f64], &[bool]),
     partials: &mut [Sums],
 ) -> Sums {
     z.par_chunks(CHUNK)
         .zip(gradient.par_chunks(CHUNK))
+        .zip(old.par_chunks(CHUNK))
         .zip(s.par_chunks(CHUNK).zip(free.par_chunks(CHUNK)))
         .zip(partials.par_iter_mut())
-        .enumerate()
-        .for_each(|(chunk, (((z, g), (s, free)), out))| {
+        .for_each(|((((z, g), old), (s, free)), out)| {
             let mut a = [0.0; 7];
-            for (((&zi, &gi), &si), &fr) in z.iter().zip(g).zip(s).zip(free) {
+            for ((((&zi, &gi), &oi), &si), &fr) in z.iter().zip(g).zip(old).zip(s).zip(free) {
                 if fr {
                     a[0] += zi;
                     a[1] += zi * gi;
                     a[2] += si;
                     a[3] += si * gi;
                     a[4] += gi;
-                }
-            }
-            if let Some(old) = old {
-                let old = &old[chunk * CHUNK..chunk * CHUNK + z.len()];
-                for ((&zi, &oi), &fr) in z.iter().zip(old).zip(free) {
-                    if fr {
-                        a[5] += zi * oi;
-                        a[6] += oi;
-                    }
+                    a[5] += zi * oi;
+                    a[6] += oi;
                 }
             }
             *out = Sums { x: a, n: [0, 0] };
@@ -638,9 +631,8 @@ impl ContactSolver {
             rings.gather(&scratch.free, z);
         }
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
-        let old = Some(&scratch.previous_gradient[..]);
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
-            (z, &scratch.gradient, old),
+            (z, &scratch.gradient, &scratch.previous_gradient),
             (&scratch.direction, free),
             &mut scratch.partials,
         )

@@ -24,9 +24,10 @@
 //! weights. Measured at 512²: the largest eigenvalue 11.9 → 5.5 with `γ = (0.7, 0.5)`.
 //!
 //! The rings are kept as lists of their points: one pass over the grid finds the first
-//! ring, and everything else visits the rings only (a few per cent to a third of the grid),
-//! so the extension costs little more than that pass even on small grids, where the
-//! transforms are cheap. The lists are built and used serially, in index order: the
+//! ring, and everything else visits the rings only. That is still not cheap where the
+//! contact set is many small islands, whose rings cover much of the grid: at 128², H = −1,
+//! the extension and its transpose take a fifth of a solve (docs/bem.md), which is why the
+//! BCCG leaves them off. The lists are built and used serially, in index order: the
 //! results do not depend on the thread count. Nothing is allocated after
 //! [`RingExtension::new`].
 
@@ -145,9 +146,8 @@ impl RingExtension {
         );
         first.clear();
         second.clear();
-        // The first ring, row by row: a point off the set with a neighbour on it. The
-        // interior of a row takes fixed offsets (no division, no wrap), its two ends the
-        // general rule.
+        // The first ring, row by row (so that no division finds a point's row and column):
+        // a point off the set with a neighbour on it.
         let (rows, cols) = (self.rows, self.cols);
         for i in 0..rows {
             let row = i * cols;
@@ -156,24 +156,17 @@ impl RingExtension {
                 if free[k] {
                     continue;
                 }
-                let interior = i > 0 && i + 1 < rows && j > 0 && j + 1 < cols;
-                let count = if interior {
-                    free[k - cols] as u32
-                        + free[k + cols] as u32
-                        + free[k - 1] as u32
-                        + free[k + 1] as u32
-                } else {
-                    let mut count = 0u32;
-                    neighbours(grid, k, |m| count += free[m] as u32);
-                    count
+                let mut entry = Entry {
+                    k,
+                    share: 0.0,
+                    interior: i > 0 && i + 1 < rows && j > 0 && j + 1 < cols,
                 };
+                let mut count = 0u32;
+                entry.neighbours(grid, |m| count += free[m] as u32);
                 if count > 0 {
                     self.label[k] = FIRST;
-                    first.push(Entry {
-                        k,
-                        share: GAMMA[0] / f64::from(count),
-                        interior,
-                    });
+                    entry.share = GAMMA[0] / f64::from(count);
+                    first.push(entry);
                 }
             }
         }

@@ -782,8 +782,9 @@ fn lane_workers<S: Sampler>(sampler: &S) -> Result<Vec<S::Worker>> {
 /// one task per worker that takes the next sample not yet taken until none is left
 /// (self-scheduling: samples of one task differ in cost by tens of per cent, and with fixed
 /// chunks a worker given the costlier samples, or slowed by another process, held the
-/// batch up while the other waited). Each sample depends on its seed only ([`sample_seed`]), not on the worker or on
-/// what that worker computed before, so the scheduling changes the time, never the numbers.
+/// batch up while the other waited). Each sample depends on its seed only
+/// ([`sample_seed`]), not on the worker or on what that worker computed before, so the
+/// scheduling changes the time, never the numbers.
 fn sample_on_lanes<S: Sampler>(
     spec: &StudySpec,
     task: Task,
