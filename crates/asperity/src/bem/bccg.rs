@@ -13,10 +13,10 @@
 //!    ones (`p = 0`, `g ≥ 0`), which the iteration leaves alone.
 //! 2. Preconditioned gradient `z = Π P_F M P_F Π g`, with `M` the symbol `E*|q|/2`
 //!    ([`super::preconditioner`]) and, under load control, `Π` the mean-centring on `F`
-//!    (the projection onto `Σ_F = 0`, which keeps the load). Measured and switched off
-//!    ([`EDGE_RINGS`]): `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of a field
-//!    on `F` over two rings of bounded points ([`super::ring_extension`]), fewer
-//!    iterations but dearer ones.
+//!    (the projection onto `Σ_F = 0`, which keeps the load). On grids of at least
+//!    [`RING_MIN_POINTS`] points `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of
+//!    a field on `F` over two rings of bounded points ([`super::ring_extension`]): fewer
+//!    iterations, each two grid sweeps dearer.
 //! 3. Direction `s = −z + β s` on `F`, zero off it (and centred again on `F` under load
 //!    control), with the Polak–Ribière `β = max(0, zᵀ(g − g_old)/z_oldᵀg_old)`: the
 //!    direction carries over when the set changes, and `β` falls to zero by itself when the
@@ -55,13 +55,14 @@ use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 
-/// Whether the preconditioner extends the gradient over two rings around the free set
-/// (`ring_extension.rs`), with the hybrid `β = max(0, min(β_PR, β_FR))` (Polak–Ribière+
-/// without). Off: with the rings the cold solves of `asperity bench bem-solve` take 10–36 %
-/// fewer iterations (1024² free, p̄ = 0.05: 57 → 44), but the ring work makes an iteration
-/// cost 1.7–2.0 padded FFT pairs instead of 1.4–1.6 (the same wall time at 1024²), and the
-/// warm solves of a study sample at 128², H = −1, take 1.3× the time (docs/bem.md).
-const EDGE_RINGS: bool = false;
+/// Grids of at least this many points extend the gradient over two rings around the free
+/// set before the preconditioner (`ring_extension.rs`), with the hybrid
+/// `β = max(0, min(β_PR, β_FR))` (Polak–Ribière+ without). The rings cut the iterations
+/// most where the contact patches span many pixels, and cost two sweeps over the grid per
+/// iteration wherever they are: measured (docs/bem.md), the solves of a study sample take
+/// 6–12 % less time at 512² and 1024², about the same at 256², and up to 20 % more at 128²
+/// and 64² (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
+const RING_MIN_POINTS: usize = 1 << 18;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -133,8 +134,7 @@ pub(super) struct BccgScratch {
     /// grids only.
     pub(super) mean_gap: Option<MeanGapScratch>,
     /// The rings around the free set that extend the gradient before the preconditioner
-    /// (only with [`EDGE_RINGS`]: their lists hold up to a grid of points each, memory
-    /// the solver's estimate does not count while they are off).
+    /// (grids of at least [`RING_MIN_POINTS`] points).
     rings: Option<RingExtension>,
 }
 
@@ -184,7 +184,7 @@ impl BccgScratch {
             extra_applications: 0,
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
-            rings: EDGE_RINGS.then(|| {
+            rings: (len >= RING_MIN_POINTS).then(|| {
                 RingExtension::new(
                     operator.rows(),
                     operator.cols(),
@@ -627,7 +627,7 @@ impl ContactSolver {
             rings.extend(&scratch.free, z);
         }
         self.preconditioner.apply(z);
-        if let Some(rings) = scratch.rings.as_ref() {
+        if let Some(rings) = scratch.rings.as_mut() {
             rings.gather(&scratch.free, z);
         }
         let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
@@ -656,7 +656,7 @@ impl ContactSolver {
         let fletcher_reeves = zg / previous_zg;
         let beta = match previous_zg > 0.0 {
             false => 0.0,
-            true if deflated || !EDGE_RINGS => polak_ribiere.max(0.0),
+            true if deflated || scratch.rings.is_none() => polak_ribiere.max(0.0),
             true => polak_ribiere.min(fletcher_reeves).max(0.0),
         };
         // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.
@@ -780,6 +780,18 @@ impl ContactSolver {
 }
 
 #[cfg(test)]
+impl ContactSolver {
+    /// Switches the rings on or off whatever the grid's size (to test the solver both ways
+    /// on small grids).
+    pub(super) fn set_edge_rings(&mut self, on: bool) {
+        let operator = &self.problem.operator;
+        let periodic = operator.boundary() == Boundary::Periodic;
+        self.bccg_scratch.rings =
+            on.then(|| RingExtension::new(operator.rows(), operator.cols(), periodic));
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::rough_grid;
     use super::super::{Control, HalfSpace, SolverKind, SolverParams};
@@ -810,16 +822,18 @@ mod tests {
         info: SolveInfo,
     }
 
+    /// `solver` (with the rings if `rings`, whatever the grid's size).
     fn solve(
         surface: &Surface,
         boundary: Boundary,
-        solver: SolverKind,
+        (solver, rings): (SolverKind, bool),
         control: Control,
     ) -> Solved {
         // Tighter than the default: the comparison asks for 1e-9 in the indentation, and a
         // residual r moves d by about r·h_rms.
         let mut s =
             ContactSolver::new(surface, half_space(boundary), params(solver, 1e-11)).unwrap();
+        s.set_edge_rings(rings);
         let (summary, info) = s.solve(control).unwrap();
         let (stiffness, _) = s.frozen_set_stiffness().unwrap();
         let set = s.pressure().iter().map(|&p| p > 0.0).collect();
@@ -833,6 +847,8 @@ mod tests {
 
     #[test]
     fn agrees_with_polonsky_keer_on_rough_surfaces() {
+        // The BCCG with and without the rings (which only grids of RING_MIN_POINTS use by
+        // default) against Polonsky–Keer.
         let grids = [(63, 63), (64, 64), (50, 72), (256, 256)];
         for ((rows, cols), boundary) in grids
             .into_iter()
@@ -840,13 +856,26 @@ mod tests {
         {
             let surface = rough_grid(rows, cols, 21);
             let load = Control::MeanPressure(0.03);
-            let pk = solve(&surface, boundary, SolverKind::PolonskyKeer, load);
-            let new = solve(&surface, boundary, SolverKind::Bccg, load);
+            let pk = (SolverKind::PolonskyKeer, false);
+            let reference = solve(&surface, boundary, pk, load);
             // Displacement control at an indentation a little below the loaded state's.
-            let indentation = Control::Indentation(0.9 * pk.summary.indentation);
-            let pk_d = solve(&surface, boundary, SolverKind::PolonskyKeer, indentation);
-            let new_d = solve(&surface, boundary, SolverKind::Bccg, indentation);
-            for (what, a, b) in [("load", &pk, &new), ("indentation", &pk_d, &new_d)] {
+            let indentation = Control::Indentation(0.9 * reference.summary.indentation);
+            let reference_d = solve(&surface, boundary, pk, indentation);
+            for (rings, what, control) in [false, true]
+                .into_iter()
+                .flat_map(|r| [(r, "load", load), (r, "indentation", indentation)])
+            {
+                let a = if what == "load" {
+                    &reference
+                } else {
+                    &reference_d
+                };
+                let b = &solve(&surface, boundary, (SolverKind::Bccg, rings), control);
+                let what = if rings {
+                    format!("{what}, rings")
+                } else {
+                    what.to_string()
+                };
                 let d_error = b.summary.indentation / a.summary.indentation - 1.0;
                 let p_error = b.summary.mean_pressure / a.summary.mean_pressure - 1.0;
                 let k_error = b.stiffness / a.stiffness - 1.0;
@@ -887,6 +916,7 @@ mod tests {
         // load control and then under displacement control at the indentation found; the
         // two must describe the same state. Polonsky–Keer under load control is the
         // reference for the contact set.
+        // With and without the rings.
         let surface = rough_grid(128, 128, 5);
         let mut solver = ContactSolver::new(
             &surface,
@@ -895,7 +925,8 @@ mod tests {
         )
         .unwrap();
         let p_star = solver.full_contact_threshold().unwrap().mean_pressure;
-        for ratio in [0.9, 0.99] {
+        for (rings, ratio) in [(false, 0.9), (false, 0.99), (true, 0.9), (true, 0.99)] {
+            solver.set_edge_rings(rings);
             let load = Control::MeanPressure(ratio * p_star);
             solver.reset();
             let (loaded, info) = solver.solve(load).unwrap();
@@ -920,7 +951,7 @@ mod tests {
             let p_error = displaced.mean_pressure / loaded.mean_pressure - 1.0;
             let d_error = loaded.indentation / reference.indentation - 1.0;
             eprintln!(
-                "p/p* = {ratio}: area {:.4}; BCCG load {} it, displacement {} it (p {p_error:.1e}); \
+                "p/p* = {ratio}, rings {rings}: area {:.4}; BCCG load {} it, displacement {} it (p {p_error:.1e}); \
                  PK {} it (d {d_error:.1e}, {differing} points differ)",
                 loaded.area_fraction, info.iterations, info_d.iterations, pk_info.iterations
             );
@@ -949,16 +980,18 @@ mod tests {
     #[test]
     fn results_do_not_depend_on_the_thread_count() {
         // 150² spans three chunks of the parallel passes: their partial sums must add up
-        // to the same bits whichever threads computed them.
+        // to the same bits whichever threads computed them (and three blocks of rows of
+        // the rings' sweeps).
         for (surface, boundary) in [rough_grid(48, 56, 3), rough_grid(150, 150, 3)]
             .iter()
             .flat_map(|s| [(s, Boundary::Free), (s, Boundary::Periodic)])
         {
-            let run = |threads: usize| {
+            let run = |threads: usize, rings: bool| {
                 crate::test_support::with_threads(threads, || {
                     let mut solver =
                         ContactSolver::new(surface, half_space(boundary), SolverParams::default())
                             .unwrap();
+                    solver.set_edge_rings(rings);
                     let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
                     let (k, _) = solver.frozen_set_stiffness().unwrap();
                     let (sd, _) = solver
@@ -967,7 +1000,9 @@ mod tests {
                     (solver.pressure().to_owned(), s, info, k, sd)
                 })
             };
-            assert_eq!(run(1), run(2), "{boundary:?}");
+            for rings in [false, true] {
+                assert_eq!(run(1, rings), run(2, rings), "{boundary:?}, rings {rings}");
+            }
         }
     }
 

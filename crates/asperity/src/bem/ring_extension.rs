@@ -23,218 +23,304 @@
 //! ones wrap). The transpose gathers the preconditioned field back onto `F` along the same
 //! weights. Measured at 512²: the largest eigenvalue 11.9 → 5.5 with `γ = (0.7, 0.5)`.
 //!
-//! The rings are kept as lists of their points: one pass over the grid finds the first
-//! ring, and everything else visits the rings only. That is still not cheap where the
-//! contact set is many small islands, whose rings cover much of the grid: at 128², H = −1,
-//! the extension and its transpose take a fifth of a solve (docs/bem.md), which is why the
-//! BCCG leaves them off. The lists are built and used serially, in index order: the
-//! results do not depend on the thread count. Nothing is allocated after
-//! [`RingExtension::new`].
+//! The extension and its transpose are each one sweep over the grid of a two-stage
+//! stencil (the first ring from the set, then the second ring from the first), both stages
+//! in one pass over blocks of rows with three rows of the first stage in flight; the
+//! rings' neighbour counts (one byte per point) are recounted only when the free set
+//! changes. Every point is written from its neighbours' values in a fixed order, so the
+//! results do not depend on the thread count. Cost (docs/bem.md): at 1024² about a fifth
+//! of an iteration; at 128² about what the rings save in iterations, which is why the BCCG
+//! uses them on large grids only. Nothing is allocated after [`RingExtension::new`].
+
+use rayon::prelude::*;
 
 /// Weights of the first and the second ring (measured, see the module docs).
 const GAMMA: [f64; 2] = [0.7, 0.5];
 
-/// Label of a point off the rings.
-const OFF: u8 = 0;
-/// Label of a first-ring point.
-const FIRST: u8 = 1;
-/// Label of a second-ring point.
-const SECOND: u8 = 2;
+/// A ring point's weight by its count of neighbours one ring in (`γ/c`; no neighbours, or
+/// off the ring: zero), for each ring; indexed by the count's low three bits.
+const WEIGHTS: [[f64; 8]; 2] = [weights(GAMMA[0]), weights(GAMMA[1])];
 
-/// The rings of the current free set, the grid they live on, and the weights.
-pub(super) struct RingExtension {
-    /// Per point: [`OFF`], [`FIRST`] or [`SECOND`] for the rings of the last extension.
-    label: Vec<u8>,
-    /// The first ring's points, ascending, with `γ₁` over their number of free neighbours.
-    first: Vec<Entry>,
-    /// The second ring's points (in the order they were found from the first), with `γ₂`
-    /// over their number of first-ring neighbours.
-    second: Vec<Entry>,
-    rows: usize,
-    cols: usize,
-    periodic: bool,
+/// `γ/c` for the counts `c` = 1 … 4, zero for the others.
+const fn weights(gamma: f64) -> [f64; 8] {
+    [
+        0.0,
+        gamma,
+        gamma / 2.0,
+        gamma / 3.0,
+        gamma / 4.0,
+        0.0,
+        0.0,
+        0.0,
+    ]
 }
 
-/// Calls `visit` with each 4-neighbour of point `k` of a `rows × cols` grid (periodic:
-/// wrapped; free: those inside the grid only).
+/// The weight of a ring point with `count` neighbours one ring in, on ring `ring` (0, 1).
 #[inline(always)]
-fn neighbours(
-    (rows, cols, periodic): (usize, usize, bool),
-    k: usize,
-    mut visit: impl FnMut(usize),
+fn weight(ring: usize, count: u8) -> f64 {
+    WEIGHTS[ring][usize::from(count & 7)]
+}
+
+/// Points per block of rows of the parallel sweeps (whole rows, at least one). Every
+/// sweep writes each point from its neighbours' values only: the blocks change no bit.
+const BLOCK: usize = 8192;
+
+/// A `rows × cols` grid and whether it wraps around (periodic) or ends (free).
+type Grid = (usize, usize, bool);
+
+/// The rings' neighbour counts for the current free set, the grid they live on, and
+/// scratch.
+pub(super) struct RingExtension {
+    /// Per point of the first ring (bounded points next to the set): its number of
+    /// neighbours on the set; zero elsewhere.
+    first: Vec<u8>,
+    /// Per point of the second ring (bounded points next to the first ring only): its
+    /// number of first-ring neighbours; zero elsewhere.
+    second: Vec<u8>,
+    /// The free set the counts are for (they change only when it does).
+    counted_for: Vec<bool>,
+    /// Per block of rows: three rows of a sweep's first stage and one of neighbour sums.
+    rolling: Vec<f64>,
+    /// The result of a sweep, swapped with the caller's field.
+    out: Vec<f64>,
+    /// A row of zeros of each type: the rows outside a free grid.
+    zeros: (Vec<f64>, Vec<u8>, Vec<bool>),
+    grid: Grid,
+}
+
+/// The row above row `i` (periodic: wrapped; free: none above the first).
+fn row_above((rows, _, periodic): Grid, i: usize) -> Option<usize> {
+    match i {
+        0 if periodic => Some(rows - 1),
+        0 => None,
+        _ => Some(i - 1),
+    }
+}
+
+/// The row below row `i` (periodic: wrapped; free: none below the last).
+fn row_below((rows, _, periodic): Grid, i: usize) -> Option<usize> {
+    match i + 1 == rows {
+        true if periodic => Some(0),
+        true => None,
+        false => Some(i + 1),
+    }
+}
+
+/// Rows `i − 1`, `i`, `i + 1` of `field` (wrapped on periodic grids; a row of `zeros` in
+/// place of those outside a free grid).
+fn rows_of<'a, T>(grid: Grid, field: &'a [T], zeros: &'a [T], i: usize) -> [&'a [T]; 3] {
+    let cols = grid.1;
+    let row = |r: Option<usize>| r.map_or(zeros, |r| &field[r * cols..][..cols]);
+    [
+        row(row_above(grid, i)),
+        row(Some(i)),
+        row(row_below(grid, i)),
+    ]
+}
+
+/// `out[j] = Σ f(a_m, b_m)` over the 4-neighbours `m` of point `j` of the middle row, from
+/// the rows above, at and below it of two fields `a` and `b` (`f(0, 0) = 0`: a row of
+/// zeros stands for one outside a free grid); periodic rows wrap, free ones end. Added in
+/// a fixed order: above, below, left, right.
+#[inline(always)]
+fn stencil<A: Copy, B: Copy, T: Copy + Default + std::ops::Add<Output = T>>(
+    periodic: bool,
+    (a, b): ([&[A]; 3], [&[B]; 3]),
+    f: impl Fn(A, B) -> T,
+    out: &mut [T],
 ) {
-    let (i, j) = (k / cols, k % cols);
-    if i > 0 {
-        visit(k - cols);
-    } else if periodic {
-        visit((rows - 1) * cols + j);
+    let n = out.len();
+    let ([a0, a1, a2], [b0, b1, b2]) = (a.map(|r| &r[..n]), b.map(|r| &r[..n]));
+    let vertical = |j: usize| f(a0[j], b0[j]) + f(a2[j], b2[j]);
+    let side = |j: Option<usize>| j.map_or(T::default(), |j| f(a1[j], b1[j]));
+    let wrap = |j: usize| periodic.then_some(j);
+    if n == 1 {
+        out[0] = vertical(0) + side(wrap(0)) + side(wrap(0));
+        return;
     }
-    if i + 1 < rows {
-        visit(k + cols);
-    } else if periodic {
-        visit(j);
+    let last = n - 1;
+    out[0] = vertical(0) + side(wrap(last)) + side(Some(1));
+    for j in 1..last {
+        out[j] =
+            f(a0[j], b0[j]) + f(a2[j], b2[j]) + f(a1[j - 1], b1[j - 1]) + f(a1[j + 1], b1[j + 1]);
     }
-    if j > 0 {
-        visit(k - 1);
-    } else if periodic {
-        visit(k + cols - 1);
-    }
-    if j + 1 < cols {
-        visit(k + 1);
-    } else if periodic {
-        visit(k + 1 - cols);
-    }
+    out[last] = vertical(last) + side(Some(last - 1)) + side(wrap(0));
 }
 
-/// A point of a ring: its index, its weight over its number of neighbours one ring in, and
-/// whether it is away from the grid's edges (its neighbours then are `k ± 1`, `k ± cols`,
-/// found without a division).
-#[derive(Clone, Copy)]
-struct Entry {
-    k: usize,
-    share: f64,
-    interior: bool,
-}
-
-impl Entry {
-    fn new(k: usize, (rows, cols): (usize, usize)) -> Self {
-        let (i, j) = (k / cols, k % cols);
-        Entry {
-            k,
-            share: 0.0,
-            interior: i > 0 && i + 1 < rows && j > 0 && j + 1 < cols,
-        }
-    }
-
-    /// Calls `visit` with each 4-neighbour (as [`neighbours`]).
-    #[inline(always)]
-    fn neighbours(self, grid: (usize, usize, bool), mut visit: impl FnMut(usize)) {
-        if self.interior {
-            let (k, cols) = (self.k, grid.1);
-            visit(k - cols);
-            visit(k + cols);
-            visit(k - 1);
-            visit(k + 1);
-        } else {
-            neighbours(grid, self.k, visit);
-        }
-    }
+/// One sweep over the grid of a two-stage stencil: `stage_one(i, row)` writes row `i` of
+/// an intermediate field, `stage_two(i, (row, sums), out)` row `i` of the result from that
+/// field's row `i` and its neighbour sums. In parallel over blocks of rows; each block
+/// computes stage one for its rows and one either side, keeping three rows at a time
+/// (the intermediate field is never stored whole, and the grid is read once).
+fn sweep(
+    grid: Grid,
+    (rolling, out, zeros): (&mut [f64], &mut [f64], &[f64]),
+    stage_one: impl Fn(usize, &mut [f64]) + Sync,
+    stage_two: impl Fn(usize, (&[f64], &[f64]), &mut [f64]) + Sync,
+) {
+    let cols = grid.1;
+    let block_rows = (BLOCK / cols).max(1);
+    out.par_chunks_mut(block_rows * cols)
+        .zip(rolling.par_chunks_mut(4 * cols))
+        .enumerate()
+        .for_each(|(b, (out, rolling))| {
+            let (slots, sums) = rolling.split_at_mut(3 * cols);
+            let first_row = b * block_rows;
+            // Slots of the rows above, at and below the current one.
+            let mut slot = [0, 1, 2];
+            let rows = [row_above(grid, first_row), Some(first_row)];
+            for (&s, r) in slot.iter().zip(rows) {
+                if let Some(r) = r {
+                    stage_one(r, &mut slots[s * cols..][..cols]);
+                }
+            }
+            for (r, out) in out.chunks_mut(cols).enumerate() {
+                let i = first_row + r;
+                if r > 0 {
+                    slot.rotate_left(1);
+                }
+                let below = row_below(grid, i);
+                if let Some(r) = below {
+                    stage_one(r, &mut slots[slot[2] * cols..][..cols]);
+                }
+                let row = |s: usize| &slots[s * cols..][..cols];
+                let present = |r: Option<usize>, s: usize| r.map_or(zeros, |_| row(s));
+                let rows = [
+                    present(row_above(grid, i), slot[0]),
+                    row(slot[1]),
+                    present(below, slot[2]),
+                ];
+                stencil(grid.2, (rows, rows), |v, _| v, sums);
+                stage_two(i, (row(slot[1]), sums), out);
+            }
+        });
 }
 
 impl RingExtension {
     /// The fields for a `rows × cols` grid (periodic or free boundaries).
     pub(super) fn new(rows: usize, cols: usize, periodic: bool) -> Self {
+        let blocks = rows.div_ceil((BLOCK / cols).max(1));
         RingExtension {
-            label: vec![OFF; rows * cols],
-            first: Vec::with_capacity(rows * cols),
-            second: Vec::with_capacity(rows * cols),
-            rows,
-            cols,
-            periodic,
+            first: vec![0; rows * cols],
+            second: vec![0; rows * cols],
+            counted_for: vec![false; rows * cols],
+            rolling: vec![0.0; blocks * 4 * cols],
+            out: vec![0.0; rows * cols],
+            zeros: (vec![0.0; cols], vec![0; cols], vec![false; cols]),
+            grid: (rows, cols, periodic),
         }
     }
 
-    /// Lists the rings of `free` (clearing the labels of the last ones first).
-    fn find_rings(&mut self, free: &[bool]) {
-        let grid = (self.rows, self.cols, self.periodic);
-        for entry in self.first.iter().chain(&self.second) {
-            self.label[entry.k] = OFF;
+    /// Counts the rings' neighbours for `free` unless they are counted already (two
+    /// passes over one byte per point).
+    fn count(&mut self, free: &[bool]) {
+        if self.counted_for[..] == *free {
+            return;
         }
-        let (mut first, mut second) = (
-            std::mem::take(&mut self.first),
-            std::mem::take(&mut self.second),
-        );
-        first.clear();
-        second.clear();
-        // The first ring, row by row (so that no division finds a point's row and column):
-        // a point off the set with a neighbour on it.
-        let (rows, cols) = (self.rows, self.cols);
-        for i in 0..rows {
-            let row = i * cols;
-            for j in 0..cols {
-                let k = row + j;
-                if free[k] {
-                    continue;
-                }
-                let mut entry = Entry {
-                    k,
-                    share: 0.0,
-                    interior: i > 0 && i + 1 < rows && j > 0 && j + 1 < cols,
-                };
-                let mut count = 0u32;
-                entry.neighbours(grid, |m| count += free[m] as u32);
-                if count > 0 {
-                    self.label[k] = FIRST;
-                    entry.share = GAMMA[0] / f64::from(count);
-                    first.push(entry);
-                }
+        let (grid, cols) = (self.grid, self.grid.1);
+        let (zeros, falses) = (&self.zeros.1[..], &self.zeros.2[..]);
+        // The first ring: bounded points with neighbours on the set.
+        for_rows(grid, &mut self.first, |i, row| {
+            let rows = rows_of(grid, free, falses, i);
+            stencil(grid.2, (rows, rows), |f, _| u8::from(f), row);
+            let own = &free[i * cols..][..cols];
+            row.iter_mut()
+                .zip(own)
+                .for_each(|(c, &f)| *c *= u8::from(!f));
+        });
+        // The second ring: bounded points off the first ring with first-ring neighbours.
+        let first = &self.first;
+        for_rows(grid, &mut self.second, |i, row| {
+            let rows = rows_of(grid, first, zeros, i);
+            stencil(grid.2, (rows, rows), |c, _| u8::from(c > 0), row);
+            let own = free[i * cols..][..cols]
+                .iter()
+                .zip(&first[i * cols..][..cols]);
+            let inner = |(&f, &c): (&bool, &u8)| f || c > 0;
+            row.iter_mut()
+                .zip(own)
+                .for_each(|(c, own)| *c *= u8::from(!inner(own)));
+        });
+        self.counted_for.copy_from_slice(free);
+    }
+
+    /// `z ← (I + E) z` for the free set `free`: `z`, zero off the set, keeps its values
+    /// there and gets the extension on the two rings (one sweep, two more passes where the
+    /// set changed).
+    pub(super) fn extend(&mut self, free: &[bool], z: &mut Vec<f64>) {
+        self.count(free);
+        let (grid, cols) = (self.grid, self.grid.1);
+        let (first, second, zr, zeros) = (&self.first, &self.second, &z[..], &self.zeros.0[..]);
+        // Stage one, the first ring: γ₁/c times the sum of its c neighbours on the set.
+        let first_ring = |i: usize, row: &mut [f64]| {
+            let rows = rows_of(grid, zr, zeros, i);
+            stencil(grid.2, (rows, rows), |z, _| z, row);
+            let own = &first[i * cols..][..cols];
+            row.iter_mut()
+                .zip(own)
+                .for_each(|(v, &c)| *v *= weight(0, c));
+        };
+        // Stage two: z on the set, the first ring, and on the second ring γ₂/c times the
+        // sum of its c first-ring neighbours.
+        let both_rings = |i: usize, (ring, sums): (&[f64], &[f64]), out: &mut [f64]| {
+            let own = (&free[i * cols..][..cols], &second[i * cols..][..cols]);
+            let own = own.0.iter().zip(own.1).zip(&zr[i * cols..][..cols]);
+            let rings = ring.iter().zip(sums);
+            for ((o, (v, s)), ((&f, &c), &z)) in out.iter_mut().zip(rings).zip(own) {
+                *o = if f { z } else { v + weight(1, c) * s };
             }
-        }
-        for entry in &first {
-            entry.neighbours(grid, |m| {
-                if !free[m] && self.label[m] == OFF {
-                    // Marked now, weighed below (its first-ring neighbours are all known).
-                    self.label[m] = SECOND;
-                    second.push(Entry::new(m, (rows, cols)));
-                }
-            });
-        }
-        for entry in second.iter_mut() {
-            let mut count = 0u32;
-            entry.neighbours(grid, |m| count += (self.label[m] == FIRST) as u32);
-            entry.share = GAMMA[1] / f64::from(count);
-        }
-        (self.first, self.second) = (first, second);
-    }
-
-    /// `z ← (I + E) z` for the free set `free`: `z` (zero off the set) keeps its values on
-    /// the set and gets the extension on the two rings.
-    pub(super) fn extend(&mut self, free: &[bool], z: &mut [f64]) {
-        self.find_rings(free);
-        let grid = (self.rows, self.cols, self.periodic);
-        for &entry in &self.first {
-            let mut sum = 0.0;
-            entry.neighbours(grid, |m| {
-                if free[m] {
-                    sum += z[m];
-                }
-            });
-            z[entry.k] = entry.share * sum;
-        }
-        for &entry in &self.second {
-            let mut sum = 0.0;
-            entry.neighbours(grid, |m| {
-                if self.label[m] == FIRST {
-                    sum += z[m];
-                }
-            });
-            z[entry.k] = entry.share * sum;
-        }
+        };
+        let fields = (&mut self.rolling[..], &mut self.out[..], zeros);
+        sweep(grid, fields, first_ring, both_rings);
+        std::mem::swap(z, &mut self.out);
     }
 
     /// `z ← (I + E)ᵀ z` on the free set `free` of the last [`RingExtension::extend`]: there
     /// `z` plus what the rings took from each point. Off the set `z` is left unspecified
-    /// (its callers read it on the set only, `P_F`).
-    pub(super) fn gather(&self, free: &[bool], z: &mut [f64]) {
-        let grid = (self.rows, self.cols, self.periodic);
-        // The second ring gives to the first, then the first (with what it got) to the set.
-        for &entry in &self.second {
-            let give = entry.share * z[entry.k];
-            entry.neighbours(grid, |m| {
-                if self.label[m] == FIRST {
-                    z[m] += give;
-                }
-            });
-        }
-        for &entry in &self.first {
-            let give = entry.share * z[entry.k];
-            entry.neighbours(grid, |m| {
-                if free[m] {
-                    z[m] += give;
-                }
-            });
-        }
+    /// (its callers read it on the set only, `P_F`). One sweep.
+    pub(super) fn gather(&mut self, free: &[bool], z: &mut Vec<f64>) {
+        let (grid, cols) = (self.grid, self.grid.1);
+        let (first, second, zr) = (&self.first, &self.second, &z[..]);
+        let (zeros, counts) = (&self.zeros.0[..], &self.zeros.1[..]);
+        // Stage one: the second ring gives to the first, which holds γ₁/c (z + what it got).
+        let first_ring = |i: usize, row: &mut [f64]| {
+            let rows = (
+                rows_of(grid, second, counts, i),
+                rows_of(grid, zr, zeros, i),
+            );
+            stencil(grid.2, rows, |c, z| weight(1, c) * z, row);
+            let own = first[i * cols..][..cols]
+                .iter()
+                .zip(&zr[i * cols..][..cols]);
+            row.iter_mut()
+                .zip(own)
+                .for_each(|(v, (&c, z))| *v = weight(0, c) * (z + *v));
+        };
+        // Stage two: the first ring gives to the set.
+        let to_set = |i: usize, (_, sums): (&[f64], &[f64]), out: &mut [f64]| {
+            let own = free[i * cols..][..cols].iter().zip(&zr[i * cols..][..cols]);
+            for ((o, s), (&f, z)) in out.iter_mut().zip(sums).zip(own) {
+                *o = if f { z + s } else { *z };
+            }
+        };
+        let fields = (&mut self.rolling[..], &mut self.out[..], zeros);
+        sweep(grid, fields, first_ring, to_set);
+        std::mem::swap(z, &mut self.out);
     }
+}
+
+/// Runs `pass(i, row)` on every row `i` of `field`, in parallel over blocks of rows.
+fn for_rows<T: Send>(grid: Grid, field: &mut [T], pass: impl Fn(usize, &mut [T]) + Sync) {
+    let cols = grid.1;
+    let block_rows = (BLOCK / cols).max(1);
+    field
+        .par_chunks_mut(block_rows * cols)
+        .enumerate()
+        .for_each(|(b, block)| {
+            for (r, row) in block.chunks_mut(cols).enumerate() {
+                pass(b * block_rows + r, row);
+            }
+        });
 }
 
 #[cfg(test)]
@@ -282,7 +368,7 @@ mod tests {
         // which have a second ring) and dense ones; the extension is checked against the
         // definition written out with coordinates, and ⟨(I + E) z, y⟩ = ⟨z, (I + E)ᵀ y⟩ on
         // the set (so that (I + E)ᵀ M (I + E) is symmetric). Twice per grid, so that the
-        // second extension starts from the first one's labels.
+        // second extension overwrites the first one's fields.
         for (rows, cols) in [(31, 31), (32, 32), (50, 72), (700, 13)] {
             for periodic in [false, true] {
                 let grid = (rows, cols, periodic);

@@ -229,13 +229,14 @@ impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow), an upper bound on what its parts hold once all have been used: the
     /// operator and the preconditioner; the profile, pressure and gap; the BCCG's five
-    /// fields, its mask and its two ring labels; the Polonsky–Keer iteration's two; the six of the stiffness
-    /// CG and its set's index list; the two of the full-contact code (periodic: three more for the coarse
-    /// correction of displacement control). The caller's [`Surface`] (one more
+    /// fields and its mask, with the rings of large grids one more field and three bytes
+    /// per point; the Polonsky–Keer iteration's two; the six of the stiffness CG and its
+    /// set's index list; the two of the full-contact code (periodic: three more for the
+    /// coarse correction of displacement control). The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        // The mask and the ring labels count as fields (rounding up); periodic grids add
-        // the coarse correction's two fields and its mask (`mean_gap.rs`).
+        // The masks and the rings' bytes count as two fields (rounding up); periodic grids
+        // add the coarse correction's two fields and its mask (`mean_gap.rs`).
         let count = if boundary == Boundary::Periodic {
             25
         } else {
