@@ -52,7 +52,8 @@ fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<(f64,
 /// Seconds per solver iteration and per frozen-set CG iteration on an `n × n` grid: solves
 /// and stiffness CGs cut off after a few iterations (their `NoConvergence` carries the
 /// count; one that converges earlier counts its own iterations), timed; the minimum of three.
-/// The CG runs on the contact set of a loose solve at p̄ = 0.01 E* (a few percent contact).
+/// The CG runs on the contact set of a loose solve at p̄ = 0.1 E* (about 20 % contact: a
+/// set too large for the direct solve of small sets, whose loads cost next to nothing).
 fn iteration_costs(n: usize) -> Result<(f64, f64)> {
     const CUT: usize = 6;
     let surface = study_surface(n, 0.8, None)?;
@@ -81,7 +82,7 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
     for _ in 0..3 {
         solver.set_params(loose)?;
         solver.reset();
-        solver.solve(Control::MeanPressure(0.01))?;
+        solver.solve(Control::MeanPressure(0.1))?;
         solver.set_params(cut)?;
         let start = Instant::now();
         let result = solver
@@ -111,12 +112,14 @@ pub fn probes_for(sizes: &[usize]) -> (usize, usize) {
 }
 
 /// `count(n)` from counts at two probe sizes by the power law through them (exponent
-/// clamped at ≥ 0); the measured count at a probe size itself.
+/// clamped at ≥ 0; a count below one, as of a sample that the direct solve of small sets
+/// did whole, taken as one for it); the measured count at a probe size itself.
 fn extrapolate(count: (f64, f64), probes: (usize, usize), n: usize) -> f64 {
     if n == probes.0 {
         return count.0;
     }
-    let slope = ((count.1 / count.0).ln() / (probes.1 as f64 / probes.0 as f64).ln()).max(0.0);
+    let ratio = count.1.max(1.0) / count.0.max(1.0);
+    let slope = (ratio.ln() / (probes.1 as f64 / probes.0 as f64).ln()).max(0.0);
     count.1 * (n as f64 / probes.1 as f64).powf(slope)
 }
 
@@ -258,6 +261,9 @@ mod tests {
         assert!((grown - 145.0 * 1.45f64.powi(3)).abs() < 1e-9, "{grown}");
         // Fewer iterations at the larger probe: held flat, never extrapolated down.
         assert_eq!(extrapolate((30.0, 20.0), probes, 1024), 20.0);
+        // No iteration at the smaller probe (its sample solved directly): from one.
+        assert!((extrapolate((0.0, 8.0), probes, 256) - 64.0).abs() < 1e-9);
+        assert_eq!(extrapolate((0.0, 0.0), probes, 256), 0.0);
     }
 
     #[test]

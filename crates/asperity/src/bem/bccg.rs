@@ -501,13 +501,17 @@ impl ContactSolver {
         if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
             mean_gap.reset();
         }
-        self.problem
-            .operator
-            .apply(&self.state.pressure, &mut self.state.gap);
-        let mut applications = 1;
+        // Small contact sets: solved directly (`small_set.rs`), then only checked here.
+        let small = self.small_set_start(target, max_iterations)?;
+        if !small.exact {
+            self.problem
+                .operator
+                .apply(&self.state.pressure, &mut self.state.gap);
+        }
+        let mut applications = small.applications + usize::from(!small.exact);
         let (mut exact, mut since_refresh) = (true, 0);
         let mut previous_zg = 0.0;
-        let mut iteration = 0;
+        let mut iteration = small.applications;
         loop {
             self.check_stop(iteration)?;
             let gradient = self.gradient_pass(target, indentation);

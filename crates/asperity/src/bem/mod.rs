@@ -51,6 +51,7 @@ mod mean_gap;
 mod polonsky_keer;
 mod preconditioner;
 mod ring_extension;
+mod small_set;
 mod solver;
 mod stiffness;
 pub mod sweep;

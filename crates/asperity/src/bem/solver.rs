@@ -40,6 +40,7 @@ use super::bccg::BccgScratch;
 use super::full_contact::{FullContactScratch, FullContactThreshold};
 use super::polonsky_keer::PkScratch;
 use super::preconditioner::FourierPreconditioner;
+use super::small_set::SmallSet;
 use super::stiffness::StiffnessWork;
 use super::{
     ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
@@ -204,6 +205,9 @@ pub struct ContactSolver {
     /// The fields of the periodic threshold and of the lower bound (`full_contact.rs`),
     /// allocated on first use.
     pub(super) full_contact_scratch: Option<FullContactScratch>,
+    /// The dense fields of the direct solve of small contact sets (`small_set.rs`),
+    /// allocated on first use.
+    pub(super) small_set: Option<SmallSet>,
     /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
     pub(super) stop: Stop,
 }
@@ -232,20 +236,24 @@ impl ContactSolver {
     /// fields and its mask, with the rings of large grids one more field and three bytes
     /// per point; the Polonsky–Keer iteration's two; the six of the stiffness CG and its
     /// set's index list; the two of the full-contact code (periodic: three more for the
-    /// coarse correction of displacement control). The caller's [`Surface`] (one more
+    /// coarse correction of displacement control); the direct solve of small sets, a
+    /// field of indices, a mask and its dense factor. The caller's [`Surface`] (one more
     /// `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
         // The masks and the rings' bytes count as two fields (rounding up); periodic grids
         // add the coarse correction's two fields and its mask (`mean_gap.rs`).
         let count = if boundary == Boundary::Periodic {
-            25
+            26
         } else {
-            22
+            23
         };
         let fields = memory::array_bytes(&[count, rows, cols], 8)?;
+        let limit = super::small_set::limit(rows.checked_mul(cols)?);
+        let factor = memory::array_bytes(&[limit + 3, limit], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
             .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
-            .checked_add(fields)
+            .checked_add(fields)?
+            .checked_add(factor)
     }
 
     /// Plans a solver for `surface` on `half_space`; validates `params`, refuses grids that
@@ -282,6 +290,7 @@ impl ContactSolver {
             pk_scratch: None,
             stiffness_work: None,
             full_contact_scratch: None,
+            small_set: None,
             stop: Stop::new(),
         })
     }
