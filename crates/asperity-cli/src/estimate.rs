@@ -34,19 +34,38 @@ const FREE: HalfSpace = HalfSpace {
     boundary: Boundary::Free,
 };
 
-/// Solver and frozen-set CG iterations of one study sample (seed 1): the 24 loads solved in
-/// turn with warm starts, the stiffness after each.
-fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<(f64, f64)> {
+/// The counts of one study sample (seed 1): the 24 loads solved in turn with warm starts,
+/// the stiffness after each.
+#[derive(Clone, Copy)]
+struct SampleCounts {
+    /// Solver iterations of the loads the BCCG solved.
+    solve: f64,
+    /// Operator applications of the loads solved directly (small contact sets, whose
+    /// stiffness takes no CG iteration): each costs about a frozen-set CG iteration.
+    direct: f64,
+    /// Frozen-set CG iterations.
+    cg: f64,
+}
+
+fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<SampleCounts> {
     let surface = study_surface(n, hurst, rolloff)?;
     let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
-    let (mut solve, mut cg) = (0usize, 0usize);
+    let mut counts = SampleCounts {
+        solve: 0.0,
+        direct: 0.0,
+        cg: 0.0,
+    };
     for p in study_pressures(n) {
         let (_, info) = solver.solve(Control::MeanPressure(p))?;
         let (_, stiffness) = solver.frozen_set_stiffness()?;
-        solve += info.iterations;
-        cg += stiffness.iterations;
+        if stiffness.iterations == 0 {
+            counts.direct += info.operator_applications as f64;
+        } else {
+            counts.solve += info.iterations as f64;
+        }
+        counts.cg += stiffness.iterations as f64;
     }
-    Ok((solve as f64, cg as f64))
+    Ok(counts)
 }
 
 /// Seconds per solver iteration and per frozen-set CG iteration on an `n × n` grid: solves
@@ -55,7 +74,9 @@ fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<(f64,
 /// The CG runs on the contact set of a loose solve at p̄ = 0.1 E* (about 20 % contact: a
 /// set too large for the direct solve of small sets, whose loads cost next to nothing).
 fn iteration_costs(n: usize) -> Result<(f64, f64)> {
-    const CUT: usize = 6;
+    // The ratio of successive loads of a sample at N = 128 (24 loads from 0.05/N² to 0.2).
+    const SWEEP_RATIO: f64 = 1.62;
+    const CUT: usize = 12;
     let surface = study_surface(n, 0.8, None)?;
     let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
     let loose = SolverParams {
@@ -82,14 +103,20 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
     for _ in 0..3 {
         solver.set_params(loose)?;
         solver.reset();
-        solver.solve(Control::MeanPressure(0.1))?;
+        solver.solve(Control::MeanPressure(0.05))?;
         solver.set_params(cut)?;
         let start = Instant::now();
         let result = solver
             .frozen_set_stiffness()
             .map(|(_, info)| info.iterations);
         cg = cg.min(per_iteration(result, start)?);
+        // A step of the study's sweep: a warm solve from the state below, with the
+        // tangent of its stiffness.
+        solver.set_params(loose)?;
         solver.reset();
+        solver.solve(Control::MeanPressure(0.05 / SWEEP_RATIO))?;
+        solver.frozen_set_stiffness()?;
+        solver.set_params(cut)?;
         let start = Instant::now();
         let result = solver
             .solve(Control::MeanPressure(0.05))
@@ -184,6 +211,7 @@ impl BemStudy<'_> {
 pub struct SizeEstimate {
     pub n: usize,
     pub solve_iterations: f64,
+    pub direct_applications: f64,
     pub cg_iterations: f64,
     pub solve_iteration_s: f64,
     pub cg_iteration_s: f64,
@@ -212,25 +240,30 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
     for &hurst in study.hursts {
         let small = sample_iterations(probes.0, hurst, study.rolloff)?;
         let large = sample_iterations(probes.1, hurst, study.rolloff)?;
-        counts.push(((small.0, large.0), (small.1, large.1)));
+        counts.push((small, large));
     }
     let mut per_size = Vec::with_capacity(study.sizes.len());
     for &n in study.sizes {
         let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
-        // Iterations of one sample, summed over H; and of the samples left per lane.
-        let (mut solve, mut cg, mut seconds) = (0.0, 0.0, 0.0);
-        for (&hurst, (solve_h, cg_h)) in study.hursts.iter().zip(&counts) {
-            let (solve_h, cg_h) = (
-                extrapolate(*solve_h, probes, n),
-                extrapolate(*cg_h, probes, n),
+        // Counts of one sample, summed over H; and seconds of the samples left per lane.
+        let (mut solve, mut direct, mut cg, mut seconds) = (0.0, 0.0, 0.0, 0.0);
+        for (&hurst, (small, large)) in study.hursts.iter().zip(&counts) {
+            let carried = |count: fn(&SampleCounts) -> f64| {
+                extrapolate((count(small), count(large)), probes, n)
+            };
+            let (solve_h, direct_h, cg_h) = (
+                carried(|c| c.solve),
+                carried(|c| c.direct),
+                carried(|c| c.cg),
             );
             let per_lane = study.samples_left(n, hurst).div_ceil(lanes) as f64;
-            (solve, cg) = (solve + solve_h, cg + cg_h);
-            seconds += per_lane * (solve_h * c_solve + cg_h * c_cg);
+            (solve, direct, cg) = (solve + solve_h, direct + direct_h, cg + cg_h);
+            seconds += per_lane * (solve_h * c_solve + (direct_h + cg_h) * c_cg);
         }
         per_size.push(SizeEstimate {
             n,
             solve_iterations: solve,
+            direct_applications: direct,
             cg_iterations: cg,
             solve_iteration_s: c_solve,
             cg_iteration_s: c_cg,

@@ -233,10 +233,12 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
         .collect()
 }
 
-/// Prints per N one line `n samples hursts lanes solve_iterations cg_iterations
-/// solve_iteration_s cg_iteration_s seconds`, then `total_seconds` and `total_hours`.
+/// Prints per N one line `n samples hursts lanes solve_iterations direct_applications
+/// cg_iterations solve_iteration_s cg_iteration_s seconds`, then `total_seconds` and
+/// `total_hours`.
 ///
-/// Per (N, H) one sample costs `I_solve·c_solve(N) + I_cg·c_cg(N)`: the per-iteration costs
+/// Per (N, H) one sample costs `I_solve·c_solve(N) + (A_direct + I_cg)·c_cg(N)` (`A_direct`
+/// the operator applications of the loads solved directly): the per-iteration costs
 /// `c` are measured at each N on one thread ([`crate::estimate`], so they include everything
 /// an iteration does on this machine), the iteration counts `I` of a whole 24-load sample are
 /// measured at the two probe sizes for every H  and carried to N by
@@ -266,12 +268,13 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
     for row in &estimate.per_size {
         println!(
             "n={} samples={} hursts={} lanes={lanes} solve_iterations={:.0} \
-             cg_iterations={:.0} solve_iteration_s={:.3e} cg_iteration_s={:.3e} \
-             seconds={:.3}",
+             direct_applications={:.0} cg_iterations={:.0} solve_iteration_s={:.3e} \
+             cg_iteration_s={:.3e} seconds={:.3}",
             row.n,
             args.samples,
             hursts.len(),
             row.solve_iterations,
+            row.direct_applications,
             row.cg_iterations,
             row.solve_iteration_s,
             row.cg_iteration_s,
