@@ -13,18 +13,22 @@
 //!    the points before it, so growing the set costs only the new rows) and solve for
 //!    `p_S`;
 //! 2. drop the points with `p ≤ 0` and go back to 1;
-//! 3. apply the operator to `p` (the one transform of an iteration) and add every point
-//!    off the set whose gap is negative; none: done.
+//! 3. apply the operator to `p` (the one transform of an iteration) and add the points off
+//!    the set whose gap is negative — all of them, or where many are (a set that carried
+//!    the load on too few points) the deepest [`MIN_ENTERING`] or twice the set's size;
+//!    none: done.
 //!
 //! The start is the predicted or warm set, or under load control from cold the highest
 //! point. The iteration gives up — leaving a pressure that keeps the load, from which the
-//! BCCG goes on — when the set would outgrow [`limit`] points (where a transform costs
-//! less than the factor), after [`MAX_SOLVES`] factorisations, or if the factor breaks
-//! down. Its result is only a start: the BCCG's own residual, on an exact `u`, decides
+//! BCCG goes on (from cold: the uniform pressure) — when the set would outgrow [`limit`]
+//! points (where a transform costs less than the factor), after [`MAX_SOLVES`]
+//! factorisations, if the factor breaks down, or at once when more than
+//! [`GIVE_UP_ENTERING`] limits' worth of points have a negative gap (a load far too large
+//! for a small set). Its result is only a start: the BCCG's own residual, on an exact `u`, decides
 //! convergence, and a converged dense solution passes it with no iteration.
 //!
 //! The factor also holds the frozen-set stiffness of the solved state: `x` is `K_SS⁻¹ 1_S`
-//! exactly, and [`ContactSolver::small_set_stiffness`] hands it to the stiffness code when
+//! exactly, and [`ContactSolver::small_set_tangent`] hands it to the stiffness code when
 //! the set is still the solved state's (its residual checked against the stiffness
 //! tolerance).
 
