@@ -186,8 +186,8 @@ impl SmallSet {
         }
     }
 
-    /// `x`, `y` and the pressures on the set for `target` (`profile` = f, `total` = P under
-    /// load control); returns `d`.
+    /// `x`, `y` and the pressures on the set for `target` (`profile` = f; under load
+    /// control `P = p̄ · len`, `len` the grid's points); returns `d`.
     fn pressures(&mut self, target: Target, profile: &[f64], len: usize) -> f64 {
         let n = self.set.len();
         let (mut x, mut y) = (std::mem::take(&mut self.x), std::mem::take(&mut self.y));
@@ -230,7 +230,9 @@ impl SmallSet {
         if self.entering.len() > GIVE_UP_ENTERING * self.limit || room == 0 {
             return false;
         }
-        let take = (self.entering.len())
+        let take = self
+            .entering
+            .len()
             .min(room)
             .min(MIN_ENTERING.max(2 * self.set.len()));
         if take < self.entering.len() {
