@@ -440,9 +440,11 @@ mod tests {
         // from operator applications (the naive oracle), on odd, even and rectangular
         // grids; the factor grown by bordering, then cut after a dropped point and grown
         // again, must solve K_SS x = 1.
-        for (rows, cols) in [(31, 31), (32, 32), (20, 36)] {
+        // The last grid has rectangular pixels (Δx = 1, Δy = 0.4).
+        for (rows, cols, dy) in [(31, 31, 1.0), (32, 32, 1.0), (20, 36, 0.4)] {
             for boundary in [Boundary::Free, Boundary::Periodic] {
-                let mut operator = ElasticOperator::new(rows, cols, 1.0, 1.0, boundary).unwrap();
+                let mut operator =
+                    ElasticOperator::with_spacings(rows, cols, 1.0, dy, 1.0, boundary).unwrap();
                 let len = rows * cols;
                 let mut unit = vec![0.0; len];
                 unit[0] = 1.0;
