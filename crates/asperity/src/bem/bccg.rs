@@ -62,7 +62,7 @@ use crate::elastic::{Boundary, ElasticOperator};
 /// iteration wherever they are: measured (docs/bem.md), the solves of a study sample take
 /// 6–12 % less time at 512² and 1024², about the same at 256², and up to 20 % more at 128²
 /// and 64² (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
-const RING_MIN_POINTS: usize = 1 << 18;
+pub(super) const RING_MIN_POINTS: usize = 1 << 18;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -785,13 +785,17 @@ impl ContactSolver {
 
 #[cfg(test)]
 impl ContactSolver {
-    /// Switches the rings on or off whatever the grid's size (to test the solver both ways
-    /// on small grids).
+    /// Switches the rings of the BCCG and of the frozen-set CG on or off whatever the grid's
+    /// size (to test the solver both ways on small grids).
     pub(super) fn set_edge_rings(&mut self, on: bool) {
         let operator = &self.problem.operator;
-        let periodic = operator.boundary() == Boundary::Periodic;
-        self.bccg_scratch.rings =
-            on.then(|| RingExtension::new(operator.rows(), operator.cols(), periodic));
+        let grid = (
+            operator.rows(),
+            operator.cols(),
+            operator.boundary() == Boundary::Periodic,
+        );
+        self.bccg_scratch.rings = on.then(|| RingExtension::new(grid.0, grid.1, grid.2));
+        self.stiffness_work = Some(super::stiffness::StiffnessWork::new(grid, on));
     }
 }
 

@@ -27,12 +27,13 @@
 //! ([`ContactSolver::predict_from_tangent`], a continuation predictor), which is the next
 //! state exactly as long as the set does not change.
 
-use super::bccg::sum4;
+use super::bccg::{sum4, RING_MIN_POINTS};
 use super::full_contact::FullContactThreshold;
 use super::preconditioner::FourierPreconditioner;
+use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{Control, SolveError, SolveInfo};
-use crate::elastic::ElasticOperator;
+use crate::elastic::{Boundary, ElasticOperator};
 use crate::stop::Stop;
 use crate::Error;
 
@@ -61,10 +62,16 @@ pub(super) struct StiffnessWork {
     /// Whether `x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
     /// tangent `dp/dd` of its pressure), not yet used by a solve.
     tangent: bool,
+    /// The rings around the set that extend the residual before the preconditioner, as in
+    /// the BCCG (`ring_extension.rs`), with the set as a mask; grids of at least
+    /// [`RING_MIN_POINTS`] points.
+    rings: Option<(RingExtension, Vec<bool>)>,
 }
 
 impl StiffnessWork {
-    fn new(len: usize) -> Self {
+    /// The fields for a `rows × cols` grid, with the rings if `rings`.
+    pub(super) fn new((rows, cols, periodic): (usize, usize, bool), rings: bool) -> Self {
+        let len = rows * cols;
         StiffnessWork {
             x: vec![0.0; len],
             residual: vec![0.0; len],
@@ -74,19 +81,29 @@ impl StiffnessWork {
             profile_pressure: vec![0.0; len],
             set: Vec::with_capacity(len),
             tangent: false,
+            rings: rings.then(|| (RingExtension::new(rows, cols, periodic), vec![false; len])),
         }
     }
 }
 
-/// `z = M r` (read on the set only: the CG never uses `z` off it); returns `rᵀz` on the
-/// set (summed by [`sum4`], in a fixed order).
+/// `z = M r`, or with the rings `(I + E)ᵀ M (I + E) r` (read on the set only: the CG never
+/// uses `z` off it; `r` is zero off the set); returns `rᵀz` on the set (summed by [`sum4`],
+/// in a fixed order).
 fn precondition_on_set(
     preconditioner: &mut FourierPreconditioner,
+    rings: Option<&mut (RingExtension, Vec<bool>)>,
     set: &[usize],
-    residual: &[f64],
-    z: &mut [f64],
+    (residual, z): (&[f64], &mut Vec<f64>),
 ) -> f64 {
-    preconditioner.apply_into(residual, z);
+    match rings {
+        Some((rings, on_set)) => {
+            z.copy_from_slice(residual);
+            rings.extend(on_set, z);
+            preconditioner.apply(z);
+            rings.gather(on_set, z);
+        }
+        None => preconditioner.apply_into(residual, z),
+    }
     sum4(set.len(), |k| residual[set[k]] * z[set[k]])
 }
 
@@ -187,13 +204,37 @@ fn conjugate_gradient_on_set(
     let n = work.x.len();
     work.set.clear();
     work.set.extend((0..n).filter(|&i| in_set(i)));
+    // The rings of the set (none where the set is the whole grid), out of `work` while the
+    // CG runs.
+    let mut taken = work.rings.take();
+    let mut rings = taken.as_mut().filter(|_| work.set.len() < n);
+    if let Some((_, on_set)) = rings.as_mut() {
+        on_set.fill(false);
+        work.set.iter().for_each(|&i| on_set[i] = true);
+    }
+    let result = iterate_on_set(operator, (preconditioner, rings), rhs, work, limits);
+    work.rings = taken;
+    result
+}
+
+/// The iterations of [`conjugate_gradient_on_set`] on the set listed in `work.set`.
+fn iterate_on_set(
+    operator: &mut ElasticOperator,
+    (preconditioner, mut rings): (
+        &mut FourierPreconditioner,
+        Option<&mut (RingExtension, Vec<bool>)>,
+    ),
+    rhs: RightHandSide<'_>,
+    work: &mut StiffnessWork,
+    limits: Limits<'_>,
+) -> Result<SolveInfo, SolveError> {
     let mut rr = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
     let b_norm = rr.sqrt();
     let mut rz = precondition_on_set(
         preconditioner,
+        rings.as_deref_mut(),
         &work.set,
-        &work.residual,
-        &mut work.preconditioned,
+        (&work.residual, &mut work.preconditioned),
     );
     // The direction is zero off the set (the operator reads all of it).
     work.direction.fill(0.0);
@@ -217,9 +258,9 @@ fn conjugate_gradient_on_set(
         })?;
         let rz_new = precondition_on_set(
             preconditioner,
+            rings.as_deref_mut(),
             &work.set,
-            &work.residual,
-            &mut work.preconditioned,
+            (&work.residual, &mut work.preconditioned),
         );
         let beta = rz_new / rz;
         let (direction, z) = (&mut work.direction, &work.preconditioned);
@@ -232,10 +273,12 @@ fn conjugate_gradient_on_set(
 
 impl ContactSolver {
     fn stiffness_work(&mut self) -> StiffnessWork {
-        let n = self.problem.rows * self.problem.cols;
+        let (rows, cols) = (self.problem.rows, self.problem.cols);
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let rings = rows * cols >= RING_MIN_POINTS;
         self.stiffness_work
             .take()
-            .unwrap_or_else(|| StiffnessWork::new(n))
+            .unwrap_or_else(|| StiffnessWork::new((rows, cols, periodic), rings))
     }
 
     /// Contact stiffness `k = ΔF/Δd` of the last solved state by the frozen contact set
