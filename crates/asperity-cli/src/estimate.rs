@@ -140,14 +140,17 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
 }
 
 /// The probe sizes for a study on grids up to `sizes`' largest: 32² and 64² (a second or
-/// two per H) up to 256², 64² and 128² above (a few seconds per H). Extrapolated from 32²
-/// and 64², the iteration counts of a 1024² sample came out 23 % high; from 64² and 128²,
-/// 6 % (solve) and 16 % (frozen-set CG) high (docs/bem.md, "Estimating a BEM study").
+/// two per H) up to 256², 128² and 256² up to 512², 256² and 512² above (a few seconds per
+/// H). The direct solve of small sets and the rings (512² and up) make the counts grow
+/// more slowly with N than the small probes show: a 1024² sample (H = 1, 2026-11-24) was
+/// estimated 2.12× too long from 64² and 128², 1.45× from 128² and 256², 1.14× from 256²
+/// and 512²; a 512² sample 1.53× from 64² and 128², 1.13× from 128² and 256²
+/// (docs/bem.md, "Estimating a BEM study").
 pub fn probes_for(sizes: &[usize]) -> (usize, usize) {
-    if sizes.iter().all(|&n| n <= 256) {
-        (32, 64)
-    } else {
-        (64, 128)
+    match sizes.iter().copied().max().unwrap_or(0) {
+        0..=256 => (32, 64),
+        257..=512 => (128, 256),
+        _ => (256, 512),
     }
 }
 
@@ -316,8 +319,8 @@ mod tests {
     fn larger_studies_probe_larger_grids() {
         assert_eq!(probes_for(&[64, 128]), (32, 64));
         assert_eq!(probes_for(&[256]), (32, 64));
-        assert_eq!(probes_for(&[256, 512]), (64, 128));
-        assert_eq!(probes_for(&[1024]), (64, 128));
+        assert_eq!(probes_for(&[256, 512]), (128, 256));
+        assert_eq!(probes_for(&[128, 1024]), (256, 512));
     }
 
     #[test]

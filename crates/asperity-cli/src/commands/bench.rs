@@ -77,9 +77,10 @@ pub struct BenchArgs {
     /// study without `rolloff`.
     #[arg(long)]
     pub rolloff: Option<f64>,
-    /// Two probe sizes at which iteration counts are measured (bem-estimate).
-    #[arg(long, default_value = "64,128")]
-    pub probes: String,
+    /// Two probe sizes at which iteration counts are measured (bem-estimate); by default
+    /// those a study on `--sizes` uses (32,64 up to 256; 128,256 up to 512; 256,512 above).
+    #[arg(long)]
+    pub probes: Option<String>,
     /// Mean pressures in units of E* (bem-solve), comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
     pub pressures: Vec<f64>,
@@ -250,10 +251,12 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
     anyhow::ensure!(args.samples > 0, "--samples must be at least 1");
     let sizes = parse_sizes(&args.sizes, "--sizes")?;
-    let probes = parse_sizes(&args.probes, "--probes")?;
-    let probes = match probes[..] {
-        [a, b] if a < b => (a, b),
-        _ => anyhow::bail!("--probes takes two increasing sizes, got {:?}", args.probes),
+    let probes = match &args.probes {
+        None => crate::estimate::probes_for(&sizes),
+        Some(text) => match parse_sizes(text, "--probes")?[..] {
+            [a, b] if a < b => (a, b),
+            _ => anyhow::bail!("--probes takes two increasing sizes, got {text:?}"),
+        },
     };
     let hursts = crate::range::parse_range(&args.hursts)?;
     let study = BemStudy {

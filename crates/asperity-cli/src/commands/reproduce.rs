@@ -38,13 +38,13 @@ pub enum Figure {
 run resumes when the same command runs again (each folder's reproduce.json records the
 figure and setting that made it, and the checksum of every file it wrote: a file edited
 since is never overwritten without --force).\nSettings: quick (minutes), medium (BEM on 256² and 512², 20 samples: hours, with an
-estimate printed before it starts), paper (the default: grids up to 1024², 60 samples: about 16 hours for all the figures)."
+estimate printed before it starts), paper (the default: grids up to 1024², 60 samples: about 10 hours for all the figures)."
 )]
 pub struct ReproduceArgs {
     /// The figure to regenerate.
     pub figure: Figure,
     /// How closely to follow the paper's grids and samples: quick (minutes), medium (BEM on
-    /// 256² and 512², hours), paper (grids up to 1024², about 16 hours for all the figures); stated
+    /// 256² and 512², hours), paper (grids up to 1024², about 10 hours for all the figures); stated
     /// in each report.
     #[arg(long, value_enum, default_value = "paper", conflicts_with = "quick")]
     pub setting: Setting,

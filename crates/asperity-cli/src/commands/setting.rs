@@ -6,7 +6,7 @@
 //! |---|---|---|---|---|
 //! | quick | N = 64, 128; H step 0.5; 20 samples | 128², 20 samples | N = 64, 128; 20 | minutes |
 //! | medium | N = 256, 512; H step 0.5; 20 samples | 512², 20 samples | N = 64 … 512; 20 | hours |
-//! | paper | N = 128 … 1024; H step 0.25; 60 samples | 1024², 60 samples, H step 0.5 | N = 128 … 1024; 60 | about 16 hours in all |
+//! | paper | N = 128 … 1024; H step 0.25; 60 samples | 1024², 60 samples, H step 0.5 | N = 128 … 1024; 60 | about 10 hours in all |
 //!
 //! A hidden `test` setting runs the medium setting's code path on tiny grids for the tests.
 
@@ -20,7 +20,7 @@ pub enum Setting {
     Quick,
     /// BEM on 256² and 512² with 20 samples: hours on 2 cores, checkpointed.
     Medium,
-    /// The paper's grids (up to 1024²) and 60 samples: about 16 hours for all the figures on 2
+    /// The paper's grids (up to 1024²) and 60 samples: about 10 hours for all the figures on 2
     /// cores (estimated), checkpointed.
     Paper,
     /// Tiny grids through the medium setting's code path (tests only).
@@ -119,7 +119,7 @@ impl Setting {
             Setting::Quick => {
                 "**Setting: quick** (`--quick`): BEM on small grids (N ≤ 128) with 20 samples \
                  instead of the paper's N up to 1024 with 60; MDR as in the paper. \
-                 `--setting medium` (hours) and `--setting paper` (about 16 hours in all) follow the \
+                 `--setting medium` (hours) and `--setting paper` (about 10 hours in all) follow the \
                  paper closer."
             }
             Setting::Medium => {
