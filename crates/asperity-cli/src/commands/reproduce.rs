@@ -44,8 +44,8 @@ pub struct ReproduceArgs {
     /// The figure to regenerate.
     pub figure: Figure,
     /// How closely to follow the paper's grids and samples: quick (minutes), medium (BEM on
-    /// 256² and 512², hours), paper (grids up to 1024², about 10 hours for all the figures); stated
-    /// in each report.
+    /// 256² and 512², hours), paper (grids up to 1024², about 10 hours for all the
+    /// figures); stated in each report.
     #[arg(long, value_enum, default_value = "paper", conflicts_with = "quick")]
     pub setting: Setting,
     /// The quick setting: `--setting quick`.

@@ -184,13 +184,7 @@ impl BccgScratch {
             extra_applications: 0,
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
-            rings: (len >= RING_MIN_POINTS).then(|| {
-                RingExtension::new(
-                    operator.rows(),
-                    operator.cols(),
-                    operator.boundary() == Boundary::Periodic,
-                )
-            }),
+            rings: (len >= RING_MIN_POINTS).then(|| RingExtension::on_grid_of(operator)),
         }
     }
 }
@@ -789,13 +783,8 @@ impl ContactSolver {
     /// size (to test the solver both ways on small grids).
     pub(super) fn set_edge_rings(&mut self, on: bool) {
         let operator = &self.problem.operator;
-        let grid = (
-            operator.rows(),
-            operator.cols(),
-            operator.boundary() == Boundary::Periodic,
-        );
-        self.bccg_scratch.rings = on.then(|| RingExtension::new(grid.0, grid.1, grid.2));
-        self.stiffness_work = Some(super::stiffness::StiffnessWork::new(grid, on));
+        self.bccg_scratch.rings = on.then(|| RingExtension::on_grid_of(operator));
+        self.stiffness_work = Some(super::stiffness::StiffnessWork::new(operator, on));
     }
 }
 

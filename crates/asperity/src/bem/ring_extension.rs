@@ -34,6 +34,8 @@
 
 use rayon::prelude::*;
 
+use crate::elastic::{Boundary, ElasticOperator};
+
 /// Weights of the first and the second ring (measured, see the module docs).
 const GAMMA: [f64; 2] = [0.7, 0.5];
 
@@ -197,6 +199,12 @@ fn sweep(
 }
 
 impl RingExtension {
+    /// The fields for the grid of `operator` (its size and boundaries).
+    pub(super) fn on_grid_of(operator: &ElasticOperator) -> Self {
+        let periodic = operator.boundary() == Boundary::Periodic;
+        Self::new(operator.rows(), operator.cols(), periodic)
+    }
+
     /// The fields for a `rows × cols` grid (periodic or free boundaries).
     pub(super) fn new(rows: usize, cols: usize, periodic: bool) -> Self {
         let blocks = rows.div_ceil((BLOCK / cols).max(1));

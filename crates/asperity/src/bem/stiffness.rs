@@ -36,7 +36,7 @@ use super::preconditioner::FourierPreconditioner;
 use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{Control, SolveError, SolveInfo};
-use crate::elastic::{Boundary, ElasticOperator};
+use crate::elastic::ElasticOperator;
 use crate::stop::Stop;
 use crate::Error;
 
@@ -72,9 +72,9 @@ pub(super) struct StiffnessWork {
 }
 
 impl StiffnessWork {
-    /// The fields for a `rows × cols` grid, with the rings if `rings`.
-    pub(super) fn new((rows, cols, periodic): (usize, usize, bool), rings: bool) -> Self {
-        let len = rows * cols;
+    /// The fields for the grid of `operator`, with the rings if `rings`.
+    pub(super) fn new(operator: &ElasticOperator, rings: bool) -> Self {
+        let len = operator.rows() * operator.cols();
         StiffnessWork {
             x: vec![0.0; len],
             residual: vec![0.0; len],
@@ -84,7 +84,7 @@ impl StiffnessWork {
             profile_pressure: vec![0.0; len],
             set: Vec::with_capacity(len),
             tangent: false,
-            rings: rings.then(|| (RingExtension::new(rows, cols, periodic), vec![false; len])),
+            rings: rings.then(|| (RingExtension::on_grid_of(operator), vec![false; len])),
         }
     }
 }
@@ -276,12 +276,11 @@ fn iterate_on_set(
 
 impl ContactSolver {
     fn stiffness_work(&mut self) -> StiffnessWork {
-        let (rows, cols) = (self.problem.rows, self.problem.cols);
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-        let rings = rows * cols >= RING_MIN_POINTS;
+        let operator = &self.problem.operator;
+        let rings = operator.rows() * operator.cols() >= RING_MIN_POINTS;
         self.stiffness_work
             .take()
-            .unwrap_or_else(|| StiffnessWork::new((rows, cols, periodic), rings))
+            .unwrap_or_else(|| StiffnessWork::new(operator, rings))
     }
 
     /// Contact stiffness `k = ΔF/Δd` of the last solved state by the frozen contact set
@@ -306,40 +305,38 @@ impl ContactSolver {
         max_iterations: usize,
     ) -> Result<(f64, SolveInfo), SolveError> {
         let mut work = self.stiffness_work();
-        let (dx, dy) = (
-            self.problem.operator.spacing(),
-            self.problem.operator.spacing_y(),
-        );
         // A set solved directly (`small_set.rs`) has its x already (a stop request goes to
         // the CG, which reports it).
         let direct = match self.stop.is_requested() {
             true => None,
             false => self.small_set_tangent(tolerance, &mut work.x),
         };
-        if let Some(residual) = direct {
-            let stiffness = work.x.iter().sum::<f64>() * dx * dy;
-            work.tangent = true;
-            self.stiffness_work = Some(work);
-            let info = SolveInfo {
+        let result = match direct {
+            Some(residual) => Ok(SolveInfo {
                 iterations: 0,
                 residual,
                 operator_applications: 0,
-            };
-            return Ok((stiffness, info));
-        }
-        let limits = Limits {
-            tolerance,
-            max_iterations,
-            stop: &self.stop,
+            }),
+            None => {
+                let limits = Limits {
+                    tolerance,
+                    max_iterations,
+                    stop: &self.stop,
+                };
+                let pressure = &self.state.pressure;
+                conjugate_gradient_on_set(
+                    &mut self.problem.operator,
+                    &mut self.preconditioner,
+                    |i| pressure[i] > 0.0,
+                    RightHandSide::Ones,
+                    &mut work,
+                    limits,
+                )
+            }
         };
-        let pressure = &self.state.pressure;
-        let result = conjugate_gradient_on_set(
-            &mut self.problem.operator,
-            &mut self.preconditioner,
-            |i| pressure[i] > 0.0,
-            RightHandSide::Ones,
-            &mut work,
-            limits,
+        let (dx, dy) = (
+            self.problem.operator.spacing(),
+            self.problem.operator.spacing_y(),
         );
         let stiffness = work.x.iter().sum::<f64>() * dx * dy;
         work.tangent = result.is_ok();

@@ -100,8 +100,8 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`crate::estimate::estimate_bem_seconds`]; probes at 32² and 64², or 64² and 128² for
-/// grids above 256²: seconds).
+/// ([`crate::estimate::estimate_bem_seconds`], at the probes of
+/// [`crate::estimate::probes_for`]: seconds to two minutes).
 fn announce(
     figure: &str,
     setting: Setting,
