@@ -152,7 +152,8 @@ fn frozen_set_stiffness_on_rectangular_pixels_equals_finite_difference() {
             let (s, _) = solver.solve(Control::MeanPressure(pressure)).unwrap();
             assert!((s.force / (pressure * surface.size() * surface.size_y()) - 1.0).abs() < 1e-12);
             let (frozen, info) = solver.frozen_set_stiffness().unwrap();
-            assert!(info.residual <= 1e-10);
+            // Converged on k's energy estimate (1e-12) at residuals of about 1e-6.
+            assert!(info.residual <= 1e-4);
             let fd = solver
                 .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
                 .unwrap();

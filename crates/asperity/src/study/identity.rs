@@ -35,6 +35,8 @@ pub struct SolverIdentity {
     pub max_iterations: usize,
     /// Relative residual of the frozen-set stiffness solve.
     pub stiffness_tolerance: f64,
+    /// Estimated relative error of the stiffness at which its solve stops.
+    pub stiffness_error: f64,
     /// Iteration limit of the frozen-set stiffness solve.
     pub stiffness_max_iterations: usize,
 }
@@ -46,6 +48,7 @@ impl From<&crate::bem::SolverParams> for SolverIdentity {
             tolerance: p.tolerance,
             max_iterations: p.max_iterations,
             stiffness_tolerance: p.stiffness_tolerance,
+            stiffness_error: p.stiffness_error,
             stiffness_max_iterations: p.stiffness_max_iterations,
         }
     }
