@@ -72,8 +72,11 @@ pub(super) const REFRESH_INTERVAL: usize = 25;
 const LOAD_ROUNDING: f64 = 1e-14;
 
 /// Pressures cut by the projection in one step that are corrected in `u` by their point
-/// responses (each one pass over the grid); beyond this many `u` is recomputed.
-const CUT_LIMIT: usize = 16;
+/// responses (each one pass over the grid); beyond this many `u` is recomputed. Measured
+/// (free boundaries, 1 and 2 threads), the corrections cost as much as an operator
+/// application from 54 cuts at 64² and 128², 62–73 at 256², 75–84 at 512² and 108–128 at
+/// 1024² on: below all of them.
+const CUT_LIMIT: usize = 48;
 
 /// Elements per chunk of the parallel passes. Fixed, never derived from the thread count:
 /// each chunk is summed in index order and the chunks' partial sums are added in chunk
