@@ -10,8 +10,9 @@
 //!   Hestenes & Stiefel 1952) and which converges with the square of the residual: the CG
 //!   stops once its last steps moved it by less than `SolverParams::stiffness_error`
 //!   ([`EnergyEstimate`]; measured at 128² and 512², k within 1.5e-14 of a CG to residual
-//!   1e-13, in 35–40 % fewer iterations), and reports `k` from it, not from `Σ x_j`, whose
-//!   rounding error is of the order of the residual (1e-10 at a residual of 1e-7).
+//!   1e-13, in 35–40 % fewer iterations than that CG and 7–19 % fewer than the residual
+//!   1e-10 of before), and reports `k` from it, not from `Σ x_j`, whose rounding error is of
+//!   the order of the residual (1e-10 at a residual of 1e-7).
 //! * [`ContactSolver::finite_difference_stiffness`] — `dF/dd` by central differences of two
 //!   more solves. By Barber's theorem (J. R. Barber, Proc. R. Soc. A 459, 2003) the two are
 //!   equal as long as the contact set does not change within the step.
@@ -130,18 +131,19 @@ struct Limits<'a> {
     stop: &'a Stop,
 }
 
-/// Iterations over which [`EnergyEstimate`] sums the decrease of the error (Strakoš & Tichý
-/// use 4 to 10; more only delays the stop by as many iterations).
+/// Iterations over which [`EnergyEstimate`] sums the decrease of the error (a delay of a
+/// few iterations, as Strakoš & Tichý use; a longer one only delays the stop).
 const ENERGY_DELAY: usize = 4;
 
-/// The error of `bᵀx_j` in CG from `x₀ = 0`, estimated as it runs. `bᵀx − bᵀx_j` is the
-/// energy norm `‖x − x_j‖²_K` of the error (`x_jᵀr_j = 0` by the Galerkin property), and the
-/// energy norm falls by exactly `α_i r_iᵀz_i` at step `i` (Hestenes & Stiefel 1952), so the
-/// last [`ENERGY_DELAY`] steps' terms sum to `‖e_{j−d}‖² − ‖e_j‖²`: a lower bound of the error
-/// `d` steps ago, close to it as soon as CG converges (Strakoš & Tichý, ETNA 13:56–80, 2002,
-/// who show the estimate holds in floating point). The frozen-set stiffness `k = 1ᵀx` needs
-/// no more than that: its CG stops when `k` is known to the estimate's precision, where
-/// the residual criterion would go on until `x` is.
+/// The error of `bᵀx_j` in CG from `x₀ = 0`, estimated as it runs. In exact arithmetic
+/// `bᵀx − bᵀx_j` is the energy norm `‖x − x_j‖²_K` of the error (`x_jᵀr_j = 0`), which falls
+/// by exactly `α_i r_iᵀz_i` at step `i` (Hestenes & Stiefel 1952): so `bᵀx` is the sum of
+/// those terms, and the last [`ENERGY_DELAY`] of them add up to `‖e_{j−d}‖² − ‖e_j‖²`, a
+/// lower bound of the error `d` steps ago, close to it as soon as CG converges. Both hold in
+/// floating point (Strakoš & Tichý, ETNA 13:56–80, 2002), where `bᵀx_j` summed from `x_j`
+/// does not (it is off by the order of the residual). The frozen-set stiffness `k = 1ᵀx`
+/// needs no more: its CG stops when `k` is known to the estimate's precision, where the
+/// residual criterion would go on until `x` is.
 struct EnergyEstimate {
     /// `Σ α_i r_iᵀz_i` so far, `bᵀx_j` in exact arithmetic.
     total: f64,
