@@ -35,8 +35,12 @@ pub struct SolverIdentity {
     pub max_iterations: usize,
     /// Relative residual of the frozen-set stiffness solve.
     pub stiffness_tolerance: f64,
-    /// Estimated relative error of the stiffness at which its solve stops.
-    pub stiffness_error: f64,
+    /// Estimated relative error of the stiffness at which its solve stops; absent in the
+    /// checkpoints of versions that stopped on the residual only (read as `None`, written
+    /// back the same, so that their checksums hold and they are refused as made with other
+    /// settings, not as damaged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness_error: Option<f64>,
     /// Iteration limit of the frozen-set stiffness solve.
     pub stiffness_max_iterations: usize,
 }
@@ -48,7 +52,7 @@ impl From<&crate::bem::SolverParams> for SolverIdentity {
             tolerance: p.tolerance,
             max_iterations: p.max_iterations,
             stiffness_tolerance: p.stiffness_tolerance,
-            stiffness_error: p.stiffness_error,
+            stiffness_error: Some(p.stiffness_error),
             stiffness_max_iterations: p.stiffness_max_iterations,
         }
     }
@@ -109,7 +113,8 @@ impl TaskIdentity {
     }
 }
 
-/// Compares two JSON objects key by key, descending into objects present on both sides.
+/// Compares two JSON objects key by key, descending into objects present on both sides; a
+/// key on one side only is a difference with `null` on the other.
 fn push_differences(
     prefix: &str,
     stored: &serde_json::Map<String, serde_json::Value>,
@@ -132,6 +137,13 @@ fn push_differences(
                 short(other)
             )),
         }
+    }
+    for (key, value) in wanted.iter().filter(|(key, _)| !stored.contains_key(*key)) {
+        out.push(format!(
+            "{prefix}{key}: stored {}, wanted {}",
+            short(&serde_json::Value::Null),
+            short(value)
+        ));
     }
 }
 
@@ -300,6 +312,29 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert_eq!(unseal::<f64>(&bytes, &id).unwrap(), 1.5);
+    }
+
+    #[test]
+    fn a_checkpoint_without_a_newer_setting_is_foreign_not_damaged() {
+        // Checkpoints written before `stiffness_error` existed (the frozen-set CG stopped on
+        // its residual only) lack the field: their checksum still holds, and they are
+        // refused for the setting, by name.
+        let mut old = identity();
+        old.solver.as_mut().unwrap().stiffness_error = None;
+        let bytes = seal(&old, 1.5f64).unwrap();
+        assert!(!String::from_utf8_lossy(&bytes).contains("stiffness_error"));
+        let id = identity();
+        match unseal::<f64>(&bytes, &id) {
+            Err(Unsealed::Foreign(d)) => {
+                assert_eq!(
+                    d,
+                    ["solver.stiffness_error: stored null, wanted 1e-12"],
+                    "{d:?}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(unseal::<f64>(&bytes, &old).unwrap(), 1.5);
     }
 
     #[test]
