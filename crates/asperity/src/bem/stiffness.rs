@@ -563,6 +563,20 @@ mod tests {
         }
     }
 
+    /// A solver with the default parameters, solved at `pressure` on the rough surface
+    /// `rough_grid(rows, cols, seed)`.
+    fn solved_rough(
+        (rows, cols, seed): (usize, usize, u64),
+        boundary: Boundary,
+        pressure: f64,
+    ) -> ContactSolver {
+        let surface = rough_grid(rows, cols, seed);
+        let mut solver =
+            ContactSolver::new(&surface, half_space(boundary), SolverParams::default()).unwrap();
+        solver.solve(Control::MeanPressure(pressure)).unwrap();
+        solver
+    }
+
     /// Grids the stiffness tests run on: even, odd, non-square.
     const GRIDS: [(usize, usize); 3] = [(64, 64), (63, 63), (50, 72)];
 
@@ -576,11 +590,7 @@ mod tests {
             .into_iter()
             .flat_map(|g| [(g, (Boundary::Free, 0.02)), (g, (Boundary::Periodic, 0.05))])
         {
-            let surface = rough_grid(rows, cols, 11);
-            let mut solver =
-                ContactSolver::new(&surface, half_space(boundary), SolverParams::default())
-                    .unwrap();
-            solver.solve(Control::MeanPressure(pressure)).unwrap();
+            let mut solver = solved_rough((rows, cols, 11), boundary, pressure);
             let (frozen, _) = solver.frozen_set_stiffness().unwrap();
             let fd = solver
                 .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
@@ -607,11 +617,7 @@ mod tests {
             .flat_map(|g| [(g, Boundary::Free), (g, Boundary::Periodic)])
         {
             for pressure in [0.05, 0.2] {
-                let surface = rough_grid(rows, cols, 17);
-                let mut solver =
-                    ContactSolver::new(&surface, half_space(boundary), SolverParams::default())
-                        .unwrap();
-                solver.solve(Control::MeanPressure(pressure)).unwrap();
+                let mut solver = solved_rough((rows, cols, 17), boundary, pressure);
                 let (k, info) = solver.frozen_set_stiffness().unwrap();
                 solver
                     .set_params(SolverParams {
