@@ -861,21 +861,16 @@ mod tests {
             // Displacement control at an indentation a little below the loaded state's.
             let indentation = Control::Indentation(0.9 * reference.summary.indentation);
             let reference_d = solve(&surface, boundary, pk, indentation);
-            for (rings, what, control) in [false, true]
+            let cases = [
+                ("load", load, &reference),
+                ("indentation", indentation, &reference_d),
+            ];
+            for (rings, (what, control, a)) in [false, true]
                 .into_iter()
-                .flat_map(|r| [(r, "load", load), (r, "indentation", indentation)])
+                .flat_map(|r| cases.map(|case| (r, case)))
             {
-                let a = if what == "load" {
-                    &reference
-                } else {
-                    &reference_d
-                };
                 let b = &solve(&surface, boundary, (SolverKind::Bccg, rings), control);
-                let what = if rings {
-                    format!("{what}, rings")
-                } else {
-                    what.to_string()
-                };
+                let what = format!("{what}{}", if rings { ", rings" } else { "" });
                 let d_error = b.summary.indentation / a.summary.indentation - 1.0;
                 let p_error = b.summary.mean_pressure / a.summary.mean_pressure - 1.0;
                 let k_error = b.stiffness / a.stiffness - 1.0;

@@ -69,8 +69,6 @@ pub(super) struct StiffnessWork {
     profile_pressure: Vec<f64>,
     /// The indices of the set, ascending (capacity: the grid).
     set: Vec<usize>,
-    /// `bᵀx` of the last CG as its energy `Σ α_i r_iᵀz_i` ([`EnergyEstimate`]).
-    energy: f64,
     /// Whether `x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
     /// tangent `dp/dd` of its pressure), not yet used by a solve.
     tangent: bool,
@@ -92,7 +90,6 @@ impl StiffnessWork {
             response: vec![0.0; len],
             profile_pressure: vec![0.0; len],
             set: Vec::with_capacity(len),
-            energy: 0.0,
             tangent: false,
             rings: rings.then(|| (RingExtension::on_grid_of(operator), vec![false; len])),
         }
@@ -256,7 +253,9 @@ fn step_on_set(
 /// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
 /// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
 /// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
-/// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual). The result is in `work.x`.
+/// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual) or on the energy estimate of
+/// `limits`. The result is in `work.x`; returned with `bᵀx` as the CG's energy
+/// ([`EnergyEstimate`]).
 /// Every pass but the two transforms visits the set's points only (listed once, in index
 /// order; the sums in a fixed order, [`sum4`], whatever the thread count).
 fn conjugate_gradient_on_set(
@@ -266,7 +265,7 @@ fn conjugate_gradient_on_set(
     rhs: RightHandSide<'_>,
     work: &mut StiffnessWork,
     limits: Limits<'_>,
-) -> Result<SolveInfo, SolveError> {
+) -> Result<(SolveInfo, f64), SolveError> {
     let n = work.x.len();
     work.set.clear();
     work.set.extend((0..n).filter(|&i| in_set(i)));
@@ -293,7 +292,7 @@ fn iterate_on_set(
     rhs: RightHandSide<'_>,
     work: &mut StiffnessWork,
     limits: Limits<'_>,
-) -> Result<SolveInfo, SolveError> {
+) -> Result<(SolveInfo, f64), SolveError> {
     let mut rr = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
     let b_norm = rr.sqrt();
     let mut rz = precondition_on_set(
@@ -316,8 +315,7 @@ fn iterate_on_set(
             0.0
         };
         if let Some(end) = finished((relative, &energy), iterations, limits) {
-            work.energy = energy.total;
-            return end;
+            return end.map(|info| (info, energy.total));
         }
         iterations += 1;
         let alpha;
@@ -378,12 +376,18 @@ impl ContactSolver {
             true => None,
             false => self.small_set_tangent(tolerance, &mut work.x),
         };
+        // k = 1ᵀx: from a CG its energy, which converges with the square of the residual
+        // where 1ᵀx_j, summed, carries an error of the order of the residual (measured at
+        // 64², 713 points: 1e-10 at a residual of 1e-7, against 1e-15 for the energy).
         let result = match direct {
-            Some(residual) => Ok(SolveInfo {
-                iterations: 0,
-                residual,
-                operator_applications: 0,
-            }),
+            Some(residual) => Ok((
+                SolveInfo {
+                    iterations: 0,
+                    residual,
+                    operator_applications: 0,
+                },
+                work.x.iter().sum::<f64>(),
+            )),
             None => {
                 let limits = Limits {
                     tolerance,
@@ -406,17 +410,9 @@ impl ContactSolver {
             self.problem.operator.spacing(),
             self.problem.operator.spacing_y(),
         );
-        // k = 1ᵀx: from the CG, its energy, which converges with the square of the residual
-        // where 1ᵀx_j, summed, carries an error of the order of the residual (measured at
-        // 64², 713 points: 1e-10 at a residual of 1e-7, against 1e-15 for the energy).
-        let sum = match direct {
-            Some(_) => work.x.iter().sum::<f64>(),
-            None => work.energy,
-        };
-        let stiffness = sum * dx * dy;
         work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
-        result.map(|info| (stiffness, info))
+        result.map(|(info, ones_x)| (ones_x * dx * dy, info))
     }
 
     /// The continuation predictor of a warm start: if the last frozen-set stiffness left
