@@ -243,6 +243,45 @@ impl RealFft2 {
         self.inverse_rows(data);
     }
 
+    /// The forward transform of `input` reduced column by column, for quadratic forms
+    /// that need no inverse transform (Parseval): every `kx` column of the spectrum is
+    /// transformed and handed to `reduce(kx, column)` while it is in cache, and the value
+    /// stored in `values[kx]` (`half_cols` of them). `spectrum` is scratch. Each column is
+    /// one lane's, so the values do not depend on the thread count.
+    pub fn forward_reduce<F>(
+        &mut self,
+        input: &[f64],
+        spectrum: &mut [Complex64],
+        values: &mut [f64],
+        reduce: F,
+    ) where
+        F: Fn(usize, &[Complex64]) -> f64 + Sync,
+    {
+        self.check_lengths(input, spectrum);
+        assert_eq!(values.len(), self.half_cols(), "one value per kx");
+        self.forward_rows(input);
+        transpose_into_columns(
+            &self.work,
+            spectrum,
+            self.data_rows,
+            self.half_cols(),
+            self.rows,
+        );
+        let (fft, rows) = (&self.col_forward, self.rows);
+        let chunk = per_lane(values.len(), self.lanes.len());
+        spectrum
+            .par_chunks_mut(chunk * rows)
+            .zip(values.par_chunks_mut(chunk))
+            .enumerate()
+            .zip(self.lanes.par_iter_mut())
+            .for_each(|((block_index, (block, out)), lane)| {
+                for (i, (column, value)) in block.chunks_exact_mut(rows).zip(out).enumerate() {
+                    fft.process_with_scratch(column, &mut lane.scratch);
+                    *value = reduce(block_index * chunk + i, column);
+                }
+            });
+    }
+
     /// The column passes of [`RealFft2::convolve`]: from the rows' half spectra in `work`
     /// through the fused forward, filter and inverse column transforms back to `work`.
     fn filter_columns<F>(&mut self, spectrum: &mut [Complex64], filter: F)

@@ -294,7 +294,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
 
 /// `asperity bench bem-solve`: one line per boundary, mean pressure and solver,
 /// `kernel n threads boundary solver mean_pressure iterations operator_applications
-/// area_fraction indentation solve_min_s solve_median_s fft_pair_s iteration_fft_pairs
+/// energy_transforms area_fraction indentation solve_min_s solve_median_s fft_pair_s iteration_fft_pairs
 /// padded_fft_pair_s iteration_padded_pairs`.
 /// Each repetition is a cold solve (the solver reset); `fft_pair_s` is the minimum time of
 /// one unpruned forward + inverse real FFT pair of the boundary's own grid (as `fft-pair`:
@@ -350,7 +350,7 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
                 let (min, median) = min_median(times);
                 println!(
                     "kernel=bem-solve n={} threads={} boundary={} solver={} mean_pressure={pressure} \
-                     iterations={} operator_applications={} area_fraction={:.6} indentation={:.9e} \
+                     iterations={} operator_applications={} energy_transforms={} area_fraction={:.6} indentation={:.9e} \
                      solve_min_s={min:.4} solve_median_s={median:.4} fft_pair_s={fft_pair:.5} \
                      iteration_fft_pairs={:.2} padded_fft_pair_s={padded_pair:.5} \
                      iteration_padded_pairs={:.2}",
@@ -360,6 +360,7 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
                     solver.name(),
                     info.iterations,
                     info.operator_applications,
+                    info.energy_transforms,
                     summary.area_fraction,
                     summary.indentation,
                     min / info.iterations.max(1) as f64 / fft_pair,

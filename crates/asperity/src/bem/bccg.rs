@@ -32,6 +32,11 @@
 //!    operator's impulse response (one grid pass each); with more, and every
 //!    [`REFRESH_INTERVAL`] iterations against drift, `u = K p` is recomputed. Convergence (the residual of the module docs below the tolerance) is
 //!    accepted only on an exact `u`.
+//! 6. A step that is expected to end in that recomputation (the last one cut more than
+//!    [`CUT_LIMIT`] pressures, as the first steps of a solve do while the set grows, or the
+//!    drift refresh is due) does not form `w = K s`: its line minimum needs only `sᵀK s`,
+//!    which the forward transform of `s` gives by Parseval
+//!    ([`ElasticOperator::energy`], about half an application). The iterates are the same.
 //!
 //! Periodic displacement control is the same iteration with `d` fixed: below full contact
 //! the objective is bounded along the constant mode, in which `K` is zero (its slope there
@@ -130,9 +135,9 @@ pub(super) struct BccgScratch {
     /// Factor of `p` and `u` that restores the load, not yet applied (1: none); applied by
     /// the next pass that reads them.
     pending_scale: f64,
-    /// Operator applications outside the step (the coarse curvature), since the solve
-    /// began.
-    extra_applications: usize,
+    /// Forward transforms outside the step (the coarse curvature `1_Oᵀ K 1_O`), since the
+    /// solve began.
+    extra_energies: usize,
     /// The coarse correction of periodic displacement control (`mean_gap.rs`); periodic
     /// grids only.
     pub(super) mean_gap: Option<MeanGapScratch>,
@@ -184,7 +189,7 @@ impl BccgScratch {
             chunk_cuts: vec![(0, 0.0); chunks * CUT_LIMIT],
             partials: vec![Sums::default(); chunks],
             pending_scale: 1.0,
-            extra_applications: 0,
+            extra_energies: 0,
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
             rings: (len >= RING_MIN_POINTS).then(|| RingExtension::on_grid_of(operator)),
@@ -246,6 +251,14 @@ struct Direction {
     zg: f64,
     /// `sᵀ Π g` of the new direction (negative: downhill).
     sg: f64,
+}
+
+/// What a step did.
+struct Step {
+    /// `u` misses part of the step (it was not updated, or cuts were not corrected).
+    stale: bool,
+    /// The projection cut more than [`CUT_LIMIT`] pressures.
+    cut_many: bool,
 }
 
 /// `g = u + f − d` and whether the point is free (`p > 0` or `g < 0`).
@@ -434,9 +447,10 @@ fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
     Sums::total(partials).x[0]
 }
 
-/// `p ← max(p + α s, 0)`, `u ← u + α w`; sums `x[0] = Σ p`, `n[0]` = cuts; the first
+/// `p ← max(p + α s, 0)` and, with `DISPLACEMENT`, `u ← u + α w` (a step after which `u`
+/// is recomputed leaves both alone); sums `x[0] = Σ p`, `n[0]` = cuts; the first
 /// [`CUT_LIMIT`] cuts of each chunk go to its slots of `chunk_cuts`.
-fn step_pass(
+fn step_pass<const DISPLACEMENT: bool>(
     (p, u): (&mut [f64], &mut [f64]),
     (s, w): (&[f64], &[f64]),
     alpha: f64,
@@ -467,7 +481,9 @@ fn step_pass(
                 } else {
                     *pi = next;
                 }
-                *ui += alpha * wi;
+                if DISPLACEMENT {
+                    *ui += alpha * wi;
+                }
                 total += *pi;
             }
             *out = Sums {
@@ -494,7 +510,7 @@ impl ContactSolver {
             Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
         };
         self.bccg_scratch.pending_scale = 1.0;
-        self.bccg_scratch.extra_applications = 0;
+        self.bccg_scratch.extra_energies = 0;
         if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
             mean_gap.reset();
         }
@@ -506,7 +522,10 @@ impl ContactSolver {
                 .apply(&self.state.pressure, &mut self.state.gap);
         }
         let mut applications = small.applications + usize::from(!small.exact);
-        let (mut exact, mut since_refresh) = (true, 0);
+        let (mut exact, mut since_refresh, mut energy_transforms) = (true, 0, 0);
+        // Whether the last step cut more pressures than the point responses correct (the
+        // first steps of a solve all do: its set is still growing).
+        let mut cutting = true;
         let mut previous_zg = 0.0;
         let mut iteration = small.applications;
         loop {
@@ -518,7 +537,8 @@ impl ContactSolver {
                 let info = SolveInfo {
                     iterations: iteration,
                     residual: gradient.residual,
-                    operator_applications: applications + self.bccg_scratch.extra_applications,
+                    operator_applications: applications,
+                    energy_transforms: energy_transforms + self.bccg_scratch.extra_energies,
                 };
                 return Ok((self.finish(indentation, gradient.contact_points), info));
             }
@@ -537,15 +557,29 @@ impl ContactSolver {
             iteration += 1;
             let direction = self.direction(target, &gradient, previous_zg);
             previous_zg = direction.zg;
-            self.problem.operator.apply(
-                &self.bccg_scratch.direction,
-                &mut self.bccg_scratch.response,
-            );
-            applications += 1;
-            let cut = self.step(target, &gradient, direction.sg, iteration)?;
-            since_refresh += 1;
-            exact = false;
-            if cut || since_refresh >= REFRESH_INTERVAL {
+            // A step expected to be followed by `u = K p` needs only `sᵀK s` of `K s`:
+            // the forward transform of `s` (Parseval), about half an application.
+            let refresh_due = cutting || since_refresh + 1 >= REFRESH_INTERVAL;
+            let curvature = if refresh_due {
+                energy_transforms += 1;
+                self.problem.operator.energy(&self.bccg_scratch.direction)
+            } else {
+                let scratch = &mut self.bccg_scratch;
+                self.problem
+                    .operator
+                    .apply(&scratch.direction, &mut scratch.response);
+                applications += 1;
+                dot(&scratch.direction, &scratch.response, &mut scratch.partials)
+            };
+            let step = self.step(
+                target,
+                &gradient,
+                (direction.sg, curvature),
+                !refresh_due,
+                iteration,
+            )?;
+            (cutting, since_refresh, exact) = (step.cut_many, since_refresh + 1, false);
+            if step.stale || since_refresh >= REFRESH_INTERVAL {
                 self.refresh_displacement();
                 (applications, exact, since_refresh) = (applications + 1, true, 0);
             }
@@ -616,7 +650,7 @@ impl ContactSolver {
             (MeanMode::Deflated, Some(mean_gap)) => {
                 let (_, applied) =
                     mean_gap.curvature(&mut self.problem.operator, &self.bccg_scratch.free);
-                self.bccg_scratch.extra_applications += applied as usize;
+                self.bccg_scratch.extra_energies += applied as usize;
                 true
             }
             _ => false,
@@ -692,19 +726,19 @@ impl ContactSolver {
         }
     }
 
-    /// `α = −sᵀΠg / sᵀw`, `p ← max(p + α s, 0)`, `u ← u + α w`, and the load restored by
-    /// scaling `p` and `u` (in the next pass). Returns whether the projection cut a pressure
-    /// that the point responses did not correct (then `u` is stale).
+    /// `α = −sᵀΠg / sᵀK s`, `p ← max(p + α s, 0)`, with `displacement` also
+    /// `u ← u + α w` (`w = K s` in the response field), and the load restored by scaling
+    /// `p` and `u` (in the next pass). `(sg, curvature)` is `(sᵀΠg, sᵀK s)`.
     fn step(
         &mut self,
         target: Target,
         gradient: &Gradient,
-        sg: f64,
+        (sg, curvature): (f64, f64),
+        displacement: bool,
         iteration: usize,
-    ) -> Result<bool, SolveError> {
+    ) -> Result<Step, SolveError> {
         let scratch = &mut self.bccg_scratch;
-        let sw = dot(&scratch.direction, &scratch.response, &mut scratch.partials);
-        if !crate::is_positive_finite(sw) {
+        if !crate::is_positive_finite(curvature) {
             // K is positive on every direction but the constant one of a periodic grid,
             // which the free set excludes short of full contact: rounding only.
             return Err(SolveError::NoConvergence {
@@ -712,18 +746,21 @@ impl ContactSolver {
                 residual: gradient.residual,
             });
         }
-        let alpha = -sg / sw;
-        let sums = step_pass(
-            (&mut self.state.pressure, &mut self.state.gap),
-            (&scratch.direction, &scratch.response),
-            alpha,
-            (&mut scratch.chunk_cuts, &mut scratch.partials),
-        );
+        let alpha = -sg / curvature;
+        let fields = (&mut self.state.pressure[..], &mut self.state.gap[..]);
+        let directions = (&scratch.direction[..], &scratch.response[..]);
+        let slots = (&mut scratch.chunk_cuts[..], &mut scratch.partials[..]);
+        let sums = if displacement {
+            step_pass::<true>(fields, directions, alpha, slots)
+        } else {
+            step_pass::<false>(fields, directions, alpha, slots)
+        };
         let (cuts, total) = (sums.n[0], sums.x[0]);
         // A few cuts are corrected by their point responses (one grid pass, far cheaper
         // than an operator application); more leave `u` stale.
-        let mut cut = cuts > CUT_LIMIT;
-        if !cut && cuts > 0 {
+        let cut_many = cuts > CUT_LIMIT;
+        let mut stale = cut_many || !displacement;
+        if !stale && cuts > 0 {
             let corrections = &mut scratch.cuts;
             corrections.clear();
             for (slots, partial) in scratch.chunk_cuts.chunks(CUT_LIMIT).zip(&scratch.partials) {
@@ -741,10 +778,10 @@ impl ContactSolver {
                 scratch.pending_scale = scale;
             } else if total <= 0.0 {
                 self.state.pressure.fill(mean_pressure);
-                cut = true;
+                stale = true;
             }
         }
-        Ok(cut)
+        Ok(Step { stale, cut_many })
     }
 
     /// Periodic displacement control: the BCCG with `d` fixed and the constant mode of the

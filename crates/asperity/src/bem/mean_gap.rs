@@ -26,8 +26,9 @@
 //! `z = Π M Π g + 1_F (Σ_F g) / (1_Oᵀ K 1_O)`. Both parts are positive semi-definite and
 //! act on complementary subspaces, so `z` is a valid preconditioned gradient, and the rest
 //! of the iteration (Polak–Ribière direction, exact line minimum, projection) is unchanged.
-//! The curvature costs one operator application whenever `F` changes (computed from `1_O`,
-//! not `1_F`, so that it keeps its relative accuracy when `O` is small).
+//! The curvature costs one forward transform whenever `F` changes (the quadratic form
+//! [`ElasticOperator::energy`], a sum of non-negative terms; computed from `1_O`, not `1_F`,
+//! so that it keeps its relative accuracy when `O` is small).
 
 use crate::elastic::ElasticOperator;
 
@@ -35,8 +36,6 @@ use crate::elastic::ElasticOperator;
 pub(super) struct MeanGapScratch {
     /// `1_O`, the indicator of the points off the free set.
     open: Vec<f64>,
-    /// `K 1_O`.
-    response: Vec<f64>,
     /// The free set of the last curvature (its recomputation is skipped while `F` stays).
     free: Vec<bool>,
     /// `1_Oᵀ K 1_O` of that set; `None` before the first.
@@ -54,7 +53,6 @@ impl MeanGapScratch {
             .max(operator.rows() as f64 * operator.spacing_y());
         MeanGapScratch {
             open: vec![0.0; len],
-            response: vec![0.0; len],
             free: vec![false; len],
             curvature: None,
             zero_mode: 0.5 * operator.modulus() * 2.0 * std::f64::consts::PI / longest,
@@ -66,8 +64,8 @@ impl MeanGapScratch {
         self.curvature = None;
     }
 
-    /// `1_Oᵀ K 1_O` for the free set `free` and whether it cost an operator application
-    /// (only when the set differs from the previous call's).
+    /// `1_Oᵀ K 1_O` for the free set `free` and whether it cost a forward transform (only
+    /// when the set differs from the previous call's).
     pub(super) fn curvature(
         &mut self,
         operator: &mut ElasticOperator,
@@ -80,13 +78,7 @@ impl MeanGapScratch {
             *o = if fr { 0.0 } else { 1.0 };
             *kept = fr;
         }
-        operator.apply(&self.open, &mut self.response);
-        let c = self
-            .open
-            .iter()
-            .zip(&self.response)
-            .map(|(o, r)| o * r)
-            .fold(0.0, |a, b| a + b);
+        let c = operator.energy(&self.open);
         self.curvature = Some(c);
         (c, true)
     }

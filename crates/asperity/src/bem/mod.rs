@@ -243,6 +243,10 @@ pub struct SolveInfo {
     /// Applications of the elastic operator (padded FFT pairs on free boundaries), the
     /// cost of the solve; the preconditioner's unpadded transforms are not counted.
     pub operator_applications: usize,
+    /// Forward transforms of the operator alone, each about half an application: quadratic
+    /// forms `sᵀK s` ([`crate::elastic::ElasticOperator::energy`]) where `K s` itself is
+    /// not needed.
+    pub energy_transforms: usize,
 }
 
 /// The scalar results of a solved contact.

@@ -88,6 +88,7 @@ impl ContactSolver {
                     iterations: iteration,
                     residual,
                     operator_applications: 2 * iteration + 1,
+                    energy_transforms: 0,
                 };
                 return Ok((self.finish(indentation, pass.contact_points), info));
             }

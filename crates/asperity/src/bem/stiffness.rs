@@ -209,6 +209,7 @@ fn finished(
             iterations,
             residual: relative,
             operator_applications: iterations,
+            energy_transforms: 0,
         }));
     }
     if iterations >= limits.max_iterations || !relative.is_finite() {
@@ -385,6 +386,7 @@ impl ContactSolver {
                     iterations: 0,
                     residual,
                     operator_applications: 0,
+                    energy_transforms: 0,
                 },
                 work.x.iter().sum::<f64>(),
             )),
