@@ -177,14 +177,7 @@ impl RealFft2 {
     /// `(cols/2+1) × rows`).
     pub fn forward(&mut self, input: &[f64], spectrum: &mut [Complex64]) {
         self.check_lengths(input, spectrum);
-        self.forward_rows(input);
-        transpose_into_columns(
-            &self.work,
-            spectrum,
-            self.data_rows,
-            self.half_cols(),
-            self.rows,
-        );
+        self.rows_into_columns(input, spectrum);
         let fft = &self.col_forward;
         for_each_column(
             spectrum,
@@ -259,14 +252,7 @@ impl RealFft2 {
     {
         self.check_lengths(input, spectrum);
         assert_eq!(values.len(), self.half_cols(), "one value per kx");
-        self.forward_rows(input);
-        transpose_into_columns(
-            &self.work,
-            spectrum,
-            self.data_rows,
-            self.half_cols(),
-            self.rows,
-        );
+        self.rows_into_columns(input, spectrum);
         let (fft, rows) = (&self.col_forward, self.rows);
         let chunk = per_lane(values.len(), self.lanes.len());
         spectrum
@@ -351,6 +337,19 @@ impl RealFft2 {
         for_each_column(spectrum, rows, &mut self.lanes, |_, column, scratch| {
             fft.process_with_scratch(column, scratch)
         });
+    }
+
+    /// The row pass of a forward transform of `input`, its half spectra transposed into
+    /// the columns of `spectrum` (zeros below the data rows), ready for the column pass.
+    fn rows_into_columns(&mut self, input: &[f64], spectrum: &mut [Complex64]) {
+        self.forward_rows(input);
+        transpose_into_columns(
+            &self.work,
+            spectrum,
+            self.data_rows,
+            self.half_cols(),
+            self.rows,
+        );
     }
 
     /// Real transforms of the `data_rows` input rows (zero-extended to `cols`) into `work`.
