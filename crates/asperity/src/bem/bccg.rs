@@ -557,27 +557,14 @@ impl ContactSolver {
             iteration += 1;
             let direction = self.direction(target, &gradient, previous_zg);
             previous_zg = direction.zg;
-            // A step expected to be followed by `u = K p` needs only `sᵀK s` of `K s`:
-            // the forward transform of `s` (Parseval), about half an application.
             let refresh_due = cutting || since_refresh + 1 >= REFRESH_INTERVAL;
-            let curvature = if refresh_due {
-                energy_transforms += 1;
-                self.problem.operator.energy(&self.bccg_scratch.direction)
-            } else {
-                let scratch = &mut self.bccg_scratch;
-                self.problem
-                    .operator
-                    .apply(&scratch.direction, &mut scratch.response);
-                applications += 1;
-                dot(&scratch.direction, &scratch.response, &mut scratch.partials)
+            let curvature = self.curvature(refresh_due);
+            (applications, energy_transforms) = match refresh_due {
+                true => (applications, energy_transforms + 1),
+                false => (applications + 1, energy_transforms),
             };
-            let step = self.step(
-                target,
-                &gradient,
-                (direction.sg, curvature),
-                !refresh_due,
-                iteration,
-            )?;
+            let line = (direction.sg, curvature);
+            let step = self.step(target, &gradient, line, !refresh_due, iteration)?;
             (cutting, since_refresh, exact) = (step.cut_many, since_refresh + 1, false);
             if step.stale || since_refresh >= REFRESH_INTERVAL {
                 self.refresh_displacement();
@@ -724,6 +711,18 @@ impl ContactSolver {
                 sg - s_mean * g_sum
             },
         }
+    }
+
+    /// `sᵀK s` of the direction. A step whose `u` is recomputed afterwards needs no more:
+    /// with `energy_only`, from the forward transform of `s` alone (Parseval, about half an
+    /// application); else with `w = K s` in the response field, for the step's `u`.
+    fn curvature(&mut self, energy_only: bool) -> f64 {
+        let (operator, scratch) = (&mut self.problem.operator, &mut self.bccg_scratch);
+        if energy_only {
+            return operator.energy(&scratch.direction);
+        }
+        operator.apply(&scratch.direction, &mut scratch.response);
+        dot(&scratch.direction, &scratch.response, &mut scratch.partials)
     }
 
     /// `α = −sᵀΠg / sᵀK s`, `p ← max(p + α s, 0)`, with `displacement` also
