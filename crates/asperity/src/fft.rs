@@ -711,6 +711,36 @@ mod tests {
     }
 
     #[test]
+    fn forward_reduce_sees_the_columns_of_the_forward_transform() {
+        // Each column's value is the reduction of that column of `forward`'s spectrum
+        // (identical bits), whatever the thread count; padded and plain grids.
+        let norms = |kx: usize, column: &[Complex64]| {
+            column.iter().map(|v| v.norm_sqr()).sum::<f64>() * (kx + 1) as f64
+        };
+        for (data_rows, data_cols, rows, cols) in PADDED_SHAPES {
+            let data = pseudo_random(data_rows * data_cols);
+            let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut spectrum = vec![Complex64::default(); fft.spectrum_len()];
+            fft.forward(&data, &mut spectrum);
+            let expected: Vec<f64> = spectrum
+                .chunks(rows)
+                .enumerate()
+                .map(|(kx, column)| norms(kx, column))
+                .collect();
+            for threads in [1, 2, 3] {
+                let values = crate::test_support::with_threads(threads, || {
+                    let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+                    let mut values = vec![f64::NAN; fft.half_cols()];
+                    let mut scratch = vec![Complex64::new(3.0, 3.0); fft.spectrum_len()];
+                    fft.forward_reduce(&data, &mut scratch, &mut values, norms);
+                    values
+                });
+                assert_eq!(values, expected, "{rows}x{cols}, {threads} threads");
+            }
+        }
+    }
+
+    #[test]
     fn padded_results_do_not_depend_on_the_thread_count() {
         let (data_rows, data_cols) = (19, 23);
         let data = pseudo_random(data_rows * data_cols);
