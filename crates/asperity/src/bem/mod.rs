@@ -240,8 +240,9 @@ pub struct SolveInfo {
     pub iterations: usize,
     /// Final residual (see the module docs; relative CG residual for the stiffness).
     pub residual: f64,
-    /// Applications of the elastic operator (padded FFT pairs on free boundaries), the
-    /// cost of the solve; the preconditioner's unpadded transforms are not counted.
+    /// Applications of the elastic operator (padded FFT pairs on free boundaries): with
+    /// `energy_transforms`, the cost of the solve; the preconditioner's unpadded
+    /// transforms are not counted.
     pub operator_applications: usize,
     /// Forward transforms of the operator alone, each about half an application: quadratic
     /// forms `sᵀK s` ([`crate::elastic::ElasticOperator::energy`]) where `K s` itself is
