@@ -327,15 +327,10 @@ impl ElasticOperator {
             |kx, column| {
                 let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
                 let (low, high) = column.split_at(kernel_rows);
-                let low_sum: f64 = low.iter().zip(k).map(|(v, &k)| k * v.norm_sqr()).sum();
-                let high_sum: f64 = high
-                    .iter()
-                    .rev()
-                    .zip(&k[1..])
-                    .map(|(v, &k)| k * v.norm_sqr())
-                    .sum();
+                let pairs = with_even_kernel((low.iter(), high.iter()), k);
+                let sum: f64 = pairs.map(|(v, k)| k * v.norm_sqr()).sum();
                 let mirrored = kx != 0 && 2 * kx != pcols;
-                (low_sum + high_sum) * if mirrored { 2.0 } else { 1.0 }
+                sum * if mirrored { 2.0 } else { 1.0 }
             },
         );
         self.column_energies.iter().sum()
@@ -370,9 +365,8 @@ impl ElasticOperator {
         self.fft
             .convolve(input, &mut self.spectrum, output, |kx, column| {
                 let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
-                // The spectrum is even in ky: value ky serves ky and prow − ky, so the
-                // column's upper part, read backwards, meets the kernel from ky = 1.
                 let (low, high) = column.split_at_mut(kernel_rows);
+                let pairs = with_even_kernel((low.iter_mut(), high.iter_mut()), k);
                 if inverse {
                     let factor = |k: f64| {
                         if k != 0.0 {
@@ -381,20 +375,28 @@ impl ElasticOperator {
                             0.0
                         }
                     };
-                    low.iter_mut().zip(k).for_each(|(v, &k)| *v *= factor(k));
-                    high.iter_mut()
-                        .rev()
-                        .zip(&k[1..])
-                        .for_each(|(v, &k)| *v *= factor(k));
+                    pairs.for_each(|(v, k)| *v *= factor(k));
                 } else {
-                    low.iter_mut().zip(k).for_each(|(v, &k)| *v *= k);
-                    high.iter_mut()
-                        .rev()
-                        .zip(&k[1..])
-                        .for_each(|(v, &k)| *v *= k);
+                    pairs.for_each(|(v, k)| *v *= k);
                 }
             });
     }
+}
+
+/// The values of a spectrum column, split at the kernel's `kernel_rows` values
+/// (`ky = 0 … prow/2`) into `(low, high)`, each with the kernel at its `ky`: the spectrum is
+/// even in `ky`, so value `ky` serves `ky` and `prow − ky`, and the upper part, read
+/// backwards, meets the kernel from `ky = 1`. Two runs, which `for_each` and `sum` fold one
+/// after the other.
+fn with_even_kernel<'a, T>(
+    (low, high): (
+        impl Iterator<Item = T> + 'a,
+        impl DoubleEndedIterator<Item = T> + 'a,
+    ),
+    k: &'a [f64],
+) -> impl Iterator<Item = (T, f64)> + 'a {
+    let k_from = |first: usize| k[first..].iter().copied();
+    low.zip(k_from(0)).chain(high.rev().zip(k_from(1)))
 }
 
 #[cfg(test)]
