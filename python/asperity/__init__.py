@@ -824,13 +824,13 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
 
 
 def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
-               levels, force, checkpoint_every, progress, description):
+               levels, alpha_sweep, force, checkpoint_every, progress, description):
     window = _core.default_window()
     args = (
         str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
         int(seed), window[0] if min_contacts is None else int(min_contacts),
         window[1] if max_fraction is None else float(max_fraction), int(levels),
-        os.fspath(out), bool(force), float(checkpoint_every),
+        bool(alpha_sweep), os.fspath(out), bool(force), float(checkpoint_every),
     )
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
     comm = _mpi.world()
@@ -879,6 +879,7 @@ def study_alpha(
     min_contacts: Optional[int] = None,
     max_fraction: Optional[float] = None,
     levels: int = 48,
+    full_sweep: bool = False,
     force: bool = False,
     checkpoint_every: float = 10.0,
     progress: ProgressArg = None,
@@ -892,7 +893,9 @@ def study_alpha(
     ``method``: ``"mdr"`` (rough lines, unit rms height) or ``"bem"`` (surfaces, unit rms
     slope, free boundaries); ``rolloff`` q0·L/2π; ``seed`` (study seed); the α window
     ``min_contacts``, ``max_fraction`` (the CLI's defaults); ``levels`` force levels of the
-    mean curves; ``force`` discards another study's checkpoints in ``out``;
+    mean curves; ``full_sweep`` solves every BEM load up to p̄ = 0.2 E* (by default a
+    sample stops loading past 4 times the largest contact fraction an α window ends at, as
+    the CLI's; the fits are the same); ``force`` discards another study's checkpoints in ``out``;
     ``checkpoint_every`` seconds between checkpoints of a task in progress (0: every
     batch). Ctrl-C stops after the samples in flight (``KeyboardInterrupt``); run again
     to resume.
@@ -908,7 +911,8 @@ def study_alpha(
     """
     sizes = [n] if np.ndim(n) == 0 else list(n)
     records = _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
-                         max_fraction, levels, force, checkpoint_every, progress, f"{method} study")
+                         max_fraction, levels, not full_sweep, force, checkpoint_every, progress,
+                         f"{method} study")
     rows = []
     for rec in records:
         r = rec["result"]
@@ -952,7 +956,8 @@ def study_curve(
         >>> c.force, c.stiffness
     """
     records = _run_study(method, [n], hurst, samples, out, rolloff, seed, min_contacts,
-                         max_fraction, levels, force, checkpoint_every, progress, f"{method} study")
+                         max_fraction, levels, False, force, checkpoint_every, progress,
+                         f"{method} study")
     rows = []
     for rec in records:
         r = rec["result"]

@@ -186,7 +186,8 @@ def study_alpha(
     *, method: str, n: Union[int, Sequence[int]], hurst: Union[str, float, Sequence[float]],
     samples: int, out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
     min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: int = ...,
-    force: bool = ..., checkpoint_every: float = ..., progress: ProgressArg = ...,
+    full_sweep: bool = ..., force: bool = ..., checkpoint_every: float = ...,
+    progress: ProgressArg = ...,
 ) -> StudyResult: ...
 def study_curve(
     *, method: str, n: int, hurst: Union[str, float, Sequence[float]], samples: int,

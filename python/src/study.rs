@@ -85,7 +85,7 @@ fn method(name: &str) -> PyResult<Method> {
 /// the CLI's derived columns (`alpha_sample_interval`, `alpha_sample_mean`, `alpha_theory`).
 #[pyfunction]
 #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-    max_fraction, levels, out, force, checkpoint_every, progress))]
+    max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress))]
 #[allow(clippy::too_many_arguments)]
 fn run_study(
     py: Python<'_>,
@@ -98,6 +98,7 @@ fn run_study(
     min_contacts: usize,
     max_fraction: f64,
     levels: usize,
+    alpha_sweep: bool,
     out: PathBuf,
     force: bool,
     checkpoint_every: f64,
@@ -113,6 +114,7 @@ fn run_study(
         min_contacts,
         max_fraction,
         levels,
+        alpha_sweep,
         checkpoint_every,
     )?;
     let (_lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
@@ -123,7 +125,8 @@ fn run_study(
     Ok(records(&results))
 }
 
-/// A study's spec from `run_study`'s arguments, validated.
+/// A study's spec from `run_study`'s arguments (`alpha_sweep`: the load sweep of an α
+/// study, [`StudySpec::with_alpha_sweep`]), validated.
 #[allow(clippy::too_many_arguments)]
 fn make_spec(
     method_name: &str,
@@ -135,6 +138,7 @@ fn make_spec(
     min_contacts: usize,
     max_fraction: f64,
     levels: usize,
+    alpha_sweep: bool,
     checkpoint_every: f64,
 ) -> PyResult<StudySpec> {
     if !(0.0..=MAX_CHECKPOINT_INTERVAL_SECONDS).contains(&checkpoint_every) {
@@ -155,6 +159,13 @@ fn make_spec(
             max_fraction,
         },
         levels,
+        sweep_end: None,
+    };
+    // As `asperity study alpha`: BEM samples stop loading past the fit windows.
+    let spec = if alpha_sweep {
+        spec.with_alpha_sweep()
+    } else {
+        spec
     };
     spec.validate().map_err(from_error)?;
     spec.ensure_fits().map_err(from_error)?;
@@ -217,7 +228,7 @@ impl StudyLedger {
     /// Opens the study as `run_study` (same arguments but the progress callback).
     #[new]
     #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-        max_fraction, levels, out, force, checkpoint_every))]
+        max_fraction, levels, alpha_sweep, out, force, checkpoint_every))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method_name: &str,
@@ -229,6 +240,7 @@ impl StudyLedger {
         min_contacts: usize,
         max_fraction: f64,
         levels: usize,
+        alpha_sweep: bool,
         out: PathBuf,
         force: bool,
         checkpoint_every: f64,
@@ -243,6 +255,7 @@ impl StudyLedger {
             min_contacts,
             max_fraction,
             levels,
+            alpha_sweep,
             checkpoint_every,
         )?;
         let (lock, store) = open_folder(&spec, out, force, checkpoint_every)?;

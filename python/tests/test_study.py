@@ -103,6 +103,27 @@ def test_a_bem_curve_study_stopped_in_the_cli_resumes_in_python(tmp_path):
     assert resumed.tasks == reference.tasks
 
 
+def test_a_bem_alpha_study_ends_its_sweeps_as_the_cli_and_fits_as_the_whole_sweep(cli, tmp_path):
+    flags = ["--method", "bem", "--n", 64, "--hurst", "-1,1", "--samples", 4, "--seed", 5]
+    study = dict(method="bem", n=[64], hurst=[-1.0, 1.0], samples=4, seed=5)
+    cli("study", "alpha", *flags, "--out", tmp_path / "cli", "--quiet")
+    # The Python study resumes in the CLI's folder: same spec (the sweep's end included).
+    ours = asperity.study_alpha(**study, out=tmp_path / "cli")
+    whole = asperity.study_alpha(**study, out=tmp_path / "whole", full_sweep=True)
+    assert ours.rows == whole.rows
+    spec = json.loads((tmp_path / "cli" / "study.json").read_text())["spec"]
+    assert spec["sweep_end"] == 0.08
+    assert "sweep_end" not in json.loads((tmp_path / "whole" / "study.json").read_text())["spec"]
+    # Each sample's curve stops at the first load past the end, short of the 24.
+    for task in ours.tasks:
+        assert task["mean_curve"][-1]["fraction"] < whole_fraction(whole, task)
+
+
+def whole_fraction(whole, task):
+    match = [t for t in whole.tasks if t["task"] == task["task"]]
+    return match[0]["mean_curve"][-1]["fraction"]
+
+
 def test_ctrl_c_stops_a_long_study_within_seconds_keeping_its_checkpoints(tmp_path):
     folder = tmp_path / "long"
     script = f"""

@@ -35,7 +35,7 @@ const FREE: HalfSpace = HalfSpace {
 };
 
 /// The counts of one study sample (seed 1): the 24 loads solved in turn with warm starts,
-/// the stiffness after each.
+/// the stiffness after each, up to the first load past the sweep's end if any.
 #[derive(Clone, Copy)]
 struct SampleCounts {
     /// Solver iterations of the loads the BCCG solved.
@@ -47,7 +47,12 @@ struct SampleCounts {
     cg: f64,
 }
 
-fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<SampleCounts> {
+fn sample_iterations(
+    n: usize,
+    hurst: f64,
+    rolloff: Option<f64>,
+    sweep_end: Option<f64>,
+) -> Result<SampleCounts> {
     let surface = study_surface(n, hurst, rolloff)?;
     let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
     let mut counts = SampleCounts {
@@ -56,7 +61,7 @@ fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<Sampl
         cg: 0.0,
     };
     for p in study_pressures(n) {
-        let (_, info) = solver.solve(Control::MeanPressure(p))?;
+        let (summary, info) = solver.solve(Control::MeanPressure(p))?;
         let (_, stiffness) = solver.frozen_set_stiffness()?;
         if stiffness.iterations == 0 {
             counts.direct += info.operator_applications as f64;
@@ -64,6 +69,9 @@ fn sample_iterations(n: usize, hurst: f64, rolloff: Option<f64>) -> Result<Sampl
             counts.solve += info.iterations as f64;
         }
         counts.cg += stiffness.iterations as f64;
+        if sweep_end.is_some_and(|end| summary.area_fraction > end) {
+            break;
+        }
     }
     Ok(counts)
 }
@@ -176,6 +184,9 @@ pub struct BemStudy<'a> {
     pub hursts: &'a [f64],
     /// Roll-off wavenumber q0 L/2π, if any.
     pub rolloff: Option<f64>,
+    /// The contact fraction past which a sample stops loading
+    /// ([`asperity::study::StudySpec::sweep_end`]); `None`: every load.
+    pub sweep_end: Option<f64>,
     /// Samples of `(N, H)` already checkpointed (not computed again), if any: see
     /// [`held_samples`].
     pub stored: &'a [HeldSamples],
@@ -254,8 +265,8 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut counts = Vec::with_capacity(study.hursts.len());
     for &hurst in study.hursts {
-        let small = sample_iterations(probes.0, hurst, study.rolloff)?;
-        let large = sample_iterations(probes.1, hurst, study.rolloff)?;
+        let small = sample_iterations(probes.0, hurst, study.rolloff, study.sweep_end)?;
+        let large = sample_iterations(probes.1, hurst, study.rolloff, study.sweep_end)?;
         counts.push((small, large));
     }
     let mut per_size = Vec::with_capacity(study.sizes.len());

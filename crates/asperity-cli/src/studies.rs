@@ -577,6 +577,7 @@ mod tests {
             seed: 1,
             window: asperity::study::FitWindow::default(),
             levels: 48,
+            sweep_end: None,
         };
         let segments = progress_segments(&spec, &[0, 3]);
         let mut eta = crate::progress::Eta::weighted(&segments);

@@ -709,3 +709,44 @@ fn a_bem_study_reports_progress_per_solved_load() {
     let err = common::stderr(&out);
     assert!(err.contains("bem study (loads): 144/144 ("), "{err}");
 }
+
+#[test]
+fn an_alpha_study_ends_its_bem_sweeps_past_the_windows_and_fits_as_the_whole_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args: Vec<&str> = "study alpha --method bem --n 64 --hurst -1,1 --samples 4 --out"
+        .split(' ')
+        .collect();
+    let ended = asperity(&[&args[..], &["a"]].concat(), d);
+    ok(&ended);
+    // Progress still counts every load of every sample.
+    let err = common::stderr(&ended);
+    assert!(err.contains("bem study (loads): 192/192 ("), "{err}");
+    ok(&asperity(
+        &[&args[..], &["f", "--full-sweep", "--quiet"]].concat(),
+        d,
+    ));
+    let read = |p: &str| std::fs::read_to_string(d.join(p)).unwrap();
+    assert_eq!(read("a/alpha.csv"), read("f/alpha.csv"));
+    // 4 × the 2 % of the window table: in the spec, so in every checkpoint's identity.
+    assert!(read("a/study.json").contains("\"sweep_end\": 0.08"));
+    assert!(!read("f/study.json").contains("sweep_end"));
+    // The whole sweep is another study: refused in the folder, which is left as it was.
+    let before = read("a/alpha.csv");
+    refused(
+        &asperity(&[&args[..], &["a", "--full-sweep"]].concat(), d),
+        "sweep_end",
+    );
+    assert_eq!(read("a/alpha.csv"), before);
+    // A curve study solves every load: the key is refused there.
+    std::fs::write(
+        d.join("c.toml"),
+        "kind = \"curve\"\nmethod = \"bem\"\nn = 32\nhurst = 0.5\nsamples = 2\nfull_sweep = true\n",
+    )
+    .unwrap();
+    refused(
+        &asperity(&["study", "file", "c.toml", "--out", "c"], d),
+        "full_sweep applies to alpha studies only",
+    );
+    assert!(!d.join("c").exists());
+}

@@ -71,6 +71,7 @@
 //!     seed: 1,
 //!     window: FitWindow::default(), // 8 contacts up to 1 % contact
 //!     levels: 48,
+//!     sweep_end: None,
 //! };
 //! let task = Task { n, hurst: 1.0 };
 //! let samples = TaskSamples::new(&spec, task)?.compute(&(0..100).collect::<Vec<_>>())?;

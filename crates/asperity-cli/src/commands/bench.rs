@@ -77,6 +77,10 @@ pub struct BenchArgs {
     /// study without `rolloff`.
     #[arg(long)]
     pub rolloff: Option<f64>,
+    /// Estimate a study that solves every load (`study curve`, `study alpha --full-sweep`)
+    /// instead of an α study's sweep, which ends past its fit windows (bem-estimate).
+    #[arg(long)]
+    pub full_sweep: bool,
     /// Two probe sizes at which iteration counts are measured (bem-estimate); by default
     /// those a study on `--sizes` uses (32,64 up to 256; 128,256 up to 512; 256,512 above).
     #[arg(long)]
@@ -259,11 +263,25 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         },
     };
     let hursts = crate::range::parse_range(&args.hursts)?;
+    // The sweep of `study alpha` with its default window on these grids.
+    let alpha = asperity::study::StudySpec {
+        method: asperity::study::Method::Bem,
+        sizes: sizes.clone(),
+        hursts: hursts.clone(),
+        samples: args.samples,
+        rolloff: args.rolloff,
+        seed: 1,
+        window: asperity::study::FitWindow::default(),
+        levels: 48,
+        sweep_end: None,
+    }
+    .with_alpha_sweep();
     let study = BemStudy {
         sizes: &sizes,
         samples: args.samples,
         hursts: &hursts,
         rolloff: args.rolloff,
+        sweep_end: alpha.sweep_end.filter(|_| !args.full_sweep),
         stored: &[],
     };
     let estimate = estimate_bem_seconds(&study, probes)?;

@@ -128,6 +128,11 @@ pub struct AlphaArgs {
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
+    /// BEM: solve every load up to p̄ = 0.2 E* (by default a sample stops loading past
+    /// 4 times the largest contact fraction an α window of the study or of `study windows`
+    /// ends at; the loads above enter no fit, and the fits are the same).
+    #[arg(long)]
+    pub full_sweep: bool,
     #[command(flatten)]
     pub common: CommonArgs,
 }
@@ -164,7 +169,7 @@ pub struct CurveArgs {
 }
 
 /// The keys of a study file: `(key, type, default, meaning)`, for `--help` and the README.
-pub const FILE_KEYS: [(&str, &str, &str, &str); 10] = [
+pub const FILE_KEYS: [(&str, &str, &str, &str); 11] = [
     (
         "kind",
         "\"alpha\" or \"curve\"",
@@ -214,6 +219,12 @@ pub const FILE_KEYS: [(&str, &str, &str, &str); 10] = [
         "integer >= 3",
         "48",
         "common force levels of the ensemble curves",
+    ),
+    (
+        "full_sweep",
+        "true or false",
+        "false",
+        "alpha, BEM: solve every load, not only those up to 4x the windows' end",
     ),
 ];
 
@@ -441,6 +452,7 @@ struct StudyFile {
     min_contacts: Option<usize>,
     max_fraction: Option<f64>,
     levels: Option<usize>,
+    full_sweep: Option<bool>,
 }
 
 /// Default number of common force levels.
@@ -464,8 +476,28 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
             max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
         },
         levels: file.levels.unwrap_or(LEVELS),
+        sweep_end: None,
     };
-    Ok((file.kind, spec))
+    if file.kind == Kind::Curve && file.full_sweep.is_some() {
+        anyhow::bail!(
+            "{}: full_sweep applies to alpha studies only (a curve study solves every load)",
+            path.display()
+        );
+    }
+    Ok((
+        file.kind,
+        with_sweep(file.kind, spec, file.full_sweep.unwrap_or(false)),
+    ))
+}
+
+/// The spec with the load sweep of its kind: an α study's BEM samples stop loading past
+/// the fits' windows ([`StudySpec::with_alpha_sweep`]) unless `full_sweep`; a curve study
+/// solves every load.
+fn with_sweep(kind: Kind, spec: StudySpec, full_sweep: bool) -> StudySpec {
+    match kind {
+        Kind::Alpha if !full_sweep => spec.with_alpha_sweep(),
+        _ => spec,
+    }
 }
 
 /// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on
@@ -513,6 +545,7 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
             max_fraction: common.max_fraction,
         },
         levels: common.levels,
+        sweep_end: None,
     }
 }
 
@@ -540,6 +573,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
     let (kind, spec, out, options) = match &args.command {
         StudyCommand::Alpha(a) => {
             let spec = spec_from(&a.common, a.n.clone(), parse_range(&a.hurst)?);
+            let spec = with_sweep(Kind::Alpha, spec, a.full_sweep);
             (
                 Kind::Alpha,
                 spec,
@@ -588,6 +622,7 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
         samples: spec.samples,
         hursts: &spec.hursts,
         rolloff: spec.rolloff,
+        sweep_end: spec.sweep_end,
         stored: &stored,
     };
     let estimate =

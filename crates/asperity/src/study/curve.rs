@@ -259,14 +259,7 @@ pub fn ensemble_alpha_of(
     window: &FitWindow,
     levels: usize,
 ) -> Option<PowerLawFit> {
-    let (starts, ends): (Vec<f64>, Vec<f64>) = samples
-        .iter()
-        .filter_map(|s| s.window_forces(window))
-        .unzip();
-    let (lo, hi) = (quantile(&starts, 0.5)?, quantile(&ends, 0.5)?);
-    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
+    let (lo, hi) = ensemble_window(samples, window)?;
     let (f, k): (Vec<f64>, Vec<f64>) = log_levels(lo, hi, levels)
         .filter_map(|force| {
             let values: Vec<f64> = samples
@@ -277,6 +270,18 @@ pub fn ensemble_alpha_of(
         })
         .unzip();
     (f.len() >= 3).then(|| power_law_fit(&f, &k).ok()).flatten()
+}
+
+/// The forces of the ensemble's window: the medians over samples of their window forces
+/// ([`SampleCurve::window_forces`]); `None` when no sample has a window or the medians
+/// leave none.
+pub fn ensemble_window(samples: &[&SampleCurve], window: &FitWindow) -> Option<(f64, f64)> {
+    let (starts, ends): (Vec<f64>, Vec<f64>) = samples
+        .iter()
+        .filter_map(|s| s.window_forces(window))
+        .unzip();
+    let (lo, hi) = (quantile(&starts, 0.5)?, quantile(&ends, 0.5)?);
+    (hi.partial_cmp(&lo) == Some(std::cmp::Ordering::Greater)).then_some((lo, hi))
 }
 
 /// The `q`-quantile (0..1) of values by linear interpolation between order statistics.

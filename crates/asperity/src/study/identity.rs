@@ -3,12 +3,13 @@
 //!
 //! Every `checkpoint/<task>.json` is stored sealed ([`seal`]): the [`TaskIdentity`] of the
 //! task that produced it (method, N, H, seed, roll-off, force levels, fit window, the
-//! samplers' scales and solver settings, and the asperity version that defines the
-//! numerics), the checkpoint itself, and the FNV-1a-64 hash ([`fnv1a64`]) of the canonical
-//! bytes of both: their compact JSON serialisation by `serde_json` (fields in declaration
-//! order, floats in shortest round-trip form). [`unseal`] recomputes the hash from the
-//! parsed content, so any edit that changes a value (or a corrupted byte that still
-//! parses) is detected, and compares the identity field by field, naming what differs.
+//! samplers' scales and solver settings, the BEM sweep's end, and the asperity version
+//! that defines the numerics), the checkpoint itself, and the FNV-1a-64 hash
+//! ([`fnv1a64`]) of the canonical bytes of both: their compact JSON serialisation by
+//! `serde_json` (fields in declaration order, floats in shortest round-trip form).
+//! [`unseal`] recomputes the hash from the parsed content, so any edit that changes a value
+//! (or a corrupted byte that still parses) is detected, and compares the identity field by
+//! field, naming what differs.
 //!
 //! FNV-1a (Fowler–Noll–Vo, 64-bit: offset basis `0xcbf29ce484222325`, prime
 //! `0x100000001b3`) is not cryptographic: it detects accidents (truncation, bit flips, hand
@@ -81,6 +82,11 @@ pub struct TaskIdentity {
     pub scales: Scales,
     /// Solver settings (BEM).
     pub solver: Option<SolverIdentity>,
+    /// The contact fraction past which BEM samples stop loading
+    /// ([`StudySpec::sweep_end`]); absent (the whole sweep) in older checkpoints, which
+    /// keep their checksums.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep_end: Option<f64>,
 }
 
 impl TaskIdentity {
@@ -100,6 +106,7 @@ impl TaskIdentity {
                 Method::Bem => Some(SolverIdentity::from(&super::samplers::bem_solver_params())),
                 Method::Mdr => None,
             },
+            sweep_end: spec.sweep_end,
         }
     }
 
@@ -257,6 +264,7 @@ mod tests {
             seed: 11,
             window: FitWindow::default(),
             levels: 10,
+            sweep_end: None,
         };
         TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 })
     }

@@ -214,6 +214,7 @@ mod tests {
             seed: 11,
             window: FitWindow::default(),
             levels: 12,
+            sweep_end: None,
         }
     }
 

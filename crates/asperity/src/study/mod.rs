@@ -103,9 +103,44 @@ pub struct StudySpec {
     pub window: FitWindow,
     /// Number of common force levels of the ensemble curves.
     pub levels: usize,
+    /// BEM: the contact fraction past which a sample stops loading (its sweep ends with
+    /// the first load above it); `None`: all [`samplers::BemSampler::LOADS`] loads, up to
+    /// p̄ = 0.2 E*. An α study needs only the low-force end ([`StudySpec::with_alpha_sweep`]);
+    /// MDR samples ignore it (their whole curve costs one pass).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep_end: Option<f64>,
 }
 
+/// An α study's BEM sweep ends past this many times the largest window fraction it may be
+/// fitted on: each sample's curve must reach the ensemble's window end, the median over
+/// samples of their window ends. Measured on `reproduce fig1 --quick` (64², 128², 9 H,
+/// 20 samples each, every sensitivity window): the first load past 4× a window's end
+/// carries at least 3.5 times that window's ensemble end force (docs/bem.md).
+pub const ALPHA_SWEEP_MARGIN: f64 = 4.0;
+
 impl StudySpec {
+    /// The spec with the sweep of an α study: BEM samples stop loading past
+    /// [`ALPHA_SWEEP_MARGIN`] times the largest contact fraction any of its α fits can end
+    /// at (its own window and those of [`sensitivity::sensitivity_windows`], on each of its
+    /// grids), or never where that is not below full contact. The fits are those of the
+    /// whole sweep, bit for bit (`samplers::tests`), at a fraction of the cost: at 128² the
+    /// loads above 10 % contact are about 40 % of a sample's time.
+    pub fn with_alpha_sweep(mut self) -> Self {
+        let largest_end = self
+            .sizes
+            .iter()
+            .flat_map(|&n| {
+                let points = n.saturating_mul(n);
+                std::iter::once(self.window)
+                    .chain(sensitivity::sensitivity_windows())
+                    .map(move |w| w.fraction_range(points).1)
+            })
+            .fold(0.0, f64::max);
+        let end = ALPHA_SWEEP_MARGIN * largest_end;
+        self.sweep_end = (self.method == Method::Bem && end < 1.0).then_some(end);
+        self
+    }
+
     /// Checks sizes, Hurst exponents, samples, roll-off and window.
     pub fn validate(&self) -> Result<()> {
         if self.sizes.is_empty() {
@@ -154,6 +189,17 @@ impl StudySpec {
             ));
         }
         self.window.validate()?;
+        if let Some(end) = self.sweep_end {
+            if !(end > 0.0 && end <= 1.0) {
+                return Err(Error::invalid(
+                    "sweep_end",
+                    format!(
+                        "the sweep's end is a contact fraction in (0, 1], got {}",
+                        crate::input::short_number(end)
+                    ),
+                ));
+            }
+        }
         self.ensure_size()?;
         self.ensure_samplers()
     }
@@ -285,6 +331,38 @@ pub fn sample_seed(study_seed: u64, method: Method, task: Task, index: usize) ->
     splitmix64(x ^ index as u64)
 }
 
+/// Refuses the samples of a sweep that ended early ([`StudySpec::sweep_end`]) when one
+/// of them ends below the ensemble's window end of the study's window or of a sensitivity
+/// window: there the fit would average fewer samples than the whole sweep's fit does.
+fn check_sweep_reaches_windows(spec: &StudySpec, samples: &[SampleCurve]) -> Result<()> {
+    let Some(end) = spec.sweep_end else {
+        return Ok(());
+    };
+    let refs: Vec<&SampleCurve> = samples.iter().collect();
+    let windows = std::iter::once(spec.window).chain(sensitivity::sensitivity_windows());
+    for window in windows {
+        let Some((_, hi)) = curve::ensemble_window(&refs, &window) else {
+            continue;
+        };
+        let short = samples
+            .iter()
+            .position(|s| s.points.last().is_some_and(|p| p.force < hi));
+        if let Some(i) = short {
+            return Err(Error::invalid(
+                "sweep_end",
+                format!(
+                    "sample {i} stopped loading at contact fraction {} below the force at \
+                     which the α window {} ends ({}): this study needs the whole load sweep",
+                    crate::input::short_number(end),
+                    window.describe(),
+                    crate::input::short_number(hi)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Produces the force–stiffness curve of one realisation. A worker holds the plans and
 /// buffers of one thread and is reused across its samples.
 pub trait Sampler: Sync {
@@ -316,6 +394,7 @@ pub struct TaskResult {
 impl TaskResult {
     /// Builds the ensemble quantities from the samples.
     pub fn from_samples(spec: &StudySpec, task: Task, samples: &[SampleCurve]) -> Result<Self> {
+        check_sweep_reaches_windows(spec, samples)?;
         let mean_curve = ensemble_curve(samples, spec.levels)?;
         let alpha_ensemble = ensemble_alpha(samples, &spec.window, spec.levels);
         let alpha_samples = samples
@@ -967,6 +1046,7 @@ mod tests {
             seed: 3,
             window: FitWindow::default(),
             levels: 16,
+            sweep_end: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let store = StudyDir::open(dir.path(), &spec, false).unwrap();
@@ -1026,6 +1106,7 @@ mod tests {
             seed: 5,
             window: FitWindow::default(),
             levels: 16,
+            sweep_end: None,
         };
         let (small, grown) = (spec(3), spec(5));
         let task = small.tasks()[0];
@@ -1087,6 +1168,7 @@ mod tests {
                 max_fraction: 1.0,
             },
             levels: 10,
+            sweep_end: None,
         }
     }
 
@@ -1101,6 +1183,37 @@ mod tests {
         s.hursts = vec![0.5];
         s.sizes = vec![2];
         assert!(s.validate().is_err());
+        s.sizes = vec![64];
+        for end in [0.0, -0.1, 1.5, f64::NAN, f64::INFINITY] {
+            s.sweep_end = Some(end);
+            let err = s.validate().unwrap_err().to_string();
+            assert!(err.contains("sweep_end"), "{end}: {err}");
+        }
+        s.sweep_end = Some(1.0);
+        s.validate().unwrap();
+    }
+
+    #[test]
+    fn an_alpha_sweep_ends_past_every_window_it_may_be_fitted_on() {
+        let mut s = spec(3);
+        s.method = Method::Bem;
+        s.window = FitWindow::default();
+        s.sizes = vec![128, 64];
+        // 4 × the sensitivity table's 2 % (above the default window's 1 %).
+        assert_eq!(s.clone().with_alpha_sweep().sweep_end, Some(0.08));
+        s.window.max_fraction = 0.05;
+        assert_eq!(s.clone().with_alpha_sweep().sweep_end, Some(0.2));
+        // On a 16² grid, 16 contacts are 6.25 % and the window spans 4× that: 25 %, so
+        // the sweep would end past full contact, and solves every load.
+        s.window.max_fraction = 0.01;
+        s.sizes = vec![64, 16];
+        assert_eq!(s.clone().with_alpha_sweep().sweep_end, None);
+        s.sizes = vec![32];
+        let end = s.clone().with_alpha_sweep().sweep_end.unwrap();
+        assert!((end - 4.0 * 4.0 * 16.0 / 1024.0).abs() < 1e-15, "{end}");
+        // MDR curves cost one pass whatever their length: no sweep to end.
+        s.method = Method::Mdr;
+        assert_eq!(s.with_alpha_sweep().sweep_end, None);
     }
 
     #[test]
@@ -1248,6 +1361,7 @@ mod tests {
                 "window.min_contacts",
                 Box::new(|s| s.window.min_contacts = 2),
             ),
+            ("sweep_end", Box::new(|s| s.sweep_end = Some(0.08))),
         ];
         for (field, change) in variants {
             let mut other = spec(6);

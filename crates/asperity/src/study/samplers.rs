@@ -9,7 +9,9 @@
 //!   control at log-spaced mean pressures with warm starts; the stiffness at each load by
 //!   the frozen contact set.
 //!   The pressures span `0.05/N²` to `0.2` E*: with the area–load law `A/A0 ≈ 2 p/(E* ḡ)`
-//!   (ḡ = 1) this runs from below one pixel in contact to roughly 30–40 % contact.
+//!   (ḡ = 1) this runs from below one pixel in contact to roughly 30–40 % contact. An α
+//!   study stops a sample's sweep at the first load past its [`StudySpec::sweep_end`]
+//!   (a few times the largest window fraction): the loads above cost most and enter no fit.
 //!
 //! Both use L = 1 and E* = 1, but MDR lines have unit rms *height* and BEM surfaces unit
 //! rms *slope*, so forces (and stiffnesses) of the two methods are on different scales;
@@ -252,6 +254,7 @@ impl std::fmt::Debug for OnLoad {
 pub struct BemSampler {
     surface: SurfaceSpec,
     mean_pressures: Vec<f64>,
+    sweep_end: Option<f64>,
     params: SolverParams,
     stop: crate::stop::Stop,
     on_load: Option<OnLoad>,
@@ -275,6 +278,7 @@ impl BemSampler {
         Ok(BemSampler {
             surface,
             mean_pressures,
+            sweep_end: spec.sweep_end,
             params: bem_solver_params(),
             stop: crate::stop::Stop::new(),
             on_load: None,
@@ -343,7 +347,7 @@ impl Sampler for BemSampler {
         };
         let points_total = self.surface.rows() * self.surface.cols();
         let mut points = Vec::with_capacity(self.mean_pressures.len());
-        for &p in &self.mean_pressures {
+        for (i, &p) in self.mean_pressures.iter().enumerate() {
             let (summary, _) = solver.solve(Control::MeanPressure(p)).map_err(bem_error)?;
             let (stiffness, _) = solver.frozen_set_stiffness().map_err(bem_error)?;
             points.push(CurvePoint {
@@ -351,8 +355,20 @@ impl Sampler for BemSampler {
                 force: summary.force,
                 stiffness,
             });
+            let past_end = self
+                .sweep_end
+                .is_some_and(|end| summary.area_fraction > end);
+            // The loads not solved count as done, so that progress ends at every load.
+            let reported = if past_end {
+                self.mean_pressures.len() - i
+            } else {
+                1
+            };
             if let Some(OnLoad(on_load)) = &self.on_load {
-                on_load();
+                (0..reported).for_each(|_| on_load());
+            }
+            if past_end {
+                break;
             }
         }
         Ok(SampleCurve {
@@ -550,6 +566,7 @@ mod tests {
             seed: 7,
             window: FitWindow::default(),
             levels: 48,
+            sweep_end: None,
         }
     }
 
@@ -692,11 +709,66 @@ mod tests {
         assert_eq!(sampler.sample(&mut worker, 1).unwrap(), finished);
     }
 
+    /// An α study's sweep, ended past its windows, fits as the whole sweep does, bit for
+    /// bit: its curves are the first loads of the whole sweep's, ending with the first load
+    /// past the end, and every α (ensemble and per sample, the study's window and each of
+    /// the sensitivity table) is the same. Ended too early, it is refused.
     #[test]
-    fn every_solved_load_is_reported() {
+    fn an_alpha_sweep_fits_as_the_whole_sweep_does() {
+        use crate::study::sensitivity::sensitivity_windows;
+        let full = spec(Method::Bem, 64, vec![-1.0, 1.0, 3.0], 6);
+        let alpha = full.clone().with_alpha_sweep();
+        let end = alpha.sweep_end.unwrap();
+        let indices: Vec<usize> = (0..full.samples).collect();
+        let curves = |spec: &StudySpec, task| {
+            TaskSamples::new(spec, task)
+                .unwrap()
+                .compute(&indices)
+                .unwrap()
+        };
+        for task in full.tasks() {
+            let (whole, ended) = (curves(&full, task), curves(&alpha, task));
+            for (w, e) in whole.iter().zip(&ended) {
+                let k = e.points.len();
+                assert!(k < w.points.len(), "H = {}: no load skipped", task.hurst);
+                assert_eq!(e.points[..], w.points[..k]);
+                assert!(e.points[k - 1].fraction > end && e.points[k - 2].fraction <= end);
+            }
+            let a = TaskResult::from_samples(&full, task, &whole).unwrap();
+            let b = TaskResult::from_samples(&alpha, task, &ended).unwrap();
+            assert!(a.alpha_ensemble.is_some());
+            assert_eq!(a.alpha_ensemble, b.alpha_ensemble);
+            assert_eq!(a.alpha_samples, b.alpha_samples);
+            for window in sensitivity_windows() {
+                let fit = |c: &[SampleCurve]| {
+                    let each: Vec<_> = c.iter().map(|s| s.alpha(&window, full.levels)).collect();
+                    (crate::study::ensemble_alpha(c, &window, full.levels), each)
+                };
+                assert_eq!(fit(&whole), fit(&ended), "{window:?}");
+            }
+        }
+        // Past 0.4 % contact only: the samples' curves end below the window's end.
+        let mut early = alpha.clone();
+        early.sweep_end = Some(0.004);
+        let task = early.tasks()[1];
+        let err = TaskResult::from_samples(&early, task, &curves(&early, task)).unwrap_err();
+        assert!(err.to_string().contains("whole load sweep"), "{err}");
+    }
+
+    /// Each load of a sample is reported once, those an α sweep skips included.
+    #[test]
+    fn every_load_is_reported() {
+        let whole = spec(Method::Bem, 32, vec![0.8], 3);
+        every_load_is_reported_in(&whole, None);
+        // On 32² the sweep ends past 25 % contact: before the last loads.
+        let alpha = whole.clone().with_alpha_sweep();
+        every_load_is_reported_in(&alpha, Some(0.25));
+    }
+
+    fn every_load_is_reported_in(spec: &StudySpec, sweep_end: Option<f64>) {
         use std::sync::atomic::{AtomicUsize, Ordering};
         use std::sync::Arc;
-        let spec = spec(Method::Bem, 16, vec![0.8], 3);
+        assert_eq!(spec.sweep_end, sweep_end);
         let task = spec.tasks()[0];
         let (loads, seen) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
         let counter = Arc::clone(&loads);
@@ -704,20 +776,23 @@ mod tests {
             counter.fetch_add(1, Ordering::Relaxed);
         });
         let dir = tempfile::tempdir().unwrap();
-        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        let store = StudyDir::open(dir.path(), spec, false).unwrap();
         let samples_seen = Arc::clone(&seen);
         let reported = move |done: usize, _: usize| {
             samples_seen.fetch_max(done, Ordering::Relaxed);
         };
         let counted =
-            run_any_task_with_loads(&spec, task, &store, &reported, Some(on_load)).unwrap();
+            run_any_task_with_loads(spec, task, &store, &reported, Some(on_load)).unwrap();
         assert_eq!(seen.load(Ordering::Relaxed), 3);
         assert_eq!(loads.load(Ordering::Relaxed), 3 * BemSampler::LOADS);
+        let solved = store.stored_samples(task).unwrap();
+        let fewest = solved.iter().map(|s| s.points.len()).min().unwrap();
+        assert_eq!(fewest < BemSampler::LOADS, sweep_end.is_some());
         // Reporting changes nothing computed.
         let plain = tempfile::tempdir().unwrap();
-        let store = StudyDir::open(plain.path(), &spec, false).unwrap();
+        let store = StudyDir::open(plain.path(), spec, false).unwrap();
         assert_eq!(
-            run_any_task(&spec, task, &store, &|_, _| {}).unwrap(),
+            run_any_task(spec, task, &store, &|_, _| {}).unwrap(),
             counted
         );
     }

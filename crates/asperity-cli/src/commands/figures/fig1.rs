@@ -39,7 +39,8 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let (mdr_sizes, mdr_samples) = setting.fig1_mdr();
     let mdr = study_spec(Method::Mdr, mdr_sizes, hursts, mdr_samples, None);
     let plan = setting.fig1_bem()?;
-    let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
+    let bem =
+        study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None).with_alpha_sweep();
     announce("fig1", setting, dir, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;

@@ -87,7 +87,8 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let (mdr_sizes, mdr_samples) = setting.fig5_mdr();
     let mdr = study_spec(Method::Mdr, mdr_sizes, vec![-0.5], mdr_samples, None);
     let plan = setting.fig5_bem();
-    let bem = study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None);
+    let bem =
+        study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None).with_alpha_sweep();
     announce("fig5", setting, dir, &[(&bem, None)])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;

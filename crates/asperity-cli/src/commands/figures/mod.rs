@@ -86,6 +86,7 @@ fn study_spec(
         seed: 2013,
         window: FitWindow::default(),
         levels: 48,
+        sweep_end: None,
     }
 }
 
@@ -127,6 +128,7 @@ fn announce(
                 samples: spec.samples,
                 hursts: &spec.hursts,
                 rolloff: *rolloff,
+                sweep_end: spec.sweep_end,
                 stored: &stored,
             };
             let estimate = crate::estimate::estimate_bem_seconds(
