@@ -108,6 +108,30 @@ fn bem_estimate_sums_its_sizes_into_the_total() {
     }
     let total: f64 = lines[2]["total_seconds"].parse().unwrap();
     assert!((total - sum).abs() <= 2e-3, "{total} vs {sum}");
+    // On 16² an α study's sweep would end past full contact: every load, as a curve's.
+    assert!(!lines[2].contains_key("sweep_end"), "{stdout}");
+}
+
+#[test]
+fn bem_estimate_follows_an_alpha_studys_sweep_unless_told_otherwise() {
+    let run = |extra: &[&str]| {
+        let args = "bench bem-estimate --sizes 64 --samples 2 --hursts 0.5 --probes 32,64";
+        let args: Vec<&str> = args.split(' ').chain(extra.iter().copied()).collect();
+        let out = asperity(&args);
+        ok(&out);
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let field = |text: &str, key: &str| -> Option<f64> {
+        text.split_whitespace()
+            .find_map(|item| item.strip_prefix(&format!("{key}=")))
+            .map(|v| v.parse().unwrap())
+    };
+    let (alpha, whole) = (run(&[]), run(&["--full-sweep"]));
+    assert_eq!(field(&alpha, "sweep_end"), Some(0.08), "{alpha}");
+    assert_eq!(field(&whole, "sweep_end"), None, "{whole}");
+    // The loads past 8 % contact are the costly ones.
+    let iterations = |t: &str| field(t, "solve_iterations").unwrap();
+    assert!(iterations(&alpha) < iterations(&whole), "{alpha}\n{whole}");
 }
 
 #[test]

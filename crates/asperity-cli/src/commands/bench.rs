@@ -239,15 +239,15 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 }
 
 /// Prints per N one line `n samples hursts lanes solve_iterations direct_applications
-/// cg_iterations solve_iteration_s cg_iteration_s seconds`, then `total_seconds` and
-/// `total_hours`.
+/// cg_iterations solve_iteration_s cg_iteration_s seconds`, then `total_seconds`,
+/// `total_hours`, `lanes` and, for an α study's sweep, `sweep_end`.
 ///
 /// Per (N, H) one sample costs `I_solve·c_solve(N) + (A_direct + I_cg)·c_cg(N)` (`A_direct`
 /// the operator applications of the loads solved directly): the per-iteration costs
 /// `c` are measured at each N on one thread ([`crate::estimate`], so they include everything
-/// an iteration does on this machine), the iteration counts `I` of a whole 24-load sample are
-/// measured at the two probe sizes for every H  and carried to N by
-/// the power law through them . A study runs its samples side by side, one
+/// an iteration does on this machine), the iteration counts `I` of a whole sample (the
+/// loads of `study alpha`'s sweep, or all 24 with `--full-sweep`) are measured at the two
+/// probe sizes for every H and carried to N by the power law through them. A study runs its samples side by side, one
 /// lane per thread (`study::run_task`), so a task of S samples takes `⌈S/lanes⌉` sample
 /// times; total = Σ_N Σ_H ⌈S/lanes⌉ · sample time. Left out: the lanes' competition for
 /// memory bandwidth (the estimate is low where it matters, at large N on many lanes),
@@ -255,13 +255,6 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
     anyhow::ensure!(args.samples > 0, "--samples must be at least 1");
     let sizes = parse_sizes(&args.sizes, "--sizes")?;
-    let probes = match &args.probes {
-        None => crate::estimate::probes_for(&sizes),
-        Some(text) => match parse_sizes(text, "--probes")?[..] {
-            [a, b] if a < b => (a, b),
-            _ => anyhow::bail!("--probes takes two increasing sizes, got {text:?}"),
-        },
-    };
     let hursts = crate::range::parse_range(&args.hursts)?;
     // The sweep of `study alpha` with its default window on these grids.
     let alpha = asperity::study::StudySpec {
@@ -276,12 +269,20 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         sweep_end: None,
     }
     .with_alpha_sweep();
+    let sweep_end = alpha.sweep_end.filter(|_| !args.full_sweep);
+    let probes = match &args.probes {
+        None => crate::estimate::probes_for(&sizes, sweep_end),
+        Some(text) => match parse_sizes(text, "--probes")?[..] {
+            [a, b] if a < b => (a, b),
+            _ => anyhow::bail!("--probes takes two increasing sizes, got {text:?}"),
+        },
+    };
     let study = BemStudy {
         sizes: &sizes,
         samples: args.samples,
         hursts: &hursts,
         rolloff: args.rolloff,
-        sweep_end: alpha.sweep_end.filter(|_| !args.full_sweep),
+        sweep_end,
         stored: &[],
     };
     let estimate = estimate_bem_seconds(&study, probes)?;
@@ -302,8 +303,9 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
             row.seconds,
         );
     }
+    let sweep = sweep_end.map_or(String::new(), |end| format!(" sweep_end={end}"));
     println!(
-        "total_seconds={:.3} total_hours={:.2} lanes={lanes}",
+        "total_seconds={:.3} total_hours={:.2} lanes={lanes}{sweep}",
         estimate.seconds,
         estimate.seconds / 3600.0
     );

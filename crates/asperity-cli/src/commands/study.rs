@@ -625,8 +625,10 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
         sweep_end: spec.sweep_end,
         stored: &stored,
     };
-    let estimate =
-        crate::estimate::estimate_bem_seconds(&study, crate::estimate::probes_for(&spec.sizes))?;
+    let estimate = crate::estimate::estimate_bem_seconds(
+        &study,
+        crate::estimate::probes_for(&spec.sizes, spec.sweep_end),
+    )?;
     let minutes = estimate.seconds / 60.0;
     let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(

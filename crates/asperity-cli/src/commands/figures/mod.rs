@@ -133,7 +133,7 @@ fn announce(
             };
             let estimate = crate::estimate::estimate_bem_seconds(
                 &study,
-                crate::estimate::probes_for(&spec.sizes),
+                crate::estimate::probes_for(&spec.sizes, spec.sweep_end),
             )?;
             let stored: usize = stored.iter().map(|s| s.samples).sum();
             eprintln!(
