@@ -772,13 +772,15 @@ fn spec_differences(stored: &StudySpec, wanted: &StudySpec) -> String {
     };
     let (a, b) = (map(stored), map(wanted));
     let clip = |v: &serde_json::Value| crate::input::clip(&v.to_string());
+    let null = serde_json::Value::Null;
+    // A key on one side only (an optional field left out) differs from `null`.
+    let only_wanted = b.iter().filter(|(k, _)| !a.contains_key(*k));
     let items: Vec<String> = a
         .iter()
-        .filter(|(k, v)| b.get(*k) != Some(*v))
-        .map(|(k, v)| {
-            let w = b.get(k).unwrap_or(&serde_json::Value::Null);
-            format!("{k}: stored {}, wanted {}", clip(v), clip(w))
-        })
+        .map(|(k, v)| (k, v, b.get(k).unwrap_or(&null)))
+        .chain(only_wanted.map(|(k, w)| (k, &null, w)))
+        .filter(|(_, v, w)| v != w)
+        .map(|(k, v, w)| format!("{k}: stored {}, wanted {}", clip(v), clip(w)))
         .collect();
     items.join(", ")
 }
@@ -1579,6 +1581,21 @@ mod tests {
         };
         let err = StudyDir::open(dir.path(), &other_seed, false).unwrap_err();
         assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
+        assert!(
+            err.to_string().contains("seed: stored 3, wanted 4"),
+            "{err}"
+        );
+        // A field the stored spec leaves out (an optional one) is named too.
+        let ended = StudySpec {
+            sweep_end: Some(0.5),
+            ..spec(20)
+        };
+        let err = StudyDir::open(dir.path(), &ended, false).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("sweep_end: stored null, wanted 0.5"),
+            "{err}"
+        );
         assert!(dir
             .path()
             .join("checkpoint")
