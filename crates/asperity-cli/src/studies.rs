@@ -29,6 +29,17 @@ pub enum Kind {
     Curve,
 }
 
+/// `", loads up to the first past 8 % contact"` for a BEM study whose samples end their
+/// sweep ([`StudySpec::sweep_end`]), empty for one that solves every load.
+pub fn describe_sweep(spec: &StudySpec) -> String {
+    spec.sweep_end.map_or(String::new(), |end| {
+        format!(
+            ", loads up to the first past {} % contact",
+            asperity::input::short_number(end * 100.0)
+        )
+    })
+}
+
 /// How a study runs (not part of what it computes).
 #[derive(Debug, Clone, Copy)]
 pub struct RunOptions {
@@ -587,6 +598,15 @@ mod tests {
         let (small, large) = (sample_cost(Method::Bem, 64), sample_cost(Method::Bem, 128));
         let left = eta.cost_to(eta.total()) - eta.cost_to(3 * loads);
         assert!((left - (4.0 * small + large)).abs() < 1e-6 * left, "{left}");
+        // The announcement states an α study's sweep (the same loads counted: an ended
+        // sweep reports the loads it skips).
+        assert_eq!(describe_sweep(&spec), "");
+        let alpha = spec.clone().with_alpha_sweep();
+        assert_eq!(
+            describe_sweep(&alpha),
+            ", loads up to the first past 8 % contact"
+        );
+        assert_eq!(progress_segments(&alpha, &[0, 3]), segments);
         // One sample of N = 64 computed in 10 s: 10 s per `small`, the rest in proportion.
         let eta_s = eta.remaining(4 * loads, 10.0).unwrap();
         assert!((eta_s - 10.0 * (3.0 * small + large) / small).abs() < 1e-9 * eta_s);

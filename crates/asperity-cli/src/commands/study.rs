@@ -632,11 +632,12 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
     let minutes = estimate.seconds / 60.0;
     let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(
-        "bem study: N = {:?}, {} H, {} samples each{}: estimated {} on this machine ({} lanes; \
+        "bem study: N = {:?}, {} H, {} samples each{}{}: estimated {} on this machine ({} lanes; \
          checkpointed: an interrupted run resumes with the same command)",
         spec.sizes,
         spec.hursts.len(),
         spec.samples,
+        crate::studies::describe_sweep(spec),
         match stored {
             0 => String::new(),
             s => format!(" ({s} already checkpointed, not counted)"),

@@ -115,11 +115,12 @@ fn announce(
     }
     for (spec, rolloff) in studies {
         eprintln!(
-            "{figure} ({} setting): BEM on N = {:?}, {} samples per (N, H), H = {}",
+            "{figure} ({} setting): BEM on N = {:?}, {} samples per (N, H), H = {}{}",
             setting.name(),
             spec.sizes,
             spec.samples,
-            describe_hursts(&spec.hursts)
+            describe_hursts(&spec.hursts),
+            crate::studies::describe_sweep(spec)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
             let stored = crate::estimate::held_samples(&dir.join("bem"), spec);
