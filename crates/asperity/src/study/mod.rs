@@ -122,9 +122,11 @@ impl StudySpec {
     /// The spec with the sweep of an α study: BEM samples stop loading past
     /// [`ALPHA_SWEEP_MARGIN`] times the largest contact fraction any of its α fits can end
     /// at (its own window and those of [`sensitivity::sensitivity_windows`], on each of its
-    /// grids), or never where that is not below full contact. The fits are those of the
-    /// whole sweep, bit for bit (`samplers::tests`), at a fraction of the cost: at 128² the
-    /// loads above 10 % contact are about 40 % of a sample's time.
+    /// grids), or never where that is not below full contact. The fits are then those of
+    /// the whole sweep, bit for bit, as long as every sample's curve reaches the ensemble's
+    /// window ends, which [`TaskResult::from_samples`] checks (`samplers::tests`); at a
+    /// fraction of the cost: at 128² the loads above 10 % contact are about 40 % of a
+    /// sample's time.
     pub fn with_alpha_sweep(mut self) -> Self {
         let largest_end = self
             .sizes
@@ -344,18 +346,19 @@ fn check_sweep_reaches_windows(spec: &StudySpec, samples: &[SampleCurve]) -> Res
         let Some((_, hi)) = curve::ensemble_window(&refs, &window) else {
             continue;
         };
-        let short = samples
-            .iter()
-            .position(|s| s.points.last().is_some_and(|p| p.force < hi));
-        if let Some(i) = short {
+        let short = samples.iter().enumerate().find_map(|(i, s)| {
+            let last = s.points.last()?.force;
+            (last < hi).then_some((i, last))
+        });
+        if let Some((i, last)) = short {
             return Err(Error::invalid(
                 "sweep_end",
                 format!(
-                    "sample {i} stopped loading at contact fraction {} below the force at \
-                     which the α window {} ends ({}): this study needs the whole load sweep",
+                    "sample {i}, its sweep ended past contact fraction {}, reached force \
+                     {last:.6e} only, below the {hi:.6e} at which the ensemble's α window ({}) \
+                     ends: this study needs the whole load sweep",
                     crate::input::short_number(end),
-                    window.describe(),
-                    crate::input::short_number(hi)
+                    window.describe()
                 ),
             ));
         }
