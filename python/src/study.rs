@@ -117,6 +117,7 @@ fn run_study(
         alpha_sweep,
         checkpoint_every,
     )?;
+    let spec = resumable(spec, &out, force);
     let (_lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
     let results = run_detached(py, |cancel| {
         run_tasks(&spec, &store, progress.as_ref(), cancel)
@@ -170,6 +171,15 @@ fn make_spec(
     spec.validate().map_err(from_error)?;
     spec.ensure_fits().map_err(from_error)?;
     Ok(spec)
+}
+
+/// The study to run in `out`, as the CLI's: `spec`, or the whole-sweep study whose
+/// samples the folder holds ([`StudyDir::resumable`]); `spec` when `force` discards it.
+fn resumable(spec: StudySpec, out: &std::path::Path, force: bool) -> StudySpec {
+    match force {
+        true => spec,
+        false => StudyDir::resumable(out, spec),
+    }
 }
 
 /// Checks, locks and opens the study folder `out` as the CLI does.
@@ -258,6 +268,7 @@ impl StudyLedger {
             alpha_sweep,
             checkpoint_every,
         )?;
+        let spec = resumable(spec, &out, force);
         let (lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
         let ledger = Ledger::restore(&store).map_err(from_error)?;
         Ok(StudyLedger {

@@ -40,6 +40,24 @@ pub fn describe_sweep(spec: &StudySpec) -> String {
     })
 }
 
+/// The study to run in `dir` ([`StudyDir::resumable`]): `spec`, or the whole-sweep study
+/// whose samples the folder holds, said on stderr; always `spec` when `discard` (--force).
+pub fn resumable(spec: StudySpec, dir: &Path, discard: bool, quiet: bool) -> StudySpec {
+    if discard {
+        return spec;
+    }
+    let run = StudyDir::resumable(dir, spec.clone());
+    if run != spec && !quiet {
+        eprintln!(
+            "{}: resuming its study, which solves every load (as α studies did before they \
+             stopped loading past their fit windows, or with --full-sweep): the same α, \
+             its checkpoints kept",
+            dir.display()
+        );
+    }
+    run
+}
+
 /// How a study runs (not part of what it computes).
 #[derive(Debug, Clone, Copy)]
 pub struct RunOptions {

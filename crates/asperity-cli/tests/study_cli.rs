@@ -738,6 +738,32 @@ fn an_alpha_study_ends_its_bem_sweeps_past_the_windows_and_fits_as_the_whole_swe
         "sweep_end",
     );
     assert_eq!(read("a/alpha.csv"), before);
+    // The other way round, a folder holding the whole sweep's samples (as every α study's
+    // did before the sweeps ended) is resumed as that study, more samples computed too.
+    let whole_spec = read("f/study.json");
+    let grown: Vec<&str> = [&args[..8], &["--samples", "5", "--out", "f"]].concat();
+    let resumed = asperity(&grown, d);
+    ok(&resumed);
+    assert!(
+        common::stderr(&resumed).contains("resuming its study, which solves every load"),
+        "{}",
+        common::stderr(&resumed)
+    );
+    assert_eq!(
+        read("f/study.json"),
+        whole_spec.replace("\"samples\": 4", "\"samples\": 5")
+    );
+    ok(&asperity(
+        &[&args[..8], &["--samples", "5", "--out", "g", "--quiet"]].concat(),
+        d,
+    ));
+    assert_eq!(read("f/alpha.csv"), read("g/alpha.csv"));
+    // --force discards it instead, for the ended sweep.
+    ok(&asperity(
+        &[&args[..], &["f", "--force", "--quiet"]].concat(),
+        d,
+    ));
+    assert!(read("f/study.json").contains("\"sweep_end\": 0.08"));
     // A curve study solves every load: the key is refused there.
     std::fs::write(
         d.join("c.toml"),

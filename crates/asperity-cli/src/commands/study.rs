@@ -598,6 +598,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
         }
     };
+    let spec = crate::studies::resumable(spec, out, options.force, options.quiet);
     if spec.method == Method::Bem && !options.quiet {
         announce_bem(&spec, out)?;
     }

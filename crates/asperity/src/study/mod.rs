@@ -577,6 +577,31 @@ impl StudyDir {
         }
     }
 
+    /// The study to run in `dir` for `spec`: `spec` itself, or, where `dir` holds samples
+    /// of the same study with every load solved (no [`StudySpec::sweep_end`]: an α study
+    /// made before α sweeps ended early, or with a full sweep), which `spec` would refuse
+    /// as another study's, that whole-sweep study, so that the run resumes its checkpoints
+    /// (its α are the same, bit for bit, at the cost of the loads past the windows). Never
+    /// the other way round: a whole sweep does not take an ended one's samples.
+    pub fn resumable(dir: &Path, spec: StudySpec) -> StudySpec {
+        if spec.sweep_end.is_none() || Self::check(dir, &spec, false).is_ok() {
+            return spec;
+        }
+        let whole = StudySpec {
+            sweep_end: None,
+            ..spec.clone()
+        };
+        let resumes = matches!(
+            Self::stored_spec(dir, &whole),
+            Ok(Stored::Same | Stored::Extended)
+        );
+        if resumes && Self::holds_samples(dir).unwrap_or(false) {
+            whole
+        } else {
+            spec
+        }
+    }
+
     /// Whether any checkpoint in `dir` holds a finished task or a sample. A checkpoint that
     /// cannot be read counts as holding one (nothing is discarded that might matter);
     /// temporary files of unfinished writes do not count.
@@ -1275,6 +1300,45 @@ mod tests {
         assert!(matches!(err, Error::ForeignCheckpoint { .. }), "{err}");
         // The stored task itself is read back.
         run_task(&spec, stored, &Synthetic, &store, &|_, _| {}).unwrap();
+    }
+
+    /// An ended sweep resumes the whole sweep whose samples the folder holds (the same
+    /// study otherwise, or that study extended); never another study's, never a folder
+    /// without samples, and never the other way round.
+    #[test]
+    fn an_ended_sweep_resumes_the_whole_sweep_a_folder_holds() {
+        let dir = tempfile::tempdir().unwrap();
+        let whole = spec(4);
+        let ended = StudySpec {
+            sweep_end: Some(0.08),
+            ..spec(4)
+        };
+        // study.json alone: the folder is free, the ended sweep runs as asked.
+        let store = StudyDir::open(dir.path(), &whole, false).unwrap();
+        assert_eq!(StudyDir::resumable(dir.path(), ended.clone()), ended);
+        let one = vec![Synthetic.sample(&mut (), 1).unwrap()];
+        store
+            .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
+            .unwrap();
+        assert_eq!(StudyDir::resumable(dir.path(), ended.clone()), whole);
+        // The same with more samples (the study extended) ...
+        let more = StudySpec {
+            samples: 9,
+            ..ended.clone()
+        };
+        let resumed = StudyDir::resumable(dir.path(), more.clone());
+        assert_eq!((resumed.sweep_end, resumed.samples), (None, 9));
+        StudyDir::open(dir.path(), &resumed, false).unwrap();
+        // ... but not with another seed, nor a whole sweep in an ended one's folder.
+        let other = StudySpec { seed: 9, ..more };
+        assert_eq!(StudyDir::resumable(dir.path(), other.clone()), other);
+        let ended_dir = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(ended_dir.path(), &ended, false).unwrap();
+        store
+            .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
+            .unwrap();
+        assert_eq!(StudyDir::resumable(ended_dir.path(), whole.clone()), whole);
+        assert!(StudyDir::open(ended_dir.path(), &whole, false).is_err());
     }
 
     #[test]
