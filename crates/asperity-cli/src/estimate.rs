@@ -69,7 +69,7 @@ fn sample_iterations(
             counts.solve += info.iterations as f64;
         }
         counts.cg += stiffness.iterations as f64;
-        if sweep_end.is_some_and(|end| summary.area_fraction > end) {
+        if asperity::study::samplers::sweep_ends_after(sweep_end, summary.area_fraction) {
             break;
         }
     }

@@ -301,6 +301,13 @@ impl BemSampler {
     }
 }
 
+/// Whether a BEM sample whose sweep ends past `sweep_end` ([`StudySpec::sweep_end`]) stops
+/// loading after a load that brought a `fraction` of its points into contact: the first
+/// load above the end is its last.
+pub fn sweep_ends_after(sweep_end: Option<f64>, fraction: f64) -> bool {
+    sweep_end.is_some_and(|end| fraction > end)
+}
+
 /// Per-thread state of the BEM sampler: the surface generator and one contact solver
 /// whose operator (FFT plans, kernel spectrum) and buffers serve every sample.
 pub struct BemWorker {
@@ -355,9 +362,7 @@ impl Sampler for BemSampler {
                 force: summary.force,
                 stiffness,
             });
-            let past_end = self
-                .sweep_end
-                .is_some_and(|end| summary.area_fraction > end);
+            let past_end = sweep_ends_after(self.sweep_end, summary.area_fraction);
             // The loads not solved count as done, so that progress ends at every load.
             let reported = if past_end {
                 self.mean_pressures.len() - i
