@@ -522,6 +522,9 @@ pub fn compare_study(dir: &Path, force: bool) -> Result<()> {
             ),
         }
     }
+    if spec.rolloff.is_some() {
+        asperity::study::sensitivity::ensure_whole_sweep(&spec, dir)?;
+    }
     let (kind, figure) = match spec.rolloff {
         Some(_) => ("steepest slope", Results::Fig2(&results, spec.window)),
         None => ("α", Results::Fig1(&results)),

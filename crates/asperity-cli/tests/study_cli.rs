@@ -758,6 +758,23 @@ fn an_alpha_study_ends_its_bem_sweeps_past_the_windows_and_fits_as_the_whole_swe
         d,
     ));
     assert_eq!(read("f/alpha.csv"), read("g/alpha.csv"));
+    // With a roll-off, `study compare` reads the steepest slope of whole mean curves: an
+    // ended sweep is refused there (its folder left as it was), a full one compared.
+    let rolled: Vec<&str> = "study alpha --method bem --n 32 --hurst 1 --samples 2 --rolloff 4 \
+                             --quiet --out"
+        .split_whitespace()
+        .collect();
+    ok(&asperity(&[&rolled[..], &["r"]].concat(), d));
+    refused(
+        &asperity(&["study", "compare", "r"], d),
+        "stopped loading past 25 % contact",
+    );
+    assert!(!d.join("r/comparison.csv").exists());
+    ok(&asperity(
+        &[&rolled[..], &["rf", "--full-sweep"]].concat(),
+        d,
+    ));
+    ok(&asperity(&["study", "compare", "rf"], d));
     // --force discards it instead, for the ended sweep.
     ok(&asperity(
         &[&args[..], &["f", "--force", "--quiet"]].concat(),

@@ -115,6 +115,25 @@ fn bootstrap_interval(
     Some((quantile(&values, 0.025)?, quantile(&values, 0.975)?))
 }
 
+/// Refuses a study whose samples ended their load sweeps for a steepest slope, which reads
+/// the whole mean curve.
+pub fn ensure_whole_sweep(spec: &super::StudySpec, dir: &std::path::Path) -> Result<()> {
+    match spec.sweep_end {
+        None => Ok(()),
+        Some(end) => Err(crate::Error::invalid(
+            "sweep_end",
+            format!(
+                "{}: its samples stopped loading past {} % contact (an α study's sweep), so \
+                 its mean curves end there, and the steepest slope of a whole curve cannot be \
+                 read off them; run the study with every load (a curve study, or an α study \
+                 with a full sweep) to compare it",
+                dir.display(),
+                crate::input::short_number(end * 100.0)
+            ),
+        )),
+    }
+}
+
 /// The steepest stretch of a mean curve: its log–log slope and where it lies.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SteepestSlope {
@@ -220,9 +239,12 @@ pub struct TaskSlope {
 }
 
 /// [`slope_with_interval`] for every task of the study in `dir` whose checkpoint holds at
-/// least 2 sample curves, with the study's window and force levels. Reads only.
+/// least 2 sample curves, with the study's window and force levels. Reads only. A study
+/// whose BEM samples ended their sweeps ([`super::StudySpec::sweep_end`], an α study's) is
+/// refused: the steepest decade may lie past the end.
 pub fn study_slopes(dir: &std::path::Path) -> Result<Vec<TaskSlope>> {
     let store = StudyDir::read(dir)?;
+    ensure_whole_sweep(store.spec(), dir)?;
     let (window, levels) = (store.spec().window, store.spec().levels);
     let mut out = Vec::new();
     for task in store.spec().tasks() {
