@@ -117,7 +117,7 @@ fn run_study(
         alpha_sweep,
         checkpoint_every,
     )?;
-    let spec = resumable(spec, &out, force);
+    let spec = resumable(py, spec, &out, force)?;
     let (_lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
     let results = run_detached(py, |cancel| {
         run_tasks(&spec, &store, progress.as_ref(), cancel)
@@ -174,12 +174,30 @@ fn make_spec(
 }
 
 /// The study to run in `out`, as the CLI's: `spec`, or the whole-sweep study whose
-/// samples the folder holds ([`StudyDir::resumable`]); `spec` when `force` discards it.
-fn resumable(spec: StudySpec, out: &std::path::Path, force: bool) -> StudySpec {
-    match force {
-        true => spec,
-        false => StudyDir::resumable(out, spec),
+/// samples the folder holds ([`StudyDir::resumable`], said by a `UserWarning`); `spec`
+/// when `force` discards it.
+fn resumable(
+    py: Python<'_>,
+    spec: StudySpec,
+    out: &std::path::Path,
+    force: bool,
+) -> PyResult<StudySpec> {
+    if force {
+        return Ok(spec);
     }
+    let run = StudyDir::resumable(out, spec.clone());
+    if run != spec {
+        let message = format!(
+            "{}: resuming its study, which solves every load (as alpha studies did before \
+             they stopped loading past their fit windows, or with full_sweep=True): the same \
+             alpha, its checkpoints kept; force=True discards them",
+            out.display()
+        );
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        let message = std::ffi::CString::new(message).map_err(|e| invalid(e.to_string()))?;
+        PyErr::warn(py, category.as_any(), &message, 1)?;
+    }
+    Ok(run)
 }
 
 /// Checks, locks and opens the study folder `out` as the CLI does.
@@ -241,6 +259,7 @@ impl StudyLedger {
         max_fraction, levels, alpha_sweep, out, force, checkpoint_every))]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         method_name: &str,
         sizes: Vec<usize>,
         hursts: Vec<f64>,
@@ -268,7 +287,7 @@ impl StudyLedger {
             alpha_sweep,
             checkpoint_every,
         )?;
-        let spec = resumable(spec, &out, force);
+        let spec = resumable(py, spec, &out, force)?;
         let (lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
         let ledger = Ledger::restore(&store).map_err(from_error)?;
         Ok(StudyLedger {

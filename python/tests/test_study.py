@@ -118,7 +118,8 @@ def test_a_bem_alpha_study_ends_its_sweeps_as_the_cli_and_fits_as_the_whole_swee
     for task in ours.tasks:
         assert task["mean_curve"][-1]["fraction"] < whole_fraction(whole, task)
     # A folder holding the whole sweep's samples is resumed as that study, as by the CLI.
-    again = asperity.study_alpha(**study, out=tmp_path / "whole")
+    with pytest.warns(UserWarning, match="resuming its study, which solves every load"):
+        again = asperity.study_alpha(**study, out=tmp_path / "whole")
     assert again.rows == whole.rows
     assert "sweep_end" not in json.loads((tmp_path / "whole" / "study.json").read_text())["spec"]
 
