@@ -181,6 +181,18 @@ fn extrapolate(count: (f64, f64), probes: (usize, usize), n: usize) -> f64 {
     count.1 * (n as f64 / probes.1 as f64).powf(slope)
 }
 
+/// A duration for a person: seconds below 2 minutes, minutes below 2 hours, else hours.
+pub fn human_duration(seconds: f64) -> String {
+    let minutes = seconds / 60.0;
+    if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else if minutes < 120.0 {
+        format!("{minutes:.0} min")
+    } else {
+        format!("{:.1} h", minutes / 60.0)
+    }
+}
+
 /// A BEM study to estimate: grids, samples per (N, H), H values and roll-off.
 pub struct BemStudy<'a> {
     /// Grid sizes N.
@@ -331,6 +343,14 @@ mod tests {
         // No iteration at the smaller probe (its sample solved directly): from one.
         assert!((extrapolate((0.0, 8.0), probes, 256) - 64.0).abs() < 1e-9);
         assert_eq!(extrapolate((0.0, 0.0), probes, 256), 0.0);
+    }
+
+    #[test]
+    fn durations_read_in_the_unit_that_fits() {
+        assert_eq!(human_duration(42.4), "42 s");
+        assert_eq!(human_duration(418.3), "7 min");
+        assert_eq!(human_duration(7199.0), "120 min");
+        assert_eq!(human_duration(15103.0), "4.2 h");
     }
 
     #[test]

@@ -630,7 +630,6 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
         &study,
         crate::estimate::probes_for(&spec.sizes, spec.sweep_end),
     )?;
-    let minutes = estimate.seconds / 60.0;
     let stored: usize = stored.iter().map(|s| s.samples).sum();
     eprintln!(
         "bem study: N = {:?}, {} H, {} samples each{}{}: estimated {} on this machine ({} lanes; \
@@ -643,13 +642,7 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
             0 => String::new(),
             s => format!(" ({s} already checkpointed, not counted)"),
         },
-        if estimate.seconds < 120.0 {
-            format!("{:.0} s", estimate.seconds)
-        } else if minutes < 120.0 {
-            format!("{minutes:.0} min")
-        } else {
-            format!("{:.1} h", minutes / 60.0)
-        },
+        crate::estimate::human_duration(estimate.seconds),
         estimate.lanes
     );
     Ok(())

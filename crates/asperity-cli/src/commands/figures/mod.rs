@@ -138,9 +138,9 @@ fn announce(
             )?;
             let stored: usize = stored.iter().map(|s| s.samples).sum();
             eprintln!(
-                "{figure}: estimated BEM time on this machine {:.1} h{} ({} lanes; \
+                "{figure}: estimated BEM time on this machine {}{} ({} lanes; \
                  checkpointed: an interrupted run resumes with the same command)",
-                estimate.seconds / 3600.0,
+                crate::estimate::human_duration(estimate.seconds),
                 match stored {
                     0 => String::new(),
                     s => format!(" for the samples left ({s} already checkpointed)"),
