@@ -182,10 +182,7 @@ fn resumable(
     out: &std::path::Path,
     force: bool,
 ) -> PyResult<StudySpec> {
-    if force {
-        return Ok(spec);
-    }
-    let run = StudyDir::resumable(out, spec.clone());
+    let run = StudyDir::resumable(out, spec.clone(), force);
     if run != spec {
         let message = format!(
             "{}: resuming its study, which solves every load (as alpha studies did before \

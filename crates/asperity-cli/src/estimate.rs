@@ -222,6 +222,25 @@ pub struct HeldSamples {
     pub samples: usize,
 }
 
+/// The estimate of the samples of the BEM study `spec` not yet stored in its folder `dir`
+/// (its roll-off and sweep, at the probes of [`probes_for`]), with the number stored.
+pub fn estimate_study(
+    spec: &asperity::study::StudySpec,
+    dir: &std::path::Path,
+) -> Result<(StudyEstimate, usize)> {
+    let stored = held_samples(dir, spec);
+    let study = BemStudy {
+        sizes: &spec.sizes,
+        samples: spec.samples,
+        hursts: &spec.hursts,
+        rolloff: spec.rolloff,
+        sweep_end: spec.sweep_end,
+        stored: &stored,
+    };
+    let estimate = estimate_bem_seconds(&study, probes_for(&spec.sizes, spec.sweep_end))?;
+    Ok((estimate, stored.iter().map(|s| s.samples).sum()))
+}
+
 /// The samples of `spec`'s tasks already stored in the study folder `dir` (none when the
 /// folder holds no study or another one: the estimate is then for the whole study).
 pub fn held_samples(dir: &std::path::Path, spec: &asperity::study::StudySpec) -> Vec<HeldSamples> {

@@ -43,10 +43,7 @@ pub fn describe_sweep(spec: &StudySpec) -> String {
 /// The study to run in `dir` ([`StudyDir::resumable`]): `spec`, or the whole-sweep study
 /// whose samples the folder holds, said on stderr; always `spec` when `discard` (--force).
 pub fn resumable(spec: StudySpec, dir: &Path, discard: bool, quiet: bool) -> StudySpec {
-    if discard {
-        return spec;
-    }
-    let run = StudyDir::resumable(dir, spec.clone());
+    let run = StudyDir::resumable(dir, spec.clone(), discard);
     if run != spec && !quiet {
         eprintln!(
             "{}: resuming its study, which solves every load (as α studies did before they \

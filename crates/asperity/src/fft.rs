@@ -253,19 +253,17 @@ impl RealFft2 {
         self.check_lengths(input, spectrum);
         assert_eq!(values.len(), self.half_cols(), "one value per kx");
         self.rows_into_columns(input, spectrum);
-        let (fft, rows) = (&self.col_forward, self.rows);
-        let chunk = per_lane(values.len(), self.lanes.len());
-        spectrum
-            .par_chunks_mut(chunk * rows)
-            .zip(values.par_chunks_mut(chunk))
-            .enumerate()
-            .zip(self.lanes.par_iter_mut())
-            .for_each(|((block_index, (block, out)), lane)| {
-                for (i, (column, value)) in block.chunks_exact_mut(rows).zip(out).enumerate() {
-                    fft.process_with_scratch(column, &mut lane.scratch);
-                    *value = reduce(block_index * chunk + i, column);
-                }
-            });
+        let fft = &self.col_forward;
+        for_each_column_into(
+            spectrum,
+            self.rows,
+            &mut self.lanes,
+            values,
+            |kx, column, scratch, value| {
+                fft.process_with_scratch(column, scratch);
+                *value = reduce(kx, column);
+            },
+        );
     }
 
     /// The column passes of [`RealFft2::convolve`]: from the rows' half spectra in `work`
@@ -415,14 +413,38 @@ fn for_each_column<F>(spectrum: &mut [Complex64], rows: usize, lanes: &mut [Lane
 where
     F: Fn(usize, &mut [Complex64], &mut [Complex64]) + Sync,
 {
-    let chunk = per_lane(spectrum.len() / rows, lanes.len());
+    // Units take no memory: nothing is allocated.
+    let mut nothing = vec![(); spectrum.len() / rows];
+    for_each_column_into(
+        spectrum,
+        rows,
+        lanes,
+        &mut nothing,
+        |kx, column, scratch, ()| f(kx, column, scratch),
+    );
+}
+
+/// [`for_each_column`] with one output per column: `f(kx, column, scratch, &mut out[kx])`.
+fn for_each_column_into<T, F>(
+    spectrum: &mut [Complex64],
+    rows: usize,
+    lanes: &mut [Lane],
+    out: &mut [T],
+    f: F,
+) where
+    T: Send,
+    F: Fn(usize, &mut [Complex64], &mut [Complex64], &mut T) + Sync,
+{
+    assert_eq!(out.len() * rows, spectrum.len(), "one output per column");
+    let chunk = per_lane(out.len(), lanes.len());
     spectrum
         .par_chunks_mut(chunk * rows)
+        .zip(out.par_chunks_mut(chunk))
         .enumerate()
         .zip(lanes.par_iter_mut())
-        .for_each(|((block_index, block), lane)| {
-            for (i, column) in block.chunks_exact_mut(rows).enumerate() {
-                f(block_index * chunk + i, column, &mut lane.scratch);
+        .for_each(|((block_index, (block, out)), lane)| {
+            for (i, (column, out)) in block.chunks_exact_mut(rows).zip(out).enumerate() {
+                f(block_index * chunk + i, column, &mut lane.scratch, out);
             }
         });
 }

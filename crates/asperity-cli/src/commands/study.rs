@@ -611,26 +611,13 @@ pub fn run(args: &StudyArgs) -> Result<()> {
 const ESTIMATE_FROM_N: usize = 256;
 
 /// Before a BEM study on grids from [`ESTIMATE_FROM_N`] on, its run time on this machine
-/// ([`crate::estimate::estimate_bem_seconds`]) for the samples not yet checkpointed in
+/// ([`crate::estimate::estimate_study`]) for the samples not yet checkpointed in
 /// `out`.
 fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
     if spec.sizes.iter().all(|&n| n < ESTIMATE_FROM_N) {
         return Ok(());
     }
-    let stored = crate::estimate::held_samples(out, spec);
-    let study = crate::estimate::BemStudy {
-        sizes: &spec.sizes,
-        samples: spec.samples,
-        hursts: &spec.hursts,
-        rolloff: spec.rolloff,
-        sweep_end: spec.sweep_end,
-        stored: &stored,
-    };
-    let estimate = crate::estimate::estimate_bem_seconds(
-        &study,
-        crate::estimate::probes_for(&spec.sizes, spec.sweep_end),
-    )?;
-    let stored: usize = stored.iter().map(|s| s.samples).sum();
+    let (estimate, stored) = crate::estimate::estimate_study(spec, out)?;
     eprintln!(
         "bem study: N = {:?}, {} H, {} samples each{}{}: estimated {} on this machine ({} lanes; \
          checkpointed: an interrupted run resumes with the same command)",

@@ -133,14 +133,18 @@ impl StudySpec {
             .iter()
             .flat_map(|&n| {
                 let points = n.saturating_mul(n);
-                std::iter::once(self.window)
-                    .chain(sensitivity::sensitivity_windows())
-                    .map(move |w| w.fraction_range(points).1)
+                self.fit_windows().map(move |w| w.fraction_range(points).1)
             })
             .fold(0.0, f64::max);
         let end = ALPHA_SWEEP_MARGIN * largest_end;
         self.sweep_end = (self.method == Method::Bem && end < 1.0).then_some(end);
         self
+    }
+
+    /// The windows the study's α may be fitted on: its own, and those of the sensitivity
+    /// table ([`sensitivity::sensitivity_windows`], refitted from its stored curves).
+    fn fit_windows(&self) -> impl Iterator<Item = FitWindow> {
+        std::iter::once(self.window).chain(sensitivity::sensitivity_windows())
     }
 
     /// Checks sizes, Hurst exponents, samples, roll-off and window.
@@ -341,8 +345,7 @@ fn check_sweep_reaches_windows(spec: &StudySpec, samples: &[SampleCurve]) -> Res
         return Ok(());
     };
     let refs: Vec<&SampleCurve> = samples.iter().collect();
-    let windows = std::iter::once(spec.window).chain(sensitivity::sensitivity_windows());
-    for window in windows {
+    for window in spec.fit_windows() {
         let Some((_, hi)) = curve::ensemble_window(&refs, &window) else {
             continue;
         };
@@ -582,9 +585,11 @@ impl StudyDir {
     /// made before α sweeps ended early, or with a full sweep), which `spec` would refuse
     /// as another study's, that whole-sweep study, so that the run resumes its checkpoints
     /// (its α are the same, bit for bit, at the cost of the loads past the windows). Never
-    /// the other way round: a whole sweep does not take an ended one's samples.
-    pub fn resumable(dir: &Path, spec: StudySpec) -> StudySpec {
-        if spec.sweep_end.is_none() || Self::check(dir, &spec, false).is_ok() {
+    /// the other way round: a whole sweep does not take an ended one's samples; and never
+    /// when `discard` (the caller discards another study's checkpoints, as in
+    /// [`StudyDir::check`]).
+    pub fn resumable(dir: &Path, spec: StudySpec, discard: bool) -> StudySpec {
+        if discard || spec.sweep_end.is_none() || Self::check(dir, &spec, false).is_ok() {
             return spec;
         }
         let whole = StudySpec {
@@ -1315,29 +1320,33 @@ mod tests {
         };
         // study.json alone: the folder is free, the ended sweep runs as asked.
         let store = StudyDir::open(dir.path(), &whole, false).unwrap();
-        assert_eq!(StudyDir::resumable(dir.path(), ended.clone()), ended);
+        assert_eq!(StudyDir::resumable(dir.path(), ended.clone(), false), ended);
         let one = vec![Synthetic.sample(&mut (), 1).unwrap()];
         store
             .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
             .unwrap();
-        assert_eq!(StudyDir::resumable(dir.path(), ended.clone()), whole);
+        assert_eq!(StudyDir::resumable(dir.path(), ended.clone(), false), whole);
+        assert_eq!(StudyDir::resumable(dir.path(), ended.clone(), true), ended);
         // The same with more samples (the study extended) ...
         let more = StudySpec {
             samples: 9,
             ..ended.clone()
         };
-        let resumed = StudyDir::resumable(dir.path(), more.clone());
+        let resumed = StudyDir::resumable(dir.path(), more.clone(), false);
         assert_eq!((resumed.sweep_end, resumed.samples), (None, 9));
         StudyDir::open(dir.path(), &resumed, false).unwrap();
         // ... but not with another seed, nor a whole sweep in an ended one's folder.
         let other = StudySpec { seed: 9, ..more };
-        assert_eq!(StudyDir::resumable(dir.path(), other.clone()), other);
+        assert_eq!(StudyDir::resumable(dir.path(), other.clone(), false), other);
         let ended_dir = tempfile::tempdir().unwrap();
         let store = StudyDir::open(ended_dir.path(), &ended, false).unwrap();
         store
             .save_in_progress(Task { n: 64, hurst: 0.5 }, &one)
             .unwrap();
-        assert_eq!(StudyDir::resumable(ended_dir.path(), whole.clone()), whole);
+        assert_eq!(
+            StudyDir::resumable(ended_dir.path(), whole.clone(), false),
+            whole
+        );
         assert!(StudyDir::open(ended_dir.path(), &whole, false).is_err());
     }
 

@@ -42,7 +42,7 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let bem =
         study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None).with_alpha_sweep();
     let bem = crate::studies::resumable(bem, &dir.join("bem"), discard, false);
-    announce("fig1", setting, dir, &[(&bem, None)])?;
+    announce("fig1", setting, dir, &[&bem])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let all: Vec<TaskResult> = mdr_results.iter().chain(&bem_results).cloned().collect();

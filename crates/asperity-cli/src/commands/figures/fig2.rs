@@ -17,7 +17,7 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let plan = setting.fig2()?;
     let (n, samples) = (plan.sizes[0], plan.samples);
     let spec = study_spec(Method::Bem, plan.sizes, plan.hursts, samples, Some(6.0));
-    announce("fig2", setting, dir, &[(&spec, Some(6.0))])?;
+    announce("fig2", setting, dir, &[&spec])?;
     let results = figure_study(dir, "bem", &spec, Kind::Curve, setting, discard)?;
     write_curves(dir, &results, force, "fig2", Some(setting.name()))?;
     let mut md = String::from(

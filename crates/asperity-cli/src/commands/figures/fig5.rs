@@ -90,7 +90,7 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
     let bem =
         study_spec(Method::Bem, plan.sizes, plan.hursts, plan.samples, None).with_alpha_sweep();
     let bem = crate::studies::resumable(bem, &dir.join("bem"), discard, false);
-    announce("fig5", setting, dir, &[(&bem, None)])?;
+    announce("fig5", setting, dir, &[&bem])?;
     let mdr_results = figure_study(dir, "mdr", &mdr, Kind::Alpha, setting, discard)?;
     let bem_results = figure_study(dir, "bem", &bem, Kind::Alpha, setting, discard)?;
     let rows = rows(&mdr_results, &bem_results);

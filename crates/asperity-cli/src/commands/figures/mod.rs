@@ -101,19 +101,13 @@ fn describe_hursts(hursts: &[f64]) -> String {
 
 /// States a figure's BEM studies before they start: grids, samples and, for the settings
 /// that take hours, the estimated run time measured on this machine
-/// ([`crate::estimate::estimate_bem_seconds`], at the probes of
-/// [`crate::estimate::probes_for`]: seconds to two minutes).
-fn announce(
-    figure: &str,
-    setting: Setting,
-    dir: &Path,
-    studies: &[(&StudySpec, Option<f64>)],
-) -> Result<()> {
+/// ([`crate::estimate::estimate_study`]: seconds to two minutes of probing).
+fn announce(figure: &str, setting: Setting, dir: &Path, studies: &[&StudySpec]) -> Result<()> {
     if setting == Setting::Quick {
         // Minutes: the report states the setting; stderr stays for errors.
         return Ok(());
     }
-    for (spec, rolloff) in studies {
+    for spec in studies {
         eprintln!(
             "{figure} ({} setting): BEM on N = {:?}, {} samples per (N, H), H = {}{}",
             setting.name(),
@@ -123,20 +117,7 @@ fn announce(
             crate::studies::describe_sweep(spec)
         );
         if matches!(setting, Setting::Medium | Setting::Paper) {
-            let stored = crate::estimate::held_samples(&dir.join("bem"), spec);
-            let study = crate::estimate::BemStudy {
-                sizes: &spec.sizes,
-                samples: spec.samples,
-                hursts: &spec.hursts,
-                rolloff: *rolloff,
-                sweep_end: spec.sweep_end,
-                stored: &stored,
-            };
-            let estimate = crate::estimate::estimate_bem_seconds(
-                &study,
-                crate::estimate::probes_for(&spec.sizes, spec.sweep_end),
-            )?;
-            let stored: usize = stored.iter().map(|s| s.samples).sum();
+            let (estimate, stored) = crate::estimate::estimate_study(spec, &dir.join("bem"))?;
             eprintln!(
                 "{figure}: estimated BEM time on this machine {}{} ({} lanes; \
                  checkpointed: an interrupted run resumes with the same command)",
