@@ -99,6 +99,7 @@ pub mod reference;
 pub mod spectrum;
 pub mod stop;
 pub mod study;
+mod sum;
 pub mod surface;
 pub mod topography;
 

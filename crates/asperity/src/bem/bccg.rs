@@ -59,6 +59,7 @@ use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
+use crate::sum::sum4;
 
 /// Grids of at least this many points extend the gradient over two rings around the free
 /// set before the preconditioner (`ring_extension.rs`), with the hybrid
@@ -416,24 +417,6 @@ fn direction_pass(
                 };
             }
         });
-}
-
-/// `Σ term(k)` over `k < len` with four accumulators (`k mod 4`), added as
-/// `(a₀ + a₁) + (a₂ + a₃)` and then the remainder in order: a fixed order (the same bits for
-/// any thread count) whose four chains of additions do not wait on each other, where one
-/// chain would wait an addition's latency per term.
-#[inline]
-pub(super) fn sum4(len: usize, term: impl Fn(usize) -> f64) -> f64 {
-    let whole = len / 4 * 4;
-    let mut acc = [0.0; 4];
-    for k in (0..whole).step_by(4) {
-        acc[0] += term(k);
-        acc[1] += term(k + 1);
-        acc[2] += term(k + 2);
-        acc[3] += term(k + 3);
-    }
-    let tail = (whole..len).map(term).fold(0.0, |a, b| a + b);
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// `Σ s·w`.

@@ -23,14 +23,17 @@
 //! ones wrap). The transpose gathers the preconditioned field back onto `F` along the same
 //! weights. Measured at 512²: the largest eigenvalue 11.9 → 5.5 with `γ = (0.7, 0.5)`.
 //!
-//! The extension and its transpose are each one sweep over the grid of a two-stage
-//! stencil (the first ring from the set, then the second ring from the first), both stages
-//! in one pass over blocks of rows with three rows of the first stage in flight; the
-//! rings' neighbour counts (one byte per point) are recounted only when the free set
-//! changes. Every point is written from its neighbours' values in a fixed order, so the
-//! results do not depend on the thread count. Cost (docs/bem.md): at 1024² about a fifth
-//! of an iteration; at 128² about what the rings save in iterations, which is why the BCCG
-//! uses them on large grids only. Nothing is allocated after [`RingExtension::new`].
+//! The rings are kept as lists, recounted only when the free set changes: per row, the
+//! columns of its first-ring points, of its second-ring points and of the set's edge (the
+//! points of the set with first-ring neighbours), with the rings' neighbour counts (one
+//! byte per point). The extension and its transpose then visit the listed points only (a
+//! quarter of the grid at 10 % contact), each in two parallel passes: values from the
+//! neighbours into a scratch field, then written in place; a second-ring value recomputes
+//! its first-ring neighbours' values rather than waiting for them. Every value is added
+//! from its neighbours in a fixed order (above, below, left, right), so the results do not
+//! depend on the thread count. Cost (docs/bem.md): at 512² and 10 % contact about a tenth
+//! of an iteration, a third of the whole-grid stencil sweeps it replaced. Nothing is
+//! allocated after [`RingExtension::new`].
 
 use rayon::prelude::*;
 
@@ -63,15 +66,38 @@ fn weight(ring: usize, count: u8) -> f64 {
     WEIGHTS[ring][usize::from(count & 7)]
 }
 
-/// Points per block of rows of the parallel sweeps (whole rows, at least one). Every
-/// sweep writes each point from its neighbours' values only: the blocks change no bit.
+/// Points per block of rows of the parallel passes (whole rows, at least one). Every
+/// pass writes each point from its neighbours' values only: the blocks change no bit.
 const BLOCK: usize = 8192;
 
 /// A `rows × cols` grid and whether it wraps around (periodic) or ends (free).
 type Grid = (usize, usize, bool);
 
-/// The rings' neighbour counts for the current free set, the grid they live on, and
-/// scratch.
+/// The lengths of a row's three lists, stored at the row's places in [`Listed::columns`].
+#[derive(Clone, Copy, Default)]
+struct RowLists {
+    first: usize,
+    second: usize,
+    edge: usize,
+}
+
+/// Points of the grid listed row by row (the rings and the edge of a set), and a value per
+/// listed point.
+struct Listed {
+    /// Per row, at the row's `cols` places: the columns of its first-ring points from the
+    /// front, of its edge points (on the set, with first-ring neighbours) from the back.
+    columns: Vec<u32>,
+    /// Per row, at the row's places: the columns of its second-ring points.
+    second_columns: Vec<u32>,
+    /// Per row, the lengths of its three lists.
+    rows: Vec<RowLists>,
+    /// A value per point of the list being updated, at its place.
+    values: Vec<f64>,
+    cols: usize,
+}
+
+/// The rings' neighbour counts and lists for the current free set, the grid they live on,
+/// and scratch.
 pub(super) struct RingExtension {
     /// Per point of the first ring (bounded points next to the set): its number of
     /// neighbours on the set; zero elsewhere.
@@ -79,14 +105,12 @@ pub(super) struct RingExtension {
     /// Per point of the second ring (bounded points next to the first ring only): its
     /// number of first-ring neighbours; zero elsewhere.
     second: Vec<u8>,
-    /// The free set the counts are for (they change only when it does).
+    /// The free set the counts and lists are for (they change only when it does).
     counted_for: Vec<bool>,
-    /// Per block of rows: three rows of a sweep's first stage and one of neighbour sums.
-    rolling: Vec<f64>,
-    /// The result of a sweep, swapped with the caller's field.
-    out: Vec<f64>,
+    /// The rings' points and the edge's, listed row by row.
+    listed: Listed,
     /// A row of zeros of each type: the rows outside a free grid.
-    zeros: (Vec<f64>, Vec<u8>, Vec<bool>),
+    zeros: (Vec<u8>, Vec<bool>),
     grid: Grid,
 }
 
@@ -120,21 +144,16 @@ fn rows_of<'a, T>(grid: Grid, field: &'a [T], zeros: &'a [T], i: usize) -> [&'a 
     ]
 }
 
-/// `out[j] = Σ f(a_m, b_m)` over the 4-neighbours `m` of point `j` of the middle row, from
-/// the rows above, at and below it of two fields `a` and `b` (`f(0, 0) = 0`: a row of
-/// zeros stands for one outside a free grid); periodic rows wrap, free ones end. Added in
-/// a fixed order: above, below, left, right.
+/// `out[j] = Σ f(a_m)` over the 4-neighbours `m` of point `j` of the middle row, from the
+/// rows above, at and below it of a field `a` (`f(0) = 0`: a row of zeros stands for one
+/// outside a free grid); periodic rows wrap, free ones end. Added in a fixed order: above,
+/// below, left, right.
 #[inline(always)]
-fn stencil<A: Copy, B: Copy, T: Copy + Default + std::ops::Add<Output = T>>(
-    periodic: bool,
-    (a, b): ([&[A]; 3], [&[B]; 3]),
-    f: impl Fn(A, B) -> T,
-    out: &mut [T],
-) {
+fn stencil<A: Copy>(periodic: bool, a: [&[A]; 3], f: impl Fn(A) -> u8, out: &mut [u8]) {
     let n = out.len();
-    let ([a0, a1, a2], [b0, b1, b2]) = (a.map(|r| &r[..n]), b.map(|r| &r[..n]));
-    let vertical = |j: usize| f(a0[j], b0[j]) + f(a2[j], b2[j]);
-    let side = |j: Option<usize>| j.map_or(T::default(), |j| f(a1[j], b1[j]));
+    let [a0, a1, a2] = a.map(|r| &r[..n]);
+    let vertical = |j: usize| f(a0[j]) + f(a2[j]);
+    let side = |j: Option<usize>| j.map_or(0, |j| f(a1[j]));
     let wrap = |j: usize| periodic.then_some(j);
     if n == 1 {
         out[0] = vertical(0) + side(wrap(0)) + side(wrap(0));
@@ -143,59 +162,55 @@ fn stencil<A: Copy, B: Copy, T: Copy + Default + std::ops::Add<Output = T>>(
     let last = n - 1;
     out[0] = vertical(0) + side(wrap(last)) + side(Some(1));
     for j in 1..last {
-        out[j] =
-            f(a0[j], b0[j]) + f(a2[j], b2[j]) + f(a1[j - 1], b1[j - 1]) + f(a1[j + 1], b1[j + 1]);
+        out[j] = f(a0[j]) + f(a2[j]) + f(a1[j - 1]) + f(a1[j + 1]);
     }
     out[last] = vertical(last) + side(Some(last - 1)) + side(wrap(0));
 }
 
-/// One sweep over the grid of a two-stage stencil: `stage_one(i, row)` writes row `i` of
-/// an intermediate field, `stage_two(i, (row, sums), out)` row `i` of the result from that
-/// field's row `i` and its neighbour sums. In parallel over blocks of rows; each block
-/// computes stage one for its rows and one either side, keeping three rows at a time
-/// (the intermediate field is never stored whole, and the grid is read once).
-fn sweep(
-    grid: Grid,
-    (rolling, out, zeros): (&mut [f64], &mut [f64], &[f64]),
-    stage_one: impl Fn(usize, &mut [f64]) + Sync,
-    stage_two: impl Fn(usize, (&[f64], &[f64]), &mut [f64]) + Sync,
-) {
-    let cols = grid.1;
-    let block_rows = (BLOCK / cols).max(1);
-    out.par_chunks_mut(block_rows * cols)
-        .zip(rolling.par_chunks_mut(4 * cols))
-        .enumerate()
-        .for_each(|(b, (out, rolling))| {
-            let (slots, sums) = rolling.split_at_mut(3 * cols);
-            let first_row = b * block_rows;
-            // Slots of the rows above, at and below the current one.
-            let mut slot = [0, 1, 2];
-            let rows = [row_above(grid, first_row), Some(first_row)];
-            for (&s, r) in slot.iter().zip(rows) {
-                if let Some(r) = r {
-                    stage_one(r, &mut slots[s * cols..][..cols]);
-                }
-            }
-            for (r, out) in out.chunks_mut(cols).enumerate() {
-                let i = first_row + r;
-                if r > 0 {
-                    slot.rotate_left(1);
-                }
-                let below = row_below(grid, i);
-                if let Some(r) = below {
-                    stage_one(r, &mut slots[slot[2] * cols..][..cols]);
-                }
-                let row = |s: usize| &slots[s * cols..][..cols];
-                let present = |r: Option<usize>, s: usize| r.map_or(zeros, |_| row(s));
-                let rows = [
-                    present(row_above(grid, i), slot[0]),
-                    row(slot[1]),
-                    present(below, slot[2]),
-                ];
-                stencil(grid.2, (rows, rows), |v, _| v, sums);
-                stage_two(i, (row(slot[1]), sums), out);
-            }
-        });
+/// `Σ f(m)` over the indices `m` of the 4-neighbours of point `(i, j)`, added in a fixed
+/// order: above, below, left, right (periodic grids wrap, free ones end).
+#[inline(always)]
+fn around(grid: Grid, (i, j): (usize, usize), f: impl Fn(usize) -> f64) -> f64 {
+    let (rows, cols, periodic) = grid;
+    let k = i * cols + j;
+    if 0 < i && i + 1 < rows && 0 < j && j + 1 < cols {
+        // Inside the grid (nearly every point): no wrapping, no ends.
+        return f(k - cols) + f(k + cols) + f(k - 1) + f(k + 1);
+    }
+    let left = match j {
+        0 => periodic.then(|| k + cols - 1),
+        _ => Some(k - 1),
+    };
+    let right = match j + 1 == cols {
+        true => periodic.then(|| k + 1 - cols),
+        false => Some(k + 1),
+    };
+    let vertical = [row_above(grid, i), row_below(grid, i)].map(|r| r.map(|r| r * cols + j));
+    vertical
+        .into_iter()
+        .chain([left, right])
+        .flatten()
+        .fold(0.0, |sum, m| sum + f(m))
+}
+
+/// One of a row's three lists.
+#[derive(Clone, Copy)]
+enum List {
+    FirstRing,
+    SecondRing,
+    Edge,
+}
+
+impl RowLists {
+    /// The places of `list` in the row's segment of `cols` places (of
+    /// [`Listed::second_columns`] for the second ring, else of [`Listed::columns`]).
+    fn places(&self, list: List, cols: usize) -> std::ops::Range<usize> {
+        match list {
+            List::FirstRing => 0..self.first,
+            List::SecondRing => 0..self.second,
+            List::Edge => cols - self.edge..cols,
+        }
+    }
 }
 
 impl RingExtension {
@@ -207,114 +222,176 @@ impl RingExtension {
 
     /// The fields for a `rows × cols` grid (periodic or free boundaries).
     pub(super) fn new(rows: usize, cols: usize, periodic: bool) -> Self {
-        let blocks = rows.div_ceil((BLOCK / cols).max(1));
+        let len = rows * cols;
+        assert!(
+            u32::try_from(cols).is_ok(),
+            "a row's columns are listed as u32"
+        );
         RingExtension {
-            first: vec![0; rows * cols],
-            second: vec![0; rows * cols],
-            counted_for: vec![false; rows * cols],
-            rolling: vec![0.0; blocks * 4 * cols],
-            out: vec![0.0; rows * cols],
-            zeros: (vec![0.0; cols], vec![0; cols], vec![false; cols]),
+            first: vec![0; len],
+            second: vec![0; len],
+            counted_for: vec![false; len],
+            listed: Listed {
+                columns: vec![0; len],
+                second_columns: vec![0; len],
+                rows: vec![RowLists::default(); rows],
+                values: vec![0.0; len],
+                cols,
+            },
+            zeros: (vec![0; cols], vec![false; cols]),
             grid: (rows, cols, periodic),
         }
     }
 
-    /// Counts the rings' neighbours for `free` unless they are counted already (two
-    /// passes over one byte per point).
+    /// Counts the rings' neighbours and lists the rings and the edge for `free` unless
+    /// they are for it already (two passes over one byte per point).
     fn count(&mut self, free: &[bool]) {
         if self.counted_for[..] == *free {
             return;
         }
         let (grid, cols) = (self.grid, self.grid.1);
-        let (zeros, falses) = (&self.zeros.1[..], &self.zeros.2[..]);
+        let (zeros, falses) = (&self.zeros.0[..], &self.zeros.1[..]);
         // The first ring: bounded points with neighbours on the set.
         for_rows(grid, &mut self.first, |i, row| {
             let rows = rows_of(grid, free, falses, i);
-            stencil(grid.2, (rows, rows), |f, _| u8::from(f), row);
+            stencil(grid.2, rows, u8::from, row);
             let own = &free[i * cols..][..cols];
             row.iter_mut()
                 .zip(own)
                 .for_each(|(c, &f)| *c *= u8::from(!f));
         });
-        // The second ring: bounded points off the first ring with first-ring neighbours.
+        // Per row: first-ring neighbours of every point, kept as the second ring's counts
+        // off the set and the first ring, and the row's lists.
         let first = &self.first;
-        for_rows(grid, &mut self.second, |i, row| {
-            let rows = rows_of(grid, first, zeros, i);
-            stencil(grid.2, (rows, rows), |c, _| u8::from(c > 0), row);
-            let own = free[i * cols..][..cols]
-                .iter()
-                .zip(&first[i * cols..][..cols]);
-            let inner = |(&f, &c): (&bool, &u8)| f || c > 0;
-            row.iter_mut()
-                .zip(own)
-                .for_each(|(c, own)| *c *= u8::from(!inner(own)));
-        });
+        self.second
+            .par_chunks_mut(cols)
+            .zip(self.listed.columns.par_chunks_mut(cols))
+            .zip(self.listed.second_columns.par_chunks_mut(cols))
+            .zip(self.listed.rows.par_iter_mut())
+            .enumerate()
+            .with_min_len((BLOCK / cols).max(1))
+            .for_each(|(i, (((second, columns), second_columns), lists))| {
+                let rows = rows_of(grid, first, zeros, i);
+                stencil(grid.2, rows, |c| u8::from(c > 0), second);
+                let (free, first) = (&free[i * cols..][..cols], &first[i * cols..][..cols]);
+                let columns = (columns, second_columns);
+                *lists = list_row((free, first, &*second), columns);
+                second
+                    .iter_mut()
+                    .zip(free.iter().zip(first))
+                    .for_each(|(c, (&f, &r))| *c *= u8::from(!f && r == 0));
+            });
         self.counted_for.copy_from_slice(free);
     }
 
     /// `z ← (I + E) z` for the free set `free`: `z`, zero off the set, keeps its values
-    /// there and gets the extension on the two rings (one sweep, two more passes where the
-    /// set changed).
-    pub(super) fn extend(&mut self, free: &[bool], z: &mut Vec<f64>) {
+    /// there and gets the extension on the two rings (two updates of listed points, two
+    /// passes over the grid's bytes where the set changed).
+    pub(super) fn extend(&mut self, free: &[bool], z: &mut [f64]) {
         self.count(free);
         let (grid, cols) = (self.grid, self.grid.1);
-        let (first, second, zr, zeros) = (&self.first, &self.second, &z[..], &self.zeros.0[..]);
-        // Stage one, the first ring: γ₁/c times the sum of its c neighbours on the set.
-        let first_ring = |i: usize, row: &mut [f64]| {
-            let rows = rows_of(grid, zr, zeros, i);
-            stencil(grid.2, (rows, rows), |z, _| z, row);
-            let own = &first[i * cols..][..cols];
-            row.iter_mut()
-                .zip(own)
-                .for_each(|(v, &c)| *v *= weight(0, c));
-        };
-        // Stage two: z on the set, the first ring, and on the second ring γ₂/c times the
-        // sum of its c first-ring neighbours.
-        let both_rings = |i: usize, (ring, sums): (&[f64], &[f64]), out: &mut [f64]| {
-            let own = (&free[i * cols..][..cols], &second[i * cols..][..cols]);
-            let own = own.0.iter().zip(own.1).zip(&zr[i * cols..][..cols]);
-            let rings = ring.iter().zip(sums);
-            for ((o, (v, s)), ((&f, &c), &z)) in out.iter_mut().zip(rings).zip(own) {
-                *o = if f { z } else { v + weight(1, c) * s };
-            }
-        };
-        let fields = (&mut self.rolling[..], &mut self.out[..], zeros);
-        sweep(grid, fields, first_ring, both_rings);
-        std::mem::swap(z, &mut self.out);
+        let (first, second) = (&self.first, &self.second);
+        // The first ring: γ₁/c times the sum of its c neighbours on the set (z is zero off
+        // it, and on the rings until they are written).
+        self.listed.update(z, List::FirstRing, |(i, j), z| {
+            weight(0, first[i * cols + j]) * around(grid, (i, j), |m| z[m])
+        });
+        // The second ring: γ₂/c times the sum of its c first-ring neighbours (it has no
+        // neighbours on the set).
+        self.listed.update(z, List::SecondRing, |(i, j), z| {
+            weight(1, second[i * cols + j]) * around(grid, (i, j), |m| z[m])
+        });
     }
 
     /// `z ← (I + E)ᵀ z` on the free set `free` of the last [`RingExtension::extend`]: there
     /// `z` plus what the rings took from each point. Off the set `z` is left unspecified
-    /// (its callers read it on the set only, `P_F`). One sweep.
-    pub(super) fn gather(&mut self, free: &[bool], z: &mut Vec<f64>) {
+    /// (its callers read it on the set only, `P_F`). Two updates of listed points.
+    pub(super) fn gather(&mut self, free: &[bool], z: &mut [f64]) {
+        debug_assert!(self.counted_for[..] == *free, "gather follows extend");
         let (grid, cols) = (self.grid, self.grid.1);
-        let (first, second, zr) = (&self.first, &self.second, &z[..]);
-        let (zeros, counts) = (&self.zeros.0[..], &self.zeros.1[..]);
-        // Stage one: the second ring gives to the first, which holds γ₁/c (z + what it got).
-        let first_ring = |i: usize, row: &mut [f64]| {
-            let rows = (
-                rows_of(grid, second, counts, i),
-                rows_of(grid, zr, zeros, i),
-            );
-            stencil(grid.2, rows, |c, z| weight(1, c) * z, row);
-            let own = first[i * cols..][..cols]
-                .iter()
-                .zip(&zr[i * cols..][..cols]);
-            row.iter_mut()
-                .zip(own)
-                .for_each(|(v, (&c, z))| *v = weight(0, c) * (z + *v));
-        };
-        // Stage two: the first ring gives to the set.
-        let to_set = |i: usize, (_, sums): (&[f64], &[f64]), out: &mut [f64]| {
-            let own = free[i * cols..][..cols].iter().zip(&zr[i * cols..][..cols]);
-            for ((o, s), (&f, z)) in out.iter_mut().zip(sums).zip(own) {
-                *o = if f { z + s } else { *z };
-            }
-        };
-        let fields = (&mut self.rolling[..], &mut self.out[..], zeros);
-        sweep(grid, fields, first_ring, to_set);
-        std::mem::swap(z, &mut self.out);
+        let (first, second) = (&self.first, &self.second);
+        // A first-ring point holds γ₁/c times its value and what its second-ring
+        // neighbours took (γ₂/c′ each; the weight is zero off the second ring) …
+        self.listed.update(z, List::FirstRing, |(i, j), z| {
+            let taken = around(grid, (i, j), |m| weight(1, second[m]) * z[m]);
+            weight(0, first[i * cols + j]) * (z[i * cols + j] + taken)
+        });
+        // … and gives it to its neighbours on the set.
+        self.listed.update(z, List::Edge, |(i, j), z| {
+            let ring = |m: usize| if first[m] > 0 { z[m] } else { 0.0 };
+            z[i * cols + j] + around(grid, (i, j), ring)
+        });
     }
+}
+
+impl Listed {
+    /// `z[k] ← value((i, j), z)` at the points `k = (i, j)` of `list`, every value from
+    /// `z` as it was before: all values first (into `values`), then written, each in
+    /// parallel over blocks of rows.
+    fn update(
+        &mut self,
+        z: &mut [f64],
+        list: List,
+        value: impl Fn((usize, usize), &[f64]) -> f64 + Sync,
+    ) {
+        let cols = self.cols;
+        let rows_per_task = (BLOCK / cols).max(1);
+        let columns = match list {
+            List::SecondRing => &self.second_columns[..],
+            List::FirstRing | List::Edge => &self.columns[..],
+        };
+        let (lists, before) = (&self.rows[..], &*z);
+        self.values
+            .par_chunks_mut(cols)
+            .zip(columns.par_chunks(cols))
+            .zip(lists.par_iter())
+            .enumerate()
+            .with_min_len(rows_per_task)
+            .for_each(|(i, ((values, columns), lists))| {
+                let places = lists.places(list, cols);
+                for (&j, v) in columns[places.clone()].iter().zip(&mut values[places]) {
+                    *v = value((i, j as usize), before);
+                }
+            });
+        z.par_chunks_mut(cols)
+            .zip(self.values.par_chunks(cols))
+            .zip(columns.par_chunks(cols))
+            .zip(lists.par_iter())
+            .with_min_len(rows_per_task)
+            .for_each(|(((z, values), columns), lists)| {
+                let places = lists.places(list, cols);
+                for (&j, &v) in columns[places.clone()].iter().zip(&values[places]) {
+                    z[j as usize] = v;
+                }
+            });
+    }
+}
+
+/// Lists a row's first-ring points (from the front of `columns.0`), its edge points (from
+/// the back) and its second-ring points (in `columns.1`) from its free set, its first-ring
+/// counts and the number of first-ring neighbours of each point, `near`.
+fn list_row(
+    (free, first, near): (&[bool], &[u8], &[u8]),
+    (columns, second_columns): (&mut [u32], &mut [u32]),
+) -> RowLists {
+    let n = free.len();
+    let mut lists = RowLists::default();
+    // Every point is written to the next place of each list and kept where it belongs: no
+    // branch on the set, which would be mispredicted at every edge. The places do not
+    // collide: point j is written after at most j points were kept, so the first ring
+    // (ending at `first`) and the edge (from `n − edge`) leave its places apart, and
+    // the last point written where both meet is the one kept there.
+    for j in 0..n {
+        let on_first = first[j] > 0;
+        let near_first = near[j] > 0;
+        columns[lists.first] = j as u32;
+        columns[n - 1 - lists.edge] = j as u32;
+        second_columns[lists.second] = j as u32;
+        lists.first += usize::from(on_first);
+        lists.edge += usize::from(free[j] && near_first);
+        lists.second += usize::from(!free[j] && !on_first && near_first);
+    }
+    lists
 }
 
 /// Runs `pass(i, row)` on every row `i` of `field`, in parallel over blocks of rows.
@@ -373,16 +450,17 @@ mod tests {
     #[test]
     fn extend_follows_the_definition_and_gather_is_its_transpose() {
         // Odd, even and rectangular grids, free and periodic, sparse sets (isolated points,
-        // which have a second ring) and dense ones; the extension is checked against the
+        // which have a second ring) and dense ones (rows whose every point is listed, where
+        // the first ring's list meets the edge's); the extension is checked against the
         // definition written out with coordinates, and ⟨(I + E) z, y⟩ = ⟨z, (I + E)ᵀ y⟩ on
-        // the set (so that (I + E)ᵀ M (I + E) is symmetric). Twice per grid, so that the
-        // second extension overwrites the first one's fields.
+        // the set (so that (I + E)ᵀ M (I + E) is symmetric). Thrice per grid, so that each
+        // extension overwrites the last one's fields.
         for (rows, cols) in [(31, 31), (32, 32), (50, 72), (700, 13)] {
             for periodic in [false, true] {
                 let grid = (rows, cols, periodic);
                 let mut rings = RingExtension::new(rows, cols, periodic);
                 let mut state = 7u64;
-                for fill in [0.05, 0.6] {
+                for fill in [0.05, 0.6, 0.95] {
                     let (free, z, y) = case(rows * cols, fill, &mut state);
                     let mut extended = z.clone();
                     rings.extend(&free, &mut extended);

@@ -37,7 +37,7 @@
 //! ([`ContactSolver::predict_from_tangent`], a continuation predictor), which is the next
 //! state exactly as long as the set does not change.
 
-use super::bccg::{sum4, RING_MIN_POINTS};
+use super::bccg::RING_MIN_POINTS;
 use super::full_contact::FullContactThreshold;
 use super::preconditioner::FourierPreconditioner;
 use super::ring_extension::RingExtension;
@@ -45,6 +45,7 @@ use super::solver::{ContactSolver, Target};
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
 use crate::stop::Stop;
+use crate::sum::sum4;
 use crate::Error;
 
 /// Right-hand side of a CG on a set.

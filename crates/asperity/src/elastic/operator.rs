@@ -36,6 +36,7 @@ use num_complex::Complex64;
 
 use super::love::{love_pixel_displacement, rectangle_self_influence, self_influence};
 use crate::fft::RealFft2;
+use crate::sum::sum4;
 use crate::{memory, Error, Result};
 
 /// Boundary conditions of the half-space grid.
@@ -327,8 +328,11 @@ impl ElasticOperator {
             |kx, column| {
                 let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
                 let (low, high) = column.split_at(kernel_rows);
-                let pairs = with_even_kernel((low.iter(), high.iter()), k);
-                let sum: f64 = pairs.map(|(v, k)| k * v.norm_sqr()).sum();
+                // `high` read backwards meets the kernel from `ky = 1` (`with_even_kernel`);
+                // four chains of additions, not one.
+                let last = high.len().wrapping_sub(1);
+                let sum = sum4(low.len(), |m| k[m] * low[m].norm_sqr())
+                    + sum4(high.len(), |m| k[m + 1] * high[last - m].norm_sqr());
                 let mirrored = kx != 0 && 2 * kx != pcols;
                 sum * if mirrored { 2.0 } else { 1.0 }
             },
