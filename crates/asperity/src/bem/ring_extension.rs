@@ -107,6 +107,8 @@ pub(super) struct RingExtension {
     second: Vec<u8>,
     /// The free set the counts and lists are for (they change only when it does).
     counted_for: Vec<bool>,
+    /// Per row: whether the free set changed there since the last count.
+    changed: Vec<bool>,
     /// The rings' points and the edge's, listed row by row.
     listed: Listed,
     /// A row of zeros of each type: the rows outside a free grid.
@@ -165,6 +167,16 @@ fn stencil<A: Copy>(periodic: bool, a: [&[A]; 3], f: impl Fn(A) -> u8, out: &mut
         out[j] = f(a0[j]) + f(a2[j]) + f(a1[j - 1]) + f(a1[j + 1]);
     }
     out[last] = vertical(last) + side(Some(last - 1)) + side(wrap(0));
+}
+
+/// Whether `test(r)` holds for a row `r` within `reach` rows of row `i` (periodic grids
+/// wrap, free ones end).
+fn within((rows, _, periodic): Grid, i: usize, reach: usize, test: impl Fn(usize) -> bool) -> bool {
+    match periodic {
+        true if 2 * reach + 1 >= rows => (0..rows).any(test),
+        true => (rows + i - reach..=rows + i + reach).any(|r| test(r % rows)),
+        false => (i.saturating_sub(reach)..=(i + reach).min(rows - 1)).any(test),
+    }
 }
 
 /// `Σ f(m)` over the indices `m` of the 4-neighbours of point `(i, j)`, added in a fixed
@@ -231,6 +243,7 @@ impl RingExtension {
             first: vec![0; len],
             second: vec![0; len],
             counted_for: vec![false; len],
+            changed: vec![false; rows],
             listed: Listed {
                 columns: vec![0; len],
                 second_columns: vec![0; len],
@@ -246,13 +259,28 @@ impl RingExtension {
     /// Counts the rings' neighbours and lists the rings and the edge for `free` unless
     /// they are for it already (two passes over one byte per point).
     fn count(&mut self, free: &[bool]) {
-        if self.counted_for[..] == *free {
+        let (grid, cols) = (self.grid, self.grid.1);
+        // A row's counts and lists depend on the set two rows either side: only rows near
+        // a change are recounted (late in a solve the set changes at a few points).
+        let counted_for = &self.counted_for;
+        self.changed
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, changed)| {
+                let row = i * cols..(i + 1) * cols;
+                *changed = free[row.clone()] != counted_for[row];
+            });
+        if !self.changed.contains(&true) {
             return;
         }
-        let (grid, cols) = (self.grid, self.grid.1);
+        let changed = &self.changed;
+        let near_change = |i: usize, reach: usize| within(grid, i, reach, |r| changed[r]);
         let (zeros, falses) = (&self.zeros.0[..], &self.zeros.1[..]);
         // The first ring: bounded points with neighbours on the set.
         for_rows(grid, &mut self.first, |i, row| {
+            if !near_change(i, 1) {
+                return;
+            }
             let rows = rows_of(grid, free, falses, i);
             stencil(grid.2, rows, u8::from, row);
             let own = &free[i * cols..][..cols];
@@ -271,6 +299,9 @@ impl RingExtension {
             .enumerate()
             .with_min_len((BLOCK / cols).max(1))
             .for_each(|(i, (((second, columns), second_columns), lists))| {
+                if !near_change(i, 2) {
+                    return;
+                }
                 let rows = rows_of(grid, first, zeros, i);
                 stencil(grid.2, rows, |c| u8::from(c > 0), second);
                 let (free, first) = (&free[i * cols..][..cols], &first[i * cols..][..cols]);
@@ -445,6 +476,47 @@ mod tests {
             .collect();
         let y = (0..len).map(|_| random(state)).collect();
         (free, z, y)
+    }
+
+    #[test]
+    fn a_recount_after_a_few_changes_is_a_fresh_count() {
+        // The counts and lists of the rows near a change are recounted, the others kept:
+        // after changes at a few points (in the first and last rows too, where periodic
+        // grids wrap), the extension and its transpose are those of a fresh count, bit for
+        // bit.
+        for (rows, cols) in [(31, 31), (50, 72), (7, 13)] {
+            for periodic in [false, true] {
+                let mut kept = RingExtension::new(rows, cols, periodic);
+                let mut state = 11u64;
+                let (mut free, z, y) = case(rows * cols, 0.3, &mut state);
+                let mut scratch = z.clone();
+                kept.extend(&free, &mut scratch);
+                for k in [
+                    0,
+                    cols + 3,
+                    rows * cols / 2,
+                    rows * cols - 1,
+                    (rows - 1) * cols,
+                ] {
+                    free[k] = !free[k];
+                    let on_set = |v: &[f64]| -> Vec<f64> {
+                        v.iter()
+                            .zip(&free)
+                            .map(|(&x, &f)| if f { x } else { 0.0 })
+                            .collect()
+                    };
+                    let mut fresh = RingExtension::new(rows, cols, periodic);
+                    let results = [&mut kept, &mut fresh].map(|rings| {
+                        let mut extended = on_set(&z);
+                        rings.extend(&free, &mut extended);
+                        let mut gathered = y.clone();
+                        rings.gather(&free, &mut gathered);
+                        (extended, on_set(&gathered))
+                    });
+                    assert!(results[0] == results[1], "{rows}x{cols} {periodic} at {k}");
+                }
+            }
+        }
     }
 
     #[test]
