@@ -218,9 +218,27 @@ impl RealFft2 {
     ) where
         F: Fn(usize, &mut [Complex64]) + Sync,
     {
+        self.convolve_prepared(input, spectrum, output, filter, |_, _| {});
+    }
+
+    /// [`RealFft2::convolve`] of the input as changed row by row by `prepare(i, row)` (row
+    /// `i` of the data block, `data_cols` values) on its way into the row transforms: for
+    /// inputs that are a cheap function of a stored field, which then need not be
+    /// written whole.
+    pub fn convolve_prepared<F, P>(
+        &mut self,
+        input: &[f64],
+        spectrum: &mut [Complex64],
+        output: &mut [f64],
+        filter: F,
+        prepare: P,
+    ) where
+        F: Fn(usize, &mut [Complex64]) + Sync,
+        P: Fn(usize, &mut [f64]) + Sync,
+    {
         self.check_lengths(input, spectrum);
         self.check_lengths(output, spectrum);
-        self.forward_rows(input);
+        self.forward_rows(input, prepare);
         self.filter_columns(spectrum, filter);
         self.inverse_rows(output);
     }
@@ -231,7 +249,7 @@ impl RealFft2 {
         F: Fn(usize, &mut [Complex64]) + Sync,
     {
         self.check_lengths(data, spectrum);
-        self.forward_rows(data);
+        self.forward_rows(data, |_, _| {});
         self.filter_columns(spectrum, filter);
         self.inverse_rows(data);
     }
@@ -340,7 +358,7 @@ impl RealFft2 {
     /// The row pass of a forward transform of `input`, its half spectra transposed into
     /// the columns of `spectrum` (zeros below the data rows), ready for the column pass.
     fn rows_into_columns(&mut self, input: &[f64], spectrum: &mut [Complex64]) {
-        self.forward_rows(input);
+        self.forward_rows(input, |_, _| {});
         transpose_into_columns(
             &self.work,
             spectrum,
@@ -350,20 +368,23 @@ impl RealFft2 {
         );
     }
 
-    /// Real transforms of the `data_rows` input rows (zero-extended to `cols`) into `work`.
-    fn forward_rows(&mut self, input: &[f64]) {
+    /// Real transforms of the `data_rows` input rows, each changed by `prepare(i, row)` and
+    /// zero-extended to `cols`, into `work`.
+    fn forward_rows(&mut self, input: &[f64], prepare: impl Fn(usize, &mut [f64]) + Sync) {
         let (data_cols, half) = (self.data_cols, self.half_cols());
         let chunk = per_lane(self.data_rows, self.lanes.len());
         let r2c = &self.r2c;
         input
             .par_chunks(chunk * data_cols)
             .zip(self.work.par_chunks_mut(chunk * half))
+            .enumerate()
             .zip(self.lanes.par_iter_mut())
-            .for_each(|((inp, out), lane)| {
-                for (row_in, row_out) in inp.chunks_exact(data_cols).zip(out.chunks_exact_mut(half))
-                {
+            .for_each(|((block, (inp, out)), lane)| {
+                let rows = inp.chunks_exact(data_cols).zip(out.chunks_exact_mut(half));
+                for (r, (row_in, row_out)) in rows.enumerate() {
                     // The transform uses its input as scratch: refill the zeros every row.
                     lane.real[..data_cols].copy_from_slice(row_in);
+                    prepare(block * chunk + r, &mut lane.real[..data_cols]);
                     lane.real[data_cols..].fill(0.0);
                     r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
                         .expect("buffer sizes are fixed at planning");
@@ -660,6 +681,39 @@ mod tests {
                     assert!((a - b).abs() < 1e-14, "{rows}x{cols} ({r},{c}): {a} vs {b}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn convolve_prepared_convolves_the_prepared_rows() {
+        // Preparing row i by adding i·j to value j is the convolution of the field with
+        // those additions, bit for bit, on plain and padded grids whose rows do not divide
+        // evenly among the lanes.
+        for (data_rows, data_cols, rows, cols) in [(7, 5, 7, 5), (5, 7, 10, 14), (3, 4, 6, 8)] {
+            let data = pseudo_random(data_rows * data_cols);
+            let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
+            let mut spec = vec![Complex64::default(); fft.spectrum_len()];
+            let filter = |kx: usize, column: &mut [Complex64]| {
+                column.iter_mut().for_each(|v| *v *= 1.0 / (1 + kx) as f64);
+            };
+            let added = |i: usize, j: usize| (i * j) as f64;
+            let mut prepared = vec![f64::NAN; data.len()];
+            let prepare = |i: usize, row: &mut [f64]| {
+                row.iter_mut()
+                    .enumerate()
+                    .for_each(|(j, v)| *v += added(i, j));
+            };
+            fft.convolve_prepared(&data, &mut spec, &mut prepared, filter, prepare);
+            let changed: Vec<f64> = (0..data.len())
+                .map(|k| data[k] + added(k / data_cols, k % data_cols))
+                .collect();
+            let mut plain = vec![f64::NAN; data.len()];
+            fft.convolve(&changed, &mut spec, &mut plain, filter);
+            assert_eq!(prepared, plain, "{data_rows}x{data_cols} in {rows}x{cols}");
+            assert_ne!(prepared, {
+                fft.convolve(&data, &mut spec, &mut plain, filter);
+                plain
+            });
         }
     }
 

@@ -116,15 +116,20 @@ pub(super) struct BccgScratch {
     pub(super) direction: Vec<f64>,
     /// `w = K s`.
     pub(super) response: Vec<f64>,
-    /// `z = Π P_F M P_F Π g` (the preconditioner works in place here).
+    /// `z = Π P_F M P_F Π g`.
     pub(super) preconditioned: Vec<f64>,
-    /// `Π g` on the free set, zero elsewhere.
+    /// `g` on the free set (not centred: `Π g` is `g` minus [`Gradient::centre`] there),
+    /// zero elsewhere; with the rings, their extension of `Π g` on them once extended.
     pub(super) gradient: Vec<f64>,
-    /// `Π g` of the previous iteration on its free set, zero elsewhere (for the
-    /// Polak–Ribière `β`).
+    /// The gradient field of the previous iteration (for the Polak–Ribière `β`; read on its
+    /// free set only).
     pub(super) previous_gradient: Vec<f64>,
     /// The free set `F` of the current iteration.
     pub(super) free: Vec<bool>,
+    /// The free set of the previous iteration.
+    previous_free: Vec<bool>,
+    /// What the previous gradient field lacks of `Π g` on its free set (subtracted).
+    previous_centre: f64,
     /// `K e_00`, the displacement under a unit pressure on pixel `(0, 0)`.
     pub(super) impulse: Vec<f64>,
     /// `(index, correction)` of the pressures cut in a step (capacity [`CUT_LIMIT`]).
@@ -188,6 +193,8 @@ impl BccgScratch {
             gradient: vec![0.0; len],
             previous_gradient: vec![0.0; len],
             free: vec![false; len],
+            previous_free: vec![false; len],
+            previous_centre: 0.0,
             impulse,
             cuts: Vec::with_capacity(CUT_LIMIT),
             chunk_cuts: vec![(0, 0.0); chunks * CUT_LIMIT],
@@ -248,6 +255,12 @@ struct Gradient {
     contact_points: usize,
     /// The residual of the module docs.
     residual: f64,
+    /// The mean `Π` removes from `g` on the free set before the preconditioner (zero for
+    /// free-boundary displacement control).
+    centre: f64,
+    /// The mean the gradient field lacks of `Π g` on the free set: the centre, but under
+    /// periodic displacement control, where the gradient keeps its mean (zero).
+    gradient_centre: f64,
 }
 
 /// What the direction passes found.
@@ -309,16 +322,17 @@ fn contact_mean(
         }
 }
 
-/// Writes `g = u + f − d` on the free set (zero elsewhere) into `z` and the free set into
-/// `free`; sums `x[0] = Σ_{p>0} g²`, `x[1] = Σ_{p=0, g<0} g²`, `x[2] = Σ_F g`,
+/// Writes `g = u + f − d` on the free set (zero elsewhere) into `gradient` and the free
+/// set into `free`; sums `x[0] = Σ_{p>0} g²`, `x[1] = Σ_{p=0, g<0} g²`, `x[2] = Σ_F g`,
 /// `n[0] = |{p > 0}|`, `n[1] = |F|`.
 fn gap_pass(
     (u, f, p): (&[f64], &[f64], &[f64]),
     d: f64,
-    (z, free): (&mut [f64], &mut [bool]),
+    (gradient, free): (&mut [f64], &mut [bool]),
     partials: &mut [Sums],
 ) -> Sums {
-    z.par_chunks_mut(CHUNK)
+    gradient
+        .par_chunks_mut(CHUNK)
         .zip(free.par_chunks_mut(CHUNK))
         .zip(u.par_chunks(CHUNK))
         .zip(f.par_chunks(CHUNK).zip(p.par_chunks(CHUNK)))
@@ -348,40 +362,28 @@ fn gap_pass(
     Sums::total(partials)
 }
 
-/// `z ← z − centre` on the free set and `gradient ← z + restore` (zero off the set;
-/// `restore` is `centre` where the gradient keeps its mean, else 0).
-fn centre_pass(z: &mut [f64], gradient: &mut [f64], free: &[bool], (centre, restore): (f64, f64)) {
-    z.par_chunks_mut(CHUNK)
-        .zip(gradient.par_chunks_mut(CHUNK))
-        .zip(free.par_chunks(CHUNK))
-        .for_each(|((z, gradient), free)| {
-            for ((zi, gi), &fr) in z.iter_mut().zip(gradient.iter_mut()).zip(free) {
-                if fr {
-                    *zi -= centre;
-                    *gi = *zi + restore;
-                } else {
-                    *gi = *zi;
-                }
-            }
-        });
-}
-
 /// Sums on the free set for the new direction: `x = [Σz, Σz·Πg, Σs, Σs·Πg, ΣΠg, Σz·g_old,
-/// Σg_old]` (`s` the old direction).
+/// Σg_old]` (`s` the old direction, `g_old` the old `Π g` on the old free set, zero off
+/// it), the gradient fields `g − centre` and `g_old − old centre` on their sets.
 fn direction_sums(
     (z, gradient, old): (&[f64], &[f64], &[f64]),
-    (s, free): (&[f64], &[bool]),
+    (s, free, old_free): (&[f64], &[bool], &[bool]),
+    (centre, old_centre): (f64, f64),
     partials: &mut [Sums],
 ) -> Sums {
     z.par_chunks(CHUNK)
         .zip(gradient.par_chunks(CHUNK))
-        .zip(old.par_chunks(CHUNK))
+        .zip(old.par_chunks(CHUNK).zip(old_free.par_chunks(CHUNK)))
         .zip(s.par_chunks(CHUNK).zip(free.par_chunks(CHUNK)))
         .zip(partials.par_iter_mut())
-        .for_each(|((((z, g), old), (s, free)), out)| {
+        .for_each(|((((z, g), (old, old_free)), (s, free)), out)| {
             let mut a = [0.0; 7];
-            for ((((&zi, &gi), &oi), &si), &fr) in z.iter().zip(g).zip(old).zip(s).zip(free) {
+            let old = old.iter().zip(old_free);
+            for ((((&zi, &gi), (&oi, &was)), &si), &fr) in z.iter().zip(g).zip(old).zip(s).zip(free)
+            {
                 if fr {
+                    let gi = gi - centre;
+                    let oi = if was { oi - old_centre } else { 0.0 };
                     a[0] += zi;
                     a[1] += zi * gi;
                     a[2] += si;
@@ -581,7 +583,7 @@ impl ContactSolver {
         let sums = gap_pass(
             (&self.state.gap, &self.problem.profile, &self.state.pressure),
             indentation,
-            (&mut scratch.preconditioned, &mut scratch.free),
+            (&mut scratch.gradient, &mut scratch.free),
             &mut scratch.partials,
         );
         let [contact_points, free_points] = sums.n;
@@ -593,17 +595,11 @@ impl ContactSolver {
             0.0
         };
         // The preconditioner sees Πg; the gradient keeps its mean where the mean is free.
-        let restore = if mode == MeanMode::Deflated {
-            centre
-        } else {
+        let gradient_centre = if mode == MeanMode::Deflated {
             0.0
+        } else {
+            centre
         };
-        centre_pass(
-            &mut scratch.preconditioned,
-            &mut scratch.gradient,
-            &scratch.free,
-            (centre, restore),
-        );
         let residual = ((sums.x[0] + sums.x[1]) / contact_points.max(1) as f64).sqrt()
             / self.problem.height_scale;
         Gradient {
@@ -611,6 +607,8 @@ impl ContactSolver {
             free_points,
             contact_points,
             residual,
+            centre,
+            gradient_centre,
         }
     }
 
@@ -631,19 +629,29 @@ impl ContactSolver {
             _ => false,
         };
         let scratch = &mut self.bccg_scratch;
-        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`).
-        let z = &mut scratch.preconditioned;
+        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`),
+        // Π g formed row by row on its way into the transform (never stored whole).
+        let (centre, cols) = (gradient.centre, self.problem.cols);
         if let Some(rings) = scratch.rings.as_mut() {
-            rings.extend(&scratch.free, z);
+            rings.extend(&scratch.free, &mut scratch.gradient, centre);
         }
-        self.preconditioner.apply(z);
+        let (free, z) = (&scratch.free[..], &mut scratch.preconditioned);
+        let centred = |i: usize, row: &mut [f64]| {
+            let free = &free[i * cols..][..cols];
+            for (v, &f) in row.iter_mut().zip(free) {
+                *v -= centre * f64::from(u8::from(f));
+            }
+        };
+        self.preconditioner
+            .apply_prepared(&scratch.gradient, z, centred);
         if let Some(rings) = scratch.rings.as_mut() {
-            rings.gather(&scratch.free, z);
+            rings.gather(free, z);
         }
-        let (z, free) = (&scratch.preconditioned[..], &scratch.free[..]);
+        let z = &scratch.preconditioned[..];
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
             (z, &scratch.gradient, &scratch.previous_gradient),
-            (&scratch.direction, free),
+            (&scratch.direction, free, &scratch.previous_free),
+            (gradient.gradient_centre, scratch.previous_centre),
             &mut scratch.partials,
         )
         .x;
@@ -691,6 +699,8 @@ impl ContactSolver {
             restart,
         );
         std::mem::swap(&mut scratch.gradient, &mut scratch.previous_gradient);
+        std::mem::swap(&mut scratch.free, &mut scratch.previous_free);
+        scratch.previous_centre = gradient.gradient_centre;
         Direction {
             zg,
             sg: if restart {

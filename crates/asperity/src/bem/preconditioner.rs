@@ -81,6 +81,20 @@ impl FourierPreconditioner {
             .convolve(input, &mut self.spectrum, output, multiply);
     }
 
+    /// `output ← M x` for the field `x` that `prepare(i, row)` makes of row `i` of `input`
+    /// (`cols` values) on its way into the transform; `input` is left alone.
+    pub(super) fn apply_prepared(
+        &mut self,
+        input: &[f64],
+        output: &mut [f64],
+        prepare: impl Fn(usize, &mut [f64]) + Sync,
+    ) {
+        let rows = self.fft.rows();
+        let multiply = multiplier(&self.symbol, rows);
+        self.fft
+            .convolve_prepared(input, &mut self.spectrum, output, multiply, prepare);
+    }
+
     /// `data ← M data` (a `rows × cols` row-major field, overwritten).
     /// One fused convolution: each column of the spectrum is multiplied while in cache.
     pub(super) fn apply(&mut self, data: &mut [f64]) {

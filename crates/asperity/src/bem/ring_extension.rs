@@ -315,17 +315,19 @@ impl RingExtension {
         self.counted_for.copy_from_slice(free);
     }
 
-    /// `z ← (I + E) z` for the free set `free`: `z`, zero off the set, keeps its values
-    /// there and gets the extension on the two rings (two updates of listed points, two
+    /// `z ← (I + E) z` for the free set `free`, of the field that is `z − centre` on the
+    /// set: `z`, zero off the set, keeps its values there (uncentred) and gets the
+    /// extension of the centred field on the two rings (two updates of listed points, two
     /// passes over the grid's bytes where the set changed).
-    pub(super) fn extend(&mut self, free: &[bool], z: &mut [f64]) {
+    pub(super) fn extend(&mut self, free: &[bool], z: &mut [f64], centre: f64) {
         self.count(free);
         let (grid, cols) = (self.grid, self.grid.1);
         let (first, second) = (&self.first, &self.second);
         // The first ring: γ₁/c times the sum of its c neighbours on the set (z is zero off
-        // it, and on the rings until they are written).
+        // it, and on the rings until they are written; `z − centre·1` there is `z − 0`).
         self.listed.update(z, List::FirstRing, |(i, j), z| {
-            weight(0, first[i * cols + j]) * around(grid, (i, j), |m| z[m])
+            let centred = |m: usize| z[m] - centre * f64::from(u8::from(free[m]));
+            weight(0, first[i * cols + j]) * around(grid, (i, j), centred)
         });
         // The second ring: γ₂/c times the sum of its c first-ring neighbours (it has no
         // neighbours on the set).
@@ -490,7 +492,7 @@ mod tests {
                 let mut state = 11u64;
                 let (mut free, z, y) = case(rows * cols, 0.3, &mut state);
                 let mut scratch = z.clone();
-                kept.extend(&free, &mut scratch);
+                kept.extend(&free, &mut scratch, 0.5);
                 for k in [
                     0,
                     cols + 3,
@@ -508,7 +510,7 @@ mod tests {
                     let mut fresh = RingExtension::new(rows, cols, periodic);
                     let results = [&mut kept, &mut fresh].map(|rings| {
                         let mut extended = on_set(&z);
-                        rings.extend(&free, &mut extended);
+                        rings.extend(&free, &mut extended, 0.5);
                         let mut gathered = y.clone();
                         rings.gather(&free, &mut gathered);
                         (extended, on_set(&gathered))
@@ -526,21 +528,26 @@ mod tests {
         // the first ring's list meets the edge's); the extension is checked against the
         // definition written out with coordinates, and ⟨(I + E) z, y⟩ = ⟨z, (I + E)ᵀ y⟩ on
         // the set (so that (I + E)ᵀ M (I + E) is symmetric). Thrice per grid, so that each
-        // extension overwrites the last one's fields.
+        // extension overwrites the last one's fields, the last one extending `z − 0.25` on
+        // the set (the rings of the centred field, the set's values kept).
         for (rows, cols) in [(31, 31), (32, 32), (50, 72), (700, 13)] {
             for periodic in [false, true] {
                 let grid = (rows, cols, periodic);
                 let mut rings = RingExtension::new(rows, cols, periodic);
                 let mut state = 7u64;
-                for fill in [0.05, 0.6, 0.95] {
+                for (fill, centre) in [(0.05, 0.0), (0.6, 0.0), (0.95, 0.25)] {
                     let (free, z, y) = case(rows * cols, fill, &mut state);
                     let mut extended = z.clone();
-                    rings.extend(&free, &mut extended);
+                    rings.extend(&free, &mut extended, centre);
+                    let centred: Vec<f64> = (0..z.len())
+                        .map(|k| if free[k] { z[k] - centre } else { 0.0 })
+                        .collect();
                     let first = |k: usize| {
                         let near = naive_neighbours(k, grid);
                         let on: Vec<usize> = near.into_iter().filter(|&m| free[m]).collect();
                         (!free[k] && !on.is_empty()).then(|| {
-                            GAMMA[0] * on.iter().map(|&m| z[m]).sum::<f64>() / on.len() as f64
+                            let sum = on.iter().map(|&m| centred[m]).sum::<f64>();
+                            GAMMA[0] * sum / on.len() as f64
                         })
                     };
                     for k in 0..rows * cols {
@@ -580,7 +587,11 @@ mod tests {
                             .map(|(&x, &f)| if f { x } else { 0.0 })
                             .collect()
                     };
-                    let (left, right) = (dot(&extended, &y), dot(&z, &on_set(&gathered)));
+                    let extended_centred: Vec<f64> = (0..z.len())
+                        .map(|k| if free[k] { centred[k] } else { extended[k] })
+                        .collect();
+                    let left = dot(&extended_centred, &y);
+                    let right = dot(&centred, &on_set(&gathered));
                     assert!(
                         (left - right).abs() < 1e-12 * left.abs().max(1.0),
                         "{left} {right}"

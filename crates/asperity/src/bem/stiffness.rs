@@ -109,7 +109,7 @@ fn precondition_on_set(
     match rings {
         Some((rings, on_set)) => {
             z.copy_from_slice(residual);
-            rings.extend(on_set, z);
+            rings.extend(on_set, z, 0.0);
             preconditioner.apply(z);
             rings.gather(on_set, z);
         }
