@@ -19,7 +19,11 @@
 //!
 //! [`RealFft2::convolve`] fuses forward and inverse for filters applied column by column:
 //! each `kx` column is transformed forward, filtered and transformed back while it is in
-//! cache.
+//! cache. Its column pass (and that of [`RealFft2::forward_reduce`]) never writes the
+//! transposed spectrum: each lane gathers a strip of a few (`COLUMN_BLOCK`) values of every row
+//! spectrum into columns of its own buffer (zeros below the data rows), transforms them
+//! there and puts the data rows back — the two transposes of the row spectra through a
+//! whole-grid spectrum were a third of a BEM solve's time at 512².
 //!
 //! Neither direction is normalised: `inverse(forward(x)) = rows·cols·x`.
 
@@ -36,6 +40,51 @@ use crate::{Error, Result};
 struct Lane {
     real: Vec<f64>,
     scratch: Vec<Complex64>,
+    /// [`COLUMN_BLOCK`] columns of the transform grid (`rows` values each), gathered from
+    /// the row spectra by the fused column pass.
+    columns: Vec<Complex64>,
+}
+
+/// Columns (`kx`) a lane gathers, transforms and returns at a time in the fused column pass
+/// ([`RealFft2::convolve`], [`RealFft2::forward_reduce`]): a strip of that many values of
+/// every row spectrum is a few whole cache lines.
+const COLUMN_BLOCK: usize = 8;
+
+/// The row spectra (`rows × half`, row-major) shared by the lanes of the fused column pass,
+/// each of which reads and writes only its own columns.
+struct SharedRows {
+    ptr: *mut Complex64,
+    rows: usize,
+    half: usize,
+}
+
+// SAFETY: the lanes access disjoint column strips (`SharedRows::strip`'s contract).
+unsafe impl Sync for SharedRows {}
+
+impl SharedRows {
+    fn new(work: &mut [Complex64], rows: usize, half: usize) -> Self {
+        assert_eq!(work.len(), rows * half, "row spectra length");
+        SharedRows {
+            ptr: work.as_mut_ptr(),
+            rows,
+            half,
+        }
+    }
+
+    /// Values `kx0 .. kx0 + width` of row `r`.
+    ///
+    /// # Safety
+    /// No two strips handed out at the same time may overlap, and the buffer must outlive
+    /// them (both hold within one fused column pass, whose lanes own disjoint columns).
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn strip(&self, r: usize, kx0: usize, width: usize) -> &mut [Complex64] {
+        assert!(
+            r < self.rows && kx0 + width <= self.half,
+            "strip inside the rows"
+        );
+        // SAFETY: in bounds (checked above); exclusive by the caller's contract.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r * self.half + kx0), width) }
+    }
 }
 
 /// A planned 2D real-to-complex FFT of a `rows × cols` grid, optionally zero-padding a
@@ -116,6 +165,11 @@ impl RealFft2 {
                 Ok(Lane {
                     real: try_vec("an FFT row buffer", cols, 0.0)?,
                     scratch: try_vec("an FFT scratch buffer", scratch_len, Complex64::default())?,
+                    columns: try_vec(
+                        "an FFT column buffer",
+                        COLUMN_BLOCK * rows,
+                        Complex64::default(),
+                    )?,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -163,6 +217,14 @@ impl RealFft2 {
         self.half_cols() * self.rows
     }
 
+    fn check_data(&self, real: &[f64]) {
+        assert_eq!(
+            real.len(),
+            self.data_rows * self.data_cols,
+            "real grid length"
+        );
+    }
+
     fn check_lengths(&self, real: &[f64], spectrum: &[Complex64]) {
         assert_eq!(
             real.len(),
@@ -207,18 +269,14 @@ impl RealFft2 {
 
     /// `output = inverse(filter(forward(input)))` with the column passes fused: every
     /// `kx` column of the spectrum is transformed forward, handed to `filter(kx, column)`
-    /// (all `rows` values of `ky`) and transformed back before the next. `spectrum` is the
-    /// scratch spectrum (overwritten); `input` and `output` are data blocks.
-    pub fn convolve<F>(
-        &mut self,
-        input: &[f64],
-        spectrum: &mut [Complex64],
-        output: &mut [f64],
-        filter: F,
-    ) where
+    /// (all `rows` values of `ky`) and transformed back while it is in cache (gathered
+    /// from the row spectra by its lane: no transposed spectrum is written). `input` and
+    /// `output` are data blocks.
+    pub fn convolve<F>(&mut self, input: &[f64], output: &mut [f64], filter: F)
+    where
         F: Fn(usize, &mut [Complex64]) + Sync,
     {
-        self.convolve_prepared(input, spectrum, output, filter, |_, _| {});
+        self.convolve_prepared(input, output, filter, |_, _| {});
     }
 
     /// [`RealFft2::convolve`] of the input as changed row by row by `prepare(i, row)` (row
@@ -228,7 +286,6 @@ impl RealFft2 {
     pub fn convolve_prepared<F, P>(
         &mut self,
         input: &[f64],
-        spectrum: &mut [Complex64],
         output: &mut [f64],
         filter: F,
         prepare: P,
@@ -236,80 +293,106 @@ impl RealFft2 {
         F: Fn(usize, &mut [Complex64]) + Sync,
         P: Fn(usize, &mut [f64]) + Sync,
     {
-        self.check_lengths(input, spectrum);
-        self.check_lengths(output, spectrum);
+        self.check_data(input);
+        self.check_data(output);
         self.forward_rows(input, prepare);
-        self.filter_columns(spectrum, filter);
+        self.filter_columns(filter);
         self.inverse_rows(output);
     }
 
     /// [`RealFft2::convolve`] with `data` both the input and the output (overwritten).
-    pub fn convolve_in_place<F>(&mut self, data: &mut [f64], spectrum: &mut [Complex64], filter: F)
+    pub fn convolve_in_place<F>(&mut self, data: &mut [f64], filter: F)
     where
         F: Fn(usize, &mut [Complex64]) + Sync,
     {
-        self.check_lengths(data, spectrum);
+        self.check_data(data);
         self.forward_rows(data, |_, _| {});
-        self.filter_columns(spectrum, filter);
+        self.filter_columns(filter);
         self.inverse_rows(data);
     }
 
     /// The forward transform of `input` reduced column by column, for quadratic forms
     /// that need no inverse transform (Parseval): every `kx` column of the spectrum is
     /// transformed and handed to `reduce(kx, column)` while it is in cache, and the value
-    /// stored in `values[kx]` (`half_cols` of them). `spectrum` is scratch. Each column is
-    /// one lane's, so the values do not depend on the thread count.
-    pub fn forward_reduce<F>(
-        &mut self,
-        input: &[f64],
-        spectrum: &mut [Complex64],
-        values: &mut [f64],
-        reduce: F,
-    ) where
+    /// stored in `values[kx]` (`half_cols` of them). Each column is one lane's, so the
+    /// values do not depend on the thread count.
+    pub fn forward_reduce<F>(&mut self, input: &[f64], values: &mut [f64], reduce: F)
+    where
         F: Fn(usize, &[Complex64]) -> f64 + Sync,
     {
-        self.check_lengths(input, spectrum);
+        self.check_data(input);
         assert_eq!(values.len(), self.half_cols(), "one value per kx");
-        self.rows_into_columns(input, spectrum);
-        let fft = &self.col_forward;
-        for_each_column_into(
-            spectrum,
-            self.rows,
-            &mut self.lanes,
-            values,
-            |kx, column, scratch, value| {
-                fft.process_with_scratch(column, scratch);
-                *value = reduce(kx, column);
-            },
-        );
+        self.forward_rows(input, |_, _| {});
+        // The plan is shared (an `Arc`): a handle, not a copy.
+        let fft = Arc::clone(&self.col_forward);
+        self.gathered_columns(values, false, |kx, column, scratch, value| {
+            fft.process_with_scratch(column, scratch);
+            *value = reduce(kx, column);
+        });
     }
 
     /// The column passes of [`RealFft2::convolve`]: from the rows' half spectra in `work`
     /// through the fused forward, filter and inverse column transforms back to `work`.
-    fn filter_columns<F>(&mut self, spectrum: &mut [Complex64], filter: F)
+    fn filter_columns<F>(&mut self, filter: F)
     where
         F: Fn(usize, &mut [Complex64]) + Sync,
     {
-        transpose_into_columns(
-            &self.work,
-            spectrum,
-            self.data_rows,
-            self.half_cols(),
-            self.rows,
-        );
-        let (forward, backward) = (&self.col_forward, &self.col_inverse);
-        for_each_column(
-            spectrum,
-            self.rows,
-            &mut self.lanes,
-            |kx, column, scratch| {
-                forward.process_with_scratch(column, scratch);
-                filter(kx, column);
-                backward.process_with_scratch(column, scratch);
-            },
-        );
-        let half = self.half_cols();
-        transpose_from_columns(spectrum, &mut self.work, self.data_rows, half, self.rows);
+        let (forward, backward) = (Arc::clone(&self.col_forward), Arc::clone(&self.col_inverse));
+        // Units take no memory: nothing is allocated.
+        let mut nothing = vec![(); self.half_cols()];
+        self.gathered_columns(&mut nothing, true, |kx, column, scratch, ()| {
+            forward.process_with_scratch(column, scratch);
+            filter(kx, column);
+            backward.process_with_scratch(column, scratch);
+        });
+    }
+
+    /// The fused column pass: every `kx` column of the transform grid is gathered from the
+    /// row spectra in `work` (zeros below the data rows) into its lane's buffer, handed to
+    /// `column(kx, values, scratch, &mut outputs[kx])`, and with `write_back` its first
+    /// `data_rows` values returned to `work`. Lanes own contiguous runs of columns and take
+    /// them [`COLUMN_BLOCK`] at a time (a strip of every row spectrum): each column is
+    /// computed whole by one lane, whatever the number of threads.
+    fn gathered_columns<T, F>(&mut self, outputs: &mut [T], write_back: bool, column: F)
+    where
+        T: Send,
+        F: Fn(usize, &mut [Complex64], &mut [Complex64], &mut T) + Sync,
+    {
+        let (rows, data_rows, half) = (self.rows, self.data_rows, self.half_cols());
+        assert_eq!(outputs.len(), half, "one output per column");
+        let shared = SharedRows::new(&mut self.work, data_rows, half);
+        let lane_columns = per_lane(half.div_ceil(COLUMN_BLOCK), self.lanes.len()) * COLUMN_BLOCK;
+        outputs
+            .par_chunks_mut(lane_columns)
+            .enumerate()
+            .zip(self.lanes.par_iter_mut())
+            .for_each(|((l, outputs), lane)| {
+                for (b, outputs) in outputs.chunks_mut(COLUMN_BLOCK).enumerate() {
+                    let (kx0, width) = (l * lane_columns + b * COLUMN_BLOCK, outputs.len());
+                    let block = &mut lane.columns[..width * rows];
+                    // SAFETY (both strips): columns kx0 .. kx0 + width are this lane's
+                    // alone, and `work` outlives the pass.
+                    for r in 0..data_rows {
+                        let strip = unsafe { shared.strip(r, kx0, width) };
+                        for (d, &v) in strip.iter().enumerate() {
+                            block[d * rows + r] = v;
+                        }
+                    }
+                    let columns = block.chunks_exact_mut(rows).zip(outputs).enumerate();
+                    for (d, (values, out)) in columns {
+                        values[data_rows..].fill(Complex64::default());
+                        column(kx0 + d, values, &mut lane.scratch, out);
+                    }
+                    if write_back {
+                        for r in 0..data_rows {
+                            let strip = unsafe { shared.strip(r, kx0, width) };
+                            for (d, v) in strip.iter_mut().enumerate() {
+                                *v = block[d * rows + r];
+                            }
+                        }
+                    }
+                }
+            });
     }
 
     /// Forward transform of a whole `rows × cols` grid (padding included) whose rows are
@@ -692,7 +775,6 @@ mod tests {
         for (data_rows, data_cols, rows, cols) in [(7, 5, 7, 5), (5, 7, 10, 14), (3, 4, 6, 8)] {
             let data = pseudo_random(data_rows * data_cols);
             let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
-            let mut spec = vec![Complex64::default(); fft.spectrum_len()];
             let filter = |kx: usize, column: &mut [Complex64]| {
                 column.iter_mut().for_each(|v| *v *= 1.0 / (1 + kx) as f64);
             };
@@ -703,15 +785,15 @@ mod tests {
                     .enumerate()
                     .for_each(|(j, v)| *v += added(i, j));
             };
-            fft.convolve_prepared(&data, &mut spec, &mut prepared, filter, prepare);
+            fft.convolve_prepared(&data, &mut prepared, filter, prepare);
             let changed: Vec<f64> = (0..data.len())
                 .map(|k| data[k] + added(k / data_cols, k % data_cols))
                 .collect();
             let mut plain = vec![f64::NAN; data.len()];
-            fft.convolve(&changed, &mut spec, &mut plain, filter);
+            fft.convolve(&changed, &mut plain, filter);
             assert_eq!(prepared, plain, "{data_rows}x{data_cols} in {rows}x{cols}");
             assert_ne!(prepared, {
-                fft.convolve(&data, &mut spec, &mut plain, filter);
+                fft.convolve(&data, &mut plain, filter);
                 plain
             });
         }
@@ -734,7 +816,7 @@ mod tests {
             let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
             let mut spec = vec![Complex64::default(); fft.spectrum_len()];
             let mut fused = vec![f64::NAN; data_rows * data_cols];
-            fft.convolve(&data, &mut spec, &mut fused, |kx, column| {
+            fft.convolve(&data, &mut fused, |kx, column| {
                 for (v, k) in column
                     .iter_mut()
                     .zip(&kernel_spec[kx * rows..(kx + 1) * rows])
@@ -807,8 +889,7 @@ mod tests {
                 let values = crate::test_support::with_threads(threads, || {
                     let mut fft = RealFft2::zero_padded(data_rows, data_cols, rows, cols).unwrap();
                     let mut values = vec![f64::NAN; fft.half_cols()];
-                    let mut scratch = vec![Complex64::new(3.0, 3.0); fft.spectrum_len()];
-                    fft.forward_reduce(&data, &mut scratch, &mut values, norms);
+                    fft.forward_reduce(&data, &mut values, norms);
                     values
                 });
                 assert_eq!(values, expected, "{rows}x{cols}, {threads} threads");
@@ -823,9 +904,8 @@ mod tests {
         let run = |threads: usize| {
             crate::test_support::with_threads(threads, || {
                 let mut fft = RealFft2::zero_padded(data_rows, data_cols, 38, 46).unwrap();
-                let mut spec = vec![Complex64::default(); fft.spectrum_len()];
                 let mut out = vec![0.0; data_rows * data_cols];
-                fft.convolve(&data, &mut spec, &mut out, |kx, column| {
+                fft.convolve(&data, &mut out, |kx, column| {
                     column
                         .iter_mut()
                         .enumerate()

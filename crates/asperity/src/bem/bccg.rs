@@ -638,8 +638,10 @@ impl ContactSolver {
         let (free, z) = (&scratch.free[..], &mut scratch.preconditioned);
         let centred = |i: usize, row: &mut [f64]| {
             let free = &free[i * cols..][..cols];
+            // `centre` on the set, +0 off it (v − 0 = v): a mask of its bits, no branch.
+            let bits = centre.to_bits();
             for (v, &f) in row.iter_mut().zip(free) {
-                *v -= centre * f64::from(u8::from(f));
+                *v -= f64::from_bits(bits & u64::from(f).wrapping_neg());
             }
         };
         self.preconditioner

@@ -35,15 +35,14 @@ pub(super) struct FourierPreconditioner {
     /// Symbol in the transposed half-spectrum layout of [`RealFft2`] (`kx`-major), with the
     /// FFT's `1/(rows·cols)` folded in.
     symbol: Vec<f64>,
-    spectrum: Vec<Complex64>,
 }
 
 impl FourierPreconditioner {
     /// Bytes of a preconditioner for a `rows × cols` grid (`None` on overflow): the FFT's
-    /// work buffer and the spectrum (complex, half grid each) and the symbol (real, half
-    /// grid). Rounded up to whole `rows × cols` real fields: three.
+    /// work buffer (complex, half grid) and the symbol (real, half grid), and the lanes'
+    /// column buffers. Rounded up to whole `rows × cols` real fields: two.
     pub(super) fn memory_bytes(rows: usize, cols: usize) -> Option<u64> {
-        memory::array_bytes(&[3, rows, cols], 8)
+        memory::array_bytes(&[2, rows, cols], 8)
     }
 
     /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of pixels
@@ -52,7 +51,6 @@ impl FourierPreconditioner {
         let fft = RealFft2::new(rows, cols)?;
         let (half, len) = (fft.half_cols(), fft.spectrum_len());
         let mut symbol = try_vec("the preconditioner's symbol", len, 0.0)?;
-        let spectrum = try_vec("the preconditioner's spectrum", len, Complex64::default())?;
         let qx_unit = 2.0 * PI / (cols as f64 * dx);
         let qy_unit = 2.0 * PI / (rows as f64 * dy);
         let q_lowest = qx_unit.min(qy_unit);
@@ -65,11 +63,7 @@ impl FourierPreconditioner {
                 symbol[kx * rows + ky] = 0.5 * modulus * q * normalisation;
             }
         }
-        Ok(FourierPreconditioner {
-            fft,
-            symbol,
-            spectrum,
-        })
+        Ok(FourierPreconditioner { fft, symbol })
     }
 
     /// `output ← M input` (`rows × cols` row-major fields): [`FourierPreconditioner::apply`]
@@ -77,8 +71,7 @@ impl FourierPreconditioner {
     pub(super) fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
         let rows = self.fft.rows();
         let multiply = multiplier(&self.symbol, rows);
-        self.fft
-            .convolve(input, &mut self.spectrum, output, multiply);
+        self.fft.convolve(input, output, multiply);
     }
 
     /// `output ← M x` for the field `x` that `prepare(i, row)` makes of row `i` of `input`
@@ -91,8 +84,7 @@ impl FourierPreconditioner {
     ) {
         let rows = self.fft.rows();
         let multiply = multiplier(&self.symbol, rows);
-        self.fft
-            .convolve_prepared(input, &mut self.spectrum, output, multiply, prepare);
+        self.fft.convolve_prepared(input, output, multiply, prepare);
     }
 
     /// `data ← M data` (a `rows × cols` row-major field, overwritten).
@@ -100,8 +92,7 @@ impl FourierPreconditioner {
     pub(super) fn apply(&mut self, data: &mut [f64]) {
         let rows = self.fft.rows();
         let multiply = multiplier(&self.symbol, rows);
-        self.fft
-            .convolve_in_place(data, &mut self.spectrum, multiply);
+        self.fft.convolve_in_place(data, multiply);
     }
 }
 

@@ -93,8 +93,6 @@ pub struct ElasticOperator {
     /// Unique values of the real, even kernel spectrum, `half_cols × kernel_rows`,
     /// normalised by `1/(padded_rows · padded_cols)`.
     kernel: Vec<f64>,
-    /// Transposed half spectrum, `half_cols × padded_rows`.
-    spectrum: Vec<Complex64>,
     /// One partial sum of [`ElasticOperator::energy`] per `kx`.
     column_energies: Vec<f64>,
 }
@@ -171,15 +169,10 @@ impl ElasticOperator {
             boundary,
             fft,
             kernel: memory::try_vec("the elastic kernel's spectrum", kernel_len, 0.0)?,
-            spectrum: memory::try_vec(
-                "the elastic operator's spectrum",
-                spectrum_len,
-                Complex64::default(),
-            )?,
             column_energies: memory::try_vec("the energy's partial sums", half_cols, 0.0)?,
         };
         match boundary {
-            Boundary::Free => operator.fill_free_kernel(),
+            Boundary::Free => operator.fill_free_kernel(spectrum_len)?,
             Boundary::Periodic => operator.fill_periodic_kernel(),
         }
         Ok(operator)
@@ -242,7 +235,13 @@ impl ElasticOperator {
     /// Spectrum of Love's coefficients sampled on the padded grid, row by row in parallel
     /// (the samples are never stored): each padded row's real transform is real (the row is
     /// even), so the real parts of the column transforms are the whole kernel.
-    fn fill_free_kernel(&mut self) {
+    fn fill_free_kernel(&mut self, spectrum_len: usize) -> Result<()> {
+        // The kernel's whole spectrum is needed once, here: not kept.
+        let mut spectrum = memory::try_vec(
+            "the elastic kernel's spectrum",
+            spectrum_len,
+            Complex64::default(),
+        )?;
         let (prow, pcol) = (self.fft.rows(), self.fft.cols());
         let (dx, dy, e) = (self.spacing_x, self.spacing_y, self.modulus);
         let kernel_rows = self.kernel_rows();
@@ -265,11 +264,10 @@ impl ElasticOperator {
                     row[c] = row[pcol - c];
                 }
             },
-            &mut self.spectrum,
+            &mut spectrum,
         );
         let scale = 1.0 / (prow * pcol) as f64;
-        for (column, kernel_column) in self
-            .spectrum
+        for (column, kernel_column) in spectrum
             .chunks_exact(prow)
             .zip(self.kernel.chunks_exact_mut(kernel_rows))
         {
@@ -277,6 +275,7 @@ impl ElasticOperator {
                 *k = value.re * scale;
             }
         }
+        Ok(())
     }
 
     /// `2 / (E* |q|) / (rows · cols)`, zero at `q = 0`, on the period `cols·Δx × rows·Δy`.
@@ -321,11 +320,8 @@ impl ElasticOperator {
         let kernel_rows = self.kernel_rows();
         let pcols = self.fft.cols();
         let kernel = &self.kernel;
-        self.fft.forward_reduce(
-            pressure,
-            &mut self.spectrum,
-            &mut self.column_energies,
-            |kx, column| {
+        self.fft
+            .forward_reduce(pressure, &mut self.column_energies, |kx, column| {
                 let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
                 let (low, high) = column.split_at(kernel_rows);
                 // `high` read backwards meets the kernel from `ky = 1` (`with_even_kernel`);
@@ -335,8 +331,7 @@ impl ElasticOperator {
                     + sum4(high.len(), |m| k[m + 1] * high[last - m].norm_sqr());
                 let mirrored = kx != 0 && 2 * kx != pcols;
                 sum * if mirrored { 2.0 } else { 1.0 }
-            },
-        );
+            });
         self.column_energies.iter().sum()
     }
 
@@ -366,24 +361,23 @@ impl ElasticOperator {
         let kernel_rows = self.kernel_rows();
         let normalisation = (prow * self.fft.cols()) as f64;
         let kernel = &self.kernel;
-        self.fft
-            .convolve(input, &mut self.spectrum, output, |kx, column| {
-                let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
-                let (low, high) = column.split_at_mut(kernel_rows);
-                let pairs = with_even_kernel((low.iter_mut(), high.iter_mut()), k);
-                if inverse {
-                    let factor = |k: f64| {
-                        if k != 0.0 {
-                            1.0 / (k * normalisation * normalisation)
-                        } else {
-                            0.0
-                        }
-                    };
-                    pairs.for_each(|(v, k)| *v *= factor(k));
-                } else {
-                    pairs.for_each(|(v, k)| *v *= k);
-                }
-            });
+        self.fft.convolve(input, output, |kx, column| {
+            let k = &kernel[kx * kernel_rows..(kx + 1) * kernel_rows];
+            let (low, high) = column.split_at_mut(kernel_rows);
+            let pairs = with_even_kernel((low.iter_mut(), high.iter_mut()), k);
+            if inverse {
+                let factor = |k: f64| {
+                    if k != 0.0 {
+                        1.0 / (k * normalisation * normalisation)
+                    } else {
+                        0.0
+                    }
+                };
+                pairs.for_each(|(v, k)| *v *= factor(k));
+            } else {
+                pairs.for_each(|(v, k)| *v *= k);
+            }
+        });
     }
 }
 
