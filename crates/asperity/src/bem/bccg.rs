@@ -16,7 +16,10 @@
 //!    (the projection onto `Σ_F = 0`, which keeps the load). On grids of at least
 //!    [`RING_MIN_POINTS`] points `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of
 //!    a field on `F` over two rings of bounded points ([`super::ring_extension`]): fewer
-//!    iterations, each two grid sweeps dearer.
+//!    iterations, each dearer by two updates of the listed ring points (and their recount
+//!    where the set changed). `Π g` is never stored: the gradient field holds `g` on `F`,
+//!    and the centring is done by whatever reads it (the transform's row pass, the rings,
+//!    the direction's sums).
 //! 3. Direction `s = −z + β s` on `F`, zero off it (and centred again on `F` under load
 //!    control), with the Polak–Ribière `β = max(0, zᵀ(g − g_old)/z_oldᵀg_old)`: the
 //!    direction carries over when the set changes, and `β` falls to zero by itself when the
@@ -49,7 +52,7 @@
 //! not depend on the thread count; each chunk sums in index order and the partial sums are
 //! added serially in chunk order, so results are bit-identical for any thread count. A
 //! pass reads the free set from a mask written once per iteration, and the sums of the new
-//! direction follow from those of the old one, so an iteration makes five passes besides
+//! direction follow from those of the old one, so an iteration makes four passes besides
 //! the step's. They allocate nothing (the solver owns every buffer).
 
 use rayon::prelude::*;
@@ -64,10 +67,11 @@ use crate::sum::sum4;
 /// Grids of at least this many points extend the gradient over two rings around the free
 /// set before the preconditioner (`ring_extension.rs`), with the hybrid
 /// `β = max(0, min(β_PR, β_FR))` (Polak–Ribière+ without). The rings cut the iterations
-/// most where the contact patches span many pixels, and cost two sweeps over the grid per
-/// iteration wherever they are: measured (docs/bem.md), the solves of a study sample take
-/// 6–12 % less time at 512² and 1024², about the same at 256², and up to 20 % more at 128²
-/// and 64² (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
+/// most where the contact patches span many pixels, and cost per iteration two updates of
+/// the listed ring points and, where the set changed, their recount: measured with the
+/// earlier whole-grid sweeps (docs/bem.md), the solves of a study sample took 6–12 % less
+/// time at 512² and 1024², about the same at 256², and up to 20 % more at 128² and 64²
+/// (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
 pub(super) const RING_MIN_POINTS: usize = 1 << 18;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
@@ -1012,7 +1016,7 @@ mod tests {
     fn results_do_not_depend_on_the_thread_count() {
         // 150² spans three chunks of the parallel passes: their partial sums must add up
         // to the same bits whichever threads computed them (and three blocks of rows of
-        // the rings' sweeps).
+        // the rings' passes).
         for (surface, boundary) in [rough_grid(48, 56, 3), rough_grid(150, 150, 3)]
             .iter()
             .flat_map(|s| [(s, Boundary::Free), (s, Boundary::Periodic)])
