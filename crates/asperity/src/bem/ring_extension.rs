@@ -23,17 +23,18 @@
 //! ones wrap). The transpose gathers the preconditioned field back onto `F` along the same
 //! weights. Measured at 512²: the largest eigenvalue 11.9 → 5.5 with `γ = (0.7, 0.5)`.
 //!
-//! The rings are kept as lists, recounted only when the free set changes: per row, the
-//! columns of its first-ring points, of its second-ring points and of the set's edge (the
-//! points of the set with first-ring neighbours), with the rings' neighbour counts (one
-//! byte per point). The extension and its transpose then visit the listed points only (a
-//! quarter of the grid at 10 % contact), each in two parallel passes: values from the
-//! neighbours into a scratch field, then written in place; a second-ring value recomputes
-//! its first-ring neighbours' values rather than waiting for them. Every value is added
-//! from its neighbours in a fixed order (above, below, left, right), so the results do not
-//! depend on the thread count. Cost (docs/bem.md): at 512² and 10 % contact about a tenth
-//! of an iteration, a third of the whole-grid stencil sweeps it replaced. Nothing is
-//! allocated after [`RingExtension::new`].
+//! The rings are kept as lists: per row, the columns of its first-ring points, of its
+//! second-ring points and of the set's edge (the points of the set with first-ring
+//! neighbours), with the rings' neighbour counts (one byte per point), recounted in the
+//! rows within two rows of a change of the free set. The extension and its transpose then
+//! visit the listed points only (a quarter of the grid at 10 % contact): the first ring,
+//! then the second from the first (extension), or the first ring from the second, then the
+//! edge from the first (transpose), each update in two parallel passes — values from the
+//! neighbours into a scratch field, then written in place. Every value is added from its
+//! neighbours in a fixed order (above, below, left, right), so the results do not depend on
+//! the thread count. Cost (docs/bem.md, "Fewer passes, no transposes"): at 512² and 10 %
+//! contact about an eighth of an iteration with the recounts, four fifths of the
+//! whole-grid stencil sweeps it replaced. Nothing is allocated after [`RingExtension::new`].
 
 use rayon::prelude::*;
 
