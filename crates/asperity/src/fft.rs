@@ -229,11 +229,7 @@ impl RealFft2 {
     }
 
     fn check_lengths(&self, real: &[f64], spectrum: &[Complex64]) {
-        assert_eq!(
-            real.len(),
-            self.data_rows * self.data_cols,
-            "real grid length"
-        );
+        self.check_data(real);
         assert_eq!(spectrum.len(), self.spectrum_len(), "spectrum length");
     }
 
@@ -520,38 +516,14 @@ fn for_each_column<F>(spectrum: &mut [Complex64], rows: usize, lanes: &mut [Lane
 where
     F: Fn(usize, &mut [Complex64], &mut [Complex64]) + Sync,
 {
-    // Units take no memory: nothing is allocated.
-    let mut nothing = vec![(); spectrum.len() / rows];
-    for_each_column_into(
-        spectrum,
-        rows,
-        lanes,
-        &mut nothing,
-        |kx, column, scratch, ()| f(kx, column, scratch),
-    );
-}
-
-/// [`for_each_column`] with one output per column: `f(kx, column, scratch, &mut out[kx])`.
-fn for_each_column_into<T, F>(
-    spectrum: &mut [Complex64],
-    rows: usize,
-    lanes: &mut [Lane],
-    out: &mut [T],
-    f: F,
-) where
-    T: Send,
-    F: Fn(usize, &mut [Complex64], &mut [Complex64], &mut T) + Sync,
-{
-    assert_eq!(out.len() * rows, spectrum.len(), "one output per column");
-    let chunk = per_lane(out.len(), lanes.len());
+    let chunk = per_lane(spectrum.len() / rows, lanes.len());
     spectrum
         .par_chunks_mut(chunk * rows)
-        .zip(out.par_chunks_mut(chunk))
         .enumerate()
         .zip(lanes.par_iter_mut())
-        .for_each(|((block_index, (block, out)), lane)| {
-            for (i, (column, out)) in block.chunks_exact_mut(rows).zip(out).enumerate() {
-                f(block_index * chunk + i, column, &mut lane.scratch, out);
+        .for_each(|((block_index, block), lane)| {
+            for (i, column) in block.chunks_exact_mut(rows).enumerate() {
+                f(block_index * chunk + i, column, &mut lane.scratch);
             }
         });
 }

@@ -58,7 +58,7 @@
 use rayon::prelude::*;
 
 use super::mean_gap::MeanGapScratch;
-use super::ring_extension::RingExtension;
+use super::ring_extension::{centre_on_set, RingExtension};
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
@@ -642,10 +642,8 @@ impl ContactSolver {
         let (free, z) = (&scratch.free[..], &mut scratch.preconditioned);
         let centred = |i: usize, row: &mut [f64]| {
             let free = &free[i * cols..][..cols];
-            // `centre` on the set, +0 off it (v − 0 = v): a mask of its bits, no branch.
-            let bits = centre.to_bits();
             for (v, &f) in row.iter_mut().zip(free) {
-                *v -= f64::from_bits(bits & u64::from(f).wrapping_neg());
+                *v -= centre_on_set(centre, f);
             }
         };
         self.preconditioner

@@ -69,9 +69,7 @@ impl FourierPreconditioner {
     /// `output ← M input` (`rows × cols` row-major fields): [`FourierPreconditioner::apply`]
     /// without first copying the input into the output.
     pub(super) fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
-        let rows = self.fft.rows();
-        let multiply = multiplier(&self.symbol, rows);
-        self.fft.convolve(input, output, multiply);
+        self.apply_prepared(input, output, |_, _| {});
     }
 
     /// `output ← M x` for the field `x` that `prepare(i, row)` makes of row `i` of `input`

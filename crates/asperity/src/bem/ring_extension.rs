@@ -180,6 +180,13 @@ fn within((rows, _, periodic): Grid, i: usize, reach: usize, test: impl Fn(usize
     }
 }
 
+/// What the centring `Π` subtracts from a value of a gradient field: `centre` on the set
+/// (`on_set`), +0 off it (`v − 0 = v`), chosen by a mask of its bits, not a branch.
+#[inline(always)]
+pub(super) fn centre_on_set(centre: f64, on_set: bool) -> f64 {
+    f64::from_bits(centre.to_bits() & u64::from(on_set).wrapping_neg())
+}
+
 /// `Σ f(m)` over the indices `m` of the 4-neighbours of point `(i, j)`, added in a fixed
 /// order: above, below, left, right (periodic grids wrap, free ones end).
 #[inline(always)]
@@ -327,7 +334,7 @@ impl RingExtension {
         // The first ring: γ₁/c times the sum of its c neighbours on the set (z is zero off
         // it, and on the rings until they are written; `z − centre·1` there is `z − 0`).
         self.listed.update(z, List::FirstRing, |(i, j), z| {
-            let centred = |m: usize| z[m] - centre * f64::from(u8::from(free[m]));
+            let centred = |m: usize| z[m] - centre_on_set(centre, free[m]);
             weight(0, first[i * cols + j]) * around(grid, (i, j), centred)
         });
         // The second ring: γ₂/c times the sum of its c first-ring neighbours (it has no

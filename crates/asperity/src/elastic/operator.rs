@@ -103,7 +103,8 @@ fn check_positive(name: &'static str, value: f64) -> Result<()> {
 
 impl ElasticOperator {
     /// Estimated peak memory of an operator for a `rows × cols` grid, in bytes (`None` on
-    /// overflow): spectrum, row-pass buffer and kernel.
+    /// overflow): row-pass buffer and kernel, and the whole spectrum the kernel's set-up
+    /// holds for a while (free boundaries; an upper bound for periodic ones).
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
         let pad = boundary.padding();
         let padded_rows = rows.checked_mul(pad)?;
