@@ -58,10 +58,12 @@
 use rayon::prelude::*;
 
 use super::mean_gap::MeanGapScratch;
+use super::preconditioner::Real;
 use super::ring_extension::{centre_on_set, RingExtension};
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
+use crate::fft::Precision;
 use crate::sum::sum4;
 
 /// Grids of at least this many points extend the gradient over two rings around the free
@@ -640,7 +642,8 @@ impl ContactSolver {
             rings.extend(&scratch.free, &mut scratch.gradient, centre);
         }
         let (free, z) = (&scratch.free[..], &mut scratch.preconditioned);
-        let centred = |i: usize, row: &mut [f64]| {
+        let centre = Real::rounded(centre);
+        let centred = |i: usize, row: &mut [Real]| {
             let free = &free[i * cols..][..cols];
             for (v, &f) in row.iter_mut().zip(free) {
                 *v -= centre_on_set(centre, f);

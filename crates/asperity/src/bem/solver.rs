@@ -39,7 +39,7 @@ use ndarray::{Array2, ArrayView2};
 use super::bccg::BccgScratch;
 use super::full_contact::{FullContactScratch, FullContactThreshold};
 use super::polonsky_keer::PkScratch;
-use super::preconditioner::FourierPreconditioner;
+use super::preconditioner::{FourierPreconditioner, Real};
 use super::small_set::SmallSet;
 use super::stiffness::StiffnessWork;
 use super::{
@@ -252,7 +252,7 @@ impl ContactSolver {
         let limit = super::small_set::limit(rows.checked_mul(cols)?);
         let factor = memory::array_bytes(&[limit + 3, limit], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
-            .checked_add(FourierPreconditioner::memory_bytes(rows, cols)?)?
+            .checked_add(FourierPreconditioner::<Real>::memory_bytes(rows, cols)?)?
             .checked_add(fields)?
             .checked_add(factor)
     }
