@@ -95,6 +95,7 @@ pub mod lock;
 pub mod mdr;
 pub mod memory;
 pub mod npy;
+mod pool;
 pub mod reference;
 pub mod spectrum;
 pub mod stop;

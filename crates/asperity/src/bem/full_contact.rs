@@ -120,7 +120,8 @@ impl ContactSolver {
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
         match self.problem.operator.boundary() {
             Boundary::Periodic => Ok(self.periodic_full_contact()),
-            Boundary::Free => self.free_full_contact(),
+            // Two CG solves: on a worker of the pool, as the solves (`pool.rs`).
+            Boundary::Free => crate::pool::on_worker(|| self.free_full_contact()),
         }
     }
 

@@ -47,6 +47,7 @@ use super::{
     SolverParams,
 };
 use crate::elastic::{Boundary, ElasticOperator};
+use crate::pool::on_worker;
 use crate::stop::Stop;
 use crate::surface::Surface;
 use crate::{memory, Error};
@@ -415,13 +416,15 @@ impl ContactSolver {
             }
         }
         let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
-        let result = match (self.params.solver, target) {
+        // On a worker of the pool: the iteration's parallel passes are then forked, not
+        // injected one by one (`pool.rs`).
+        let result = on_worker(|| match (self.params.solver, target) {
             (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
                 self.bccg_periodic_indentation(d)
             }
             (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
             (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
-        };
+        });
         match result {
             // Every point in contact, under load or displacement control: no contact
             // problem is left; refused with the threshold (free boundaries: only known
