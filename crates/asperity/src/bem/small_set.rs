@@ -24,7 +24,8 @@
 //! points (where a transform costs less than the factor), after [`MAX_SOLVES`]
 //! factorisations, if the factor breaks down, or at once when more than
 //! [`GIVE_UP_ENTERING`] limits' worth of points have a negative gap (a load far too large
-//! for a small set). Its result is only a start: the BCCG's own residual, on an exact `u`, decides
+//! for a small set; from cold a bound tells that before the check's operator
+//! application, `ContactSolver::highest_point_gives_up`). Its result is only a start: the BCCG's own residual, on an exact `u`, decides
 //! convergence, and a converged dense solution passes it with no iteration.
 //!
 //! The factor also holds the frozen-set stiffness of the solved state: `x` is `K_SS⁻¹ 1_S`
@@ -295,6 +296,16 @@ impl ContactSolver {
                 exact: false,
             });
         }
+        if let Target::MeanPressure(p) = target {
+            if start > limit && self.highest_point_gives_up(p, limit) {
+                // The first solve would give up: straight to the uniform start.
+                self.state.pressure.fill(p);
+                return Ok(SmallSetRun {
+                    applications: 0,
+                    exact: false,
+                });
+            }
+        }
         let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         let small = self
             .small_set
@@ -331,6 +342,27 @@ impl ContactSolver {
             }
             _ => Ok(run),
         }
+    }
+
+    /// Whether the direct iteration from cold would give up at its first check, known
+    /// without it: the whole load `P = n p̄` on the highest point (`f = 0`) indents it by
+    /// `d = K₀₀ P` and opens the gap `f(x) − P (K₀₀ − K(x))` elsewhere, which is below
+    /// `f(x) − P (K₀₀ − K_max)` with `K_max` the largest response off the loaded pixel. The
+    /// points where that bound is below the entering slack (less a margin for the rounding
+    /// of the transforms) would all enter: more than [`GIVE_UP_ENTERING`] limits of them
+    /// and the check, an operator application, would give up.
+    fn highest_point_gives_up(&self, mean_pressure: f64, limit: usize) -> bool {
+        let impulse = &self.bccg_scratch.impulse;
+        let load = mean_pressure * impulse.len() as f64;
+        let largest_off = impulse[1..]
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &k| m.max(k));
+        let opened = load * (impulse[0] - largest_off);
+        let slack = GAP_SLACK * self.params.tolerance * self.problem.height_scale;
+        let below = opened - slack - 1e-9 * load * impulse[0];
+        let entering = self.problem.profile.iter().filter(|&&f| f < below).count();
+        // The highest point itself (f = 0) is on the set, not entering.
+        entering.saturating_sub(1) > GIVE_UP_ENTERING * limit
     }
 
     /// The iteration of the module docs from the set in `small_set`.
@@ -561,6 +593,52 @@ mod tests {
                     assert_eq!(b.4, 0, "{what}: stiffness iterations");
                     assert!(b.3 <= 6, "{what}: {} applications", b.3);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn the_cold_shortcut_predicts_only_checks_that_give_up() {
+        // From cold, the whole load on the highest point: wherever the bound says the
+        // first check gives up, running it (one operator application) must give up, and
+        // the bound must say so at all but the loads just past where the check starts to
+        // give up (else it saves nothing); free and periodic, odd, even and rectangular
+        // grids.
+        for (rows, cols) in [(63, 63), (64, 64), (50, 72)] {
+            for boundary in [Boundary::Free, Boundary::Periodic] {
+                let surface = rough_grid(rows, cols, 11);
+                let params = SolverParams::default();
+                let mut solver =
+                    ContactSolver::new(&surface, half_space(boundary), params).unwrap();
+                let limit = limit(rows * cols);
+                let (mut predicted, mut missed) = (0, 0);
+                // Loads 1e-4 … 1e-1 in steps of 10^(1/8): the bound must follow the check
+                // closely (a bound that ignores the response off the loaded point predicts
+                // give-ups a step or more early).
+                for p in (0..=24).map(|e| 1e-4 * 10f64.powf(e as f64 / 8.0)) {
+                    let shortcut = solver.highest_point_gives_up(p, limit);
+                    let f = &solver.problem.profile;
+                    let top = (0..f.len()).fold(0, |t, k| if f[k] < f[t] { k } else { t });
+                    let periodic = boundary == Boundary::Periodic;
+                    let small = solver
+                        .small_set
+                        .get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
+                    small.clear();
+                    small.push(top);
+                    let run = solver
+                        .small_set_iterate(Target::MeanPressure(p), 100)
+                        .unwrap();
+                    let solved = solver.small_set.as_ref().unwrap().solved;
+                    let gave_up = run.applications == 1 && !solved;
+                    let what = format!("{rows}x{cols} {boundary:?} p = {p}");
+                    assert!(!shortcut || gave_up, "{what}: predicted a give-up");
+                    predicted += usize::from(shortcut);
+                    missed += usize::from(gave_up && !shortcut);
+                }
+                // And close behind it: at most two steps of load where the check gives up
+                // and the bound does not yet know (measured: one or two).
+                let what = format!("{rows}x{cols} {boundary:?}: {predicted} predicted");
+                assert!(predicted >= 2 && missed <= 2, "{what}, {missed} missed");
             }
         }
     }
