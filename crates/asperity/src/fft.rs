@@ -48,6 +48,8 @@ pub trait Precision: FftNum + Default {
     fn widened(self) -> f64;
     /// `row` as a row of this type, if it is one (`f64`): written in place, not copied.
     fn as_own(row: &mut [f64]) -> Option<&mut [Self]>;
+    /// `dst ← src` rounded to this type (a plain copy for `f64`).
+    fn load(dst: &mut [Self], src: &[f64]);
 }
 
 impl Precision for f64 {
@@ -62,6 +64,9 @@ impl Precision for f64 {
     fn as_own(row: &mut [f64]) -> Option<&mut [Self]> {
         Some(row)
     }
+    fn load(dst: &mut [Self], src: &[f64]) {
+        dst.copy_from_slice(src);
+    }
 }
 
 impl Precision for f32 {
@@ -75,6 +80,11 @@ impl Precision for f32 {
     }
     fn as_own(_: &mut [f64]) -> Option<&mut [Self]> {
         None
+    }
+    fn load(dst: &mut [Self], src: &[f64]) {
+        for (d, &x) in dst.iter_mut().zip(src) {
+            *d = x as f32;
+        }
     }
 }
 
@@ -524,9 +534,7 @@ impl<T: Precision> RealFft2<T> {
                 let rows = inp.chunks_exact(data_cols).zip(out.chunks_exact_mut(half));
                 for (r, (row_in, row_out)) in rows.enumerate() {
                     // The transform uses its input as scratch: refill the zeros every row.
-                    for (v, &x) in lane.real.iter_mut().zip(row_in) {
-                        *v = T::rounded(x);
-                    }
+                    T::load(&mut lane.real[..data_cols], row_in);
                     prepare(block * chunk + r, &mut lane.real[..data_cols]);
                     lane.real[data_cols..].fill(T::default());
                     r2c.process_with_scratch(&mut lane.real, row_out, &mut lane.scratch)
