@@ -187,8 +187,8 @@ impl RealFft2 {
 }
 
 impl<T: Precision> RealFft2<T> {
-    /// [`RealFft2::zero_padded`] in precision `T` (`rows × cols` and the data block of the
-    /// same size: no padding).
+    /// [`RealFft2::zero_padded`] in precision `T`: a `rows × cols` transform of a
+    /// `data_rows × data_cols` data block (the same sizes for no padding).
     pub fn planned(data_rows: usize, data_cols: usize, rows: usize, cols: usize) -> Result<Self> {
         if data_rows < 1 || data_cols < 1 {
             return Err(Error::invalid(
