@@ -38,9 +38,9 @@ use crate::memory::try_vec;
 use crate::{Error, Result};
 
 /// The floating-point type a [`RealFft2`] computes in: `f64` (the default, and the only
-/// one whose results are exact to rounding in double precision) or `f32` (about twice as
-/// fast, relative errors of about 1e-7: for approximations such as preconditioners). Its
-/// real inputs and outputs are `f64` either way.
+/// one whose results are exact to rounding in double precision) or `f32` (faster, with
+/// relative errors of about 1e-7: for approximations such as preconditioners). Its real
+/// inputs and outputs are `f64` either way.
 pub trait Precision: FftNum + Default {
     /// `x` rounded to this type.
     fn rounded(x: f64) -> Self;
