@@ -95,7 +95,7 @@ impl Precision for f32 {
 struct Lane<T> {
     real: Vec<T>,
     scratch: Vec<Complex<T>>,
-    /// [`COLUMN_BLOCK`] columns of the transform grid (`rows` values each), gathered from
+    /// [`Precision::STRIP`] columns of the transform grid (`rows` values each), gathered from
     /// the row spectra by the fused column pass.
     columns: Vec<Complex<T>>,
 }

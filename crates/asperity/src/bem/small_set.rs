@@ -25,8 +25,9 @@
 //! factorisations, if the factor breaks down, or at once when more than
 //! [`GIVE_UP_ENTERING`] limits' worth of points have a negative gap (a load far too large
 //! for a small set; from cold a bound tells that before the check's operator
-//! application, `ContactSolver::highest_point_gives_up`). Its result is only a start: the BCCG's own residual, on an exact `u`, decides
-//! convergence, and a converged dense solution passes it with no iteration.
+//! application, `ContactSolver::highest_point_gives_up`). Its result is only a start: the
+//! BCCG's own residual, on an exact `u`, decides convergence, and a converged dense
+//! solution passes it with no iteration.
 //!
 //! The factor also holds the frozen-set stiffness of the solved state: `x` is `K_SS⁻¹ 1_S`
 //! exactly, and [`ContactSolver::small_set_tangent`] hands it to the stiffness code when
@@ -276,6 +277,12 @@ impl SmallSet {
     }
 }
 
+/// The highest point of the surface: the first index of the smallest profile value
+/// (`f = 0` there), where a load from cold begins.
+fn highest_point(profile: &[f64]) -> usize {
+    (0..profile.len()).fold(0, |t, k| if profile[k] < profile[t] { k } else { t })
+}
+
 impl ContactSolver {
     /// Runs the direct iteration from the start [`ContactSolver::initialise`] left, if its
     /// set is small (module docs); leaves a pressure for the BCCG to finish.
@@ -312,15 +319,7 @@ impl ContactSolver {
             .get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
         small.clear();
         if start > limit {
-            // From cold: the highest point (f = 0 there).
-            let top = (0..len).fold(0, |t, k| {
-                if self.problem.profile[k] < self.problem.profile[t] {
-                    k
-                } else {
-                    t
-                }
-            });
-            small.push(top);
+            small.push(highest_point(&self.problem.profile));
         } else {
             for (k, &p) in self.state.pressure.iter().enumerate() {
                 if p > 0.0 {
@@ -617,8 +616,7 @@ mod tests {
                 // give-ups a step or more early).
                 for p in (0..=24).map(|e| 1e-4 * 10f64.powf(e as f64 / 8.0)) {
                     let shortcut = solver.highest_point_gives_up(p, limit);
-                    let f = &solver.problem.profile;
-                    let top = (0..f.len()).fold(0, |t, k| if f[k] < f[t] { k } else { t });
+                    let top = highest_point(&solver.problem.profile);
                     let periodic = boundary == Boundary::Periodic;
                     let small = solver
                         .small_set
