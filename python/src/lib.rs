@@ -21,6 +21,11 @@ mod topography;
 
 use pyo3::prelude::*;
 
+/// Large buffers on transparent huge pages, as in the `asperity` binary
+/// (`asperity::huge_pages`): the module's own allocations only (numpy keeps its own).
+#[global_allocator]
+static ALLOCATOR: asperity::huge_pages::HugePageAlloc = asperity::huge_pages::HugePageAlloc;
+
 /// The compiled module.
 #[pymodule]
 fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -17,6 +17,11 @@ mod studies;
 
 use clap::Parser;
 
+/// Large buffers (the solvers' fields, surfaces, spectra) on transparent huge pages:
+/// fewer page faults and TLB misses (`asperity::huge_pages`).
+#[global_allocator]
+static ALLOCATOR: asperity::huge_pages::HugePageAlloc = asperity::huge_pages::HugePageAlloc;
+
 fn main() {
     // Under MPI (the `mpi` feature), rank 0 runs the command and the other ranks compute
     // samples for its studies (see `distributed`).

@@ -44,6 +44,8 @@ use crate::{Error, Result};
 pub trait Precision: FftNum + Default {
     /// `x` rounded to this type.
     fn rounded(x: f64) -> Self;
+    /// `self` in double precision (exact).
+    fn widened(self) -> f64;
     /// `row` as a row of this type, if it is one (`f64`): written in place, not copied.
     fn as_own(row: &mut [f64]) -> Option<&mut [Self]>;
     /// `dst ← src` rounded to this type (a plain copy for `f64`).
@@ -58,6 +60,10 @@ impl Precision for f64 {
     #[inline(always)]
     fn rounded(x: f64) -> Self {
         x
+    }
+    #[inline(always)]
+    fn widened(self) -> f64 {
+        self
     }
     fn as_own(row: &mut [f64]) -> Option<&mut [Self]> {
         Some(row)
@@ -75,6 +81,10 @@ impl Precision for f32 {
     #[inline(always)]
     fn rounded(x: f64) -> Self {
         x as f32
+    }
+    #[inline(always)]
+    fn widened(self) -> f64 {
+        f64::from(self)
     }
     fn as_own(_: &mut [f64]) -> Option<&mut [Self]> {
         None

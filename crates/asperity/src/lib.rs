@@ -89,6 +89,7 @@ pub mod elastic;
 mod error;
 pub mod fft;
 pub mod fit;
+pub mod huge_pages;
 pub mod input;
 pub mod io;
 pub mod lock;

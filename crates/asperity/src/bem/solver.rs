@@ -233,7 +233,7 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow), an upper bound on what its parts hold once all have been used: the
-    /// operator and the preconditioner; the profile, pressure and gap; the BCCG's five
+    /// operator, its single-precision copy and the preconditioner; the profile, pressure and gap; the BCCG's five
     /// fields and its mask, with the rings of large grids one more field and eleven bytes
     /// per point (counts and lists); the Polonsky–Keer iteration's two; the six of the
     /// stiffness CG and its set's index list (on large grids its rings' field and twelve
@@ -253,6 +253,9 @@ impl ContactSolver {
         let limit = super::small_set::limit(rows.checked_mul(cols)?);
         let factor = memory::array_bytes(&[limit + 3, limit], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
+            .checked_add(ElasticOperator::single_precision_memory_bytes(
+                rows, cols, boundary,
+            )?)?
             .checked_add(FourierPreconditioner::<Real>::memory_bytes(rows, cols)?)?
             .checked_add(fields)?
             .checked_add(factor)
@@ -282,7 +285,7 @@ impl ContactSolver {
             surface.spacing_y(),
             half_space.modulus,
         )?;
-        let bccg_scratch = BccgScratch::new(&mut problem.operator);
+        let bccg_scratch = BccgScratch::new(&mut problem.operator)?;
         Ok(ContactSolver {
             problem,
             params,
