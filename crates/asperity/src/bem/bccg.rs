@@ -183,11 +183,10 @@ pub(super) struct BccgScratch {
     /// Whether a step expected to end in a refresh takes `sᵀK s` from the forward
     /// transform alone (always, but in the test that compares it with forming `K s`).
     energy_steps: bool,
-    /// The operator in single precision, for the iterations far from convergence
-    /// ([`SINGLE_PRECISION_ABOVE`]).
+    /// The operator in single precision (module docs, step 7).
     single: ElasticOperator<f32>,
-    /// Whether iterations far from convergence use `single` (always, but in the test that
-    /// compares the solves with and without it).
+    /// Whether the iteration uses `single` (always, but in the test that compares the
+    /// solves with and without it).
     single_steps: bool,
 }
 
@@ -307,6 +306,27 @@ struct Direction {
     zg: f64,
     /// `sᵀ Π g` of the new direction (negative: downhill).
     sg: f64,
+}
+
+/// What the displacement field `u` holds, from the most exact to the least.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Displacement {
+    /// `K p` recomputed in double precision, and no step since.
+    Exact,
+    /// Steps since, `u` updated by recurrence (and by `K s` in single precision).
+    Recurrence,
+    /// Recomputed in single precision since the last recomputation in double precision.
+    Single,
+}
+
+impl Displacement {
+    /// After a recomputation of `u`, in single precision or not.
+    fn recomputed(single: bool) -> Self {
+        match single {
+            true => Displacement::Single,
+            false => Displacement::Exact,
+        }
+    }
 }
 
 /// What a step did.
@@ -543,17 +563,7 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let self_influence = self.problem.operator.self_influence();
-        self.initialise(target, self_influence);
-        let mut indentation = match target {
-            Target::Indentation(d) => d,
-            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
-        };
-        self.bccg_scratch.pending_scale = 1.0;
-        self.bccg_scratch.extra_energies = 0;
-        if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
-            mean_gap.reset();
-        }
+        let mut indentation = self.bccg_start(target);
         // Small contact sets: solved directly (`small_set.rs`), then only checked here.
         let small = self.small_set_start(target, max_iterations)?;
         if !small.exact {
@@ -562,9 +572,7 @@ impl ContactSolver {
                 .apply(&self.state.pressure, &mut self.state.gap);
         }
         let mut applications = small.applications + usize::from(!small.exact);
-        let (mut exact, mut since_refresh, mut energy_transforms) = (true, 0, 0);
-        // Whether `u` holds single-precision results (recomputed before convergence).
-        let mut approximate = false;
+        let (mut u, mut since_refresh, mut energy_transforms) = (Displacement::Exact, 0, 0);
         // Whether the last step cut more pressures than the point responses correct (the
         // first steps of a solve all do: its set is still growing).
         let mut cutting = true;
@@ -574,7 +582,7 @@ impl ContactSolver {
             self.check_stop(iteration)?;
             let gradient = self.gradient_pass(target, indentation);
             indentation = gradient.indentation;
-            if gradient.residual < tolerance && exact {
+            if gradient.residual < tolerance && u == Displacement::Exact {
                 self.write_gap(indentation);
                 let info = SolveInfo {
                     iterations: iteration,
@@ -587,12 +595,12 @@ impl ContactSolver {
             let far = self.bccg_scratch.single_steps && gradient.residual > SINGLE_PRECISION_ABOVE;
             let refresh_due = self.bccg_scratch.energy_steps
                 && (cutting || since_refresh + 1 >= REFRESH_INTERVAL);
-            if gradient.residual < tolerance || (approximate && !far && !refresh_due) {
+            let leaving_single = u == Displacement::Single && !far && !refresh_due;
+            if gradient.residual < tolerance || leaving_single {
                 // Converged on the recurrence, or near enough to need double precision
                 // (and no recomputation of `u` due after the step): the exact displacement.
                 self.refresh_displacement(false);
-                (applications, exact, since_refresh) = (applications + 1, true, 0);
-                approximate = false;
+                (applications, u, since_refresh) = (applications + 1, Displacement::Exact, 0);
                 continue;
             }
             if iteration >= max_iterations || !gradient.residual.is_finite() {
@@ -604,10 +612,8 @@ impl ContactSolver {
             iteration += 1;
             let direction = self.direction(target, &gradient, previous_zg);
             previous_zg = direction.zg;
-            let single = match refresh_due {
-                true => far,
-                false => self.bccg_scratch.single_steps,
-            };
+            // Energies in single precision while far; every `K s` (`far` implies single steps).
+            let single = far || (!refresh_due && self.bccg_scratch.single_steps);
             let curvature = self.curvature(refresh_due, single);
             (applications, energy_transforms) = match refresh_due {
                 true => (applications, energy_transforms + 1),
@@ -615,13 +621,31 @@ impl ContactSolver {
             };
             let line = (direction.sg, curvature);
             let step = self.step(target, &gradient, line, !refresh_due, iteration)?;
-            (cutting, since_refresh, exact) = (step.cut_many, since_refresh + 1, false);
+            (cutting, since_refresh) = (step.cut_many, since_refresh + 1);
+            u = u.max(Displacement::Recurrence);
             if step.stale || since_refresh >= REFRESH_INTERVAL {
                 self.refresh_displacement(far);
-                (applications, exact, since_refresh) = (applications + 1, !far, 0);
-                approximate = far;
+                (applications, u) = (applications + 1, Displacement::recomputed(far));
+                since_refresh = 0;
             }
         }
+    }
+
+    /// The start of a solve of `target`: the initial pressure, the iteration's scalars
+    /// reset; returns the first `d` (the last solve's under load control).
+    fn bccg_start(&mut self, target: Target) -> f64 {
+        let self_influence = self.problem.operator.self_influence();
+        self.initialise(target, self_influence);
+        let indentation = match target {
+            Target::Indentation(d) => d,
+            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
+        };
+        self.bccg_scratch.pending_scale = 1.0;
+        self.bccg_scratch.extra_energies = 0;
+        if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
+            mean_gap.reset();
+        }
+        indentation
     }
 
     /// Passes over the grid: `d` (load control, the mean of `u + f` on the contact set),
