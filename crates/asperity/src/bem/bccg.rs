@@ -1128,68 +1128,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn energy_steps_are_the_steps_that_form_k_s() {
-        // The line minimum of a step that ends in u = K p from Parseval's sᵀK s (the
-        // forward transform alone) against w = K s and sᵀw: the same iterates up to
-        // rounding, so the same iterations and results, for fewer applications. Odd, even
-        // and rectangular grids, free and periodic, load and displacement control.
-        for (rows, cols, seed) in [(63, 63, 5), (64, 64, 6), (50, 72, 7)] {
-            let surface = rough_grid(rows, cols, seed);
-            for boundary in [Boundary::Free, Boundary::Periodic] {
-                let run = |control: Control, energy_steps: bool| {
-                    let params = params(SolverKind::Bccg, 1e-10);
-                    let mut s = ContactSolver::new(&surface, half_space(boundary), params).unwrap();
-                    s.bccg_scratch.energy_steps = energy_steps;
-                    // Double precision throughout: the two ways are then equal to rounding.
-                    s.bccg_scratch.single_steps = false;
-                    s.solve(control).unwrap()
-                };
-                let (loaded, _) = run(Control::MeanPressure(0.03), true);
-                let displaced = Control::Indentation(0.8 * loaded.indentation);
-                for control in [Control::MeanPressure(0.03), displaced] {
-                    let case = format!("{rows}x{cols} {boundary:?} {control:?}");
-                    let (with, with_info) = run(control, true);
-                    let (without, without_info) = run(control, false);
-                    assert_eq!(with_info.iterations, without_info.iterations, "{case}");
-                    // (Periodic displacement control takes its coarse curvature from the
-                    // forward transform either way.)
-                    let energies = (with_info.energy_transforms, without_info.energy_transforms);
-                    assert!(energies.0 > energies.1, "{case}: no energy step");
-                    let applications = (
-                        with_info.operator_applications,
-                        without_info.operator_applications,
-                    );
-                    assert!(applications.0 < applications.1, "{case}: {applications:?}");
-                    let relative = |a: f64, b: f64| (a - b).abs() / b.abs();
-                    assert!(
-                        relative(with.indentation, without.indentation) < 1e-12,
-                        "{case}"
-                    );
-                    assert!(
-                        relative(with.mean_pressure, without.mean_pressure) < 1e-12,
-                        "{case}"
-                    );
-                    assert_eq!(with.contact_points, without.contact_points, "{case}");
-                }
-            }
-        }
-    }
+    /// A solve's summary, information and pressure field.
+    type TwoWaySolve = (ContactSummary, SolveInfo, ndarray::Array2<f64>);
 
-    #[test]
-    fn single_precision_steps_reach_the_double_precision_solution() {
-        // The steps far from convergence in single precision against double precision
-        // throughout: the iterates differ (by rounding of about 1e-7), the solutions do not
-        // beyond the tolerance (1e-10 here: the same contact set, the indentation and load
-        // to 1e-9), nor the iteration counts by more than one. Odd, even and rectangular
-        // grids, free and periodic, load and displacement control.
+    /// Solves every case of the comparison tests two ways, the solver set up by
+    /// `configure(solver, true)` and `configure(solver, false)`, and hands both to
+    /// `compare(case, first, second)`: odd, even and rectangular grids, free and periodic,
+    /// load control (p̄ = 0.03) and displacement control (0.8 of its indentation),
+    /// tolerance 1e-10.
+    fn compare_two_ways(
+        configure: impl Fn(&mut ContactSolver, bool),
+        compare: impl Fn(&str, &TwoWaySolve, &TwoWaySolve),
+    ) {
         for (rows, cols, seed) in [(63, 63, 5), (64, 64, 6), (50, 72, 7)] {
             let surface = rough_grid(rows, cols, seed);
             for boundary in [Boundary::Free, Boundary::Periodic] {
-                let run = |control: Control, single_steps: bool| {
+                let run = |control: Control, way: bool| {
                     let params = params(SolverKind::Bccg, 1e-10);
                     let mut s = ContactSolver::new(&surface, half_space(boundary), params).unwrap();
-                    s.bccg_scratch.single_steps = single_steps;
+                    configure(&mut s, way);
                     let (summary, info) = s.solve(control).unwrap();
                     (summary, info, s.pressure().to_owned())
                 };
@@ -1197,25 +1154,70 @@ mod tests {
                 let displaced = Control::Indentation(0.8 * loaded.indentation);
                 for control in [Control::MeanPressure(0.03), displaced] {
                     let case = format!("{rows}x{cols} {boundary:?} {control:?}");
-                    let (single, single_info, single_p) = run(control, true);
-                    let (double, double_info, double_p) = run(control, false);
-                    assert_ne!(single_p, double_p, "{case}: no single-precision step");
-                    let iterations = (single_info.iterations, double_info.iterations);
-                    assert!(
-                        iterations.0.abs_diff(iterations.1) <= 1,
-                        "{case}: {iterations:?}"
-                    );
-                    let relative = |a: f64, b: f64| (a - b).abs() / b.abs();
-                    let d_error = relative(single.indentation, double.indentation);
-                    assert!(d_error < 1e-9, "{case}: indentation {d_error:e}");
-                    let p_error = relative(single.mean_pressure, double.mean_pressure);
-                    assert!(p_error < 1e-9, "{case}: load {p_error:e}");
-                    let set =
-                        |p: &ndarray::Array2<f64>| p.iter().map(|&v| v > 0.0).collect::<Vec<_>>();
-                    assert_eq!(set(&single_p), set(&double_p), "{case}");
+                    compare(&case, &run(control, true), &run(control, false));
                 }
             }
         }
+    }
+
+    fn relative(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn energy_steps_are_the_steps_that_form_k_s() {
+        // The line minimum of a step that ends in u = K p from Parseval's sᵀK s (the
+        // forward transform alone) against w = K s and sᵀw, in double precision throughout:
+        // the same iterates up to rounding, so the same iterations and results, for fewer
+        // applications.
+        let configure = |s: &mut ContactSolver, energy_steps: bool| {
+            s.bccg_scratch.energy_steps = energy_steps;
+            s.bccg_scratch.single_steps = false;
+        };
+        compare_two_ways(configure, |case, with, without| {
+            let ((with, with_info, _), (without, without_info, _)) = (with, without);
+            assert_eq!(with_info.iterations, without_info.iterations, "{case}");
+            // (Periodic displacement control takes its coarse curvature from the forward
+            // transform either way.)
+            let energies = (with_info.energy_transforms, without_info.energy_transforms);
+            assert!(energies.0 > energies.1, "{case}: no energy step");
+            let applications = (
+                with_info.operator_applications,
+                without_info.operator_applications,
+            );
+            assert!(applications.0 < applications.1, "{case}: {applications:?}");
+            let d_error = relative(with.indentation, without.indentation);
+            assert!(d_error < 1e-12, "{case}: indentation {d_error:e}");
+            let p_error = relative(with.mean_pressure, without.mean_pressure);
+            assert!(p_error < 1e-12, "{case}: load {p_error:e}");
+            assert_eq!(with.contact_points, without.contact_points, "{case}");
+        });
+    }
+
+    #[test]
+    fn single_precision_steps_reach_the_double_precision_solution() {
+        // Every K s, and the energies and recomputations of u far from convergence, in
+        // single precision against double precision throughout: the iterates differ (by
+        // rounding of about 1e-7), the solutions do not beyond the tolerance (the same
+        // contact set, the indentation and load to 1e-9), nor the iteration counts by more
+        // than one.
+        let configure = |s: &mut ContactSolver, single: bool| s.bccg_scratch.single_steps = single;
+        compare_two_ways(configure, |case, single, double| {
+            let ((single, single_info, single_p), (double, double_info, double_p)) =
+                (single, double);
+            assert_ne!(single_p, double_p, "{case}: no single-precision step");
+            let iterations = (single_info.iterations, double_info.iterations);
+            assert!(
+                iterations.0.abs_diff(iterations.1) <= 1,
+                "{case}: {iterations:?}"
+            );
+            let d_error = relative(single.indentation, double.indentation);
+            assert!(d_error < 1e-9, "{case}: indentation {d_error:e}");
+            let p_error = relative(single.mean_pressure, double.mean_pressure);
+            assert!(p_error < 1e-9, "{case}: load {p_error:e}");
+            let set = |p: &ndarray::Array2<f64>| p.iter().map(|&v| v > 0.0).collect::<Vec<_>>();
+            assert_eq!(set(single_p), set(double_p), "{case}");
+        });
     }
 
     #[test]
