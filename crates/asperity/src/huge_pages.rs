@@ -4,10 +4,9 @@
 //! spectrum 8 MiB), and with 4 KiB pages every first touch of a page is a fault: the first
 //! 512² BEM solve of a process faulted 6 049 times (free boundaries, 2 threads; 473 with
 //! this allocator) and took 0.23–0.24 s instead of 0.22 s. The kernel's transparent huge
-//! pages (THP) map
-//! 2 MiB per fault, but only in 2 MiB-aligned ranges of a mapping marked for them
-//! (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, the common default) or in
-//! any mapping (`always`). The C allocator aligns its large blocks to 4 KiB only, so a
+//! pages (THP) map 2 MiB per fault, but only in 2 MiB-aligned ranges of a mapping marked
+//! for them (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, the common
+//! default) or in any mapping (`always`). The C allocator aligns its large blocks to 4 KiB only, so a
 //! 2 MiB field never covers an aligned range.
 //!
 //! [`HugePageAlloc`] maps every block of at least [`LARGE`] bytes by itself, aligned to
@@ -153,7 +152,7 @@ unsafe impl GlobalAlloc for HugePageAlloc {
         let new_layout = unsafe { Layout::from_size_align_unchecked(new_size, layout.align()) };
         match (mapped(layout), mapped(new_layout)) {
             (false, false) => unsafe { System.realloc(ptr, layout, new_size) },
-            // A mapping's spare room up to its whole huge pages is already there.
+            // A mapping's spare room up to its last whole page is already there.
             (true, true) if mapping_len(new_size) == mapping_len(layout.size()) => ptr,
             _ => {
                 let moved = unsafe { self.alloc(new_layout) };

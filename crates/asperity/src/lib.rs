@@ -112,6 +112,18 @@ pub(crate) use error::{is_positive_finite, positive_finite};
 pub(crate) mod test_support {
     //! Helpers shared by the unit tests.
 
+    /// `max |a − b| / max |a|`: the largest deviation of `b` from `a`, relative to the
+    /// largest magnitude of `a` (for comparisons of precisions).
+    pub fn relative_max_error(a: &[f64], b: &[f64]) -> f64 {
+        assert_eq!(a.len(), b.len(), "compared fields differ in length");
+        let largest = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let error = a
+            .iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        error / largest
+    }
+
     /// Runs `f` on a fresh rayon pool of `threads` threads (determinism tests).
     pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         rayon::ThreadPoolBuilder::new()

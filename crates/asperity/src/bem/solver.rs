@@ -233,9 +233,9 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
     /// overflow), an upper bound on what its parts hold once all have been used: the
-    /// operator, its single-precision copy and the preconditioner; the profile, pressure and gap; the BCCG's five
-    /// fields and its mask, with the rings of large grids one more field and eleven bytes
-    /// per point (counts and lists); the Polonsky–Keer iteration's two; the six of the
+    /// operator, its single-precision copy and the preconditioner; the profile, pressure
+    /// and gap; the BCCG's five fields and its mask, with the rings of large grids one more
+    /// field and eleven bytes per point (counts and lists); the Polonsky–Keer iteration's two; the six of the
     /// stiffness CG and its set's index list (on large grids its rings' field and twelve
     /// bytes per point); the two of the full-contact code (periodic: three more for the
     /// coarse correction of displacement control); the direct solve of small sets, a field

@@ -112,12 +112,7 @@ impl ElasticOperator {
     /// overflow): row-pass buffer and kernel, and the whole spectrum the kernel's set-up
     /// holds for a while (free boundaries; an upper bound for periodic ones).
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let pad = boundary.padding();
-        let padded_rows = rows.checked_mul(pad)?;
-        let half_cols = cols.checked_mul(pad)? / 2 + 1;
-        let spectrum = memory::array_bytes(&[half_cols, padded_rows], 16)?;
-        let work = memory::array_bytes(&[rows, half_cols], 16)?;
-        let kernel = memory::array_bytes(&[half_cols, padded_rows / 2 + 1], 8)?;
+        let [work, kernel, spectrum] = buffer_bytes(rows, cols, boundary, 8)?;
         spectrum.checked_add(work)?.checked_add(kernel)
     }
 
@@ -223,13 +218,23 @@ impl ElasticOperator {
         cols: usize,
         boundary: Boundary,
     ) -> Option<u64> {
-        let pad = boundary.padding();
-        let padded_rows = rows.checked_mul(pad)?;
-        let half_cols = cols.checked_mul(pad)? / 2 + 1;
-        let work = memory::array_bytes(&[rows, half_cols], 8)?;
-        let kernel = memory::array_bytes(&[half_cols, padded_rows / 2 + 1], 4)?;
+        let [work, kernel, _] = buffer_bytes(rows, cols, boundary, 4)?;
         work.checked_add(kernel)
     }
+}
+
+/// The buffers of an operator for a `rows × cols` grid computing with `real` bytes per real
+/// value (8 or 4), in bytes (`None` on overflow): its row-pass buffer and its kernel, and
+/// the whole spectrum (complex `f64`) that the kernel's set-up holds for a while.
+fn buffer_bytes(rows: usize, cols: usize, boundary: Boundary, real: usize) -> Option<[u64; 3]> {
+    let pad = boundary.padding();
+    let padded_rows = rows.checked_mul(pad)?;
+    let half_cols = cols.checked_mul(pad)? / 2 + 1;
+    Some([
+        memory::array_bytes(&[rows, half_cols], 2 * real)?,
+        memory::array_bytes(&[half_cols, padded_rows / 2 + 1], real)?,
+        memory::array_bytes(&[half_cols, padded_rows], 16)?,
+    ])
 }
 
 impl<T: Precision> ElasticOperator<T> {
@@ -458,6 +463,7 @@ fn with_even_kernel<'a, T, K: Copy>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::relative_max_error;
 
     fn pseudo_random(n: usize, seed: usize) -> Vec<f64> {
         (0..n)
@@ -782,14 +788,10 @@ mod tests {
                 let (mut u, mut u_single) = (vec![0.0; p.len()], vec![f64::NAN; p.len()]);
                 op.apply(&p, &mut u);
                 single.apply(&p, &mut u_single);
-                let largest = u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                let error = u
-                    .iter()
-                    .zip(&u_single)
-                    .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                let error = relative_max_error(&u, &u_single);
                 let case = format!("{rows}x{cols} {boundary:?}");
-                assert!(error < 1e-5 * largest, "{case}: {error:e} of {largest:e}");
-                assert!(error > 1e-9 * largest, "{case}: not single? {error:e}");
+                assert!(error < 1e-5, "{case}: {error:e} of the largest value");
+                assert!(error > 1e-9, "{case}: not single? {error:e}");
                 let (energy, energy_single) = (op.energy(&p), single.energy(&p));
                 let relative = (energy_single / energy - 1.0).abs();
                 assert!(
