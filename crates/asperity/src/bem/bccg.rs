@@ -921,7 +921,7 @@ impl ContactSolver {
 #[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::rough_grid;
-    use super::super::{Control, HalfSpace, SolverKind, SolverParams};
+    use super::super::{Control, HalfSpace, Parallelism, SolverKind, SolverParams};
     use super::*;
     use crate::elastic::Boundary;
     use crate::surface::Surface;
@@ -1103,16 +1103,19 @@ mod tests {
     fn results_do_not_depend_on_the_thread_count() {
         // 150² spans three chunks of the parallel passes: their partial sums must add up
         // to the same bits whichever threads computed them (and three blocks of rows of
-        // the rings' passes).
+        // the rings' passes), with the other threads kept awake or not.
         for (surface, boundary) in [rough_grid(48, 56, 3), rough_grid(150, 150, 3)]
             .iter()
             .flat_map(|s| [(s, Boundary::Free), (s, Boundary::Periodic)])
         {
-            let run = |threads: usize, rings: bool| {
+            let run = |threads: usize, rings: bool, parallelism: Parallelism| {
                 crate::test_support::with_threads(threads, || {
+                    let params = SolverParams {
+                        parallelism,
+                        ..SolverParams::default()
+                    };
                     let mut solver =
-                        ContactSolver::new(surface, half_space(boundary), SolverParams::default())
-                            .unwrap();
+                        ContactSolver::new(surface, half_space(boundary), params).unwrap();
                     solver.set_edge_rings(rings);
                     let (s, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
                     let (k, _) = solver.frozen_set_stiffness().unwrap();
@@ -1123,7 +1126,11 @@ mod tests {
                 })
             };
             for rings in [false, true] {
-                assert_eq!(run(1, rings), run(2, rings), "{boundary:?}, rings {rings}");
+                let one = run(1, rings, Parallelism::Exclusive);
+                for parallelism in [Parallelism::Exclusive, Parallelism::Shared] {
+                    let two = run(2, rings, parallelism);
+                    assert_eq!(one, two, "{boundary:?}, rings {rings}, {parallelism:?}");
+                }
             }
         }
     }

@@ -121,7 +121,9 @@ impl ContactSolver {
         match self.problem.operator.boundary() {
             Boundary::Periodic => Ok(self.periodic_full_contact()),
             // Two CG solves: on a worker of the pool, as the solves (`pool.rs`).
-            Boundary::Free => crate::pool::on_worker(|| self.free_full_contact()),
+            Boundary::Free => {
+                crate::pool::on_worker(self.params.parallelism, || self.free_full_contact())
+            }
         }
     }
 

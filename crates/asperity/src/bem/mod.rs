@@ -156,6 +156,22 @@ impl std::str::FromStr for SolverKind {
     }
 }
 
+/// How a solve shares the threads of the rayon pool it runs on. The numbers do not depend
+/// on it (nor on the number of threads); the time does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Parallelism {
+    /// The solve has the pool to itself, as when solves run one at a time (the CLI's `bem`
+    /// and `contact`, the Python package): while it runs, the pool's other threads wait for
+    /// its parallel passes awake instead of sleeping between them. Measured at 256² on 2
+    /// threads, 10–20 % off a solve (`pool.rs`). Solves started at the same time from
+    /// several threads fall back to [`Parallelism::Shared`].
+    #[default]
+    Exclusive,
+    /// The pool runs other work beside the solve (a study's lanes, each solving its own
+    /// sample): idle threads sleep as rayon's do, so that they take up that work.
+    Shared,
+}
+
 /// Parameters of the contact solver (validated by [`ContactSolver::new`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverParams {
@@ -174,6 +190,8 @@ pub struct SolverParams {
     pub stiffness_error: f64,
     /// Iterations of the frozen-set CG before [`SolveError::NoConvergence`]; ≥ 1.
     pub stiffness_max_iterations: usize,
+    /// How the solves share the thread pool ([`Parallelism::Exclusive`] by default).
+    pub parallelism: Parallelism,
 }
 
 impl Default for SolverParams {
@@ -182,7 +200,7 @@ impl Default for SolverParams {
     /// (estimated relative error) or to `1e-10` relative residual, in at most 10 000
     /// iterations. The stiffness is then far more precise than the contact set it belongs
     /// to: a solve to `1e-8` may leave a point of pressure `~1e-8` in or out, which moves
-    /// `k` by up to `~1e-7` (measured at 128²).
+    /// `k` by up to `~1e-7` (measured at 128²). [`Parallelism::Exclusive`].
     fn default() -> Self {
         SolverParams {
             solver: SolverKind::Bccg,
@@ -191,6 +209,7 @@ impl Default for SolverParams {
             stiffness_tolerance: 1e-10,
             stiffness_error: 1e-12,
             stiffness_max_iterations: 10_000,
+            parallelism: Parallelism::Exclusive,
         }
     }
 }

@@ -420,8 +420,9 @@ impl ContactSolver {
         }
         let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
         // On a worker of the pool: the iteration's parallel passes are then forked, not
-        // injected one by one (`pool.rs`).
-        let result = on_worker(|| match (self.params.solver, target) {
+        // injected one by one, and the other workers wait for them awake (`pool.rs`).
+        let parallelism = self.params.parallelism;
+        let result = on_worker(parallelism, || match (self.params.solver, target) {
             (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
                 self.bccg_periodic_indentation(d)
             }

@@ -362,7 +362,9 @@ impl ContactSolver {
             self.params.stiffness_max_iterations,
         );
         // On a worker of the pool, as the solves (`pool.rs`).
-        crate::pool::on_worker(|| self.set_stiffness(tolerance, max_iterations))
+        crate::pool::on_worker(self.params.parallelism, || {
+            self.set_stiffness(tolerance, max_iterations)
+        })
     }
 
     /// The frozen-set stiffness of the current pressure's contact set, by CG to `tolerance`

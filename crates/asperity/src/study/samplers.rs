@@ -26,7 +26,7 @@ use super::{
     run_task, CurvePoint, Method, ProgressFn, SampleCurve, Sampler, StudyDir, StudySpec, Task,
     TaskResult,
 };
-use crate::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use crate::bem::{ContactSolver, Control, HalfSpace, Parallelism, SolverParams};
 use crate::elastic::Boundary;
 use crate::mdr::LinearCurve;
 use crate::memory::{array_bytes, ensure_fits};
@@ -226,9 +226,13 @@ fn psd_of(spec: &StudySpec, task: Task) -> Result<Psd> {
 }
 
 /// The contact solver settings of every BEM sample (recorded in each checkpoint's
-/// identity, [`super::identity::SolverIdentity`]).
+/// identity, [`super::identity::SolverIdentity`]). The samples are solved in parallel lanes
+/// that share the pool ([`Parallelism::Shared`]).
 pub(crate) fn bem_solver_params() -> SolverParams {
-    SolverParams::default()
+    SolverParams {
+        parallelism: Parallelism::Shared,
+        ..SolverParams::default()
+    }
 }
 
 /// Called after each solved load of a BEM sample, on the thread that solved it: progress
