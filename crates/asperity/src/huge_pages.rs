@@ -24,6 +24,11 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 
+mod medium;
+
+pub use medium::MEDIUM;
+use medium::{is_medium, Pool};
+
 /// Blocks of at least this many bytes (1 MiB) are mapped on their own; smaller ones, most
 /// allocations, keep the system allocator's speed. A block of less than a huge page gains
 /// nothing yet costs nothing either (its pages stay small), so the bound need not be
@@ -36,6 +41,33 @@ const HUGE_PAGE: usize = 2 << 20;
 /// The allocator of the module docs.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct HugePageAlloc;
+
+/// The medium blocks of every [`HugePageAlloc`].
+static MEDIUM_BLOCKS: Pool = Pool::new();
+
+/// Where a block lives: decided by its layout alone, so that a block is returned where it
+/// came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Home {
+    /// The system allocator (small blocks, and any of a stricter alignment).
+    System,
+    /// [`MEDIUM_BLOCKS`] (`medium.rs`).
+    Medium,
+    /// A mapping of its own.
+    Mapped,
+}
+
+impl Home {
+    fn of(layout: Layout) -> Home {
+        if mapped(layout) {
+            Home::Mapped
+        } else if is_medium(layout.size(), layout.align()) {
+            Home::Medium
+        } else {
+            Home::System
+        }
+    }
+}
 
 /// Whether a block goes to its own mapping: large, and aligned to no more than a huge page
 /// (a stricter alignment, never asked in practice, stays with the system allocator).
@@ -118,54 +150,62 @@ mod map {
     }
 }
 
-// SAFETY: every block is either the system allocator's (and returned to it with the same
-// layout) or a mapping of its own of at least its size, aligned to 2 MiB (at least its
-// alignment), returned whole: `mapped` depends on the layout only, and a reallocation
-// keeps the alignment.
+// SAFETY: every block is the system allocator's (and returned to it with the same layout),
+// a medium block of at least its size aligned to 64 KiB (`medium.rs`), or a mapping of its
+// own of at least its size aligned to 2 MiB, returned whole: the home depends on the
+// layout only ([`Home::of`]; blocks of stricter alignments stay with the system
+// allocator), and a reallocation keeps the alignment.
 unsafe impl GlobalAlloc for HugePageAlloc {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if mapped(layout) {
-            unsafe { map::map(layout.size()) }
-        } else {
-            unsafe { System.alloc(layout) }
+        match Home::of(layout) {
+            Home::System => unsafe { System.alloc(layout) },
+            Home::Medium => unsafe { MEDIUM_BLOCKS.alloc(layout.size(), false) },
+            Home::Mapped => unsafe { map::map(layout.size()) },
         }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if mapped(layout) {
-            unsafe { map::map(layout.size()) } // anonymous mappings are zero
-        } else {
-            unsafe { System.alloc_zeroed(layout) }
+        match Home::of(layout) {
+            Home::System => unsafe { System.alloc_zeroed(layout) },
+            Home::Medium => unsafe { MEDIUM_BLOCKS.alloc(layout.size(), true) },
+            // Anonymous mappings are zero.
+            Home::Mapped => unsafe { map::map(layout.size()) },
         }
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        if mapped(layout) {
-            unsafe { map::unmap(ptr, layout.size()) }
-        } else {
-            unsafe { System.dealloc(ptr, layout) }
+        match Home::of(layout) {
+            Home::System => unsafe { System.dealloc(ptr, layout) },
+            Home::Medium => unsafe { MEDIUM_BLOCKS.dealloc(ptr, layout.size()) },
+            Home::Mapped => unsafe { map::unmap(ptr, layout.size()) },
         }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         // SAFETY: the caller guarantees a valid size for the alignment.
         let new_layout = unsafe { Layout::from_size_align_unchecked(new_size, layout.align()) };
-        match (mapped(layout), mapped(new_layout)) {
-            (false, false) => unsafe { System.realloc(ptr, layout, new_size) },
-            // A mapping's spare room up to its last whole page is already there.
-            (true, true) if mapping_len(new_size) == mapping_len(layout.size()) => ptr,
-            _ => {
-                let moved = unsafe { self.alloc(new_layout) };
-                if !moved.is_null() {
-                    let kept = layout.size().min(new_size);
-                    unsafe {
-                        std::ptr::copy_nonoverlapping(ptr, moved, kept);
-                        self.dealloc(ptr, layout);
-                    }
-                }
-                moved
+        let (old_size, old_home) = (layout.size(), Home::of(layout));
+        let in_place = match (old_home, Home::of(new_layout)) {
+            (Home::System, Home::System) => {
+                return unsafe { System.realloc(ptr, layout, new_size) };
+            }
+            // The block's spare room (up to the mapping's last page, or the end of its
+            // size class) is already there.
+            (Home::Mapped, Home::Mapped) => mapping_len(new_size) == mapping_len(old_size),
+            (Home::Medium, Home::Medium) => Pool::same_room(old_size, new_size),
+            _ => false,
+        };
+        if in_place {
+            return ptr;
+        }
+        let moved = unsafe { self.alloc(new_layout) };
+        if !moved.is_null() {
+            unsafe {
+                std::ptr::copy_nonoverlapping(ptr, moved, old_size.min(new_size));
+                self.dealloc(ptr, layout);
             }
         }
+        moved
     }
 }
 
@@ -180,6 +220,12 @@ mod tests {
         let a = HugePageAlloc;
         for &(from, to) in &[
             (64, 4096),
+            (4096, MEDIUM + 8),
+            (MEDIUM + 8, MEDIUM + 100),
+            (MEDIUM + 100, 3 * MEDIUM),
+            (3 * MEDIUM, LARGE + 8),
+            (LARGE + 8, 5 * MEDIUM),
+            (5 * MEDIUM, 100),
             (4096, LARGE + 8),
             (LARGE + 8, 3 * LARGE),
             (3 * LARGE, 3 * LARGE + 100),
@@ -196,8 +242,10 @@ mod tests {
                 for i in 0..from {
                     *p.add(i) = (i % 251) as u8;
                 }
-                if mapped(layout) {
-                    assert_eq!(p as usize % HUGE_PAGE, 0, "mapped block of {from} aligned");
+                match Home::of(layout) {
+                    Home::Mapped => assert_eq!(p as usize % HUGE_PAGE, 0, "{from} aligned"),
+                    Home::Medium => assert_eq!(p as usize % (64 << 10), 0, "{from} aligned"),
+                    Home::System => {}
                 }
                 let q = a.realloc(p, layout, to);
                 assert!(!q.is_null());
