@@ -42,8 +42,30 @@ const HUGE_PAGE: usize = 2 << 20;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct HugePageAlloc;
 
-/// The medium blocks of every [`HugePageAlloc`].
+/// The medium blocks of every [`HugePageAlloc`]; reached through [`medium_blocks`].
 static MEDIUM_BLOCKS: Pool = Pool::new();
+
+/// [`MEDIUM_BLOCKS`], with its lock held across `fork` (registered on first use): a child
+/// forked while another thread held it (Python's `multiprocessing` forks by default) would
+/// otherwise find it held for ever, or the free lists half updated. The C allocator guards
+/// its own locks the same way.
+fn medium_blocks() -> &'static Pool {
+    #[cfg(target_os = "linux")]
+    {
+        static FORK_HANDLERS: std::sync::Once = std::sync::Once::new();
+        extern "C" fn before_fork() {
+            MEDIUM_BLOCKS.lock();
+        }
+        extern "C" fn after_fork() {
+            MEDIUM_BLOCKS.unlock();
+        }
+        // SAFETY: the handlers only take and release the pool's lock.
+        FORK_HANDLERS.call_once(|| unsafe {
+            libc::pthread_atfork(Some(before_fork), Some(after_fork), Some(after_fork));
+        });
+    }
+    &MEDIUM_BLOCKS
+}
 
 /// Where a block lives: decided by its layout alone, so that a block is returned where it
 /// came from.
@@ -159,7 +181,7 @@ unsafe impl GlobalAlloc for HugePageAlloc {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         match Home::of(layout) {
             Home::System => unsafe { System.alloc(layout) },
-            Home::Medium => unsafe { MEDIUM_BLOCKS.alloc(layout.size(), false) },
+            Home::Medium => unsafe { medium_blocks().alloc(layout.size(), false) },
             Home::Mapped => unsafe { map::map(layout.size()) },
         }
     }
@@ -167,7 +189,7 @@ unsafe impl GlobalAlloc for HugePageAlloc {
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         match Home::of(layout) {
             Home::System => unsafe { System.alloc_zeroed(layout) },
-            Home::Medium => unsafe { MEDIUM_BLOCKS.alloc(layout.size(), true) },
+            Home::Medium => unsafe { medium_blocks().alloc(layout.size(), true) },
             // Anonymous mappings are zero.
             Home::Mapped => unsafe { map::map(layout.size()) },
         }
@@ -176,7 +198,7 @@ unsafe impl GlobalAlloc for HugePageAlloc {
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         match Home::of(layout) {
             Home::System => unsafe { System.dealloc(ptr, layout) },
-            Home::Medium => unsafe { MEDIUM_BLOCKS.dealloc(ptr, layout.size()) },
+            Home::Medium => unsafe { medium_blocks().dealloc(ptr, layout.size()) },
             Home::Mapped => unsafe { map::unmap(ptr, layout.size()) },
         }
     }
@@ -287,5 +309,64 @@ mod tests {
             );
             a.dealloc(p.cast(), layout);
         }
+    }
+
+    /// A child forked while other threads take and return medium blocks can take one too:
+    /// the pool's lock is held across the fork, never inherited held.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_forked_child_can_take_medium_blocks() {
+        let layout = Layout::from_size_align(3 * MEDIUM, 8).unwrap();
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        std::thread::scope(|s| {
+            for _ in 0..2 {
+                s.spawn(|| {
+                    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                        unsafe {
+                            let p = HugePageAlloc.alloc(layout);
+                            HugePageAlloc.dealloc(p, layout);
+                        }
+                    }
+                });
+            }
+            let statuses: Vec<_> = (0..50)
+                .map(|_| {
+                    // SAFETY: the child only allocates, frees and exits.
+                    let child = unsafe { libc::fork() };
+                    assert!(child >= 0, "fork failed");
+                    if child == 0 {
+                        unsafe {
+                            let p = HugePageAlloc.alloc_zeroed(layout);
+                            let ok = !p.is_null() && *p.add(12345) == 0;
+                            HugePageAlloc.dealloc(p, layout);
+                            libc::_exit(if ok { 0 } else { 1 });
+                        }
+                    }
+                    exit_status(child)
+                })
+                .collect();
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            assert!(statuses.iter().all(|&s| s == Some(0)), "{statuses:?}");
+        });
+    }
+
+    /// The exit status of child `pid`, or `None` (after killing it) if it has not exited
+    /// within 2 s.
+    #[cfg(target_os = "linux")]
+    fn exit_status(pid: libc::pid_t) -> Option<i32> {
+        let started = std::time::Instant::now();
+        let mut status = 0;
+        while started.elapsed() < std::time::Duration::from_secs(2) {
+            // SAFETY: waiting on our own child.
+            if unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) } == pid {
+                return libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        unsafe {
+            libc::kill(pid, libc::SIGKILL);
+            libc::waitpid(pid, &mut status, 0);
+        }
+        None
     }
 }

@@ -96,6 +96,15 @@ impl Pool {
 
     /// Runs `f` on the state under the lock (held for a few instructions, or a mapping).
     fn with_state<R>(&self, f: impl FnOnce(&mut State) -> R) -> R {
+        self.lock();
+        // SAFETY: the lock is held: no other reference to the state exists.
+        let result = f(unsafe { &mut *self.state.get() });
+        self.unlock();
+        result
+    }
+
+    /// Takes the lock (spinning: it is held for a few instructions, or a mapping).
+    pub(super) fn lock(&self) {
         while self
             .lock
             .compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed)
@@ -103,10 +112,11 @@ impl Pool {
         {
             std::hint::spin_loop();
         }
-        // SAFETY: the lock is held: no other reference to the state exists.
-        let result = f(unsafe { &mut *self.state.get() });
+    }
+
+    /// Releases the lock taken by [`Pool::lock`].
+    pub(super) fn unlock(&self) {
         self.lock.store(false, Ordering::Release);
-        result
     }
 }
 
