@@ -16,7 +16,7 @@
 //! [`Parallelism::Exclusive`] runs, every other worker runs [`keep_awake`]: it executes
 //! the pool's pending jobs as they appear ([`rayon::yield_now`]) and yields to the system
 //! in between, as rayon's own idle loop does before it sleeps. Measured (`bench
-//! bem-solve`, 256², free boundaries, 2 threads): solves 10–16 % faster, and their spread
+//! bem-solve`, 256², 2 threads): solves 14–21 % faster (3–7 % at 512²), and their spread
 //! gone. Not for a study's lanes ([`Parallelism::Shared`]): there every worker has its own
 //! sample to solve, and a worker held awake for another lane's solve is one taken from its
 //! own (`reproduce fig1 --quick` took 17.4 s against 15.4–15.9 s with keepers in every

@@ -163,7 +163,7 @@ pub enum Parallelism {
     /// The solve has the pool to itself, as when solves run one at a time (the CLI's `bem`
     /// and `contact`, the Python package): while it runs, the pool's other threads wait for
     /// its parallel passes awake instead of sleeping between them. Measured at 256² on 2
-    /// threads, 10–20 % off a solve (`pool.rs`). Solves started at the same time from
+    /// threads, 14–21 % off a solve (`pool.rs`). Solves started at the same time from
     /// several threads fall back to [`Parallelism::Shared`].
     #[default]
     Exclusive,
