@@ -6,12 +6,14 @@
 //! this allocator) and took 0.23–0.24 s instead of 0.22 s. The kernel's transparent huge
 //! pages (THP) map 2 MiB per fault, but only in 2 MiB-aligned ranges of a mapping marked
 //! for them (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, the common
-//! default) or in any mapping (`always`). The C allocator aligns its large blocks to 4 KiB only, so a
-//! 2 MiB field never covers an aligned range.
+//! default) or in any mapping (`always`). The C allocator aligns its large blocks to 4 KiB
+//! only, so a 2 MiB field never covers an aligned range.
 //!
 //! [`HugePageAlloc`] maps every block of at least [`LARGE`] bytes by itself, aligned to
-//! 2 MiB and marked `MADV_HUGEPAGE`, and leaves smaller blocks to the system allocator.
-//! Mapped memory is zero, so zeroed blocks cost no pass of their own. Where the kernel
+//! 2 MiB and marked `MADV_HUGEPAGE`; packs blocks of [`MEDIUM`] bytes up to [`LARGE`] into
+//! shared regions marked the same way (`huge_pages/medium.rs`); and leaves smaller blocks
+//! to the system allocator. Mapped memory is zero, so zeroed blocks cost no pass of their
+//! own. Where the kernel
 //! gives no huge pages (THP `never`, or no contiguous memory) the mapping is an ordinary
 //! one: nothing fails, the pages are just small. Applications opt in, as the `asperity`
 //! binary and the Python module do:

@@ -45,10 +45,8 @@ const MAX_IDLE: Duration = Duration::from_millis(10);
 /// returns (see the module docs).
 pub(crate) fn on_worker<R: Send>(parallelism: Parallelism, op: impl FnOnce() -> R + Send) -> R {
     if parallelism == Parallelism::Shared || rayon::current_num_threads() < 2 {
-        return match rayon::current_thread_index() {
-            Some(_) => op(),
-            None => rayon::join(op, || ()).0,
-        };
+        // On a worker, `join` runs `op` in place; from outside, it injects it once.
+        return rayon::join(op, || ()).0;
     }
     let stop = &AtomicBool::new(false);
     rayon::scope(|scope| {

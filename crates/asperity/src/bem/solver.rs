@@ -235,12 +235,12 @@ impl ContactSolver {
     /// overflow), an upper bound on what its parts hold once all have been used: the
     /// operator, its single-precision copy and the preconditioner; the profile, pressure
     /// and gap; the BCCG's five fields and its mask, with the rings of large grids one more
-    /// field and eleven bytes per point (counts and lists); the Polonsky–Keer iteration's two; the six of the
-    /// stiffness CG and its set's index list (on large grids its rings' field and twelve
-    /// bytes per point); the two of the full-contact code (periodic: three more for the
-    /// coarse correction of displacement control); the direct solve of small sets, a field
-    /// of indices, a mask and its dense factor. The caller's [`Surface`] (one more
-    /// `rows × cols` field while the solver is built) is not included.
+    /// field and eleven bytes per point (counts and lists); the Polonsky–Keer iteration's
+    /// two; the six of the stiffness CG and its set's index list (on large grids its rings'
+    /// field and twelve bytes per point); the two of the full-contact code (periodic: three
+    /// more for the coarse correction of displacement control); the direct solve of small
+    /// sets, a field of indices, a mask and its dense factor. The caller's [`Surface`] (one
+    /// more `rows × cols` field while the solver is built) is not included.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
         // The masks and the rings' bytes (27 per point) count as four fields (rounding up);
         // periodic grids add the coarse correction's two fields and its mask (`mean_gap.rs`).

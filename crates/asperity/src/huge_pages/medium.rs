@@ -157,16 +157,21 @@ impl State {
 mod tests {
     use super::*;
 
-    /// Fills `len` bytes at `p` with a pattern of `seed`.
+    /// Byte `i` of the test pattern of `seed`.
+    fn pattern(i: usize, seed: u8) -> u8 {
+        (i as u8).wrapping_mul(31).wrapping_add(seed)
+    }
+
+    /// Fills `len` bytes at `p` with the pattern of `seed`.
     unsafe fn fill(p: *mut u8, len: usize, seed: u8) {
         for i in 0..len {
-            unsafe { *p.add(i) = (i as u8).wrapping_mul(31).wrapping_add(seed) };
+            unsafe { *p.add(i) = pattern(i, seed) };
         }
     }
 
     /// Whether `len` bytes at `p` hold the pattern of `seed`.
     unsafe fn holds(p: *const u8, len: usize, seed: u8) -> bool {
-        (0..len).all(|i| unsafe { *p.add(i) } == (i as u8).wrapping_mul(31).wrapping_add(seed))
+        (0..len).all(|i| unsafe { *p.add(i) } == pattern(i, seed))
     }
 
     #[test]
@@ -223,9 +228,8 @@ mod tests {
         let e = unsafe { pool.alloc(600_000, false) };
         assert_eq!(e, b);
         let kept = unsafe { std::slice::from_raw_parts(e, 600_000) };
-        let pattern = |i: usize| (i as u8).wrapping_mul(31).wrapping_add(2);
         assert!(
-            (8..600_000).all(|i| kept[i] == pattern(i)),
+            (8..600_000).all(|i| kept[i] == pattern(i, 2)),
             "past its list link"
         );
         assert!(Pool::same_room(300_000, 320_000) && !Pool::same_room(300_000, 330_000));
