@@ -122,6 +122,12 @@ fn library_error(error: &asperity::Error) -> String {
              --force to discard it",
             dir.display()
         ),
+        E::NarrowerStudy { dir, reason } => format!(
+            "{}: holds results this run would leave out: {reason}; include them (the \
+             folder's study grows, its checkpoints are reused), use another --out, or \
+             --force to leave them out (their checkpoints are kept)",
+            dir.display()
+        ),
         E::DamagedStudy { path, reason } => format!(
             "{}: {reason}, or use --force to discard the folder's checkpoints",
             path.display()

@@ -604,6 +604,50 @@ fn a_finished_study_grows_by_another_n_or_h_reusing_its_checkpoints() {
     assert_eq!(csv.lines().count(), 5, "header and 4 tasks: {csv}");
 }
 
+/// Item 7 of issue 33: a run into a finished study's folder that would leave out one of
+/// its (N, H) or take fewer samples is refused (its results would be replaced by fewer),
+/// every output untouched; --force runs it and keeps the left-out task's checkpoint.
+#[test]
+fn a_narrower_run_into_a_finished_study_is_refused_without_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let study = |n: &str, samples: &str, extra: &[&str]| {
+        let args = [
+            &[
+                "study",
+                "alpha",
+                "--method",
+                "mdr",
+                "--n",
+                n,
+                "--hurst",
+                "0.5",
+                "--samples",
+                samples,
+                "--quiet",
+                "--out",
+                "g",
+            ][..],
+            extra,
+        ]
+        .concat();
+        asperity(&args, d)
+    };
+    ok(&study("256,512", "4", &[]));
+    let outputs = ["alpha.csv", "alpha.png", "alpha.svg", "study.json"];
+    let read = || outputs.map(|f| std::fs::read(d.join("g").join(f)).unwrap());
+    let before = read();
+    refused(&study("256", "4", &[]), "N = [512]");
+    refused(&study("256,512", "3", &[]), "samples (stored 4, wanted 3)");
+    assert_eq!(read(), before, "nothing replaced");
+    // Growing is allowed: every stored task is in the run.
+    ok(&study("256,512,1024", "4", &[]));
+    let csv = std::fs::read_to_string(d.join("g/alpha.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    ok(&study("256", "4", &["--force"]));
+    assert!(d.join("g/checkpoint/mdr_n512_h+0.500000.json").exists());
+}
+
 /// The steepest log–log slope over one decade of force of `curve.csv`'s mean curve for
 /// one H, from 8 contacts on: a least-squares fit of ln k on ln F over every run of rows
 /// spanning at least a decade, written here independently of the library.

@@ -94,6 +94,15 @@ pub enum Error {
         /// What differs.
         reason: String,
     },
+    /// A study folder holds samples of the same study over (N, H) values or a sample count
+    /// that a run would leave out of its results: a folder only grows ([`crate::study::StudyDir::check`]).
+    #[error("{dir}: holds results this run would leave out: {reason}; include them (the folder's study grows, its checkpoints are reused), use another folder, or leave them out anyway (force; their checkpoints are kept)")]
+    NarrowerStudy {
+        /// The study folder.
+        dir: PathBuf,
+        /// What the run leaves out.
+        reason: String,
+    },
     /// A study file or checkpoint in a study folder is damaged or from an older version: the
     /// study goes on once it is repaired or removed, or once the folder's checkpoints are
     /// discarded (`force`).

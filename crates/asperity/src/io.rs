@@ -90,6 +90,107 @@ fn finished(path: &Path) {
     }
 }
 
+/// Refuses `path` when it is a symbolic link: the lock, checkpoints and temporary files
+/// are never written through a link (one planted in an output folder would redirect the
+/// write to the file it names). A missing path is fine.
+pub fn refuse_link(path: &Path) -> Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => Err(bad_output(
+            path,
+            "is a symbolic link; asperity does not write through links here: remove it",
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Adds `O_NOFOLLOW` (where it exists) to `options`: opening a symbolic link then fails
+/// (`ELOOP`) instead of opening the file it names.
+pub fn no_follow(options: &mut std::fs::OpenOptions) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW);
+    }
+    #[cfg(not(unix))]
+    let _ = options;
+}
+
+/// Creates the temporary file `tmp` for writing: a new file (`O_EXCL`), never through a
+/// link (`O_EXCL` does not follow one; `O_NOFOLLOW` as well). A file or link already
+/// there is an error, not overwritten.
+/// Whatever is already at `tmp` carries this process's PID in its name, so it is a
+/// leftover of a dead process that had the same PID (or a planted link): it is removed
+/// (a link itself, never the file it names) and the creation is tried once more.
+fn create_temp(tmp: &Path) -> Result<File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true).create_new(true);
+    no_follow(&mut options);
+    match options.open(tmp) {
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            let _ = std::fs::remove_file(tmp);
+            options.open(tmp).map_err(|e| Error::io(tmp, e))
+        }
+        other => other.map_err(|e| Error::io(tmp, e)),
+    }
+}
+
+/// Removes the temporary files that writes of `target` killed before they finished (by
+/// `SIGKILL`, which runs no clean-up) left beside it: `.NAME.PID.K.tmp[.EXT]` whose PID is
+/// no live process. Best effort; called after a successful commit.
+fn remove_stale_temps(target: &Path) {
+    let (Some(name), Some(folder)) = (target.file_name(), target.parent()) else {
+        return;
+    };
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(rest) = file_name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
+            continue;
+        };
+        if stale_temp_pid(rest).is_some_and(|pid| !process_alive(pid)) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// The PID of a temporary name's tail `PID.K.tmp[.EXT]`, if it is one.
+fn stale_temp_pid(rest: &str) -> Option<u32> {
+    let mut parts = rest.splitn(4, '.');
+    let pid = parts.next()?.parse::<u32>().ok()?;
+    parts.next()?.parse::<usize>().ok()?;
+    (parts.next()? == "tmp").then_some(pid)
+}
+
+/// Whether process `pid` exists (Unix; elsewhere every process counts as alive, so
+/// nothing is removed). This process counts as alive.
+fn process_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        if pid == std::process::id() {
+            return true;
+        }
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return true;
+        };
+        // SAFETY: signal 0 only checks that the process exists; nothing is sent.
+        let rc = unsafe { libc::kill(pid, 0) };
+        rc == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
 /// The sidecar path of an array file: `surface.npy` → `surface.npy.json`.
 pub fn sidecar_path(path: &Path) -> PathBuf {
     let mut name = path.as_os_str().to_os_string();
@@ -317,6 +418,11 @@ impl StagedOutputs {
             finished(&old);
         }
         unfinished(&tmp);
+        // Made here, new and not through a link, before the writer opens it by name.
+        if let Err(e) = create_temp(&tmp) {
+            finished(&tmp);
+            return Err(e.into());
+        }
         match write(&tmp) {
             Ok(()) => {
                 self.entries[index].tmp = Some(tmp);
@@ -336,7 +442,10 @@ impl StagedOutputs {
         F: FnOnce(&mut BufWriter<File>) -> Result<()>,
     {
         self.write_file_with(target, None, |tmp| {
-            let file = File::create(tmp).map_err(|e| Error::io(tmp, e))?;
+            let mut options = std::fs::OpenOptions::new();
+            options.write(true);
+            no_follow(&mut options);
+            let file = options.open(tmp).map_err(|e| Error::io(tmp, e))?;
             let mut writer = BufWriter::new(file);
             write(&mut writer)?;
             writer.flush().map_err(|e| Error::io(tmp, e))?;
@@ -421,6 +530,9 @@ impl StagedOutputs {
         result?;
         for folder in self.created_folders.drain(..) {
             finished(&folder);
+        }
+        for e in &self.entries {
+            remove_stale_temps(&e.target);
         }
         Ok(())
     }
@@ -727,6 +839,58 @@ mod tests {
         assert_eq!(entries(d), ["a.npy", "a.npy.json"]);
         assert_eq!(std::fs::read(&a).unwrap(), b"A");
         assert_eq!(std::fs::read(&b).unwrap(), b"B");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_the_temporary_name_is_never_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim.txt");
+        std::fs::write(&victim, "precious").unwrap();
+        let out = dir.path().join("out.json");
+        // The temporary names are predictable (PID and index): plant a link at each.
+        for (i, ext) in [(0, None), (0, Some("png"))] {
+            std::os::unix::fs::symlink(&victim, temp_path(&out, i, ext)).unwrap();
+        }
+        write_bytes(&out, false, b"result").unwrap();
+        let mut staged = StagedOutputs::new([dir.path().join("out.png")], false).unwrap();
+        let png = dir.path().join("out.png");
+        staged
+            .write_file_with(&png, Some("png"), |tmp| {
+                std::fs::write(tmp, b"image").map_err(|e| Error::io(tmp, e))
+            })
+            .unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        assert_eq!(std::fs::read(&out).unwrap(), b"result");
+        assert_eq!(std::fs::read(&png).unwrap(), b"image");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn temporary_files_of_killed_writes_are_removed_by_the_next_commit() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("surface.npy");
+        // A process that no longer exists: a child that has exited and been reaped.
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let stale = dir.path().join(format!(".surface.npy.{dead}.0.tmp"));
+        let stale_png = dir.path().join(format!(".surface.npy.{dead}.1.tmp.png"));
+        let live = dir
+            .path()
+            .join(format!(".surface.npy.{}.7.tmp", std::process::id()));
+        let other = dir.path().join(format!(".other.npy.{dead}.0.tmp"));
+        for p in [&stale, &stale_png, &live, &other] {
+            std::fs::write(p, b"partial").unwrap();
+        }
+        write_bytes(&out, false, b"done").unwrap();
+        assert!(!stale.exists() && !stale_png.exists());
+        assert!(live.exists(), "a live process's temporary file is kept");
+        assert!(
+            other.exists(),
+            "another output's temporary file is not touched"
+        );
     }
 
     #[test]

@@ -29,13 +29,11 @@ impl FolderLock {
     /// Locks the existing folder `dir`, or fails at once with [`Error::FolderInUse`].
     pub fn acquire(dir: &Path) -> Result<FolderLock> {
         let path = dir.join(LOCK_FILE);
-        let mut file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(|e| Error::io(&path, e))?;
+        crate::io::refuse_link(&path)?;
+        let mut options = std::fs::OpenOptions::new();
+        options.read(true).write(true).create(true).truncate(false);
+        crate::io::no_follow(&mut options);
+        let mut file = options.open(&path).map_err(|e| link_or_io(&path, e))?;
         if !try_lock(&file).map_err(|e| Error::io(&path, e))? {
             return Err(Error::FolderInUse {
                 dir: dir.to_path_buf(),
@@ -56,6 +54,18 @@ impl FolderLock {
     pub fn dir(&self) -> &Path {
         &self.dir
     }
+}
+
+/// A link planted between the check and the open makes `O_NOFOLLOW` fail with `ELOOP`:
+/// the same refusal as [`crate::io::refuse_link`].
+fn link_or_io(path: &Path, e: std::io::Error) -> Error {
+    #[cfg(unix)]
+    if e.raw_os_error() == Some(libc::ELOOP) {
+        return crate::io::refuse_link(path)
+            .err()
+            .unwrap_or(Error::io(path, e));
+    }
+    Error::io(path, e)
 }
 
 /// `PID 1234`, as recorded by the holder (at most 32 bytes are read).
@@ -106,5 +116,22 @@ mod tests {
         assert!(!err.contains('\n'), "{err}");
         drop(first);
         FolderLock::acquire(dir.path()).unwrap();
+    }
+
+    #[test]
+    fn a_link_in_place_of_the_lock_file_is_refused_and_its_target_untouched() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim.txt");
+        std::fs::write(&victim, "precious").unwrap();
+        std::os::unix::fs::symlink(&victim, dir.path().join(LOCK_FILE)).unwrap();
+        let err = FolderLock::acquire(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        // A dangling link is refused too (it would create the file it names).
+        let dangling = tempfile::tempdir().unwrap();
+        let target = dangling.path().join("created");
+        std::os::unix::fs::symlink(&target, dangling.path().join(LOCK_FILE)).unwrap();
+        assert!(FolderLock::acquire(dangling.path()).is_err());
+        assert!(!target.exists());
     }
 }

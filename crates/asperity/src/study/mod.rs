@@ -500,9 +500,12 @@ pub struct StudyDir {
 enum Stored {
     None,
     Same,
-    /// The same study over fewer or other N, H or samples: it is extended, each
+    /// The same study over more N, H or samples: it is extended, each
     /// checkpoint reused where its task's identity matches.
     Extended,
+    /// The same study without some of the stored one's (N, H) or with fewer samples:
+    /// what the stored study finished would be left out of the results.
+    Narrower(String),
     Other(String),
     Corrupt(String),
 }
@@ -538,7 +541,10 @@ impl StudyDir {
             ..manifest.spec.clone()
         };
         if &extended == spec {
-            return Ok(Stored::Extended);
+            return Ok(match narrowing(&manifest.spec, spec) {
+                Some(left_out) => Stored::Narrower(left_out),
+                None => Stored::Extended,
+            });
         }
         Ok(Stored::Other(spec_differences(&manifest.spec, spec)))
     }
@@ -554,12 +560,25 @@ impl StudyDir {
     ///   (or a corrupt `study.json`, or checkpoints without one) and `discard` is set, or
     ///   its `study.json` names another study but no checkpoint holds a sample (that study
     ///   stopped before its first checkpoint: nothing is lost);
+    /// * [`Error::NarrowerStudy`] when it holds samples of the same study and `spec` leaves
+    ///   out one of its (N, H) or takes fewer samples (its results would shrink: a folder
+    ///   only grows), unless `discard`, which then keeps every checkpoint (`Ok(false)`);
     /// * [`Error::ForeignCheckpoint`] when it holds samples of another study, and
     ///   [`Error::Metadata`] when its `study.json` is corrupt and checkpoints hold samples.
     pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
         let stored = Self::stored_spec(dir, spec)?;
         if matches!(stored, Stored::Same | Stored::Extended) {
             return Ok(false);
+        }
+        if let Stored::Narrower(left_out) = stored {
+            // Its checkpoints stay valid (a later run over them reads them back).
+            if discard || !Self::holds_samples(dir)? {
+                return Ok(false);
+            }
+            return Err(Error::NarrowerStudy {
+                dir: dir.to_path_buf(),
+                reason: left_out,
+            });
         }
         if !Self::holds_samples(dir)? {
             return Ok(!matches!(stored, Stored::None));
@@ -568,7 +587,7 @@ impl StudyDir {
             return Ok(true);
         }
         match stored {
-            Stored::None | Stored::Same | Stored::Extended => Ok(false),
+            Stored::None | Stored::Same | Stored::Extended | Stored::Narrower(_) => Ok(false),
             Stored::Other(differences) => Err(Error::ForeignCheckpoint {
                 dir: dir.to_path_buf(),
                 reason: format!("its study.json has other parameters: {differences}"),
@@ -664,6 +683,7 @@ impl StudyDir {
         for task in spec.tasks() {
             store.load(task)?;
         }
+        io::refuse_link(&dir.join("checkpoint"))?;
         std::fs::create_dir_all(dir.join("checkpoint")).map_err(|e| Error::io(dir, e))?;
         let manifest = Manifest {
             format: MANIFEST_FORMAT.into(),
@@ -706,6 +726,13 @@ impl StudyDir {
         &self.dir
     }
 
+    /// Refuses a symbolic link in place of the checkpoint folder or of the checkpoint
+    /// `path`: a link planted in the study folder would redirect the study's writes.
+    fn refuse_links(&self, path: &Path) -> Result<()> {
+        io::refuse_link(&self.dir.join("checkpoint"))?;
+        io::refuse_link(path)
+    }
+
     fn checkpoint_path(&self, task: Task) -> PathBuf {
         let key = task.key(self.spec.method);
         self.dir.join("checkpoint").join(format!("{key}.json"))
@@ -715,6 +742,7 @@ impl StudyDir {
     /// this task with this study's settings (its identity).
     fn load(&self, task: Task) -> Result<Option<Checkpoint>> {
         let path = self.checkpoint_path(task);
+        self.refuse_links(&path)?;
         let length = match std::fs::metadata(&path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(Error::io(&path, e)),
@@ -750,6 +778,7 @@ impl StudyDir {
 
     fn save(&self, task: Task, checkpoint: &Checkpoint) -> Result<()> {
         let path = self.checkpoint_path(task);
+        self.refuse_links(&path)?;
         let bytes =
             identity::seal(&TaskIdentity::of(&self.spec, task), checkpoint).map_err(|reason| {
                 Error::Metadata {
@@ -795,6 +824,40 @@ impl StudyDir {
             },
         )
     }
+}
+
+/// What `spec`, the same study as `stored` over other N, H or samples, leaves out of
+/// it: `None` when it covers every (N, H) of `stored` with at least its samples (it grows
+/// the study), else e.g. `N = 4096 (stored 4096, wanted 2048)`.
+fn narrowing(stored: &StudySpec, spec: &StudySpec) -> Option<String> {
+    let mut left_out = Vec::new();
+    let sizes: Vec<usize> = (stored.sizes.iter())
+        .filter(|n| !spec.sizes.contains(n))
+        .copied()
+        .collect();
+    if !sizes.is_empty() {
+        left_out.push(format!(
+            "N = {sizes:?} (stored {:?}, wanted {:?})",
+            stored.sizes, spec.sizes
+        ));
+    }
+    let hursts: Vec<f64> = (stored.hursts.iter())
+        .filter(|h| !spec.hursts.iter().any(|w| w.to_bits() == h.to_bits()))
+        .copied()
+        .collect();
+    if !hursts.is_empty() {
+        left_out.push(format!(
+            "H = {hursts:?} (stored {:?}, wanted {:?})",
+            stored.hursts, spec.hursts
+        ));
+    }
+    if spec.samples < stored.samples {
+        left_out.push(format!(
+            "samples (stored {}, wanted {})",
+            stored.samples, spec.samples
+        ));
+    }
+    (!left_out.is_empty()).then(|| left_out.join(", "))
 }
 
 /// The fields of two specs that differ, as `name: stored X, wanted Y`.
@@ -1385,6 +1448,29 @@ mod tests {
         )))
         .unwrap();
         assert!(StudyDir::open(dir.path(), &other, false).is_err());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_in_place_of_checkpoints_are_refused_and_their_targets_untouched() {
+        let task = Task { n: 64, hurst: 0.5 };
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim.json");
+        std::fs::write(&victim, "precious").unwrap();
+        let store = StudyDir::open(dir.path(), &spec(4), false).unwrap();
+        std::os::unix::fs::symlink(&victim, checkpoint_file(dir.path(), task)).unwrap();
+        let sample = Synthetic.sample(&mut (), 1).unwrap();
+        let err = store.save_in_progress(task, &[sample]).unwrap_err();
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert!(StudyDir::open(dir.path(), &spec(4), false).is_err());
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        // A link in place of the checkpoint folder.
+        let elsewhere = tempfile::tempdir().unwrap();
+        let linked = tempfile::tempdir().unwrap();
+        std::os::unix::fs::symlink(elsewhere.path(), linked.path().join("checkpoint")).unwrap();
+        let err = StudyDir::open(linked.path(), &spec(4), false).unwrap_err();
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
     }
 
     fn checkpoint_file(dir: &Path, task: Task) -> PathBuf {
