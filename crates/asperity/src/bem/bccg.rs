@@ -73,6 +73,7 @@
 
 use rayon::prelude::*;
 
+use super::interface::Interface;
 use super::mean_gap::MeanGapScratch;
 use super::preconditioner::Real;
 use super::ring_extension::{centre_on_set, RingExtension};
@@ -337,11 +338,16 @@ struct Step {
     cut_many: bool,
 }
 
+/// The contact rule of the BCCG: the hard wall, asked of [`Interface`] (a constant, so
+/// the passes compile to the rule itself). A cap would need the upper bound in the
+/// projection, the cut corrections and the load restoration.
+const WALL: Interface = Interface::HardWall;
+
 /// `g = u + f − d` and whether the point is free (`p > 0` or `g < 0`).
 #[inline]
 fn gap_at(u: f64, f: f64, d: f64, p: f64) -> (f64, bool) {
     let g = u + f - d;
-    (g, p > 0.0 || g < 0.0)
+    (g, WALL.is_free(p, g))
 }
 
 /// Load control's `d`: the mean of `u + f` on the contact set, summed about `previous` so
@@ -364,7 +370,7 @@ fn contact_mean(
                     *ui *= scale;
                     *pi *= scale;
                 }
-                if *pi > 0.0 {
+                if WALL.elastic(*pi) {
                     s.n[0] += 1;
                     s.x[0] += *ui + fi - previous;
                 }
@@ -404,7 +410,7 @@ fn gap_pass(
                 .zip(f.iter().zip(p))
             {
                 let (g, is_free) = gap_at(ui, fi, d, pi);
-                if pi > 0.0 {
+                if WALL.elastic(pi) {
                     s.n[0] += 1;
                     s.x[0] += g * g;
                 } else if g < 0.0 {

@@ -26,6 +26,12 @@
 //!   preconditions the constant mode, which the periodic kernel does not see, by its exact
 //!   curvature on the free set (`mean_gap.rs`); Polonsky–Keer runs its own iteration with `d`
 //!   fixed (slow near full contact, but it converges: it is the reference).
+//! * **Contact law**: [`Interface`] is the one place that knows what "in contact" means
+//!   (`interface.rs`): [`Interface::HardWall`] (the above, the default) or
+//!   [`Interface::Hardness`], the pressure capped at a hardness `H` (elastic–perfectly-plastic
+//!   contact, solved by Polonsky–Keer; its plastic displacement and the loading–unloading
+//!   [`load_path`] in `plasticity.rs`, docs/hardness.md). Set by
+//!   [`ContactSolver::set_interface`].
 //! * **Stopping**: [`ContactSolver::with_stop`] hands the solver a [`crate::stop::Stop`]
 //!   flag, which every iteration (BCCG, Polonsky–Keer, the
 //!   frozen-set and full-contact CGs) polls; a requested stop ends the solve with
@@ -45,9 +51,11 @@
 
 mod bccg;
 mod full_contact;
+mod interface;
 #[cfg(test)]
 mod interruption;
 mod mean_gap;
+mod plasticity;
 mod polonsky_keer;
 mod preconditioner;
 mod ring_extension;
@@ -57,6 +65,8 @@ mod stiffness;
 pub mod sweep;
 
 pub use full_contact::FullContactThreshold;
+pub use interface::Interface;
+pub use plasticity::{load_path, PathPoint};
 pub use solver::{ContactProblem, ContactSolver};
 
 use ndarray::Array2;
@@ -284,6 +294,11 @@ pub struct ContactSummary {
     pub area_fraction: f64,
     /// Number of grid points in contact.
     pub contact_points: usize,
+    /// Fraction of grid points at the hardness (`p = H`, [`Interface::Hardness`]; zero for
+    /// the hard wall).
+    pub plastic_fraction: f64,
+    /// Number of grid points at the hardness.
+    pub plastic_points: usize,
 }
 
 /// A solved contact with its fields (`rows × cols`, row-major like the surface).

@@ -19,6 +19,7 @@
 //! keeps results bit-identical for any thread count (the FFTs are parallel and
 //! independent of it too).
 
+use super::interface::Interface;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 
@@ -59,6 +60,7 @@ impl ContactSolver {
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let load_control = matches!(target, Target::MeanPressure(_));
+        let interface = self.interface;
         let self_influence = self.problem.operator.self_influence();
         self.initialise(target, self_influence);
         let mut indentation = match target {
@@ -74,10 +76,10 @@ impl ContactSolver {
                 .operator
                 .apply(&self.state.pressure, &mut self.state.gap);
             let pass = gap_and_direction(
-                &self.state.pressure,
+                interface,
+                (&self.state.pressure, &self.problem.profile),
                 &mut self.state.gap,
                 &mut pk.direction,
-                &self.problem.profile,
                 load_control,
                 &mut indentation,
                 if conjugate { g_old } else { 0.0 },
@@ -103,17 +105,19 @@ impl ContactSolver {
 
             self.problem.operator.apply(&pk.direction, &mut pk.response);
             let tau = step_length(
+                interface,
                 &self.state.pressure,
                 &self.state.gap,
                 &pk.direction,
                 &pk.response,
                 load_control,
-                pass.contact_points,
+                pass.elastic_points,
             );
             // Penetrating points enter with p = −τ g; before any step exists (empty
             // set), a Jacobi step with the self-influence.
             let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
             let (total, entered) = update_pressure(
+                interface,
                 &mut self.state.pressure,
                 &self.state.gap,
                 &pk.direction,
@@ -133,6 +137,9 @@ impl ContactSolver {
             return true;
         };
         let pressure = &mut self.state.pressure;
+        if let Interface::Hardness { h } = self.interface {
+            return restore_capped_load(pressure, mean_pressure, h, total);
+        }
         if total > 0.0 {
             let scale = mean_pressure * pressure.len() as f64 / total;
             pressure.iter_mut().for_each(|v| *v *= scale);
@@ -146,10 +153,14 @@ impl ContactSolver {
 
 /// Sums of passes A and B over the grid.
 pub(super) struct GapPass {
+    /// Points in contact (`p > 0`).
     pub(super) contact_points: usize,
-    /// `G = Σ_{p>0} g²`.
+    /// Points on the elastic set ([`Interface::elastic`]; the contact points for the hard
+    /// wall).
+    pub(super) elastic_points: usize,
+    /// `G = Σ g²` on the elastic set.
     pub(super) gap_squared: f64,
-    /// `Σ_{p=0} min(g, 0)²`.
+    /// The squared violations off it (`Σ_{p=0} min(g, 0)²`, and `Σ_{p=H} max(g, 0)²`).
     pub(super) penetration_squared: f64,
 }
 
@@ -166,30 +177,31 @@ impl GapPass {
 /// (summed about its previous value, so that `G` does not cancel); `t` becomes the new
 /// conjugate direction (`previous_g = 0`: steepest descent).
 pub(super) fn gap_and_direction(
-    p: &[f64],
+    interface: Interface,
+    (p, f): (&[f64], &[f64]),
     gap: &mut [f64],
     t: &mut [f64],
-    f: &[f64],
     load_control: bool,
     indentation: &mut f64,
     previous_g: f64,
 ) -> GapPass {
     // Pass A: u + f, its mean and spread on the contact set about the last indentation.
     let shift = *indentation;
-    let (mut contact_points, mut sum, mut sum_sq) = (0usize, 0.0, 0.0);
+    let (mut contact_points, mut elastic_points, mut sum, mut sum_sq) = (0usize, 0usize, 0.0, 0.0);
     for ((g, &fi), &pi) in gap.iter_mut().zip(f).zip(p) {
         *g += fi;
-        if pi > 0.0 {
+        contact_points += interface.in_contact(pi) as usize;
+        if interface.elastic(pi) {
             let w = *g - shift;
-            contact_points += 1;
+            elastic_points += 1;
             sum += w;
             sum_sq += w * w;
         }
     }
-    let g_estimate = if load_control && contact_points > 0 {
-        let mean = sum / contact_points as f64;
+    let g_estimate = if load_control && elastic_points > 0 {
+        let mean = sum / elastic_points as f64;
         *indentation = shift + mean;
-        (sum_sq - contact_points as f64 * mean * mean).max(0.0)
+        (sum_sq - elastic_points as f64 * mean * mean).max(0.0)
     } else {
         sum_sq
     };
@@ -203,18 +215,20 @@ pub(super) fn gap_and_direction(
     let (mut gap_squared, mut penetration_squared) = (0.0, 0.0);
     for ((g, ti), &pi) in gap.iter_mut().zip(t.iter_mut()).zip(p) {
         *g -= d;
-        if pi > 0.0 {
+        if interface.elastic(pi) {
             gap_squared += *g * *g;
             *ti = *g + beta * *ti;
         } else {
             *ti = 0.0;
-            if *g < 0.0 {
-                penetration_squared += *g * *g;
+            let v = interface.violation(pi, *g);
+            if v != 0.0 {
+                penetration_squared += v * v;
             }
         }
     }
     GapPass {
         contact_points,
+        elastic_points,
         gap_squared,
         penetration_squared,
     }
@@ -223,6 +237,7 @@ pub(super) fn gap_and_direction(
 /// Pass C: `τ = Σ g t / Σ (r − r̄) t` on the contact set, `r̄` its mean there under load
 /// control (zero under displacement control). Zero when the set is empty.
 fn step_length(
+    interface: Interface,
     p: &[f64],
     gap: &[f64],
     t: &[f64],
@@ -232,7 +247,7 @@ fn step_length(
 ) -> f64 {
     let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
     for (((&pi, &gi), &ti), &ri) in p.iter().zip(gap).zip(t).zip(r) {
-        if pi > 0.0 {
+        if interface.elastic(pi) {
             sum_r += ri;
             sum_rt += ri * ti;
             sum_t += ti;
@@ -255,6 +270,7 @@ fn step_length(
 /// Pass D: `p ← max(p − τ t, 0)` on the contact set; penetrating points outside it enter
 /// with `p = −entry_step · g`. Returns `Σ p` and whether any point entered.
 fn update_pressure(
+    interface: Interface,
     p: &mut [f64],
     gap: &[f64],
     t: &[f64],
@@ -263,15 +279,79 @@ fn update_pressure(
 ) -> (f64, bool) {
     let (mut total, mut entered) = (0.0, false);
     for ((pi, &gi), &ti) in p.iter_mut().zip(gap).zip(t) {
-        if *pi > 0.0 {
-            *pi = (*pi - tau * ti).max(0.0);
-        } else if gi < 0.0 {
-            *pi = -entry_step * gi;
+        if interface.elastic(*pi) {
+            *pi = interface.project(*pi - tau * ti);
+        } else if interface.is_free(*pi, gi) {
+            // Out of contact and penetrating (enters), or at the cap and pulling away
+            // (leaves it): the hard wall's `max(−e g, 0)` is `−e g` itself.
+            *pi = interface.project(*pi - entry_step * gi);
             entered = true;
         }
         total += *pi;
     }
     (total, entered)
+}
+
+/// Pass E under a cap `h`: the pressures (summing to `total`) scaled to the load. Where no
+/// point is at or would reach the cap that is the hard wall's scaling, bit for bit. Else
+/// the points at the cap stay there (scaling them down would release the whole plastic
+/// set at every step that overshot the load) and the others are scaled by the `s` for
+/// which `n_H h + Σ min(s p, h) = n p̄` ([`capped_scale`]); if the capped points alone
+/// carry more than the load, every point is scaled. Reset to uniform if the points in
+/// contact cannot carry the load below the cap. False after a reset.
+fn restore_capped_load(pressure: &mut [f64], mean_pressure: f64, h: f64, total: f64) -> bool {
+    let wanted = mean_pressure * pressure.len() as f64;
+    let in_contact = pressure.iter().filter(|&&p| p > 0.0).count();
+    if (in_contact as f64) * h <= wanted || total <= 0.0 {
+        pressure.fill(mean_pressure);
+        return false;
+    }
+    let plain = wanted / total;
+    let peak = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
+    if peak < h && peak * plain < h {
+        pressure.iter_mut().for_each(|v| *v *= plain);
+        return true;
+    }
+    let capped = pressure.iter().filter(|&&p| p >= h).count();
+    let keep_capped = (capped as f64) * h < wanted;
+    let scale = capped_scale(pressure, wanted, h, keep_capped);
+    for p in pressure.iter_mut() {
+        if !(keep_capped && *p >= h) {
+            *p = (scale * *p).min(h);
+        }
+    }
+    true
+}
+
+/// The `s` for which the load `Σ min(s p, h)` (points at the cap held there if
+/// `keep_capped`) is `wanted`: Newton's method on this increasing, concave,
+/// piecewise-linear function of `s`, exact once the capped set settles (from below it
+/// stays below and rises; the left slope at a kink, so that a scale that caps every point
+/// still moves down).
+fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64 {
+    let mut scale = 1.0;
+    for _ in 0..64 {
+        let (mut carried, mut slope) = (0.0, 0.0);
+        for &p in pressure {
+            if keep_capped && p >= h {
+                carried += h;
+            } else if scale * p <= h {
+                carried += scale * p;
+                slope += p;
+            } else {
+                carried += h;
+            }
+        }
+        if slope <= 0.0 {
+            break;
+        }
+        let next = scale + (wanted - carried) / slope;
+        if next == scale {
+            break;
+        }
+        scale = next;
+    }
+    scale
 }
 
 #[cfg(test)]

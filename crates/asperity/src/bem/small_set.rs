@@ -34,8 +34,12 @@
 //! the set is still the solved state's (its residual checked against the stiffness
 //! tolerance).
 
+use super::interface::Interface;
 use super::solver::{ContactSolver, Target};
 use super::SolveError;
+
+/// The contact rule of the direct solve (it serves the BCCG, which solves the hard wall).
+const WALL: Interface = Interface::HardWall;
 use crate::elastic::Boundary;
 
 /// Factorisations per solve after which the iteration gives up (the active set cycles).
@@ -295,7 +299,12 @@ impl ContactSolver {
         let (rows, cols) = (self.problem.rows, self.problem.cols);
         let len = rows * cols;
         let limit = limit(len);
-        let start = self.state.pressure.iter().filter(|&&p| p > 0.0).count();
+        let start = self
+            .state
+            .pressure
+            .iter()
+            .filter(|&&p| WALL.in_contact(p))
+            .count();
         let cold_load = self.state.solved.is_none() && matches!(target, Target::MeanPressure(_));
         if start > limit && !cold_load {
             return Ok(SmallSetRun {
@@ -322,7 +331,7 @@ impl ContactSolver {
             small.push(highest_point(&self.problem.profile));
         } else {
             for (k, &p) in self.state.pressure.iter().enumerate() {
-                if p > 0.0 {
+                if WALL.in_contact(p) {
                     small.push(k);
                 }
             }
@@ -424,8 +433,8 @@ impl ContactSolver {
         let small = self.small_set.as_ref().filter(|s| s.solved)?;
         let pressure = &self.state.pressure;
         let (set, n) = (&small.set, small.set.len());
-        let loaded = pressure.iter().filter(|&&p| p > 0.0).count();
-        if loaded != n || set.iter().any(|&k| pressure[k] <= 0.0) {
+        let loaded = pressure.iter().filter(|&&p| WALL.in_contact(p)).count();
+        if loaded != n || set.iter().any(|&k| !WALL.in_contact(pressure[k])) {
             return None;
         }
         let impulse = &self.bccg_scratch.impulse;

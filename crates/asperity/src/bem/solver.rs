@@ -38,6 +38,7 @@ use ndarray::{Array2, ArrayView2};
 
 use super::bccg::BccgScratch;
 use super::full_contact::{FullContactScratch, FullContactThreshold};
+use super::interface::Interface;
 use super::polonsky_keer::PkScratch;
 use super::preconditioner::{FourierPreconditioner, Real};
 use super::small_set::SmallSet;
@@ -211,6 +212,13 @@ pub struct ContactSolver {
     pub(super) small_set: Option<SmallSet>,
     /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
     pub(super) stop: Stop,
+    /// What "in contact" means ([`ContactSolver::set_interface`]; the hard wall by
+    /// default).
+    pub(super) interface: Interface,
+    /// The permanent (plastic) displacement kept by
+    /// [`ContactSolver::keep_plastic_displacement`], added to the profile; allocated on
+    /// first use.
+    pub(super) permanent: Option<Vec<f64>>,
 }
 
 /// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
@@ -297,6 +305,8 @@ impl ContactSolver {
             full_contact_scratch: None,
             small_set: None,
             stop: Stop::new(),
+            interface: Interface::HardWall,
+            permanent: None,
         })
     }
 
@@ -337,6 +347,7 @@ impl ContactSolver {
     /// The next solve starts cold, exactly as with a new solver.
     pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
         self.problem.set_surface(surface)?;
+        self.permanent = None;
         self.state.pressure.fill(0.0);
         self.state.solved = None;
         self.state.full_contact = None;
@@ -400,6 +411,7 @@ impl ContactSolver {
                 Target::Indentation(d)
             }
         };
+        self.check_interface(target)?;
         let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         if periodic {
             // Exact thresholds, known before solving: the mean pressure max(K⁺f) and, with
@@ -441,6 +453,23 @@ impl ContactSolver {
             Err(_) => self.state.solved = None,
         }
         result
+    }
+
+    /// Refuses what the interface cannot solve: a mean pressure at or above the hardness,
+    /// a hardness with the BCCG (which solves the hard wall only, for now).
+    fn check_interface(&self, target: Target) -> Result<(), SolveError> {
+        if let Target::MeanPressure(p) = target {
+            self.interface.check_mean_pressure(p)?;
+        }
+        if self.params.solver == SolverKind::Bccg && self.interface != Interface::HardWall {
+            return Err(Error::invalid(
+                "solver",
+                "the BCCG solves the hard wall only for now; a hardness needs the \
+                 Polonsky-Keer solver (pk)",
+            )
+            .into());
+        }
+        Ok(())
     }
 
     /// The error for a `requested` load or indentation that closes the gap everywhere, with
@@ -504,28 +533,36 @@ impl ContactSolver {
             Target::MeanPressure(mean_pressure) => {
                 let current = self.state.pressure.iter().sum::<f64>() / n;
                 if warm && current > 0.0 {
-                    let scale = mean_pressure / current;
-                    self.state.pressure.iter_mut().for_each(|p| *p *= scale);
+                    let (scale, interface) = (mean_pressure / current, self.interface);
+                    // (The hard wall's projection of p·scale ≥ 0 is the identity.)
+                    for p in self.state.pressure.iter_mut() {
+                        *p = interface.project(*p * scale);
+                    }
                 } else {
                     self.state.pressure.fill(mean_pressure);
                 }
             }
             Target::Indentation(d) => {
-                let any = self.state.pressure.iter().any(|&p| p > 0.0);
+                let interface = self.interface;
+                let any = self.state.pressure.iter().any(|&p| interface.in_contact(p));
                 if !(warm && any) {
                     for (p, f) in self.state.pressure.iter_mut().zip(&self.problem.profile) {
-                        *p = (d - f).max(0.0) / self_influence;
+                        *p = interface.project((d - f).max(0.0) / self_influence);
                     }
                 }
             }
         }
     }
 
-    /// Scalars of the converged state; the gap buffer is cleaned to `g ≥ 0`, zero on the
-    /// contact set (its residual there is below the tolerance).
+    /// Scalars of the converged state; the gap buffer is cleaned by the interface
+    /// ([`Interface::clean_gap`]: `g ≥ 0`, zero on the contact set, its residual there
+    /// being below the tolerance; at a hardness `g ≤ 0` on the capped points).
     pub(super) fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
-        for (g, p) in self.state.gap.iter_mut().zip(&self.state.pressure) {
-            *g = if *p > 0.0 { 0.0 } else { g.max(0.0) };
+        let interface = self.interface;
+        let mut plastic_points = 0;
+        for (g, &p) in self.state.gap.iter_mut().zip(&self.state.pressure) {
+            *g = interface.clean_gap(p, *g);
+            plastic_points += interface.plastic(p) as usize;
         }
         let n = self.problem.rows * self.problem.cols;
         let mean_pressure = self.state.pressure.iter().sum::<f64>() / n as f64;
@@ -535,6 +572,8 @@ impl ContactSolver {
             indentation,
             area_fraction: contact_points as f64 / n as f64,
             contact_points,
+            plastic_fraction: plastic_points as f64 / n as f64,
+            plastic_points,
         }
     }
 }

@@ -39,6 +39,7 @@
 
 use super::bccg::RING_MIN_POINTS;
 use super::full_contact::FullContactThreshold;
+use super::interface::Interface;
 use super::preconditioner::FourierPreconditioner;
 use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
@@ -377,7 +378,8 @@ impl ContactSolver {
         let mut work = self.stiffness_work();
         // A set solved directly (`small_set.rs`) has its x already (a stop request goes to
         // the CG, which reports it).
-        let direct = match self.stop.is_requested() {
+        // (The direct solve knows the hard wall's set only.)
+        let direct = match self.stop.is_requested() || self.interface != Interface::HardWall {
             true => None,
             false => self.small_set_tangent(tolerance, &mut work.x),
         };
@@ -401,11 +403,11 @@ impl ContactSolver {
                     max_iterations,
                     stop: &self.stop,
                 };
-                let pressure = &self.state.pressure;
+                let (pressure, interface) = (&self.state.pressure, self.interface);
                 conjugate_gradient_on_set(
                     &mut self.problem.operator,
                     &mut self.preconditioner,
-                    |i| pressure[i] > 0.0,
+                    |i| interface.elastic(pressure[i]),
                     RightHandSide::Ones,
                     &mut work,
                     limits,
@@ -435,6 +437,11 @@ impl ContactSolver {
         let (Some(solved), true) = (self.state.solved, std::mem::take(&mut work.tangent)) else {
             return false;
         };
+        // Under a cap the tangent holds while no point reaches it or leaves it: the
+        // previous pressure is the safer start.
+        if self.interface != Interface::HardWall {
+            return false;
+        }
         let n = self.state.pressure.len() as f64;
         let step = match target {
             Target::MeanPressure(mean_pressure) => {

@@ -1,0 +1,381 @@
+//! Elastic–perfectly-plastic contact: the pressure capped at a hardness `H`
+//! ([`Interface::Hardness`]), the plastic displacement it leaves, and a load path that
+//! keeps it (loading, unloading, reloading: hysteresis).
+//!
+//! Under a cap the solved state has three sets: out of contact (`p = 0`, `g ≥ 0`), elastic
+//! (`0 < p < H`, `g = 0`) and plastic (`p = H`, `g ≤ 0`). On the plastic set the rigid
+//! indenter has pushed into the surface by `−g ≥ 0` more than the elastic half-space
+//! accommodates: that is the **plastic displacement** ([`ContactSolver::plastic_displacement`]).
+//! A solve alone leaves the surface as it was (solving twice gives the same answer);
+//! [`ContactSolver::keep_plastic_displacement`] makes it permanent (the profile `f` becomes
+//! `f + w`, the surface flattened where it yielded), which is what a load path does after
+//! each step ([`load_path`]): unloading from there is elastic on the flattened surface
+//! until it separates, reloading is elastic up to the largest load reached before, and only
+//! beyond it does the surface yield again.
+//!
+//! **Stiffness**: the frozen-set stiffness is taken on the *elastic* set `0 < p < H`. A
+//! small extra approach `Δd` raises the pressure where the surface is elastic; where it is
+//! at the hardness the pressure cannot rise (perfect plasticity), so those points carry
+//! no extra load and are left out of the set: `k` is the loading tangent `dF/dd`, which the
+//! finite-difference stiffness confirms (a test below). On unloading the plastic points
+//! unload elastically; after [`ContactSolver::keep_plastic_displacement`] they are at
+//! `g = 0` and, once the load drops, below the cap, so the unloading stiffness is that of
+//! the whole contact set.
+//!
+//! The peers: ContactMechanics (`PlasticSystem`, `hardness=` on its Polonsky–Keer) and
+//! tamaas (`KatoSaturated`) solve the same problem.
+
+use ndarray::Array2;
+
+use super::interface::Interface;
+use super::solver::ContactSolver;
+use super::{ContactSummary, Control, SolveError};
+
+impl ContactSolver {
+    /// Solves with `interface` from now on (validated; the hard wall by default). The
+    /// next solve starts cold; a kept plastic displacement stays.
+    pub fn set_interface(&mut self, interface: Interface) -> Result<(), SolveError> {
+        interface.validate()?;
+        self.interface = interface;
+        self.reset();
+        Ok(())
+    }
+
+    /// The solver with `interface` (builder form of [`ContactSolver::set_interface`]).
+    pub fn with_interface(mut self, interface: Interface) -> Result<Self, SolveError> {
+        self.set_interface(interface)?;
+        Ok(self)
+    }
+
+    /// The interface in use.
+    pub fn interface(&self) -> Interface {
+        self.interface
+    }
+
+    /// The plastic displacement of the last solve, `−g ≥ 0` where the pressure is at the
+    /// hardness, zero elsewhere (`rows × cols`). `None` before a successful solve.
+    pub fn plastic_displacement(&self) -> Option<Array2<f64>> {
+        self.state.solved?;
+        let (rows, cols) = self.dim();
+        let interface = self.interface;
+        let w = self
+            .state
+            .pressure
+            .iter()
+            .zip(&self.state.gap)
+            .map(|(&p, &g)| match interface.plastic(p) {
+                true => (-g).max(0.0),
+                false => 0.0,
+            })
+            .collect();
+        Some(Array2::from_shape_vec((rows, cols), w).expect("grid-sized"))
+    }
+
+    /// Makes the plastic displacement of the last solve permanent: the profile becomes
+    /// `f + w` (the surface flattened where it yielded) and the gap there zero, so the
+    /// solved state stays a solution of the new profile. Returns the largest `w` added.
+    /// Without a solved state nothing changes.
+    pub fn keep_plastic_displacement(&mut self) -> f64 {
+        if self.state.solved.is_none() {
+            return 0.0;
+        }
+        let len = self.problem.profile.len();
+        let permanent = self.permanent.get_or_insert_with(|| vec![0.0; len]);
+        let interface = self.interface;
+        let mut largest = 0.0f64;
+        for (((f, g), &p), total) in self
+            .problem
+            .profile
+            .iter_mut()
+            .zip(self.state.gap.iter_mut())
+            .zip(&self.state.pressure)
+            .zip(permanent.iter_mut())
+        {
+            if interface.plastic(p) && *g < 0.0 {
+                let w = -*g;
+                *f += w;
+                *total += w;
+                *g = 0.0;
+                largest = largest.max(w);
+            }
+        }
+        largest
+    }
+
+    /// The permanent displacement kept so far (zero before any), `rows × cols`.
+    pub fn permanent_displacement(&self) -> Array2<f64> {
+        let (rows, cols) = self.dim();
+        match &self.permanent {
+            Some(w) => Array2::from_shape_vec((rows, cols), w.clone()).expect("grid-sized"),
+            None => Array2::zeros((rows, cols)),
+        }
+    }
+}
+
+/// One step of a [`load_path`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    /// The load or indentation of the step.
+    pub control: Control,
+    /// The solved scalars (force, indentation, contact and plastic fractions).
+    pub summary: ContactSummary,
+    /// The frozen-set stiffness (on the elastic set, see the module docs).
+    pub stiffness: f64,
+    /// Iterations of the solve.
+    pub iterations: usize,
+    /// The largest permanent displacement so far.
+    pub permanent_max: f64,
+}
+
+/// Walks `controls` in order (e.g. loading up, unloading, reloading), each step warm from
+/// the last, keeping the plastic displacement of each
+/// ([`ContactSolver::keep_plastic_displacement`]): the force, area and stiffness of the
+/// way down differ from the way up (hysteresis). The first error ends the path.
+pub fn load_path(
+    solver: &mut ContactSolver,
+    controls: &[Control],
+) -> Result<Vec<PathPoint>, SolveError> {
+    let mut points = Vec::with_capacity(controls.len());
+    let mut permanent_max = 0.0f64;
+    for &control in controls {
+        let (summary, info) = solver.solve(control)?;
+        let (stiffness, _) = solver.frozen_set_stiffness()?;
+        permanent_max = permanent_max.max(solver.keep_plastic_displacement());
+        if let Some(w) = &solver.permanent {
+            permanent_max = w.iter().fold(permanent_max, |m, &x| m.max(x));
+        }
+        points.push(PathPoint {
+            control,
+            summary,
+            stiffness,
+            iterations: info.iterations,
+            permanent_max,
+        });
+    }
+    Ok(points)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::polonsky_keer::tests::rough_grid;
+    use super::super::{HalfSpace, SolverKind, SolverParams};
+    use super::*;
+    use crate::elastic::Boundary;
+
+    fn pk_solver(rows: usize, cols: usize, seed: u64, boundary: Boundary) -> ContactSolver {
+        let params = SolverParams {
+            solver: SolverKind::PolonskyKeer,
+            ..SolverParams::default()
+        };
+        let half_space = HalfSpace {
+            modulus: 1.0,
+            boundary,
+        };
+        ContactSolver::new(&rough_grid(rows, cols, seed), half_space, params).unwrap()
+    }
+
+    const GRIDS: [(usize, usize); 3] = [(31, 31), (32, 32), (24, 40)];
+    const BOUNDARIES: [Boundary; 2] = [Boundary::Free, Boundary::Periodic];
+
+    /// Every point satisfies the capped contact conditions: `0 ≤ p ≤ H`; `g = 0` on the
+    /// elastic set (the cleaned gap), `g ≥ 0` out of contact, `g ≤ 0` at the cap; the
+    /// summary counts what the fields say.
+    fn check_complementarity(solver: &ContactSolver, h: f64) {
+        let summary = solver.summary().unwrap();
+        let (mut contact, mut plastic) = (0, 0);
+        for (&p, &g) in solver.pressure().iter().zip(solver.gap()) {
+            assert!((0.0..=h).contains(&p), "p = {p} outside [0, {h}]");
+            if p == h {
+                assert!(g <= 0.0, "g = {g} at the cap");
+                plastic += 1;
+            } else if p > 0.0 {
+                assert_eq!(g, 0.0);
+            } else {
+                assert!(g >= 0.0);
+            }
+            contact += (p > 0.0) as usize;
+        }
+        assert_eq!(summary.contact_points, contact);
+        assert_eq!(summary.plastic_points, plastic);
+        let w = solver.plastic_displacement().unwrap();
+        for ((&wi, &p), &g) in w.iter().zip(solver.pressure()).zip(solver.gap()) {
+            assert_eq!(wi, if p == h { -g } else { 0.0 });
+        }
+    }
+
+    #[test]
+    fn capped_solves_satisfy_the_conditions_at_every_point() {
+        // Odd, even and non-square grids, free and periodic, load and displacement
+        // control, at a hardness that caps part of the contact.
+        for (rows, cols) in GRIDS {
+            for boundary in BOUNDARIES {
+                let mut solver = pk_solver(rows, cols, 3, boundary);
+                let (elastic, _) = solver.solve(Control::MeanPressure(0.02)).unwrap();
+                let peak = solver.pressure().fold(0.0f64, |m, &p| m.max(p));
+                let h = 0.5 * peak;
+                solver
+                    .set_interface(Interface::hardness(h).unwrap())
+                    .unwrap();
+                let (s, info) = solver.solve(Control::MeanPressure(0.02)).unwrap();
+                let case = format!("{rows}x{cols} {boundary:?}");
+                assert!(s.plastic_points > 0, "{case}");
+                assert!((s.mean_pressure - 0.02).abs() < 1e-12, "{case}: {s:?}");
+                // Capping spreads the load: more area, a deeper indenter.
+                assert!(s.contact_points > elastic.contact_points, "{case}");
+                assert!(s.indentation > elastic.indentation, "{case}");
+                assert!(info.residual < 1e-8, "{case}");
+                check_complementarity(&solver, h);
+                // Displacement control at that indentation gives the same state.
+                solver.reset();
+                let (d, _) = solver.solve(Control::Indentation(s.indentation)).unwrap();
+                assert!(
+                    (d.mean_pressure / s.mean_pressure - 1.0).abs() < 1e-6,
+                    "{case}"
+                );
+                assert_eq!(d.plastic_points, s.plastic_points, "{case}");
+                check_complementarity(&solver, h);
+            }
+        }
+    }
+
+    #[test]
+    fn a_cap_no_iterate_reaches_gives_the_elastic_result_exactly() {
+        for (rows, cols) in GRIDS {
+            for boundary in BOUNDARIES {
+                for control in [Control::MeanPressure(0.03), Control::Indentation(0.02)] {
+                    let mut wall = pk_solver(rows, cols, 5, boundary);
+                    let want = wall.solve(control).unwrap();
+                    // Above the solution's peak and above the cold start of displacement
+                    // control (local springs (d − f)/K₀₀): no iterate reaches it.
+                    let peak = wall.pressure().fold(0.0f64, |m, &p| m.max(p));
+                    let springs = match control {
+                        Control::Indentation(d) => d / wall.problem.operator.self_influence(),
+                        _ => 0.0,
+                    };
+                    let peak = peak.max(springs);
+                    let mut capped = pk_solver(rows, cols, 5, boundary)
+                        .with_interface(Interface::hardness(1.5 * peak).unwrap())
+                        .unwrap();
+                    let got = capped.solve(control).unwrap();
+                    assert_eq!(got, want, "{rows}x{cols} {boundary:?} {control:?}");
+                    assert_eq!(capped.pressure(), wall.pressure());
+                    assert_eq!(capped.gap(), wall.gap());
+                    assert_eq!(
+                        capped.frozen_set_stiffness().unwrap().0,
+                        wall.frozen_set_stiffness().unwrap().0
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_vanishing_hardness_gives_the_bearing_area_fully_plastic() {
+        // H → 0 at a fixed approach d: the elastic displacements (of order H) vanish, the
+        // surface is cut where the indenter passes through it, {f < d}, and every contact
+        // point is at the cap: F = H·A.
+        for (rows, cols) in GRIDS {
+            for boundary in BOUNDARIES {
+                let mut solver = pk_solver(rows, cols, 8, boundary);
+                let h = 1e-9;
+                solver
+                    .set_interface(Interface::hardness(h).unwrap())
+                    .unwrap();
+                let profile = solver.problem().profile().to_owned();
+                let mut sorted: Vec<f64> = profile.iter().copied().collect();
+                sorted.sort_by(f64::total_cmp);
+                // An approach midway between two profile values near 10 % bearing area,
+                // far from both compared with the elastic displacements (~1e-9).
+                let k = sorted.len() / 10;
+                let d = 0.5 * (sorted[k] + sorted[k + 1]);
+                assert!(sorted[k + 1] - sorted[k] > 1e-6);
+                let (s, _) = solver.solve(Control::Indentation(d)).unwrap();
+                let case = format!("{rows}x{cols} {boundary:?}");
+                let bearing: Vec<bool> = profile.iter().map(|&f| f < d).collect();
+                let contact: Vec<bool> = solver.pressure().iter().map(|&p| p > 0.0).collect();
+                assert_eq!(contact, bearing, "{case}");
+                assert_eq!(s.plastic_points, s.contact_points, "{case}");
+                let (dx, dy) = solver.problem().spacings();
+                let fully_plastic = h * s.contact_points as f64 * dx * dy;
+                assert!((s.force / fully_plastic - 1.0).abs() < 1e-12, "{case}");
+                check_complementarity(&solver, h);
+            }
+        }
+    }
+
+    #[test]
+    fn the_frozen_elastic_set_gives_the_loading_tangent() {
+        // k on 0 < p < H against dF/dd by central differences of two capped solves; the
+        // sets move within the step (points reach the cap), hence 3 %.
+        for boundary in BOUNDARIES {
+            let mut solver = pk_solver(48, 48, 2, boundary);
+            solver
+                .set_interface(Interface::hardness(0.3).unwrap())
+                .unwrap();
+            let (s, _) = solver.solve(Control::MeanPressure(0.03)).unwrap();
+            assert!(s.plastic_points > 0);
+            let (k, _) = solver.frozen_set_stiffness().unwrap();
+            let d = s.indentation;
+            let (up, _) = solver.solve(Control::Indentation(d * 1.001)).unwrap();
+            let (down, _) = solver.solve(Control::Indentation(d * 0.999)).unwrap();
+            let fd = (up.force - down.force) / (up.indentation - down.indentation);
+            assert!((k / fd - 1.0).abs() < 0.03, "{boundary:?}: {k} vs {fd}");
+        }
+    }
+
+    #[test]
+    fn a_load_path_keeps_the_plastic_displacement() {
+        for boundary in BOUNDARIES {
+            let mut solver = pk_solver(40, 40, 4, boundary);
+            solver
+                .set_interface(Interface::hardness(0.3).unwrap())
+                .unwrap();
+            let loads = [0.01, 0.04, 0.01, 0.04].map(Control::MeanPressure);
+            let path = load_path(&mut solver, &loads).unwrap();
+            let [first, top, down, again] = [path[0], path[1], path[2], path[3]];
+            assert!(top.summary.plastic_points > 0 && top.permanent_max > 0.0);
+            // Unloading is elastic on the flattened surface: the indenter stands deeper
+            // than on the way up at the same load, nothing yields, the area is larger.
+            assert!(
+                down.summary.indentation > first.summary.indentation,
+                "{boundary:?}"
+            );
+            assert_eq!(down.summary.plastic_points, 0, "{boundary:?}");
+            assert_eq!(down.permanent_max, top.permanent_max);
+            assert!(down.summary.contact_points >= first.summary.contact_points);
+            // Reloading to the largest load comes back to the state of the way up and
+            // adds (to the tolerance) no plastic displacement.
+            let dd = again.summary.indentation / top.summary.indentation - 1.0;
+            assert!(dd.abs() < 1e-6, "{boundary:?}: {dd}");
+            assert!(again.permanent_max - top.permanent_max < 1e-8 * top.permanent_max);
+            // The solver keeps the permanent field; a new surface forgets it.
+            let w = solver.permanent_displacement();
+            assert!(w.iter().all(|&x| x >= 0.0));
+            assert_eq!(w.fold(0.0f64, |m, &x| m.max(x)), again.permanent_max);
+        }
+    }
+
+    #[test]
+    fn bad_hardness_and_loads_beyond_it_are_refused() {
+        let mut solver = pk_solver(16, 16, 1, Boundary::Free);
+        for h in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let err = solver.set_interface(Interface::Hardness { h }).unwrap_err();
+            assert!(err.to_string().contains("hardness"), "{err}");
+        }
+        solver
+            .set_interface(Interface::hardness(0.1).unwrap())
+            .unwrap();
+        let err = solver.solve(Control::MeanPressure(0.1)).unwrap_err();
+        assert!(
+            err.to_string().contains("at or above the hardness"),
+            "{err}"
+        );
+        let area = solver.nominal_area();
+        assert!(solver.solve(Control::Force(0.2 * area)).is_err());
+        let mut params = *solver.params();
+        params.solver = SolverKind::Bccg;
+        solver.set_params(params).unwrap();
+        let err = solver.solve(Control::MeanPressure(0.01)).unwrap_err();
+        assert!(err.to_string().contains("pk"), "{err}");
+    }
+}
