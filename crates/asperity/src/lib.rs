@@ -96,6 +96,7 @@ pub mod lock;
 pub mod mdr;
 pub mod memory;
 pub mod npy;
+pub mod persson;
 mod pool;
 pub mod reference;
 pub mod spectrum;
