@@ -422,3 +422,169 @@ fn x3p_written_by_import_reads_back_bit_exact() {
     ok(&out);
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 3);
 }
+
+#[test]
+fn a_table_with_column_names_is_not_a_surface() {
+    // asperity's own outputs: `stats --psd` (q, psd, q_l_2pi) and an `mdr` curve
+    // (indentation, force, stiffness, contacts) are tables, not height maps or profiles.
+    let dir = tempfile::tempdir().unwrap();
+    let mut psd = String::from("q,psd,q_l_2pi\n");
+    let mut curve = String::from("indentation,force,stiffness,contacts\n");
+    for i in 1..=128 {
+        let q = i as f64 * 1e5;
+        psd += &format!("{q:e},{:e},{:e}\n", 1e-30 / q, q * 1e-6);
+        curve += &format!(
+            "{:e},{:e},{:e},{i}\n",
+            i as f64 * 1e-9,
+            i as f64 * 1e-3,
+            2.0
+        );
+    }
+    std::fs::write(dir.path().join("psd.csv"), psd).unwrap();
+    std::fs::write(dir.path().join("curve.csv"), curve).unwrap();
+    let out = asperity(
+        &[
+            "bem",
+            "--surface",
+            "psd.csv",
+            "--size",
+            "1",
+            "--modulus",
+            "1e9",
+            "--pressures",
+            "1e5",
+            "--out",
+            "b.csv",
+        ],
+        dir.path(),
+    );
+    assert_refused(
+        &out,
+        dir.path(),
+        &["psd.csv", "curve.csv"],
+        "a table is not a topography",
+    );
+    let out = asperity(&["stats", "curve.csv", "--size", "1"], dir.path());
+    refused(&out, "refused rather than guessed");
+}
+
+#[test]
+fn small_matrices_are_refused_not_reinterpreted() {
+    // A 2 × 3 and a 2 × 2 matrix without a header: too few rows to tell a matrix from
+    // x y z or x z columns (they were read as a 2 × 2 map with 2 holes and as a profile).
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m23.txt"), "1 2 3\n4 5 6\n").unwrap();
+    std::fs::write(dir.path().join("m22.txt"), "1 2\n3 4\n").unwrap();
+    for name in ["m23.txt", "m22.txt"] {
+        let out = asperity(
+            &["import", name, "--size", "1", "--out", "o.npy"],
+            dir.path(),
+        );
+        refused(&out, "refused rather than guessed");
+    }
+    // With a header saying it is a matrix, the 2 × 3 one is read as one.
+    std::fs::write(
+        dir.path().join("h23.txt"),
+        "# Value units: nm\n1 2 3\n4 5 6\n",
+    )
+    .unwrap();
+    let out = asperity(
+        &[
+            "import",
+            "h23.txt",
+            "--size",
+            "3e-9",
+            "--out",
+            "o.npy",
+            "--detrend",
+            "none",
+        ],
+        dir.path(),
+    );
+    ok(&out);
+    assert_eq!(npy(&dir.path().join("o.npy")).shape(), &[2, 3]);
+}
+
+/// `shared/topographies` file `name` with the f32 at `offset` set to +inf, in `dir`.
+fn with_infinity(shared: &Path, name: &str, dir: &Path, offset: impl Fn(&[u8]) -> usize) -> String {
+    let mut bytes = std::fs::read(shared.join(name)).unwrap();
+    let at = offset(&bytes);
+    bytes[at..at + 4].copy_from_slice(&f32::INFINITY.to_le_bytes());
+    std::fs::write(dir.join(name), bytes).unwrap();
+    name.to_string()
+}
+
+#[test]
+fn an_infinite_height_is_an_undefined_point() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let al3d_offset = |b: &[u8]| {
+        let key = b
+            .windows(16)
+            .position(|w| w == b"DepthImageOffset")
+            .unwrap();
+        let value = &b[key + 20..key + 50];
+        let text: String = value
+            .iter()
+            .take_while(|&&c| c != 0)
+            .map(|&c| c as char)
+            .collect();
+        text.trim().parse::<usize>().unwrap() + 40
+    };
+    let files = [
+        with_infinity(&shared, "tmd-1.tmd", dir.path(), |b| b.len() - 4),
+        with_infinity(&shared, "plu-1.plu", dir.path(), |_| 500 + 8 + 40),
+        with_infinity(&shared, "al3d-1.al3d", dir.path(), al3d_offset),
+    ];
+    for name in &files {
+        // Undefined, so refused without a filling, and filled with one: never written as inf.
+        let out = asperity(
+            &[
+                "import",
+                name,
+                "--out",
+                "o.npy",
+                "--detrend",
+                "none",
+                "--force",
+            ],
+            dir.path(),
+        );
+        refused(&out, "1 of");
+        let out = asperity(
+            &[
+                "import",
+                name,
+                "--out",
+                "o.npy",
+                "--detrend",
+                "none",
+                "--fill",
+                "harmonic",
+                "--force",
+            ],
+            dir.path(),
+        );
+        ok(&out);
+        assert!(
+            npy(&dir.path().join("o.npy")).iter().all(|v| v.is_finite()),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn a_corrupt_header_gives_a_short_line() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    // A DI header line lost its leading backslash and its line break for 6000 bytes.
+    let bytes = std::fs::read(shared.join("di-1.di")).unwrap();
+    let at = bytes.windows(3).position(|w| w == b"\r\n\\").unwrap() + 2;
+    let mut corrupt = bytes[..at].to_vec();
+    corrupt.extend(std::iter::repeat_n(b'x', 6000));
+    corrupt.extend_from_slice(&bytes[at + 1..]);
+    std::fs::write(dir.path().join("c.di"), corrupt).unwrap();
+    let out = asperity(&["import", "c.di", "--out", "o.npy"], dir.path());
+    let err = refused(&out, "c.di");
+    assert!(err.len() < 600, "{} bytes: {err}", err.len());
+}

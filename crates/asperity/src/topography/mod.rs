@@ -468,7 +468,34 @@ pub fn clean(
 fn bad_file(path: &Path, reason: impl Into<String>) -> Error {
     Error::BadArrayFile {
         path: path.to_path_buf(),
-        reason: reason.into(),
+        reason: one_line(&reason.into()),
+    }
+}
+
+/// An error message as one line of at most [`MAX_REASON`] characters: control characters
+/// (a corrupt header's line breaks) become spaces, the rest is cut with `…`.
+fn one_line(reason: &str) -> String {
+    let flat: String = reason
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    match flat.char_indices().nth(MAX_REASON) {
+        Some((i, _)) => format!("{}…", &flat[..i]),
+        None => flat,
+    }
+}
+
+/// The longest error message about a file's content, in characters.
+const MAX_REASON: usize = 400;
+
+/// Infinite heights are undefined points (NaN), whatever the reader: no reader passes an
+/// infinity on.
+fn infinities_undefined(reading: &mut Reading) {
+    for c in &mut reading.channels {
+        match &mut c.heights {
+            Heights::Areal(h) => h.mapv_inplace(|v| if v.is_finite() { v } else { f64::NAN }),
+            Heights::Profile(h) => h.mapv_inplace(|v| if v.is_finite() { v } else { f64::NAN }),
+        }
     }
 }
 
@@ -513,8 +540,15 @@ pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
     topography_from(path, reading, notes, options)
 }
 
-/// Reads `bytes` in the format found by content, else by the extension of `path`.
+/// Reads `bytes` in the format found by content, else by the extension of `path`;
+/// infinite heights made undefined.
 fn detect_and_read(path: &Path, bytes: &[u8]) -> Result<(Reading, Vec<String>)> {
+    let (mut reading, notes) = detect_and_read_raw(path, bytes)?;
+    infinities_undefined(&mut reading);
+    Ok((reading, notes))
+}
+
+fn detect_and_read_raw(path: &Path, bytes: &[u8]) -> Result<(Reading, Vec<String>)> {
     if let Some(f) = FORMATS.iter().find(|f| (f.sniff)(bytes)) {
         return Ok(((f.read)(bytes)?, Vec::new()));
     }
@@ -547,9 +581,9 @@ fn detect_and_read(path: &Path, bytes: &[u8]) -> Result<(Reading, Vec<String>)> 
 fn read_text(bytes: &[u8]) -> Result<(Reading, Vec<String>)> {
     match text::kind(bytes)? {
         text::TextKind::Matrix => Ok((text::read(bytes)?, Vec::new())),
-        // Three columns that are no x y z grid may still be a small matrix.
-        text::TextKind::Columns => xyz::read_with_notes(bytes)
-            .or_else(|e| text::read(bytes).map(|r| (r, Vec::new())).map_err(|_| e)),
+        // Never re-read as a matrix what is no list of coordinates: a layout the reader
+        // is not sure of is refused, saying what it saw.
+        text::TextKind::Columns => xyz::read_with_notes(bytes),
     }
 }
 
@@ -980,5 +1014,57 @@ mod tests {
         std::fs::write(&path, b"PK\x05").unwrap();
         let err = read_file(&path, &ReadOptions::default()).unwrap_err();
         assert!(err.to_string().contains("x3p"), "{err}");
+    }
+}
+
+#[cfg(test)]
+mod shared_sets {
+    //! The binary files of `shared/topographies-2` read like SurfaceTopography 1.27.1's
+    //! reference, one test per file (the text and X3P files are tested beside their
+    //! readers).
+    use super::testkit::{check_shared, Expect};
+
+    fn check(name: &str) {
+        check_shared("topographies-2", name, Expect::default());
+    }
+
+    #[test]
+    fn di_2_height_height_deflection() {
+        check("di-2.di");
+    }
+
+    #[test]
+    fn di_3_zsensor_first_of_four() {
+        check("di-3.di");
+    }
+
+    #[test]
+    fn di_4_zsensor_amplitude_phase() {
+        check("di-4.di");
+    }
+
+    #[test]
+    fn di_5_zsensor_peak_force_error() {
+        check("di-5.di");
+    }
+
+    #[test]
+    fn di_6_two_heights_phase_amplitude() {
+        check("di-6.di");
+    }
+
+    #[test]
+    fn frt_1_with_undefined_points() {
+        check("frt-1.frt");
+    }
+
+    #[test]
+    fn sur_3_with_undefined_points() {
+        check("sur-3.sur");
+    }
+
+    #[test]
+    fn wsxm_top_1() {
+        check("top-1.top");
     }
 }

@@ -229,3 +229,138 @@ pub(crate) fn assert_close<'a>(got: impl IntoIterator<Item = &'a f64>, want: &[f
         assert!(same, "{got:?} vs {want:?}");
     }
 }
+
+/// `shared/<set>` (`topographies-2`, `topographies-3`), or `None` with a notice.
+pub(crate) fn set_dir(set: &str) -> Option<PathBuf> {
+    let dir = shared_dir()?.parent()?.join(set);
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("shared/{set} not found beside the repository: skipping");
+        None
+    }
+}
+
+/// What a file of a further shared set is expected to read as, beyond the reference's
+/// heights: the deliberate differences are stated by the caller.
+pub(crate) struct Expect {
+    /// Compare the list of channel names with the reference's.
+    pub channel_names: bool,
+    /// The unit our reader gives (`None`: the file gives none), where it differs on purpose
+    /// from the reference's; `Some(None)` keeps the reference's.
+    pub unit: Option<Option<&'static str>>,
+    /// Our heights are the reference's times this factor (a unit the peer ignores).
+    pub height_factor: f64,
+    /// Our sizes `[x, y]` in metres where the reference has none or differs on purpose.
+    pub size: Option<[Option<f64>; 2]>,
+}
+
+impl Default for Expect {
+    fn default() -> Self {
+        Expect {
+            channel_names: true,
+            unit: None,
+            height_factor: 1.0,
+            size: None,
+        }
+    }
+}
+
+/// Reads `shared/<set>/<name>` as `read_file` would (detection by content, then
+/// extension) and checks the default channel against SurfaceTopography's reference:
+/// the channel's name, the heights in metres to 1e-12 relative (NaN at the same points,
+/// their count as recorded), the grid, the sizes (1e-12) and the unit. Returns `false`
+/// (with a notice) where the folder is absent.
+pub(crate) fn check_shared(set: &str, name: &str, expect: Expect) -> bool {
+    let Some(dir) = set_dir(set) else {
+        return false;
+    };
+    let path = dir.join(name);
+    let bytes = std::fs::read(&path).unwrap();
+    let (reading, _) =
+        super::detect_and_read(&path, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let json = std::fs::read_to_string(dir.join(format!("{name}.reference.json"))).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let want: ndarray::ArrayD<f64> =
+        ndarray_npy::read_npy(dir.join(format!("{name}.reference.npy"))).unwrap();
+    let names: Vec<&str> = reading.channels.iter().map(|c| c.name.as_str()).collect();
+    if expect.channel_names {
+        let want_names: Vec<&str> = meta["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        assert_eq!(names, want_names, "{name}: channel names");
+    }
+    let c = reading
+        .channels
+        .iter()
+        .find(|c| c.is_height)
+        .expect("a height channel");
+    if expect.channel_names {
+        assert_eq!(c.name, meta["default_channel"].as_str().unwrap(), "{name}");
+    }
+    assert_heights(name, &c.heights, &want, expect.height_factor, &meta);
+    let unit = match expect.unit {
+        Some(u) => u.map(str::to_string),
+        None => meta["unit"].as_str().map(str::to_string),
+    };
+    assert_eq!(c.unit, unit, "{name}: unit");
+    let size = expect.size.unwrap_or_else(|| {
+        let s = &meta["physical_sizes_m"];
+        [s[0].as_f64(), s[1].as_f64()]
+    });
+    for (axis, (got, want)) in c.size.iter().zip(size).enumerate() {
+        match (*got, want) {
+            (Some(g), Some(w)) => assert!(
+                (g - w).abs() <= 1e-12 * w.abs(),
+                "{name}: size[{axis}] {g} vs {w}"
+            ),
+            (g, w) => assert_eq!(g, w, "{name}: size[{axis}]"),
+        }
+    }
+    true
+}
+
+/// The heights against the reference `[x, y]` array times `factor`: grid, values to
+/// 1e-12 relative, NaN at the same points and as many as recorded.
+fn assert_heights(
+    name: &str,
+    heights: &Heights,
+    want: &ndarray::ArrayD<f64>,
+    factor: f64,
+    meta: &serde_json::Value,
+) {
+    let got: Vec<f64> = match heights {
+        Heights::Areal(h) => {
+            assert_eq!(want.shape(), &[h.ncols(), h.nrows()], "{name}: grid [x, y]");
+            h.t().iter().copied().collect()
+        }
+        Heights::Profile(h) => {
+            assert_eq!(want.shape(), &[h.len()], "{name}: profile length");
+            h.to_vec()
+        }
+    };
+    let mut undefined = 0;
+    for (i, (g, w)) in got.iter().zip(want.iter()).enumerate() {
+        let w = w * factor;
+        if w.is_nan() {
+            undefined += 1;
+            assert!(
+                g.is_nan(),
+                "{name} [{i}]: {g} where the reference is undefined"
+            );
+        } else {
+            assert!(
+                (g - w).abs() <= 1e-12 * w.abs(),
+                "{name} [{i}]: {g} vs reference {w}"
+            );
+        }
+    }
+    assert_eq!(
+        undefined as u64,
+        meta["undefined_points"].as_u64().unwrap(),
+        "{name}: undefined points"
+    );
+}

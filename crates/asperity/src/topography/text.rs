@@ -98,33 +98,100 @@ pub(crate) fn kind(bytes: &[u8]) -> Result<TextKind> {
                 TextKind::Columns
             });
         }
-        header |= header_entry(line).is_some();
+        header |= !header_entries(line).is_empty();
     }
     Err(bad(FORMAT, "no line of numbers in the first 400 lines"))
 }
 
-/// A header entry `key: value` or `key = value`, key lower-cased, `#` and spaces trimmed.
-fn header_entry(line: &str) -> Option<(String, String)> {
+/// The header keys this reader knows, with the spellings that mean the same (Gwyddion's
+/// German export; the `h=… w=…` grid line of some interferometer exports).
+fn known_key(key: &str) -> Option<&'static str> {
+    Some(match key {
+        "channel" | "kanal" => "channel",
+        "width" | "breite" => "width",
+        "height" | "höhe" => "height",
+        "value units" | "werteinheiten" => "value units",
+        "x-length" => "x-length",
+        "y-length" => "y-length",
+        "x-unit" => "x-unit",
+        "y-unit" => "y-unit",
+        "z-unit" => "z-unit",
+        "h" => "rows",
+        "w" => "cols",
+        "pixel size" => "pixel size",
+        "data unit" => "data unit",
+        "height conversion factor (-> m)" => "to metres",
+        _ => return None,
+    })
+}
+
+/// Words in a header key that say it changes the meaning of the numbers: an unknown key
+/// holding one is refused rather than ignored.
+const MEANINGFUL: &[&str] = &[
+    "unit",
+    "factor",
+    "scale",
+    "size",
+    "pixel",
+    "spacing",
+    "offset",
+    "resolution",
+    "step",
+    "range",
+    "multiplier",
+    "length",
+    "width",
+    "height",
+    "conversion",
+    "einheit",
+];
+
+/// A header line split into `key: value` / `key = value` pairs, key lower-cased, `#` and
+/// spaces trimmed; a line of several `k=v` tokens (`h=650 w=650`) gives several.
+fn raw_entries(line: &str) -> Vec<(String, String)> {
     let line = line.trim().trim_start_matches('#').trim();
     if line.len() > MAX_HEADER_LINE {
-        return None;
+        return Vec::new();
     }
-    let (key, value) = line.split_once(':').or_else(|| line.split_once('='))?;
-    let key = key.trim().to_ascii_lowercase();
-    let known = [
-        "channel",
-        "width",
-        "height",
-        "value units",
-        "x-length",
-        "y-length",
-        "x-unit",
-        "y-unit",
-        "z-unit",
-    ];
-    known
-        .contains(&key.as_str())
-        .then(|| (key, value.trim().to_string()))
+    let words: Vec<&str> = line.split_whitespace().collect();
+    if words.len() > 1 && words.iter().all(|w| w.contains('=')) {
+        return words
+            .iter()
+            .filter_map(|w| w.split_once('='))
+            .map(|(k, v)| (k.trim().to_lowercase(), v.trim().to_string()))
+            .collect();
+    }
+    match line.split_once(':').or_else(|| line.split_once('=')) {
+        Some((k, v)) => vec![(k.trim().to_lowercase(), v.trim().to_string())],
+        None => Vec::new(),
+    }
+}
+
+/// The known header entries of a line, keys in their one spelling.
+fn header_entries(line: &str) -> Vec<(String, String)> {
+    raw_entries(line)
+        .into_iter()
+        .filter_map(|(k, v)| known_key(&k).map(|k| (k.to_string(), v)))
+        .collect()
+}
+
+/// Why a header line before the data cannot be passed over: an unknown key that may
+/// change the numbers' meaning, or a line of words that is no comment (`#`), such as the
+/// column names of a table. `None`: a comment or known entries.
+fn unknown_header(line: &str) -> Option<String> {
+    let entries = raw_entries(line);
+    if let Some((key, _)) = entries
+        .iter()
+        .find(|(k, _)| known_key(k).is_none() && MEANINGFUL.iter().any(|w| k.contains(w)))
+    {
+        return Some(format!(
+            "header entry `{key}` is not one this reader knows, and it may change the heights or sizes"
+        ));
+    }
+    if entries.is_empty() && !line.trim_start().starts_with('#') {
+        return Some("neither a header entry (`key: value`), a `#` comment nor a row of numbers (column names of a table?)".into());
+    }
+    None
 }
 
 /// A length with its unit (`12.34 µm`), in metres; `None` when the unit is unknown.
@@ -145,6 +212,15 @@ struct Block {
     values: Vec<f64>,
     rows: usize,
     cols: usize,
+}
+
+/// A line shortened for an error message (at most 60 characters).
+pub(crate) fn clip(line: &str) -> String {
+    let line = line.trim();
+    match line.char_indices().nth(60) {
+        Some((i, _)) => format!("{}…", &line[..i]),
+        None => line.to_string(),
+    }
 }
 
 /// Reads a text height matrix (see the module docs).
@@ -170,11 +246,24 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
             }
             block.values.extend_from_slice(&row);
             block.rows += 1;
-        } else if let Some(entry) = header_entry(line) {
+        } else if let Some(why) = unknown_header(line) {
+            return Err(bad(
+                FORMAT,
+                format!(
+                    "line {} `{}`: {why}; refused rather than guessed",
+                    number + 1,
+                    clip(line)
+                ),
+            ));
+        } else if !header_entries(line).is_empty() {
             if blocks.last().is_some_and(|b| b.rows > 0) {
                 blocks.push(Block::default());
             }
-            blocks.last_mut().expect("one block").header.push(entry);
+            blocks
+                .last_mut()
+                .expect("one block")
+                .header
+                .extend(header_entries(line));
         } else if blocks.last().is_some_and(|b| b.rows > 0) {
             return Err(bad(
                 FORMAT,
@@ -216,10 +305,14 @@ fn channel(index: usize, block: Block) -> Result<Channel> {
             ),
         ));
     }
-    let z_unit = get("value units").or(get("z-unit")).map(str::trim);
-    let z_factor = z_unit.and_then(unit_to_metres);
+    check_grid(&block, get("rows"), get("cols"))?;
+    let (z_unit, z_factor) = z_scale(
+        get("to metres"),
+        get("value units").or(get("z-unit")).or(get("data unit")),
+    )?;
     // Sizes: `Width: 12.34 µm`, or `x-length = 12.34` with `x-unit = µm`; a size without
-    // a known unit is taken in the heights' unit when that is a length, else ignored.
+    // a known unit is taken in the heights' unit when that is a length, else ignored;
+    // `pixel size = 0.37 µm` gives both (square pixels).
     let size = |value: Option<&str>, unit: Option<&str>| -> Option<f64> {
         let (v, with_unit) = length(value?)?;
         if with_unit {
@@ -230,8 +323,14 @@ fn channel(index: usize, block: Block) -> Result<Channel> {
             None => Some(v),
         }
     };
-    let sx = size(get("width").or(get("x-length")), get("x-unit"));
-    let sy = size(get("height").or(get("y-length")), get("y-unit"));
+    let pixel = match get("pixel size") {
+        Some(p) => Some(pixel_size(p)?),
+        None => None,
+    };
+    let sx = size(get("width").or(get("x-length")), get("x-unit"))
+        .or(pixel.map(|p| p * block.cols as f64));
+    let sy = size(get("height").or(get("y-length")), get("y-unit"))
+        .or(pixel.map(|p| p * block.rows as f64));
     let mut heights = Array2::from_shape_vec((block.rows, block.cols), block.values)
         .map_err(|e| bad(FORMAT, e.to_string()))?;
     if let Some(f) = z_factor {
@@ -243,9 +342,60 @@ fn channel(index: usize, block: Block) -> Result<Channel> {
             .unwrap_or_else(|| format!("channel {index}")),
         heights: Heights::Areal(heights),
         size: [sx, sy],
-        unit: z_unit.map(super::canonical_unit),
+        unit: z_unit.as_deref().map(super::canonical_unit),
         is_height: z_unit.is_none() || z_factor.is_some(),
     })
+}
+
+/// The heights' unit and factor to metres: a `height conversion factor (-> m)` (the raw
+/// numbers times it are metres, whatever their own unit), else the unit the header names.
+fn z_scale(to_metres: Option<&str>, unit: Option<&str>) -> Result<(Option<String>, Option<f64>)> {
+    if let Some(text) = to_metres {
+        let f: f64 = text.trim().parse().map_err(|_| {
+            bad(
+                FORMAT,
+                format!("height conversion factor {text:?} is not a number"),
+            )
+        })?;
+        if !crate::is_positive_finite(f) {
+            return Err(bad(
+                FORMAT,
+                format!("height conversion factor {f} is not positive and finite"),
+            ));
+        }
+        return Ok((Some("m".into()), Some(f)));
+    }
+    let unit = unit.map(|u| u.trim().to_string());
+    let factor = unit.as_deref().and_then(unit_to_metres);
+    Ok((unit, factor))
+}
+
+/// `pixel size = 3.7e-7 m`: a length with a known unit, in metres.
+fn pixel_size(value: &str) -> Result<f64> {
+    match length(value) {
+        Some((v, true)) if crate::is_positive_finite(v) => Ok(v),
+        _ => Err(bad(
+            FORMAT,
+            format!("pixel size {value:?} is not a positive length with a known unit"),
+        )),
+    }
+}
+
+/// The header's grid (`h=… w=…`), where given, must be the matrix's.
+fn check_grid(block: &Block, rows: Option<&str>, cols: Option<&str>) -> Result<()> {
+    for (what, given, found) in [("h", rows, block.rows), ("w", cols, block.cols)] {
+        let Some(given) = given else { continue };
+        if given.trim().parse::<usize>().ok() != Some(found) {
+            return Err(bad(
+                FORMAT,
+                format!(
+                    "the header says {what}={given} but the matrix has {} rows of {} values",
+                    block.rows, block.cols
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -315,6 +465,58 @@ mod tests {
         assert!(r.channels[0].is_height && !r.channels[1].is_height);
         assert!(read(b"1 2 3\n4 5\n").is_err());
         assert!(read(b"# Width: 1 m\n").is_err());
+    }
+
+    #[test]
+    fn pixel_size_and_height_conversion_factor_headers_match_the_reference() {
+        // `h=… w=…`, `pixel size=… m`, `data unit=rad`, `height conversion factor (-> m)=…`:
+        // the heights are the numbers times the factor, in metres; the sizes pixel × count.
+        use crate::topography::testkit::{check_shared, Expect};
+        for name in ["matrix-2.txt", "matrix-4.txt"] {
+            let expect = Expect {
+                channel_names: false, // the peer's `Default`, our `channel 0`
+                ..Expect::default()
+            };
+            check_shared("topographies-2", name, expect);
+        }
+        let text =
+            "h=2 w=3\npixel size=2 um\ndata unit=rad\nheight conversion factor (-> m)=1e-8\n\
+                    1 2 3\n4 5 6\n";
+        let c = &read(text.as_bytes()).unwrap().channels[0];
+        assert_eq!(c.size, [Some(6e-6), Some(4e-6)]);
+        assert_eq!(c.unit.as_deref(), Some("m"));
+        let Heights::Areal(h) = &c.heights else {
+            panic!()
+        };
+        assert_close(h[(1, 2)], 6e-8, 1e-15, "6 × 1e-8");
+        // The header's grid must be the matrix's.
+        let err = read(text.replace("w=3", "w=4").as_bytes()).unwrap_err();
+        assert!(err.to_string().contains("w=4"), "{err}");
+    }
+
+    #[test]
+    fn german_gwyddion_export_matches_the_reference() {
+        use crate::topography::testkit::{check_shared, Expect};
+        check_shared(
+            "topographies-2",
+            "gwyddion-export-german.txt",
+            Expect::default(),
+        );
+    }
+
+    #[test]
+    fn a_header_the_reader_does_not_know_is_refused_not_ignored() {
+        for text in [
+            "z scale factor = 1e-9\n1 2 3 4\n5 6 7 8\n",
+            "# Pixel spacing: 3 nm\n1 2 3 4\n5 6 7 8\n",
+            "a,b,c,d\n1,2,3,4\n5,6,7,8\n",
+        ] {
+            let err = read(text.as_bytes()).unwrap_err().to_string();
+            assert!(err.contains("line 1") && err.contains("refused"), "{err}");
+            assert_eq!(err.lines().count(), 1);
+        }
+        // A comment without a key, or a key that cannot change the numbers, is passed over.
+        assert!(read(b"# made by hand\n# Date: 2024-01-01\n1 2 3 4\n5 6 7 8\n").is_ok());
     }
 
     #[test]

@@ -85,7 +85,9 @@ struct Layout {
     z_increment: f64,
     z_offset: f64,
     payload: Option<String>,
+    payload_md5: Option<String>,
     valid_points: Option<String>,
+    valid_md5: Option<String>,
 }
 
 fn layout(root: roxmltree::Node<'_, '_>) -> Result<Layout> {
@@ -155,7 +157,15 @@ fn layout(root: roxmltree::Node<'_, '_>) -> Result<Layout> {
         z_increment: optional("Increment", 1.0)?,
         z_offset: optional("Offset", 0.0)?,
         payload: text_at(record3, &["DataLink", "PointDataLink"]).map(str::to_string),
-        valid_points: text_at(record3, &["ValidPointsLink"]).map(str::to_string),
+        payload_md5: text_at(record3, &["DataLink", "MD5ChecksumPointData"]).map(str::to_string),
+        // The valid-points link sits in `DataLink` (openGPS samples) or in `Record3`.
+        valid_points: text_at(record3, &["DataLink", "ValidPointsLink"])
+            .or_else(|| text_at(record3, &["ValidPointsLink"]))
+            .filter(|s| !s.is_empty())
+            .map(str::to_string),
+        valid_md5: text_at(record3, &["DataLink", "MD5ChecksumValidPoints"])
+            .or_else(|| text_at(record3, &["MD5ChecksumValidPoints"]))
+            .map(str::to_string),
     })
 }
 
@@ -225,17 +235,21 @@ impl Layout {
     }
 }
 
-/// Reads an archive entry of exactly `len` bytes (checked against the archive's sizes
-/// and the memory before allocating).
+/// Reads an archive entry of exactly `len` bytes: its declared size must be `len` (a
+/// payload that does not match the grid and data type of `main.xml` is refused), checked
+/// against the compressed size and the memory before allocating, and read to its end so
+/// that the zip CRC-32 is verified.
 fn entry(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str, len: usize) -> Result<Vec<u8>> {
     let file = archive
         .by_name(name)
         .map_err(|_| bad(FORMAT, format!("the archive has no {name}")))?;
     let declared = file.size();
-    if declared < len as u64 {
+    if declared != len as u64 {
         return Err(bad(
             FORMAT,
-            format!("{name} holds {declared} bytes, the grid needs {len}"),
+            format!(
+                "{name} holds {declared} bytes where the grid and data type of main.xml need {len}"
+            ),
         ));
     }
     if (len as u64)
@@ -257,40 +271,131 @@ fn entry(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str, len: usize) -> Res
         Some(len as u64 * 2),
     )?;
     let mut data = Vec::with_capacity(len);
-    file.take(len as u64)
+    file.take(len as u64 + 1)
         .read_to_end(&mut data)
-        .map_err(|e| bad(FORMAT, format!("{name}: {e}")))?;
+        .map_err(|e| entry_error(name, e))?;
     if data.len() != len {
         return Err(bad(
             FORMAT,
-            format!("{name} is truncated: {} of {len} bytes", data.len()),
+            format!("{name} holds {} bytes, not the {len} declared", data.len()),
         ));
     }
     Ok(data)
 }
 
+/// A failed read of an archive entry; a zip CRC-32 mismatch said in those words.
+fn entry_error(name: &str, e: std::io::Error) -> Error {
+    if e.to_string().contains("checksum") {
+        bad(
+            FORMAT,
+            format!("{name} fails its zip CRC-32 check: the archive is corrupt"),
+        )
+    } else {
+        bad(FORMAT, format!("{name}: {e}"))
+    }
+}
+
+/// Checks `data` against an MD5 checksum recorded in `main.xml` or `md5checksum.hex`
+/// (hex, either case); an empty record is no checksum.
+fn check_md5(what: &str, data: &[u8], recorded: Option<&str>) -> Result<()> {
+    let Some(want) = recorded.map(str::trim).filter(|s| !s.is_empty()) else {
+        return Ok(());
+    };
+    let got = md5_hex(data);
+    if got.eq_ignore_ascii_case(want) {
+        Ok(())
+    } else {
+        Err(bad(
+            FORMAT,
+            format!("{what} fails its MD5 checksum (recorded {want}, computed {got}): the file is corrupt"),
+        ))
+    }
+}
+
+/// `main.xml`, read whole (so its CRC-32 is checked) up to [`MAX_XML`] bytes.
+fn main_xml_text(archive: &mut ZipArchive<Cursor<&[u8]>>) -> Result<String> {
+    let file = archive
+        .by_name("main.xml")
+        .map_err(|_| bad(FORMAT, "the archive has no main.xml"))?;
+    let mut xml = String::new();
+    file.take(MAX_XML + 1)
+        .read_to_string(&mut xml)
+        .map_err(|e| entry_error("main.xml", e))?;
+    if xml.len() as u64 > MAX_XML {
+        return Err(bad(
+            FORMAT,
+            format!("main.xml is larger than {MAX_XML} bytes"),
+        ));
+    }
+    Ok(xml)
+}
+
+/// The checksum file that `Record4/ChecksumFile` names: `HEX *NAME` lines, each checked
+/// against the archive entry it names (`main.xml` where no name is given; the standard's
+/// choice, while some writers record the payload's). Absent: nothing to check.
+fn check_checksum_file(
+    archive: &mut ZipArchive<Cursor<&[u8]>>,
+    root: roxmltree::Node<'_, '_>,
+    xml: &str,
+) -> Result<()> {
+    let Some(name) = text_at(root, &["Record4", "ChecksumFile"]).filter(|n| !n.is_empty()) else {
+        return Ok(());
+    };
+    let Ok(file) = archive.by_name(name) else {
+        return Ok(());
+    };
+    if file.size() > 4096 {
+        return Err(bad(
+            FORMAT,
+            format!("{name} is larger than a checksum file"),
+        ));
+    }
+    let mut text = String::new();
+    file.take(4097)
+        .read_to_string(&mut text)
+        .map_err(|e| entry_error(name, e))?;
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let mut parts = line.split_whitespace();
+        let hex = parts.next().unwrap_or("");
+        let target = parts
+            .next()
+            .map_or("main.xml", |t| t.trim_start_matches('*'));
+        if target == "main.xml" {
+            check_md5("main.xml", xml.as_bytes(), Some(hex))?;
+        } else {
+            let size = archive.by_name(target).map(|f| f.size()).map_err(|_| {
+                bad(
+                    FORMAT,
+                    format!("{name} names {target}, which the archive lacks"),
+                )
+            })?;
+            let len =
+                usize::try_from(size).map_err(|_| bad(FORMAT, format!("{target} is too large")))?;
+            let data = entry(archive, target, len)?;
+            check_md5(target, &data, Some(hex))?;
+        }
+    }
+    Ok(())
+}
+
 /// Reads an X3P file (see the module docs).
 pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     let mut archive = ZipArchive::new(Cursor::new(bytes)).map_err(zip_error)?;
-    let xml = {
-        let file = archive
-            .by_name("main.xml")
-            .map_err(|_| bad(FORMAT, "the archive has no main.xml"))?;
-        let mut xml = String::new();
-        file.take(MAX_XML)
-            .read_to_string(&mut xml)
-            .map_err(|e| bad(FORMAT, format!("main.xml: {e}")))?;
-        xml
-    };
+    let xml = main_xml_text(&mut archive)?;
     let doc =
         roxmltree::Document::parse(&xml).map_err(|e| bad(FORMAT, format!("main.xml: {e}")))?;
     let root = doc.root_element();
+    check_checksum_file(&mut archive, root, &xml)?;
     let layout = layout(root)?;
     let count = layout.validate()?;
     let mut values = match &layout.payload {
         Some(name) => {
             let width = layout.width();
-            let data = entry(&mut archive, name, count * width)?;
+            let len = count
+                .checked_mul(width)
+                .ok_or_else(|| bad(FORMAT, "the grid is larger than any memory"))?;
+            let data = entry(&mut archive, name, len)?;
+            check_md5(name, &data, layout.payload_md5.as_deref())?;
             data.chunks_exact(width)
                 .map(|c| layout.decode(c))
                 .collect::<Vec<f64>>()
@@ -299,6 +404,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     };
     if let Some(name) = &layout.valid_points {
         let bits = entry(&mut archive, name, count.div_ceil(8))?;
+        check_md5(name, &bits, layout.valid_md5.as_deref())?;
         for (i, v) in values.iter_mut().enumerate() {
             if bits[i / 8] >> (i % 8) & 1 == 0 {
                 *v = f64::NAN;
@@ -534,6 +640,159 @@ mod tests {
         assert_close(h[(0, 1)], 1e-6 - 2e-9, 1e-15, "offset + increment · raw");
         assert!(h[(1, 0)].is_nan());
         assert_eq!(r.channels[0].size, [Some(2e-6), Some(4e-6)]);
+    }
+
+    /// The archive `bytes` with each entry passed through `edit(name, data)`; with
+    /// `rehash`, `md5checksum.hex` is rewritten for the edited `main.xml`.
+    fn rezip(bytes: &[u8], rehash: bool, edit: impl Fn(&str, Vec<u8>) -> Vec<u8>) -> Vec<u8> {
+        let mut archive = ZipArchive::new(Cursor::new(bytes)).unwrap();
+        let mut out = ZipWriter::new(Cursor::new(Vec::new()));
+        let mut xml = Vec::new();
+        for i in 0..archive.len() {
+            let mut file = archive.by_index(i).unwrap();
+            let name = file.name().to_string();
+            let mut data = Vec::new();
+            file.read_to_end(&mut data).unwrap();
+            let data = edit(&name, data);
+            if name == "main.xml" {
+                xml = data.clone();
+            }
+            let data = if rehash && name == "md5checksum.hex" {
+                format!("{} *main.xml\n", md5_hex(&xml)).into_bytes()
+            } else {
+                data
+            };
+            out.start_file(name, SimpleFileOptions::default()).unwrap();
+            out.write_all(&data).unwrap();
+        }
+        out.finish().unwrap().into_inner()
+    }
+
+    fn map_bytes() -> Vec<u8> {
+        let h = Array2::from_shape_fn((6, 5), |(r, c)| ((r * 5 + c) as f64).cos() * 1e-7);
+        to_bytes(h.view(), [5e-6, 6e-6]).unwrap()
+    }
+
+    #[test]
+    fn a_corrupted_payload_fails_its_checksums() {
+        // One bit flipped in the stored payload: the zip CRC-32 fails.
+        let bytes = map_bytes();
+        let mut archive = ZipArchive::new(Cursor::new(&bytes[..])).unwrap();
+        let payload = archive
+            .by_name("bindata/data.bin")
+            .unwrap()
+            .data_start()
+            .unwrap() as usize
+            + 40;
+        let mut flipped = bytes.clone();
+        flipped[payload] ^= 0x10;
+        let err = read(&flipped).unwrap_err().to_string();
+        assert!(err.contains("CRC-32"), "{err}");
+        // The CRC-32 made consistent (re-zipped) but MD5ChecksumPointData not: refused.
+        let edited = rezip(&bytes, false, |name, mut data| {
+            if name.ends_with("data.bin") {
+                data[17] ^= 0x01;
+            }
+            data
+        });
+        let err = read(&edited).unwrap_err().to_string();
+        assert!(err.contains("MD5"), "{err}");
+        // main.xml that no longer matches md5checksum.hex: refused.
+        let edited = rezip(&bytes, false, |name, data| {
+            if name == "main.xml" {
+                String::from_utf8(data)
+                    .unwrap()
+                    .replace("<Comment/>", "<Comment>x</Comment>")
+                    .into_bytes()
+            } else {
+                data
+            }
+        });
+        let err = read(&edited).unwrap_err().to_string();
+        assert!(err.contains("main.xml fails its MD5"), "{err}");
+    }
+
+    #[test]
+    fn a_deflated_payload_with_a_flipped_bit_is_refused() {
+        let Some(dir) = folder() else { return };
+        // x3p-2.x3p's payload is deflated: every single-bit flip inside it is refused
+        // (a deflate error, or the CRC-32 / MD5 of what inflates).
+        let bytes = std::fs::read(dir.join("x3p-2.x3p")).unwrap();
+        let mut archive = ZipArchive::new(Cursor::new(&bytes[..])).unwrap();
+        let file = archive.by_name("bindata/data.bin").unwrap();
+        let start = file.data_start().unwrap() as usize;
+        let compressed = file.compressed_size() as usize;
+        drop(file);
+        let mut copy = bytes.clone();
+        for k in 0..40 {
+            let i = start + 200 + k * (compressed - 400) / 40;
+            copy[i] ^= 1 << (k % 8);
+            assert!(
+                read(&copy).is_err(),
+                "bit {} of byte {i} flipped was read",
+                k % 8
+            );
+            copy[i] = bytes[i];
+        }
+    }
+
+    #[test]
+    fn a_payload_that_does_not_match_the_header_is_refused() {
+        let bytes = map_bytes();
+        // The header says float32 where the payload holds float64: twice the bytes.
+        let edited = rezip(&bytes, true, |name, data| {
+            if name == "main.xml" {
+                String::from_utf8(data)
+                    .unwrap()
+                    .replace(
+                        "<CZ><AxisType>A</AxisType><DataType>D",
+                        "<CZ><AxisType>A</AxisType><DataType>F",
+                    )
+                    .into_bytes()
+            } else {
+                data
+            }
+        });
+        let err = read(&edited).unwrap_err().to_string();
+        assert!(err.contains("holds 240 bytes where"), "{err}");
+        // A payload longer than the grid (one more row of heights): refused.
+        let edited = rezip(&bytes, true, |name, data| {
+            if name == "main.xml" {
+                String::from_utf8(data)
+                    .unwrap()
+                    .replace("<SizeY>6</SizeY>", "<SizeY>5</SizeY>")
+                    .into_bytes()
+            } else {
+                data
+            }
+        });
+        let err = read(&edited).unwrap_err().to_string();
+        assert!(err.contains("need 200"), "{err}");
+    }
+
+    #[test]
+    fn valid_points_mask_and_scaled_integers_match_the_reference() {
+        // openGPS sample 4: int16 heights with increment and offset, a valid-points bit
+        // array (in `DataLink`) marking one point undefined, lower-case MD5s.
+        use super::super::testkit::{check_shared, Expect};
+        let expect = Expect {
+            channel_names: false, // the peer names the channel `Default`, we `heights`
+            ..Expect::default()
+        };
+        check_shared("topographies-3", "openfmc-ISO5436-sample4_bin.x3p", expect);
+    }
+
+    #[test]
+    fn surface_topography_written_files_match_the_reference() {
+        // SurfaceTopography's own writer records the payload's MD5 in md5checksum.hex.
+        use super::super::testkit::{check_shared, Expect};
+        for name in ["st-written-1.x3p", "st-written-2.x3p"] {
+            let expect = Expect {
+                channel_names: false,
+                ..Expect::default()
+            };
+            check_shared("topographies-2", name, expect);
+        }
     }
 
     #[test]
