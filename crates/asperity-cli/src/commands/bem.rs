@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow};
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
@@ -32,12 +32,13 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --boundary periodic --forces 0.02 --tol 1e-10\n  \
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --out reference.csv\n  \
+    asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --hardness 0.3\n  \
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n  \
     asperity bem --surface scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
 (stiffness by the frozen contact set; indentation from the highest point, or with\n\
-periodic boundaries relative to the mean elastic displacement); then\n\
-stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_seconds, peak_rss_mib with\n\
+periodic boundaries relative to the mean elastic displacement); then plastic_fraction\n\
+with --hardness, stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_seconds, peak_rss_mib with\n\
 --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
 any solve.")]
@@ -119,6 +120,13 @@ pub struct BemArgs {
     /// Maximum solver iterations per load.
     #[arg(long, default_value_t = SolverParams::default().max_iterations, allow_hyphen_values = true)]
     pub max_iter: usize,
+    /// Cap the contact pressure at this hardness (in the units of the pressures and
+    /// --modulus: E* units by default): elastic–perfectly-plastic contact
+    /// (docs/hardness.md), solved with --solver pk; adds the column plastic_fraction. Each
+    /// load is solved on the surface as given (warm-started; the library's load path keeps
+    /// the plastic displacement between loads).
+    #[arg(long, value_name = "H", allow_hyphen_values = true)]
+    pub hardness: Option<f64>,
     /// Output table (CSV); printed to stdout when absent. Its inputs go to OUT.csv.json
     /// beside it (surface, L and its source, E*, boundary, tolerance, loads, columns).
     #[arg(long, value_name = "OUT.csv")]
@@ -400,6 +408,7 @@ fn check_tolerance(tol: f64) -> Result<()> {
 struct Columns {
     fd: bool,
     timing: bool,
+    plastic: bool,
 }
 
 impl Columns {
@@ -413,6 +422,9 @@ impl Columns {
             "iterations",
             "residual",
         ];
+        if self.plastic {
+            header.push("plastic_fraction");
+        }
         if self.fd {
             header.push("stiffness_fd");
         }
@@ -436,6 +448,9 @@ impl Columns {
             r.info.iterations.to_string(),
             format_number(r.info.residual),
         ];
+        if self.plastic {
+            cells.push(format_number(r.summary.plastic_fraction));
+        }
         if self.fd {
             cells.push(number(r.stiffness_fd));
         }
@@ -531,6 +546,7 @@ struct Plan {
     params: SolverParams,
     size: [Option<f64>; 2],
     columns: Columns,
+    interface: Interface,
 }
 
 /// Step 1a: every argument that can be checked without touching a file.
@@ -566,9 +582,22 @@ fn plan(args: &BemArgs) -> Result<Plan> {
             bail!("--plot draws the stiffness: drop --no-stiffness");
         }
     }
+    let interface = match args.hardness {
+        Some(h) => Interface::hardness(h).context("--hardness")?,
+        None => Interface::HardWall,
+    };
+    if interface != Interface::HardWall && params.solver != SolverKind::PolonskyKeer {
+        bail!("--hardness needs --solver pk (the BCCG solves the hard wall only, for now)");
+    }
+    for load in &loads {
+        if let Control::MeanPressure(p) = *load {
+            interface.check_mean_pressure(p).context("--hardness")?;
+        }
+    }
     let columns = Columns {
         fd: args.fd_stiffness,
         timing: args.timing,
+        plastic: args.hardness.is_some(),
     };
     Ok(Plan {
         boundary,
@@ -576,6 +605,7 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         params,
         size,
         columns,
+        interface,
     })
 }
 
@@ -834,7 +864,8 @@ pub fn run(args: &BemArgs) -> Result<()> {
         modulus: args.modulus,
         boundary: plan.boundary,
     };
-    let mut solver = ContactSolver::new(&surface, half_space, plan.params)?;
+    let mut solver =
+        ContactSolver::new(&surface, half_space, plan.params)?.with_interface(plan.interface)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
     let rows = solve(args, &plan, &mut solver, &mut outputs)?;
