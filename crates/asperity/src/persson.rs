@@ -493,3 +493,8 @@ fn tail_table() -> &'static [f64] {
 
 #[cfg(test)]
 mod tests;
+
+/// The code blocks of `docs/persson.md`, run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/persson.md")]
+pub struct PerssonPage;
