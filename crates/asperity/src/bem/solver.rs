@@ -25,7 +25,12 @@
 //! by both: the initial pressure (warm or cold start, `initialise`) and
 //! the summary of a converged state (`finish`).
 //!
-//! **Extending the core** (an adhesive or a plasticity-capped contact, say): put the new
+//! **The contact law** is the solver's [`Interface`] (`interface.rs`, set by
+//! [`ContactSolver::set_interface`]): every rule of what "in contact" means is asked of it
+//! (the BCCG asks the constant hard wall). A new law that the existing iterations can solve
+//! (as Polonsky–Keer solves the hardness cap, `plasticity.rs`) is a new variant there.
+//!
+//! **Extending the core** (an adhesive contact, say, which needs its own iteration): put the new
 //! iteration in a file of its own with its scratch struct (`struct AdhesionScratch`), add
 //! one `Option<AdhesionScratch>` field to [`ContactSolver`] allocated on the iteration's
 //! first use (as `pk_scratch` is), a [`SolverKind`] variant dispatched in
