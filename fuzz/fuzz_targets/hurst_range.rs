@@ -3,9 +3,8 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-// The CLI's parser (a module of the binary crate), included as the Python package does.
-#[path = "../../crates/asperity-cli/src/range.rs"]
-mod range;
+// The front ends' one parser (crates/asperity-app), the one the CLI and Python use.
+use asperity_app::range;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {

@@ -65,6 +65,7 @@ __all__ = [
     "Surface",
     "Sweep",
     "Topography",
+    "contact",
     "line",
     "mdr",
     "psd",
@@ -283,7 +284,7 @@ def surface(
     """
     heights, meta = _core.generate_surface(
         n, m, float(hurst), _opt(rolloff), _opt(cutoff), _opt(short_cutoff),
-        _opt(rms_height), _opt(rms_slope), float(size), int(seed),
+        _opt(rms_height), _opt(rms_slope), float(size), _seed(seed),
     )
     return Surface(heights, float(size), json.loads(meta))
 
@@ -309,9 +310,17 @@ def line(
     """
     heights, meta = _core.generate_line(
         n, float(hurst), _opt(rolloff), _opt(cutoff), _opt(rms_height), _opt(rms_slope),
-        float(size), int(seed),
+        float(size), _seed(seed),
     )
     return Line(heights, float(size), json.loads(meta))
+
+
+def _seed(seed: Any) -> str:
+    """A seed as the front-end layer reads it: an integer's digits; anything else (1.5,
+    True) as written, which the layer refuses in the CLI's words."""
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+        return str(int(seed))
+    return str(seed)
 
 
 def _opt(value: Optional[float]) -> Optional[float]:
@@ -483,7 +492,7 @@ class Sweep:
         return self.columns[name]
 
     def __len__(self) -> int:
-        return len(self.columns["force"])
+        return len(next(iter(self.columns.values())))
 
 
 _BOUNDARIES = ("free", "periodic")
@@ -541,7 +550,7 @@ class Solver:
         if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
             raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
         if max_iterations < 0:
-            raise ValueError(f"invalid max iterations: must be at least 1, got {max_iterations}")
+            raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
         self._core = _core.Solver(
             heights, size_x, size_y, float(modulus), str(boundary), float(tolerance),
             int(max_iterations), str(solver),
@@ -629,7 +638,7 @@ class Solver:
             >>> sweep = solver.sweep(nloads=20, pmin=1e-4, pmax=1e-1)
             >>> sweep.force, sweep.stiffness, sweep.area_fraction
         """
-        quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax)
+        quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields)
         fd = float(fd_step) if fd_stiffness else None
         bar = _Progress(progress, "bem")
         try:
@@ -684,20 +693,53 @@ def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, flo
     return heights, 1.0 if size is None else float(size), None
 
 
-def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax) -> Tuple[str, List[float]]:
-    lists = [(name, v) for name, v in (("pressures", pressures), ("forces", forces), ("indentations", indentations)) if v is not None]
-    if len(lists) + (nloads is not None) != 1:
-        raise ValueError("give one of pressures=, forces=, indentations= or nloads= with pmin= and pmax=")
-    if lists:
-        name, values = lists[0]
-        values = [float(v) for v in np.atleast_1d(np.asarray(values, dtype=np.float64))]
-        _core.check_loads(name, values, name == "indentations")
-        return {"pressures": "pressure", "forces": "force", "indentations": "indentation"}[name], values
-    if pmin is None or pmax is None:
-        raise ValueError("nloads needs pmin= and pmax=")
-    if isinstance(nloads, bool) or int(nloads) != nloads or nloads < 0:
+def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) -> Tuple[str, List[float]]:
+    def values(v):
+        return None if v is None else [float(x) for x in np.atleast_1d(np.asarray(v, dtype=np.float64))]
+    if nloads is not None and (isinstance(nloads, bool) or int(nloads) != nloads or nloads < 0):
         raise ValueError(f"nloads must be a count, got {nloads!r}")
-    return "pressure", _core.log_pressures(int(nloads), float(pmin), float(pmax))
+    return _core.sweep_loads(
+        values(forces), values(pressures), values(indentations),
+        None if nloads is None else int(nloads), _opt(pmin), _opt(pmax), bool(fields),
+    )
+
+
+def contact(
+    surface: Any,
+    size: Optional[float] = None,
+    *,
+    pressures: Sequence[float],
+    modulus: Optional[float] = None,
+    young: Optional[float] = None,
+    poisson: Optional[float] = None,
+    boundary: str = "free",
+    tolerance: float = 1e-8,
+    map: bool = False,
+) -> Sweep:
+    """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
+    pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
+    ``modulus`` or from ``young`` E and ``poisson`` ν as E/(1 − ν²). The same request,
+    rules and load sweep as the CLI (warm starts, full contact checked before any solve,
+    frozen-set stiffness), so the same numbers bit for bit.
+
+    Returns the CLI's columns as numpy arrays: ``mean_pressure_pa``, ``force_n``,
+    ``contact_area_m2``, ``area_fraction``, ``mean_gap_m``, ``stiffness_n_per_m``,
+    ``patches``, ``indentation_m``, ``iterations``, ``residual``; ``effective_modulus``;
+    with ``map=True`` also ``map``, the contact set (True in contact) of the last load.
+
+    Example::
+
+        >>> t = asperity.read_topography("scan.x3p", detrend="plane")
+        >>> c = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e5, 1e6])
+        >>> c.contact_area_m2, c.stiffness_n_per_m
+    """
+    heights, size_x, size_y = _surface_input(surface, size)
+    loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
+    columns = _core.contact(
+        heights, size_x, size_y, loads, _opt(modulus), _opt(young), _opt(poisson),
+        str(boundary), float(tolerance), bool(map),
+    )
+    return Sweep(columns)
 
 
 # --------------------------------------------------------------------------------------

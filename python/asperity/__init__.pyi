@@ -153,6 +153,12 @@ class Solver:
     def full_contact_threshold(self) -> Dict[str, Optional[float]]: ...
     def reset(self) -> None: ...
 
+def contact(
+    surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
+    modulus: Optional[float] = ..., young: Optional[float] = ..., poisson: Optional[float] = ...,
+    boundary: str = ..., tolerance: float = ..., map: bool = ...,
+) -> Sweep: ...
+
 @dataclass
 class MdrCurve:
     indentation: F64

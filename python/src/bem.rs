@@ -10,83 +10,48 @@
 use asperity::bem::sweep::{
     sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow,
 };
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
+use asperity::bem::{ContactSolver, Control, SolveError};
 use asperity::elastic::Boundary;
-use asperity::memory::{array_bytes, ensure_fits};
+use asperity::memory::array_bytes;
 use asperity::surface::Surface;
+use asperity_app::bem::{check_fd_step, ensure_solver_fits, Loads, SolverRequest};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::owned_2d;
-use crate::errors::{from_error, from_solve, invalid};
+use crate::errors::{from_error, from_solve, invalid, refused, request_error};
 use crate::interrupt::{run_detached, run_detached_with, Cancel};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Solver>()?;
-    m.add_function(wrap_pyfunction!(check_loads, m)?)?;
-    m.add_function(wrap_pyfunction!(log_pressures, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_loads, m)?)?;
     Ok(())
 }
 
-/// The CLI's check of a list of loads (`forces`, `pressures` > 0; `indentations` ≥ 0).
+/// The loads of a sweep as `(quantity, values)`: exactly one of the three lists or
+/// `nloads` mean pressures log-spaced from `pmin` to `pmax`, checked by the front-end
+/// layer's rules (`fields`: every load's fields are kept, for its memory check).
 #[pyfunction]
-fn check_loads(name: &str, values: Vec<f64>, allow_zero: bool) -> PyResult<()> {
-    if values.is_empty() {
-        return Err(invalid(format!("{name}: give at least one value")));
-    }
-    for v in values {
-        if !(v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0))) {
-            return Err(invalid(format!(
-                "{name}: {v} is not allowed (values must be finite and {})",
-                if allow_zero { ">= 0" } else { "> 0" }
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// `nloads` mean pressures log-spaced from `pmin` to `pmax`, as `asperity bem --nloads`.
-#[pyfunction]
-fn log_pressures(nloads: usize, pmin: f64, pmax: f64) -> PyResult<Vec<f64>> {
-    if nloads == 0 {
-        return Err(invalid("nloads must be at least 1"));
-    }
-    check_loads("pmin", vec![pmin], false)?;
-    check_loads("pmax", vec![pmax], false)?;
-    if pmax < pmin {
-        return Err(invalid(format!(
-            "pmax ({pmax}) must not be smaller than pmin ({pmin})"
-        )));
-    }
-    ensure_fits(
-        &format!("nloads {nloads}: the bookkeeping of {nloads} loads"),
-        array_bytes(&[nloads], 1024),
-    )
-    .map_err(from_error)?;
-    Ok((0..nloads)
-        .map(|i| {
-            let t = if nloads == 1 {
-                0.0
-            } else {
-                i as f64 / (nloads - 1) as f64
-            };
-            pmin * (pmax / pmin).powf(t)
-        })
-        .collect())
-}
-
-/// The solver choice as the library's [`SolverKind`]: `"bccg"` (the library's default) or
-/// `"pk"` (Polonsky–Keer), the CLI's `--solver` names; `"default"` is kept as an alias of
-/// the library's default (the name the first release of the package documented).
-fn solver_kind(name: &str) -> PyResult<SolverKind> {
-    match name {
-        "bccg" | "default" => Ok(SolverKind::Bccg),
-        "pk" => Ok(SolverKind::PolonskyKeer),
-        other => Err(invalid(format!(
-            "invalid solver: expected \"bccg\" (the default) or \"pk\" (Polonsky–Keer), got {other:?}"
-        ))),
-    }
+#[pyo3(signature = (forces, pressures, indentations, nloads, pmin, pmax, fields))]
+fn sweep_loads(
+    forces: Option<Vec<f64>>,
+    pressures: Option<Vec<f64>>,
+    indentations: Option<Vec<f64>>,
+    nloads: Option<usize>,
+    pmin: Option<f64>,
+    pmax: Option<f64>,
+    fields: bool,
+) -> PyResult<(&'static str, Vec<f64>)> {
+    let loads = Loads::from_options(forces, pressures, indentations, nloads, (pmin, pmax))
+        .map_err(refused)?;
+    let controls = loads.controls(fields).map_err(request_error)?;
+    let quantity = match loads {
+        Loads::Forces(_) => "force",
+        Loads::Indentations(_) => "indentation",
+        Loads::Pressures(_) | Loads::LogPressures { .. } => "pressure",
+    };
+    Ok((quantity, controls.iter().map(|c| c.value()).collect()))
 }
 
 /// A load as the library's control: `quantity` is `pressure`, `force` or `indentation`.
@@ -102,7 +67,7 @@ fn control(quantity: &str, value: f64) -> PyResult<Control> {
 }
 
 /// `error` with `context: ` in front (a `SolveError` keeps its type and attributes).
-fn with_context(error: SolveError, context: &str) -> PyErr {
+pub(crate) fn with_context(error: SolveError, context: &str) -> PyErr {
     let err = from_solve(error);
     Python::attach(|py| {
         let value = err.value(py);
@@ -185,13 +150,14 @@ impl Solver {
         max_iterations: usize,
         solver: &str,
     ) -> PyResult<Self> {
-        let solver = solver_kind(solver)?;
-        let boundary: Boundary = boundary.parse().map_err(from_error)?;
-        if !(modulus.is_finite() && modulus > 0.0) {
-            return Err(invalid(format!(
-                "modulus must be positive and finite, got {modulus}"
-            )));
-        }
+        let request = SolverRequest {
+            modulus,
+            boundary: boundary.into(),
+            solver: solver.into(),
+            tolerance,
+            max_iterations,
+        };
+        let (half_space, params) = request.validate().map_err(refused)?;
         for (name, size) in [("size", Some(size_x)), ("size_y", size_y)] {
             if let Some(size) = size.filter(|s| !(s.is_finite() && *s > 0.0)) {
                 return Err(invalid(format!(
@@ -199,30 +165,9 @@ impl Solver {
                 )));
             }
         }
-        if !(tolerance.is_finite() && tolerance > 0.0) {
-            return Err(invalid(format!(
-                "tolerance must be positive and finite, got {tolerance}"
-            )));
-        }
-        let params = SolverParams {
-            solver,
-            tolerance,
-            max_iterations,
-            ..SolverParams::default()
-        };
-        params.validate().map_err(from_error)?;
         let (rows, cols) = heights.as_array().dim();
-        let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
-            .zip(array_bytes(&[rows, cols], 8))
-            .and_then(|(solver, heights)| solver.checked_add(heights));
-        ensure_fits(
-            &format!(
-                "a BEM solver on a {rows}x{cols} surface ({} boundaries)",
-                boundary.name()
-            ),
-            bytes,
-        )
-        .map_err(from_error)?;
+        ensure_solver_fits(rows, cols, half_space.boundary, array_bytes(&[rows, cols], 8))
+            .map_err(from_error)?;
         if rows < 2 || cols < 2 {
             return Err(invalid(format!(
                 "invalid grid: a surface needs at least 2x2 points, got ({rows}, {cols})"
@@ -234,13 +179,12 @@ impl Solver {
             None => Surface::new(owned, size_x),
         }
         .map_err(from_error)?;
-        let half_space = HalfSpace { modulus, boundary };
         let solver = run_detached(py, |_| ContactSolver::new(&surface, half_space, params))?
             .map_err(from_solve)?;
         Ok(Solver {
             solver,
             modulus,
-            boundary,
+            boundary: half_space.boundary,
             size: size_x,
         })
     }
@@ -379,6 +323,9 @@ impl Solver {
             .iter()
             .map(|&v| control(quantity, v))
             .collect::<PyResult<Vec<_>>>()?;
+        if let Some(step) = fd_step {
+            check_fd_step(step).map_err(refused)?;
+        }
         let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         let params = SweepParams { stiffness, fd_step };
         let (rows, observer) = run_detached_with(py, &stop, |cancel| {

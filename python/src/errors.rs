@@ -16,6 +16,7 @@
 
 use asperity::bem::SolveError;
 use asperity::Error;
+use asperity_app::{Names, Refusal, RequestError};
 use pyo3::exceptions::{
     PyBlockingIOError, PyKeyboardInterrupt, PyMemoryError, PyOSError, PyRuntimeError, PyValueError,
 };
@@ -93,6 +94,25 @@ fn prefix(py: Python<'_>, err: PyErr, context: &str) -> PyErr {
     let message = value.str().map(|s| s.to_string()).unwrap_or_default();
     let _ = value.setattr("args", (format!("{context}: {message}"),));
     err
+}
+
+/// A request refused by the front-end layer's rules: `ValueError` in Python's words
+/// (keywords, not flags).
+pub fn refused(refusal: Refusal) -> PyErr {
+    PyValueError::new_err(refusal.words(Names::Keywords))
+}
+
+/// A request the front-end layer cannot run: refused by a rule (`ValueError`), or by the
+/// library for what it would need (`MemoryError` for memory), in Python's words.
+pub fn request_error(error: RequestError) -> PyErr {
+    let words = error.words(Names::Keywords);
+    match error {
+        RequestError::Invalid(source) => from_error(*source),
+        RequestError::Library { source, .. } if matches!(*source, Error::OutOfMemory { .. }) => {
+            PyMemoryError::new_err(words)
+        }
+        _ => PyValueError::new_err(words),
+    }
 }
 
 /// `ValueError(message)`: for the binding's own checks of its arguments.

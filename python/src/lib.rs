@@ -9,12 +9,10 @@
 
 mod arrays;
 mod bem;
+mod contact;
 mod errors;
 mod interrupt;
 mod mdr;
-/// The CLI's `--hurst` syntax, one parser for both front ends.
-#[path = "../../crates/asperity-cli/src/range.rs"]
-mod range;
 mod study;
 mod surface;
 mod topography;
@@ -41,6 +39,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     surface::register(m)?;
     bem::register(m)?;
+    contact::register(m)?;
     mdr::register(m)?;
     study::register(m)?;
     topography::register(m)?;

@@ -25,7 +25,7 @@ use serde_json::json;
 
 use crate::errors::{from_error, invalid};
 use crate::interrupt::{run_detached, Cancel};
-use crate::range::parse_range;
+use asperity_app::range::parse_range;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_study, m)?)?;

@@ -6,18 +6,15 @@ use std::path::PathBuf;
 
 use asperity::fit::power_law_fit;
 use asperity::io::{sidecar_path, StagedOutputs};
-use asperity::spectrum::{LongWavelength, Psd};
-use asperity::surface::stats::{line_psd, line_summary, radial_psd_2d, surface_summary, Summary};
-use asperity::surface::{
-    Line, LineGenerator, LineSpec, Normalisation, Surface, SurfaceGenerator, SurfaceSpec,
-};
+use asperity::surface::stats::{line_psd, line_summary, radial_psd_2d, surface_summary};
+use asperity::surface::{Line, LineGenerator, Surface, SurfaceGenerator};
+use asperity_app::surface::{ensure_usable, sidecar, SurfaceRequest};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use serde_json::json;
 
 use crate::arrays::{heights, owned_1d, Heights};
-use crate::errors::{from_error, invalid};
+use crate::errors::{from_error, invalid, refused, request_error};
 use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -30,46 +27,29 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// The long-wavelength end of the spectrum, as the CLI's `--rolloff` / `--cutoff`.
-fn long_wavelength(rolloff: Option<f64>, cutoff: Option<f64>) -> PyResult<LongWavelength> {
-    match (rolloff, cutoff) {
-        (Some(_), Some(_)) => Err(invalid(
-            "give at most one of rolloff and cutoff (a roll-off keeps the power below q0 flat, a cut-off removes it)",
-        )),
-        (Some(q0), None) => Ok(LongWavelength::RollOff { q0 }),
-        (None, Some(q0)) => Ok(LongWavelength::CutOff { q0 }),
-        (None, None) => Ok(LongWavelength::None),
+/// The request of Python's keywords (`m`: a surface's rows, `None` for a line).
+#[allow(clippy::too_many_arguments)]
+fn request(
+    n: usize,
+    m: Option<usize>,
+    hurst: f64,
+    (rolloff, cutoff, short_cutoff): (Option<f64>, Option<f64>, Option<f64>),
+    (rms_height, rms_slope): (Option<f64>, Option<f64>),
+    size: f64,
+    seed: String,
+) -> SurfaceRequest {
+    SurfaceRequest {
+        n,
+        m,
+        hurst,
+        rolloff,
+        cutoff,
+        short_cutoff,
+        rms_height,
+        rms_slope,
+        size,
+        seed,
     }
-}
-
-/// The normalisation, as the CLI's `--rms-height` / `--rms-slope` (unit rms height when
-/// neither is given).
-fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> PyResult<Normalisation> {
-    match (rms_height, rms_slope) {
-        (Some(_), Some(_)) => Err(invalid("give at most one of rms_height and rms_slope")),
-        (_, Some(s)) => Ok(Normalisation::RmsSlope(s)),
-        (Some(h), None) => Ok(Normalisation::RmsHeight(h)),
-        (None, None) => Ok(Normalisation::default()),
-    }
-}
-
-/// The sidecar the CLI writes beside its .npy, as JSON text.
-fn sidecar(
-    kind: &str,
-    shape: &[usize],
-    seed: u64,
-    spec: serde_json::Value,
-    stats: &Summary,
-) -> String {
-    json!({
-        "kind": kind,
-        "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
-        "shape": shape,
-        "seed": seed,
-        "spec": spec,
-        "stats": stats,
-    })
-    .to_string()
 }
 
 /// Generates a surface; returns its heights and the CLI's sidecar (JSON text).
@@ -87,20 +67,20 @@ fn generate_surface<'py>(
     rms_height: Option<f64>,
     rms_slope: Option<f64>,
     size: f64,
-    seed: u64,
+    seed: String,
 ) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, String)> {
-    let psd =
-        Psd::new(hurst, long_wavelength(rolloff, cutoff)?, short_cutoff).map_err(from_error)?;
-    let rows = m.unwrap_or(n);
-    let spec = SurfaceSpec::new(rows, n, size, psd, normalisation(rms_height, rms_slope)?)
-        .map_err(from_error)?;
+    let cutoffs = (rolloff, cutoff, short_cutoff);
+    let (spec, seed) = request(n, m, hurst, cutoffs, (rms_height, rms_slope), size, seed)
+        .surface()
+        .map_err(request_error)?;
+    let rows = spec.rows();
     let surface = run_detached(py, |_| {
         SurfaceGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
     })?
     .map_err(from_error)?;
     let stats = surface_summary(&surface);
-    let spec_json = serde_json::to_value(spec).expect("a spec serialises");
-    let meta = sidecar("surface", &[rows, n], seed, spec_json, &stats);
+    ensure_usable(&stats, size).map_err(refused)?;
+    let meta = sidecar("surface", &[rows, n], seed, &spec, &stats).to_string();
     Ok((surface.into_heights().into_pyarray(py), meta))
 }
 
@@ -117,18 +97,19 @@ fn generate_line<'py>(
     rms_height: Option<f64>,
     rms_slope: Option<f64>,
     size: f64,
-    seed: u64,
+    seed: String,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, String)> {
-    let psd = Psd::new(hurst, long_wavelength(rolloff, cutoff)?, None).map_err(from_error)?;
-    let spec =
-        LineSpec::new(n, size, psd, normalisation(rms_height, rms_slope)?).map_err(from_error)?;
+    let cutoffs = (rolloff, cutoff, None);
+    let (spec, seed) = request(n, None, hurst, cutoffs, (rms_height, rms_slope), size, seed)
+        .line()
+        .map_err(request_error)?;
     let line = run_detached(py, |_| {
         LineGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
     })?
     .map_err(from_error)?;
     let stats = line_summary(&line);
-    let spec_json = serde_json::to_value(spec).expect("a spec serialises");
-    let meta = sidecar("line", &[n], seed, spec_json, &stats);
+    ensure_usable(&stats, size).map_err(refused)?;
+    let meta = sidecar("line", &[n], seed, &spec, &stats).to_string();
     Ok((line.into_heights().into_pyarray(py), meta))
 }
 

@@ -10,8 +10,8 @@ mod interrupt;
 mod output;
 mod plot;
 mod progress;
-mod range;
 mod report;
+mod request;
 mod rerun;
 mod studies;
 

@@ -239,7 +239,7 @@ fn bad_input_is_one_line_exit_2_and_nothing_written() {
         ),
         (
             vec!["--surface", s, "--pressures", "0.01", "--max-iter", "0"],
-            "--max-iter 0: invalid max iterations: must be at least 1",
+            "--max-iter must be at least 1, got 0",
         ),
         (
             vec![

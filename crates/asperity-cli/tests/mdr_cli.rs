@@ -409,10 +409,13 @@ fn missing_required_arguments_are_named() {
     );
     refused(&out, "--radial-step");
     refused(&out, "not provided");
-    // `bem` without any load flag names the load options it needs.
+    // `bem` without any load flag names the load options it needs (the front-end layer's
+    // words, the same as Python's).
     let out = asperity(&["bem", "--surface", "s.npy"], dir.path());
-    refused(&out, "not provided");
-    refused(&out, "--forces");
+    refused(
+        &out,
+        "give one of --forces, --pressures, --indentations or --nloads with --pmin and --pmax",
+    );
 }
 
 #[test]

@@ -10,12 +10,14 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow};
-use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverKind, SolverParams};
-use asperity::elastic::Boundary;
+use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepRow};
+use asperity::bem::{ContactSolver, Control, Interface, SolverKind};
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
-use asperity::memory::{array_bytes, ensure_fits};
+use asperity::memory::array_bytes;
 use asperity::surface::Surface;
+use asperity_app::bem::{
+    bookkeeping_bytes, ensure_solver_fits, BemPlan, BemRequest, Loads, SolverRequest, FD_STEP,
+};
 use serde_json::json;
 
 use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
@@ -42,7 +44,6 @@ with --hardness, stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_
 --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
 any solve.")]
-#[command(group(clap::ArgGroup::new("loads").required(true).args(["forces", "pressures", "indentations", "nloads"])))]
 pub struct BemArgs {
     /// Surface heights, positive up: a .npy (float64, 2D), or a measured file (X3P, SDF,
     /// text matrix, x y z, ...; sizes and units from the file, see --channel, --detrend,
@@ -60,7 +61,7 @@ pub struct BemArgs {
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Boundary conditions: free (zero-padded, no periodic images; the paper's) or periodic.
-    #[arg(long, default_value = "free", value_parser = ["free", "periodic"])]
+    #[arg(long, default_value = "free")]
     pub boundary: String,
     /// Total forces (load control), comma separated.
     #[arg(
@@ -90,35 +91,25 @@ pub struct BemArgs {
     )]
     pub indentations: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
-    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"], allow_hyphen_values = true)]
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
     pub nloads: Option<usize>,
     /// Smallest mean pressure for --nloads.
-    #[arg(
-        long,
-        value_name = "P",
-        allow_hyphen_values = true,
-        requires = "nloads"
-    )]
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
     /// Largest mean pressure for --nloads.
-    #[arg(
-        long,
-        value_name = "P",
-        allow_hyphen_values = true,
-        requires = "nloads"
-    )]
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmax: Option<f64>,
     /// Convergence tolerance: rms gap violation on the contact set over the rms height.
-    #[arg(long, default_value_t = SolverParams::default().tolerance, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SolverRequest::default().tolerance, allow_hyphen_values = true)]
     pub tol: f64,
     /// The solver: bccg (default; Fourier-preconditioned bound-constrained conjugate
     /// gradients without restart, tens of iterations) or pk (Polonsky & Keer 1999, the
     /// reference; a few times more iterations, each twice as costly). Both converge to the
     /// same contact to --tol.
-    #[arg(long, default_value = "bccg", value_parser = ["bccg", "pk"])]
+    #[arg(long, default_value = "bccg")]
     pub solver: String,
     /// Maximum solver iterations per load.
-    #[arg(long, default_value_t = SolverParams::default().max_iterations, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SolverRequest::default().max_iterations, allow_hyphen_values = true)]
     pub max_iter: usize,
     /// Cap the contact pressure at this hardness (in the units of the pressures and
     /// --modulus: E* units by default): elastic–perfectly-plastic contact
@@ -160,84 +151,6 @@ pub struct BemArgs {
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
-}
-
-/// Relative step of `--fd-stiffness`: the load × (1 ± FD_STEP).
-const FD_STEP: f64 = 1e-3;
-
-/// Memory kept per load besides the solver (control, row, CSV cells, JSON record), and with
-/// `--fields` per load also (two field paths, their staged entries): generous estimates.
-const BYTES_PER_LOAD: usize = 1024;
-const BYTES_PER_FIELD_LOAD: usize = 2048;
-
-fn bookkeeping_bytes(loads: usize, fields: bool) -> Option<u64> {
-    let per_load = BYTES_PER_LOAD + if fields { BYTES_PER_FIELD_LOAD } else { 0 };
-    array_bytes(&[loads], per_load)
-}
-
-/// The loads requested, as solver controls.
-fn controls(args: &BemArgs) -> Result<Vec<Control>> {
-    let check = |name: &str, values: &[f64], allow_zero: bool| -> Result<()> {
-        if values.is_empty() {
-            bail!("--{name}: give at least one value");
-        }
-        for &v in values {
-            let ok = v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0));
-            if !ok {
-                bail!(
-                    "--{name}: {v} is not allowed (values must be finite and {})",
-                    if allow_zero { ">= 0" } else { "> 0" }
-                );
-            }
-        }
-        Ok(())
-    };
-    if let Some(forces) = &args.forces {
-        check("forces", forces, false)?;
-        return Ok(forces.iter().map(|&f| Control::Force(f)).collect());
-    }
-    if let Some(pressures) = &args.pressures {
-        check("pressures", pressures, false)?;
-        return Ok(pressures
-            .iter()
-            .map(|&p| Control::MeanPressure(p))
-            .collect());
-    }
-    if let Some(indentations) = &args.indentations {
-        check("indentations", indentations, true)?;
-        return Ok(indentations
-            .iter()
-            .map(|&d| Control::Indentation(d))
-            .collect());
-    }
-    let (Some(k), Some(pmin), Some(pmax)) = (args.nloads, args.pmin, args.pmax) else {
-        bail!(
-            "give one of --forces, --pressures, --indentations or --nloads with --pmin and --pmax"
-        );
-    };
-    if k == 0 {
-        bail!("--nloads must be at least 1");
-    }
-    check("pmin", &[pmin], false)?;
-    check("pmax", &[pmax], false)?;
-    if pmax < pmin {
-        bail!("--pmax ({pmax}) must not be smaller than --pmin ({pmin})");
-    }
-    // K loads are listed (and, with --fields, 2K files): check before allocating.
-    ensure_fits(
-        &format!("--nloads {k}: the bookkeeping of {k} loads"),
-        bookkeeping_bytes(k, args.fields.is_some()),
-    )?;
-    Ok((0..k)
-        .map(|i| {
-            let t = if k == 1 {
-                0.0
-            } else {
-                i as f64 / (k - 1) as f64
-            };
-            Control::MeanPressure(pmin * (pmax / pmin).powf(t))
-        })
-        .collect())
 }
 
 /// Peak resident memory of this process (MiB), from /proc/self/status (Linux).
@@ -368,38 +281,6 @@ impl SizeSource {
             SizeSource::Default => "default",
         }
     }
-}
-
-/// The loads as given on the command line, for the record in OUT.csv.json.
-fn loads_record(args: &BemArgs) -> serde_json::Value {
-    if let Some(v) = &args.forces {
-        json!({ "quantity": "force", "values": v })
-    } else if let Some(v) = &args.pressures {
-        json!({ "quantity": "mean pressure", "values": v })
-    } else if let Some(v) = &args.indentations {
-        json!({ "quantity": "indentation", "values": v })
-    } else {
-        json!({
-            "quantity": "mean pressure", "nloads": args.nloads, "pmin": args.pmin,
-            "pmax": args.pmax, "spacing": "logarithmic",
-        })
-    }
-}
-
-/// The largest `--tol`: a relative residual of 1e-2 (gaps on the contact set of 1 % of the
-/// rms height) is already far coarser than any use of the results; at 1 and above the
-/// criterion means nothing.
-const MAX_TOL: f64 = 1e-2;
-
-/// `--tol` in (0, [`MAX_TOL`]].
-fn check_tolerance(tol: f64) -> Result<()> {
-    if !(tol > 0.0 && tol <= MAX_TOL) {
-        bail!(
-            "--tol must be positive and at most {MAX_TOL:e} (a relative residual), got {}",
-            asperity::input::short_number(tol)
-        );
-    }
-    Ok(())
 }
 
 /// The columns written: the fixed ones, then `stiffness_fd` with `--fd-stiffness` and the
@@ -541,41 +422,49 @@ fn sweep_charts(
 
 /// The checked arguments: everything a solve needs besides the surface.
 struct Plan {
-    boundary: Boundary,
-    loads: Vec<Control>,
-    params: SolverParams,
+    request: BemRequest,
+    bem: BemPlan,
     size: [Option<f64>; 2],
     columns: Columns,
     interface: Interface,
 }
 
-/// Step 1a: every argument that can be checked without touching a file.
+/// The request of the arguments: the loads, the solver and what each load computes.
+fn request(args: &BemArgs) -> Result<BemRequest> {
+    let loads = Loads::from_options(
+        args.forces.clone(),
+        args.pressures.clone(),
+        args.indentations.clone(),
+        args.nloads,
+        (args.pmin, args.pmax),
+    )?;
+    Ok(BemRequest {
+        solver: SolverRequest {
+            modulus: args.modulus,
+            boundary: args.boundary.clone(),
+            solver: args.solver.clone(),
+            tolerance: args.tol,
+            max_iterations: args.max_iter,
+        },
+        loads,
+        stiffness: !args.no_stiffness,
+        fd_step: args.fd_stiffness.then_some(FD_STEP),
+        fields: args.fields.is_some(),
+    })
+}
+
+/// Step 1a: every argument that can be checked without touching a file: the request (the
+/// front-end layer's rules), the size, the plot.
 fn plan(args: &BemArgs) -> Result<Plan> {
-    let boundary: Boundary = args.boundary.parse()?;
-    let loads = controls(args)?;
-    if !(args.modulus.is_finite() && args.modulus > 0.0) {
-        bail!(
-            "--modulus must be positive and finite, got {}",
-            args.modulus
-        );
-    }
+    let request = request(args)?;
+    let bem = request.validate()?;
     let size = match &args.size {
         Some(text) => parse_size(text)?,
         None => [None, None],
     };
-    check_tolerance(args.tol)?;
-    let params = SolverParams {
-        solver: args.solver.parse::<SolverKind>()?,
-        tolerance: args.tol,
-        max_iterations: args.max_iter,
-        ..SolverParams::default()
-    };
-    params
-        .validate()
-        .with_context(|| format!("--max-iter {}", args.max_iter))?;
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
-        if loads.len() < 2 {
+        if bem.loads.len() < 2 {
             bail!("--plot needs at least 2 loads (a curve), got 1");
         }
         if args.no_stiffness {
@@ -586,10 +475,10 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         Some(h) => Interface::hardness(h).context("--hardness")?,
         None => Interface::HardWall,
     };
-    if interface != Interface::HardWall && params.solver != SolverKind::PolonskyKeer {
+    if interface != Interface::HardWall && bem.params.solver != SolverKind::PolonskyKeer {
         bail!("--hardness needs --solver pk (the BCCG solves the hard wall only, for now)");
     }
-    for load in &loads {
+    for load in &bem.loads {
         if let Control::MeanPressure(p) = *load {
             interface.check_mean_pressure(p).context("--hardness")?;
         }
@@ -600,9 +489,8 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         plastic: args.hardness.is_some(),
     };
     Ok(Plan {
-        boundary,
-        loads,
-        params,
+        request,
+        bem,
         size,
         columns,
         interface,
@@ -637,27 +525,6 @@ fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
     Ok(Outputs { staged, fields })
 }
 
-/// Refuses a solve of a `rows`×`cols` surface that does not fit in memory (`extra`: bytes
-/// needed besides the solver).
-fn ensure_solver_fits(
-    rows: usize,
-    cols: usize,
-    boundary: Boundary,
-    extra: Option<u64>,
-) -> Result<()> {
-    let bytes = ContactSolver::memory_bytes(rows, cols, boundary)
-        .zip(extra)
-        .and_then(|(solver, extra)| solver.checked_add(extra));
-    ensure_fits(
-        &format!(
-            "asperity bem on a {rows}x{cols} surface ({} boundaries)",
-            boundary.name()
-        ),
-        bytes,
-    )?;
-    Ok(())
-}
-
 /// Step 1c: the surface, with where its side length came from. A `.npy`'s memory is checked
 /// from its header before its data is read (the solver plus the heights, alive while the
 /// solver is built, plus the per-load bookkeeping); a measured file is read, bounded, by
@@ -670,7 +537,7 @@ fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, S
             .to_surface()
             .with_context(|| format!("{}", args.surface.display()))?;
         let (rows, cols) = surface.dim();
-        ensure_solver_fits(rows, cols, plan.boundary, Some(0))?;
+        ensure_solver_fits(rows, cols, plan.bem.half_space.boundary, Some(0))?;
         let source = match args.size {
             Some(_) => SizeSource::Flag,
             None => SizeSource::File,
@@ -679,9 +546,9 @@ fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, S
     }
     if let [rows, cols] = read_npy_shape(&args.surface)?[..] {
         let extra = array_bytes(&[rows, cols], 8)
-            .zip(bookkeeping_bytes(plan.loads.len(), fields))
+            .zip(bookkeeping_bytes(plan.bem.loads.len(), fields))
             .and_then(|(heights, loads)| heights.checked_add(loads));
-        ensure_solver_fits(rows, cols, plan.boundary, extra)?;
+        ensure_solver_fits(rows, cols, plan.bem.half_space.boundary, extra)?;
     }
     let [size_x, size_y] = plan.size;
     let sidecar_size = match size_x {
@@ -736,18 +603,14 @@ fn solve(
     solver: &mut ContactSolver,
     outputs: &mut Outputs,
 ) -> Result<Vec<Row>> {
-    let loads = &plan.loads;
+    let loads = &plan.bem.loads;
     let mut observer = CliObserver {
         staged: &mut outputs.staged,
         fields: outputs.fields.as_deref(),
         progress: Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2),
         peak_rss: args.timing.then(Vec::new),
     };
-    let params = SweepParams {
-        stiffness: !args.no_stiffness,
-        fd_step: args.fd_stiffness.then_some(FD_STEP),
-    };
-    let solved = sweep(solver, loads, params, &mut observer).map_err(sweep_error)?;
+    let solved = sweep(solver, loads, plan.bem.sweep, &mut observer).map_err(sweep_error)?;
     observer.progress.finish();
     let peak_rss = observer.peak_rss.take().unwrap_or_default();
     Ok(solved
@@ -771,11 +634,11 @@ fn record(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Val
         "size_y": surface.size_y,
         "size_source": surface.source.name(),
         "modulus": args.modulus,
-        "boundary": plan.boundary.name(),
-        "solver": args.solver,
+        "boundary": plan.bem.half_space.boundary.name(),
+        "solver": plan.bem.params.solver.name(),
         "tolerance": args.tol,
         "max_iterations": args.max_iter,
-        "loads": loads_record(args),
+        "loads": plan.request.loads.record(),
         "stiffness": if args.no_stiffness { None } else { Some("frozen contact set") },
         "fd_relative_step": args.fd_stiffness.then_some(FD_STEP),
         "fields": args.fields,
@@ -807,7 +670,7 @@ fn write(
     }
     if let Some(plot) = &args.plot {
         let physical = matches!(surface.source, SizeSource::File);
-        let boundary = plan.boundary.name();
+        let boundary = plan.bem.half_space.boundary.name();
         let charts = sweep_charts(
             rows,
             plan.columns.fd,
@@ -851,7 +714,7 @@ fn print_stdout(bytes: &[u8]) -> Result<()> {
 /// Runs `asperity bem`: plan (every check before the first solve), solve, write.
 pub fn run(args: &BemArgs) -> Result<()> {
     let plan = plan(args)?;
-    let mut outputs = stage_outputs(args, plan.loads.len())?;
+    let mut outputs = stage_outputs(args, plan.bem.loads.len())?;
     let (surface, source) = read_surface(args, &plan, outputs.fields.is_some())?;
     let info = SurfaceInfo {
         grid: surface.dim(),
@@ -860,12 +723,8 @@ pub fn run(args: &BemArgs) -> Result<()> {
         square_pixels: surface.has_square_pixels(),
         source,
     };
-    let half_space = HalfSpace {
-        modulus: args.modulus,
-        boundary: plan.boundary,
-    };
-    let mut solver =
-        ContactSolver::new(&surface, half_space, plan.params)?.with_interface(plan.interface)?;
+    let mut solver = ContactSolver::new(&surface, plan.bem.half_space, plan.bem.params)?
+        .with_interface(plan.interface)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
     let rows = solve(args, &plan, &mut solver, &mut outputs)?;

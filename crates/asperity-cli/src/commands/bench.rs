@@ -255,7 +255,7 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
     anyhow::ensure!(args.samples > 0, "--samples must be at least 1");
     let sizes = parse_sizes(&args.sizes, "--sizes")?;
-    let hursts = crate::range::parse_range(&args.hursts)?;
+    let hursts = asperity_app::range::parse_range(&args.hursts)?;
     // The sweep of `study alpha` with its default window on these grids.
     let alpha = asperity::study::StudySpec {
         method: asperity::study::Method::Bem,

@@ -10,8 +10,8 @@
 //!
 //! A hidden `test` setting runs the medium setting's code path on tiny grids for the tests.
 
-use crate::range::parse_range;
 use anyhow::Result;
+use asperity_app::range::parse_range;
 
 /// How closely `reproduce` follows the paper (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -13,8 +13,8 @@ use asperity::study::{FitWindow, Method, StudySpec, CHECKPOINT_INTERVAL};
 use serde::de::{self, Visitor};
 use serde::Deserialize;
 
-use crate::range::parse_range;
 use crate::studies::{execute, Kind, RunOptions};
+use asperity_app::range::parse_range;
 
 /// `--method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize)]

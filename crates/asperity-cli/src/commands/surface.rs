@@ -4,10 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use asperity::io::{sidecar_path, StagedOutputs};
-use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::stats::{line_summary, surface_summary};
-use asperity::surface::{LineGenerator, LineSpec, Normalisation, SurfaceGenerator, SurfaceSpec};
-use serde_json::json;
+use asperity::surface::{LineGenerator, SurfaceGenerator};
+use asperity_app::surface::{ensure_usable, sidecar as generated_sidecar, SurfaceRequest};
+
+use crate::request::refused;
 
 /// Spectrum options shared by `surface` and `line`.
 #[derive(Debug, Clone, clap::Args)]
@@ -16,7 +17,7 @@ pub struct SpectrumArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: f64,
     /// Long-wavelength roll-off q0·L/2π: C2D flat below q0 (paper eq. 7).
-    #[arg(long, value_name = "Q", conflicts_with = "cutoff")]
+    #[arg(long, value_name = "Q")]
     pub rolloff: Option<f64>,
     /// Long-wavelength cut-off q0·L/2π: no power below q0 (paper eq. 8).
     #[arg(long, value_name = "Q")]
@@ -24,9 +25,10 @@ pub struct SpectrumArgs {
     /// Side length L (units of the heights).
     #[arg(long, default_value_t = 1.0)]
     pub size: f64,
-    /// Random seed; the same seed gives bit-identical heights whatever the thread count.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Random seed (a whole number from 0 to 2^64 − 1); the same seed gives bit-identical
+    /// heights whatever the thread count.
+    #[arg(long, default_value = "0")]
+    pub seed: String,
     /// Output file (.npy, float64); a JSON sidecar FILE.npy.json records every parameter.
     #[arg(long, value_parser = array_path)]
     pub out: PathBuf,
@@ -54,16 +56,6 @@ fn array_path(text: &str) -> Result<PathBuf, String> {
     }
 }
 
-impl SpectrumArgs {
-    fn long_wavelength(&self) -> LongWavelength {
-        match (self.rolloff, self.cutoff) {
-            (Some(q0), _) => LongWavelength::RollOff { q0 },
-            (None, Some(q0)) => LongWavelength::CutOff { q0 },
-            (None, None) => LongWavelength::None,
-        }
-    }
-}
-
 /// Arguments of `asperity surface`.
 #[derive(Debug, clap::Args)]
 #[command(
@@ -85,7 +77,7 @@ pub struct SurfaceArgs {
     #[arg(long, value_name = "Q")]
     pub short_cutoff: Option<f64>,
     /// Scale to this rms height (default 1 when neither this nor --rms-slope is given).
-    #[arg(long, conflicts_with = "rms_slope")]
+    #[arg(long)]
     pub rms_height: Option<f64>,
     /// Scale to this rms slope (forward differences).
     #[arg(long)]
@@ -108,56 +100,43 @@ pub struct LineArgs {
     #[command(flatten)]
     pub spectrum: SpectrumArgs,
     /// Scale to this rms height (default 1 when neither this nor --rms-slope is given).
-    #[arg(long, conflicts_with = "rms_slope")]
+    #[arg(long)]
     pub rms_height: Option<f64>,
     /// Scale to this rms slope (forward differences).
     #[arg(long)]
     pub rms_slope: Option<f64>,
 }
 
-fn normalisation(rms_height: Option<f64>, rms_slope: Option<f64>) -> Normalisation {
-    match (rms_height, rms_slope) {
-        (_, Some(s)) => Normalisation::RmsSlope(s),
-        (Some(h), None) => Normalisation::RmsHeight(h),
-        (None, None) => Normalisation::default(),
+/// The request of the arguments (`rows`: `--m` of a surface, `None` for a line).
+fn request(
+    n: usize,
+    m: Option<usize>,
+    s: &SpectrumArgs,
+    short_cutoff: Option<f64>,
+    (rms_height, rms_slope): (Option<f64>, Option<f64>),
+) -> SurfaceRequest {
+    SurfaceRequest {
+        n,
+        m,
+        hurst: s.hurst,
+        rolloff: s.rolloff,
+        cutoff: s.cutoff,
+        short_cutoff,
+        rms_height,
+        rms_slope,
+        size: s.size,
+        seed: s.seed.clone(),
     }
-}
-
-/// Refuses a generated profile that float64 cannot represent: heights that underflow to
-/// zero (a tiny --rms-height) or slopes that overflow (a tiny --size), naming the inputs.
-fn ensure_usable(rms_height: f64, rms_slope: f64, s: &SpectrumArgs) -> Result<()> {
-    let short = asperity::input::short_number;
-    if !(rms_height.is_finite() && rms_height > 0.0) {
-        anyhow::bail!(
-            "the generated heights are not representable (rms height {}): --rms-height or \
-             --rms-slope with --size {} is beyond the range of float64",
-            short(rms_height),
-            short(s.size)
-        );
-    }
-    if !(rms_slope.is_finite() && rms_slope > 0.0) {
-        anyhow::bail!(
-            "the generated slopes are not representable (rms slope {}): --size {} is too \
-             small for float64 slopes",
-            short(rms_slope),
-            short(s.size)
-        );
-    }
-    Ok(())
 }
 
 /// Runs `asperity surface`.
 pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let s = &args.spectrum;
-    let psd = Psd::new(s.hurst, s.long_wavelength(), args.short_cutoff)?;
-    let rows = args.m.unwrap_or(args.n);
-    let spec = SurfaceSpec::new(
-        rows,
-        args.n,
-        s.size,
-        psd,
-        normalisation(args.rms_height, args.rms_slope),
-    )?;
+    let norm = (args.rms_height, args.rms_slope);
+    let (spec, seed) = request(args.n, args.m, s, args.short_cutoff, norm)
+        .surface()
+        .map_err(refused)?;
+    let rows = spec.rows();
     let sidecar = sidecar_path(&s.out);
     let mut outputs = vec![s.out.as_path(), sidecar.as_path()];
     outputs.extend(args.png.as_deref());
@@ -172,22 +151,13 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
         }
     }
     let start = std::time::Instant::now();
-    let surface = SurfaceGenerator::new(&spec)?.try_generate(s.seed)?;
+    let surface = SurfaceGenerator::new(&spec)?.try_generate(seed)?;
     let elapsed = start.elapsed().as_secs_f64();
     let summary = surface_summary(&surface);
-    ensure_usable(summary.rms_height, summary.rms_slope, s)?;
+    ensure_usable(&summary, s.size)?;
     staged.write_npy_2d(&s.out, surface.heights())?;
-    staged.write_json(
-        &sidecar,
-        &json!({
-            "kind": "surface",
-            "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
-            "shape": [rows, args.n],
-            "seed": s.seed,
-            "spec": spec,
-            "stats": summary,
-        }),
-    )?;
+    let record = generated_sidecar("surface", &[rows, args.n], seed, &spec, &summary);
+    staged.write_json(&sidecar, &record)?;
     if let Some(png) = &args.png {
         crate::plot::greyscale_png(&mut staged, png, surface.heights().view())?;
     }
@@ -205,30 +175,18 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
 /// Runs `asperity line`.
 pub fn run_line(args: &LineArgs) -> Result<()> {
     let s = &args.spectrum;
-    let psd = Psd::new(s.hurst, s.long_wavelength(), None)?;
-    let spec = LineSpec::new(
-        args.n,
-        s.size,
-        psd,
-        normalisation(args.rms_height, args.rms_slope),
-    )?;
+    let norm = (args.rms_height, args.rms_slope);
+    let (spec, seed) = request(args.n, None, s, None, norm)
+        .line()
+        .map_err(refused)?;
     let sidecar = sidecar_path(&s.out);
     let mut staged = StagedOutputs::new([&s.out, &sidecar], s.force)?;
-    let line = LineGenerator::new(&spec)?.try_generate(s.seed)?;
+    let line = LineGenerator::new(&spec)?.try_generate(seed)?;
     let summary = line_summary(&line);
-    ensure_usable(summary.rms_height, summary.rms_slope, s)?;
+    ensure_usable(&summary, s.size)?;
     staged.write_npy_1d(&s.out, line.heights())?;
-    staged.write_json(
-        &sidecar,
-        &json!({
-            "kind": "line",
-            "generator": format!("asperity {}", env!("CARGO_PKG_VERSION")),
-            "shape": [args.n],
-            "seed": s.seed,
-            "spec": spec,
-            "stats": summary,
-        }),
-    )?;
+    let record = generated_sidecar("line", &[args.n], seed, &spec, &summary);
+    staged.write_json(&sidecar, &record)?;
     staged.commit()?;
     eprintln!(
         "wrote {} ({} points): rms height {:.6e}, rms slope {:.6e}",

@@ -4,10 +4,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::range::parse_range;
 use anyhow::Result;
 use asperity::study::theory::alpha_theory;
 use asperity::study::{Method, TaskResult};
+use asperity_app::range::parse_range;
 
 use super::super::setting::Setting;
 use super::{announce, describe_hursts, figure_study, study_spec};

@@ -1,9 +1,9 @@
 //! The `--hurst` syntax of the CLI and of study files: comma-separated items, each a value
 //! or an inclusive range `A:B:STEP` (e.g. `-1:0:0.5,0.8,2:3:1`).
 //!
-//! A front end's syntax, so it lives here and not in the library, which takes plain lists
-//! of H values. The Python package accepts the same strings and the fuzz target checks the
-//! parser: both include this file (`#[path]`), so it depends on `asperity` and `std` only.
+//! A front end's syntax, so it lives in the front-end layer and not in the library, which
+//! takes plain lists of H values: the CLI, the Python package and the fuzz target all use
+//! this one parser.
 
 use asperity::input::{clip, short_number};
 use asperity::{Error, Result};

@@ -1,0 +1,360 @@
+//! `asperity contact`: a measured surface pressed into an elastic half-space at a list of
+//! mean pressures, in physical units — the request ([`ContactRequest`]), its run on the
+//! library's load sweep ([`run`]) and its result columns ([`COLUMNS`]).
+
+use std::convert::Infallible;
+
+use asperity::bem::sweep::{sweep, SweepError, SweepObserver, SweepParams, SweepRow};
+use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use asperity::topography::patches::count_patches;
+use ndarray::Array2;
+use serde::{Deserialize, Serialize};
+
+use crate::bem::{check_modulus, check_tolerance, check_values, params as bem, parse_boundary};
+use crate::refusal::Refusal;
+
+/// The parameters of `asperity contact` besides those it shares with `asperity bem`.
+pub mod params {
+    use crate::refusal::Param;
+
+    /// Young's modulus E.
+    pub const YOUNG: Param = Param::new("--young", "young");
+    /// Poisson's ratio ν.
+    pub const POISSON: Param = Param::new("--poisson", "poisson");
+}
+
+use params::*;
+
+/// E* from either the effective modulus itself or Young's modulus E and Poisson's ratio ν:
+/// `E* = E/(1 − ν²)`, with ν in `[0, 0.5)`.
+pub fn effective_modulus(
+    modulus: Option<f64>,
+    young: Option<f64>,
+    poisson: Option<f64>,
+) -> Result<f64, Refusal> {
+    match (modulus, young, poisson) {
+        (Some(m), None, None) => {
+            check_modulus(bem::MODULUS, m)?;
+            Ok(m)
+        }
+        (None, Some(e), Some(nu)) => {
+            if !(nu.is_finite() && (0.0..0.5).contains(&nu)) {
+                return Err(Refusal::of(POISSON)
+                    .text(format!(" must be in [0, 0.5) (Poisson's ratio), got {nu}")));
+            }
+            check_modulus(YOUNG, e)?;
+            let e_star = e / (1.0 - nu * nu);
+            check_modulus(bem::MODULUS, e_star)?;
+            Ok(e_star)
+        }
+        _ => Err(Refusal::saying("give either ")
+            .param(bem::MODULUS)
+            .text(" E* or ")
+            .param(YOUNG)
+            .text(" E with ")
+            .param(POISSON)
+            .text(" ν")),
+    }
+}
+
+/// An `asperity contact` request (SI units).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactRequest {
+    /// E*, Pa (or `young` with `poisson`).
+    pub modulus: Option<f64>,
+    /// Young's modulus E, Pa.
+    pub young: Option<f64>,
+    /// Poisson's ratio ν.
+    pub poisson: Option<f64>,
+    /// Mean pressures over the nominal area, Pa.
+    pub pressures: Vec<f64>,
+    /// `free` or `periodic`.
+    pub boundary: String,
+    /// The BEM's tolerance (rms gap violation over the rms height).
+    pub tolerance: f64,
+}
+
+impl Default for ContactRequest {
+    /// No modulus and no load yet; free boundaries, the library's tolerance.
+    fn default() -> Self {
+        ContactRequest {
+            modulus: None,
+            young: None,
+            poisson: None,
+            pressures: Vec::new(),
+            boundary: "free".into(),
+            tolerance: SolverParams::default().tolerance,
+        }
+    }
+}
+
+/// A validated [`ContactRequest`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPlan {
+    /// E* and the boundary conditions.
+    pub half_space: HalfSpace,
+    /// The library's solver with the request's tolerance.
+    pub params: SolverParams,
+    /// The mean pressures, in the given order.
+    pub loads: Vec<Control>,
+}
+
+impl ContactRequest {
+    /// The plan, or why not: E*, the boundary, the pressures, the tolerance.
+    pub fn validate(&self) -> Result<ContactPlan, Refusal> {
+        let modulus = effective_modulus(self.modulus, self.young, self.poisson)?;
+        let boundary = parse_boundary(&self.boundary)?;
+        check_values(bem::PRESSURES, &self.pressures, false)?;
+        check_tolerance(self.tolerance)?;
+        Ok(ContactPlan {
+            half_space: HalfSpace { modulus, boundary },
+            params: SolverParams {
+                tolerance: self.tolerance,
+                ..SolverParams::default()
+            },
+            loads: self
+                .pressures
+                .iter()
+                .map(|&p| Control::MeanPressure(p))
+                .collect(),
+        })
+    }
+}
+
+/// The columns of `asperity contact`'s table (SI units), in the order of
+/// [`ContactRow::values`].
+pub const COLUMNS: [&str; 10] = [
+    "mean_pressure_pa",
+    "force_n",
+    "contact_area_m2",
+    "area_fraction",
+    "mean_gap_m",
+    "stiffness_n_per_m",
+    "patches",
+    "indentation_m",
+    "iterations",
+    "residual",
+];
+
+/// One load's results, SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactRow {
+    /// Mean pressure, Pa.
+    pub pressure: f64,
+    /// Total force, N.
+    pub force: f64,
+    /// True contact area, m².
+    pub area: f64,
+    /// Contact area over the nominal area.
+    pub fraction: f64,
+    /// Mean gap over the nominal area, m.
+    pub mean_gap: f64,
+    /// Frozen-set stiffness, N/m.
+    pub stiffness: f64,
+    /// 4-connected contact patches.
+    pub patches: usize,
+    /// Indentation, m.
+    pub indentation: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Solver residual.
+    pub residual: f64,
+}
+
+/// A value of a row: a number or a count.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Value {
+    /// A real number.
+    Number(f64),
+    /// A count.
+    Count(usize),
+}
+
+impl ContactRow {
+    /// The row's values, in the order of [`COLUMNS`].
+    pub fn values(&self) -> [Value; 10] {
+        use Value::{Count, Number};
+        [
+            Number(self.pressure),
+            Number(self.force),
+            Number(self.area),
+            Number(self.fraction),
+            Number(self.mean_gap),
+            Number(self.stiffness),
+            Count(self.patches),
+            Number(self.indentation),
+            Count(self.iterations),
+            Number(self.residual),
+        ]
+    }
+}
+
+/// The rows of a run and, when asked for, the contact set of the last load.
+#[derive(Debug, Clone)]
+pub struct ContactRun {
+    /// One row per load.
+    pub rows: Vec<ContactRow>,
+    /// The contact set (`true` in contact) of the last load.
+    pub map: Option<Array2<bool>>,
+}
+
+/// Takes each load's mean gap, patches and (for the last load) contact map.
+struct Observer {
+    loads: usize,
+    keep_map: bool,
+    pixel_area: f64,
+    fields: (f64, usize),
+    map: Option<Array2<bool>>,
+    rows: Vec<ContactRow>,
+}
+
+impl SweepObserver for Observer {
+    type Error = Infallible;
+
+    fn solved(&mut self, load: usize, solver: &ContactSolver) -> Result<(), Infallible> {
+        let contact = solver.pressure().mapv(|v| v > 0.0);
+        let mean_gap = solver.gap().mean().unwrap_or(f64::NAN);
+        self.fields = (mean_gap, count_patches(contact.view()));
+        if self.keep_map && load + 1 == self.loads {
+            self.map = Some(contact);
+        }
+        Ok(())
+    }
+
+    fn finished(&mut self, _load: usize, row: &SweepRow) -> Result<(), Infallible> {
+        let s = &row.summary;
+        self.rows.push(ContactRow {
+            pressure: s.mean_pressure,
+            force: s.force,
+            area: s.contact_points as f64 * self.pixel_area,
+            fraction: s.area_fraction,
+            mean_gap: self.fields.0,
+            stiffness: row.stiffness.unwrap_or(f64::NAN),
+            patches: self.fields.1,
+            indentation: s.indentation,
+            iterations: row.info.iterations,
+            residual: row.info.residual,
+        });
+        Ok(())
+    }
+}
+
+/// Runs the plan's loads on `solver` (the library's sweep: full contact checked before any
+/// solve, warm starts, frozen-set stiffness); `pixel_area` in m², `keep_map`: keep the
+/// contact set of the last load.
+pub fn run(
+    solver: &mut ContactSolver,
+    plan: &ContactPlan,
+    pixel_area: f64,
+    keep_map: bool,
+) -> Result<ContactRun, SweepError<Infallible>> {
+    let mut observer = Observer {
+        loads: plan.loads.len(),
+        keep_map,
+        pixel_area,
+        fields: (f64::NAN, 0),
+        map: None,
+        rows: Vec::with_capacity(plan.loads.len()),
+    };
+    let params = SweepParams {
+        stiffness: true,
+        fd_step: None,
+    };
+    sweep(solver, &plan.loads, params, &mut observer)?;
+    Ok(ContactRun {
+        rows: observer.rows,
+        map: observer.map,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refusal in Python's words.
+    fn first(refusal: &Refusal) -> String {
+        refusal.words(crate::refusal::Names::Keywords)
+    }
+
+    #[test]
+    fn effective_modulus_from_young_and_poisson() {
+        assert_eq!(
+            effective_modulus(None, Some(210e9), Some(0.3)),
+            Ok(210e9 / 0.91)
+        );
+        assert_eq!(effective_modulus(Some(2.0), None, None), Ok(2.0));
+        let cases = [
+            (
+                (None, Some(1.0), Some(0.5)),
+                "poisson must be in [0, 0.5) (Poisson's ratio), got 0.5",
+            ),
+            (
+                (None, Some(-1.0), Some(0.3)),
+                "young must be positive and finite, got -1",
+            ),
+            (
+                (Some(0.0), None, None),
+                "modulus must be positive and finite, got 0",
+            ),
+            (
+                (Some(1.0), Some(1.0), Some(0.3)),
+                "give either modulus E* or young E with poisson ν",
+            ),
+        ];
+        for ((m, e, nu), words) in cases {
+            assert_eq!(first(&effective_modulus(m, e, nu).unwrap_err()), words);
+        }
+    }
+
+    #[test]
+    fn contact_refuses_a_meaningless_tolerance() {
+        // The reliability item: `contact --tol` had no upper bound.
+        let request = ContactRequest {
+            modulus: Some(1e9),
+            pressures: vec![1e5],
+            tolerance: 10.0,
+            ..ContactRequest::default()
+        };
+        let err = request.validate().unwrap_err().to_string();
+        assert!(
+            err.starts_with("--tol must be positive and at most 1e-2"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn run_is_the_sweep_with_fields_taken_after_each_solve() {
+        use asperity::surface::Surface;
+        let heights = Array2::from_shape_fn((24, 24), |(i, j)| {
+            ((i as f64) * 0.7).sin() * ((j as f64) * 0.4).cos() * 1e-6
+        });
+        let surface = Surface::new(heights, 1e-4).unwrap();
+        let request = ContactRequest {
+            modulus: Some(1e9),
+            pressures: vec![1e4, 1e5],
+            ..ContactRequest::default()
+        };
+        let plan = request.validate().unwrap();
+        let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        let pixel = surface.spacing() * surface.spacing_y();
+        let run = run(&mut solver, &plan, pixel, true).unwrap();
+        // The same solves by hand, as `asperity contact` ran them before it used the sweep.
+        let mut by_hand = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        for (row, control) in run.rows.iter().zip(&plan.loads) {
+            let (summary, info) = by_hand.solve(*control).unwrap();
+            let contact = by_hand.pressure().mapv(|v| v > 0.0);
+            assert_eq!(row.patches, count_patches(contact.view()));
+            assert_eq!(row.mean_gap, by_hand.gap().mean().unwrap());
+            assert_eq!(row.stiffness, by_hand.frozen_set_stiffness().unwrap().0);
+            assert_eq!(row.area, summary.contact_points as f64 * pixel);
+            assert_eq!(
+                (row.iterations, row.residual),
+                (info.iterations, info.residual)
+            );
+            assert_eq!(row.force, summary.force);
+        }
+        let map = run.map.unwrap();
+        assert_eq!(map, by_hand.pressure().mapv(|v| v > 0.0));
+        assert_eq!(COLUMNS.len(), run.rows[0].values().len());
+    }
+}

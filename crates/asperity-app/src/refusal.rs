@@ -1,0 +1,166 @@
+//! Why a request is refused, in words that name its parameters the way the front end that
+//! made it does: a flag of the CLI (`--tol`) or a keyword of Python (`tolerance`).
+
+use std::fmt;
+
+/// One parameter of a request, as each front end names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Param {
+    /// The CLI's flag, with its dashes (`--tol`).
+    pub flag: &'static str,
+    /// The Python keyword (`tolerance`).
+    pub keyword: &'static str,
+}
+
+impl Param {
+    /// A parameter called `flag` on the command line and `keyword` in Python.
+    pub const fn new(flag: &'static str, keyword: &'static str) -> Self {
+        Param { flag, keyword }
+    }
+
+    /// Its name in `names`.
+    pub fn name(self, names: Names) -> &'static str {
+        match names {
+            Names::Flags => self.flag,
+            Names::Keywords => self.keyword,
+        }
+    }
+}
+
+/// How a front end names parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Names {
+    /// The CLI's flags (`--tol`).
+    Flags,
+    /// Python's keywords (`tolerance`).
+    Keywords,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Part {
+    Text(String),
+    Param(Param),
+}
+
+/// A refused request: one line of text in which the parameters are named by the front end
+/// ([`Refusal::words`]). Built from pieces: `Refusal::of(TOL).text(" must be …")`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    parts: Vec<Part>,
+}
+
+impl Refusal {
+    /// A refusal that starts with the name of `param`.
+    pub fn of(param: Param) -> Self {
+        Refusal {
+            parts: vec![Part::Param(param)],
+        }
+    }
+
+    /// A refusal that starts with `text`.
+    pub fn saying(text: impl Into<String>) -> Self {
+        Refusal {
+            parts: vec![Part::Text(text.into())],
+        }
+    }
+
+    /// `text` appended.
+    pub fn text(mut self, text: impl Into<String>) -> Self {
+        self.parts.push(Part::Text(text.into()));
+        self
+    }
+
+    /// The name of `param` appended.
+    pub fn param(mut self, param: Param) -> Self {
+        self.parts.push(Part::Param(param));
+        self
+    }
+
+    /// The line, with every parameter named as `names` says.
+    pub fn words(&self, names: Names) -> String {
+        self.parts
+            .iter()
+            .map(|part| match part {
+                Part::Text(text) => text.as_str(),
+                Part::Param(param) => param.name(names),
+            })
+            .collect()
+    }
+}
+
+/// A request that cannot be run: refused by a rule, or (the memory guard) refused by the
+/// library for what it would need.
+#[derive(Debug, thiserror::Error)]
+pub enum RequestError {
+    /// A rule of the request refuses it.
+    #[error("{}", .0.words(Names::Flags))]
+    Refused(Refusal),
+    /// The library refuses what `param` asks for (memory, ...).
+    #[error("{} {value}: {source}", .param.flag)]
+    Library {
+        /// The parameter that asks for it.
+        param: Param,
+        /// Its value, as given.
+        value: String,
+        /// The library's error.
+        source: Box<asperity::Error>,
+    },
+    /// The library refuses the request in its own words, which name the parameter as
+    /// Python does (`invalid rms_height: …`; the CLI turns the name into its flag's).
+    #[error("{0}")]
+    Invalid(Box<asperity::Error>),
+}
+
+impl RequestError {
+    /// The line, with parameters named as `names` says.
+    pub fn words(&self, names: Names) -> String {
+        match self {
+            RequestError::Refused(refusal) => refusal.words(names),
+            RequestError::Library {
+                param,
+                value,
+                source,
+            } => format!("{} {value}: {source}", param.name(names)),
+            RequestError::Invalid(source) => source.to_string(),
+        }
+    }
+}
+
+impl From<Refusal> for RequestError {
+    fn from(refusal: Refusal) -> Self {
+        RequestError::Refused(refusal)
+    }
+}
+
+impl fmt::Display for Refusal {
+    /// The CLI's words (flags); Python renders [`Refusal::words`] with [`Names::Keywords`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.words(Names::Flags))
+    }
+}
+
+impl std::error::Error for Refusal {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TOL: Param = Param::new("--tol", "tolerance");
+    const PMIN: Param = Param::new("--pmin", "pmin");
+
+    #[test]
+    fn refusals_name_parameters_as_the_front_end_does() {
+        let r = Refusal::of(TOL)
+            .text(" must be below ")
+            .param(PMIN)
+            .text(", got 2");
+        assert_eq!(r.words(Names::Flags), "--tol must be below --pmin, got 2");
+        assert_eq!(
+            r.words(Names::Keywords),
+            "tolerance must be below pmin, got 2"
+        );
+        assert_eq!(r.to_string(), r.words(Names::Flags));
+        let e = RequestError::from(Refusal::saying("give one of ").param(TOL));
+        assert_eq!(e.words(Names::Keywords), "give one of tolerance");
+    }
+}

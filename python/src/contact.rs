@@ -1,0 +1,101 @@
+//! `asperity.contact`: the CLI's `asperity contact` (a surface in SI units pressed into an
+//! elastic half-space at a list of mean pressures), run by the front-end layer
+//! ([`asperity_app::contact`]) as the CLI runs it: the same request, rules and sweep.
+
+use asperity::bem::sweep::{SweepError, SweepFailure};
+use asperity::bem::ContactSolver;
+use asperity::memory::array_bytes;
+use asperity::surface::Surface;
+use asperity_app::bem::ensure_solver_fits;
+use asperity_app::contact::{self as app, ContactRequest, Value, COLUMNS};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::arrays::owned_2d;
+use crate::bem::with_context;
+use crate::errors::{from_error, from_solve, invalid, refused};
+use crate::interrupt::run_detached_with;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(contact, m)?)?;
+    Ok(())
+}
+
+/// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
+/// the last load with `map`).
+#[pyfunction]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map))]
+#[allow(clippy::too_many_arguments)]
+fn contact<'py>(
+    py: Python<'py>,
+    heights: PyReadonlyArray2<'_, f64>,
+    size_x: f64,
+    size_y: Option<f64>,
+    pressures: Vec<f64>,
+    modulus: Option<f64>,
+    young: Option<f64>,
+    poisson: Option<f64>,
+    boundary: &str,
+    tolerance: f64,
+    map: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let request = ContactRequest {
+        modulus,
+        young,
+        poisson,
+        pressures,
+        boundary: boundary.into(),
+        tolerance,
+    };
+    let plan = request.validate().map_err(refused)?;
+    let (rows, cols) = heights.as_array().dim();
+    ensure_solver_fits(
+        rows,
+        cols,
+        plan.half_space.boundary,
+        array_bytes(&[rows, cols], 8),
+    )
+    .map_err(from_error)?;
+    let owned = owned_2d(&heights);
+    let surface = match size_y {
+        Some(size_y) => Surface::with_sizes(owned, size_x, size_y),
+        None => Surface::new(owned, size_x),
+    }
+    .map_err(from_error)?;
+    let pixel_area = surface.spacing() * surface.spacing_y();
+    let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).map_err(from_solve)?;
+    drop(surface);
+    let stop = solver.stop().clone();
+    let run = run_detached_with(py, &stop, |_| {
+        app::run(&mut solver, &plan, pixel_area, map)
+    })?
+    .map_err(|e: SweepError<_>| match e.explain("fd_stiffness") {
+        SweepFailure::Input(source) => from_solve(source),
+        SweepFailure::AtLoad { context, source } => with_context(source, &context),
+        SweepFailure::StepBeyondFullContact(message) => invalid(message),
+        SweepFailure::Stopped(never) => match never {},
+    })?;
+    let dict = PyDict::new(py);
+    for (k, name) in COLUMNS.iter().enumerate() {
+        let column: Vec<Value> = run.rows.iter().map(|row| row.values()[k]).collect();
+        if column.iter().all(|v| matches!(v, Value::Count(_))) {
+            let counts = column.iter().map(|v| match *v {
+                Value::Count(n) => n as u64,
+                Value::Number(_) => unreachable!("a column of counts"),
+            });
+            dict.set_item(name, PyArray1::from_iter(py, counts))?;
+        } else {
+            let numbers = column.iter().map(|v| match *v {
+                Value::Number(x) => x,
+                Value::Count(n) => n as f64,
+            });
+            dict.set_item(name, PyArray1::from_iter(py, numbers))?;
+        }
+    }
+    if let Some(map) = run.map {
+        dict.set_item("map", map.into_pyarray(py))?;
+    }
+    dict.set_item("effective_modulus", plan.half_space.modulus)?;
+    Ok(dict)
+}

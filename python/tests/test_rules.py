@@ -1,0 +1,203 @@
+"""One set of rules and words: every invalid request below is given to the CLI (the real
+binary) and to Python, and both refuse it in the same words, the CLI naming flags
+(`--tol`) where Python names keywords (`tolerance`).
+
+The rules live once, in the front-end layer (crates/asperity-app); each row is one rule of
+one command, with a fragment of the expected words so that a row cannot pass by some other
+refusal."""
+
+import math
+
+import numpy as np
+import pytest
+
+import asperity
+
+from conftest import cli_error
+
+# Each flag of the table and the keyword that Python names it by.
+KEYWORDS = {
+    "--forces": "forces",
+    "--pressures": "pressures",
+    "--indentations": "indentations",
+    "--nloads": "nloads",
+    "--pmin": "pmin",
+    "--pmax": "pmax",
+    "--modulus": "modulus",
+    "--young": "young",
+    "--poisson": "poisson",
+    "--boundary": "boundary",
+    "--solver": "solver",
+    "--tol": "tolerance",
+    "--max-iter": "max_iterations",
+    "--n": "n",
+    "--hurst": "hurst",
+    "--rolloff": "rolloff",
+    "--cutoff": "cutoff",
+    "--rms-height": "rms_height",
+    "--rms-slope": "rms_slope",
+    "--size": "size",
+    "--seed": "seed",
+}
+
+
+def in_keywords(words: str) -> str:
+    """The CLI's words with each flag replaced by its keyword (longest flags first)."""
+    for flag in sorted(KEYWORDS, key=len, reverse=True):
+        words = words.replace(flag, KEYWORDS[flag])
+    return words
+
+
+NAN, INF = math.nan, math.inf
+
+# asperity bem: (flags, Solver keywords, sweep keywords, expected words in keywords).
+BEM = [
+    (["--forces", "-1"], {}, dict(forces=[-1]), "forces: -1 is not allowed (values must be finite and > 0)"),
+    (["--forces", "nan"], {}, dict(forces=[NAN]), "forces: NaN is not allowed"),
+    (["--pressures", "0"], {}, dict(pressures=[0]), "pressures: 0 is not allowed"),
+    (["--pressures", "0.01,inf"], {}, dict(pressures=[0.01, INF]), "pressures: inf is not allowed"),
+    (["--indentations", "-0.5"], {}, dict(indentations=[-0.5]), "(values must be finite and >= 0)"),
+    ([], {}, {}, "give one of forces, pressures, indentations or nloads with pmin and pmax"),
+    (["--forces", "1", "--pressures", "1"], {}, dict(forces=[1], pressures=[1]), "give one of"),
+    (["--nloads", "0", "--pmin", "1e-3", "--pmax", "1e-2"], {}, dict(nloads=0, pmin=1e-3, pmax=1e-2),
+     "nloads must be at least 1, got 0"),
+    (["--nloads", "3", "--pmin", "1e-3"], {}, dict(nloads=3, pmin=1e-3), "nloads needs pmin and pmax"),
+    (["--nloads", "3", "--pmin", "-1", "--pmax", "1"], {}, dict(nloads=3, pmin=-1, pmax=1),
+     "pmin: -1 is not allowed"),
+    (["--nloads", "3", "--pmin", "0.1", "--pmax", "0.01"], {}, dict(nloads=3, pmin=0.1, pmax=0.01),
+     "pmax (0.01) must not be smaller than pmin (0.1)"),
+    (["--nloads", "3", "--pmin", "1e-3", "--pmax", "nan"], {}, dict(nloads=3, pmin=1e-3, pmax=NAN),
+     "pmax: NaN is not allowed"),
+    (["--pressures", "0.01", "--tol", "0"], dict(tolerance=0), None,
+     "tolerance must be positive and at most 1e-2 (a relative residual), got 0"),
+    (["--pressures", "0.01", "--tol", "0.5"], dict(tolerance=0.5), None, "at most 1e-2"),
+    (["--pressures", "0.01", "--tol", "10"], dict(tolerance=10), None, "got 10"),
+    (["--pressures", "0.01", "--tol=-1e-6"], dict(tolerance=-1e-6), None, "got -1e-6"),
+    (["--pressures", "0.01", "--tol", "nan"], dict(tolerance=NAN), None, "tolerance must be positive"),
+    (["--pressures", "0.01", "--max-iter", "0"], dict(max_iterations=0), None,
+     "max_iterations must be at least 1, got 0"),
+    (["--pressures", "0.01", "--solver", "cg"], dict(solver="cg"), None,
+     'solver must be "bccg" (the default) or "pk" (Polonsky–Keer), got "cg"'),
+    (["--pressures", "0.01", "--boundary", "open"], dict(boundary="open"), None,
+     'boundary must be "free" (the default) or "periodic", got "open"'),
+    (["--pressures", "0.01", "--modulus", "0"], dict(modulus=0), None,
+     "modulus must be positive and finite, got 0"),
+    (["--pressures", "0.01", "--modulus", "-1"], dict(modulus=-1), None, "got -1"),
+    (["--pressures", "0.01", "--modulus", "inf"], dict(modulus=INF), None, "got inf"),
+    (["--pressures", "0.01", "--modulus", "nan"], dict(modulus=NAN), None, "got NaN"),
+]
+
+# asperity contact: (flags, keywords, expected words in keywords).
+CONTACT = [
+    (["--pressures", "1e5"], dict(pressures=[1e5]), "give either modulus E* or young E with poisson ν"),
+    (["--young", "1e9", "--pressures", "1e5"], dict(young=1e9, pressures=[1e5]), "give either"),
+    (["--poisson", "0.3", "--pressures", "1e5"], dict(poisson=0.3, pressures=[1e5]), "give either"),
+    (["--modulus", "1e9", "--young", "1e9", "--poisson", "0.3", "--pressures", "1e5"],
+     dict(modulus=1e9, young=1e9, poisson=0.3, pressures=[1e5]), "give either"),
+    (["--young", "1e9", "--poisson", "0.5", "--pressures", "1e5"],
+     dict(young=1e9, poisson=0.5, pressures=[1e5]), "poisson must be in [0, 0.5) (Poisson's ratio), got 0.5"),
+    (["--young", "1e9", "--poisson", "-0.1", "--pressures", "1e5"],
+     dict(young=1e9, poisson=-0.1, pressures=[1e5]), "got -0.1"),
+    (["--young", "1e9", "--poisson", "nan", "--pressures", "1e5"],
+     dict(young=1e9, poisson=NAN, pressures=[1e5]), "poisson must be in"),
+    (["--young", "-1", "--poisson", "0.3", "--pressures", "1e5"],
+     dict(young=-1, poisson=0.3, pressures=[1e5]), "young must be positive and finite, got -1"),
+    (["--modulus", "0", "--pressures", "1e5"], dict(modulus=0, pressures=[1e5]),
+     "modulus must be positive and finite, got 0"),
+    (["--modulus", "1e9", "--pressures", "-1"], dict(modulus=1e9, pressures=[-1]),
+     "pressures: -1 is not allowed"),
+    (["--modulus", "1e9"], dict(modulus=1e9, pressures=[]), "pressures: give at least one value"),
+    # The reliability item: contact's tolerance had no upper bound (Python's 10 was taken).
+    (["--modulus", "1e9", "--pressures", "1e5", "--tol", "10"],
+     dict(modulus=1e9, pressures=[1e5], tolerance=10), "tolerance must be positive and at most 1e-2"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--tol", "0"],
+     dict(modulus=1e9, pressures=[1e5], tolerance=0), "got 0"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--boundary", "open"],
+     dict(modulus=1e9, pressures=[1e5], boundary="open"), 'boundary must be "free"'),
+]
+
+
+# asperity surface / line: (command, flags, keywords, expected words in keywords).
+SURFACE = [
+    ("surface", ["--seed", "1.5"], dict(seed=1.5),
+     "seed must be a whole number from 0 to 18446744073709551615, got 1.5"),
+    ("surface", ["--seed", "-1"], dict(seed=-1), "got -1"),
+    ("line", ["--seed", "True"], dict(seed=True), "got True"),
+    ("surface", ["--rolloff", "2", "--cutoff", "2"], dict(rolloff=2, cutoff=2),
+     "give at most one of rolloff and cutoff (a roll-off keeps the power below q0 flat"),
+    ("line", ["--rms-height", "1", "--rms-slope", "1"], dict(rms_height=1, rms_slope=1),
+     "give at most one of rms_height and rms_slope"),
+    ("surface", ["--rms-height", "1e-320"], dict(rms_height=1e-320),
+     "the generated heights are not representable (rms height 0): rms_height or rms_slope "
+     "with size 1 is beyond the range of float64"),
+]
+
+
+def test_the_table_covers_every_rule_of_bem_contact_and_surfaces():
+    assert len(BEM) + len(CONTACT) + len(SURFACE) >= 30
+    fragments = [row[-1] for row in BEM + CONTACT + SURFACE]
+    assert all(fragments)
+
+
+@pytest.fixture(scope="module")
+def heights(tmp_path_factory):
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_slope=1, seed=1)
+    path = tmp_path_factory.mktemp("rules") / "s.npy"
+    s.save(path)
+    return s.heights, path
+
+
+def python_words(call) -> str:
+    with pytest.raises(ValueError) as refused:
+        call()
+    return str(refused.value)
+
+
+@pytest.mark.parametrize("flags,solver_kw,sweep_kw,words", BEM)
+def test_bem_refuses_alike(cli, heights, flags, solver_kw, sweep_kw, words):
+    array, path = heights
+    theirs = in_keywords(cli_error(cli("bem", "--surface", path, *flags, ok=False)))
+
+    def call():
+        solver = asperity.Solver(array, **solver_kw)
+        solver.sweep(**(sweep_kw if sweep_kw is not None else dict(pressures=[0.01])))
+
+    ours = python_words(call)
+    assert ours == theirs
+    assert words in ours
+
+
+@pytest.mark.parametrize("flags,kwargs,words", CONTACT)
+def test_contact_refuses_alike(cli, heights, flags, kwargs, words):
+    array, path = heights
+    theirs = in_keywords(cli_error(cli("contact", path, *flags, ok=False)))
+    ours = python_words(lambda: asperity.contact(array, 1e-4, **kwargs))
+    assert ours == theirs
+    assert words in ours
+
+
+@pytest.mark.parametrize("command,flags,kwargs,words", SURFACE)
+def test_surfaces_refuse_alike(cli, tmp_path, command, flags, kwargs, words):
+    theirs = cli(command, "--n", 16, "--hurst", 0.5, *flags, "--out", tmp_path / "x.npy", ok=False)
+    theirs = in_keywords(cli_error(theirs))
+    ours = python_words(lambda: getattr(asperity, command)(16, hurst=0.5, **kwargs))
+    assert ours == theirs
+    assert words in ours
+    assert not (tmp_path / "x.npy").exists()
+
+
+def test_contact_equals_the_cli(cli, tmp_path):
+    """`asperity.contact` gives the CLI's table bit for bit (the same request and sweep)."""
+    s = asperity.surface(64, hurst=0.8, rolloff=2, rms_slope=1, seed=2, size=1e-4)
+    heights = s.heights * 1e-6
+    np.save(tmp_path / "h.npy", heights)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none", "--out", tmp_path / "t.npy")
+    cli("contact", tmp_path / "t.npy", "--young", 210e9, "--poisson", 0.3, "--pressures",
+        "1e6,1e7", "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    t = asperity.read_topography(tmp_path / "t.npy")
+    ours = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e6, 1e7], map=True)
+    for name in theirs.dtype.names:
+        assert np.array_equal(ours[name], theirs[name]), name
+    assert ours.map.dtype == bool and ours.map.sum() > 0
+    assert ours.effective_modulus == 210e9 / (1 - 0.3**2)
