@@ -6,6 +6,9 @@
 //! duration of the uninterrupted run, so every run of the test tries the same points on a
 //! given machine. Each test prints how many kills it tried and how many landed before the
 //! run ended.
+//!
+//! Both are in the slow tier (minutes): `cargo test --release -- --ignored`, which `.ci/run`
+//! and the README's test command run after the fast tier.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -79,6 +82,7 @@ fn results(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 
 /// A small BEM study: for each kill point a fresh folder is killed once and resumed.
 #[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
 fn a_bem_study_killed_anywhere_resumes_byte_identical() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -136,6 +140,7 @@ fn a_bem_study_killed_anywhere_resumes_byte_identical() {
 /// `reproduce fig1 --quick`, killed three times in a row at random points (each resume
 /// is itself interrupted), then finished: the same bytes as one uninterrupted run.
 #[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
 fn reproduce_fig1_killed_repeatedly_resumes_byte_identical() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -42,6 +42,7 @@ fn the_same_command_runs_again_and_foreign_folders_are_refused_first() {
 }
 
 #[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
 fn an_interrupted_figure_resumes_to_the_uninterrupted_numbers() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

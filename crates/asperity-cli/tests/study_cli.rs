@@ -87,6 +87,7 @@ fn truncated_checkpoint_resumes_to_identical_results() {
 }
 
 #[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
 fn killed_study_resumes_to_the_uninterrupted_result() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -146,6 +147,7 @@ fn killed_study_resumes_to_the_uninterrupted_result() {
 }
 
 #[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
 fn terminated_study_removes_its_temporary_files_and_resumes() {
     // SIGTERM (like Ctrl-C) runs the handler: unfinished outputs' temporary files go, the
     // exit status is 130, and the checkpoints written so far let the study resume.
