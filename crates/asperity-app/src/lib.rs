@@ -28,6 +28,7 @@
 
 pub mod bem;
 pub mod contact;
+pub mod mdr;
 pub mod range;
 pub mod refusal;
 pub mod surface;

@@ -401,14 +401,13 @@ fn negative_indentation_range_is_refused_by_the_range_check() {
 
 #[test]
 fn missing_required_arguments_are_named() {
-    // clap's multi-line message is folded into one line that keeps the missing names.
+    // The front-end layer names what is missing (the same words as Python's).
     let dir = tempfile::tempdir().unwrap();
     let out = asperity(
         &["mdr", "--radial", "tip.npy", "--n", "5", "--dx", "1e-3"],
         dir.path(),
     );
-    refused(&out, "--radial-step");
-    refused(&out, "not provided");
+    refused(&out, "--radial needs --radial-step");
     // `bem` without any load flag names the load options it needs (the front-end layer's
     // words, the same as Python's).
     let out = asperity(&["bem", "--surface", "s.npy"], dir.path());
