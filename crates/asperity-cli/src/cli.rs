@@ -33,6 +33,8 @@ pub enum Command {
     Import(commands::import::ImportArgs),
     /// Contact area, mean gap, stiffness and patches of a measured surface against load (SI units).
     Contact(commands::contact::ContactArgs),
+    /// Persson's theory from a surface's own PSD: contact area, mean gap, stiffness vs pressure.
+    Persson(commands::persson::PerssonArgs),
     /// Time a library kernel (for comparisons with other tools; see bench/).
     Bench(commands::bench::BenchArgs),
     /// Regenerate a figure of the paper or the book chapter.

@@ -7,6 +7,7 @@ pub mod figures;
 pub mod import;
 pub mod mdr;
 pub mod measured;
+pub mod persson;
 pub mod reproduce;
 pub mod setting;
 pub mod stats;
@@ -26,6 +27,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Study(args) => study::run(&args),
         Command::Import(args) => import::run(&args),
         Command::Contact(args) => contact::run(&args),
+        Command::Persson(args) => persson::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     }

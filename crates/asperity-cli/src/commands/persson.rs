@@ -1,0 +1,175 @@
+//! `asperity persson`: Persson's theory for a surface, from its own radially averaged PSD
+//! (the library's `persson` module, docs/persson.md): relative contact area, mean
+//! interfacial separation and contact stiffness against the mean pressure.
+//!
+//! A command of its own rather than an option of `stats` or `bem`: it needs its own inputs
+//! (E*, pressures, γ, κ) and writes a load table, which `stats` does not; and it runs in
+//! milliseconds without a solver, which `bem` would make wait for its checks and solves.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use asperity::persson::{Persson, PerssonParams, PERSSON_KAPPA};
+use asperity::surface::Surface;
+
+use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
+use crate::output::Table;
+
+/// Arguments of `asperity persson`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:\n  \
+    asperity surface --n 256 --hurst 0.8 --rolloff 6 --rms-slope 1 --seed 1 --out s.npy\n  \
+    asperity persson s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out persson.csv\n  \
+    asperity persson s.npy --pressures 0.001,0.01 --kappa 2 --gamma 0.4\n  \
+    asperity persson scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
+Columns: pressure (mean pressure, in the unit of --modulus), area_fraction (A/A0),\n\
+mean_gap (in the length unit of the surface: metres for a measured file),\n\
+stiffness_per_area (K = -dp/dū, pressure per length), contact_stiffness (K·A0, force per\n\
+length, comparable with `asperity bem`'s stiffness). Equations: Persson 2001 (area),\n\
+Persson 2007 with Yang & Persson 2008's S = γ + (1-γ)P² (separation); see docs/persson.md.")]
+#[command(group(clap::ArgGroup::new("loads").required(true).args(["pressures", "nloads"])))]
+pub struct PerssonArgs {
+    /// Surface heights, positive up: a .npy (float64, 2D; L from its sidecar, else 1) or a
+    /// measured file (X3P, SDF, text matrix, x y z, ...; sizes and units from the file).
+    pub surface: PathBuf,
+    /// Side lengths X[,Y] (overrides the sidecar's or the file's).
+    #[arg(long, value_name = "X[,Y]")]
+    pub size: Option<String>,
+    #[command(flatten)]
+    pub measured: MeasuredArgs,
+    /// Effective modulus E*.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub modulus: f64,
+    /// Mean pressures, comma separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        value_name = "P1,P2,…"
+    )]
+    pub pressures: Option<Vec<f64>>,
+    /// Number of mean pressures, log-spaced from --pmin to --pmax.
+    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"])]
+    pub nloads: Option<usize>,
+    /// Smallest mean pressure for --nloads.
+    #[arg(
+        long,
+        value_name = "P",
+        allow_hyphen_values = true,
+        requires = "nloads"
+    )]
+    pub pmin: Option<f64>,
+    /// Largest mean pressure for --nloads.
+    #[arg(
+        long,
+        value_name = "P",
+        allow_hyphen_values = true,
+        requires = "nloads"
+    )]
+    pub pmax: Option<f64>,
+    /// Yang & Persson's elastic-energy factor γ, in (0, 1] (1: no correction).
+    #[arg(long, default_value_t = PerssonParams::default().gamma, allow_hyphen_values = true)]
+    pub gamma: f64,
+    /// Small-load area coefficient κ in A/A0 → κ p/(E* ḡ) [default: √(8/π), Persson 2001;
+    /// simulations find about 2].
+    #[arg(long, default_value_t = PERSSON_KAPPA, allow_hyphen_values = true)]
+    pub kappa: f64,
+    /// Output table (CSV); printed to stdout when absent.
+    #[arg(long, value_name = "OUT.csv")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an existing output.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `asperity persson`.
+pub fn run(args: &PerssonArgs) -> Result<()> {
+    let params = PerssonParams {
+        modulus: args.modulus,
+        gamma: args.gamma,
+        kappa: args.kappa,
+    };
+    params.validate()?;
+    let pressures = pressures(args)?;
+    let surface = read_surface(args)?;
+    let theory = Persson::from_surface(&surface, params)
+        .with_context(|| format!("{}", args.surface.display()))?;
+    let mut table = Table::new(&[
+        "pressure",
+        "area_fraction",
+        "mean_gap",
+        "stiffness_per_area",
+        "contact_stiffness",
+    ]);
+    for p in pressures {
+        let point = theory.predict(p)?;
+        table.push_numbers(&[
+            point.pressure,
+            point.area_fraction,
+            point.mean_gap,
+            point.stiffness,
+            point.contact_stiffness,
+        ]);
+    }
+    match &args.out {
+        Some(path) => table.write(path, args.force)?,
+        None => print!("{}", String::from_utf8(table.to_csv()?)?),
+    }
+    eprintln!(
+        "{}: {}x{}, rms height {:.4e}, rms gradient (spectral) {:.4e}, u0 {:.4e} (γ = {}, κ = {})",
+        args.surface.display(),
+        surface.dim().0,
+        surface.dim().1,
+        theory.rms_height(),
+        theory.rms_gradient(),
+        theory.u0(),
+        params.gamma,
+        params.kappa
+    );
+    Ok(())
+}
+
+/// The pressures: the list, or `--nloads` log-spaced ones; each positive and finite.
+fn pressures(args: &PerssonArgs) -> Result<Vec<f64>> {
+    let list: Vec<f64> = match (&args.pressures, args.nloads, args.pmin, args.pmax) {
+        (Some(list), ..) => list.clone(),
+        (None, Some(k), Some(lo), Some(hi)) => {
+            if k == 0 || !(lo > 0.0 && hi >= lo && hi.is_finite()) {
+                bail!(
+                    "--nloads needs K >= 1 and 0 < --pmin <= --pmax, finite; got {k}, {lo}, {hi}"
+                );
+            }
+            asperity::fit::log_levels(lo, hi, k).collect()
+        }
+        _ => bail!("give --pressures or --nloads with --pmin and --pmax"),
+    };
+    if let Some(p) = list.iter().find(|p| !(p.is_finite() && **p > 0.0)) {
+        bail!("mean pressures must be positive and finite, got {p}");
+    }
+    Ok(list)
+}
+
+/// The surface: a measured file (or an imported .npy) through the topography reader, else
+/// a .npy with its side length from --size, its sidecar or 1.
+fn read_surface(args: &PerssonArgs) -> Result<Surface> {
+    if !is_npy(&args.surface) || has_import_sidecar(&args.surface) {
+        let t = load(&args.surface, &args.measured, args.size.as_deref())?;
+        return t
+            .to_surface()
+            .with_context(|| format!("{}", args.surface.display()));
+    }
+    let [x, y] = match args.size.as_deref() {
+        Some(text) => parse_size(text)?,
+        None => [None, None],
+    };
+    let size_x = match x {
+        Some(size) => size,
+        None => asperity::io::sidecar_size(&args.surface)?.unwrap_or(1.0),
+    };
+    let heights = asperity::io::read_npy_2d(&args.surface)?;
+    let surface = match y {
+        Some(size_y) => Surface::with_sizes(heights, size_x, size_y),
+        None => Surface::new(heights, size_x),
+    };
+    surface.with_context(|| format!("{}", args.surface.display()))
+}
