@@ -24,12 +24,15 @@ use serde::Serialize;
 use crate::{Error, Result};
 
 pub(crate) mod al3d;
+pub(crate) mod bcr;
 pub(crate) mod bytes;
 pub(crate) mod di;
 pub(crate) mod frt;
+pub(crate) mod gwy;
 pub mod inpaint;
 pub mod level;
 pub(crate) mod metropro;
+pub(crate) mod netcdf;
 pub(crate) mod opd;
 pub mod patches;
 pub(crate) mod plu;
@@ -178,6 +181,18 @@ const FORMATS: &[Format] = &[
         read: x3p::read,
     },
     Format {
+        name: "gwy",
+        extensions: &["gwy"],
+        sniff: gwy::sniff,
+        read: gwy::read,
+    },
+    Format {
+        name: "netcdf",
+        extensions: &["nc"],
+        sniff: netcdf::sniff,
+        read: netcdf::read,
+    },
+    Format {
         name: "sdf",
         extensions: &["sdf"],
         sniff: sdf::sniff,
@@ -232,6 +247,12 @@ const FORMATS: &[Format] = &[
         extensions: &["tmd"],
         sniff: tmd::sniff,
         read: tmd::read,
+    },
+    Format {
+        name: "bcr",
+        extensions: &["bcr", "bcrf"],
+        sniff: bcr::sniff,
+        read: bcr::read,
     },
     Format {
         name: "plu",
