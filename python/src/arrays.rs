@@ -30,9 +30,27 @@ pub enum Heights {
     Surface(Array2<f64>),
 }
 
+/// Bytes per point of the work on a copied height array (`stats`, `psd`): the copy, its
+/// centred copy, the half spectrum and the FFT's buffer, and the PSD's ring sums, as the
+/// CLI's `stats` counts them.
+const HEIGHTS_WORK_BYTES: usize = 4 * 8 + 12;
+
+/// Refuses, with `MemoryError`, an array whose copy and the work on it
+/// (`bytes_per_point` a point) do not fit in the memory available ([`ensure_fits`]): a
+/// broadcast array (`numpy.broadcast_to`) of a few bytes can stand for terabytes, and a
+/// failed allocation would abort the interpreter.
+pub fn ensure_copy_fits(shape: &[usize], bytes_per_point: usize, what: &str) -> PyResult<()> {
+    asperity::memory::ensure_fits(
+        &format!("copying {what} (shape {shape:?})"),
+        asperity::memory::array_bytes(shape, bytes_per_point),
+    )
+    .map_err(crate::errors::from_error)
+}
+
 /// Splits a float64 array of any dimension into a line or a surface.
 pub fn heights(array: &PyReadonlyArrayDyn<'_, f64>, what: &str) -> PyResult<Heights> {
     let view = array.as_array();
+    ensure_copy_fits(view.shape(), HEIGHTS_WORK_BYTES, what)?;
     match view.ndim() {
         1 => Ok(Heights::Line(
             view.into_dimensionality::<ndarray::Ix1>()

@@ -122,17 +122,31 @@ pub fn run_detached_with<R: Send>(
 }
 
 thread_local! {
-    /// The rayon pool of this (Python) thread, built on its first long computation and
-    /// dropped, with its threads, when the thread ends.
-    static POOL: std::cell::OnceCell<Arc<rayon::ThreadPool>> = const { std::cell::OnceCell::new() };
+    /// The rayon pool of this (Python) thread and the process it was built in, built on its
+    /// first long computation and dropped, with its threads, when the thread ends.
+    static POOL: std::cell::RefCell<Option<(u32, Arc<rayon::ThreadPool>)>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 /// The calling thread's own rayon pool (module docs): as many threads as rayon's global pool
 /// would have (`RAYON_NUM_THREADS`, else one per core).
+///
+/// A process forked after the pool was built (Python's `multiprocessing` forks by default)
+/// inherits the pool without its threads: work handed to it would wait forever. So a pool
+/// is used only in the process that built it; a forked child builds its own (the parent's,
+/// whose threads do not exist here, is leaked rather than dropped: dropping it would signal
+/// threads that are not there).
 fn calling_thread_pool() -> PyResult<Arc<rayon::ThreadPool>> {
+    let pid = std::process::id();
     POOL.with(|cell| {
-        if let Some(pool) = cell.get() {
-            return Ok(Arc::clone(pool));
+        let mut slot = cell.borrow_mut();
+        match slot.take() {
+            Some((built_in, pool)) if built_in == pid => {
+                *slot = Some((built_in, Arc::clone(&pool)));
+                return Ok(pool);
+            }
+            Some((_, inherited)) => std::mem::forget(inherited),
+            None => {}
         }
         let pool = rayon::ThreadPoolBuilder::new()
             .thread_name(|i| format!("asperity-{i}"))
@@ -142,6 +156,8 @@ fn calling_thread_pool() -> PyResult<Arc<rayon::ThreadPool>> {
                     "cannot start asperity's worker threads: {e}"
                 ))
             })?;
-        Ok(Arc::clone(cell.get_or_init(|| Arc::new(pool))))
+        let pool = Arc::new(pool);
+        *slot = Some((pid, Arc::clone(&pool)));
+        Ok(pool)
     })
 }

@@ -157,10 +157,13 @@ fn summary<'py>(
     array: PyReadonlyArrayDyn<'_, f64>,
     size: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let s = match profile(&array, size)? {
+    let profile = profile(&array, size)?;
+    // On the calling thread's pool like every computation here (its sums are parallel):
+    // rayon's global pool has no threads in a process forked after it started.
+    let s = run_detached(py, move |_| match profile {
         Profile::Line(line) => line_summary(&line),
         Profile::Surface(surface) => surface_summary(&surface),
-    };
+    })?;
     let dict = PyDict::new(py);
     dict.set_item("rms_height", s.rms_height)?;
     dict.set_item("rms_slope", s.rms_slope)?;

@@ -232,45 +232,31 @@ def test_the_gil_is_released_during_a_solve():
     assert ticks > 100, f"the main thread ran {ticks} times in {elapsed:.2f} s"
 
 
-GIL_TIMING = """
-import threading, time, asperity
-s = asperity.surface(192, hurst=0.8, rolloff=4, rms_slope=1.0, seed=3)
-solvers = [asperity.Solver(s) for _ in range(2)]
-def job(solver):
-    solver.reset()
-    solver.sweep(pressures=[0.002, 0.005, 0.01, 0.02, 0.05])
-job(solvers[0]); job(solvers[1])  # warm up
-serial, parallel = float('inf'), float('inf')
-for _ in range(3):
-    t0 = time.perf_counter()
-    job(solvers[0]); job(solvers[1])
-    serial = min(serial, time.perf_counter() - t0)
+def test_two_sweeps_in_two_threads_run_at_once():
+    """Two sweeps started from two Python threads are in flight together: each one's
+    progress callback after its first load waits at a barrier for the other's. Were the
+    sweeps serialised (the GIL or a library lock held through a sweep), the second could
+    never reach its callback and the barrier would time out. No timing is asserted (issue
+    33, item 16: the suite must pass on a busy machine); the speed-up of two threads is
+    measured by bench/python_threads.py instead."""
+    s = asperity.surface(128, hurst=0.8, rolloff=4, rms_slope=1.0, seed=3)
+    solvers = [asperity.Solver(s) for _ in range(2)]
+    barrier = threading.Barrier(2, timeout=120)
+    errors = []
+
+    def job(solver):
+        def report(done, total):
+            if done == 1:
+                barrier.wait()
+        try:
+            solver.sweep(pressures=[0.002, 0.005, 0.01], progress=report)
+        except Exception as e:  # noqa: BLE001 - reported by the assertion below
+            errors.append(e)
+
     threads = [threading.Thread(target=job, args=(sv,)) for sv in solvers]
-    t0 = time.perf_counter()
-    [t.start() for t in threads]; [t.join() for t in threads]
-    parallel = min(parallel, time.perf_counter() - t0)
-print(serial, parallel)
-"""
-
-
-@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs 2 cores")
-def test_two_solves_in_two_threads_take_about_the_time_of_one():
-    """With one library thread per solve (RAYON_NUM_THREADS=1), two sweeps in two threads
-    on 2 cores take about the time of one when the GIL is released (ratio ≈ 0.5 to the
-    same two sweeps run one after the other), and at least as long as the serial run when it
-    is held (ratio ≥ 1: the threads take turns). Serial and parallel runs alternate, minimum
-    of 3 each, so that a change in the machine's load hits both. The bound 0.9 is generous
-    because the test machine is shared with other builds, which take the second core now
-    and then (measured: 0.58 at load average 4, 0.74 at load average 7.5 on 2 cores);
-    test_the_gil_is_released_during_a_solve shows the release independently of load."""
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    out = subprocess.run([sys.executable, "-c", GIL_TIMING], env=env, capture_output=True,
-                         text=True, cwd="/")
-    assert out.returncode == 0, out.stderr
-    serial, parallel = map(float, out.stdout.split())
-    print(f"two sweeps one after the other {serial:.3f} s, in two threads {parallel:.3f} s, "
-          f"ratio {parallel / serial:.2f}")
-    assert parallel < 0.9 * serial, f"serial {serial:.3f} s, two threads {parallel:.3f} s"
+    [t.start() for t in threads]
+    [t.join() for t in threads]
+    assert not errors, errors
 
 
 def test_ctrl_c_stops_a_sweep_between_loads(tmp_path):

@@ -3,13 +3,59 @@
 //! renamed into place, so an interrupt never leaves a half-written output or a stray
 //! `.tmp` file. Finished outputs and study checkpoints stay; a study resumes from them.
 //!
+//! While a study computes its samples ([`graceful`]), the first interrupt only asks it to
+//! stop ([`stop`], the study folder's stop request): the study checkpoints the samples it
+//! finished and the front end then exits with 130 ([`exit_interrupted`]); a second
+//! interrupt exits at once.
+//!
 //! The library keeps no process-wide state: it reports each unfinished path to the
 //! [`asperity::io::OutputWatcher`] installed here, and this module owns the list.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{LazyLock, Mutex, MutexGuard};
 
 use asperity::io::OutputWatcher;
+use asperity::stop::Stop;
+
+/// The stop request of the study running in this process.
+static STOP: LazyLock<Stop> = LazyLock::new(Stop::new);
+
+/// Whether a study that checkpoints on [`STOP`] is computing now.
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+
+/// The stop request a study polls (hand it to `StudyDir::with_stop`).
+pub fn stop() -> Stop {
+    STOP.clone()
+}
+
+/// Whether an interrupt asked the study to stop.
+pub fn stop_requested() -> bool {
+    STOP.is_requested()
+}
+
+/// While the returned guard lives, the first interrupt requests [`stop`] instead of
+/// exiting: the study checkpoints what it finished, then calls [`exit_interrupted`].
+pub fn graceful() -> Graceful {
+    GRACEFUL.store(true, Ordering::SeqCst);
+    Graceful
+}
+
+/// See [`graceful`]; interrupts exit at once again once dropped.
+pub struct Graceful;
+
+impl Drop for Graceful {
+    fn drop(&mut self) {
+        GRACEFUL.store(false, Ordering::SeqCst);
+    }
+}
+
+/// Removes the unfinished outputs and exits with 130.
+pub fn exit_interrupted() -> ! {
+    std::mem::forget(UNFINISHED.remove_all());
+    eprintln!("interrupted: unfinished outputs removed (a study resumes when run again)");
+    std::process::exit(130);
+}
 
 /// The temporary files and folders of unfinished outputs, in the order they were made.
 struct Unfinished(Mutex<Vec<PathBuf>>);
@@ -64,9 +110,14 @@ impl OutputWatcher for Unfinished {
 pub fn install() {
     let _ = asperity::io::watch_outputs(&UNFINISHED);
     let handler = ctrlc::set_handler(|| {
-        std::mem::forget(UNFINISHED.remove_all());
-        eprintln!("interrupted: unfinished outputs removed (a study resumes when run again)");
-        std::process::exit(130);
+        if GRACEFUL.load(Ordering::SeqCst) && !STOP.is_requested() {
+            STOP.request();
+            eprintln!(
+                "interrupted: checkpointing the finished samples (interrupt again to quit at once)"
+            );
+            return;
+        }
+        exit_interrupted();
     });
     if let Err(err) = handler {
         eprintln!(

@@ -37,6 +37,11 @@ fn main() {
 
 /// Parses the command line and runs it; returns the exit status.
 fn run() -> i32 {
+    if let Some(message) = non_utf8_argument() {
+        eprintln!("error: {message}");
+        return 2;
+    }
+    stdout_errors_exit();
     let cli = match cli::Cli::try_parse() {
         Ok(cli) => cli,
         // --help, --version; and `asperity` or `asperity study` alone: the help (on
@@ -79,6 +84,41 @@ fn run() -> i32 {
         return 2;
     }
     0
+}
+
+/// A refusal of the first argument that is not UTF-8 (a file name in another encoding):
+/// every command records its inputs and outputs in JSON, which holds UTF-8 text only, so
+/// such a name is refused up front rather than half-way (it made them panic).
+fn non_utf8_argument() -> Option<String> {
+    let bad = std::env::args_os().skip(1).find(|a| a.to_str().is_none())?;
+    Some(format!(
+        "argument {} is not UTF-8 text: asperity records its files' names in JSON (UTF-8); \
+         rename the file or folder",
+        bad.to_string_lossy()
+    ))
+}
+
+/// Makes a failed write to standard output end the process the way a command-line tool
+/// should instead of with a panic (Rust's `println!` panics when the write fails): a
+/// closed pipe (`asperity stats s.npy | head -1`) ends it quietly with status 141 (as
+/// SIGPIPE would), any other failure (`> /dev/full`) with one line and status 2. Other
+/// panics keep the default report.
+fn stdout_errors_exit() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let text = (payload.downcast_ref::<String>().map(String::as_str))
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        let Some(reason) = text.strip_prefix("failed printing to stdout: ") else {
+            return default(info);
+        };
+        if reason.contains("os error 32") {
+            std::process::exit(141);
+        }
+        eprintln!("error: writing to standard output: {reason}");
+        std::process::exit(2);
+    }));
 }
 
 /// One cause of an error as the CLI says it. The library names its parameters and

@@ -104,10 +104,18 @@ pub fn execute(
     StudyDir::check(dir, spec, force)?;
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
     let _lock = StudyDir::lock(dir)?;
-    let store = StudyDir::open(dir, spec, force)?.with_checkpoint_interval(checkpoint_every);
+    let store = StudyDir::open(dir, spec, force)?
+        .with_checkpoint_interval(checkpoint_every)
+        .with_stop(crate::interrupt::stop());
     let stored = stored_per_task(&store)?;
     let progress = Arc::new(study_progress(spec, &stored, quiet));
-    let results = run_tasks(&store, &stored, &progress, quiet)?;
+    let results = run_tasks(&store, &stored, &progress, quiet);
+    if crate::interrupt::stop_requested() {
+        // The study checkpointed what it finished (Ctrl-C): exit as an interrupt does.
+        progress.finish();
+        crate::interrupt::exit_interrupted();
+    }
+    let results = results?;
     progress.finish();
     let (table, chart) = match kind {
         Kind::Alpha => (
@@ -201,6 +209,8 @@ fn run_tasks(
     }
     // Without MPI, `quiet` is the progress bar's alone.
     let _ = quiet;
+    // The first Ctrl-C stops the samples and checkpoints the finished ones.
+    let _graceful = crate::interrupt::graceful();
     let tasks = spec.tasks();
     // Every load solved in this run is one step; at the end of a batch of samples the
     // count is set to what the finished samples hold, which all their loads reached.

@@ -650,6 +650,61 @@ fn a_narrower_run_into_a_finished_study_is_refused_without_force() {
     assert!(d.join("g/checkpoint/mdr_n512_h+0.500000.json").exists());
 }
 
+/// Item 8 of issue 33: Ctrl-C before the first checkpoint interval keeps the samples
+/// finished so far (the study stops, checkpoints them, exits with 130) and the rerun
+/// resumes from them.
+#[test]
+fn ctrl_c_checkpoints_the_finished_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "study",
+        "alpha",
+        "--method",
+        "mdr",
+        "--n",
+        "65536",
+        "--hurst",
+        "0.5",
+        "--samples",
+        "100000",
+        "--checkpoint-every",
+        "100000",
+        "--quiet",
+        "--out",
+        "g",
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_asperity"))
+        .args(args)
+        .current_dir(dir.path())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let checkpoint = dir.path().join("g/checkpoint/mdr_n65536_h+0.500000.json");
+    let start = Instant::now();
+    // Samples take milliseconds: a few seconds after the folder is open, many are done.
+    while !dir.path().join("g/study.json").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_secs(3));
+    assert!(child.try_wait().unwrap().is_none(), "still running");
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&checkpoint).expect("a checkpoint was written");
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let held = value["content"]["samples"].as_array().map_or(0, Vec::len);
+    assert!(held > 0, "no sample kept: {text:.200}");
+}
+
 /// The steepest log–log slope over one decade of force of `curve.csv`'s mean curve for
 /// one H, from 8 contacts on: a least-squares fit of ln k on ln F over every run of rows
 /// spanning at least a decade, written here independently of the library.

@@ -94,6 +94,13 @@ pub enum Error {
         /// What differs.
         reason: String,
     },
+    /// A study was stopped on request ([`crate::study::StudyDir::with_stop`]); the samples
+    /// it finished are checkpointed.
+    #[error("{dir}: study interrupted; its finished samples are checkpointed, and it resumes when run again")]
+    Interrupted {
+        /// The study folder.
+        dir: PathBuf,
+    },
     /// A study folder holds samples of the same study over (N, H) values or a sample count
     /// that a run would leave out of its results: a folder only grows ([`crate::study::StudyDir::check`]).
     #[error("{dir}: holds results this run would leave out: {reason}; include them (the folder's study grows, its checkpoints are reused), use another folder, or leave them out anyway (force; their checkpoints are kept)")]

@@ -233,11 +233,31 @@ fn checked_output_key(path: &Path, force: bool) -> Result<PathBuf> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    if !parent.exists() {
-        return Err(bad_output(
-            path,
-            format!("folder {} does not exist", parent.display()),
-        ));
+    // `exists()` is false for any error: only a folder that is missing is said to be.
+    match std::fs::metadata(parent) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(bad_output(
+                path,
+                format!("folder {} does not exist", parent.display()),
+            ));
+        }
+        #[cfg(unix)]
+        Err(e) if e.raw_os_error() == Some(libc::ENOTDIR) => {
+            return Err(bad_output(
+                path,
+                format!(
+                    "{} is not a folder (a file stands in its path)",
+                    parent.display()
+                ),
+            ));
+        }
+        Err(e) => {
+            return Err(bad_output(
+                path,
+                format!("folder {} cannot be accessed ({e})", parent.display()),
+            ));
+        }
+        Ok(_) => {}
     }
     if !parent.is_dir() {
         return Err(bad_output(
@@ -891,6 +911,20 @@ mod tests {
             other.exists(),
             "another output's temporary file is not touched"
         );
+    }
+
+    /// Issue 33 item 15: an output under a file (a path through a file, not a folder)
+    /// said "does not exist" of a path that exists.
+    #[test]
+    fn an_output_under_a_file_is_not_said_to_be_in_a_missing_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("plain.txt");
+        std::fs::write(&file, "x").unwrap();
+        let err = write_bytes(&file.join("sub").join("out.csv"), false, b"x")
+            .unwrap_err()
+            .to_string();
+        assert!(!err.contains("does not exist"), "{err}");
+        assert!(err.contains("is not a folder"), "{err}");
     }
 
     #[test]

@@ -288,14 +288,16 @@ impl Inputs {
 /// A `.npy` array, its side length from --size, the sidecar, else 1.
 fn npy_inputs(args: &StatsArgs, hints: &SidecarHints, size_x: Option<f64>) -> Result<Inputs> {
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
-    // the file, checked from the header before the data are read.
+    // the file; the PSD's ring sums up to 12 bytes a point more (their parallel blocks hold
+    // at most about as many entries as the half spectrum): checked from the header before
+    // the data are read.
     let shape = read_npy_shape(&args.file)?;
     ensure_fits(
         &format!(
             "computing the statistics of {} (shape {shape:?})",
             args.file.display()
         ),
-        array_bytes(&shape, 4 * 8),
+        array_bytes(&shape, 4 * 8 + 12),
     )?;
     let size = size_x.or(hints.size).unwrap_or(1.0);
     let array = read_npy(&args.file)?;
@@ -309,7 +311,7 @@ fn npy_inputs(args: &StatsArgs, hints: &SidecarHints, size_x: Option<f64>) -> Re
             let (r, c) = surface.dim();
             (
                 surface_summary(&surface),
-                radial_psd_2d(&surface)?,
+                radial_psd_2d(&surface).with_context(|| args.file.display().to_string())?,
                 vec![r, c],
                 2.0,
             )

@@ -569,6 +569,9 @@ impl ContactSolver {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        // Single-precision energies only where the problem's scales keep them inside f32's
+        // range (heights ×1e17 overflowed `sᵀK s` to infinity: issue 33, item 12).
+        let single_steps = self.bccg_scratch.single_steps && self.f32_safe(target);
         let mut indentation = self.bccg_start(target);
         // Small contact sets: solved directly (`small_set.rs`), then only checked here.
         let small = self.small_set_start(target, max_iterations)?;
@@ -598,7 +601,7 @@ impl ContactSolver {
                 };
                 return Ok((self.finish(indentation, gradient.contact_points), info));
             }
-            let far = self.bccg_scratch.single_steps && gradient.residual > SINGLE_PRECISION_ABOVE;
+            let far = single_steps && gradient.residual > SINGLE_PRECISION_ABOVE;
             let refresh_due = self.bccg_scratch.energy_steps
                 && (cutting || since_refresh + 1 >= REFRESH_INTERVAL);
             let leaving_single = u == Displacement::Single && !far && !refresh_due;
@@ -619,7 +622,7 @@ impl ContactSolver {
             let direction = self.direction(target, &gradient, previous_zg);
             previous_zg = direction.zg;
             // Energies in single precision while far; every `K s` (`far` implies single steps).
-            let single = far || (!refresh_due && self.bccg_scratch.single_steps);
+            let single = far || (!refresh_due && single_steps);
             let curvature = self.curvature(refresh_due, single);
             (applications, energy_transforms) = match refresh_due {
                 true => (applications, energy_transforms + 1),
@@ -803,6 +806,20 @@ impl ContactSolver {
         }
     }
 
+    /// Whether the heights' scale (rms of the profile) and the load's (the mean pressure or
+    /// indentation asked) lie within `2^±40`: the sums of squares of an f32 transform of a grid of up to 2^26
+    /// points then stay far inside f32's range (`3.4e38` down to `1.2e-38`). Outside, the
+    /// energies are computed in double precision (as PK's always are): the result is the
+    /// same, only slower, whatever the units.
+    fn f32_safe(&self, target: Target) -> bool {
+        let inside = |x: f64| x == 0.0 || (x.abs() > 2f64.powi(-40) && x.abs() < 2f64.powi(40));
+        let load = match target {
+            Target::MeanPressure(p) => p,
+            Target::Indentation(d) => d,
+        };
+        inside(self.problem.height_scale) && inside(load)
+    }
+
     /// `sᵀK s` of the direction (with `single`, in single precision). A step whose `u` is
     /// recomputed afterwards needs no more: with `energy_only`, from the forward transform
     /// of `s` alone (Parseval, about half an application); else with `w = K s` in the
@@ -927,6 +944,36 @@ impl ContactSolver {
 #[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::rough_grid;
+
+    /// Issue 33 item 12: the default BCCG solves a problem whose heights and pressures are
+    /// scaled by 1e17 (or 1e-17, or its modulus and pressures by 1e17) to the contact of
+    /// the unscaled one; before, ×1e17 failed in its first iteration (single-precision
+    /// energies overflowed) while PK solved it.
+    #[test]
+    fn results_do_not_depend_on_the_units() {
+        let base = rough_grid(64, 64, 5);
+        let solve = |heights: f64, modulus: f64, pressure: f64| {
+            let surface = Surface::new(base.heights() * heights, 1.0).unwrap();
+            let half_space = HalfSpace {
+                modulus,
+                boundary: Boundary::Free,
+            };
+            let mut s = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+            s.solve(Control::MeanPressure(pressure)).unwrap().0
+        };
+        let reference = solve(1.0, 1.0, 0.01);
+        for (heights, modulus, pressure) in
+            [(1e17, 1.0, 1e15), (1e-17, 1.0, 1e-19), (1.0, 1e17, 1e15)]
+        {
+            let got = solve(heights, modulus, pressure);
+            assert_eq!(
+                got.contact_points, reference.contact_points,
+                "{heights:e} {modulus:e}"
+            );
+            let d = got.indentation / heights / reference.indentation - 1.0;
+            assert!(d.abs() < 1e-6, "{heights:e} {modulus:e}: {d:e}");
+        }
+    }
     use super::super::{Control, HalfSpace, Parallelism, SolverKind, SolverParams};
     use super::*;
     use crate::elastic::Boundary;

@@ -321,7 +321,7 @@ pub enum SolveError {
     #[error(transparent)]
     Input(#[from] crate::Error),
     /// The iteration did not reach the tolerance.
-    #[error("no convergence after {iterations} iterations (residual {residual:.3e})")]
+    #[error("{}", no_convergence_message(*iterations, *residual))]
     NoConvergence {
         /// Iterations done.
         iterations: usize,
@@ -351,6 +351,24 @@ pub enum SolveError {
     },
 }
 
+/// `no convergence after 12 iterations (residual 3.2e-4)`; a residual that is not a
+/// number says the solve broke down, which more iterations would not mend.
+fn no_convergence_message(iterations: usize, residual: f64) -> String {
+    if residual.is_finite() {
+        return format!("no convergence after {iterations} iterations (residual {residual:.3e})");
+    }
+    let when = match iterations {
+        0 => "before its first iteration".to_string(),
+        1 => "in its first iteration".to_string(),
+        n => format!("after {n} iterations"),
+    };
+    format!(
+        "the solve broke down {when}: its residual is not a finite number (heights, loads \
+         or modulus too large or too small for floating-point arithmetic: give them in \
+         other units)"
+    )
+}
+
 fn beyond_full_contact_message(requested: &Control, full_contact: Option<f64>) -> String {
     let quantity = requested.quantity();
     let threshold = match full_contact {
@@ -364,4 +382,37 @@ fn beyond_full_contact_message(requested: &Control, full_contact: Option<f64>) -
         "{quantity} {:.6e} is beyond full contact{threshold}",
         requested.value()
     )
+}
+
+#[cfg(test)]
+mod message_tests {
+    use super::*;
+
+    /// Issue 33 item 15: "no convergence after 0 iterations (residual NaN)" told the user
+    /// to iterate more; a residual that is not a number is a breakdown, said as one.
+    #[test]
+    fn a_solve_that_broke_down_says_so() {
+        let text = SolveError::NoConvergence {
+            iterations: 0,
+            residual: f64::NAN,
+        }
+        .to_string();
+        assert!(
+            !text.contains("NaN") && !text.contains("after 0 iterations"),
+            "{text}"
+        );
+        assert!(
+            text.contains("broke down before its first iteration"),
+            "{text}"
+        );
+        let text = SolveError::NoConvergence {
+            iterations: 12,
+            residual: 3.2e-4,
+        }
+        .to_string();
+        assert_eq!(
+            text,
+            "no convergence after 12 iterations (residual 3.200e-4)"
+        );
+    }
 }

@@ -494,6 +494,7 @@ pub struct StudyDir {
     dir: PathBuf,
     spec: StudySpec,
     interval: std::time::Duration,
+    stop: crate::stop::Stop,
 }
 
 /// What a folder's `study.json` says, as [`StudyDir::check`] sees it.
@@ -677,6 +678,7 @@ impl StudyDir {
             dir: dir.to_path_buf(),
             spec: spec.clone(),
             interval: CHECKPOINT_INTERVAL,
+            stop: crate::stop::Stop::new(),
         };
         // Every checkpoint already there is verified before the folder is claimed, so that
         // a refused run leaves it exactly as it was.
@@ -711,6 +713,7 @@ impl StudyDir {
             dir: dir.to_path_buf(),
             spec: manifest.spec,
             interval: CHECKPOINT_INTERVAL,
+            stop: crate::stop::Stop::new(),
         })
     }
 
@@ -719,6 +722,20 @@ impl StudyDir {
     pub fn with_checkpoint_interval(mut self, interval: std::time::Duration) -> Self {
         self.interval = interval;
         self
+    }
+
+    /// Tasks run on this folder ([`run_task`], [`run_any_task_with_loads`]) stop once
+    /// `stop` is requested: between samples, and (BEM) within a solver iteration; the
+    /// samples finished by then are checkpointed and the task ends with
+    /// [`Error::Interrupted`] (or the interrupted sample's error).
+    pub fn with_stop(mut self, stop: crate::stop::Stop) -> Self {
+        self.stop = stop;
+        self
+    }
+
+    /// The stop request the tasks run on this folder poll ([`StudyDir::with_stop`]).
+    pub fn stop(&self) -> &crate::stop::Stop {
+        &self.stop
     }
 
     /// The folder.
@@ -917,15 +934,24 @@ pub fn run_task<S: Sampler>(
     let batch = batch_size(spec.method, task.n, workers.len());
     let mut last_save = std::time::Instant::now();
     while samples.len() < spec.samples {
+        if store.stop.is_requested() {
+            store.save_in_progress(task, &samples)?;
+            return Err(Error::Interrupted {
+                dir: store.dir.clone(),
+            });
+        }
         let indices: Vec<usize> =
             (samples.len()..(samples.len() + batch).min(spec.samples)).collect();
-        samples.extend(sample_on_lanes(
-            spec,
-            task,
-            sampler,
-            &mut workers,
-            &indices,
-        )?);
+        let computed = sample_on_lanes(spec, task, sampler, &mut workers, &indices);
+        let held = samples.len();
+        if let Err(error) = take_finished(&mut samples, computed) {
+            // The samples finished before the one that failed (or was interrupted) are
+            // kept, whenever the last checkpoint was.
+            if samples.len() > held {
+                store.save_in_progress(task, &samples)?;
+            }
+            return Err(error);
+        }
         if samples.len() < spec.samples && last_save.elapsed() >= store.interval {
             store.save_in_progress(task, &samples)?;
             last_save = std::time::Instant::now();
@@ -933,6 +959,15 @@ pub fn run_task<S: Sampler>(
         progress(samples.len(), spec.samples);
     }
     store.finish(task, samples)
+}
+
+/// Appends the samples of a batch, in index order, up to the first that failed; returns
+/// that one's error.
+fn take_finished(samples: &mut Vec<SampleCurve>, batch: Vec<Result<SampleCurve>>) -> Result<()> {
+    for sample in batch {
+        samples.push(sample?);
+    }
+    Ok(())
 }
 
 /// Samples computed between two chances to checkpoint and report progress: four per
@@ -968,7 +1003,7 @@ fn sample_on_lanes<S: Sampler>(
     sampler: &S,
     workers: &mut [S::Worker],
     indices: &[usize],
-) -> Result<Vec<SampleCurve>> {
+) -> Vec<Result<SampleCurve>> {
     let next = std::sync::atomic::AtomicUsize::new(0);
     let taken = || next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let done: Vec<Vec<(usize, Result<SampleCurve>)>> = workers
@@ -1228,8 +1263,12 @@ mod tests {
             run_any_task(&grown, task, &fresh, &|_, _| {}).unwrap(),
             grown_result
         );
-        // Shrinking takes the first samples: again a fresh run's result.
-        let store = StudyDir::open(dir.path(), &small, false).unwrap();
+        // Shrinking would leave samples out of the results: refused unless discarding
+        // (force), which keeps the checkpoint and takes its first samples: again a fresh
+        // run's result.
+        let err = StudyDir::open(dir.path(), &small, false).unwrap_err();
+        assert!(matches!(err, Error::NarrowerStudy { .. }), "{err}");
+        let store = StudyDir::open(dir.path(), &small, true).unwrap();
         let shrunk = run_any_task(&small, task, &store, &|_, _| {}).unwrap();
         let fresh_dir = tempfile::tempdir().unwrap();
         let fresh = StudyDir::open(fresh_dir.path(), &small, false).unwrap();
@@ -1448,6 +1487,59 @@ mod tests {
         )))
         .unwrap();
         assert!(StudyDir::open(dir.path(), &other, false).is_err());
+    }
+
+    /// Fails (and requests `stop`) on the sample whose seed is `failing`.
+    struct FailsAt {
+        failing: u64,
+        stop: crate::stop::Stop,
+    }
+
+    impl Sampler for FailsAt {
+        type Worker = ();
+        fn worker(&self) -> Result<()> {
+            Ok(())
+        }
+        fn sample(&self, worker: &mut (), seed: u64) -> Result<SampleCurve> {
+            if seed == self.failing {
+                self.stop.request();
+                return Err(Error::invalid("sample", "interrupted"));
+            }
+            Synthetic.sample(worker, seed)
+        }
+    }
+
+    /// Item 8 of issue 33: a task stopped early (Ctrl-C) or by a failed sample keeps the
+    /// samples it finished, though no checkpoint interval has passed.
+    #[test]
+    fn an_interrupted_task_checkpoints_the_samples_it_finished() {
+        let task = Task { n: 64, hurst: 0.5 };
+        let dir = tempfile::tempdir().unwrap();
+        let stop = crate::stop::Stop::new();
+        let store = StudyDir::open(dir.path(), &spec(20), false)
+            .unwrap()
+            .with_stop(stop.clone());
+        let failing = FailsAt {
+            failing: sample_seed(3, Method::Mdr, task, 6),
+            stop: stop.clone(),
+        };
+        assert!(run_task(&spec(20), task, &failing, &store, &|_, _| {}).is_err());
+        let Restored::Partial(held) = store.restore(task).unwrap() else {
+            panic!("not finished")
+        };
+        assert_eq!(held.len(), 6, "samples 0 to 5 kept");
+        // Resumed with the stop still requested: nothing computed, nothing lost.
+        let err = run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap_err();
+        assert!(matches!(err, Error::Interrupted { .. }), "{err}");
+        assert_eq!(store.samples_held(task, 20).unwrap(), 6);
+        stop.clear();
+        let resumed = run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap();
+        let fresh = {
+            let other = tempfile::tempdir().unwrap();
+            let store = StudyDir::open(other.path(), &spec(20), false).unwrap();
+            run_task(&spec(20), task, &Synthetic, &store, &|_, _| {}).unwrap()
+        };
+        assert_eq!(resumed, fresh);
     }
 
     #[cfg(unix)]

@@ -527,6 +527,8 @@ impl TaskSamples {
             Lanes::Bem(s, w) => super::sample_on_lanes(spec, task, s, w, indices),
             Lanes::Mdr(s, w) => super::sample_on_lanes(spec, task, s, w, indices),
         }
+        .into_iter()
+        .collect()
     }
 }
 
@@ -551,7 +553,7 @@ pub fn run_any_task_with_loads(
 ) -> Result<TaskResult> {
     match spec.method {
         Method::Bem => {
-            let mut sampler = BemSampler::new(spec, task)?;
+            let mut sampler = BemSampler::new(spec, task)?.with_stop(store.stop().clone());
             sampler.on_load = on_load;
             run_task(spec, task, &sampler, store, progress)
         }

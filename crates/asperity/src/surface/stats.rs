@@ -127,10 +127,14 @@ pub fn radial_psd_2d(surface: &Surface) -> Result<Vec<PsdBin>> {
     let (rows, cols) = surface.dim();
     let size = surface.size();
     let area = size * size * rows as f64 / cols as f64;
+    // Heights far from 1 are scaled by a power of two (exact) so that |c|² neither
+    // overflows nor underflows; the PSD, in height², is scaled back and refused where it
+    // leaves the range of f64.
+    let scale = unit_scale(max_abs(surface.heights()));
     let mean = surface.heights().mean().unwrap_or(0.0);
     let mut centred = try_vec("the PSD's copy of the surface", rows * cols, 0.0)?;
     for (c, h) in centred.iter_mut().zip(surface.heights()) {
-        *c = h - mean;
+        *c = (h - mean) * scale;
     }
     let mut fft = RealFft2::new(rows, cols)?;
     let mut spectrum = try_vec(
@@ -143,7 +147,7 @@ pub fn radial_psd_2d(surface: &Surface) -> Result<Vec<PsdBin>> {
     let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
     let norm = area / (std::f64::consts::TAU.powi(2) * ((rows * cols) as f64).powi(2));
     let sums = ring_sums(&spectrum, rows, cols, aspect, kappa_max, norm);
-    Ok(sums
+    let bins: Vec<PsdBin> = sums
         .into_iter()
         .skip(1)
         .filter(|s| s.2 > 0)
@@ -152,7 +156,32 @@ pub fn radial_psd_2d(surface: &Surface) -> Result<Vec<PsdBin>> {
             psd: p / m as f64,
             modes: m,
         })
-        .collect())
+        .collect();
+    unscaled_psd(bins, scale)
+}
+
+/// The PSD bins of heights scaled by `scale` ([`unit_scale`]) brought back to the heights'
+/// units (÷ scale²); an error where a value leaves the range of f64 (overflows, or a
+/// nonzero value underflows to zero), which no front end should print as `inf` or 0.
+fn unscaled_psd(mut bins: Vec<PsdBin>, scale: f64) -> Result<Vec<PsdBin>> {
+    if scale == 1.0 {
+        return Ok(bins);
+    }
+    for bin in &mut bins {
+        let value = bin.psd / (scale * scale);
+        if !value.is_finite() || (value == 0.0 && bin.psd != 0.0) || value.is_subnormal() {
+            return Err(crate::Error::invalid(
+                "heights",
+                format!(
+                    "their PSD (height² × length²) is beyond the range of f64 numbers \
+                     (heights of order {:.0e}): give the heights in other units",
+                    1.0 / scale
+                ),
+            ));
+        }
+        bin.psd = value;
+    }
+    Ok(bins)
 }
 
 /// 1D PSD `C1D(q)` of a line at `q = 2πk/L`, `k = 1 … n/2`.
@@ -189,24 +218,72 @@ pub struct Summary {
     pub rms_curvature: Option<f64>,
 }
 
-/// Summary statistics of a surface.
+/// The power of two that brings heights whose largest magnitude is `max_abs` near 1, or 1
+/// where they are within `2^±300` already. The rms sums square (and the PSD squares)
+/// heights: beyond about `1e154` a square overflows to infinity, below about `1e-162` it
+/// underflows to zero. Scaling by a power of two is exact, so heights in the usual range
+/// give the same bits as unscaled and extreme ones their true statistics.
+pub(crate) fn unit_scale(max_abs: f64) -> f64 {
+    if !(max_abs.is_finite() && max_abs > 0.0) {
+        return 1.0;
+    }
+    let exponent = max_abs.log2().floor() as i32;
+    if exponent.abs() <= 300 {
+        1.0
+    } else {
+        2f64.powi(-exponent)
+    }
+}
+
+fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+}
+
+impl Summary {
+    /// Every statistic divided by `scale` (they are all linear in the heights).
+    fn unscaled(self, scale: f64) -> Summary {
+        Summary {
+            rms_height: self.rms_height / scale,
+            rms_slope: self.rms_slope / scale,
+            rms_curvature: self.rms_curvature.map(|c| c / scale),
+        }
+    }
+}
+
+/// Summary statistics of a surface (heights of any magnitude: see [`unit_scale`]).
 pub fn surface_summary(surface: &Surface) -> Summary {
-    let h = surface.heights().view();
+    let scale = unit_scale(max_abs(surface.heights()));
+    let scaled;
+    let h = if scale == 1.0 {
+        surface.heights().view()
+    } else {
+        scaled = surface.heights() * scale;
+        scaled.view()
+    };
     Summary {
         rms_height: rms_height_2d(h),
         rms_slope: rms_slope_2d(h, surface.spacing()),
         rms_curvature: rms_curvature_2d(h, surface.spacing()),
     }
+    .unscaled(scale)
 }
 
-/// Summary statistics of a line.
+/// Summary statistics of a line (heights of any magnitude: see [`unit_scale`]).
 pub fn line_summary(line: &Line) -> Summary {
-    let h = line.heights().as_slice().expect("contiguous");
+    let scale = unit_scale(max_abs(line.heights()));
+    let scaled: Vec<f64>;
+    let h = if scale == 1.0 {
+        line.heights().as_slice().expect("contiguous")
+    } else {
+        scaled = line.heights().iter().map(|v| v * scale).collect();
+        &scaled
+    };
     Summary {
         rms_height: rms_height(h.iter().copied()),
         rms_slope: rms_slope_1d(h, line.spacing()),
         rms_curvature: rms_curvature_1d(h, line.spacing()),
     }
+    .unscaled(scale)
 }
 
 /// Sums over the rings `round(|(kx, ky·aspect)|) = κ` of a half spectrum in transposed
@@ -225,12 +302,13 @@ pub(crate) fn ring_sums(
     norm: f64,
 ) -> Vec<(f64, f64, usize)> {
     use rayon::prelude::*;
+    let width = ring_block_width(rows, cols / 2 + 1, kappa_max);
     let blocks: Vec<Vec<(f64, f64, usize)>> = spectrum
-        .par_chunks(rows * RING_BLOCK)
+        .par_chunks(rows * width)
         .enumerate()
         .map(|(block, columns)| {
             let mut sums = vec![(0.0f64, 0.0f64, 0usize); kappa_max + 1];
-            let first = block * RING_BLOCK;
+            let first = block * width;
             for (dk, column) in columns.chunks(rows).enumerate() {
                 add_column_rings(&mut sums, column, first + dk, cols, aspect, norm);
             }
@@ -248,8 +326,19 @@ pub(crate) fn ring_sums(
     sums
 }
 
-/// Columns of the half spectrum per parallel block of [`ring_sums`].
+/// Columns of the half spectrum per parallel block of [`ring_sums`] (at least).
 const RING_BLOCK: usize = 64;
+
+/// The columns per block of [`ring_sums`]: [`RING_BLOCK`], or more where the blocks' ring
+/// sums (one array of `kappa_max + 1` per block) would hold more entries than the spectrum
+/// has values — a map of a few rows and millions of columns (2 × 4,000,000) made 31,250
+/// blocks of 2,000,001 rings each (1.5 TB) before. Depends on the shape only, so the sums
+/// stay independent of the thread count; square and most rectangular grids keep
+/// [`RING_BLOCK`].
+fn ring_block_width(rows: usize, columns: usize, kappa_max: usize) -> usize {
+    let max_blocks = (rows * columns / (kappa_max + 1)).max(1);
+    RING_BLOCK.max(columns.div_ceil(max_blocks))
+}
 
 /// Adds column `kx` (its `rows` values over ky) to the ring sums.
 fn add_column_rings(
@@ -293,6 +382,76 @@ mod tests {
     use super::*;
     use ndarray::Array2;
     use std::f64::consts::TAU;
+
+    /// Issue 33 item 14: the ring sums of a map of 2 rows and millions of columns stay
+    /// within about the spectrum's size (before: one array of all rings per 64 columns).
+    #[test]
+    fn ring_blocks_of_a_very_wide_map_stay_within_the_spectrum_size() {
+        let (rows, cols) = (2usize, 4_000_000usize);
+        let columns = cols / 2 + 1;
+        let aspect = cols as f64 / rows as f64;
+        let kappa_max = ((cols / 2) as f64).min((rows / 2) as f64 * aspect).floor() as usize;
+        let blocks = columns.div_ceil(ring_block_width(rows, columns, kappa_max));
+        assert!(
+            blocks * (kappa_max + 1) <= 2 * rows * columns,
+            "{blocks} blocks"
+        );
+        // A square grid keeps its blocks (and so its bits).
+        assert_eq!(ring_block_width(1024, 513, 512), RING_BLOCK);
+        assert_eq!(ring_block_width(4096, 2049, 2048), RING_BLOCK);
+        // And the PSD of a wide map is computed (small enough for a test).
+        let wide = Surface::new(
+            Array2::from_shape_fn((2, 20_000), |(r, c)| ((c * 13 + r) as f64 * 0.01).sin()),
+            1.0,
+        )
+        .unwrap();
+        assert!(!radial_psd_2d(&wide).unwrap().is_empty());
+    }
+
+    /// Issue 33 item 5: heights ×1e200 and ×1e-170 have the statistics of the unscaled
+    /// heights times the factor (exactly, for a power of two; to rounding otherwise), not
+    /// inf or 0; a PSD beyond the range of f64 is refused, one within it is scaled.
+    #[test]
+    fn statistics_do_not_depend_on_the_heights_units() {
+        let heights = Array2::from_shape_fn((32, 48), |(r, c)| {
+            ((r * 7 + c * 3) as f64 * 0.37).sin() + 0.1 * (c as f64).cos()
+        });
+        let plain = Surface::new(heights.clone(), 1.0).unwrap();
+        let reference = surface_summary(&plain);
+        let line = Line::new(heights.row(3).to_owned(), 1.0).unwrap();
+        let line_reference = line_summary(&line);
+        for factor in [1e200, 1e-170, 2f64.powi(700), 2f64.powi(-600)] {
+            let scaled = Surface::new(&heights * factor, 1.0).unwrap();
+            let got = surface_summary(&scaled);
+            let close = |a: f64, b: f64| ((a / factor) / b - 1.0).abs() < 1e-14;
+            assert!(
+                close(got.rms_height, reference.rms_height),
+                "{factor:e} {got:?}"
+            );
+            assert!(
+                close(got.rms_slope, reference.rms_slope),
+                "{factor:e} {got:?}"
+            );
+            let curvature = (got.rms_curvature.unwrap(), reference.rms_curvature.unwrap());
+            assert!(close(curvature.0, curvature.1), "{factor:e} {got:?}");
+            let scaled_line = Line::new(heights.row(3).to_owned() * factor, 1.0).unwrap();
+            let got = line_summary(&scaled_line);
+            assert!(
+                close(got.rms_height, line_reference.rms_height),
+                "{factor:e}"
+            );
+            assert!(close(got.rms_slope, line_reference.rms_slope), "{factor:e}");
+        }
+        let psd = radial_psd_2d(&plain).unwrap();
+        let small = radial_psd_2d(&Surface::new(&heights * 1e-100, 1.0).unwrap()).unwrap();
+        for (a, b) in small.iter().zip(&psd) {
+            assert!((a.psd / 1e-200 / b.psd - 1.0).abs() < 1e-12, "{a:?} {b:?}");
+        }
+        for factor in [1e200, 1e-170] {
+            let err = radial_psd_2d(&Surface::new(&heights * factor, 1.0).unwrap()).unwrap_err();
+            assert!(err.to_string().contains("beyond the range"), "{err}");
+        }
+    }
 
     #[test]
     fn sinusoid_statistics_match_closed_forms() {

@@ -70,9 +70,19 @@ fn moments(values: impl Iterator<Item = f64> + Clone) -> Moments {
         .clone()
         .fold((0.0, 0.0), |(s, n), v| (s + v, n + 1.0));
     let mean = sum / n;
+    // The fourth powers overflow from heights of about 1e77 on (Sku became NaN) and
+    // underflow below about 1e-81: the deviations are scaled by a power of two near their
+    // largest (exact), the moments computed, and the rms and mean deviation scaled back;
+    // skewness and kurtosis do not depend on the scale.
+    let largest = values.clone().fold(0.0f64, |m, v| m.max((v - mean).abs()));
+    let scale = if largest.is_finite() && largest > 0.0 {
+        2f64.powi(-(largest.log2().floor() as i32))
+    } else {
+        1.0
+    };
     let (mut a, mut m2, mut m3, mut m4) = (0.0, 0.0, 0.0, 0.0);
     for v in values {
-        let d = v - mean;
+        let d = (v - mean) * scale;
         a += d.abs();
         m2 += d * d;
         m3 += d * d * d;
@@ -87,8 +97,8 @@ fn moments(values: impl Iterator<Item = f64> + Clone) -> Moments {
         (0.0, 0.0)
     };
     Moments {
-        rms,
-        abs: a,
+        rms: rms / scale,
+        abs: a / scale,
         skew,
         kurt,
     }
@@ -285,6 +295,32 @@ mod tests {
     use super::*;
     use ndarray::{Array1, Array2};
     use std::f64::consts::PI;
+
+    /// Issue 33 item 15: heights near 1e80 gave `Sku: NaN` (their fourth powers
+    /// overflow); heights of any magnitude now give the moments of the unscaled ones.
+    #[test]
+    fn moments_do_not_depend_on_the_heights_units() {
+        let h = Array2::from_shape_fn((16, 16), |(r, c)| ((r * 5 + c * 11) as f64 * 0.3).sin());
+        let reference = areal(h.view(), 0.1, 0.1).unwrap();
+        for factor in [1e80, 1e150, 1e-90, 2f64.powi(300)] {
+            let got = areal((&h * factor).view(), 0.1, 0.1).unwrap();
+            assert!(
+                got.sku.is_finite() && got.ssk.is_finite(),
+                "{factor:e}: {got:?}"
+            );
+            assert!((got.sku / reference.sku - 1.0).abs() < 1e-13, "{factor:e}");
+            assert!((got.ssk / reference.ssk - 1.0).abs() < 1e-12, "{factor:e}");
+            assert!(
+                (got.sq / factor / reference.sq - 1.0).abs() < 1e-14,
+                "{factor:e}"
+            );
+            let p = profile((&h.row(2) * factor).view(), 0.1).unwrap();
+            assert!(
+                p.rku.is_finite() && p.rq.is_finite() && p.rq > 0.0,
+                "{factor:e}"
+            );
+        }
+    }
 
     /// The parallel sums (cell slopes by rows, PSD rings by column blocks) are added in a
     /// fixed order: 1, 2 and 3 threads give the very same bits, on a grid with several
