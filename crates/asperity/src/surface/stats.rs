@@ -250,7 +250,8 @@ impl Summary {
     }
 }
 
-/// Summary statistics of a surface (heights of any magnitude: see [`unit_scale`]).
+/// Summary statistics of a surface, for heights of any magnitude (scaled by a power of two
+/// when far from 1).
 pub fn surface_summary(surface: &Surface) -> Summary {
     let scale = unit_scale(max_abs(surface.heights()));
     let scaled;
@@ -268,7 +269,8 @@ pub fn surface_summary(surface: &Surface) -> Summary {
     .unscaled(scale)
 }
 
-/// Summary statistics of a line (heights of any magnitude: see [`unit_scale`]).
+/// Summary statistics of a line, for heights of any magnitude (scaled by a power of two
+/// when far from 1).
 pub fn line_summary(line: &Line) -> Summary {
     let scale = unit_scale(max_abs(line.heights()));
     let scaled: Vec<f64>;
