@@ -169,6 +169,7 @@ fn make_spec(
         spec
     };
     spec.validate().map_err(from_error)?;
+    asperity_app::study::check_min_contacts(&spec).map_err(crate::errors::refused)?;
     spec.ensure_fits().map_err(from_error)?;
     Ok(spec)
 }

@@ -50,6 +50,7 @@ KEYWORDS = {
     "--dmin": "dmin",
     "--dmax": "dmax",
     "--breakpoints": "breakpoints",
+    "--min-contacts": "min_contacts",
 }
 
 
@@ -254,6 +255,18 @@ def test_mdr_refuses_alike(cli, tmp_path, flags, kwargs, words):
     ours = python_words(lambda: asperity.mdr(**kwargs))
     assert ours == theirs
     assert words in ours
+
+
+@pytest.mark.parametrize("method,n,min_contacts", [("mdr", 32, 33), ("bem", 8, 65)])
+def test_a_fit_window_above_the_grid_is_refused_alike(cli, tmp_path, method, n, min_contacts):
+    theirs = cli("study", "alpha", "--method", method, "--n", n, "--hurst", 0.5, "--samples", 1,
+                 "--min-contacts", min_contacts, "--out", tmp_path / "cli", ok=False)
+    theirs = in_keywords(cli_error(theirs))
+    ours = python_words(lambda: asperity.study_alpha(
+        method=method, n=n, hurst=0.5, samples=1, min_contacts=min_contacts, out=tmp_path / "py"))
+    assert ours == theirs
+    assert f"min_contacts {min_contacts} is above the number of points" in ours
+    assert not (tmp_path / "cli").exists() and not (tmp_path / "py").exists()
 
 
 def test_contact_equals_the_cli(cli, tmp_path):

@@ -31,6 +31,7 @@ pub mod contact;
 pub mod mdr;
 pub mod range;
 pub mod refusal;
+pub mod study;
 pub mod surface;
 
 pub use refusal::{Names, Param, Refusal, RequestError};

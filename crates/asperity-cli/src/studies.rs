@@ -100,6 +100,7 @@ pub fn execute(
         setting,
     } = options;
     spec.validate()?;
+    asperity_app::study::check_min_contacts(spec)?;
     spec.ensure_fits()?;
     StudyDir::check(dir, spec, force)?;
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
