@@ -706,26 +706,24 @@ impl ContactSolver {
         }
     }
 
-    /// Preconditions the gradient and makes the new direction `s` (in the direction
-    /// buffer, zero off the free set, centred on it under load control). The sums of the
-    /// new direction follow from those of the old one (one pass of sums, one of writes).
-    fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> Direction {
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-        let mode = MeanMode::of(target, periodic);
-        let load_control = mode == MeanMode::Projected;
-        let deflated = match (mode, self.bccg_scratch.mean_gap.as_mut()) {
-            (MeanMode::Deflated, Some(mean_gap)) => {
-                let (_, applied) =
-                    mean_gap.curvature(&mut self.problem.operator, &self.bccg_scratch.free);
-                self.bccg_scratch.extra_energies += applied as usize;
-                true
-            }
-            _ => false,
+    /// Under displacement control with the mean gap deflated: the coarse curvature of the
+    /// free set, for the coarse constant of the preconditioned gradient. False where the
+    /// solve carries no mean-gap scratch (no deflation then).
+    fn deflate_mean(&mut self) -> bool {
+        let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() else {
+            return false;
         };
+        let (_, applied) = mean_gap.curvature(&mut self.problem.operator, &self.bccg_scratch.free);
+        self.bccg_scratch.extra_energies += applied as usize;
+        true
+    }
+
+    /// z = P_F M Π g into the preconditioned buffer, or with the rings
+    /// P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`), Π g formed row by row on its way
+    /// into the transform (never stored whole).
+    fn precondition_gradient(&mut self, centre: f64) {
         let scratch = &mut self.bccg_scratch;
-        // z = P_F M Π g, or with the rings P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`),
-        // Π g formed row by row on its way into the transform (never stored whole).
-        let (centre, cols) = (gradient.centre, self.problem.cols);
+        let cols = self.problem.cols;
         if let Some(rings) = scratch.rings.as_mut() {
             rings.extend(&scratch.free, &mut scratch.gradient, centre);
         }
@@ -742,7 +740,19 @@ impl ContactSolver {
         if let Some(rings) = scratch.rings.as_mut() {
             rings.gather(free, z);
         }
-        let z = &scratch.preconditioned[..];
+    }
+
+    /// Preconditions the gradient and makes the new direction `s` (in the direction
+    /// buffer, zero off the free set, centred on it under load control). The sums of the
+    /// new direction follow from those of the old one (one pass of sums, one of writes).
+    fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> Direction {
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let mode = MeanMode::of(target, periodic);
+        let load_control = mode == MeanMode::Projected;
+        let deflated = mode == MeanMode::Deflated && self.deflate_mean();
+        self.precondition_gradient(gradient.centre);
+        let scratch = &mut self.bccg_scratch;
+        let (free, z) = (&scratch.free[..], &scratch.preconditioned[..]);
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
             (z, &scratch.gradient, &scratch.previous_gradient),
             (&scratch.direction, free, &scratch.previous_free),
