@@ -141,8 +141,8 @@ SURFACE = [
     ("line", ["--rms-height", "1", "--rms-slope", "1"], dict(rms_height=1, rms_slope=1),
      "give at most one of rms_height and rms_slope"),
     ("surface", ["--rms-height", "1e-320"], dict(rms_height=1e-320),
-     "the generated heights are not representable (rms height 0): rms_height or rms_slope "
-     "with size 1 is beyond the range of float64"),
+     "the generated heights are not representable (rms height 1e-320): rms_height or "
+     "rms_slope with size 1 is beyond the range of float64"),
 ]
 
 

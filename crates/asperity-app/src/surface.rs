@@ -149,9 +149,10 @@ fn invalid(source: asperity::Error) -> RequestError {
 }
 
 /// Refuses a generated profile that float64 cannot represent: heights that underflow to
-/// zero (a tiny rms height) or slopes that overflow (a tiny size), naming the inputs.
+/// zero or into the subnormal range, where they keep only a few bits (a tiny rms height),
+/// or slopes that overflow (a tiny size), naming the inputs.
 pub fn ensure_usable(summary: &Summary, size: f64) -> Result<(), Refusal> {
-    if !(summary.rms_height.is_finite() && summary.rms_height > 0.0) {
+    if !(summary.rms_height.is_finite() && summary.rms_height >= f64::MIN_POSITIVE) {
         return Err(Refusal::saying(format!(
             "the generated heights are not representable (rms height {}): ",
             short_number(summary.rms_height)
