@@ -816,29 +816,9 @@ pub(crate) mod test_files {
     use ndarray::ArrayD;
     use ndarray_npy::ReadNpyExt;
 
-    /// `<repo>/../shared/topographies` (CI clones the repo with `shared/` beside it; a git
-    /// worktree elsewhere sets `ASPERITY_TOPOGRAPHIES`), or `None` with a printed notice
-    /// when it is absent.
+    /// `shared/topographies` and where it is looked for: [`super::testkit::set_dir`].
     pub fn folder() -> Option<PathBuf> {
-        let dir = std::env::var_os("ASPERITY_TOPOGRAPHIES")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| {
-                PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/topographies")
-            });
-        if dir.is_dir() {
-            return Some(dir);
-        }
-        // CI has the shared files beside the repository: a skip there would hide a gap.
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "{} is absent, and CI needs the shared test files",
-            dir.display()
-        );
-        eprintln!(
-            "skipped: {} is absent (the shared test files)",
-            dir.display()
-        );
-        None
+        super::testkit::set_dir("topographies")
     }
 
     /// The reference heights (SurfaceTopography's, `[x, y]`, metres, NaN undefined).

@@ -8,21 +8,6 @@ use ndarray::Array2;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// The folder of the real files: `shared/` beside the repository (CI), or beside the
-/// folder of worktrees (development checkouts one level deeper).
-fn shared_dir() -> Option<PathBuf> {
-    [
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/topographies"),
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../../../shared/topographies"
-        ),
-    ]
-    .iter()
-    .map(PathBuf::from)
-    .find(|p| p.is_dir())
-}
-
 /// SurfaceTopography's reading of one file.
 pub(crate) struct Reference {
     /// The file's bytes.
@@ -43,15 +28,7 @@ pub(crate) struct Reference {
 
 /// The file `name` and its reference, or `None` (with a notice) where the folder is absent.
 pub(crate) fn reference(name: &str) -> Option<Reference> {
-    let Some(dir) = shared_dir() else {
-        // CI has the shared files beside the repository: a skip there would hide a gap.
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "shared/topographies not found beside the repository, and CI needs it ({name})"
-        );
-        eprintln!("shared/topographies not found beside the repository: skipping {name}");
-        return None;
-    };
+    let dir = set_dir("topographies")?;
     let bytes = std::fs::read(dir.join(name)).expect("reading the shared file");
     let heights_xy: Array2<f64> =
         ndarray_npy::read_npy(dir.join(format!("{name}.reference.npy"))).expect("reference npy");
@@ -235,13 +212,26 @@ pub(crate) fn assert_close<'a>(got: impl IntoIterator<Item = &'a f64>, want: &[f
     }
 }
 
-/// `shared/<set>` (`topographies-2`, `topographies-3`), or `None` with a notice.
+/// `shared/<set>` (`topographies`, `topographies-2`, `topographies-3`): beside the
+/// repository (CI), beside the folder of worktrees (development checkouts one level
+/// deeper), or beside `$ASPERITY_TOPOGRAPHIES` where it is set (it names
+/// `shared/topographies`). `None` with a notice where the folder is absent; under CI, which
+/// has the shared files beside the repository, a failure instead: a skip would hide a gap.
 pub(crate) fn set_dir(set: &str) -> Option<PathBuf> {
-    let dir = shared_dir().and_then(|d| Some(d.parent()?.join(set)));
-    if let Some(dir) = dir.filter(|d| d.is_dir()) {
+    let roots: Vec<PathBuf> = match std::env::var_os("ASPERITY_TOPOGRAPHIES") {
+        Some(dir) => PathBuf::from(dir)
+            .parent()
+            .map(PathBuf::from)
+            .into_iter()
+            .collect(),
+        None => vec![
+            PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared")),
+            PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../../shared")),
+        ],
+    };
+    if let Some(dir) = roots.iter().map(|r| r.join(set)).find(|d| d.is_dir()) {
         return Some(dir);
     }
-    // CI has the shared files beside the repository: a skip there would hide a gap.
     assert!(
         std::env::var_os("CI").is_none(),
         "shared/{set} not found beside the repository, and CI needs it"
