@@ -21,7 +21,7 @@
 //!   `polonsky_keer.rs`) stay selectable as the reference. The solver owns the operator, its
 //!   plans and every buffer, so one solver serves many loads, and it starts each solve from
 //!   the previous pressure (warm start), moved along the tangent `dp/dd` to the new load
-//!   when the frozen-set stiffness of the previous state computed it (`stiffness.rs`). Periodic displacement control is a direct solve
+//!   when the frozen-set stiffness of the previous state computed it (`stiffness/`). Periodic displacement control is a direct solve
 //!   with the indentation (equivalently the mean gap `mean(f) − d`) fixed: the BCCG
 //!   preconditions the constant mode, which the periodic kernel does not see, by its exact
 //!   curvature on the free set (`mean_gap.rs`); Polonsky–Keer runs its own iteration with `d`
@@ -196,7 +196,7 @@ pub struct SolverParams {
     pub stiffness_tolerance: f64,
     /// Estimated relative error of the frozen-set stiffness `k = 1ᵀx` at which its CG
     /// stops if the residual has not stopped it yet (the decrease of the CG's energy error
-    /// over its last iterations, see `stiffness.rs`); ≥ 0, 0 for the residual only.
+    /// over its last iterations, see `stiffness/`); ≥ 0, 0 for the residual only.
     pub stiffness_error: f64,
     /// Iterations of the frozen-set CG before [`SolveError::NoConvergence`]; ≥ 1.
     pub stiffness_max_iterations: usize,

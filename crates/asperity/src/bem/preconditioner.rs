@@ -109,6 +109,27 @@ impl<T: Precision> FourierPreconditioner<T> {
     }
 }
 
+/// An approximate inverse `M ≈ K⁻¹` of a [`crate::elastic::HalfSpaceOperator`], as the
+/// conjugate gradients use it: it maps a residual (a displacement) to a search direction (a
+/// load). Symmetric positive definite; allocates nothing; independent of the thread count.
+pub(crate) trait Preconditioner {
+    /// `output ← M input` (`rows × cols` row-major fields).
+    fn apply_into(&mut self, input: &[f64], output: &mut [f64]);
+
+    /// `data ← M data` (overwritten).
+    fn apply(&mut self, data: &mut [f64]);
+}
+
+impl<T: Precision> Preconditioner for FourierPreconditioner<T> {
+    fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
+        FourierPreconditioner::apply_into(self, input, output);
+    }
+
+    fn apply(&mut self, data: &mut [f64]) {
+        FourierPreconditioner::apply(self, data);
+    }
+}
+
 /// The filter of the fused convolution: column `kx` of the spectrum times its symbol.
 fn multiplier<T: Precision>(
     symbol: &[T],

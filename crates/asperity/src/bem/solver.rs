@@ -11,7 +11,7 @@
 //!   threshold).
 //! * One scratch struct per algorithm, in its own file and used by no other:
 //!   `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs`), `PkScratch`
-//!   (`polonsky_keer.rs`), `StiffnessWork` (`stiffness.rs`: the frozen-set CG and the
+//!   (`polonsky_keer.rs`), `StiffnessWork` (`stiffness/`: the frozen-set CG and the
 //!   free-boundary threshold's CG) and `FullContactScratch` (`full_contact.rs`: the
 //!   periodic threshold and the lower bound). Scratch that not every solver needs is
 //!   allocated on first use and kept, so warm solves allocate nothing.
@@ -206,7 +206,7 @@ pub struct ContactSolver {
     /// The Polonsky–Keer iteration's own fields (`polonsky_keer.rs`), allocated on its
     /// first solve.
     pub(super) pk_scratch: Option<PkScratch>,
-    /// The fields of the frozen-set and free-boundary threshold CGs (`stiffness.rs`),
+    /// The fields of the frozen-set and free-boundary threshold CGs (`stiffness/`),
     /// allocated on first use.
     pub(super) stiffness_work: Option<StiffnessWork>,
     /// The fields of the periodic threshold and of the lower bound (`full_contact.rs`),
@@ -525,7 +525,7 @@ impl ContactSolver {
     }
 
     /// Initial pressure: the continuation predictor when the last solve's frozen-set
-    /// stiffness left its tangent (`stiffness.rs`), else the previous solution (rescaled to
+    /// stiffness left its tangent (`stiffness/`), else the previous solution (rescaled to
     /// the new load) or a cold start (uniform pressure under load control; local springs
     /// `max(d − f, 0)/K₀₀` under displacement control).
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {

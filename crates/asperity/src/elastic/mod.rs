@@ -8,12 +8,17 @@
 //!   real FFTs, with **free** boundaries (the grid zero-padded to `2N × 2M`, no periodic
 //!   images; Hockney 1970) or **periodic** boundaries. Plans, the kernel's spectrum and all
 //!   buffers are made once; [`ElasticOperator::apply`] allocates nothing.
+//! * [`half_space`]: [`HalfSpaceOperator`], what the contact solvers need of an elastic
+//!   body (apply, self-influence, energy, the grid), which [`ElasticOperator`] implements:
+//!   the place where another kernel (tangential, layered, on a device) plugs in.
 //!
 //! Units: `u` in the unit of lengths when `p` is in the unit of `E*`; displacement is
 //! positive into the half-space (down), pressure positive in compression.
 
+pub mod half_space;
 pub mod love;
 pub mod operator;
 
+pub use half_space::HalfSpaceOperator;
 pub use love::{love_pixel_displacement, rectangle_self_influence, self_influence};
 pub use operator::{Boundary, ElasticOperator};

@@ -22,7 +22,9 @@
 //! the grid) and `y = K⁻¹ f`, the pressure `d q − y` is non-negative everywhere from
 //! `d* = max(y/q)` on.
 //!
-//! Both CGs are preconditioned with the Fourier approximate inverse of the operator
+//! Both are the one conjugate gradient on a set of [`cg`] (generic over the
+//! [`crate::elastic::HalfSpaceOperator`], faer-style `CgParams`/`CgInfo`/`CgError`), with
+//! the solver's elastic operator. Both CGs are preconditioned with the Fourier approximate inverse of the operator
 //! restricted to the set (`P_S M P_S`, [`super::preconditioner`]); on grids of at least
 //! [`RING_MIN_POINTS`] points the residual is extended over two rings of the set first,
 //! `P_S (I + E)ᵀ M (I + E) P_S`, as in the BCCG ([`super::ring_extension`]: 25–30 % fewer
@@ -37,308 +39,49 @@
 //! ([`ContactSolver::predict_from_tangent`], a continuation predictor), which is the next
 //! state exactly as long as the set does not change.
 
+pub(crate) mod cg;
+
 use super::bccg::RING_MIN_POINTS;
 use super::full_contact::FullContactThreshold;
 use super::interface::Interface;
-use super::preconditioner::FourierPreconditioner;
-use super::ring_extension::RingExtension;
 use super::solver::{ContactSolver, Target};
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ElasticOperator;
-use crate::stop::Stop;
-use crate::sum::sum4;
 use crate::Error;
-
-/// Right-hand side of a CG on a set.
-#[derive(Clone, Copy)]
-enum RightHandSide<'a> {
-    /// A uniform unit displacement on the set.
-    Ones,
-    /// Given values (read on the set only).
-    Values(&'a [f64]),
-}
+use cg::{conjugate_gradient_on_set, CgInfo, CgParams, CgWork, RightHandSide};
 
 /// The fields of the stiffness and full-contact CGs, owned by the solver and allocated on
 /// first use: never the solved state's.
 pub(super) struct StiffnessWork {
-    /// The CG's unknown (the pressures on the set).
-    x: Vec<f64>,
-    residual: Vec<f64>,
-    preconditioned: Vec<f64>,
-    direction: Vec<f64>,
-    response: Vec<f64>,
+    /// The CG's fields; its unknown `cg.x` holds the pressures on the set.
+    cg: CgWork,
     /// `K⁻¹f` of the full-contact threshold.
     profile_pressure: Vec<f64>,
-    /// The indices of the set, ascending (capacity: the grid).
-    set: Vec<usize>,
-    /// Whether `x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
+    /// Whether `cg.x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
     /// tangent `dp/dd` of its pressure), not yet used by a solve.
     tangent: bool,
-    /// The rings around the set that extend the residual before the preconditioner, as in
-    /// the BCCG (`ring_extension.rs`), with the set as a mask; grids of at least
-    /// [`RING_MIN_POINTS`] points.
-    rings: Option<(RingExtension, Vec<bool>)>,
 }
 
 impl StiffnessWork {
-    /// The fields for the grid of `operator`, with the rings if `rings`.
+    /// The fields for the grid of `operator`, with the rings around the set (as in the
+    /// BCCG, `ring_extension.rs`) if `rings`.
     pub(super) fn new(operator: &ElasticOperator, rings: bool) -> Self {
         let len = operator.rows() * operator.cols();
         StiffnessWork {
-            x: vec![0.0; len],
-            residual: vec![0.0; len],
-            preconditioned: vec![0.0; len],
-            direction: vec![0.0; len],
-            response: vec![0.0; len],
+            cg: CgWork::for_operator(operator, rings),
             profile_pressure: vec![0.0; len],
-            set: Vec::with_capacity(len),
             tangent: false,
-            rings: rings.then(|| (RingExtension::on_grid_of(operator), vec![false; len])),
         }
     }
 }
 
-/// `z = M r`, or with the rings `(I + E)ᵀ M (I + E) r` (read on the set only: the CG never
-/// uses `z` off it; `r` is zero off the set); returns `rᵀz` on the set (summed by [`sum4`],
-/// in a fixed order).
-fn precondition_on_set(
-    preconditioner: &mut FourierPreconditioner,
-    rings: Option<&mut (RingExtension, Vec<bool>)>,
-    set: &[usize],
-    (residual, z): (&[f64], &mut Vec<f64>),
-) -> f64 {
-    match rings {
-        Some((rings, on_set)) => {
-            z.copy_from_slice(residual);
-            rings.extend(on_set, z, 0.0);
-            preconditioner.apply(z);
-            rings.gather(on_set, z);
-        }
-        None => preconditioner.apply_into(residual, z),
-    }
-    sum4(set.len(), |k| residual[set[k]] * z[set[k]])
-}
-
-/// When a CG stops: at `tolerance` relative residual, or (where `energy` is set) when the
-/// estimated relative error of `bᵀx` is below `energy` ([`EnergyEstimate`]), after
-/// `max_iterations`, or when `stop` is requested.
-#[derive(Clone, Copy)]
-struct Limits<'a> {
-    tolerance: f64,
-    energy: Option<f64>,
-    max_iterations: usize,
-    stop: &'a Stop,
-}
-
-/// Iterations over which [`EnergyEstimate`] sums the decrease of the error (a delay of a
-/// few iterations, as Strakoš & Tichý use; a longer one only delays the stop).
-const ENERGY_DELAY: usize = 4;
-
-/// The error of `bᵀx_j` in CG from `x₀ = 0`, estimated as it runs. In exact arithmetic
-/// `bᵀx − bᵀx_j` is the energy norm `‖x − x_j‖²_K` of the error (`x_jᵀr_j = 0`), which falls
-/// by exactly `α_i r_iᵀz_i` at step `i` (Hestenes & Stiefel 1952): so `bᵀx` is the sum of
-/// those terms, and the last [`ENERGY_DELAY`] of them add up to `‖e_{j−d}‖² − ‖e_j‖²`, a
-/// lower bound of the error `d` steps ago, close to it as soon as CG converges. Both hold in
-/// floating point (Strakoš & Tichý, ETNA 13:56–80, 2002), where `bᵀx_j` summed from `x_j`
-/// does not (it is off by the order of the residual). The frozen-set stiffness `k = 1ᵀx`
-/// needs no more: its CG stops when `k` is known to the estimate's precision, where the
-/// residual criterion would go on until `x` is.
-struct EnergyEstimate {
-    /// `Σ α_i r_iᵀz_i` so far, `bᵀx_j` in exact arithmetic.
-    total: f64,
-    /// The last [`ENERGY_DELAY`] terms (cyclic).
-    recent: [f64; ENERGY_DELAY],
-    steps: usize,
-}
-
-impl EnergyEstimate {
-    fn new() -> Self {
-        EnergyEstimate {
-            total: 0.0,
-            recent: [0.0; ENERGY_DELAY],
-            steps: 0,
-        }
-    }
-
-    /// Records the step `α r_iᵀz_i`.
-    fn add(&mut self, alpha: f64, rz: f64) {
-        let term = alpha * rz;
-        self.total += term;
-        self.recent[self.steps % ENERGY_DELAY] = term;
-        self.steps += 1;
-    }
-
-    /// Whether the last [`ENERGY_DELAY`] steps moved `bᵀx` by at most `relative` of it.
-    fn converged(&self, relative: f64) -> bool {
-        self.steps >= ENERGY_DELAY && self.recent.iter().sum::<f64>() <= relative * self.total.abs()
-    }
-}
-
-/// `x = 0`, `r = b` on the set (zero off it); returns `‖b‖²`.
-fn start_on_set(
-    (x, residual): (&mut [f64], &mut [f64]),
-    set: &[usize],
-    rhs: RightHandSide<'_>,
-) -> f64 {
-    x.fill(0.0);
-    residual.fill(0.0);
-    let mut rr = 0.0;
-    for &i in set {
-        let b = match rhs {
-            RightHandSide::Ones => 1.0,
-            RightHandSide::Values(v) => v[i],
-        };
-        residual[i] = b;
-        rr += b * b;
-    }
-    rr
-}
-
-/// The end of a CG at relative residual `relative` after `iterations`, if it ends there:
-/// converged (on the residual or on the estimate `energy`), out of iterations (or not
-/// finite), or stopped.
-fn finished(
-    (relative, energy): (f64, &EnergyEstimate),
-    iterations: usize,
-    limits: Limits<'_>,
-) -> Option<Result<SolveInfo, SolveError>> {
-    if limits.stop.is_requested() {
-        return Some(Err(SolveError::Interrupted { iterations }));
-    }
-    let energy_converged = limits.energy.is_some_and(|e| energy.converged(e));
-    if relative.is_finite() && (relative <= limits.tolerance || energy_converged) {
-        return Some(Ok(SolveInfo {
-            iterations,
-            residual: relative,
-            operator_applications: iterations,
-            energy_transforms: 0,
-        }));
-    }
-    if iterations >= limits.max_iterations || !relative.is_finite() {
-        return Some(Err(SolveError::NoConvergence {
-            iterations,
-            residual: relative,
-        }));
-    }
-    None
-}
-
-/// One CG step on the set: `w = K s`, `α = rz / sᵀw`, `x += α s`, `r −= α w`; returns the
-/// new `‖r‖²` and `α`, or `None` when the curvature `sᵀw` or `rz` is not positive (`K_SS`
-/// and `M_SS` are positive definite: round-off only).
-fn step_on_set(
-    operator: &mut ElasticOperator,
-    work: &mut StiffnessWork,
-    rz: f64,
-) -> Option<(f64, f64)> {
-    let StiffnessWork {
-        x,
-        residual,
-        direction,
-        response,
-        set,
-        ..
-    } = work;
-    operator.apply(direction, response);
-    let curvature = sum4(set.len(), |k| direction[set[k]] * response[set[k]]);
-    if !(curvature > 0.0 && rz > 0.0) {
-        return None;
-    }
-    let alpha = rz / curvature;
-    for &i in set.iter() {
-        x[i] += alpha * direction[i];
-        residual[i] -= alpha * response[i];
-    }
-    let rr = sum4(set.len(), |k| residual[set[k]] * residual[set[k]]);
-    Some((rr, alpha))
-}
-
-/// Solves `K_SS x = b_S` by preconditioned conjugate gradients (x zero off the set
-/// `S = {i : in_set(i)}`), with the Fourier preconditioner restricted to the set,
-/// `P_S M P_S` (symmetric positive definite on the set, so CG applies unchanged). Stops at
-/// `‖r‖ ≤ tolerance ‖b‖` (the unpreconditioned residual) or on the energy estimate of
-/// `limits`. The result is in `work.x`; returned with `bᵀx` as the CG's energy
-/// ([`EnergyEstimate`]).
-/// Every pass but the two transforms visits the set's points only (listed once, in index
-/// order; the sums in a fixed order, [`sum4`], whatever the thread count).
-fn conjugate_gradient_on_set(
-    operator: &mut ElasticOperator,
-    preconditioner: &mut FourierPreconditioner,
-    in_set: impl Fn(usize) -> bool,
-    rhs: RightHandSide<'_>,
-    work: &mut StiffnessWork,
-    limits: Limits<'_>,
-) -> Result<(SolveInfo, f64), SolveError> {
-    let n = work.x.len();
-    work.set.clear();
-    work.set.extend((0..n).filter(|&i| in_set(i)));
-    // The rings of the set (none where the set is the whole grid), out of `work` while the
-    // CG runs.
-    let mut taken = work.rings.take();
-    let mut rings = taken.as_mut().filter(|_| work.set.len() < n);
-    if let Some((_, on_set)) = rings.as_mut() {
-        on_set.fill(false);
-        work.set.iter().for_each(|&i| on_set[i] = true);
-    }
-    let result = iterate_on_set(operator, (preconditioner, rings), rhs, work, limits);
-    work.rings = taken;
-    result
-}
-
-/// The iterations of [`conjugate_gradient_on_set`] on the set listed in `work.set`.
-fn iterate_on_set(
-    operator: &mut ElasticOperator,
-    (preconditioner, mut rings): (
-        &mut FourierPreconditioner,
-        Option<&mut (RingExtension, Vec<bool>)>,
-    ),
-    rhs: RightHandSide<'_>,
-    work: &mut StiffnessWork,
-    limits: Limits<'_>,
-) -> Result<(SolveInfo, f64), SolveError> {
-    let mut rr = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
-    let b_norm = rr.sqrt();
-    let mut rz = precondition_on_set(
-        preconditioner,
-        rings.as_deref_mut(),
-        &work.set,
-        (&work.residual, &mut work.preconditioned),
-    );
-    // The direction is zero off the set (the operator reads all of it).
-    work.direction.fill(0.0);
-    for &i in &work.set {
-        work.direction[i] = work.preconditioned[i];
-    }
-    let mut iterations = 0;
-    let mut energy = EnergyEstimate::new();
-    loop {
-        let relative = if b_norm > 0.0 {
-            rr.sqrt() / b_norm
-        } else {
-            0.0
-        };
-        if let Some(end) = finished((relative, &energy), iterations, limits) {
-            return end.map(|info| (info, energy.total));
-        }
-        iterations += 1;
-        let alpha;
-        (rr, alpha) = step_on_set(operator, work, rz).ok_or(SolveError::NoConvergence {
-            iterations,
-            residual: relative,
-        })?;
-        energy.add(alpha, rz);
-        let rz_new = precondition_on_set(
-            preconditioner,
-            rings.as_deref_mut(),
-            &work.set,
-            (&work.residual, &mut work.preconditioned),
-        );
-        let beta = rz_new / rz;
-        let (direction, z) = (&mut work.direction, &work.preconditioned);
-        for &i in &work.set {
-            direction[i] = z[i] + beta * direction[i];
-        }
-        rz = rz_new;
+/// The CG's info as the solver reports it.
+fn solve_info(info: &CgInfo) -> SolveInfo {
+    SolveInfo {
+        iterations: info.iterations,
+        residual: info.residual,
+        operator_applications: info.iterations,
+        energy_transforms: 0,
     }
 }
 
@@ -381,7 +124,7 @@ impl ContactSolver {
         // (The direct solve knows the hard wall's set only.)
         let direct = match self.stop.is_requested() || self.interface != Interface::HardWall {
             true => None,
-            false => self.small_set_tangent(tolerance, &mut work.x),
+            false => self.small_set_tangent(tolerance, &mut work.cg.x),
         };
         // k = 1ᵀx: from a CG its energy, which converges with the square of the residual
         // where 1ᵀx_j, summed, carries an error of the order of the residual (measured at
@@ -394,14 +137,13 @@ impl ContactSolver {
                     operator_applications: 0,
                     energy_transforms: 0,
                 },
-                work.x.iter().sum::<f64>(),
+                work.cg.x.iter().sum::<f64>(),
             )),
             None => {
-                let limits = Limits {
+                let params = CgParams {
                     tolerance,
-                    energy: Some(self.params.stiffness_error).filter(|&e| e > 0.0),
+                    energy_error: Some(self.params.stiffness_error).filter(|&e| e > 0.0),
                     max_iterations,
-                    stop: &self.stop,
                 };
                 let (pressure, interface) = (&self.state.pressure, self.interface);
                 conjugate_gradient_on_set(
@@ -409,9 +151,11 @@ impl ContactSolver {
                     &mut self.preconditioner,
                     |i| interface.elastic(pressure[i]),
                     RightHandSide::Ones,
-                    &mut work,
-                    limits,
+                    &mut work.cg,
+                    (&params, &self.stop),
                 )
+                .map(|info| (solve_info(&info), info.energy))
+                .map_err(SolveError::from)
             }
         };
         let (dx, dy) = (
@@ -445,7 +189,7 @@ impl ContactSolver {
         let n = self.state.pressure.len() as f64;
         let step = match target {
             Target::MeanPressure(mean_pressure) => {
-                let x_sum: f64 = work.x.iter().sum();
+                let x_sum: f64 = work.cg.x.iter().sum();
                 let p_sum: f64 = self.state.pressure.iter().sum();
                 if !crate::is_positive_finite(x_sum) {
                     return false;
@@ -455,7 +199,7 @@ impl ContactSolver {
             Target::Indentation(d) => d - solved.indentation,
         };
         let mut total = 0.0;
-        for (p, &x) in self.state.pressure.iter_mut().zip(&work.x) {
+        for (p, &x) in self.state.pressure.iter_mut().zip(&work.cg.x) {
             *p = (*p + step * x).max(0.0);
             total += *p;
         }
@@ -509,34 +253,35 @@ impl ContactSolver {
             self.params.stiffness_max_iterations,
         );
         // The threshold reads q and y point by point: the residual criterion only.
-        let limits = Limits {
+        let params = CgParams {
             tolerance,
-            energy: None,
+            energy_error: None,
             max_iterations,
-            stop: &self.stop,
         };
+        let limits = (&params, &self.stop);
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
             &mut self.problem.operator,
             &mut self.preconditioner,
             |_| true,
             RightHandSide::Values(&self.problem.profile),
-            &mut work,
+            &mut work.cg,
             limits,
         )
         .and_then(|_| {
-            std::mem::swap(&mut work.x, &mut work.profile_pressure);
+            std::mem::swap(&mut work.cg.x, &mut work.profile_pressure);
             conjugate_gradient_on_set(
                 &mut self.problem.operator,
                 &mut self.preconditioner,
                 |_| true,
                 RightHandSide::Ones,
-                &mut work,
+                &mut work.cg,
                 limits,
             )
         })
+        .map_err(SolveError::from)
         .map(|_| {
-            let q_y = work.x.iter().zip(work.profile_pressure.iter());
+            let q_y = work.cg.x.iter().zip(work.profile_pressure.iter());
             let indentation = q_y
                 .clone()
                 .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
