@@ -68,7 +68,7 @@ fn contact<'py>(
     drop(surface);
     let stop = solver.stop().clone();
     let run = run_detached_with(py, &stop, |_| {
-        app::run(&mut solver, &plan, pixel_area, map)
+        app::run(&mut solver, &plan, pixel_area, map, &mut || {})
     })?
     .map_err(|e: SweepError<_>| match e.explain("fd_stiffness") {
         SweepFailure::Input(source) => from_solve(source),

@@ -199,8 +199,9 @@ pub struct ContactRun {
 }
 
 /// Takes each load's mean gap, patches and (for the last load) contact map.
-struct Observer {
+struct Observer<'a> {
     loads: usize,
+    on_load: &'a mut dyn FnMut(),
     keep_map: bool,
     pixel_area: f64,
     fields: (f64, usize),
@@ -208,7 +209,7 @@ struct Observer {
     rows: Vec<ContactRow>,
 }
 
-impl SweepObserver for Observer {
+impl SweepObserver for Observer<'_> {
     type Error = Infallible;
 
     fn solved(&mut self, load: usize, solver: &ContactSolver) -> Result<(), Infallible> {
@@ -235,21 +236,24 @@ impl SweepObserver for Observer {
             iterations: row.info.iterations,
             residual: row.info.residual,
         });
+        (self.on_load)();
         Ok(())
     }
 }
 
 /// Runs the plan's loads on `solver` (the library's sweep: full contact checked before any
 /// solve, warm starts, frozen-set stiffness); `pixel_area` in m², `keep_map`: keep the
-/// contact set of the last load.
+/// contact set of the last load; `on_load` is called after each load is done (progress).
 pub fn run(
     solver: &mut ContactSolver,
     plan: &ContactPlan,
     pixel_area: f64,
     keep_map: bool,
+    on_load: &mut dyn FnMut(),
 ) -> Result<ContactRun, SweepError<Infallible>> {
     let mut observer = Observer {
         loads: plan.loads.len(),
+        on_load,
         keep_map,
         pixel_area,
         fields: (f64::NAN, 0),
@@ -337,7 +341,7 @@ mod tests {
         let plan = request.validate().unwrap();
         let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
         let pixel = surface.spacing() * surface.spacing_y();
-        let run = run(&mut solver, &plan, pixel, true).unwrap();
+        let run = run(&mut solver, &plan, pixel, true, &mut || {}).unwrap();
         // The same solves by hand, as `asperity contact` ran them before it used the sweep.
         let mut by_hand = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
         for (row, control) in run.rows.iter().zip(&plan.loads) {

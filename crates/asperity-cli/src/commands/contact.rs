@@ -24,6 +24,7 @@ use serde_json::json;
 use super::measured::{load, record, MeasuredArgs};
 use crate::output::{format_number, Table};
 use crate::plot::{greyscale_png, stage_charts, Chart, ImageFormat, Series, Style};
+use crate::progress::Progress;
 
 /// Arguments of `asperity contact`.
 #[derive(Debug, clap::Args)]
@@ -78,6 +79,9 @@ pub struct ContactArgs {
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
+    /// No progress output.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// The request of the arguments.
@@ -199,8 +203,17 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         .with_context(|| format!("{}", args.file.display()))?;
     let pixel_area = surface.spacing() * surface.spacing_y();
     drop(surface);
-    let solved =
-        contact::run(&mut solver, &plan, pixel_area, args.map.is_some()).map_err(sweep_error)?;
+    let loads = plan.loads.len();
+    let progress = Progress::new("contact", loads as u64, args.quiet || loads < 2);
+    let solved = contact::run(
+        &mut solver,
+        &plan,
+        pixel_area,
+        args.map.is_some(),
+        &mut || progress.inc(),
+    )
+    .map_err(sweep_error)?;
+    progress.finish();
     let table = table(&solved.rows);
     match &record_path {
         Some(record_path) => {
