@@ -13,6 +13,9 @@
 //!   highest point).
 //! * [`linear_curve`]: the whole curve of a line on linear springs in `O(N log N)`, with a
 //!   reusable buffer for ensembles of thousands of lines.
+//! * [`adhesion`]: Heß's rule — springs that stick once touched and let go from the
+//!   edges of a contact at `√(2πaΔγ/E*)`: JKR for a sphere, Kendall for a punch, loading–
+//!   unloading loops and pull-off under force and displacement control.
 //! * [`radix_sort`]: the `O(N)` descending sort of doubles behind [`LinearCurve`].
 //!
 //! The low-force exponent α of `k ∝ F^α` (3) of an ensemble of lines is the study's
@@ -34,12 +37,14 @@
 //! # Ok::<(), asperity::Error>(())
 //! ```
 
+pub mod adhesion;
 pub mod foundation;
 pub mod indenter;
 pub mod linear_curve;
 pub mod radix_sort;
 pub mod spring;
 
+pub use adhesion::{AdhesiveLine, PullOffs};
 pub use foundation::{log_spaced, CurvePoint, Foundation};
 pub use indenter::{spring_positions, Axisymmetric, RadialProfile, PUNCH_EDGE_TOLERANCE};
 pub use linear_curve::LinearCurve;
