@@ -7,9 +7,7 @@
 //! warm start), so a sweep gives the CLI's numbers bit for bit. The solver polls the stop
 //! flag that Ctrl-C sets ([`crate::interrupt`]), so one long solve stops too.
 
-use asperity::bem::sweep::{
-    sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow,
-};
+use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow};
 use asperity::bem::{ContactSolver, Control, SolveError};
 use asperity::elastic::Boundary;
 use asperity::memory::array_bytes;
@@ -166,8 +164,13 @@ impl Solver {
             }
         }
         let (rows, cols) = heights.as_array().dim();
-        ensure_solver_fits(rows, cols, half_space.boundary, array_bytes(&[rows, cols], 8))
-            .map_err(from_error)?;
+        ensure_solver_fits(
+            rows,
+            cols,
+            half_space.boundary,
+            array_bytes(&[rows, cols], 8),
+        )
+        .map_err(from_error)?;
         if rows < 2 || cols < 2 {
             return Err(invalid(format!(
                 "invalid grid: a surface needs at least 2x2 points, got ({rows}, {cols})"

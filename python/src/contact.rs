@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 use crate::arrays::owned_2d;
 use crate::bem::with_context;
 use crate::errors::{from_error, from_solve, invalid, refused};
-use crate::interrupt::run_detached_with;
+use crate::interrupt::{run_detached, run_detached_with};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact, m)?)?;
@@ -64,7 +64,12 @@ fn contact<'py>(
     }
     .map_err(from_error)?;
     let pixel_area = surface.spacing() * surface.spacing_y();
-    let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).map_err(from_solve)?;
+    // Set-up is parallel work too: on the calling thread's pool, never rayon's global one
+    // (a process forked after it started has it without threads: issue 33, item 9).
+    let mut solver = run_detached(py, |_| {
+        ContactSolver::new(&surface, plan.half_space, plan.params)
+    })?
+    .map_err(from_solve)?;
     drop(surface);
     let stop = solver.stop().clone();
     let run = run_detached_with(py, &stop, |_| {

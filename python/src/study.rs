@@ -16,8 +16,8 @@ use asperity::lock::FolderLock;
 use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
-    run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec,
-    Task, TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
+    run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec, Task,
+    TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 use asperity::Error;
 use pyo3::prelude::*;

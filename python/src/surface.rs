@@ -74,11 +74,13 @@ fn generate_surface<'py>(
         .surface()
         .map_err(request_error)?;
     let rows = spec.rows();
-    let surface = run_detached(py, |_| {
-        SurfaceGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
+    // The statistics' sums are parallel: on the calling thread's pool too (see `summary`).
+    let (surface, stats) = run_detached(py, |_| {
+        let surface = SurfaceGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))?;
+        let stats = surface_summary(&surface);
+        Ok((surface, stats))
     })?
     .map_err(from_error)?;
-    let stats = surface_summary(&surface);
     ensure_usable(&stats, size).map_err(refused)?;
     let meta = sidecar("surface", &[rows, n], seed, &spec, &stats).to_string();
     Ok((surface.into_heights().into_pyarray(py), meta))
@@ -103,11 +105,12 @@ fn generate_line<'py>(
     let (spec, seed) = request(n, None, hurst, cutoffs, (rms_height, rms_slope), size, seed)
         .line()
         .map_err(request_error)?;
-    let line = run_detached(py, |_| {
-        LineGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))
+    let (line, stats) = run_detached(py, |_| {
+        let line = LineGenerator::new(&spec).and_then(|mut g| g.try_generate(seed))?;
+        let stats = line_summary(&line);
+        Ok((line, stats))
     })?
     .map_err(from_error)?;
-    let stats = line_summary(&line);
     ensure_usable(&stats, size).map_err(refused)?;
     let meta = sidecar("line", &[n], seed, &spec, &stats).to_string();
     Ok((line.into_heights().into_pyarray(py), meta))
