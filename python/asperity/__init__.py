@@ -44,6 +44,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
@@ -54,6 +55,7 @@ from . import _mpi
 from ._asperity import BeyondFullContactError, ConvergenceError, __version__
 
 __all__ = [
+    "AsperityWarning",
     "BeyondFullContactError",
     "ContactResult",
     "ConvergenceError",
@@ -65,6 +67,8 @@ __all__ = [
     "Surface",
     "Sweep",
     "Topography",
+    "UnitWarning",
+    "UnlevelledWarning",
     "contact",
     "line",
     "mdr",
@@ -327,31 +331,87 @@ def _opt(value: Optional[float]) -> Optional[float]:
     return None if value is None else float(value)
 
 
-def _heights_and_size(values: Any, size: Optional[float], what: str) -> Tuple[np.ndarray, float]:
+def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
+                  ) -> Tuple[np.ndarray, float, Optional[float], bool, Optional[str]]:
+    """What :func:`stats` and :func:`psd` hand to the front-end layer: heights, size along x,
+    size along y (rectangular pixels), whether they are measured (ISO parameters, a size per
+    axis) and a generated surface's metadata (JSON: its spectrum sets the default fit
+    range)."""
     if isinstance(values, (Surface, Line)):
-        return values.heights, values.size if size is None else float(size)
-    size = 1.0 if size is None else float(size)
-    return _float64(values, what), size
+        if isinstance(size, (tuple, list)):
+            raise ValueError("size: a generated surface has square pixels; give one size")
+        size_x = values.size if size is None else float(size)
+        return values.heights, size_x, None, False, json.dumps(values.metadata)
+    if isinstance(values, Topography):
+        if size is not None:
+            raise ValueError("size: the topography has its own sizes")
+        return values.heights, values.size, values.size_y, True, None
+    heights_of = getattr(values, "heights", None)
+    if callable(heights_of) and hasattr(values, "physical_sizes"):
+        # SurfaceTopography: heights()[x, y] with physical_sizes (sx,) or (sx, sy).
+        if size is not None:
+            raise ValueError("size: the topography has its own physical_sizes")
+        sizes = [float(v) for v in np.atleast_1d(values.physical_sizes)]
+        heights = _float64(heights_of(), "heights")
+        if heights.ndim == 2:
+            if len(sizes) != 2:
+                raise ValueError(f"heights: expected two physical sizes (sx, sy), got {sizes!r}")
+            return heights.T, sizes[0], sizes[1], True, None
+        return heights, sizes[0], None, True, None
+    heights = _float64(values, "heights")
+    if isinstance(size, (tuple, list)):
+        if len(size) != 2 or heights.ndim != 2:
+            raise ValueError(f"size: give L, or (x, y) for a 2D map, got {size!r}")
+        return heights, _positive(size[0], "size"), _positive(size[1], "size"), True, None
+    return heights, 1.0 if size is None else float(size), None, False, None
 
 
-def stats(values: Any, *, size: Optional[float] = None) -> Dict[str, Optional[float]]:
-    """rms height, rms slope (forward differences) and rms curvature of a surface (2D) or
-    line (1D), as ``asperity stats``. ``size`` is L along x (default: the object's, else 1).
+def _statistics(values: Any, size, fit_from, fit_to) -> Dict[str, Any]:
+    heights, size_x, size_y, measured, metadata = _stats_source(values, size)
+    result = _core.statistics(heights, size_x, size_y, measured, metadata,
+                              _opt(fit_from), _opt(fit_to))
+    if result["iso"] is not None:
+        result["iso"] = json.loads(result["iso"])
+    return result
+
+
+_PSD_KEYS = ("q", "psd", "modes", "size", "fit_prefactor", "fit_stderr", "fit_points")
+
+
+def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
+          fit_from: Optional[float] = None, fit_to: Optional[float] = None) -> Dict[str, Any]:
+    """The statistics ``asperity stats`` prints, by the same code: ``rms_height``,
+    ``rms_slope`` (forward differences), ``rms_curvature`` (half the rms five-point
+    Laplacian; per-axis spacings on rectangular pixels), the PSD's power-law fit
+    (``psd_slope`` with its 95 % interval ``psd_slope_low`` .. ``psd_slope_high``, over the
+    rings ``fit_from`` .. ``fit_to`` in q·L/2π, ``fit_note`` when there is none, and
+    ``hurst_estimate``) and, for a measured topography, ``iso``: the ISO 25178 (map) or
+    ISO 4287 (profile) parameters.
+
+    ``values``: a :class:`Surface` or :class:`Line` (their spec sets the default fit range,
+    as the sidecar does for the CLI), a :class:`Topography` (both sizes: rectangular pixels
+    are handled), a SurfaceTopography topography, or an array with ``size`` = L along x
+    (square pixels; default 1) or ``(x, y)`` for a map with rectangular pixels.
+    ``fit_from``/``fit_to`` default to 2 (or the spec's roll-off or cut-off) and Nyquist
+    (or below the spec's short cut-off).
 
     Example::
 
         >>> asperity.stats(asperity.line(1024, hurst=0.5, rms_slope=2.0))["rms_slope"]
         2.0...
     """
-    heights, size = _heights_and_size(values, size, "heights")
-    return _core.summary(heights, size)
+    result = _statistics(values, size, fit_from, fit_to)
+    for key in _PSD_KEYS:
+        del result[key]
+    return result
 
 
 @dataclass
 class Psd:
     """A power spectrum: wavenumbers ``q`` (rad/length), values ``psd`` (C2D for a surface,
-    radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; with
-    ``fit`` (exponent, prefactor, interval) and ``hurst`` when a fit range was given."""
+    radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; the
+    power law ``fit`` (exponent, prefactor, stderr, low, high, points) over the rings
+    ``fit_from`` .. ``fit_to`` and ``hurst``, or ``None`` with the reason in ``fit_note``."""
 
     q: np.ndarray
     psd: np.ndarray
@@ -359,6 +419,9 @@ class Psd:
     wavenumber: np.ndarray
     fit: Optional[Dict[str, float]] = None
     hurst: Optional[float] = None
+    fit_from: Optional[float] = None
+    fit_to: Optional[float] = None
+    fit_note: Optional[str] = None
 
 
 @dataclass
@@ -386,15 +449,43 @@ class Topography:
         return (self.size,) if self.size_y is None else (self.size, self.size_y)
 
 
+class AsperityWarning(UserWarning):
+    """The base of asperity's warnings (``warnings.simplefilter("error", AsperityWarning)``
+    turns them all into errors)."""
+
+
+class UnlevelledWarning(AsperityWarning):
+    """A measured surface looks tilted and no levelling was chosen (``detrend=``): its
+    heights are used as they are, which makes contact areas, slopes and heights wrong. The
+    CLI prints the same words as ``warning:`` lines."""
+
+
+class UnitWarning(AsperityWarning):
+    """A measured file gives no unit: its numbers are used as metres."""
+
+
+_WARNINGS = {"unlevelled": UnlevelledWarning, "unit": UnitWarning}
+
+
 def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None, str, int] = None,
-                    size: Union[None, float, Tuple[float, float]] = None) -> Topography:
-    """Reads a measured file with the library's readers, the ones ``asperity import`` and
-    ``asperity stats FILE`` use (format by content, then extension: X3P, SDF, text and
-    Gwyddion matrices, x y z lists, x z profiles, SUR, PLU, OPD, DI, AL3D, MetroPro DAT,
-    FRT, WSxM, TMD, ``.npy``). ``channel``: a name or 0-based index (default: the first
-    height channel); ``size``: ``x`` or ``(x, y)`` in metres where the file carries none,
-    or to override it. No cleaning is done (levelling, filling: the CLI's ``import``).
-    Bad files raise ``ValueError`` with the CLI's one line.
+                    size: Union[None, float, Tuple[float, float]] = None,
+                    detrend: Optional[str] = None, fill: Optional[str] = None) -> Topography:
+    """Reads a measured file with the library's readers and cleans it as asked, by the call
+    ``asperity import`` and every command's measured surface use (format by content, then
+    extension: X3P, SDF, text and Gwyddion matrices, x y z lists, x z profiles, SUR, PLU,
+    OPD, DI, AL3D, MetroPro DAT, FRT, WSxM, TMD, ``.npy``). ``channel``: a name or 0-based
+    index (default: the first height channel); ``size``: ``x`` or ``(x, y)`` in metres
+    where the file carries none, or to override it; ``detrend``: ``none``, ``mean``,
+    ``plane``, ``poly2``, ``poly3``, ``lines`` or ``line-means`` (default: none chosen, and
+    an :class:`UnlevelledWarning` when the surface looks tilted, as the CLI warns);
+    ``fill``: ``harmonic`` (Laplace inpainting) or ``refuse`` undefined points (default:
+    they stay NaN). A file with no unit gives a :class:`UnitWarning`. The cleaning is
+    recorded in ``provenance["cleaning"]``. Bad files raise ``ValueError`` with the CLI's
+    one line.
+
+    Example::
+
+        >>> t = asperity.read_topography("scan.x3p", detrend="plane")  # doctest: +SKIP
     """
     if isinstance(size, (tuple, list)):
         if len(size) != 2:
@@ -402,8 +493,11 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
         size_x, size_y = _positive(size[0], "size"), _positive(size[1], "size")
     else:
         size_x, size_y = _positive(size, "size"), None
-    heights, sizes, provenance = _core.read_topography(
-        os.fspath(path), None if channel is None else str(channel), size_x, size_y)
+    heights, sizes, provenance, warned = _core.read_topography(
+        os.fspath(path), None if channel is None else str(channel), size_x, size_y,
+        detrend, fill)
+    for category, words in warned:
+        warnings.warn(f"{os.fspath(path)}: {words}", _WARNINGS[category], stacklevel=2)
     return Topography(heights=heights, size=float(sizes[0]),
                       size_y=float(sizes[1]) if len(sizes) > 1 else None,
                       provenance=json.loads(provenance))
@@ -412,14 +506,15 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
 def psd(
     values: Any,
     *,
-    size: Optional[float] = None,
+    size: Union[None, float, Tuple[float, float]] = None,
     fit_from: Optional[float] = None,
     fit_to: Optional[float] = None,
 ) -> Psd:
-    """The PSD of a surface or line, as ``asperity stats --psd``, and, with ``fit_from``
-    and/or ``fit_to`` (wavelengths per side, q·L/2π; defaults 1 and the last bin), the
-    least-squares power law ``C ∝ q^p`` over the bins whose rounded q·L/2π lies in the
-    range, with the Hurst estimate ``H = -(p + d)/2`` (d = 2 for surfaces, 1 for lines).
+    """The PSD of a surface or line, as ``asperity stats --psd``, with the least-squares
+    power law ``C ∝ q^p`` over the bins whose rounded q·L/2π lies in ``fit_from`` ..
+    ``fit_to`` (the defaults of :func:`stats`: 2, or the spec's roll-off, to Nyquist) and
+    the Hurst estimate ``H = -(p + d)/2`` (d = 2 for surfaces, 1 for lines). ``values`` and
+    ``size`` as for :func:`stats` (rectangular pixels included).
 
     Example::
 
@@ -428,21 +523,15 @@ def psd(
         >>> abs(spectrum.hurst - 0.8) < 0.1
         True
     """
-    heights, size = _heights_and_size(values, size, "heights")
-    q, c, modes = _core.psd(heights, size)
-    wavenumber = q * size / (2 * np.pi)
-    result = Psd(q, c, modes, wavenumber)
-    if fit_from is not None or fit_to is not None:
-        low = 1.0 if fit_from is None else _positive(fit_from, "fit_from")
-        high = float(np.round(wavenumber[-1])) if fit_to is None else _positive(fit_to, "fit_to")
-        if not low < high:
-            raise ValueError(f"invalid PSD fit range: fit_from {low} must be below fit_to {high}")
-        ring = np.round(wavenumber)
-        keep = (ring >= low) & (ring <= high) & (c > 0)
-        result.fit = _core.fit_power_law(np.ascontiguousarray(q[keep]), np.ascontiguousarray(c[keep]))
-        offset = 2.0 if np.ndim(heights) == 2 else 1.0
-        result.hurst = -(result.fit["exponent"] + offset) / 2.0
-    return result
+    r = _statistics(values, size, fit_from, fit_to)
+    wavenumber = r["q"] * r["size"] / (2 * np.pi)
+    fit = None
+    if r["psd_slope"] is not None:
+        fit = {"exponent": r["psd_slope"], "prefactor": r["fit_prefactor"],
+               "stderr": r["fit_stderr"], "low": r["psd_slope_low"],
+               "high": r["psd_slope_high"], "points": r["fit_points"]}
+    return Psd(r["q"], r["psd"], r["modes"], wavenumber, fit, r["hurst_estimate"],
+               r["fit_from"], r["fit_to"], r["fit_note"])
 
 
 # --------------------------------------------------------------------------------------

@@ -1,19 +1,21 @@
 //! Surfaces and lines (`asperity surface`, `asperity line`), their statistics and PSD
-//! (`asperity stats`): the same library calls as `crates/asperity-cli/src/commands/
-//! surface.rs` and `stats.rs`.
+//! (`asperity stats`): conversions to and from the front-end layer's requests
+//! (`asperity_app::surface`, `asperity_app::stats`), the ones the CLI makes.
 
 use std::path::PathBuf;
 
-use asperity::fit::power_law_fit;
 use asperity::io::{sidecar_path, StagedOutputs};
-use asperity::surface::stats::{line_psd, line_summary, radial_psd_2d, surface_summary};
-use asperity::surface::{Line, LineGenerator, Surface, SurfaceGenerator};
+use asperity::surface::stats::{line_summary, surface_summary};
+use asperity::surface::{LineGenerator, SurfaceGenerator};
+use asperity::topography;
+use asperity_app::stats::{compute, SpectrumHints, Statistics, StatsRequest, StatsSource};
 use asperity_app::surface::{ensure_usable, sidecar, SurfaceRequest};
-use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArray1, PyReadonlyArrayDyn};
+use asperity_app::Names;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::arrays::{heights, owned_1d, Heights};
+use crate::arrays::{heights, Heights};
 use crate::errors::{from_error, invalid, refused, request_error};
 use crate::interrupt::run_detached;
 
@@ -21,9 +23,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(generate_surface, m)?)?;
     m.add_function(wrap_pyfunction!(generate_line, m)?)?;
     m.add_function(wrap_pyfunction!(save_heights, m)?)?;
-    m.add_function(wrap_pyfunction!(summary, m)?)?;
-    m.add_function(wrap_pyfunction!(psd, m)?)?;
-    m.add_function(wrap_pyfunction!(fit_power_law, m)?)?;
+    m.add_function(wrap_pyfunction!(statistics, m)?)?;
     Ok(())
 }
 
@@ -140,89 +140,85 @@ fn save_heights(
 }
 
 /// A line or a surface of the given heights and side length.
-enum Profile {
-    Line(Line),
-    Surface(Surface),
-}
-
-fn profile(array: &PyReadonlyArrayDyn<'_, f64>, size: f64) -> PyResult<Profile> {
-    match heights(array, "heights")? {
-        Heights::Line(h) => Line::new(h, size).map(Profile::Line),
-        Heights::Surface(h) => Surface::new(h, size).map(Profile::Surface),
-    }
-    .map_err(from_error)
-}
-
-/// rms height, slope and curvature (`asperity stats`).
+/// The statistics of `asperity stats`, by the front-end layer's one path: heights on square
+/// pixels of side `size_x / cols` with the spectrum hints of a generated surface's metadata
+/// (JSON), or (`measured`) a measured topography with a size per axis (`size_y` `None`:
+/// square pixels), which adds the ISO parameters. Returns the CLI's `--json` fields with
+/// the PSD's `q`, `psd` and `modes` as arrays.
 #[pyfunction]
-fn summary<'py>(
+#[pyo3(signature = (array, size_x, size_y, measured, metadata, fit_from, fit_to))]
+#[allow(clippy::too_many_arguments)]
+fn statistics<'py>(
     py: Python<'py>,
     array: PyReadonlyArrayDyn<'_, f64>,
-    size: f64,
+    size_x: f64,
+    size_y: Option<f64>,
+    measured: bool,
+    metadata: Option<String>,
+    fit_from: Option<f64>,
+    fit_to: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let profile = profile(&array, size)?;
+    let request = StatsRequest { fit_from, fit_to };
+    request.validate().map_err(refused)?;
+    let source = match (heights(&array, "heights")?, measured) {
+        (Heights::Line(h), true) => StatsSource::Measured {
+            heights: topography::Heights::Profile(h),
+            sizes: vec![size_x],
+        },
+        (Heights::Surface(h), true) => {
+            let square = size_x * h.nrows() as f64 / h.ncols() as f64;
+            StatsSource::Measured {
+                heights: topography::Heights::Areal(h),
+                sizes: vec![size_x, size_y.unwrap_or(square)],
+            }
+        }
+        (h, false) => {
+            let metadata: Option<serde_json::Value> =
+                metadata.and_then(|text| serde_json::from_str(&text).ok());
+            StatsSource::Grid {
+                heights: match h {
+                    Heights::Line(h) => h.into_dyn(),
+                    Heights::Surface(h) => h.into_dyn(),
+                },
+                size: size_x,
+                hints: metadata
+                    .map_or_else(SpectrumHints::default, |v| SpectrumHints::from_sidecar(&v)),
+            }
+        }
+    };
     // On the calling thread's pool like every computation here (its sums are parallel):
     // rayon's global pool has no threads in a process forked after it started.
-    let s = run_detached(py, move |_| match profile {
-        Profile::Line(line) => line_summary(&line),
-        Profile::Surface(surface) => surface_summary(&surface),
-    })?;
+    let stats =
+        run_detached(py, move |_| compute(&request, source, "heights"))?.map_err(request_error)?;
+    statistics_dict(py, &stats)
+}
+
+fn statistics_dict<'py>(py: Python<'py>, stats: &Statistics) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
+    let s = &stats.summary;
     dict.set_item("rms_height", s.rms_height)?;
     dict.set_item("rms_slope", s.rms_slope)?;
     dict.set_item("rms_curvature", s.rms_curvature)?;
-    Ok(dict)
-}
-
-/// The PSD (radially averaged for a surface): wavenumbers q, PSD values and the number of
-/// Fourier modes of each bin.
-#[pyfunction]
-#[allow(clippy::type_complexity)]
-fn psd<'py>(
-    py: Python<'py>,
-    array: PyReadonlyArrayDyn<'_, f64>,
-    size: f64,
-) -> PyResult<(
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<u64>>,
-)> {
-    let profile = profile(&array, size)?;
-    let bins = run_detached(py, move |_| match profile {
-        Profile::Line(line) => Ok(line_psd(&line)),
-        Profile::Surface(surface) => radial_psd_2d(&surface),
-    })?
-    .map_err(from_error)?;
+    let (f, plan) = (stats.fit, &stats.plan);
+    dict.set_item("psd_slope", f.map(|f| f.exponent))?;
+    dict.set_item("psd_slope_low", f.map(|f| f.low))?;
+    dict.set_item("psd_slope_high", f.map(|f| f.high))?;
+    dict.set_item("fit_points", f.map(|f| f.points))?;
+    dict.set_item("fit_prefactor", f.map(|f| f.prefactor))?;
+    dict.set_item("fit_stderr", f.map(|f| f.stderr))?;
+    dict.set_item("fit_from", plan.range.map(|r| r.0))?;
+    dict.set_item("fit_to", plan.range.map(|r| r.1))?;
+    let note = plan.note.as_ref().map(|n| n.words(Names::Keywords));
+    dict.set_item("fit_note", note)?;
+    dict.set_item("hurst_estimate", stats.hurst)?;
+    dict.set_item("iso", stats.iso.as_ref().map(|v| v.to_string()))?;
+    dict.set_item("size", stats.size)?;
     let column = |f: &dyn Fn(&asperity::surface::stats::PsdBin) -> f64| {
-        ndarray::Array1::from_iter(bins.iter().map(f)).into_dyn()
+        ndarray::Array1::from_iter(stats.bins.iter().map(f))
     };
-    let modes = ndarray::Array1::from_iter(bins.iter().map(|b| b.modes as u64)).into_dyn();
-    Ok((
-        column(&|b| b.q).into_pyarray(py),
-        column(&|b| b.psd).into_pyarray(py),
-        modes.into_pyarray(py),
-    ))
-}
-
-/// Least-squares power law `y = A x^p` on log–log axes, with the 95 % interval of `p`.
-#[pyfunction]
-fn fit_power_law<'py>(
-    py: Python<'py>,
-    x: PyReadonlyArray1<'_, f64>,
-    y: PyReadonlyArray1<'_, f64>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (x, y) = (owned_1d(&x), owned_1d(&y));
-    let fit = power_law_fit(
-        x.as_slice().expect("contiguous"),
-        y.as_slice().expect("contiguous"),
-    )
-    .map_err(from_error)?;
-    let dict = PyDict::new(py);
-    dict.set_item("exponent", fit.exponent)?;
-    dict.set_item("prefactor", fit.prefactor)?;
-    dict.set_item("stderr", fit.stderr)?;
-    dict.set_item("low", fit.low)?;
-    dict.set_item("high", fit.high)?;
-    dict.set_item("points", fit.points)?;
+    let modes = ndarray::Array1::from_iter(stats.bins.iter().map(|b| b.modes as u64));
+    dict.set_item("q", column(&|b| b.q).into_pyarray(py))?;
+    dict.set_item("psd", column(&|b| b.psd).into_pyarray(py))?;
+    dict.set_item("modes", modes.into_pyarray(py))?;
     Ok(dict)
 }

@@ -1,14 +1,18 @@
-//! Measured topographies through the library's readers (`asperity import` / `stats FILE`):
-//! X3P, SDF, text and Gwyddion matrices, x y z lists, profiles, SUR, PLU, OPD, DI, AL3D,
-//! MetroPro, FRT, WSxM, TMD and `.npy`, detected by content first, then by extension.
+//! Measured topographies through the front-end layer's one call
+//! (`asperity_app::measured::open`, the one `asperity import` / `stats FILE` use): X3P, SDF,
+//! text and Gwyddion matrices, x y z lists, profiles, SUR, PLU, OPD, DI, AL3D, MetroPro,
+//! FRT, WSxM, TMD and `.npy`, detected by content first, then by extension; levelled and
+//! filled as asked, with the CLI's warnings.
 
 use std::path::PathBuf;
 
-use asperity::topography::{read_file, ChannelChoice, Heights, ReadOptions};
+use asperity::topography::{Fill, Heights};
+use asperity_app::measured::{open, MeasuredRequest, WarningKind};
+use asperity_app::Names;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 
-use crate::errors::from_error;
+use crate::errors::request_error;
 use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -16,30 +20,51 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Reads a measured file with the GIL released: the heights (rows × cols = y × x for a
-/// map, or a profile; metres where the file gives a length unit, NaN where undefined), the
-/// physical sizes (`[x, y]` or `[x]`) and the provenance as JSON (source, format, channel,
-/// channels, units, size source).
+/// What `read_topography` hands to Python: the heights, the sizes, the provenance (JSON)
+/// and the warnings as `(category, words)`.
+type Read = (Py<PyAny>, Vec<f64>, String, Vec<(&'static str, String)>);
+
+/// Reads and cleans a measured file with the GIL released: the heights (rows × cols = y × x
+/// for a map, or a profile; metres where the file gives a length unit, NaN where undefined
+/// and no filling was named), the physical sizes (`[x, y]` or `[x]`), the provenance as
+/// JSON (source, format, channel, channels, units, size source, cleaning) and the warnings
+/// (`unlevelled` or `unit`, with their words).
 #[pyfunction]
-#[pyo3(signature = (path, channel, size_x, size_y))]
+#[pyo3(signature = (path, channel, size_x, size_y, detrend, fill))]
 fn read_topography(
     py: Python<'_>,
     path: PathBuf,
     channel: Option<String>,
     size_x: Option<f64>,
     size_y: Option<f64>,
-) -> PyResult<(Py<PyAny>, Vec<f64>, String)> {
-    let options = ReadOptions {
-        channel: channel.map(|c| c.parse::<ChannelChoice>().unwrap_or_else(|e| match e {})),
+    detrend: Option<String>,
+    fill: Option<String>,
+) -> PyResult<Read> {
+    let request = MeasuredRequest {
+        channel,
         size: size_x.map(|x| [Some(x), size_y]),
-        ..ReadOptions::default()
+        detrend,
+        fill,
     };
-    let topography = run_detached(py, |_| read_file(&path, &options))?.map_err(from_error)?;
+    let opened =
+        run_detached(py, |_| open(&path, &request, Some(Fill::Keep)))?.map_err(request_error)?;
+    let warnings = opened
+        .warnings
+        .iter()
+        .map(|w| {
+            let category = match w.kind {
+                WarningKind::Unlevelled => "unlevelled",
+                WarningKind::NoUnit => "unit",
+            };
+            (category, w.words.words(Names::Keywords))
+        })
+        .collect();
+    let topography = opened.topography;
     let provenance =
         serde_json::to_string(&topography.provenance).expect("the provenance serialises");
     let heights = match topography.heights {
         Heights::Areal(h) => h.into_pyarray(py).into_any().unbind(),
         Heights::Profile(h) => h.into_pyarray(py).into_any().unbind(),
     };
-    Ok((heights, topography.sizes, provenance))
+    Ok((heights, topography.sizes, provenance, warnings))
 }

@@ -60,8 +60,14 @@ def test_stats_and_psd_equal_the_cli(cli, tmp_path):
     s = asperity.surface(64, hurst=0.8, rolloff=2, seed=4, size=3)
     s.save(tmp_path / "s.npy")
     report = json.loads(cli("stats", tmp_path / "s.npy", "--json", "--psd", tmp_path / "psd.csv").stdout)
-    assert asperity.stats(s) == report["stats"]
+    ours = asperity.stats(s)
+    assert {k: ours[k] for k in report["stats"]} == report["stats"]
+    # The default fit range is one rule (it was 1 in Python, 2 in the CLI).
+    for key in ("psd_slope", "psd_slope_low", "psd_slope_high", "fit_from", "fit_to",
+                "fit_note", "hurst_estimate", "iso"):
+        assert ours[key] == report[key], key
     table = read_csv(tmp_path / "psd.csv")
+    assert asperity.psd(s).fit["exponent"] == report["psd_slope"]
     spectrum = asperity.psd(s, fit_from=report["fit_from"], fit_to=report["fit_to"])
     assert spectrum.q.tolist() == table["q"]
     assert spectrum.psd.tolist() == table["psd"]
@@ -71,7 +77,15 @@ def test_stats_and_psd_equal_the_cli(cli, tmp_path):
     line = asperity.line(1024, hurst=0.3, seed=2)
     line.save(tmp_path / "l.npy")
     report = json.loads(cli("stats", tmp_path / "l.npy", "--json").stdout)
-    assert asperity.stats(line) == report["stats"]
+    ours = asperity.stats(line)
+    assert {k: ours[k] for k in report["stats"]} == report["stats"]
+    assert (ours["psd_slope"], ours["fit_from"]) == (report["psd_slope"], report["fit_from"])
+    # A spec's roll-off above 2 sets the lower end, in both front ends.
+    knee = asperity.surface(64, hurst=0.8, rolloff=6, seed=4)
+    knee.save(tmp_path / "k.npy")
+    report = json.loads(cli("stats", tmp_path / "k.npy", "--json").stdout)
+    assert asperity.stats(knee)["fit_from"] == report["fit_from"] == 6
+    assert asperity.psd(knee).fit["exponent"] == report["psd_slope"]
 
 
 BEM_CASES = [

@@ -51,6 +51,10 @@ KEYWORDS = {
     "--dmax": "dmax",
     "--breakpoints": "breakpoints",
     "--min-contacts": "min_contacts",
+    "--fit-from": "fit_from",
+    "--fit-to": "fit_to",
+    "--detrend": "detrend",
+    "--fill": "fill",
 }
 
 
@@ -192,9 +196,38 @@ MDR = [
 ]
 
 
+# asperity stats (on the 32 × 32 surface: Nyquist at q·L/2π = 16): (flags, keywords,
+# expected words in keywords).
+STATS = [
+    (["--fit-from", "-1"], dict(fit_from=-1),
+     "invalid fit_from: must be a positive number of wavelengths per side, got -1"),
+    (["--fit-to", "0"], dict(fit_to=0), "invalid fit_to: must be a positive number"),
+    (["--fit-from", "nan"], dict(fit_from=NAN), "got NaN"),
+    (["--fit-from", "8", "--fit-to", "4"], dict(fit_from=8, fit_to=4),
+     "invalid PSD fit range: fit_from 8 must be below fit_to 4"),
+    (["--fit-from", "20"], dict(fit_from=20),
+     "invalid fit_from 20: the PSD fit range would be empty, its upper end is 16 (Nyquist); "
+     "give a smaller fit_from"),
+    (["--fit-to", "1.5"], dict(fit_to=1.5),
+     "invalid fit_to 1.5: the PSD fit range would be empty, its lower end is 2 (the default "
+     "lower end); give a larger fit_to or a smaller fit_from"),
+]
+
+# A measured file's cleaning (every command that reads one; Python's read_topography):
+# (flags, keywords, expected words in keywords).
+MEASURED = [
+    (["--detrend", "tilt"], dict(detrend="tilt"),
+     'detrend must be one of none, mean, plane, poly2, poly3, lines, line-means, got "tilt"'),
+    (["--fill", "zero"], dict(fill="zero"),
+     'fill must be harmonic (Laplace inpainting) or refuse, got "zero"'),
+]
+
+ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED
+
+
 def test_the_table_covers_every_rule_of_every_command_moved():
-    assert len(BEM) + len(CONTACT) + len(SURFACE) + len(MDR) >= 30
-    fragments = [row[-1] for row in BEM + CONTACT + SURFACE + MDR]
+    assert len(ALL) >= 30
+    fragments = [row[-1] for row in ALL]
     assert all(fragments)
 
 
@@ -257,6 +290,27 @@ def test_mdr_refuses_alike(cli, tmp_path, flags, kwargs, words):
     assert words in ours
 
 
+@pytest.mark.parametrize("flags,kwargs,words", STATS)
+def test_stats_refuses_alike(cli, heights, flags, kwargs, words):
+    array, path = heights
+    theirs = in_keywords(cli_error(cli("stats", path, *flags, ok=False)))
+    ours = python_words(lambda: asperity.stats(array, **kwargs))
+    assert ours == theirs
+    assert words in ours
+    assert python_words(lambda: asperity.psd(array, **kwargs)) == ours
+
+
+@pytest.mark.parametrize("command", ["stats", "import", "contact"])
+@pytest.mark.parametrize("flags,kwargs,words", MEASURED)
+def test_measured_options_are_refused_alike(cli, heights, tmp_path, command, flags, kwargs, words):
+    _, path = heights
+    extra = {"import": ["--out", tmp_path / "t.npy"], "contact": ["--modulus", "1e9"]}
+    theirs = in_keywords(cli_error(cli(command, path, *flags, *extra.get(command, []), ok=False)))
+    ours = python_words(lambda: asperity.read_topography(path, **kwargs))
+    assert ours == theirs
+    assert words in ours
+
+
 @pytest.mark.parametrize("method,n,min_contacts", [("mdr", 32, 33), ("bem", 8, 65)])
 def test_a_fit_window_above_the_grid_is_refused_alike(cli, tmp_path, method, n, min_contacts):
     theirs = cli("study", "alpha", "--method", method, "--n", n, "--hurst", 0.5, "--samples", 1,
@@ -278,7 +332,7 @@ def test_contact_equals_the_cli(cli, tmp_path):
     cli("contact", tmp_path / "t.npy", "--young", 210e9, "--poisson", 0.3, "--pressures",
         "1e4,1e5", "--detrend", "none", "--out", tmp_path / "c.csv")
     theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
-    t = asperity.read_topography(tmp_path / "t.npy")
+    t = asperity.read_topography(tmp_path / "t.npy", detrend="none")
     ours = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e4, 1e5], map=True)
     for name in theirs.dtype.names:
         assert np.array_equal(ours[name], theirs[name]), name

@@ -1,6 +1,8 @@
-"""Measured topographies through the library's readers: Python reads what
-`asperity import` reads (heights bit for bit, sizes, provenance), bad files raise the CLI's
-one-line error, and a measured map with rectangular pixels goes straight to the Solver."""
+"""Measured topographies through the front-end layer's one call: Python reads what
+`asperity import` reads (heights bit for bit, sizes, provenance), levels and fills as the
+CLI does and warns where it warns, bad files raise the CLI's one-line error, a measured map
+with rectangular pixels goes straight to the Solver, and its statistics are the CLI's and
+SurfaceTopography's."""
 
 import json
 import os
@@ -30,7 +32,7 @@ def shared(name):
 @pytest.mark.parametrize("name", FILES)
 def test_python_reads_what_the_cli_imports(cli, tmp_path, name):
     path = shared(name)
-    t = asperity.read_topography(path)
+    t = asperity.read_topography(path, detrend="none")
     out = tmp_path / "t.npy"
     undefined = np.isnan(t.heights)
     # The CLI refuses undefined points unless they are filled; filling keeps the others.
@@ -74,3 +76,97 @@ def test_a_measured_map_with_rectangular_pixels_goes_to_the_solver(cli, tmp_path
     values = {k: float(v) for k, v in zip(header.split(","), row.split(",")) if v}
     assert result.area_fraction == values["area_fraction"]
     assert result.indentation == values["indentation"]
+
+
+# ------------------------------------------- statistics on rectangular pixels (issue 36)
+
+
+def test_stats_on_rectangular_pixels_equal_the_cli(cli):
+    """Python's stats of a measured map with rectangular pixels are the CLI's, bit for bit
+    (one code path); given the heights with one size, pixels are square by definition and
+    the numbers differ, which is why the Topography (or size=(x, y)) must be passed."""
+    path = shared("x3p-2.x3p")
+    report = json.loads(cli("stats", path, "--json").stdout)
+    t = asperity.read_topography(path)
+    ours = asperity.stats(t)
+    for key, value in report["stats"].items():
+        assert ours[key] == value, key
+    for key in ("psd_slope", "psd_slope_low", "psd_slope_high", "fit_from", "fit_to",
+                "hurst_estimate", "iso"):
+        assert ours[key] == report[key], key
+    assert ours["rms_curvature"] is not None
+    # size=(x, y) with the bare heights is the same request.
+    assert asperity.stats(t.heights, size=t.physical_sizes) == ours
+    spectrum = asperity.psd(t)
+    assert spectrum.fit["exponent"] == report["psd_slope"]
+    square = asperity.stats(t.heights, size=t.size)
+    assert square["rms_slope"] > 1.3 * ours["rms_slope"], "the drift issue 36 reported"
+
+
+def test_rms_slope_and_curvature_per_axis_equal_surface_topography():
+    """Against SurfaceTopography 1.27 on the measured map with rectangular pixels
+    (Δy/Δx = 2.46): along each axis alone (the map's own rows, or columns, repeated, so
+    that only that axis' spacing enters), and on the whole map."""
+    ST = pytest.importorskip("SurfaceTopography")
+    t = asperity.read_topography(shared("x3p-2.x3p"))
+    rows, cols = t.heights.shape
+    along_x = np.tile(t.heights[rows // 2], (rows, 1))           # varies along x only
+    along_y = np.tile(t.heights[:, cols // 2][:, None], (1, cols))  # along y only
+    for h in (along_x, along_y, t.heights):
+        theirs = ST.Topography(h.T.copy(), physical_sizes=t.physical_sizes, periodic=False)
+        ours = asperity.stats(h, size=t.physical_sizes)
+        # Half the rms five-point Laplacian on the interior points: the same definition.
+        assert ours["rms_curvature"] == pytest.approx(theirs.rms_curvature_from_area(), rel=1e-12)
+        if h is along_x:
+            assert ours["rms_slope"] == pytest.approx(theirs.rms_slope_from_profile(), rel=1e-12)
+        elif h is along_y:
+            flipped = ST.Topography(h.copy(), physical_sizes=t.physical_sizes[::-1], periodic=False)
+            assert ours["rms_slope"] == pytest.approx(flipped.rms_slope_from_profile(), rel=1e-12)
+        else:
+            # SurfaceTopography averages both differences over the same (rows-1)×(cols-1)
+            # cells, asperity each over all its pairs: one row or column of 650 apart.
+            assert ours["rms_slope"] == pytest.approx(theirs.rms_gradient(), rel=2e-3)
+    whole = asperity.stats(t)
+    assert whole["rms_curvature"] == asperity.stats(t.heights, size=t.physical_sizes)["rms_curvature"]
+
+
+def tilted_text_map(tmp_path):
+    """A tilted map in a text matrix (no unit, no size in the file)."""
+    rng = np.random.default_rng(5)
+    y, x = np.mgrid[0:40, 0:50]
+    path = tmp_path / "tilted.txt"
+    np.savetxt(path, 1e-6 * (0.05 * x + 0.02 * y) + 1e-8 * rng.standard_normal((40, 50)))
+    return path
+
+
+def test_unlevelled_data_warn_in_python_as_in_the_cli(cli, tmp_path):
+    path = tilted_text_map(tmp_path)
+    err = cli("stats", path, "--size", "5e-5,4e-5").stderr
+    theirs = [l[len("warning: "):].replace("--detrend", "detrend")
+              for l in err.splitlines() if l.startswith("warning: ")]
+    with pytest.warns(asperity.AsperityWarning) as caught:
+        asperity.read_topography(path, size=(5e-5, 4e-5))
+    assert [str(w.message) for w in caught] == theirs
+    assert [w.category for w in caught] == [asperity.UnlevelledWarning, asperity.UnitWarning]
+    assert "looks tilted" in theirs[0] and "(choose detrend)" in theirs[0]
+    # A chosen levelling removes the tilt and the warning; the category can be filtered.
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", asperity.UnlevelledWarning)
+        warnings.simplefilter("ignore", asperity.UnitWarning)
+        t = asperity.read_topography(path, size=(5e-5, 4e-5), detrend="plane")
+        with pytest.raises(asperity.UnlevelledWarning):
+            asperity.read_topography(path, size=(5e-5, 4e-5))
+    report = json.loads(cli("stats", path, "--size", "5e-5,4e-5", "--detrend", "plane",
+                            "--json").stdout)
+    assert t.provenance["cleaning"] == report["measured"]["cleaning"] != []
+    assert asperity.stats(t)["rms_slope"] == report["stats"]["rms_slope"]
+
+
+def test_filling_undefined_points_is_the_cli_s(cli, tmp_path):
+    path = shared("x3p-2.x3p")
+    t = asperity.read_topography(path, detrend="plane", fill="harmonic")
+    report = json.loads(cli("stats", path, "--detrend", "plane", "--fill", "harmonic",
+                            "--json").stdout)
+    assert t.provenance["cleaning"] == report["measured"]["cleaning"]
+    assert asperity.stats(t)["iso"] == report["iso"]

@@ -29,8 +29,10 @@
 pub mod bem;
 pub mod contact;
 pub mod mdr;
+pub mod measured;
 pub mod range;
 pub mod refusal;
+pub mod stats;
 pub mod study;
 pub mod surface;
 

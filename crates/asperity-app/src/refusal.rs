@@ -76,6 +76,12 @@ impl Refusal {
         self
     }
 
+    /// The pieces of `other` appended.
+    pub fn join(mut self, other: &Refusal) -> Self {
+        self.parts.extend(other.parts.iter().cloned());
+        self
+    }
+
     /// The line, with every parameter named as `names` says.
     pub fn words(&self, names: Names) -> String {
         self.parts

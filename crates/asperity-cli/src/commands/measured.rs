@@ -1,12 +1,15 @@
 //! Measured topographies in every command: the shared options (`--channel`, `--detrend`,
-//! `--fill`, `--size`) and the loading of an instrument file into a levelled, filled
-//! surface or line with its provenance. Warnings (a tilt left in place) go to stderr.
+//! `--fill`, `--size`) turned into the front-end layer's request, opened by its one call
+//! ([`asperity_app::measured::open`]). Warnings (a tilt left in place) go to stderr.
 
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use asperity::topography::level::Detrend;
-use asperity::topography::{self, ChannelChoice, Fill, Levelling, ReadOptions, Topography};
+use asperity::topography::Topography;
+use asperity_app::measured::{open, parse_detrend, parse_fill, MeasuredRequest};
+use asperity_app::Names;
+
+pub use asperity_app::measured::record;
 
 /// Options for reading a measured file (ignored for `.npy` made by asperity, except
 /// `--size`).
@@ -20,25 +23,27 @@ pub struct MeasuredArgs {
     /// poly3 (polynomial of degree 2, 3 in x and y), lines (each scan line's least-squares
     /// line), line-means (each scan line's mean). Without it a tilted surface is used as
     /// it is, with a warning.
-    #[arg(long, value_name = "HOW", value_parser = ["none", "mean", "plane", "poly2", "poly3", "lines", "line-means"])]
+    #[arg(long, value_name = "HOW")]
     pub detrend: Option<String>,
     /// Undefined points of a measured file: harmonic (Laplace inpainting) or refuse (an
     /// error with their count, also the default).
-    #[arg(long, value_name = "HOW", value_parser = ["harmonic", "refuse"])]
+    #[arg(long, value_name = "HOW")]
     pub fill: Option<String>,
 }
 
-/// The `--detrend` choice (`None`: not given; `Some(None)`: `none`).
-fn detrend(args: &MeasuredArgs) -> Option<Option<Detrend>> {
-    args.detrend.as_deref().map(|d| match d {
-        "mean" => Some(Detrend::Mean),
-        "plane" => Some(Detrend::Polynomial(1)),
-        "poly2" => Some(Detrend::Polynomial(2)),
-        "poly3" => Some(Detrend::Polynomial(3)),
-        "lines" => Some(Detrend::RowLines),
-        "line-means" => Some(Detrend::RowMeans),
-        _ => None,
-    })
+impl MeasuredArgs {
+    /// Refuses a levelling or filling that is none of the names, whether or not the
+    /// surface turns out to be a measured file.
+    pub fn check(&self) -> Result<()> {
+        let named = |r: asperity_app::Refusal| anyhow::anyhow!(r.words(Names::Flags));
+        if let Some(name) = &self.detrend {
+            parse_detrend(name).map_err(named)?;
+        }
+        if let Some(name) = &self.fill {
+            parse_fill(name).map_err(named)?;
+        }
+        Ok(())
+    }
 }
 
 /// Parses `--size X[,Y]` (metres for a measured file).
@@ -81,54 +86,23 @@ pub fn has_import_sidecar(path: &Path) -> bool {
         .is_some_and(|v| v["sizes"].is_array())
 }
 
-/// Reads `path` (any supported format) and cleans it as the options say; prints the
-/// warnings to stderr. `size` is `--size` as given.
+/// Reads `path` (any supported format) and cleans it as the options say (undefined points
+/// without `--fill` are refused); prints the warnings to stderr. `size` is `--size` as
+/// given.
 pub fn load(path: &Path, args: &MeasuredArgs, size: Option<&str>) -> Result<Topography> {
-    let options = ReadOptions {
-        channel: args
-            .channel
-            .as_deref()
-            .map(|c| c.parse::<ChannelChoice>().expect("infallible")),
+    let request = MeasuredRequest {
+        channel: args.channel.clone(),
         size: size.map(parse_size).transpose()?,
-        ..ReadOptions::default()
+        detrend: args.detrend.clone(),
+        fill: args.fill.clone(),
     };
-    let mut topography = topography::read_file(path, &options)?;
-    let fill = match args.fill.as_deref() {
-        Some("harmonic") => Some(Fill::Harmonic),
-        Some(_) => Some(Fill::Refuse),
-        None => None,
-    };
-    let levelling = match detrend(args) {
-        Some(Some(d)) => Levelling::By(d),
-        Some(None) => Levelling::None,
-        None => Levelling::Unchosen,
-    };
-    let warnings = topography::clean(&mut topography, levelling, fill)?;
-    for w in warnings {
-        eprintln!("warning: {}: {w} (choose --detrend)", path.display());
-    }
-    if topography.provenance.unit.is_none() && topography.provenance.format != "npy" {
+    let opened = open(path, &request, None).map_err(crate::request::refused)?;
+    for w in &opened.warnings {
         eprintln!(
-            "warning: {}: the file gives no unit; its numbers are used as metres",
-            path.display()
+            "warning: {}: {}",
+            path.display(),
+            w.words.words(Names::Flags)
         );
     }
-    Ok(topography)
-}
-
-/// The provenance record written to sidecars.
-pub fn record(t: &Topography) -> serde_json::Value {
-    serde_json::json!({
-        "source": t.provenance.source,
-        "format": t.provenance.format,
-        "channel": t.provenance.channel,
-        "channel_index": t.provenance.channel_index,
-        "channels": t.provenance.channels,
-        "file_unit": t.provenance.file_unit,
-        "unit": t.provenance.unit.clone().unwrap_or_else(|| "m (assumed: the file gives none)".into()),
-        "shape": t.heights.shape(),
-        "sizes": t.sizes,
-        "size_source": t.provenance.size_source,
-        "cleaning": t.provenance.cleaning,
-    })
+    Ok(opened.topography)
 }

@@ -21,13 +21,31 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Surface(args) => surface::run_surface(&args),
         Command::Line(args) => surface::run_line(&args),
-        Command::Stats(args) => stats::run(&args),
-        Command::Bem(args) => bem::run(&args),
-        Command::Mdr(args) => mdr::run(&args),
+        Command::Stats(args) => {
+            args.measured.check()?;
+            stats::run(&args)
+        }
+        Command::Bem(args) => {
+            args.measured.check()?;
+            bem::run(&args)
+        }
+        Command::Mdr(args) => {
+            args.measured.check()?;
+            mdr::run(&args)
+        }
         Command::Study(args) => study::run(&args),
-        Command::Import(args) => import::run(&args),
-        Command::Contact(args) => contact::run(&args),
-        Command::Persson(args) => persson::run(&args),
+        Command::Import(args) => {
+            args.measured.check()?;
+            import::run(&args)
+        }
+        Command::Contact(args) => {
+            args.measured.check()?;
+            contact::run(&args)
+        }
+        Command::Persson(args) => {
+            args.measured.check()?;
+            persson::run(&args)
+        }
         Command::Bench(args) => bench::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     }

@@ -415,6 +415,8 @@ pub enum Fill {
     Harmonic,
     /// Refuse a topography with undefined points, giving their count.
     Refuse,
+    /// Keep undefined points undefined (NaN): what uses the heights next refuses them.
+    Keep,
 }
 
 /// The levelling [`clean`] applies.
@@ -449,7 +451,7 @@ pub fn clean(
             ),
         ));
     }
-    if undefined > 0 && fill != Some(Fill::Harmonic) {
+    if undefined > 0 && !matches!(fill, Some(Fill::Harmonic | Fill::Keep)) {
         let how = if fill.is_none() {
             "no filling was chosen"
         } else {
@@ -477,7 +479,7 @@ pub fn clean(
             }
         }
     }
-    if undefined > 0 {
+    if undefined > 0 && fill == Some(Fill::Harmonic) {
         let filled = inpaint::fill_harmonic(&mut topography.heights, &spacings)?;
         topography.provenance.cleaning.push(format!(
             "filled {filled} undefined points by harmonic (Laplace) inpainting"

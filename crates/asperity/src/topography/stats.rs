@@ -290,6 +290,28 @@ pub fn rms_slope_forward(h: ArrayView2<f64>, dx: f64, dy: f64) -> f64 {
     (mean_square(ny * (nx - 1), sx) + mean_square(nx * (ny - 1), sy)).sqrt()
 }
 
+/// rms mean curvature of a map on pixels `dx` × `dy` (rectangular allowed): half the rms of
+/// the five-point Laplacian `(h[r,c+1] − 2h[r,c] + h[r,c−1])/Δx² + (h[r+1,c] − 2h[r,c] +
+/// h[r−1,c])/Δy²` over the interior points, the definition of [`crate::surface::stats`]
+/// with a spacing per axis; `None` below 3 × 3 points.
+pub fn rms_curvature(h: ArrayView2<f64>, dx: f64, dy: f64) -> Option<f64> {
+    let (rows, cols) = h.dim();
+    if rows < 3 || cols < 3 {
+        return None;
+    }
+    let (wx, wy) = (1.0 / (dx * dx), 1.0 / (dy * dy));
+    let mut sum = 0.0;
+    for r in 1..rows - 1 {
+        for c in 1..cols - 1 {
+            let centre = 2.0 * h[[r, c]];
+            let lap = (h[[r, c + 1]] - centre + h[[r, c - 1]]) * wx
+                + (h[[r + 1, c]] - centre + h[[r - 1, c]]) * wy;
+            sum += lap * lap;
+        }
+    }
+    Some(0.5 * (sum / ((rows - 2) * (cols - 2)) as f64).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -457,6 +479,32 @@ mod tests {
             1e-15,
             "slope 4",
         );
+    }
+
+    #[test]
+    fn curvature_on_rectangular_pixels_is_exact_for_a_quadratic() {
+        // h = a x² + b y²: the five-point Laplacian is exactly 2a + 2b at every interior
+        // point, on any pixels, so the rms mean curvature is |a + b|.
+        let (dx, dy, a, b) = (0.3, 0.7, 1.5, -0.25);
+        let h = Array2::from_shape_fn((7, 11), |(r, c)| {
+            let (x, y) = (c as f64 * dx, r as f64 * dy);
+            a * x * x + b * y * y
+        });
+        close(
+            rms_curvature(h.view(), dx, dy).unwrap(),
+            a + b,
+            1e-12,
+            "quadratic",
+        );
+        // On square pixels, the crate's definition.
+        let rough = Array2::from_shape_fn((9, 13), |(r, c)| ((r * 5 + c * 3) as f64 * 0.7).sin());
+        close(
+            rms_curvature(rough.view(), 0.25, 0.25).unwrap(),
+            crate::surface::stats::rms_curvature_2d(rough.view(), 0.25).unwrap(),
+            1e-13,
+            "square pixels",
+        );
+        assert_eq!(rms_curvature(Array2::zeros((2, 5)).view(), 1.0, 1.0), None);
     }
 
     #[test]
