@@ -6,7 +6,8 @@
 //! refuse the same requests in the same words.
 
 use asperity::mdr::{
-    log_spaced, Axisymmetric, CurvePoint, Foundation, LinearCurve, RadialProfile, Spring, SpringLaw,
+    log_spaced, AdhesiveLine, Axisymmetric, CurvePoint, Foundation, LinearCurve, PullOffs,
+    RadialProfile, Spring, SpringLaw,
 };
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::rms_height;
@@ -57,6 +58,8 @@ pub mod params {
     pub const DMAX: Param = Param::new("--dmax", "dmax");
     /// The exact curve of linear springs on a line.
     pub const BREAKPOINTS: Param = Param::new("--breakpoints", "breakpoints");
+    /// The work of adhesion Δγ (Heß's rule).
+    pub const WORK_OF_ADHESION: Param = Param::new("--work-of-adhesion", "work_of_adhesion");
 }
 
 use params::*;
@@ -162,6 +165,10 @@ pub struct MdrRequest {
     pub dmax: Option<f64>,
     /// The exact curve of linear springs on a line.
     pub breakpoints: bool,
+    /// The work of adhesion Δγ: springs stick by Heß's rule, the indentations are a load
+    /// path, and a retraction to pull-off follows ([`MdrRequest::compute_adhesive`]).
+    #[serde(default)]
+    pub work_of_adhesion: Option<f64>,
 }
 
 impl Default for MdrRequest {
@@ -189,6 +196,7 @@ impl Default for MdrRequest {
             dmin: None,
             dmax: None,
             breakpoints: false,
+            work_of_adhesion: None,
         }
     }
 }
@@ -237,11 +245,33 @@ impl MdrRequest {
                 .text(" and ")
                 .param(NLOADS));
         }
+        self.check_adhesion()?;
         if self.indentations.is_some() && self.nloads.is_some() {
             return Err(Refusal::saying("give at most one of ")
                 .param(INDENTATIONS)
                 .text(" and ")
                 .param(NLOADS));
+        }
+        Ok(())
+    }
+
+    /// With a work of adhesion: positive and finite, linear springs, no breakpoints.
+    fn check_adhesion(&self) -> Result<(), Refusal> {
+        let Some(w) = self.work_of_adhesion else {
+            return Ok(());
+        };
+        if !(w.is_finite() && w > 0.0) {
+            return Err(Refusal::saying("invalid ")
+                .param(WORK_OF_ADHESION)
+                .text(format!(
+                    ": the work of adhesion Δγ must be positive and finite, got {w}"
+                )));
+        }
+        if self.spring != "linear" || self.breakpoints {
+            return Err(Refusal::of(WORK_OF_ADHESION).text(
+                " needs linear springs and a list of indentations or nloads (Heß's rule holds \
+                 for springs of stiffness E*·Δx; the retraction's exact curve is always written)",
+            ));
         }
         Ok(())
     }
@@ -399,10 +429,20 @@ impl MdrRequest {
         row_bytes: usize,
     ) -> Result<Vec<f64>, RequestError> {
         if let Some(list) = &self.indentations {
-            if let Some(bad) = list.iter().find(|d| !d.is_finite() || **d < 0.0) {
+            // An adhesive load path may retract past first contact (d < 0).
+            let adhesive = self.work_of_adhesion.is_some();
+            if let Some(bad) = list
+                .iter()
+                .find(|d| !d.is_finite() || (**d < 0.0 && !adhesive))
+            {
+                let rule = if adhesive {
+                    "finite"
+                } else {
+                    "finite and >= 0"
+                };
                 let refusal = Refusal::saying("invalid ")
                     .param(INDENTATIONS)
-                    .text(format!(": each must be finite and >= 0, got {bad}"));
+                    .text(format!(": each must be {rule}, got {bad}"));
                 return Err(refusal.into());
             }
             return Ok(list.clone());
@@ -480,6 +520,82 @@ impl MdrRequest {
 /// The columns of an MDR curve.
 pub const COLUMNS: [&str; 4] = ["indentation", "force", "stiffness", "contacts"];
 
+/// The columns of an adhesive MDR curve: [`COLUMNS`] and the branch.
+pub const ADHESIVE_COLUMNS: [&str; 5] = ["indentation", "force", "stiffness", "contacts", "branch"];
+
+/// Whether a row of an adhesive curve was reached going in or coming out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Branch {
+    /// The indentation grew (or stayed): springs attach as they are pressed.
+    Approach,
+    /// The indentation fell: springs let go by Heß's rule.
+    Retract,
+}
+
+impl Branch {
+    /// `approach` or `retract`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Branch::Approach => "approach",
+            Branch::Retract => "retract",
+        }
+    }
+}
+
+impl MdrRequest {
+    /// The adhesive curve (a work of adhesion given): the indenter follows the
+    /// indentations in their order (a load path: any finite values, up and down), every
+    /// release on the way reported, then retracts until the last spring lets go (the exact
+    /// curve, [`AdhesiveLine::retract`]). Returns the path and the pull-offs (`None` if
+    /// nothing was in contact at the end of the path).
+    pub fn compute_adhesive(
+        &self,
+        indenter: &Indenter,
+        row_bytes: usize,
+        emit: &mut dyn FnMut(CurvePoint, Branch),
+    ) -> Result<(Vec<f64>, Option<PullOffs>), RequestError> {
+        let w = self.work_of_adhesion.unwrap_or_default();
+        let (spacing, modulus) = (indenter.spacing, self.modulus);
+        let mut line = if indenter.is_line {
+            AdhesiveLine::from_heights(&indenter.values, spacing, modulus, w)
+        } else {
+            AdhesiveLine::from_profile(&indenter.values, spacing, modulus, w)
+        }
+        .map_err(invalid)?;
+        let spring = Spring::new(SpringLaw::Linear, spacing, modulus).map_err(invalid)?;
+        let foundation = if indenter.is_line {
+            Foundation::from_heights(&indenter.values, spring)
+        } else {
+            Foundation::from_profile(&indenter.values, spring)
+        }
+        .map_err(invalid)?;
+        let levels = self.levels(&foundation, row_bytes)?;
+        // Each retraction reports two rows per release, at most one release per spring
+        // attached before it: one full retraction's rows besides the path's.
+        ensure_rows_fit(
+            levels.len() + 2 * indenter.values.len(),
+            INDENTATIONS,
+            row_bytes,
+        )?;
+        let mut last = 0.0;
+        for &d in &levels {
+            let branch = if d >= last {
+                Branch::Approach
+            } else {
+                Branch::Retract
+            };
+            let point = line
+                .move_to(d, &mut |p| emit(p, Branch::Retract))
+                .map_err(invalid)?;
+            emit(point, branch);
+            last = d;
+        }
+        let pull_offs = line.retract(&mut |p| emit(p, Branch::Retract));
+        Ok((levels, pull_offs))
+    }
+}
+
 /// Refuses `rows` output rows of `per_row` bytes that would not fit in memory.
 fn ensure_rows_fit(rows: usize, param: Param, per_row: usize) -> Result<(), RequestError> {
     let what = format!("{rows} rows of about {per_row} bytes");
@@ -552,5 +668,92 @@ mod tests {
             points,
             vec![foundation.evaluate(1e-4), foundation.evaluate(1e-3)]
         );
+    }
+
+    #[test]
+    fn an_adhesive_sphere_retracts_to_the_jkr_pull_off() {
+        let request = MdrRequest {
+            profile: Some("hertz".into()),
+            radius: Some(1.0),
+            n: Some(1001),
+            dx: Some(1e-3),
+            indentations: Some(vec![0.01, 0.09, 0.05]),
+            work_of_adhesion: Some(1e-3),
+            ..MdrRequest::default()
+        };
+        request.check().unwrap();
+        let indenter = request.closed_form().unwrap();
+        let mut rows = Vec::new();
+        let (levels, pull_offs) = request
+            .compute_adhesive(&indenter, 0, &mut |p, b| rows.push((p, b)))
+            .unwrap();
+        assert_eq!(levels, vec![0.01, 0.09, 0.05]);
+        assert_eq!(rows[0].1, Branch::Approach);
+        assert_eq!(rows.last().unwrap().1, Branch::Retract);
+        assert_eq!(rows.last().unwrap().0.contacts, 0);
+        let jkr = asperity::reference::Jkr::new(1.0, 1.0, 1e-3).unwrap();
+        let expected = jkr.pull_off_force(asperity::reference::PullOff::ForceControlled);
+        let force = pull_offs.unwrap().force_controlled.force;
+        assert!(
+            (force / expected - 1.0).abs() < 1e-3,
+            "{force} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn adhesion_is_refused_in_one_set_of_words() {
+        let base = MdrRequest {
+            profile: Some("hertz".into()),
+            radius: Some(1.0),
+            n: Some(11),
+            dx: Some(0.1),
+            ..MdrRequest::default()
+        };
+        for w in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let request = MdrRequest {
+                work_of_adhesion: Some(w),
+                ..base.clone()
+            };
+            let words = request.check().unwrap_err().words(Names::Keywords);
+            assert_eq!(
+                words,
+                format!("invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got {w}")
+            );
+        }
+        let hertz_springs = MdrRequest {
+            work_of_adhesion: Some(1.0),
+            spring: "hertz".into(),
+            ..base.clone()
+        };
+        let words = hertz_springs.check().unwrap_err().to_string();
+        assert!(
+            words.starts_with("--work-of-adhesion needs linear springs"),
+            "{words}"
+        );
+        // A path may go below first contact with adhesion, not without.
+        let path = MdrRequest {
+            indentations: Some(vec![0.01, -0.01]),
+            ..base.clone()
+        };
+        let indenter = path.closed_form().unwrap();
+        let err = path
+            .compute(
+                &indenter,
+                Spring::new(SpringLaw::Linear, 0.1, 1.0).unwrap(),
+                0,
+                &mut |_| {},
+            )
+            .unwrap_err();
+        assert!(
+            err.to_string().contains("finite and >= 0, got -0.01"),
+            "{err}"
+        );
+        let adhesive = MdrRequest {
+            work_of_adhesion: Some(1e-3),
+            ..path
+        };
+        assert!(adhesive
+            .compute_adhesive(&indenter, 0, &mut |_, _| {})
+            .is_ok());
     }
 }

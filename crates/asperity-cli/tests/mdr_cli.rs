@@ -955,3 +955,77 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
         .contains("<svg"));
     assert_eq!(names(d), ["c.csv", "c.csv.json", "old.svg"]);
 }
+
+#[test]
+fn adhesive_sphere_loop_lets_go_at_the_jkr_pull_offs() {
+    // R = 1, E* = 1, Δγ = 1e-3 on 1001 springs Δx = 1e-3 apart: the force-controlled
+    // pull-off radius is 152 Δx, the displacement-controlled one 73 Δx (library tests:
+    // 4e-5 and 4.5e-3 at this Δx).
+    let dir = tempfile::tempdir().unwrap();
+    let out = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "1001",
+            "--dx",
+            "1e-3",
+            "--work-of-adhesion",
+            "1e-3",
+            "--indentations",
+            "0.02,0.09,0.05",
+            "--out",
+            "jkr.csv",
+            "--plot",
+            "jkr.svg",
+        ],
+        dir.path(),
+    );
+    ok(&out);
+    let text = std::fs::read_to_string(dir.path().join("jkr.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("indentation,force,stiffness,contacts,branch")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0][4], "approach");
+    assert_eq!(rows[1][4], "approach");
+    assert_eq!(rows.last().unwrap()[3], "0");
+    let least = rows
+        .iter()
+        .map(|r| r[1].parse::<f64>().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    let expected = -1.5 * std::f64::consts::PI * 1e-3;
+    assert!((least / expected - 1.0).abs() < 1e-3, "{least}");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("jkr.csv.json")).unwrap())
+            .unwrap();
+    let pull = &record["adhesion"]["pull_off"];
+    let force = pull["force_controlled"]["force"].as_f64().unwrap();
+    assert!((force / least - 1.0).abs() < 1e-6, "{force} vs {least}");
+    let displacement = pull["displacement_controlled"]["force"].as_f64().unwrap();
+    let expected = -5.0 / 6.0 * std::f64::consts::PI * 1e-3;
+    assert!(
+        (displacement / expected - 1.0).abs() < 1e-2,
+        "{displacement}"
+    );
+    assert!(stderr(&out).contains("pull-off: force control F = "));
+    assert!(dir.path().join("jkr.svg").exists());
+    // Refusals: one line, before any output.
+    for (w, words) in [
+        ("0", "invalid --work-of-adhesion: the work of adhesion Δγ must be positive and finite, got 0"),
+        ("nan", "invalid --work-of-adhesion: the work of adhesion Δγ must be positive and finite, got NaN"),
+    ] {
+        let out = asperity(
+            &["mdr", "--profile", "hertz", "--radius", "1", "--n", "11", "--dx", "0.1",
+              "--work-of-adhesion", w, "--out", "no.csv"],
+            dir.path(),
+        );
+        refused(&out, words);
+        assert!(!dir.path().join("no.csv").exists());
+    }
+}

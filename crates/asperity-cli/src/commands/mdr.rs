@@ -9,8 +9,9 @@ use asperity::io::{read_npy_1d, sidecar_path, StagedOutputs};
 use serde_json::json;
 
 use super::measured::{has_import_sidecar, is_npy, load, record, MeasuredArgs};
-use asperity::mdr::{CurvePoint, Spring, SpringLaw};
-use asperity_app::mdr::{Indenter, MdrRequest, COLUMNS};
+use asperity::mdr::{CurvePoint, PullOffs, Spring, SpringLaw};
+use asperity::reference::Jkr;
+use asperity_app::mdr::{Branch, Indenter, MdrRequest, ADHESIVE_COLUMNS, COLUMNS};
 
 use crate::request::refused;
 
@@ -28,7 +29,8 @@ use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
     asperity mdr --profile cone --slope 0.2 --n 4001 --dx 1e-3 --nloads 20 --out cone.csv\n  \
     asperity mdr --radial tip.npy --radial-step 1e-3 --n 1001 --dx 1e-3 --nloads 30\n  \
     asperity mdr --line line.npy --nloads 40 --out curve.csv --plot curve.svg\n  \
-    asperity mdr --line profile.csv --detrend mean --modulus 1e9 --nloads 20 --out curve.csv\n\n\
+    asperity mdr --line profile.csv --detrend mean --modulus 1e9 --nloads 20 --out curve.csv\n  \
+    asperity mdr --profile hertz --radius 1 --n 1001 --dx 1e-3 --work-of-adhesion 1e-3 --indentations 0.09 --out jkr.csv --plot jkr.svg\n\n\
     Output columns: indentation, force, stiffness, contacts. Indentation is measured from \
     first contact (the highest point of a line, the tip of an indenter). With --out, \
     OUT.csv.json records the inputs.")]
@@ -112,6 +114,16 @@ pub struct MdrArgs {
     /// that is 0, and k = 0.
     #[arg(long)]
     pub breakpoints: bool,
+    /// Work of adhesion Δγ (energy per area, in the units of E*·length; J/m² with E* in Pa
+    /// and lengths in m): springs stick once pressed and let go from the edges of each
+    /// contact at the elongation √(2πaΔγ/E*) (Heß's rule; JKR for a sphere, Kendall for a
+    /// punch). Linear springs only. The indentations become a load path (in their order,
+    /// negative allowed), after which the indenter retracts until the last spring lets go;
+    /// the retraction's exact curve is written (a row just before and after each release)
+    /// with a fifth column, branch (approach|retract), and both pull-off forces (force
+    /// and displacement control) go to standard error and OUT.csv.json.
+    #[arg(long, value_name = "DGAMMA", allow_hyphen_values = true)]
+    pub work_of_adhesion: Option<f64>,
     /// Output CSV (default: standard output). Its inputs go to OUT.csv.json beside it
     /// (indenter and where it came from, springs, E*, spring law, indentations, columns).
     #[arg(long, value_name = "OUT.csv")]
@@ -155,6 +167,7 @@ fn request(args: &MdrArgs) -> MdrRequest {
         dmin: args.dmin,
         dmax: args.dmax,
         breakpoints: args.breakpoints,
+        work_of_adhesion: args.work_of_adhesion,
     }
 }
 
@@ -275,6 +288,10 @@ fn check_plot(args: &MdrArgs) -> Result<()> {
         return Ok(());
     };
     ImageFormat::from_path(plot, "--plot")?;
+    if args.work_of_adhesion.is_some() {
+        // The retraction to pull-off is a curve whatever the path.
+        return Ok(());
+    }
     let count = match (&args.indentations, args.nloads) {
         (Some(list), _) => list.len(),
         (None, Some(n)) if !args.breakpoints => n,
@@ -315,6 +332,25 @@ fn record_of(
     })
 }
 
+/// A pull-off point as the record writes it.
+fn point_json(p: &CurvePoint) -> serde_json::Value {
+    json!({ "force": p.force, "indentation": p.indentation, "contacts": p.contacts })
+}
+
+/// The adhesion part of OUT.csv.json.
+fn adhesion_record(w: f64, pull_offs: Option<&PullOffs>) -> serde_json::Value {
+    json!({
+        "work_of_adhesion": w,
+        "rule": "Heß: springs attach when pressed; the ends of a contact of half-width a let \
+                 go at the edge elongation sqrt(2π a Δγ / E*)",
+        "pull_off": pull_offs.map(|p| json!({
+            "force_controlled": point_json(&p.force_controlled),
+            "displacement_controlled": point_json(&p.displacement_controlled),
+        })),
+        "columns": ADHESIVE_COLUMNS,
+    })
+}
+
 /// Runs `asperity mdr`: check, compute, then write every output together.
 pub fn run(args: &MdrArgs) -> Result<()> {
     // Every output is checked before any work, and all are written together at the end.
@@ -328,6 +364,9 @@ pub fn run(args: &MdrArgs) -> Result<()> {
         staged.ensure_not_input(input)?;
     }
     let indenter = load_indenter(args, &request)?;
+    if let Some(w) = args.work_of_adhesion {
+        return run_adhesive(args, &request, &indenter, w, staged, record_path.as_deref());
+    }
     let law = request.spring_law(&indenter)?;
     let spring = Spring::new(law, indenter.spacing, args.modulus)?;
     let mut table = Table::new(&COLUMNS);
@@ -377,6 +416,152 @@ pub fn run(args: &MdrArgs) -> Result<()> {
         ),
         None => match std::io::stdout().write_all(&table.to_csv()?) {
             // A closed pipe (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+            other => other?,
+        },
+    }
+    Ok(())
+}
+
+/// The F–d panel of an adhesive loop: approach and retraction (from the last point of the
+/// approach on), JKR's curve for a sphere (dashed), the pull-offs marked.
+fn loop_chart(
+    points: &[(CurvePoint, Branch)],
+    pull: Option<&PullOffs>,
+    jkr: Option<Jkr>,
+    title: &str,
+) -> Chart {
+    let xy = |p: &CurvePoint| (p.indentation, p.force);
+    let approach = points
+        .iter()
+        .filter(|(_, b)| *b == Branch::Approach)
+        .map(|(p, _)| xy(p))
+        .collect();
+    let first_retract = points
+        .iter()
+        .position(|(_, b)| *b == Branch::Retract)
+        .unwrap_or(points.len());
+    let retract = points[first_retract.saturating_sub(1)..]
+        .iter()
+        .map(|(p, _)| xy(p))
+        .collect();
+    let mut series = vec![
+        Series::new("approach (springs attach)", approach, Style::LinePoints),
+        Series::new("retraction (Heß's rule)", retract, Style::Line),
+    ];
+    if let Some(jkr) = jkr {
+        // Contact radii up to beyond the deepest approach (a²/R − Δl ≤ a²/R), the curve
+        // cut there.
+        let largest = points
+            .iter()
+            .map(|(p, _)| p.indentation)
+            .fold(0.0f64, f64::max);
+        let a_top = 2.0 * (jkr.radius * largest).sqrt();
+        let curve = (1..=800)
+            .map(|i| a_top * i as f64 / 800.0)
+            .map(|a| (jkr.approach(a), jkr.force(a)))
+            .filter(|&(d, _)| d <= largest)
+            .collect();
+        series.push(Series::new("JKR (equilibrium)", curve, Style::Dashed));
+    }
+    if let Some(p) = pull {
+        let mark = |q: &CurvePoint| vec![(q.indentation, q.force)];
+        series.push(Series::new(
+            format!(
+                "pull-off, force control: F = {:.4e}",
+                p.force_controlled.force
+            ),
+            mark(&p.force_controlled),
+            Style::Points,
+        ));
+        series.push(Series::new(
+            format!(
+                "pull-off, displacement control: F = {:.4e}",
+                p.displacement_controlled.force
+            ),
+            mark(&p.displacement_controlled),
+            Style::Points,
+        ));
+    }
+    Chart {
+        title: title.into(),
+        x_label: "indentation d  [length]".into(),
+        y_label: "normal force F  [E*·length²]".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+/// `asperity mdr --work-of-adhesion`: the load path, then the retraction to pull-off.
+fn run_adhesive(
+    args: &MdrArgs,
+    request: &MdrRequest,
+    indenter: &Indenter,
+    w: f64,
+    mut staged: StagedOutputs,
+    record_path: Option<&Path>,
+) -> Result<()> {
+    let mut table = Table::new(&ADHESIVE_COLUMNS);
+    let mut rows: Vec<(CurvePoint, Branch)> = Vec::new();
+    let row_bytes = ROW_BYTES + plot_row_bytes(args);
+    let (levels, pull_offs) = request
+        .compute_adhesive(indenter, row_bytes, &mut |p, branch| {
+            table.push(&[
+                format_number(p.indentation),
+                format_number(p.force),
+                format_number(p.stiffness),
+                p.contacts.to_string(),
+                branch.name().to_string(),
+            ]);
+            if args.plot.is_some() {
+                rows.push((p, branch));
+            }
+        })
+        .map_err(refused)?;
+    if let Some(plot) = &args.plot {
+        let title = format!("{}, Δγ = {w}, E* = {}", indenter.description, args.modulus);
+        let jkr = match (request.profile.as_deref(), request.radius) {
+            (Some("hertz"), Some(radius)) => Jkr::new(radius, args.modulus, w).ok(),
+            _ => None,
+        };
+        let chart = loop_chart(&rows, pull_offs.as_ref(), jkr, &title);
+        stage_charts(&mut staged, plot, &[chart])
+            .with_context(|| format!("writing {}", plot.display()))?;
+    }
+    if let (Some(out), Some(record_path)) = (&args.out, record_path) {
+        table
+            .stage(&mut staged, out)
+            .with_context(|| format!("writing {}", out.display()))?;
+        let mut record = record_of(args, indenter, SpringLaw::Linear, Some(&levels));
+        record["adhesion"] = adhesion_record(w, pull_offs.as_ref());
+        record["columns"] = json!(ADHESIVE_COLUMNS);
+        staged
+            .write_json(record_path, &record)
+            .with_context(|| format!("writing {}", record_path.display()))?;
+    }
+    staged.commit()?;
+    match &pull_offs {
+        Some(p) => eprintln!(
+            "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
+            format_number(p.force_controlled.force),
+            format_number(p.force_controlled.indentation),
+            format_number(p.displacement_controlled.force),
+            format_number(p.displacement_controlled.indentation),
+        ),
+        None => eprintln!("pull-off: nothing in contact at the end of the path"),
+    }
+    if let Some(plot) = &args.plot {
+        eprintln!("wrote {}", plot.display());
+    }
+    match &args.out {
+        Some(out) => eprintln!(
+            "wrote {} ({} rows): {}",
+            out.display(),
+            table.len(),
+            indenter.description
+        ),
+        None => match std::io::stdout().write_all(&table.to_csv()?) {
             Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
             other => other?,
         },
