@@ -840,7 +840,10 @@ def contact(
 class MdrCurve:
     """An MDR curve (``asperity mdr``): ``indentation`` (from first contact), ``force``,
     ``stiffness`` (dF/dd), ``contacts`` (springs compressed), with a ``description`` of the
-    indenter, the ``spring`` law and its ``critical_depth`` u0."""
+    indenter, the ``spring`` law and its ``critical_depth`` u0. With a work of adhesion,
+    also ``branch`` (``"approach"`` or ``"retract"`` per row) and ``pull_off``
+    (``{"force_controlled": {...}, "displacement_controlled": {...}}``, each with
+    ``force``, ``indentation`` and ``contacts``; None if nothing was in contact)."""
 
     indentation: np.ndarray
     force: np.ndarray
@@ -849,6 +852,8 @@ class MdrCurve:
     description: str
     spring: str
     critical_depth: float
+    branch: Optional[List[str]] = None
+    pull_off: Optional[Dict[str, Dict[str, float]]] = None
 
 
 def mdr(
@@ -874,6 +879,7 @@ def mdr(
     dmin: Optional[float] = None,
     dmax: Optional[float] = None,
     breakpoints: bool = False,
+    work_of_adhesion: Optional[float] = None,
 ) -> MdrCurve:
     """Force, stiffness and contacts of an indenter on the MDR spring foundation, with
     every option of ``asperity mdr``.
@@ -889,6 +895,10 @@ def mdr(
     Indentations: a list, or ``nloads`` (default 50) log-spaced from ``dmin`` (default
     dmax·1e-6) to ``dmax`` (default: full contact); or ``breakpoints=True``: the exact
     piecewise-linear curve of linear springs on a line, one row per contact count.
+    Adhesion: ``work_of_adhesion`` Δγ (linear springs) makes the springs stick by Heß's
+    rule (let go at √(2πaΔγ/E*)): the indentations become a load path (negative allowed),
+    then the indenter retracts to pull-off, the exact curve returned with ``branch`` and
+    ``pull_off`` (as ``asperity mdr --work-of-adhesion``).
 
     Example::
 
@@ -896,6 +906,10 @@ def mdr(
         ...                  indentations=[1e-6, 1e-4])
         >>> l = asperity.line(32768, hurst=0.5, seed=1)
         >>> curve = asperity.mdr(line=l, nloads=40)
+        >>> jkr = asperity.mdr(profile="hertz", radius=1.0, n=1001, dx=1e-3,
+        ...                    work_of_adhesion=1e-3, indentations=[0.09])
+        >>> round(jkr.pull_off["force_controlled"]["force"] / (-1.5 * np.pi * 1e-3), 3)
+        1.0
     """
     line_heights = None
     if line is not None:
@@ -918,7 +932,7 @@ def mdr(
         line_heights, profile, radial_values, _opt(radial_step), _opt(radius), _opt(slope),
         _opt(coefficient), _opt(exponent), n, _opt(dx), _opt(size), float(modulus), str(spring),
         _opt(hurst), _opt(rms_height), _opt(asperity_radius), levels, nloads, _opt(dmin),
-        _opt(dmax), bool(breakpoints),
+        _opt(dmax), bool(breakpoints), _opt(work_of_adhesion),
     )
     return MdrCurve(**out)
 

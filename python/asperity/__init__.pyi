@@ -180,6 +180,8 @@ class MdrCurve:
     description: str
     spring: str
     critical_depth: float
+    branch: Optional[List[str]] = ...
+    pull_off: Optional[Dict[str, Dict[str, float]]] = ...
 
 def mdr(
     *, line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
@@ -190,6 +192,7 @@ def mdr(
     asperity_radius: Optional[float] = ..., indentations: Optional[Sequence[float]] = ...,
     nloads: Optional[int] = ..., dmin: Optional[float] = ..., dmax: Optional[float] = ...,
     breakpoints: bool = ...,
+    work_of_adhesion: Optional[float] = ...,
 ) -> MdrCurve: ...
 
 @dataclass

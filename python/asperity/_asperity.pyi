@@ -76,7 +76,7 @@ def mdr_curve(
     dx: Optional[float], size: Optional[float], modulus: float, spring: str,
     hurst: Optional[float], rms_height: Optional[float], asperity_radius: Optional[float],
     indentations: Optional[List[float]], nloads: Optional[int], dmin: Optional[float],
-    dmax: Optional[float], breakpoints: bool,
+    dmax: Optional[float], breakpoints: bool, work_of_adhesion: Optional[float],
 ) -> Dict[str, Any]: ...
 def run_study(
     method_name: str, sizes: List[int], hursts: List[float], samples: int,

@@ -6,8 +6,8 @@
 //! rules and words, and the same curve (`Foundation::evaluate`, `LinearCurve::breakpoint`),
 //! so the numbers are the CLI's.
 
-use asperity::mdr::{CurvePoint, Spring};
-use asperity_app::mdr::{Indenter, MdrRequest};
+use asperity::mdr::{CurvePoint, Spring, SpringLaw};
+use asperity_app::mdr::{Branch, Indenter, MdrRequest};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -26,7 +26,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 #[pyo3(signature = (line, profile, radial, radial_step, radius, slope, coefficient, exponent,
     n, dx, size, modulus, spring, hurst, rms_height, asperity_radius, indentations, nloads,
-    dmin, dmax, breakpoints))]
+    dmin, dmax, breakpoints, work_of_adhesion))]
 #[allow(clippy::too_many_arguments)]
 fn mdr_curve<'py>(
     py: Python<'py>,
@@ -51,6 +51,7 @@ fn mdr_curve<'py>(
     dmin: Option<f64>,
     dmax: Option<f64>,
     breakpoints: bool,
+    work_of_adhesion: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = MdrRequest {
         line: line.is_some(),
@@ -74,6 +75,7 @@ fn mdr_curve<'py>(
         dmin,
         dmax,
         breakpoints,
+        work_of_adhesion,
     };
     request.check().map_err(refused)?;
     let indenter = match (&line, &radial) {
@@ -88,16 +90,28 @@ fn mdr_curve<'py>(
         }
         (None, None) => request.closed_form().map_err(request_error)?,
     };
+    if work_of_adhesion.is_some() {
+        return adhesive_curve(py, &request, indenter);
+    }
     let law = request.spring_law(&indenter).map_err(refused)?;
     let spring = Spring::new(law, indenter.spacing, modulus).map_err(from_error)?;
     let row_bytes = std::mem::size_of::<CurvePoint>();
-    let points = run_detached(py, |_| {
+    let points: Vec<CurvePoint> = run_detached(py, |_| {
         let mut points = Vec::new();
         request
             .compute(&indenter, spring, row_bytes, &mut |p| points.push(p))
             .map(|_| points)
     })?
     .map_err(request_error)?;
+    let dict = columns(py, &points)?;
+    dict.set_item("description", indenter.description)?;
+    dict.set_item("spring", law.name())?;
+    dict.set_item("critical_depth", spring.critical_depth())?;
+    Ok(dict)
+}
+
+/// The four columns of a curve.
+fn columns<'py>(py: Python<'py>, points: &[CurvePoint]) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     let column = |f: &dyn Fn(&CurvePoint) -> f64| PyArray1::from_iter(py, points.iter().map(f));
     dict.set_item("indentation", column(&|p| p.indentation))?;
@@ -107,8 +121,52 @@ fn mdr_curve<'py>(
         "contacts",
         PyArray1::from_iter(py, points.iter().map(|p| p.contacts as u64)),
     )?;
+    Ok(dict)
+}
+
+/// `work_of_adhesion` given: the load path and the retraction to pull-off, as
+/// `asperity mdr --work-of-adhesion` computes them.
+fn adhesive_curve<'py>(
+    py: Python<'py>,
+    request: &MdrRequest,
+    indenter: Indenter,
+) -> PyResult<Bound<'py, PyDict>> {
+    let row_bytes = std::mem::size_of::<(CurvePoint, Branch)>();
+    let (rows, pull_offs) = run_detached(py, |_| {
+        let mut rows = Vec::new();
+        request
+            .compute_adhesive(&indenter, row_bytes, &mut |p, b| rows.push((p, b)))
+            .map(|(_, pull_offs)| (rows, pull_offs))
+    })?
+    .map_err(request_error)?;
+    let points: Vec<CurvePoint> = rows.iter().map(|(p, _)| *p).collect();
+    let dict = columns(py, &points)?;
+    let branches: Vec<&str> = rows.iter().map(|(_, b)| b.name()).collect();
+    dict.set_item("branch", branches)?;
+    let pull_off = match pull_offs {
+        Some(p) => {
+            let point = |q: &CurvePoint| -> PyResult<Bound<'py, PyDict>> {
+                let d = PyDict::new(py);
+                d.set_item("force", q.force)?;
+                d.set_item("indentation", q.indentation)?;
+                d.set_item("contacts", q.contacts)?;
+                Ok(d)
+            };
+            let d = PyDict::new(py);
+            d.set_item("force_controlled", point(&p.force_controlled)?)?;
+            d.set_item(
+                "displacement_controlled",
+                point(&p.displacement_controlled)?,
+            )?;
+            Some(d)
+        }
+        None => None,
+    };
+    dict.set_item("pull_off", pull_off)?;
     dict.set_item("description", indenter.description)?;
-    dict.set_item("spring", law.name())?;
+    let spring =
+        Spring::new(SpringLaw::Linear, indenter.spacing, request.modulus).map_err(from_error)?;
+    dict.set_item("spring", SpringLaw::Linear.name())?;
     dict.set_item("critical_depth", spring.critical_depth())?;
     Ok(dict)
 }

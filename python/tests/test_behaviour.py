@@ -333,3 +333,25 @@ def test_progress_callbacks_and_their_exceptions(rough):
 
     with pytest.raises(RuntimeError, match="stop here"):
         asperity.Solver(rough).sweep(pressures=[0.001, 0.01, 0.02], progress=fail)
+
+
+def test_adhesive_mdr_is_the_clis_loop_and_jkrs_pull_off(cli, tmp_path):
+    # The same request through both front ends: the same rows, branches and pull-offs;
+    # the force-controlled pull-off within 1e-4 of −1.5πΔγR (a = 152 Δx; the library's
+    # convergence test measures 4e-5 here).
+    args = dict(profile="hertz", radius=1.0, n=1001, dx=1e-3, work_of_adhesion=1e-3,
+                indentations=[0.02, 0.09, 0.05])
+    ours = asperity.mdr(**args)
+    cli("mdr", "--profile", "hertz", "--radius", 1, "--n", 1001, "--dx", 1e-3,
+        "--work-of-adhesion", 1e-3, "--indentations", "0.02,0.09,0.05",
+        "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True, dtype=None,
+                           encoding="utf-8")
+    assert list(theirs["branch"]) == ours.branch
+    np.testing.assert_allclose(theirs["force"], ours.force, rtol=1e-12, atol=1e-18)
+    assert ours.contacts[-1] == 0 and ours.branch[0] == "approach"
+    pull = ours.pull_off["force_controlled"]["force"]
+    assert abs(pull / (-1.5 * np.pi * 1e-3) - 1) < 1e-4
+    assert pull == ours.force.min()
+    record = __import__("json").loads((tmp_path / "c.csv.json").read_text())
+    assert record["adhesion"]["pull_off"]["force_controlled"]["force"] == pull

@@ -50,6 +50,7 @@ KEYWORDS = {
     "--dmin": "dmin",
     "--dmax": "dmax",
     "--breakpoints": "breakpoints",
+    "--work-of-adhesion": "work_of_adhesion",
     "--min-contacts": "min_contacts",
     "--fit-from": "fit_from",
     "--fit-to": "fit_to",
@@ -193,6 +194,15 @@ MDR = [
     (["--profile", "punch", "--radius", "0.1", "--n", "401", "--dx", "1e-3"],
      dict(profile="punch", radius=0.1, n=401, dx=1e-3), "give dmax, or indentations"),
     (HERTZ[0] + ["--dmin", "-1"], dict(HERTZ[1], dmin=-1), "dmin/dmax/nloads: "),
+    (HERTZ[0] + ["--work-of-adhesion", "0"], dict(HERTZ[1], work_of_adhesion=0),
+     "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got 0"),
+    (HERTZ[0] + ["--work-of-adhesion", "inf"], dict(HERTZ[1], work_of_adhesion=float("inf")),
+     "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got inf"),
+    (HERTZ[0] + ["--work-of-adhesion", "-1e-3"], dict(HERTZ[1], work_of_adhesion=-1e-3),
+     "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got -0.001"),
+    (HERTZ[0] + ["--work-of-adhesion", "1e-3", "--spring", "hertz"],
+     dict(HERTZ[1], work_of_adhesion=1e-3, spring="hertz"),
+     "work_of_adhesion needs linear springs"),
 ]
 
 
