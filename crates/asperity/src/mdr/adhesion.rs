@@ -51,6 +51,21 @@
 //!   the one that leaves no spring attached.
 //!
 //! Cost: `O(N)` per move, `O(N log N)` for a whole retraction (a heap of contacts).
+//!
+//! # Example
+//! ```
+//! use asperity::mdr::{AdhesiveLine, Axisymmetric};
+//! use asperity::reference::{Jkr, PullOff};
+//! let dx = 1e-3;
+//! let profile = Axisymmetric::Sphere { radius: 1.0 }.sample(1001, dx)?;
+//! let mut line = AdhesiveLine::from_profile(&profile, dx, 1.0, 1e-3)?;
+//! line.move_to(0.09, &mut |_| {})?; // a = 0.3
+//! let pull = line.retract(&mut |_| {}).expect("in contact");
+//! let jkr = Jkr::new(1.0, 1.0, 1e-3)?;
+//! let expected = jkr.pull_off_force(PullOff::ForceControlled);
+//! assert!((pull.force_controlled.force / expected - 1.0).abs() < 1e-4);
+//! # Ok::<(), asperity::Error>(())
+//! ```
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
