@@ -28,6 +28,8 @@ static ALLOCATOR: asperity::huge_pages::HugePageAlloc = asperity::huge_pages::Hu
 #[pymodule]
 fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // Under `ulimit -v`, one malloc arena for all threads (see the function's docs).
+    asperity::memory::fit_allocator_to_address_space_limit();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(
         "ConvergenceError",

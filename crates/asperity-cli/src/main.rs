@@ -61,12 +61,19 @@ fn run() -> i32 {
     };
     // Ctrl-C, SIGTERM or SIGHUP: unfinished outputs are removed, status 130.
     interrupt::install();
-    // The command runs on a thread of rayon's pool, so that its parallel loops (FFT
+    // The command runs on a thread of a rayon pool, so that its parallel loops (FFT
     // passes, the solvers' chunked passes, a study's lanes) run there directly: called from
     // the main thread, every one of them would be handed to the pool and waited for (two
     // thread switches per loop; measured: a one-thread BEM study ran 3.9× slower than on
     // two threads).
-    if let Err(err) = rayon::scope(|_| commands::run(cli)) {
+    let pool = match worker_pool() {
+        Ok(pool) => pool,
+        Err(message) => {
+            eprintln!("error: {message}");
+            return 2;
+        }
+    };
+    if let Err(err) = pool.install(|| commands::run(cli)) {
         // One line: the chain of causes joined, as a user reads it; a cause that its
         // parent's message already ends with (library errors print their source) is skipped.
         let mut line = String::new();
@@ -84,6 +91,33 @@ fn run() -> i32 {
         return 2;
     }
     0
+}
+
+/// The pool the command runs on: one worker per core (or `RAYON_NUM_THREADS`). Where its
+/// threads cannot all start (an address-space limit, `ulimit -v`, leaves no room for their
+/// stacks) the command runs on one thread, with a warning, instead of panicking in rayon's
+/// global pool (issue 33, item 11); if even that fails, a one-line error. Under such a
+/// limit the C allocator shares one arena between threads first (`asperity::memory`).
+fn worker_pool() -> Result<rayon::ThreadPool, String> {
+    asperity::memory::fit_allocator_to_address_space_limit();
+    let named = |i: usize| format!("asperity-{i}");
+    match rayon::ThreadPoolBuilder::new().thread_name(named).build() {
+        Ok(pool) => Ok(pool),
+        Err(first) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .thread_name(named)
+                .build()
+                .map_err(|e| {
+                    format!("cannot start a worker thread: {e} (is ulimit -v too low?)")
+                })?;
+            eprintln!(
+                "warning: running on 1 thread: the worker threads could not all start ({first}; \
+                 is ulimit -v too low?)"
+            );
+            Ok(pool)
+        }
+    }
 }
 
 /// A refusal of the first argument that is not UTF-8 (a file name in another encoding):

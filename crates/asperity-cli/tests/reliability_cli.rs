@@ -554,3 +554,61 @@ fn long_output_names_work_or_are_refused_first() {
     );
     assert_eq!(files(d).len(), 2);
 }
+
+/// Issue 33, item 11: under an address-space limit (`ulimit -v`) a run either works or is
+/// refused with one line (status 2) — never a panic (rayon's pool unable to start its
+/// threads: status 101) or an abort (an allocation the guard let through failing in a
+/// thread's own malloc arena: SIGABRT). 36 runs: 6 limits × 1, 2 and 8 threads × 2 commands
+/// (surface generation, a BEM sweep with stiffness); before the fix 8 of them failed.
+#[test]
+fn an_address_space_limit_gives_a_result_or_a_refusal_never_a_crash() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let exe = env!("CARGO_BIN_EXE_asperity");
+    let prepare = std::process::Command::new(exe)
+        .args([
+            "surface",
+            "--n",
+            "256",
+            "--hurst",
+            "0.8",
+            "--rms-slope",
+            "1",
+        ])
+        .args(["--seed", "1", "--out", "s.npy"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert!(prepare.status.success());
+    let commands = [
+        "surface --n 512 --hurst 0.8 --out u.npy --force",
+        "bem --surface s.npy --pressures 0.01,0.05",
+    ];
+    let (mut worked, mut refused) = (0, 0);
+    for kib in [20_000, 40_000, 80_000, 120_000, 160_000, 320_000] {
+        for threads in ["1", "2", "8"] {
+            for command in commands {
+                let out = std::process::Command::new("sh")
+                    .arg("-c")
+                    .arg(format!("ulimit -v {kib} && exec '{exe}' {command}"))
+                    .env("RAYON_NUM_THREADS", threads)
+                    .current_dir(d)
+                    .output()
+                    .expect("run sh");
+                let err = String::from_utf8_lossy(&out.stderr);
+                match out.status.code() {
+                    Some(0) => worked += 1,
+                    Some(2) => {
+                        assert_eq!(err.trim_end().lines().count(), 1, "{kib} KiB: {err}");
+                        refused += 1;
+                    }
+                    code => panic!("{command} at {kib} KiB, {threads} threads: {code:?}: {err}"),
+                }
+            }
+        }
+    }
+    assert!(
+        worked > 0 && refused > 0,
+        "{worked} worked, {refused} refused"
+    );
+}

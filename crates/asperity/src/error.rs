@@ -178,9 +178,14 @@ fn out_of_memory_message(
 ) -> String {
     match (needed_mib, available_mib) {
         (None, _) => format!("{what} exceeds addressable memory"),
-        (Some(needed), Some(available)) => format!(
+        (Some(needed), Some(available)) if needed > available => format!(
             "{what} needs about {needed} MiB of memory but only {available} MiB are available \
              (limited by {limited_by})"
+        ),
+        // Refused by the 90 % margin of `memory::ensure_fits`: say so, not "only".
+        (Some(needed), Some(available)) => format!(
+            "{what} needs about {needed} MiB of memory, more than 90 % of the {available} MiB \
+             available (limited by {limited_by}); asperity keeps a tenth free"
         ),
         (Some(needed), None) => {
             format!("{what} needs about {needed} MiB of memory, which could not be allocated ({limited_by})")

@@ -249,6 +249,32 @@ fn cgroup_headroom(root: &Path) -> Option<u64> {
     })
 }
 
+/// Fits the C allocator to an address-space limit (`ulimit -v`), where one is set: glibc
+/// gives each thread that allocates its own arena and reserves 64 MiB of address space for
+/// each, so on 8 threads half a GiB of the limit went to reservations that the estimates
+/// of [`ensure_fits`] cannot see, and allocations the guard had let through failed (an
+/// abort: issue 33, item 11). With a limit, every thread shares one arena; without one,
+/// nothing changes. Call once at start-up, before threads are started. Returns whether it
+/// changed the allocator.
+pub fn fit_allocator_to_address_space_limit() -> bool {
+    if address_space_limit().is_none() {
+        return false;
+    }
+    one_malloc_arena()
+}
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn one_malloc_arena() -> bool {
+    // SAFETY: mallopt only sets a tuning parameter of glibc's allocator; M_ARENA_MAX may be
+    // set at any time (it limits arenas created from then on).
+    unsafe { libc::mallopt(libc::M_ARENA_MAX, 1) == 1 }
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn one_malloc_arena() -> bool {
+    false
+}
+
 /// `RLIMIT_AS` less the address space already in use (`VmSize`), if a limit is set.
 fn address_space_headroom() -> Option<u64> {
     let limit = address_space_limit()?;
@@ -346,7 +372,14 @@ mod tests {
         );
         // 90 % of the available memory is the threshold.
         check_fits("x", Some(90 * MIB), Some(&limit(100))).unwrap();
-        assert!(check_fits("x", Some(91 * MIB), Some(&limit(100))).is_err());
+        // Within the margin: no "only 100 MiB" for a need of 91 (issue 33, item 15).
+        assert_eq!(
+            check_fits("x", Some(91 * MIB), Some(&limit(100)))
+                .unwrap_err()
+                .to_string(),
+            "x needs about 91 MiB of memory, more than 90 % of the 100 MiB available \
+             (limited by a test limit); asperity keeps a tenth free"
+        );
         check_fits("x", Some(u64::MAX / 4), None).unwrap();
     }
 
