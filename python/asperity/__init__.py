@@ -951,6 +951,10 @@ class StudyResult:
     columns: Dict[str, np.ndarray]
     rows: List[Dict[str, Any]]
     tasks: List[Dict[str, Any]]
+    #: Each task's row of the comparison with the paper (see :meth:`comparison`).
+    comparisons: List[Optional[Dict[str, Any]]] = field(default_factory=list, repr=False)
+    #: Whether the study has a roll-off (compared by its steepest slope instead).
+    rolloff: bool = False
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -960,6 +964,29 @@ class StudyResult:
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
+
+    def comparison(self) -> Dict[str, np.ndarray]:
+        """The comparison with the paper, as ``asperity study compare`` writes it to
+        ``comparison.csv`` (one definition, the library's ``study::compare``): per task
+        with a fit, ``method``, ``n``, ``hurst``, ``quantity`` (``alpha``), ``ours`` (the
+        ensemble α), ``low``/``high`` (its 95 % interval: ± t·s/√m over the m per-sample
+        α), ``reference`` (eq. (6), eq. (24) or Hertz 1/3), ``source``, ``tolerance`` and
+        the ``verdict``: ``agrees`` (the reference inside the interval), ``close``
+        (within 0.02) or ``differs``. A study with a roll-off is compared by its steepest
+        slope, which needs the folder's sample curves: use ``asperity study compare``."""
+        found = [c for c in self.comparisons if c is not None]
+        if self.rolloff:
+            raise ValueError("a roll-off study is compared by its steepest slope: run "
+                             "`asperity study compare DIR` on its folder")
+        names = ("method", "n", "hurst", "quantity", "ours", "low", "high", "reference",
+                 "source", "tolerance")
+        columns = {}
+        for name in names:
+            values = [c["row"][name] for c in found]
+            text = name in ("method", "quantity", "source")
+            columns[name] = np.array(values, dtype=object if text else np.float64)
+        columns["verdict"] = np.array([c["verdict"] for c in found], dtype=object)
+        return columns
 
 
 def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
@@ -1070,7 +1097,8 @@ def study_alpha(
             "alpha_fit_high": fit.get("high"), "alpha_sample_mean": rec["alpha_sample_mean"],
             "samples_fitted": len(r["alpha_samples"]), "alpha_theory": rec["alpha_theory"],
         })
-    return StudyResult(_columns(rows, _ALPHA_COLUMNS), rows, [rec["result"] for rec in records])
+    return StudyResult(_columns(rows, _ALPHA_COLUMNS), rows, [rec["result"] for rec in records],
+                       [rec["comparison"] for rec in records], rolloff is not None)
 
 
 def study_curve(

@@ -13,6 +13,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use asperity::lock::FolderLock;
+use asperity::study::compare;
 use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
@@ -123,7 +124,7 @@ fn run_study(
         run_tasks(&spec, &store, progress.as_ref(), cancel)
     })?
     .map_err(from_error)?;
-    Ok(records(&results))
+    Ok(records(&spec, &results))
 }
 
 /// A study's spec from `run_study`'s arguments (`alpha_sweep`: the load sweep of an α
@@ -215,16 +216,28 @@ fn open_folder(
     Ok((lock, store))
 }
 
-/// The task results as JSON text, each with the CLI's derived columns.
-fn records(results: &[TaskResult]) -> String {
+/// The task results as JSON text, each with the CLI's derived columns and, for a study
+/// without roll-off, its row of the comparison with the paper (`asperity study compare`:
+/// α beside eq. (6)/(24) with the 95 % interval of the ensemble α and the verdict; a
+/// roll-off study is compared by its steepest slope, which needs the stored sample
+/// curves: `None` here).
+fn records(spec: &StudySpec, results: &[TaskResult]) -> String {
     let records: Vec<serde_json::Value> = results
         .iter()
         .map(|r| {
+            let comparison = match spec.rolloff {
+                Some(_) => None,
+                None => compare::rows(&compare::Results::Fig1(std::slice::from_ref(r)), &[])
+                    .into_iter()
+                    .next()
+                    .map(|row| json!({"row": row, "verdict": compare::verdict(&row)})),
+            };
             json!({
                 "result": r,
                 "alpha_sample_interval": r.alpha_sample_interval(),
                 "alpha_sample_mean": r.alpha_sample_mean(),
                 "alpha_theory": alpha_theory(r.task.hurst, r.task.n),
+                "comparison": comparison,
             })
         })
         .collect();
@@ -345,7 +358,7 @@ impl StudyLedger {
         if !ledger.finished() {
             return Err(invalid("the study is not finished"));
         }
-        Ok(records(&ledger.results()))
+        Ok(records(&self.spec, &ledger.results()))
     }
 
     /// Releases the folder's lock.

@@ -77,6 +77,32 @@ def test_an_mdr_study_equals_the_cli_and_resumes_there(cli, tmp_path):
     assert (tmp_path / "resumed" / "alpha.csv").read_bytes() == (tmp_path / "cli" / "alpha.csv").read_bytes()
 
 
+def test_the_comparison_with_the_paper_equals_study_compare(cli, tmp_path):
+    """`StudyResult.comparison()` is `asperity study compare`'s comparison.csv, row for row,
+    with the verdict that the rule gives (re-derived here from the CSV: the reference
+    inside [low − tol, high + tol] agrees, within 0.02 + tol is close) and that report.md
+    prints."""
+    cli("study", "alpha", *MDR_FLAGS, "--out", tmp_path / "cli", "--quiet")
+    cli("study", "compare", tmp_path / "cli")
+    with open(tmp_path / "cli" / "comparison.csv", newline="") as f:
+        theirs = list(csv.DictReader(f))
+    report = (tmp_path / "cli" / "report.md").read_text()
+    ours = asperity.study_alpha(**MDR, out=tmp_path / "py").comparison()
+    assert len(theirs) == len(ours["ours"]) == 6
+    for i, row in enumerate(theirs):
+        for name in ("method", "quantity", "source"):
+            assert ours[name][i] == row[name], name
+        for name in ("n", "hurst", "ours", "low", "high", "reference", "tolerance"):
+            assert ours[name][i] == float(row[name]), name
+        low, high, ref, tol = (float(row[k]) for k in ("low", "high", "reference", "tolerance"))
+        verdict = ("agrees" if low - tol <= ref <= high + tol else
+                   "close" if abs(float(row["ours"]) - ref) <= 0.02 + tol else "differs")
+        assert ours["verdict"][i] == verdict
+        assert low < float(row["ours"]) < high
+    assert report.count("| agrees |") == list(ours["verdict"]).count("agrees")
+    assert report.count("| differs |") == list(ours["verdict"]).count("differs")
+
+
 BEM = dict(method="bem", n=32, hurst=[0.5], samples=16, seed=5)
 BEM_FLAGS = ["--method", "bem", "--n", 32, "--hurst", 0.5, "--samples", 16, "--seed", 5]
 

@@ -39,6 +39,7 @@
 //! yet computed and checkpoints every sample received ([`StudyDir::save_received`]), in
 //! index order or not, so that a lost process costs only the samples it was computing.
 
+pub mod compare;
 pub mod curve;
 pub mod identity;
 pub mod ledger;
