@@ -33,6 +33,7 @@ pub mod inpaint;
 pub mod level;
 pub(crate) mod metropro;
 pub(crate) mod netcdf;
+pub(crate) mod nid;
 pub(crate) mod opd;
 pub mod patches;
 pub(crate) mod plu;
@@ -253,6 +254,12 @@ const FORMATS: &[Format] = &[
         extensions: &["bcr", "bcrf"],
         sniff: bcr::sniff,
         read: bcr::read,
+    },
+    Format {
+        name: "nid",
+        extensions: &["nid"],
+        sniff: nid::sniff,
+        read: nid::read,
     },
     Format {
         name: "plu",
