@@ -32,6 +32,7 @@ pub(crate) mod gwy;
 pub mod inpaint;
 pub mod level;
 pub(crate) mod metropro;
+pub(crate) mod mi;
 pub(crate) mod netcdf;
 pub(crate) mod nid;
 pub(crate) mod opd;
@@ -254,6 +255,12 @@ const FORMATS: &[Format] = &[
         extensions: &["bcr", "bcrf"],
         sniff: bcr::sniff,
         read: bcr::read,
+    },
+    Format {
+        name: "mi",
+        extensions: &["mi"],
+        sniff: mi::sniff,
+        read: mi::read,
     },
     Format {
         name: "nid",
