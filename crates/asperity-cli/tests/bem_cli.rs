@@ -1274,55 +1274,51 @@ fn size_takes_both_sides() {
 fn hardness_caps_the_pressure_and_adds_the_plastic_fraction() {
     let dir = tempfile::tempdir().unwrap();
     let s = surface(dir.path());
-    let (csv, fields) = (dir.path().join("h.csv"), dir.path().join("hf"));
     let run = |extra: &[&str]| {
         let mut args = vec!["bem", "--surface", s.to_str().unwrap(), "--quiet"];
         args.extend_from_slice(extra);
         asperity(&args)
     };
-    let out = run(&[
-        "--pressures",
-        "0.01,0.03",
-        "--solver",
-        "pk",
-        "--hardness",
-        "0.3",
-        "--out",
-        csv.to_str().unwrap(),
-        "--fields",
-        fields.to_str().unwrap(),
-    ]);
-    ok(&out);
-    let (header, rows) = read_csv(&csv);
-    let plastic = column(&header, "plastic_fraction");
-    let area = column(&header, "area_fraction");
-    for (k, row) in rows.iter().enumerate() {
-        let p: Array2<f64> = read_npy(fields.join(format!("pressure_{k}.npy"))).unwrap();
-        let n = p.len() as f64;
-        assert!(p.iter().all(|&v| (0.0..=0.3).contains(&v)));
-        let at_cap = p.iter().filter(|&&v| v == 0.3).count() as f64;
-        assert!(at_cap > 0.0);
-        assert_eq!(row[plastic], at_cap / n);
-        assert!(row[plastic] < row[area]);
+    // The default BCCG and Polonsky–Keer: the same plastic fractions (the same sets).
+    let mut fractions = Vec::new();
+    for (name, solver) in [("bccg", &[][..]), ("pk", &["--solver", "pk"][..])] {
+        let csv = dir.path().join(format!("h_{name}.csv"));
+        let fields = dir.path().join(format!("hf_{name}"));
+        let mut args = vec!["--pressures", "0.01,0.03", "--hardness", "0.3"];
+        args.extend_from_slice(solver);
+        args.extend_from_slice(&["--out", csv.to_str().unwrap()]);
+        args.extend_from_slice(&["--fields", fields.to_str().unwrap()]);
+        ok(&run(&args));
+        let (header, rows) = read_csv(&csv);
+        let plastic = column(&header, "plastic_fraction");
+        let area = column(&header, "area_fraction");
+        for (k, row) in rows.iter().enumerate() {
+            let p: Array2<f64> = read_npy(fields.join(format!("pressure_{k}.npy"))).unwrap();
+            let n = p.len() as f64;
+            assert!(p.iter().all(|&v| (0.0..=0.3).contains(&v)));
+            let at_cap = p.iter().filter(|&&v| v == 0.3).count() as f64;
+            assert!(at_cap > 0.0);
+            assert_eq!(row[plastic], at_cap / n);
+            assert!(row[plastic] < row[area]);
+        }
+        fractions.push(rows.iter().map(|r| r[plastic]).collect::<Vec<_>>());
     }
+    assert_eq!(fractions[0], fractions[1]);
     // Refused before any work, one line each: a bad hardness, a load the cap cannot
-    // carry, the BCCG with a cap.
+    // carry.
     for (extra, needle) in [
+        (&["--pressures", "0.01", "--hardness", "0"][..], "hardness"),
         (
-            &["--pressures", "0.01", "--solver", "pk", "--hardness", "0"][..],
+            &["--pressures", "0.01", "--hardness", "nan"][..],
             "hardness",
         ),
         (
-            &["--pressures", "0.01", "--solver", "pk", "--hardness", "nan"][..],
-            "hardness",
-        ),
-        (
-            &["--pressures", "0.3", "--solver", "pk", "--hardness", "0.3"][..],
+            &["--pressures", "0.3", "--hardness", "0.3"][..],
             "at or above the hardness",
         ),
         (
-            &["--pressures", "0.01", "--hardness", "0.3"][..],
-            "--solver pk",
+            &["--pressures", "0.01", "--solver", "pk", "--hardness", "-1"][..],
+            "hardness",
         ),
     ] {
         refused(&run(extra), needle);

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepRow};
-use asperity::bem::{ContactSolver, Control, Interface, SolverKind};
+use asperity::bem::{ContactSolver, Control, Interface};
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
@@ -34,7 +34,7 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --boundary periodic --forces 0.02 --tol 1e-10\n  \
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --out reference.csv\n  \
-    asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --hardness 0.3\n  \
+    asperity bem --surface s.npy --pressures 0.01,0.05 --hardness 0.3\n  \
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n  \
     asperity bem --surface scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
@@ -113,7 +113,7 @@ pub struct BemArgs {
     pub max_iter: usize,
     /// Cap the contact pressure at this hardness (in the units of the pressures and
     /// --modulus: E* units by default): elastic–perfectly-plastic contact
-    /// (docs/hardness.md), solved with --solver pk; adds the column plastic_fraction. Each
+    /// (docs/hardness.md), with either solver; adds the column plastic_fraction. Each
     /// load is solved on the surface as given (warm-started; the library's load path keeps
     /// the plastic displacement between loads).
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
@@ -475,9 +475,6 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         Some(h) => Interface::hardness(h).context("--hardness")?,
         None => Interface::HardWall,
     };
-    if interface != Interface::HardWall && bem.params.solver != SolverKind::PolonskyKeer {
-        bail!("--hardness needs --solver pk (the BCCG solves the hard wall only, for now)");
-    }
     for load in &bem.loads {
         if let Control::MeanPressure(p) = *load {
             interface.check_mean_pressure(p).context("--hardness")?;

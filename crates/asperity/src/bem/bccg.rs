@@ -73,10 +73,11 @@
 
 use rayon::prelude::*;
 
-use super::interface::Interface;
+use super::interface::{restore_capped_load, Interface};
 use super::mean_gap::MeanGapScratch;
 use super::preconditioner::Real;
 use super::ring_extension::{centre_on_set, RingExtension};
+use super::small_set::SmallSetRun;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
@@ -189,6 +190,9 @@ pub(super) struct BccgScratch {
     /// Whether the iteration uses `single` (always, but in the test that compares the
     /// solves with and without it).
     single_steps: bool,
+    /// Under a cap: a step left fewer points in contact than the load needs below the cap
+    /// (the solve is then handed to Polonsky–Keer, [`ContactSolver::capped_bccg`]).
+    capacity_lost: bool,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -243,6 +247,7 @@ impl BccgScratch {
             energy_steps: true,
             single: operator.single_precision()?,
             single_steps: true,
+            capacity_lost: false,
         })
     }
 }
@@ -338,24 +343,52 @@ struct Step {
     cut_many: bool,
 }
 
-/// The contact rule of the BCCG: the hard wall, asked of [`Interface`] (a constant, so
-/// the passes compile to the rule itself). A cap would need the upper bound in the
-/// projection, the cut corrections and the load restoration.
-const WALL: Interface = Interface::HardWall;
+/// The contact rule of a pass, asked of [`Interface`]: the hard wall, or with `CAPPED` the
+/// hardness `h`. A compile-time choice, so that each pass compiles to its rule (the hard
+/// wall's passes are those of before the cap, to the bit); the solver picks the pass of its
+/// interface ([`Rule::of`]).
+#[inline(always)]
+fn rule<const CAPPED: bool>(h: f64) -> Interface {
+    match CAPPED {
+        true => Interface::Hardness { h },
+        false => Interface::HardWall,
+    }
+}
 
-/// `g = u + f − d` and whether the point is free (`p > 0` or `g < 0`).
+/// The interface as the passes take it: whether capped, and the cap.
+#[derive(Clone, Copy)]
+struct Rule {
+    capped: bool,
+    h: f64,
+}
+
+impl Rule {
+    /// The rule of `interface` (the BCCG knows the hard wall and the hardness).
+    fn of(interface: Interface) -> Self {
+        match interface {
+            Interface::Hardness { h } => Rule { capped: true, h },
+            _ => Rule {
+                capped: false,
+                h: f64::INFINITY,
+            },
+        }
+    }
+}
+
+/// `g = u + f − d` and whether the point is free ([`Interface::is_free`]: `p > 0` or
+/// `g < 0` for the hard wall).
 #[inline]
-fn gap_at(u: f64, f: f64, d: f64, p: f64) -> (f64, bool) {
+fn gap_at<const CAPPED: bool>(u: f64, f: f64, d: f64, p: f64, h: f64) -> (f64, bool) {
     let g = u + f - d;
-    (g, WALL.is_free(p, g))
+    (g, rule::<CAPPED>(h).is_free(p, g))
 }
 
 /// Load control's `d`: the mean of `u + f` on the contact set, summed about `previous` so
 /// that the residual does not cancel; `p` and `u` are first multiplied by `scale` (the
 /// pending load restoration; 1: none).
-fn contact_mean(
+fn contact_mean<const CAPPED: bool>(
     (u, p, f): (&mut [f64], &mut [f64], &[f64]),
-    previous: f64,
+    (previous, h): (f64, f64),
     scale: f64,
     partials: &mut [Sums],
 ) -> f64 {
@@ -370,7 +403,7 @@ fn contact_mean(
                     *ui *= scale;
                     *pi *= scale;
                 }
-                if WALL.elastic(*pi) {
+                if rule::<CAPPED>(h).elastic(*pi) {
                     s.n[0] += 1;
                     s.x[0] += *ui + fi - previous;
                 }
@@ -387,11 +420,12 @@ fn contact_mean(
 }
 
 /// Writes `g = u + f − d` on the free set (zero elsewhere) into `gradient` and the free
-/// set into `free`; sums `x[0] = Σ_{p>0} g²`, `x[1] = Σ_{p=0, g<0} g²`, `x[2] = Σ_F g`,
-/// `n[0] = |{p > 0}|`, `n[1] = |F|`.
-fn gap_pass(
+/// set into `free`; sums `x[0] = Σ g²` on the elastic set, `x[1]` the squared violations
+/// elsewhere ([`Interface::violation`]: `Σ_{p=0, g<0} g²` for the hard wall, and
+/// `Σ_{p=h, g>0} g²` at a cap), `x[2] = Σ_F g`, `n[0] = |{p > 0}|`, `n[1] = |F|`.
+fn gap_pass<const CAPPED: bool>(
     (u, f, p): (&[f64], &[f64], &[f64]),
-    d: f64,
+    (d, h): (f64, f64),
     (gradient, free): (&mut [f64], &mut [bool]),
     partials: &mut [Sums],
 ) -> Sums {
@@ -409,12 +443,16 @@ fn gap_pass(
                 .zip(u)
                 .zip(f.iter().zip(p))
             {
-                let (g, is_free) = gap_at(ui, fi, d, pi);
-                if WALL.elastic(pi) {
-                    s.n[0] += 1;
+                let (g, is_free) = gap_at::<CAPPED>(ui, fi, d, pi, h);
+                let rule = rule::<CAPPED>(h);
+                s.n[0] += rule.in_contact(pi) as usize;
+                if rule.elastic(pi) {
                     s.x[0] += g * g;
-                } else if g < 0.0 {
-                    s.x[1] += g * g;
+                } else {
+                    let v = rule.violation(pi, g);
+                    if v != 0.0 {
+                        s.x[1] += v * v;
+                    }
                 }
                 *zi = if is_free { g } else { 0.0 };
                 *fr = is_free;
@@ -513,13 +551,15 @@ fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
     Sums::total(partials).x[0]
 }
 
-/// `p ← max(p + α s, 0)` and, with `DISPLACEMENT`, `u ← u + α w` (a step after which `u`
-/// is recomputed leaves both alone); sums `x[0] = Σ p`, `n[0]` = cuts; the first
-/// [`CUT_LIMIT`] cuts of each chunk go to its slots of `chunk_cuts`.
-fn step_pass<const DISPLACEMENT: bool>(
+/// `p ← max(p + α s, 0)` (with `CAPPED`: `min(max(p + α s, 0), h)`, the projection of
+/// [`Interface::project`]) and, with `DISPLACEMENT`, `u ← u + α w` (a step after which
+/// `u` is recomputed leaves both alone); sums `x[0] = Σ p`, `x[1] = max p` (`CAPPED`),
+/// `n[0]` = cuts; the first [`CUT_LIMIT`] cuts of each chunk go to its slots of
+/// `chunk_cuts`, each with the part of the step the bound refused.
+fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
     (p, u): (&mut [f64], &mut [f64]),
     (s, w): (&[f64], &[f64]),
-    alpha: f64,
+    (alpha, h): (f64, f64),
     (chunk_cuts, partials): (&mut [(usize, f64)], &mut [Sums]),
 ) -> Sums {
     p.par_chunks_mut(CHUNK)
@@ -529,7 +569,7 @@ fn step_pass<const DISPLACEMENT: bool>(
         .zip(partials.par_iter_mut())
         .enumerate()
         .for_each(|(chunk, ((((p, u), (s, w)), slots), out))| {
-            let (mut cuts, mut total) = (0usize, 0.0);
+            let (mut cuts, mut total, mut peak) = (0usize, 0.0, 0.0f64);
             for (index, ((pi, ui), (&si, &wi))) in p
                 .iter_mut()
                 .zip(u.iter_mut())
@@ -544,6 +584,13 @@ fn step_pass<const DISPLACEMENT: bool>(
                         slots[cuts] = (chunk * CHUNK + index, -next);
                     }
                     cuts += 1;
+                } else if CAPPED && next > h {
+                    // The cap allows h: `u` misses `K e (h − next)`.
+                    *pi = h;
+                    if cuts < CUT_LIMIT {
+                        slots[cuts] = (chunk * CHUNK + index, h - next);
+                    }
+                    cuts += 1;
                 } else {
                     *pi = next;
                 }
@@ -551,9 +598,12 @@ fn step_pass<const DISPLACEMENT: bool>(
                     *ui += alpha * wi;
                 }
                 total += *pi;
+                if CAPPED {
+                    peak = peak.max(*pi);
+                }
             }
             *out = Sums {
-                x: [total, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                x: [total, peak, 0.0, 0.0, 0.0, 0.0, 0.0],
                 n: [cuts, 0],
             };
         });
@@ -575,6 +625,7 @@ impl ContactSolver {
         let mut indentation = self.bccg_start(target);
         // Small contact sets: solved directly (`small_set.rs`), then only checked here.
         let small = self.small_set_start(target, max_iterations)?;
+        let small = self.cap_small_set(target, small);
         if !small.exact {
             self.problem
                 .operator
@@ -640,6 +691,30 @@ impl ContactSolver {
         }
     }
 
+    /// Under a cap: the direct solve of a small set (`small_set.rs`) knows the hard wall
+    /// only; where its pressure passes the cap, it is projected onto `[0, h]`, the load
+    /// restored, and the BCCG goes on from there (`u` then recomputed). Where it does not,
+    /// it is the capped solution as well.
+    fn cap_small_set(&mut self, target: Target, small: SmallSetRun) -> SmallSetRun {
+        let Interface::Hardness { h } = self.interface else {
+            return small;
+        };
+        let pressure = &mut self.state.pressure;
+        if !pressure.iter().any(|&p| p > h) {
+            return small;
+        }
+        pressure.iter_mut().for_each(|p| *p = p.min(h));
+        if let Target::MeanPressure(mean_pressure) = target {
+            let total = pressure.iter().sum::<f64>();
+            let (u, f) = (&self.state.gap, &self.problem.profile);
+            restore_capped_load(pressure, (mean_pressure, h), total, |i| u[i] + f[i]);
+        }
+        SmallSetRun {
+            applications: small.applications,
+            exact: false,
+        }
+    }
+
     /// The start of a solve of `target`: the initial pressure, the iteration's scalars
     /// reset; returns the first `d` (the last solve's under load control).
     fn bccg_start(&mut self, target: Target) -> f64 {
@@ -651,6 +726,7 @@ impl ContactSolver {
         };
         self.bccg_scratch.pending_scale = 1.0;
         self.bccg_scratch.extra_energies = 0;
+        self.bccg_scratch.capacity_lost = false;
         if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
             mean_gap.reset();
         }
@@ -662,6 +738,7 @@ impl ContactSolver {
     /// elsewhere) into the preconditioner's field and the gradient field.
     fn gradient_pass(&mut self, target: Target, previous: f64) -> Gradient {
         let scratch = &mut self.bccg_scratch;
+        let Rule { capped, h } = Rule::of(self.interface);
         let indentation = match target {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => {
@@ -671,15 +748,23 @@ impl ContactSolver {
                     &self.problem.profile[..],
                 );
                 let scale = std::mem::replace(&mut scratch.pending_scale, 1.0);
-                contact_mean(fields, previous, scale, &mut scratch.partials)
+                let partials = &mut scratch.partials;
+                match capped {
+                    false => contact_mean::<false>(fields, (previous, h), scale, partials),
+                    true => contact_mean::<true>(fields, (previous, h), scale, partials),
+                }
             }
         };
-        let sums = gap_pass(
-            (&self.state.gap, &self.problem.profile, &self.state.pressure),
-            indentation,
-            (&mut scratch.gradient, &mut scratch.free),
-            &mut scratch.partials,
+        let fields = (
+            &self.state.gap[..],
+            &self.problem.profile[..],
+            &self.state.pressure[..],
         );
+        let out = (&mut scratch.gradient[..], &mut scratch.free[..]);
+        let sums = match capped {
+            false => gap_pass::<false>(fields, (indentation, h), out, &mut scratch.partials),
+            true => gap_pass::<true>(fields, (indentation, h), out, &mut scratch.partials),
+        };
         let [contact_points, free_points] = sums.n;
         let periodic = self.problem.operator.boundary() == Boundary::Periodic;
         let mode = MeanMode::of(target, periodic);
@@ -871,12 +956,18 @@ impl ContactSolver {
         let fields = (&mut self.state.pressure[..], &mut self.state.gap[..]);
         let directions = (&scratch.direction[..], &scratch.response[..]);
         let slots = (&mut scratch.chunk_cuts[..], &mut scratch.partials[..]);
-        let sums = if displacement {
-            step_pass::<true>(fields, directions, alpha, slots)
-        } else {
-            step_pass::<false>(fields, directions, alpha, slots)
+        let Rule { capped, h } = Rule::of(self.interface);
+        let sums = match (displacement, capped) {
+            (true, false) => step_pass::<true, false>(fields, directions, (alpha, h), slots),
+            (false, false) => step_pass::<false, false>(fields, directions, (alpha, h), slots),
+            (true, true) => step_pass::<true, true>(fields, directions, (alpha, h), slots),
+            (false, true) => step_pass::<false, true>(fields, directions, (alpha, h), slots),
         };
         let (cuts, total) = (sums.n[0], sums.x[0]);
+        let peak = match capped {
+            true => scratch.partials.iter().fold(0.0f64, |m, s| m.max(s.x[1])),
+            false => 0.0,
+        };
         // A few cuts are corrected by their point responses (one grid pass, far cheaper
         // than an operator application); more leave `u` stale.
         let cut_many = cuts > CUT_LIMIT;
@@ -895,7 +986,24 @@ impl ContactSolver {
             let n = self.state.pressure.len() as f64;
             let scale = mean_pressure * n / total;
             // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
-            if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
+            let rescaled = (scale - 1.0).abs() > LOAD_ROUNDING;
+            if total > 0.0 && capped && rescaled && (peak >= h || scale * peak > h) {
+                // Scaled, points at the cap would leave it (the whole plastic set released
+                // at every step that overshot the load) or others pass it: the load is
+                // restored by the capped scaling of Polonsky–Keer, the capped points kept
+                // there, after which `u` is recomputed.
+                let (u, f) = (&self.state.gap, &self.problem.profile);
+                let level = |i: usize| u[i] + f[i];
+                let pressure = &mut self.state.pressure;
+                if !restore_capped_load(pressure, (mean_pressure, h), total, level) {
+                    scratch.capacity_lost = true;
+                    return Err(SolveError::NoConvergence {
+                        iterations: iteration,
+                        residual: gradient.residual,
+                    });
+                }
+                stale = true;
+            } else if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
                 scratch.pending_scale = scale;
             } else if total <= 0.0 {
                 self.state.pressure.fill(mean_pressure);
@@ -903,6 +1011,36 @@ impl ContactSolver {
             }
         }
         Ok(Step { stale, cut_many })
+    }
+
+    /// The BCCG under a cap. Near fully plastic contact under load control (measured: H =
+    /// 0.1 E*, rms gradient 0.08, p̄ ≥ 0.09 E* on free boundaries), a step can leave fewer
+    /// points in contact than the load needs below the cap, where no scaling restores it;
+    /// the solve then goes on with the capped Polonsky–Keer from cold, which converges
+    /// there, and reports the iterations and applications of both.
+    pub(super) fn capped_bccg(
+        &mut self,
+        target: Target,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let result = self.bccg(target, tolerance, max_iterations);
+        let Err(SolveError::NoConvergence { iterations, .. }) = result else {
+            return result;
+        };
+        if !self.bccg_scratch.capacity_lost {
+            return result;
+        }
+        let left = max_iterations.saturating_sub(iterations).max(1);
+        let (summary, info) = self.polonsky_keer(target, tolerance, left)?;
+        Ok((
+            summary,
+            SolveInfo {
+                iterations: iterations + info.iterations,
+                operator_applications: iterations + info.operator_applications,
+                ..info
+            },
+        ))
     }
 
     /// Periodic displacement control: the BCCG with `d` fixed and the constant mode of the

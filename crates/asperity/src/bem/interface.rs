@@ -151,6 +151,118 @@ impl Interface {
     }
 }
 
+/// The load restoration of Polonsky–Keer's pass E and of the BCCG's step under a cap `h`:
+/// the pressures (summing to `total`) scaled to the load. Where no point is at or would
+/// reach the cap that is the hard wall's scaling, bit for bit. Else the points at the cap
+/// stay there (scaling them down would release the whole plastic set at every step that
+/// overshot the load) and the others are scaled by the `s` for which
+/// `n_H h + Σ min(s p, h) = n p̄` ([`capped_scale`]); if the capped points alone carry more
+/// than the load, every point is scaled. Where the points in contact cannot carry the load
+/// below the cap, the pressure restarts from the bearing area that can
+/// ([`bearing_start`], ordered by `level`, the gap up to a constant). False after such a
+/// restart.
+pub(super) fn restore_capped_load(
+    pressure: &mut [f64],
+    (mean_pressure, h): (f64, f64),
+    total: f64,
+    level: impl Fn(usize) -> f64,
+) -> bool {
+    let wanted = mean_pressure * pressure.len() as f64;
+    let in_contact = pressure.iter().filter(|&&p| p > 0.0).count();
+    if (in_contact as f64) * h <= wanted || total <= 0.0 {
+        bearing_start(pressure, (mean_pressure, h), level);
+        return false;
+    }
+    let plain = wanted / total;
+    let peak = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
+    if peak < h && peak * plain < h {
+        pressure.iter_mut().for_each(|v| *v *= plain);
+        return true;
+    }
+    let capped = pressure.iter().filter(|&&p| p >= h).count();
+    let keep_capped = (capped as f64) * h < wanted;
+    let scale = capped_scale(pressure, wanted, h, keep_capped);
+    for p in pressure.iter_mut() {
+        if !(keep_capped && *p >= h) {
+            *p = (scale * *p).min(h);
+        }
+    }
+    true
+}
+
+/// A start that carries the load `n p̄` below the cap `h`: the pressure `n p̄ / m`, uniform
+/// on the `m ≥ n p̄ / h` points of lowest `level` (the gap up to a constant: the points the
+/// indenter penetrates most), zero elsewhere — the bearing area of a fully plastic contact,
+/// the limit `h → 0` of the capped problem (ContactMechanics' capped Polonsky–Keer finds the
+/// same set by bisection on a gap offset). The threshold is found by bisection on the
+/// levels (at most 64 passes, no allocation); ties at the threshold all enter.
+pub(super) fn bearing_start(
+    pressure: &mut [f64],
+    (mean_pressure, h): (f64, f64),
+    level: impl Fn(usize) -> f64,
+) {
+    let n = pressure.len();
+    let wanted = mean_pressure * n as f64;
+    let needed = ((wanted / h).ceil() as usize).clamp(1, n);
+    let (mut low, mut high) = (0..n).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), i| {
+        (lo.min(level(i)), hi.max(level(i)))
+    });
+    // Invariant: fewer than `needed` points lie at or below `low`, at least `needed` at or
+    // below `high` (unless `low` is the lowest level and enough points tie at it).
+    let count = |t: f64| (0..n).filter(|&i| level(i) <= t).count();
+    if count(low) < needed {
+        for _ in 0..64 {
+            let mid = 0.5 * (low + high);
+            if !(mid > low && mid < high) {
+                break;
+            }
+            if count(mid) >= needed {
+                high = mid;
+            } else {
+                low = mid;
+            }
+        }
+    } else {
+        high = low;
+    }
+    let m = count(high).max(1);
+    let value = wanted / m as f64;
+    for (i, p) in pressure.iter_mut().enumerate() {
+        *p = if level(i) <= high { value } else { 0.0 };
+    }
+}
+
+/// The `s` for which the load `Σ min(s p, h)` (points at the cap held there if
+/// `keep_capped`) is `wanted`: Newton's method on this increasing, concave,
+/// piecewise-linear function of `s`, exact once the capped set settles (from below it
+/// stays below and rises; the left slope at a kink, so that a scale that caps every point
+/// still moves down).
+fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64 {
+    let mut scale = 1.0;
+    for _ in 0..64 {
+        let (mut carried, mut slope) = (0.0, 0.0);
+        for &p in pressure {
+            if keep_capped && p >= h {
+                carried += h;
+            } else if scale * p <= h {
+                carried += scale * p;
+                slope += p;
+            } else {
+                carried += h;
+            }
+        }
+        if slope <= 0.0 {
+            break;
+        }
+        let next = scale + (wanted - carried) / slope;
+        if next == scale {
+            break;
+        }
+        scale = next;
+    }
+    scale
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

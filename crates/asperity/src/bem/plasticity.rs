@@ -162,9 +162,16 @@ mod tests {
     use super::*;
     use crate::elastic::Boundary;
 
-    fn pk_solver(rows: usize, cols: usize, seed: u64, boundary: Boundary) -> ContactSolver {
+    /// Both solvers know the cap: every test runs on each.
+    const KINDS: [SolverKind; 2] = [SolverKind::Bccg, SolverKind::PolonskyKeer];
+
+    fn solver_of(
+        solver: SolverKind,
+        (rows, cols, seed): (usize, usize, u64),
+        boundary: Boundary,
+    ) -> ContactSolver {
         let params = SolverParams {
-            solver: SolverKind::PolonskyKeer,
+            solver,
             ..SolverParams::default()
         };
         let half_space = HalfSpace {
@@ -205,65 +212,69 @@ mod tests {
 
     #[test]
     fn capped_solves_satisfy_the_conditions_at_every_point() {
-        // Odd, even and non-square grids, free and periodic, load and displacement
-        // control, at a hardness that caps part of the contact.
-        for (rows, cols) in GRIDS {
-            for boundary in BOUNDARIES {
-                let mut solver = pk_solver(rows, cols, 3, boundary);
-                let (elastic, _) = solver.solve(Control::MeanPressure(0.02)).unwrap();
-                let peak = solver.pressure().fold(0.0f64, |m, &p| m.max(p));
-                let h = 0.5 * peak;
-                solver
-                    .set_interface(Interface::hardness(h).unwrap())
-                    .unwrap();
-                let (s, info) = solver.solve(Control::MeanPressure(0.02)).unwrap();
-                let case = format!("{rows}x{cols} {boundary:?}");
-                assert!(s.plastic_points > 0, "{case}");
-                assert!((s.mean_pressure - 0.02).abs() < 1e-12, "{case}: {s:?}");
-                // Capping spreads the load: more area, a deeper indenter.
-                assert!(s.contact_points > elastic.contact_points, "{case}");
-                assert!(s.indentation > elastic.indentation, "{case}");
-                assert!(info.residual < 1e-8, "{case}");
-                check_complementarity(&solver, h);
-                // Displacement control at that indentation gives the same state.
-                solver.reset();
-                let (d, _) = solver.solve(Control::Indentation(s.indentation)).unwrap();
-                assert!(
-                    (d.mean_pressure / s.mean_pressure - 1.0).abs() < 1e-6,
-                    "{case}"
-                );
-                assert_eq!(d.plastic_points, s.plastic_points, "{case}");
-                check_complementarity(&solver, h);
+        for kind in KINDS {
+            // Odd, even and non-square grids, free and periodic, load and displacement
+            // control, at a hardness that caps part of the contact.
+            for (rows, cols) in GRIDS {
+                for boundary in BOUNDARIES {
+                    let mut solver = solver_of(kind, (rows, cols, 3), boundary);
+                    let (elastic, _) = solver.solve(Control::MeanPressure(0.02)).unwrap();
+                    let peak = solver.pressure().fold(0.0f64, |m, &p| m.max(p));
+                    let h = 0.5 * peak;
+                    solver
+                        .set_interface(Interface::hardness(h).unwrap())
+                        .unwrap();
+                    let (s, info) = solver.solve(Control::MeanPressure(0.02)).unwrap();
+                    let case = format!("{kind:?} {rows}x{cols} {boundary:?}");
+                    assert!(s.plastic_points > 0, "{case}");
+                    assert!((s.mean_pressure - 0.02).abs() < 1e-12, "{case}: {s:?}");
+                    // Capping spreads the load: more area, a deeper indenter.
+                    assert!(s.contact_points > elastic.contact_points, "{case}");
+                    assert!(s.indentation > elastic.indentation, "{case}");
+                    assert!(info.residual < 1e-8, "{case}");
+                    check_complementarity(&solver, h);
+                    // Displacement control at that indentation gives the same state.
+                    solver.reset();
+                    let (d, _) = solver.solve(Control::Indentation(s.indentation)).unwrap();
+                    assert!(
+                        (d.mean_pressure / s.mean_pressure - 1.0).abs() < 1e-6,
+                        "{case}"
+                    );
+                    assert_eq!(d.plastic_points, s.plastic_points, "{case}");
+                    check_complementarity(&solver, h);
+                }
             }
         }
     }
 
     #[test]
     fn a_cap_no_iterate_reaches_gives_the_elastic_result_exactly() {
-        for (rows, cols) in GRIDS {
-            for boundary in BOUNDARIES {
-                for control in [Control::MeanPressure(0.03), Control::Indentation(0.02)] {
-                    let mut wall = pk_solver(rows, cols, 5, boundary);
-                    let want = wall.solve(control).unwrap();
-                    // Above the solution's peak and above the cold start of displacement
-                    // control (local springs (d − f)/K₀₀): no iterate reaches it.
-                    let peak = wall.pressure().fold(0.0f64, |m, &p| m.max(p));
-                    let springs = match control {
-                        Control::Indentation(d) => d / wall.problem.operator.self_influence(),
-                        _ => 0.0,
-                    };
-                    let peak = peak.max(springs);
-                    let mut capped = pk_solver(rows, cols, 5, boundary)
-                        .with_interface(Interface::hardness(1.5 * peak).unwrap())
-                        .unwrap();
-                    let got = capped.solve(control).unwrap();
-                    assert_eq!(got, want, "{rows}x{cols} {boundary:?} {control:?}");
-                    assert_eq!(capped.pressure(), wall.pressure());
-                    assert_eq!(capped.gap(), wall.gap());
-                    assert_eq!(
-                        capped.frozen_set_stiffness().unwrap().0,
-                        wall.frozen_set_stiffness().unwrap().0
-                    );
+        for kind in KINDS {
+            for (rows, cols) in GRIDS {
+                for boundary in BOUNDARIES {
+                    for control in [Control::MeanPressure(0.03), Control::Indentation(0.02)] {
+                        let mut wall = solver_of(kind, (rows, cols, 5), boundary);
+                        let want = wall.solve(control).unwrap();
+                        // Above the solution's peak and above the cold start of displacement
+                        // control (local springs (d − f)/K₀₀): no iterate reaches it.
+                        let peak = wall.pressure().fold(0.0f64, |m, &p| m.max(p));
+                        let springs = match control {
+                            Control::Indentation(d) => d / wall.problem.operator.self_influence(),
+                            _ => 0.0,
+                        };
+                        let peak = peak.max(springs);
+                        let mut capped = solver_of(kind, (rows, cols, 5), boundary)
+                            .with_interface(Interface::hardness(1.5 * peak).unwrap())
+                            .unwrap();
+                        let got = capped.solve(control).unwrap();
+                        assert_eq!(got, want, "{rows}x{cols} {boundary:?} {control:?}");
+                        assert_eq!(capped.pressure(), wall.pressure());
+                        assert_eq!(capped.gap(), wall.gap());
+                        assert_eq!(
+                            capped.frozen_set_stiffness().unwrap().0,
+                            wall.frozen_set_stiffness().unwrap().0
+                        );
+                    }
                 }
             }
         }
@@ -271,111 +282,183 @@ mod tests {
 
     #[test]
     fn a_vanishing_hardness_gives_the_bearing_area_fully_plastic() {
-        // H → 0 at a fixed approach d: the elastic displacements (of order H) vanish, the
-        // surface is cut where the indenter passes through it, {f < d}, and every contact
-        // point is at the cap: F = H·A.
-        for (rows, cols) in GRIDS {
-            for boundary in BOUNDARIES {
-                let mut solver = pk_solver(rows, cols, 8, boundary);
-                let h = 1e-9;
-                solver
-                    .set_interface(Interface::hardness(h).unwrap())
-                    .unwrap();
-                let profile = solver.problem().profile().to_owned();
-                let mut sorted: Vec<f64> = profile.iter().copied().collect();
-                sorted.sort_by(f64::total_cmp);
-                // An approach midway between two profile values near 10 % bearing area,
-                // far from both compared with the elastic displacements (~1e-9).
-                let k = sorted.len() / 10;
-                let d = 0.5 * (sorted[k] + sorted[k + 1]);
-                assert!(sorted[k + 1] - sorted[k] > 1e-6);
-                let (s, _) = solver.solve(Control::Indentation(d)).unwrap();
-                let case = format!("{rows}x{cols} {boundary:?}");
-                let bearing: Vec<bool> = profile.iter().map(|&f| f < d).collect();
-                let contact: Vec<bool> = solver.pressure().iter().map(|&p| p > 0.0).collect();
-                assert_eq!(contact, bearing, "{case}");
-                assert_eq!(s.plastic_points, s.contact_points, "{case}");
-                let (dx, dy) = solver.problem().spacings();
-                let fully_plastic = h * s.contact_points as f64 * dx * dy;
-                assert!((s.force / fully_plastic - 1.0).abs() < 1e-12, "{case}");
-                check_complementarity(&solver, h);
+        for kind in KINDS {
+            // H → 0 at a fixed approach d: the elastic displacements (of order H) vanish, the
+            // surface is cut where the indenter passes through it, {f < d}, and every contact
+            // point is at the cap: F = H·A.
+            for (rows, cols) in GRIDS {
+                for boundary in BOUNDARIES {
+                    let mut solver = solver_of(kind, (rows, cols, 8), boundary);
+                    let h = 1e-9;
+                    solver
+                        .set_interface(Interface::hardness(h).unwrap())
+                        .unwrap();
+                    let profile = solver.problem().profile().to_owned();
+                    let mut sorted: Vec<f64> = profile.iter().copied().collect();
+                    sorted.sort_by(f64::total_cmp);
+                    // An approach midway between two profile values near 10 % bearing area,
+                    // far from both compared with the elastic displacements (~1e-9).
+                    let k = sorted.len() / 10;
+                    let d = 0.5 * (sorted[k] + sorted[k + 1]);
+                    assert!(sorted[k + 1] - sorted[k] > 1e-6);
+                    let (s, _) = solver.solve(Control::Indentation(d)).unwrap();
+                    let case = format!("{kind:?} {rows}x{cols} {boundary:?}");
+                    let bearing: Vec<bool> = profile.iter().map(|&f| f < d).collect();
+                    let contact: Vec<bool> = solver.pressure().iter().map(|&p| p > 0.0).collect();
+                    assert_eq!(contact, bearing, "{case}");
+                    assert_eq!(s.plastic_points, s.contact_points, "{case}");
+                    let (dx, dy) = solver.problem().spacings();
+                    let fully_plastic = h * s.contact_points as f64 * dx * dy;
+                    assert!((s.force / fully_plastic - 1.0).abs() < 1e-12, "{case}");
+                    check_complementarity(&solver, h);
+                }
             }
         }
     }
 
     #[test]
     fn the_frozen_elastic_set_gives_the_loading_tangent() {
-        // k on 0 < p < H against dF/dd by central differences of two capped solves; the
-        // sets move within the step (points reach the cap), hence 3 %.
-        for boundary in BOUNDARIES {
-            let mut solver = pk_solver(48, 48, 2, boundary);
-            solver
-                .set_interface(Interface::hardness(0.3).unwrap())
-                .unwrap();
-            let (s, _) = solver.solve(Control::MeanPressure(0.03)).unwrap();
-            assert!(s.plastic_points > 0);
-            let (k, _) = solver.frozen_set_stiffness().unwrap();
-            let d = s.indentation;
-            let (up, _) = solver.solve(Control::Indentation(d * 1.001)).unwrap();
-            let (down, _) = solver.solve(Control::Indentation(d * 0.999)).unwrap();
-            let fd = (up.force - down.force) / (up.indentation - down.indentation);
-            assert!((k / fd - 1.0).abs() < 0.03, "{boundary:?}: {k} vs {fd}");
+        for kind in KINDS {
+            // k on 0 < p < H against dF/dd by central differences of two capped solves; the
+            // sets move within the step (points reach the cap), hence 3 %.
+            for boundary in BOUNDARIES {
+                let mut solver = solver_of(kind, (48, 48, 2), boundary);
+                solver
+                    .set_interface(Interface::hardness(0.3).unwrap())
+                    .unwrap();
+                let (s, _) = solver.solve(Control::MeanPressure(0.03)).unwrap();
+                assert!(s.plastic_points > 0);
+                let (k, _) = solver.frozen_set_stiffness().unwrap();
+                let d = s.indentation;
+                let (up, _) = solver.solve(Control::Indentation(d * 1.001)).unwrap();
+                let (down, _) = solver.solve(Control::Indentation(d * 0.999)).unwrap();
+                let fd = (up.force - down.force) / (up.indentation - down.indentation);
+                assert!((k / fd - 1.0).abs() < 0.03, "{boundary:?}: {k} vs {fd}");
+            }
         }
     }
 
     #[test]
     fn a_load_path_keeps_the_plastic_displacement() {
-        for boundary in BOUNDARIES {
-            let mut solver = pk_solver(40, 40, 4, boundary);
-            solver
-                .set_interface(Interface::hardness(0.3).unwrap())
-                .unwrap();
-            let loads = [0.01, 0.04, 0.01, 0.04].map(Control::MeanPressure);
-            let path = load_path(&mut solver, &loads).unwrap();
-            let [first, top, down, again] = [path[0], path[1], path[2], path[3]];
-            assert!(top.summary.plastic_points > 0 && top.permanent_max > 0.0);
-            // Unloading is elastic on the flattened surface: the indenter stands deeper
-            // than on the way up at the same load, nothing yields, the area is larger.
-            assert!(
-                down.summary.indentation > first.summary.indentation,
-                "{boundary:?}"
-            );
-            assert_eq!(down.summary.plastic_points, 0, "{boundary:?}");
-            assert_eq!(down.permanent_max, top.permanent_max);
-            assert!(down.summary.contact_points >= first.summary.contact_points);
-            // Reloading to the largest load comes back to the state of the way up and
-            // adds (to the tolerance) no plastic displacement.
-            let dd = again.summary.indentation / top.summary.indentation - 1.0;
-            assert!(dd.abs() < 1e-6, "{boundary:?}: {dd}");
-            assert!(again.permanent_max - top.permanent_max < 1e-8 * top.permanent_max);
-            // The solver keeps the permanent field; a new surface forgets it.
-            let w = solver.permanent_displacement();
-            assert!(w.iter().all(|&x| x >= 0.0));
-            assert_eq!(w.fold(0.0f64, |m, &x| m.max(x)), again.permanent_max);
+        for kind in KINDS {
+            for boundary in BOUNDARIES {
+                let mut solver = solver_of(kind, (40, 40, 4), boundary);
+                solver
+                    .set_interface(Interface::hardness(0.3).unwrap())
+                    .unwrap();
+                let loads = [0.01, 0.04, 0.01, 0.04].map(Control::MeanPressure);
+                let path = load_path(&mut solver, &loads).unwrap();
+                let [first, top, down, again] = [path[0], path[1], path[2], path[3]];
+                assert!(top.summary.plastic_points > 0 && top.permanent_max > 0.0);
+                // Unloading is elastic on the flattened surface: the indenter stands deeper
+                // than on the way up at the same load, nothing yields, the area is larger.
+                assert!(
+                    down.summary.indentation > first.summary.indentation,
+                    "{boundary:?}"
+                );
+                assert_eq!(down.summary.plastic_points, 0, "{boundary:?}");
+                assert_eq!(down.permanent_max, top.permanent_max);
+                assert!(down.summary.contact_points >= first.summary.contact_points);
+                // Reloading to the largest load comes back to the state of the way up and
+                // adds (to the tolerance) no plastic displacement.
+                let dd = again.summary.indentation / top.summary.indentation - 1.0;
+                assert!(dd.abs() < 1e-6, "{boundary:?}: {dd}");
+                assert!(again.permanent_max - top.permanent_max < 1e-8 * top.permanent_max);
+                // The solver keeps the permanent field; a new surface forgets it.
+                let w = solver.permanent_displacement();
+                assert!(w.iter().all(|&x| x >= 0.0));
+                assert_eq!(w.fold(0.0f64, |m, &x| m.max(x)), again.permanent_max);
+            }
         }
     }
 
     #[test]
     fn bad_hardness_and_loads_beyond_it_are_refused() {
-        let mut solver = pk_solver(16, 16, 1, Boundary::Free);
-        for h in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-            let err = solver.set_interface(Interface::Hardness { h }).unwrap_err();
-            assert!(err.to_string().contains("hardness"), "{err}");
+        for kind in KINDS {
+            let mut solver = solver_of(kind, (16, 16, 1), Boundary::Free);
+            for h in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+                let err = solver.set_interface(Interface::Hardness { h }).unwrap_err();
+                assert!(err.to_string().contains("hardness"), "{err}");
+            }
+            solver
+                .set_interface(Interface::hardness(0.1).unwrap())
+                .unwrap();
+            let err = solver.solve(Control::MeanPressure(0.1)).unwrap_err();
+            assert!(
+                err.to_string().contains("at or above the hardness"),
+                "{err}"
+            );
+            let area = solver.nominal_area();
+            assert!(solver.solve(Control::Force(0.2 * area)).is_err());
         }
-        solver
-            .set_interface(Interface::hardness(0.1).unwrap())
-            .unwrap();
-        let err = solver.solve(Control::MeanPressure(0.1)).unwrap_err();
-        assert!(
-            err.to_string().contains("at or above the hardness"),
-            "{err}"
-        );
-        let area = solver.nominal_area();
-        assert!(solver.solve(Control::Force(0.2 * area)).is_err());
-        let mut params = *solver.params();
-        params.solver = SolverKind::Bccg;
-        solver.set_params(params).unwrap();
-        let err = solver.solve(Control::MeanPressure(0.01)).unwrap_err();
-        assert!(err.to_string().contains("pk"), "{err}");
+    }
+
+    /// A rough surface of `n²` points, rms gradient `rms_slope` (Hurst 0.8, roll-off 6).
+    fn rough_surface(n: usize, rms_slope: f64, seed: u64) -> crate::surface::Surface {
+        use crate::spectrum::{LongWavelength, Psd};
+        use crate::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
+        let psd = Psd::new(0.8, LongWavelength::RollOff { q0: 6.0 }, None).unwrap();
+        let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(rms_slope)).unwrap();
+        SurfaceGenerator::new(&spec).unwrap().generate(seed)
+    }
+
+    #[test]
+    fn the_bccg_and_polonsky_keer_agree_up_to_fully_plastic_contact() {
+        // ContactMechanics' open case (H = 0.1 E*, rms gradient 0.08; its capped PK does not
+        // converge above p̄ ≈ 0.07 E*), up to 95 % of the fully plastic load (at 99 % this 64² grid is in full contact, which
+        // is refused): both solvers
+        // converge from cold, at every point within the conditions, with the same contact
+        // and plastic sets and pressures within 1e-6 H (two solutions to the tolerance
+        // 1e-8 of the residual, in rms heights). Free and periodic, load control, and
+        // displacement control at the solved indentation.
+        let surface = rough_surface(64, 0.08, 2);
+        let h = 0.1;
+        for boundary in BOUNDARIES {
+            for p in [0.03, 0.07, 0.09, 0.095] {
+                let solve = |kind, control| {
+                    let params = SolverParams {
+                        solver: kind,
+                        ..SolverParams::default()
+                    };
+                    let half_space = HalfSpace {
+                        modulus: 1.0,
+                        boundary,
+                    };
+                    let mut solver = ContactSolver::new(&surface, half_space, params)
+                        .unwrap()
+                        .with_interface(Interface::hardness(h).unwrap())
+                        .unwrap();
+                    let (summary, info) = solver.solve(control).unwrap();
+                    check_complementarity(&solver, h);
+                    (summary, info, solver.pressure().to_owned())
+                };
+                let load = Control::MeanPressure(p);
+                let (bccg, info, bccg_p) = solve(SolverKind::Bccg, load);
+                let (pk, pk_info, pk_p) = solve(SolverKind::PolonskyKeer, load);
+                let case = format!("{boundary:?} p = {p}");
+                eprintln!(
+                    "{case}: area {:.4} plastic {:.4}, BCCG {} iterations, PK {}",
+                    bccg.area_fraction, bccg.plastic_fraction, info.iterations, pk_info.iterations
+                );
+                assert_eq!(bccg.contact_points, pk.contact_points, "{case}");
+                assert_eq!(bccg.plastic_points, pk.plastic_points, "{case}");
+                let gap = bccg_p
+                    .iter()
+                    .zip(&pk_p)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(gap < 1e-6 * h, "{case}: max |Δp| {gap:e}");
+                let by_displacement = Control::Indentation(bccg.indentation);
+                let (d, _, d_p) = solve(SolverKind::Bccg, by_displacement);
+                assert_eq!(d.plastic_points, bccg.plastic_points, "{case}");
+                let gap = bccg_p
+                    .iter()
+                    .zip(&d_p)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(
+                    gap < 1e-5 * h,
+                    "{case}: displacement control, max |Δp| {gap:e}"
+                );
+            }
+        }
     }
 }

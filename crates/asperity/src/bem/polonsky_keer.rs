@@ -19,7 +19,7 @@
 //! keeps results bit-identical for any thread count (the FFTs are parallel and
 //! independent of it too).
 
-use super::interface::Interface;
+use super::interface::{restore_capped_load, Interface};
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 
@@ -138,7 +138,8 @@ impl ContactSolver {
         };
         let pressure = &mut self.state.pressure;
         if let Interface::Hardness { h } = self.interface {
-            return restore_capped_load(pressure, mean_pressure, h, total);
+            let gap = &self.state.gap;
+            return restore_capped_load(pressure, (mean_pressure, h), total, |i| gap[i]);
         }
         if total > 0.0 {
             let scale = mean_pressure * pressure.len() as f64 / total;
@@ -290,68 +291,6 @@ fn update_pressure(
         total += *pi;
     }
     (total, entered)
-}
-
-/// Pass E under a cap `h`: the pressures (summing to `total`) scaled to the load. Where no
-/// point is at or would reach the cap that is the hard wall's scaling, bit for bit. Else
-/// the points at the cap stay there (scaling them down would release the whole plastic
-/// set at every step that overshot the load) and the others are scaled by the `s` for
-/// which `n_H h + Σ min(s p, h) = n p̄` ([`capped_scale`]); if the capped points alone
-/// carry more than the load, every point is scaled. Reset to uniform if the points in
-/// contact cannot carry the load below the cap. False after a reset.
-fn restore_capped_load(pressure: &mut [f64], mean_pressure: f64, h: f64, total: f64) -> bool {
-    let wanted = mean_pressure * pressure.len() as f64;
-    let in_contact = pressure.iter().filter(|&&p| p > 0.0).count();
-    if (in_contact as f64) * h <= wanted || total <= 0.0 {
-        pressure.fill(mean_pressure);
-        return false;
-    }
-    let plain = wanted / total;
-    let peak = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
-    if peak < h && peak * plain < h {
-        pressure.iter_mut().for_each(|v| *v *= plain);
-        return true;
-    }
-    let capped = pressure.iter().filter(|&&p| p >= h).count();
-    let keep_capped = (capped as f64) * h < wanted;
-    let scale = capped_scale(pressure, wanted, h, keep_capped);
-    for p in pressure.iter_mut() {
-        if !(keep_capped && *p >= h) {
-            *p = (scale * *p).min(h);
-        }
-    }
-    true
-}
-
-/// The `s` for which the load `Σ min(s p, h)` (points at the cap held there if
-/// `keep_capped`) is `wanted`: Newton's method on this increasing, concave,
-/// piecewise-linear function of `s`, exact once the capped set settles (from below it
-/// stays below and rises; the left slope at a kink, so that a scale that caps every point
-/// still moves down).
-fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64 {
-    let mut scale = 1.0;
-    for _ in 0..64 {
-        let (mut carried, mut slope) = (0.0, 0.0);
-        for &p in pressure {
-            if keep_capped && p >= h {
-                carried += h;
-            } else if scale * p <= h {
-                carried += scale * p;
-                slope += p;
-            } else {
-                carried += h;
-            }
-        }
-        if slope <= 0.0 {
-            break;
-        }
-        let next = scale + (wanted - carried) / slope;
-        if next == scale {
-            break;
-        }
-        scale = next;
-    }
-    scale
 }
 
 #[cfg(test)]

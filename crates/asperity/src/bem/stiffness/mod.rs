@@ -121,8 +121,11 @@ impl ContactSolver {
         let mut work = self.stiffness_work();
         // A set solved directly (`small_set.rs`) has its x already (a stop request goes to
         // the CG, which reports it).
-        // (The direct solve knows the hard wall's set only.)
-        let direct = match self.stop.is_requested() || self.interface != Interface::HardWall {
+        // (The direct solve knows the hard wall's set only: not where a point is plastic.)
+        let interface = self.interface;
+        let plastic = interface != Interface::HardWall
+            && self.state.pressure.iter().any(|&p| interface.plastic(p));
+        let direct = match self.stop.is_requested() || plastic {
             true => None,
             false => self.small_set_tangent(tolerance, &mut work.cg.x),
         };
