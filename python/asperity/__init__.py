@@ -1001,7 +1001,7 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
     args = (
         str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
         int(seed), window[0] if min_contacts is None else int(min_contacts),
-        window[1] if max_fraction is None else float(max_fraction), int(levels),
+        window[1] if max_fraction is None else float(max_fraction), None if levels is None else int(levels),
         bool(alpha_sweep), os.fspath(out), bool(force), float(checkpoint_every),
     )
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
@@ -1050,7 +1050,7 @@ def study_alpha(
     seed: int = 1,
     min_contacts: Optional[int] = None,
     max_fraction: Optional[float] = None,
-    levels: int = 48,
+    levels: Optional[int] = None,
     full_sweep: bool = False,
     force: bool = False,
     checkpoint_every: float = 10.0,
@@ -1065,7 +1065,7 @@ def study_alpha(
     ``method``: ``"mdr"`` (rough lines, unit rms height) or ``"bem"`` (surfaces, unit rms
     slope, free boundaries); ``rolloff`` q0·L/2π; ``seed`` (study seed); the α window
     ``min_contacts``, ``max_fraction`` (the CLI's defaults); ``levels`` force levels of the
-    mean curves; ``full_sweep`` solves every BEM load up to p̄ = 0.2 E* (by default a
+    mean curves (default: the library's ``DEFAULT_LEVELS``, 48, as the CLI's); ``full_sweep`` solves every BEM load up to p̄ = 0.2 E* (by default a
     sample stops loading past 4 times the largest contact fraction an α window ends at, as
     the CLI's; the fits are the same); ``force`` discards another study's checkpoints in ``out``;
     ``checkpoint_every`` seconds between checkpoints of a task in progress (0: every
@@ -1112,7 +1112,7 @@ def study_curve(
     seed: int = 1,
     min_contacts: Optional[int] = None,
     max_fraction: Optional[float] = None,
-    levels: int = 48,
+    levels: Optional[int] = None,
     force: bool = False,
     checkpoint_every: float = 10.0,
     progress: ProgressArg = None,

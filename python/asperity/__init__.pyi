@@ -209,13 +209,13 @@ class StudyResult:
 def study_alpha(
     *, method: str, n: Union[int, Sequence[int]], hurst: Union[str, float, Sequence[float]],
     samples: int, out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
-    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: int = ...,
+    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
     full_sweep: bool = ..., force: bool = ..., checkpoint_every: float = ...,
     progress: ProgressArg = ...,
 ) -> StudyResult: ...
 def study_curve(
     *, method: str, n: int, hurst: Union[str, float, Sequence[float]], samples: int,
     out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
-    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: int = ...,
+    min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
     force: bool = ..., checkpoint_every: float = ..., progress: ProgressArg = ...,
 ) -> StudyResult: ...

@@ -18,7 +18,7 @@ use asperity::study::samplers::{BemSampler, MdrSampler};
 use asperity::study::theory::alpha_theory;
 use asperity::study::{
     run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec, Task,
-    TaskResult, TaskSamples, MAX_CHECKPOINT_INTERVAL_SECONDS,
+    TaskResult, TaskSamples, DEFAULT_LEVELS, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 use asperity::Error;
 use pyo3::prelude::*;
@@ -98,7 +98,7 @@ fn run_study(
     seed: u64,
     min_contacts: usize,
     max_fraction: f64,
-    levels: usize,
+    levels: Option<usize>,
     alpha_sweep: bool,
     out: PathBuf,
     force: bool,
@@ -139,7 +139,7 @@ fn make_spec(
     seed: u64,
     min_contacts: usize,
     max_fraction: f64,
-    levels: usize,
+    levels: Option<usize>,
     alpha_sweep: bool,
     checkpoint_every: f64,
 ) -> PyResult<StudySpec> {
@@ -160,7 +160,7 @@ fn make_spec(
             min_contacts,
             max_fraction,
         },
-        levels,
+        levels: levels.unwrap_or(DEFAULT_LEVELS),
         sweep_end: None,
     };
     // As `asperity study alpha`: BEM samples stop loading past the fit windows.
@@ -279,7 +279,7 @@ impl StudyLedger {
         seed: u64,
         min_contacts: usize,
         max_fraction: f64,
-        levels: usize,
+        levels: Option<usize>,
         alpha_sweep: bool,
         out: PathBuf,
         force: bool,

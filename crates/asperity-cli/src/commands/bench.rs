@@ -265,7 +265,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         rolloff: args.rolloff,
         seed: 1,
         window: asperity::study::FitWindow::default(),
-        levels: 48,
+        levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
     }
     .with_alpha_sweep();

@@ -57,7 +57,7 @@ pub struct CommonArgs {
     #[arg(long, default_value_t = FitWindow::default().max_fraction)]
     pub max_fraction: f64,
     /// Common force levels of the ensemble-mean curves.
-    #[arg(long, default_value_t = 48)]
+    #[arg(long, default_value_t = asperity::study::DEFAULT_LEVELS)]
     pub levels: usize,
     #[command(flatten)]
     pub run: RunArgs,
@@ -456,7 +456,7 @@ struct StudyFile {
 }
 
 /// Default number of common force levels.
-const LEVELS: usize = 48;
+const LEVELS: usize = asperity::study::DEFAULT_LEVELS;
 
 /// Reads a study file's text: the kind and the spec (not yet validated). Errors name the
 /// file, the line and column, and the key concerned, in one line.

@@ -255,6 +255,10 @@ impl StudySpec {
     }
 }
 
+/// The number of common force levels of the ensemble curves when none is asked for (the
+/// CLI's `--levels`, Python's `levels`, the figures and the benchmarks).
+pub const DEFAULT_LEVELS: usize = 48;
+
 /// The most force levels of an ensemble curve.
 pub const MAX_LEVELS: usize = 100_000;
 

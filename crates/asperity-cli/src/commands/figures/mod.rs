@@ -85,7 +85,7 @@ fn study_spec(
         rolloff,
         seed: 2013,
         window: FitWindow::default(),
-        levels: 48,
+        levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
     }
 }
