@@ -391,3 +391,74 @@ mod tests {
         assert!((gamma(2.5) - 1.329_340_388_179_137).abs() < 1e-13);
     }
 }
+
+/// Cattaneo–Mindlin: a rigid sphere of radius `radius` pressed to indentation `d` on a
+/// half-space, then loaded monotonically by a tangential force `Q ≤ μF` (normal–tangential
+/// coupling neglected; Johnson, *Contact Mechanics*, §7.2; Popov & Heß ch. 7). `ratio` is
+/// `G*/E*` (`2(1−ν)/(2−ν)` for one Poisson's ratio ν, [`crate::mdr::mindlin_ratio`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CattaneoMindlin {
+    /// Sphere radius R.
+    pub radius: f64,
+    /// Effective modulus E*.
+    pub modulus: f64,
+    /// `G*/E*`.
+    pub ratio: f64,
+    /// Friction coefficient μ.
+    pub friction: f64,
+}
+
+impl CattaneoMindlin {
+    fn hertz(&self) -> Hertz {
+        Hertz {
+            radius: self.radius,
+            modulus: self.modulus,
+        }
+    }
+
+    /// `Q / μF` at indentation `d`.
+    fn load_ratio(&self, indentation: f64, force: f64) -> f64 {
+        force / (self.friction * self.hertz().force(indentation))
+    }
+
+    /// Stick radius `c = a (1 − Q/μF)^{1/3}`.
+    pub fn stick_radius(&self, indentation: f64, force: f64) -> f64 {
+        let a = self.hertz().contact_radius(indentation);
+        a * (1.0 - self.load_ratio(indentation, force)).cbrt()
+    }
+
+    /// Tangential displacement `u = μ (E*/G*) d [1 − (1 − Q/μF)^{2/3}]`.
+    pub fn displacement(&self, indentation: f64, force: f64) -> f64 {
+        let scale = self.friction / self.ratio * indentation;
+        scale * (1.0 - (1.0 - self.load_ratio(indentation, force)).powf(2.0 / 3.0))
+    }
+
+    /// Displacement on unloading from `Q*` to `Q` (Mindlin & Deresiewicz):
+    /// `u = μ (E*/G*) d [2(1 − (Q*−Q)/2μF)^{2/3} − (1 − Q*/μF)^{2/3} − 1]`.
+    pub fn unloading_displacement(&self, indentation: f64, amplitude: f64, force: f64) -> f64 {
+        let scale = self.friction / self.ratio * indentation;
+        let back = self.load_ratio(indentation, amplitude - force) / 2.0;
+        let top = self.load_ratio(indentation, amplitude);
+        scale * (2.0 * (1.0 - back).powf(2.0 / 3.0) - (1.0 - top).powf(2.0 / 3.0) - 1.0)
+    }
+
+    /// Mindlin's no-slip tangential stiffness `2 G* a`.
+    pub fn no_slip_stiffness(&self, indentation: f64) -> f64 {
+        2.0 * self.ratio * self.modulus * self.hertz().contact_radius(indentation)
+    }
+
+    /// Energy dissipated per cycle of amplitude `Q*` (Mindlin & Deresiewicz):
+    /// `9μ²F²/(10a)·((2−ν₁)/G₁ + (2−ν₂)/G₂)·[1 − (1 − Q*/μF)^{5/3} −
+    /// (5Q*/6μF)(1 + (1 − Q*/μF)^{2/3})]`, where the compliance sum is `4/G*`. Its
+    /// small-amplitude limit `(16/81) μ²E*²a⁵q³/(G*R²)` (`q = Q*/μF`) is what the slipping
+    /// edge of width `∝ q` gives by direct integration.
+    pub fn dissipation(&self, indentation: f64, amplitude: f64) -> f64 {
+        let hertz = self.hertz();
+        let (f, a) = (hertz.force(indentation), hertz.contact_radius(indentation));
+        let q = self.load_ratio(indentation, amplitude);
+        let g = self.ratio * self.modulus;
+        let bracket =
+            1.0 - (1.0 - q).powf(5.0 / 3.0) - 5.0 * q / 6.0 * (1.0 + (1.0 - q).powf(2.0 / 3.0));
+        18.0 * (self.friction * f).powi(2) / (5.0 * g * a) * bracket
+    }
+}

@@ -17,6 +17,9 @@
 //!   edges of a contact at `√(2πaΔγ/E*)`: JKR for a sphere, Kendall for a punch, loading–
 //!   unloading loops and pull-off under force and displacement control.
 //! * [`radix_sort`]: the `O(N)` descending sort of doubles behind [`LinearCurve`].
+//! * [`tangential`]: tangential springs beside the normal ones — Mindlin's no-slip
+//!   stiffness, partial slip under `Q ≤ μF` (Ciavarella–Jäger) and the hysteresis cycle
+//!   ([`PartialSlip`]).
 //!
 //! The low-force exponent α of `k ∝ F^α` (3) of an ensemble of lines is the study's
 //! ([`crate::study::curve`]: one fit window and estimator for MDR and BEM alike).
@@ -43,9 +46,13 @@ pub mod indenter;
 pub mod linear_curve;
 pub mod radix_sort;
 pub mod spring;
+pub mod tangential;
 
 pub use adhesion::{AdhesiveLine, PullOffs};
 pub use foundation::{log_spaced, CurvePoint, Foundation};
 pub use indenter::{spring_positions, Axisymmetric, RadialProfile, PUNCH_EDGE_TOLERANCE};
 pub use linear_curve::LinearCurve;
 pub use spring::{fractal_asymptote, Spring, SpringLaw, FRACTAL_CONSTANT};
+pub use tangential::{
+    check_friction, check_poisson, mindlin_ratio, Branch, LoopPoint, PartialSlip,
+};
