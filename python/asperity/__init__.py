@@ -72,6 +72,7 @@ __all__ = [
     "contact",
     "line",
     "mdr",
+    "mdr_slip",
     "psd",
     "read_topography",
     "stats",
@@ -804,6 +805,8 @@ def contact(
     boundary: str = "free",
     tolerance: float = 1e-8,
     map: bool = False,
+    resistivity: Optional[Sequence[float]] = None,
+    thermal_conductivity: Optional[Sequence[float]] = None,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -815,6 +818,9 @@ def contact(
     ``contact_area_m2``, ``area_fraction``, ``mean_gap_m``, ``stiffness_n_per_m``,
     ``patches``, ``indentation_m``, ``iterations``, ``residual``; ``effective_modulus``;
     with ``map=True`` also ``map``, the contact set (True in contact) of the last load.
+    With ``resistivity`` (ρ₁, ρ₂ of the two bodies, Ω·m) also ``electrical_conductance_s``
+    = 2k/(E*(ρ₁+ρ₂)); with ``thermal_conductivity`` (κ₁, κ₂, W/(m·K)) also
+    ``thermal_conductance_w_per_k`` = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy).
 
     Example::
 
@@ -827,6 +833,9 @@ def contact(
     columns = _core.contact(
         heights, size_x, size_y, loads, _opt(modulus), _opt(young), _opt(poisson),
         str(boundary), float(tolerance), bool(map),
+        None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
+        None if thermal_conductivity is None
+        else [float(v) for v in np.atleast_1d(thermal_conductivity)],
     )
     return Sweep(columns)
 
@@ -935,6 +944,94 @@ def mdr(
         _opt(dmax), bool(breakpoints), _opt(work_of_adhesion),
     )
     return MdrCurve(**out)
+
+
+@dataclass
+class SlipCycle:
+    """A tangential cycle (``asperity mdr --tangential-force``): ``branch`` (``loading``,
+    ``unloading``, ``reloading``), ``tangential_displacement``, ``tangential_force``,
+    ``stick_springs`` and, for axisymmetric indenters, ``stick_radius`` (else None); the
+    ``summary`` (indentation, normal_force, friction_limit μF, no_slip_stiffness,
+    stiffness_ratio G*/E*, dissipation_per_cycle, contacts) and a ``description``."""
+
+    branch: List[str]
+    tangential_displacement: np.ndarray
+    tangential_force: np.ndarray
+    stick_springs: np.ndarray
+    stick_radius: Optional[np.ndarray]
+    summary: Dict[str, Any]
+    description: str
+
+
+def mdr_slip(
+    *,
+    tangential_force: float,
+    friction: Optional[float] = None,
+    poisson: float = 0.3,
+    cycle_points: Optional[int] = None,
+    indentations: Optional[Sequence[float]] = None,
+    line: Any = None,
+    profile: Optional[str] = None,
+    radial: Any = None,
+    radial_step: Optional[float] = None,
+    radius: Optional[float] = None,
+    slope: Optional[float] = None,
+    coefficient: Optional[float] = None,
+    exponent: Optional[float] = None,
+    n: Optional[int] = None,
+    dx: Optional[float] = None,
+    size: Optional[float] = None,
+    modulus: float = 1.0,
+    spring: str = "linear",
+    hurst: Optional[float] = None,
+    rms_height: Optional[float] = None,
+    asperity_radius: Optional[float] = None,
+    work_of_adhesion: Optional[float] = None,
+) -> SlipCycle:
+    """Partial slip under a tangential force amplitude ``tangential_force`` Q* ≤ μF at the one
+    indentation of ``indentations``: loading from rest to Q*, unloading to −Q*, reloading to
+    Q* (``asperity mdr --tangential-force``). ``friction`` μ > 0; ``poisson`` ν in [0, 0.5]
+    gives tangential springs G*/E* = 2(1−ν)/(2−ν) times the normal ones. The indenter and
+    springs take the keywords of :func:`mdr` (``profile``, ``radius``, ``n``, ``dx``,
+    ``spring``, ``modulus``, ...).
+
+    Example (Cattaneo–Mindlin: c/a = (1 − Q/μF)^{1/3})::
+
+        >>> c = asperity.mdr_slip(profile="hertz", radius=1.0, n=4001, dx=1e-3,
+        ...                       indentations=[1.0], tangential_force=1/3, friction=0.5)
+        >>> round(float(c.stick_radius[49]), 3)  # top of the loading branch: 0.5^(1/3)
+        0.794
+    """
+    import json
+
+    line_heights = None
+    if line is not None:
+        if isinstance(line, Line):
+            size = line.size if size is None else size
+            line_heights = line.heights
+        else:
+            line_heights = _float64(line, "line")
+    radial_values = None if radial is None else _float64(radial, "radial")
+    request = {
+        "line": line_heights is not None, "radial": radial_values is not None,
+        "profile": profile, "radial_step": _opt(radial_step), "radius": _opt(radius),
+        "slope": _opt(slope), "coefficient": _opt(coefficient), "exponent": _opt(exponent),
+        "n": n, "dx": _opt(dx), "size": _opt(size), "modulus": float(modulus),
+        "spring": str(spring), "hurst": _opt(hurst), "rms_height": _opt(rms_height),
+        "asperity_radius": _opt(asperity_radius), "breakpoints": False,
+        "work_of_adhesion": _opt(work_of_adhesion),
+    }
+    if indentations is not None:
+        request["indentations"] = [
+            float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))
+        ]
+    out = _core.mdr_slip(
+        json.dumps(request), line_heights, radial_values, float(tangential_force),
+        _opt(friction), float(poisson), cycle_points,
+    )
+    out["summary"] = json.loads(out["summary"])
+    out.setdefault("stick_radius", None)
+    return SlipCycle(**out)
 
 
 # --------------------------------------------------------------------------------------

@@ -169,6 +169,8 @@ def contact(
     surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
     modulus: Optional[float] = ..., young: Optional[float] = ..., poisson: Optional[float] = ...,
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
+    resistivity: Optional[Sequence[float]] = ...,
+    thermal_conductivity: Optional[Sequence[float]] = ...,
 ) -> Sweep: ...
 
 @dataclass
@@ -194,6 +196,27 @@ def mdr(
     breakpoints: bool = ...,
     work_of_adhesion: Optional[float] = ...,
 ) -> MdrCurve: ...
+
+@dataclass
+class SlipCycle:
+    branch: List[str]
+    tangential_displacement: F64
+    tangential_force: F64
+    stick_springs: npt.NDArray[np.uint64]
+    stick_radius: Optional[F64]
+    summary: Dict[str, Any]
+    description: str
+
+def mdr_slip(
+    *, tangential_force: float, friction: Optional[float] = ..., poisson: float = ...,
+    cycle_points: Optional[int] = ..., indentations: Optional[Sequence[float]] = ...,
+    line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
+    radial_step: Optional[float] = ..., radius: Optional[float] = ..., slope: Optional[float] = ...,
+    coefficient: Optional[float] = ..., exponent: Optional[float] = ..., n: Optional[int] = ...,
+    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: float = ...,
+    spring: str = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
+    asperity_radius: Optional[float] = ..., work_of_adhesion: Optional[float] = ...,
+) -> SlipCycle: ...
 
 @dataclass
 class StudyResult:

@@ -44,6 +44,7 @@ def contact(
     heights: npt.NDArray[np.float64], size_x: float, size_y: Optional[float],
     pressures: List[float], modulus: Optional[float], young: Optional[float],
     poisson: Optional[float], boundary: str, tolerance: float, map: bool,
+    resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
 ) -> Dict[str, Any]: ...
 
 class Solver:
@@ -77,6 +78,11 @@ def mdr_curve(
     hurst: Optional[float], rms_height: Optional[float], asperity_radius: Optional[float],
     indentations: Optional[List[float]], nloads: Optional[int], dmin: Optional[float],
     dmax: Optional[float], breakpoints: bool, work_of_adhesion: Optional[float],
+) -> Dict[str, Any]: ...
+
+def mdr_slip(
+    request: str, line: Optional[F64], radial: Optional[F64], tangential_force: float,
+    friction: Optional[float], poisson: float, cycle_points: Optional[int],
 ) -> Dict[str, Any]: ...
 def run_study(
     method_name: str, sizes: List[int], hursts: List[float], samples: int,

@@ -7,7 +7,7 @@ use asperity::bem::ContactSolver;
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::ensure_solver_fits;
-use asperity_app::contact::{self as app, ContactRequest, Value, COLUMNS};
+use asperity_app::contact::{self as app, ContactRequest, Value};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -25,7 +25,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -39,6 +39,8 @@ fn contact<'py>(
     boundary: &str,
     tolerance: f64,
     map: bool,
+    resistivity: Option<Vec<f64>>,
+    thermal_conductivity: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ContactRequest {
         modulus,
@@ -47,6 +49,8 @@ fn contact<'py>(
         pressures,
         boundary: boundary.into(),
         tolerance,
+        resistivity,
+        thermal_conductivity,
     };
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();
@@ -82,8 +86,8 @@ fn contact<'py>(
         SweepFailure::Stopped(never) => match never {},
     })?;
     let dict = PyDict::new(py);
-    for (k, name) in COLUMNS.iter().enumerate() {
-        let column: Vec<Value> = run.rows.iter().map(|row| row.values()[k]).collect();
+    for (k, name) in app::columns(&plan).iter().enumerate() {
+        let column: Vec<Value> = run.rows.iter().map(|row| row.all_values()[k]).collect();
         if column.iter().all(|v| matches!(v, Value::Count(_))) {
             let counts = column.iter().map(|v| match *v {
                 Value::Count(n) => n as u64,

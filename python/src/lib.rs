@@ -13,6 +13,7 @@ mod contact;
 mod errors;
 mod interrupt;
 mod mdr;
+mod slip;
 mod study;
 mod surface;
 mod topography;
@@ -43,6 +44,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bem::register(m)?;
     contact::register(m)?;
     mdr::register(m)?;
+    slip::register(m)?;
     study::register(m)?;
     topography::register(m)?;
     Ok(())

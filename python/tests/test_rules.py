@@ -56,6 +56,12 @@ KEYWORDS = {
     "--fit-to": "fit_to",
     "--detrend": "detrend",
     "--fill": "fill",
+    "--tangential-force": "tangential_force",
+    "--resistivity": "resistivity",
+    "--thermal-conductivity": "thermal_conductivity",
+    "tangential-force": "tangential_force",
+    "--friction": "friction",
+    "--cycle-points": "cycle_points",
 }
 
 
@@ -132,6 +138,18 @@ CONTACT = [
      dict(modulus=1e9, pressures=[1e5], tolerance=0), "got 0"),
     (["--modulus", "1e9", "--pressures", "1e5", "--boundary", "open"],
      dict(modulus=1e9, pressures=[1e5], boundary="open"), 'boundary must be "free"'),
+    (["--modulus", "1e9", "--pressures", "1e5", "--resistivity", "1e-8"],
+     dict(modulus=1e9, pressures=[1e5], resistivity=[1e-8]),
+     "invalid resistivity: give two values, body 1 and body 2, got 1"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--resistivity", "1e-8,0"],
+     dict(modulus=1e9, pressures=[1e5], resistivity=[1e-8, 0]),
+     "invalid resistivity: each body's resistivity must be positive and finite, got 0"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--thermal-conductivity", "inf,1"],
+     dict(modulus=1e9, pressures=[1e5], thermal_conductivity=[INF, 1]),
+     "invalid thermal_conductivity: each body's thermal conductivity must be positive and "
+     "finite, got inf"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--thermal-conductivity", "1,-5"],
+     dict(modulus=1e9, pressures=[1e5], thermal_conductivity=[1, -5]), "got -5"),
 ]
 
 
@@ -233,6 +251,86 @@ MEASURED = [
 ]
 
 ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED
+# asperity mdr --tangential-force (Python: mdr_slip): (flags, keywords, expected words in
+# keywords), on a sphere at d = 1 (μF = 2/3 with μ = 0.5).
+SPHERE = (["--profile", "hertz", "--radius", "1", "--n", "401", "--dx", "0.01", "--indentations", "1"],
+          dict(profile="hertz", radius=1, n=401, dx=0.01, indentations=[1]))
+SLIP = [
+    (["--tangential-force", "0.1", "--friction", "0.5", "--poisson", "0.6"],
+     dict(tangential_force=0.1, friction=0.5, poisson=0.6),
+     "invalid poisson: Poisson's ratio ν must be in [0, 0.5], got 0.6"),
+    (["--tangential-force", "0.1", "--friction", "0.5", "--poisson", "-0.1"],
+     dict(tangential_force=0.1, friction=0.5, poisson=-0.1), "got -0.1"),
+    (["--tangential-force", "0.1"], dict(tangential_force=0.1), "tangential_force needs friction"),
+    (["--tangential-force", "0.1", "--friction", "0"], dict(tangential_force=0.1, friction=0),
+     "invalid friction: the friction coefficient μ must be positive and finite, got 0"),
+    (["--tangential-force", "0.1", "--friction", "inf"], dict(tangential_force=0.1, friction=INF),
+     "got inf"),
+    (["--tangential-force", "-1", "--friction", "0.5"], dict(tangential_force=-1, friction=0.5),
+     "invalid tangential_force: the tangential force Q* must be positive and finite, got -1"),
+    (["--tangential-force", "0.7", "--friction", "0.5"], dict(tangential_force=0.7, friction=0.5),
+     "invalid tangential_force: the tangential force Q must be finite with |Q| <= μF = 6.66"),
+    (["--tangential-force", "0.1", "--friction", "0.5", "--work-of-adhesion", "1e-3"],
+     dict(tangential_force=0.1, friction=0.5, work_of_adhesion=1e-3),
+     "tangential_force is for non-adhesive contact: drop work_of_adhesion"),
+    (["--tangential-force", "0.1", "--friction", "0.5", "--cycle-points", "1"],
+     dict(tangential_force=0.1, friction=0.5, cycle_points=1),
+     "invalid cycle_points: a branch needs at least 2 points, got 1"),
+]
+
+
+@pytest.mark.parametrize("flags,kwargs,words", SLIP)
+def test_mdr_slip_refuses_alike(cli, flags, kwargs, words):
+    theirs = in_keywords(cli_error(cli("mdr", *SPHERE[0], *flags, ok=False)))
+    ours = python_words(lambda: asperity.mdr_slip(**SPHERE[1], **kwargs))
+    assert ours == theirs
+    assert words in ours
+
+
+def test_mdr_slip_needs_one_indentation_alike(cli):
+    flags = ["--profile", "hertz", "--radius", "1", "--n", "401", "--dx", "0.01",
+             "--indentations", "0.5,1", "--tangential-force", "0.1", "--friction", "0.5"]
+    theirs = in_keywords(cli_error(cli("mdr", *flags, ok=False)))
+    ours = python_words(lambda: asperity.mdr_slip(
+        profile="hertz", radius=1, n=401, dx=0.01, indentations=[0.5, 1], tangential_force=0.1,
+        friction=0.5))
+    assert ours == theirs == "tangential_force needs exactly one indentation: indentations d"
+
+
+def test_mdr_slip_equals_the_cli(cli, tmp_path):
+    """`asperity.mdr_slip` gives the CLI's cycle bit for bit, and Cattaneo–Mindlin's stick
+    radius at the top of the loading branch (a/Δx = 200: within 1e-2)."""
+    cli("mdr", *SPHERE[0], "--tangential-force", 1 / 3, "--friction", 0.5, "--cycle-points", 9,
+        "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True, dtype=None,
+                           encoding="utf-8")
+    ours = asperity.mdr_slip(**SPHERE[1], tangential_force=1 / 3, friction=0.5, cycle_points=9)
+    assert list(theirs["branch"]) == ours.branch
+    for name in ["tangential_displacement", "tangential_force", "stick_springs", "stick_radius"]:
+        assert np.array_equal(getattr(ours, name), theirs[name]), name
+    assert abs(ours.stick_radius[8] - 0.5 ** (1 / 3)) < 1e-2
+    assert ours.summary["stiffness_ratio"] == 2 * 0.7 / 1.7
+
+
+def test_contact_conductance_is_the_clis_and_barbers(cli, tmp_path):
+    """The conductance columns are the CLI's bit for bit, and 2k/(E*(ρ₁+ρ₂)),
+    (2k/E*)·κ₁κ₂/(κ₁+κ₂) of the stiffness column."""
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_slope=1, seed=3, size=1e-4)
+    heights = s.heights * 1e-6
+    np.save(tmp_path / "h.npy", heights)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none", "--out", tmp_path / "t.npy")
+    cli("contact", tmp_path / "t.npy", "--modulus", 1e11, "--pressures", "1e4,1e5",
+        "--resistivity", "1.7e-8,2.8e-8", "--thermal-conductivity", "400,50", "--detrend", "none",
+        "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    t = asperity.read_topography(tmp_path / "t.npy")
+    ours = asperity.contact(t, modulus=1e11, pressures=[1e4, 1e5],
+                            resistivity=[1.7e-8, 2.8e-8], thermal_conductivity=[400, 50])
+    for name in ["stiffness_n_per_m", "electrical_conductance_s", "thermal_conductance_w_per_k"]:
+        assert np.array_equal(ours[name], theirs[name]), name
+    k = ours["stiffness_n_per_m"]
+    assert np.allclose(ours["electrical_conductance_s"], 2 * k / (1e11 * 4.5e-8), rtol=1e-14)
+    assert np.allclose(ours["thermal_conductance_w_per_k"], 2 * k / 1e11 * 400 * 50 / 450, rtol=1e-14)
 
 
 def test_the_table_covers_every_rule_of_every_command_moved():

@@ -4,6 +4,7 @@
 
 use std::convert::Infallible;
 
+use asperity::bem::conductance::Transport;
 use asperity::bem::sweep::{sweep, SweepError, SweepObserver, SweepParams, SweepRow};
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
 use asperity::topography::patches::count_patches;
@@ -11,7 +12,7 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::bem::{check_modulus, check_tolerance, check_values, params as bem, parse_boundary};
-use crate::refusal::Refusal;
+use crate::refusal::{Param, Refusal};
 
 /// The parameters of `asperity contact` besides those it shares with `asperity bem`.
 pub mod params {
@@ -21,6 +22,11 @@ pub mod params {
     pub const YOUNG: Param = Param::new("--young", "young");
     /// Poisson's ratio ν.
     pub const POISSON: Param = Param::new("--poisson", "poisson");
+    /// The two bodies' electrical resistivities.
+    pub const RESISTIVITY: Param = Param::new("--resistivity", "resistivity");
+    /// The two bodies' thermal conductivities.
+    pub const THERMAL_CONDUCTIVITY: Param =
+        Param::new("--thermal-conductivity", "thermal_conductivity");
 }
 
 use params::*;
@@ -72,6 +78,12 @@ pub struct ContactRequest {
     pub boundary: String,
     /// The BEM's tolerance (rms gap violation over the rms height).
     pub tolerance: f64,
+    /// Electrical resistivities of body 1 and body 2, Ω·m (conductance by Barber's analogy).
+    #[serde(default)]
+    pub resistivity: Option<Vec<f64>>,
+    /// Thermal conductivities of body 1 and body 2, W/(m·K).
+    #[serde(default)]
+    pub thermal_conductivity: Option<Vec<f64>>,
 }
 
 impl Default for ContactRequest {
@@ -84,6 +96,8 @@ impl Default for ContactRequest {
             pressures: Vec::new(),
             boundary: "free".into(),
             tolerance: SolverParams::default().tolerance,
+            resistivity: None,
+            thermal_conductivity: None,
         }
     }
 }
@@ -97,6 +111,32 @@ pub struct ContactPlan {
     pub params: SolverParams,
     /// The mean pressures, in the given order.
     pub loads: Vec<Control>,
+    /// The bodies' resistivities and conductivities, if given.
+    pub transport: Transport,
+}
+
+/// Two values, one per body, each positive and finite.
+fn body_pair(
+    param: Param,
+    what: &str,
+    values: &Option<Vec<f64>>,
+) -> Result<Option<[f64; 2]>, Refusal> {
+    let Some(values) = values else {
+        return Ok(None);
+    };
+    let invalid = || Refusal::saying("invalid ").param(param);
+    if values.len() != 2 {
+        return Err(invalid().text(format!(
+            ": give two values, body 1 and body 2, got {}",
+            values.len()
+        )));
+    }
+    if let Some(bad) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        return Err(invalid().text(format!(
+            ": each body's {what} must be positive and finite, got {bad}"
+        )));
+    }
+    Ok(Some([values[0], values[1]]))
 }
 
 impl ContactRequest {
@@ -106,7 +146,18 @@ impl ContactRequest {
         let boundary = parse_boundary(&self.boundary)?;
         check_values(bem::PRESSURES, &self.pressures, false)?;
         check_tolerance(self.tolerance)?;
+        let resistivity = body_pair(RESISTIVITY, "resistivity", &self.resistivity)?;
+        let thermal = body_pair(
+            THERMAL_CONDUCTIVITY,
+            "thermal conductivity",
+            &self.thermal_conductivity,
+        )?;
+        let transport = Transport {
+            resistivity,
+            thermal_conductivity: thermal,
+        };
         Ok(ContactPlan {
+            transport,
             half_space: HalfSpace { modulus, boundary },
             params: SolverParams {
                 tolerance: self.tolerance,
@@ -159,6 +210,23 @@ pub struct ContactRow {
     pub iterations: usize,
     /// Solver residual.
     pub residual: f64,
+    /// Electrical conductance by Barber's analogy, S (with resistivities).
+    pub electrical_conductance: Option<f64>,
+    /// Thermal conductance by Barber's analogy, W/K (with conductivities).
+    pub thermal_conductance: Option<f64>,
+}
+
+/// The columns of `plan`'s table: [`COLUMNS`], then `electrical_conductance_s` and
+/// `thermal_conductance_w_per_k` when their bodies' properties are given.
+pub fn columns(plan: &ContactPlan) -> Vec<&'static str> {
+    let mut columns = COLUMNS.to_vec();
+    if plan.transport.resistivity.is_some() {
+        columns.push("electrical_conductance_s");
+    }
+    if plan.transport.thermal_conductivity.is_some() {
+        columns.push("thermal_conductance_w_per_k");
+    }
+    columns
 }
 
 /// A value of a row: a number or a count.
@@ -187,6 +255,14 @@ impl ContactRow {
             Number(self.residual),
         ]
     }
+
+    /// The row's values in the order of [`columns`] (the conductances that were asked for).
+    pub fn all_values(&self) -> Vec<Value> {
+        let mut values = self.values().to_vec();
+        let conductances = [self.electrical_conductance, self.thermal_conductance];
+        values.extend(conductances.into_iter().flatten().map(Value::Number));
+        values
+    }
 }
 
 /// The rows of a run and, when asked for, the contact set of the last load.
@@ -204,6 +280,8 @@ struct Observer<'a> {
     on_load: &'a mut dyn FnMut(),
     keep_map: bool,
     pixel_area: f64,
+    transport: Transport,
+    modulus: f64,
     fields: (f64, usize),
     map: Option<Array2<bool>>,
     rows: Vec<ContactRow>,
@@ -224,13 +302,16 @@ impl SweepObserver for Observer<'_> {
 
     fn finished(&mut self, _load: usize, row: &SweepRow) -> Result<(), Infallible> {
         let s = &row.summary;
+        let stiffness = row.stiffness.unwrap_or(f64::NAN);
         self.rows.push(ContactRow {
+            electrical_conductance: self.transport.electrical(stiffness, self.modulus),
+            thermal_conductance: self.transport.thermal(stiffness, self.modulus),
             pressure: s.mean_pressure,
             force: s.force,
             area: s.contact_points as f64 * self.pixel_area,
             fraction: s.area_fraction,
             mean_gap: self.fields.0,
-            stiffness: row.stiffness.unwrap_or(f64::NAN),
+            stiffness,
             patches: self.fields.1,
             indentation: s.indentation,
             iterations: row.info.iterations,
@@ -256,6 +337,8 @@ pub fn run(
         on_load,
         keep_map,
         pixel_area,
+        transport: plan.transport,
+        modulus: plan.half_space.modulus,
         fields: (f64::NAN, 0),
         map: None,
         rows: Vec::with_capacity(plan.loads.len()),
@@ -360,5 +443,54 @@ mod tests {
         let map = run.map.unwrap();
         assert_eq!(map, by_hand.pressure().mapv(|v| v > 0.0));
         assert_eq!(COLUMNS.len(), run.rows[0].values().len());
+        assert_eq!(columns(&plan).len(), run.rows[0].all_values().len());
+    }
+
+    #[test]
+    fn conductance_columns_follow_barbers_analogy() {
+        use asperity::surface::Surface;
+        let heights = Array2::from_shape_fn((24, 24), |(i, j)| {
+            ((i as f64) * 0.7).sin() * ((j as f64) * 0.4).cos() * 1e-6
+        });
+        let surface = Surface::new(heights, 1e-4).unwrap();
+        let request = ContactRequest {
+            modulus: Some(1e9),
+            pressures: vec![1e5],
+            resistivity: Some(vec![1e-8, 3e-8]),
+            thermal_conductivity: Some(vec![50.0, 200.0]),
+            ..ContactRequest::default()
+        };
+        let plan = request.validate().unwrap();
+        let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        let row = run(&mut solver, &plan, 1.0, false, &mut || ())
+            .unwrap()
+            .rows[0];
+        let k = row.stiffness;
+        assert_eq!(row.electrical_conductance, Some(2.0 * k / (1e9 * 4e-8)));
+        let thermal = row.thermal_conductance.unwrap() / (2.0 * k / 1e9 * 40.0);
+        assert!((thermal - 1.0).abs() < 1e-15);
+        let names = columns(&plan);
+        assert_eq!(
+            &names[10..],
+            ["electrical_conductance_s", "thermal_conductance_w_per_k"]
+        );
+        assert_eq!(row.all_values().len(), 12);
+        let refused = |r: Option<Vec<f64>>, t: Option<Vec<f64>>| {
+            let request = ContactRequest {
+                resistivity: r,
+                thermal_conductivity: t,
+                ..request.clone()
+            };
+            first(&request.validate().unwrap_err())
+        };
+        assert_eq!(
+            refused(Some(vec![1e-8]), None),
+            "invalid resistivity: give two values, body 1 and body 2, got 1"
+        );
+        assert_eq!(
+            refused(None, Some(vec![1.0, -2.0])),
+            "invalid thermal_conductivity: each body's thermal conductivity must be positive \
+             and finite, got -2"
+        );
     }
 }

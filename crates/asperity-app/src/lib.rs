@@ -32,6 +32,7 @@ pub mod mdr;
 pub mod measured;
 pub mod range;
 pub mod refusal;
+pub mod slip;
 pub mod stats;
 pub mod study;
 pub mod surface;

@@ -171,8 +171,9 @@ fn in_cli_words(cause: &(dyn std::error::Error + 'static)) -> String {
 
 /// The CLI flag (without `--`) of a library parameter whose name differs from it.
 fn flag(parameter: &str) -> &str {
-    const FLAGS: [(&str, &str); 4] = [
+    const FLAGS: [(&str, &str); 5] = [
         ("rms_height", "rms-height"),
+        ("tangential_force", "tangential-force"),
         ("rms_slope", "rms-slope"),
         ("radial_step", "radial-step"),
         ("short_cutoff", "short-cutoff"),

@@ -1029,3 +1029,92 @@ fn adhesive_sphere_loop_lets_go_at_the_jkr_pull_offs() {
         assert!(!dir.path().join("no.csv").exists());
     }
 }
+
+#[test]
+fn tangential_force_gives_the_cattaneo_mindlin_cycle() {
+    // Sphere R = 1 at d = 1 (a = 1, F = 4/3), a/Δx = 1000, μ = 0.5, ν = 0.3, Q* = μF/2.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cycle.csv");
+    let o = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "2401",
+            "--dx",
+            "1e-3",
+            "--indentations",
+            "1",
+            "--tangential-force",
+            "0.3333333333333333",
+            "--friction",
+            "0.5",
+            "--cycle-points",
+            "5",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    ok(&o);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 15);
+    let top = &rows[4];
+    assert_eq!(top[0], "loading");
+    let exact = asperity::reference::CattaneoMindlin {
+        radius: 1.0,
+        modulus: 1.0,
+        ratio: asperity::mdr::mindlin_ratio(0.3).unwrap(),
+        friction: 0.5,
+    };
+    let u: f64 = top[1].parse().unwrap();
+    let u_exact = exact.displacement(1.0, 1.0 / 3.0);
+    assert!((u / u_exact - 1.0).abs() < 1e-3, "u {u} vs {u_exact}");
+    let c: f64 = top[4].parse().unwrap();
+    assert!((c - 0.5f64.cbrt()).abs() < 1e-3, "c/a {c}");
+    // The unloading branch ends at (−u*, −Q*); the record holds the cycle's summary.
+    let end = &rows[9];
+    assert_eq!(end[0], "unloading");
+    assert!((end[1].parse::<f64>().unwrap() + u).abs() < 1e-12);
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("cycle.csv.json")).unwrap())
+            .unwrap();
+    let k = record["cycle"]["no_slip_stiffness"].as_f64().unwrap();
+    assert!(
+        (k / exact.no_slip_stiffness(1.0) - 1.0).abs() < 1e-3,
+        "k_t {k}"
+    );
+    // Beyond μF: refused, nothing written.
+    let o = asperity(
+        &[
+            "mdr",
+            "--profile",
+            "hertz",
+            "--radius",
+            "1",
+            "--n",
+            "2401",
+            "--dx",
+            "1e-3",
+            "--indentations",
+            "1",
+            "--tangential-force",
+            "0.7",
+            "--friction",
+            "0.5",
+            "--out",
+            dir.path().join("x.csv").to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    refused(&o, "|Q| <= μF");
+    assert!(!dir.path().join("x.csv").exists());
+}

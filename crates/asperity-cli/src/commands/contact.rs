@@ -18,7 +18,7 @@ use asperity::bem::sweep::{SweepError, SweepFailure};
 use asperity::bem::ContactSolver;
 use asperity::io::{sidecar_path, StagedOutputs};
 use asperity_app::bem::{ensure_solver_fits, SolverRequest};
-use asperity_app::contact::{self, ContactPlan, ContactRequest, ContactRow, Value, COLUMNS};
+use asperity_app::contact::{self, ContactPlan, ContactRequest, ContactRow, Value};
 use serde_json::json;
 
 use super::measured::{load, record, MeasuredArgs};
@@ -76,6 +76,24 @@ pub struct ContactArgs {
     /// Contact map at the largest load (.png): contact black, free surface white.
     #[arg(long, value_name = "FILE.png")]
     pub map: Option<PathBuf>,
+    /// Electrical resistivities ρ₁,ρ₂ of the two bodies, Ω·m: adds the column
+    /// electrical_conductance_s, C = 2k/(E*(ρ₁+ρ₂)) (Barber's analogy).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "R1,R2"
+    )]
+    pub resistivity: Option<Vec<f64>>,
+    /// Thermal conductivities κ₁,κ₂ of the two bodies, W/(m·K): adds the column
+    /// thermal_conductance_w_per_k, C = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "K1,K2"
+    )]
+    pub thermal_conductivity: Option<Vec<f64>>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -93,6 +111,8 @@ fn request(args: &ContactArgs) -> ContactRequest {
         pressures: args.pressures.clone(),
         boundary: args.boundary.clone(),
         tolerance: args.tol,
+        resistivity: args.resistivity.clone(),
+        thermal_conductivity: args.thermal_conductivity.clone(),
     }
 }
 
@@ -128,11 +148,11 @@ fn sweep_error(error: SweepError<Infallible>) -> anyhow::Error {
 }
 
 /// The table of step 3, SI units.
-fn table(rows: &[ContactRow]) -> Table {
-    let mut table = Table::new(&COLUMNS);
+fn table(plan: &ContactPlan, rows: &[ContactRow]) -> Table {
+    let mut table = Table::new(&contact::columns(plan));
     for row in rows {
         let cells: Vec<String> = row
-            .values()
+            .all_values()
             .iter()
             .map(|v| match *v {
                 Value::Number(x) => format_number(x),
@@ -214,7 +234,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     )
     .map_err(sweep_error)?;
     progress.finish();
-    let table = table(&solved.rows);
+    let table = table(&plan, &solved.rows);
     match &record_path {
         Some(record_path) => {
             table.stage(&mut staged, args.out.as_deref().expect("with its record"))?;
@@ -226,7 +246,11 @@ pub fn run(args: &ContactArgs) -> Result<()> {
                 "boundary": boundary.name(),
                 "tolerance": args.tol,
                 "pressures_pa": args.pressures,
-                "units": "SI: m, Pa, N, m², N/m",
+                "resistivity_ohm_m": args.resistivity,
+                "thermal_conductivity_w_per_m_k": args.thermal_conductivity,
+                "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
+                    2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",
+                "units": "SI: m, Pa, N, m², N/m, S, W/K",
             });
             staged.write_json(record_path, &inputs)?;
         }

@@ -133,6 +133,23 @@ pub struct MdrArgs {
     /// divided by E* (length² and length); points at d = 0 or F = 0 are left out.
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Partial slip instead of the normal curve: the tangential force amplitude Q* (same
+    /// force units as F, at most μF) of a cycle at the one indentation of --indentations:
+    /// loading from rest to Q*, unloading to −Q*, reloading to Q* (Ciavarella–Jäger on the
+    /// springs; Cattaneo–Mindlin for a sphere). Columns: branch, tangential_displacement,
+    /// tangential_force, stick_springs, and stick_radius for axisymmetric indenters.
+    #[arg(long, allow_hyphen_values = true, value_name = "Q")]
+    pub tangential_force: Option<f64>,
+    /// Friction coefficient μ of --tangential-force.
+    #[arg(long, allow_hyphen_values = true)]
+    pub friction: Option<f64>,
+    /// Poisson's ratio ν in [0, 0.5] of --tangential-force (both bodies, or the elastic one
+    /// on a rigid one): tangential springs G*/E* = 2(1−ν)/(2−ν) times the normal ones.
+    #[arg(long, allow_hyphen_values = true, default_value_t = asperity_app::slip::DEFAULT_POISSON)]
+    pub poisson: f64,
+    /// Points per branch of the --tangential-force cycle (default 50).
+    #[arg(long)]
+    pub cycle_points: Option<usize>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -211,7 +228,7 @@ fn npy_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
 
 /// The indenter of the request: a line or radial samples read from their file, or a
 /// closed form.
-fn load_indenter(args: &MdrArgs, request: &MdrRequest) -> Result<Indenter> {
+pub(super) fn load_indenter(args: &MdrArgs, request: &MdrRequest) -> Result<Indenter> {
     if let Some(path) = &args.line {
         return if !is_npy(path) || has_import_sidecar(path) {
             measured_line(args, path)
@@ -356,6 +373,9 @@ pub fn run(args: &MdrArgs) -> Result<()> {
     // Every output is checked before any work, and all are written together at the end.
     let request = request(args);
     request.check()?;
+    if args.tangential_force.is_some() {
+        return super::mdr_slip::run(args, &request);
+    }
     check_plot(args)?;
     let record_path = args.out.as_deref().map(sidecar_path);
     let outputs = args.out.iter().chain(&record_path).chain(&args.plot);

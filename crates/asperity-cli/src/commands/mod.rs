@@ -6,6 +6,7 @@ pub mod contact;
 pub mod figures;
 pub mod import;
 pub mod mdr;
+pub mod mdr_slip;
 pub mod measured;
 pub mod persson;
 pub mod reproduce;

@@ -50,6 +50,7 @@
 //! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
 
 mod bccg;
+pub mod conductance;
 mod full_contact;
 mod interface;
 #[cfg(test)]
@@ -63,6 +64,7 @@ mod small_set;
 mod solver;
 mod stiffness;
 pub mod sweep;
+pub mod tangential;
 
 pub use full_contact::FullContactThreshold;
 pub use interface::Interface;

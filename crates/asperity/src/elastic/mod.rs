@@ -12,13 +12,20 @@
 //!   body (apply, self-influence, energy, the grid), which [`ElasticOperator`] implements:
 //!   the place where another kernel (tangential, layered, on a device) plugs in.
 //!
+//! * [`cerruti`]: Cerruti's closed form for the **tangential** displacement caused by a
+//!   uniform tangential traction on a rectangular pixel, along the traction (the kernel of
+//!   the tangential stiffness; normal–tangential coupling neglected), and its periodic
+//!   spectrum.
+//!
 //! Units: `u` in the unit of lengths when `p` is in the unit of `E*`; displacement is
 //! positive into the half-space (down), pressure positive in compression.
 
+pub mod cerruti;
 pub mod half_space;
 pub mod love;
 pub mod operator;
 
+pub use cerruti::{cerruti_pixel_displacement, cerruti_spectrum, Direction};
 pub use half_space::HalfSpaceOperator;
 pub use love::{love_pixel_displacement, rectangle_self_influence, self_influence};
-pub use operator::{Boundary, ElasticOperator};
+pub use operator::{Boundary, ElasticOperator, Kernel};

@@ -39,6 +39,7 @@ use std::f64::consts::PI;
 
 use num_complex::Complex64;
 
+use super::cerruti::{cerruti_pixel_displacement, cerruti_spectrum, Direction};
 use super::love::{love_pixel_displacement, rectangle_self_influence, self_influence};
 use crate::fft::{Precision, RealFft2};
 use crate::sum::sum4;
@@ -85,6 +86,44 @@ impl std::str::FromStr for Boundary {
     }
 }
 
+/// Which displacement the operator gives for which load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kernel {
+    /// Normal displacement from pressure (Love's coefficients; Boussinesq).
+    Normal,
+    /// Tangential displacement along `direction` from a tangential traction along it
+    /// (Cerruti's coefficients, [`super::cerruti`]; the coupling to the normal problem and
+    /// the cross term neglected), for Poisson's ratio `poisson` in `[0, 0.5]`.
+    Tangential {
+        /// Poisson's ratio ν.
+        poisson: f64,
+        /// The direction of traction and displacement.
+        direction: Direction,
+    },
+}
+
+impl Kernel {
+    /// The displacement at `(x, y)` per unit load on a `dx × dy` pixel at the origin.
+    fn pixel(self, x: f64, y: f64, dx: f64, dy: f64, modulus: f64) -> f64 {
+        match self {
+            Kernel::Normal => love_pixel_displacement(x, y, dx, dy, modulus),
+            Kernel::Tangential { poisson, direction } => {
+                cerruti_pixel_displacement(x, y, dx, dy, modulus, poisson, direction)
+            }
+        }
+    }
+
+    /// The periodic kernel's spectrum at `(qx, qy) ≠ 0`.
+    fn spectrum(self, qx: f64, qy: f64, modulus: f64) -> f64 {
+        match self {
+            Kernel::Normal => 2.0 / (modulus * qx.hypot(qy)),
+            Kernel::Tangential { poisson, direction } => {
+                cerruti_spectrum(qx, qy, modulus, poisson, direction)
+            }
+        }
+    }
+}
+
 /// The half-space convolution operator of one grid (see the module docs), computing in
 /// `T` (`f64`; `f32` for the copy of [`ElasticOperator::single_precision`]).
 pub struct ElasticOperator<T: Precision = f64> {
@@ -94,6 +133,8 @@ pub struct ElasticOperator<T: Precision = f64> {
     spacing_y: f64,
     modulus: f64,
     boundary: Boundary,
+    /// Normal (Love) or tangential (Cerruti) coefficients.
+    kind: Kernel,
     /// The padded (free) or plain (periodic) transform of the grid.
     fft: RealFft2<T>,
     /// Unique values of the real, even kernel spectrum, `half_cols × kernel_rows`,
@@ -139,6 +180,40 @@ impl ElasticOperator {
         modulus: f64,
         boundary: Boundary,
     ) -> Result<Self> {
+        Self::with_kernel(
+            rows,
+            cols,
+            (spacing_x, spacing_y),
+            modulus,
+            boundary,
+            Kernel::Normal,
+        )
+    }
+
+    /// The operator of the tangential displacement along `direction` from a tangential
+    /// traction along it, for Poisson's ratio `poisson` in `[0, 0.5]` (Cerruti's
+    /// coefficients; [`Kernel::Tangential`]), on the grid of
+    /// [`ElasticOperator::with_spacings`].
+    pub fn tangential(
+        (rows, cols): (usize, usize),
+        (spacing_x, spacing_y): (f64, f64),
+        modulus: f64,
+        boundary: Boundary,
+        (poisson, direction): (f64, Direction),
+    ) -> Result<Self> {
+        crate::mdr::check_poisson(poisson)?;
+        let kind = Kernel::Tangential { poisson, direction };
+        Self::with_kernel(rows, cols, (spacing_x, spacing_y), modulus, boundary, kind)
+    }
+
+    fn with_kernel(
+        rows: usize,
+        cols: usize,
+        (spacing_x, spacing_y): (f64, f64),
+        modulus: f64,
+        boundary: Boundary,
+        kind: Kernel,
+    ) -> Result<Self> {
         if rows < 1 || cols < 1 {
             return Err(Error::invalid(
                 "grid",
@@ -169,6 +244,7 @@ impl ElasticOperator {
             spacing_y,
             modulus,
             boundary,
+            kind,
             fft,
             kernel: memory::try_vec("the elastic kernel's spectrum", kernel_len, 0.0)?,
             column_energies: memory::try_vec("the energy's partial sums", half_cols, 0.0)?,
@@ -205,6 +281,7 @@ impl ElasticOperator {
             spacing_y: self.spacing_y,
             modulus: self.modulus,
             boundary,
+            kind: self.kind,
             fft,
             kernel,
             column_energies: self.column_energies.clone(),
@@ -277,6 +354,10 @@ impl<T: Precision> ElasticOperator<T> {
     /// `Δx × Δy` rectangle ([`rectangle_self_influence`]; for square pixels exactly
     /// [`self_influence`]).
     pub fn self_influence(&self) -> f64 {
+        if let Kernel::Tangential { .. } = self.kind {
+            let (dx, dy) = (self.spacing_x, self.spacing_y);
+            return self.kind.pixel(0.0, 0.0, dx, dy, self.modulus);
+        }
         if self.spacing_x == self.spacing_y {
             self_influence(self.spacing_x, self.modulus)
         } else {
@@ -305,7 +386,7 @@ impl ElasticOperator {
             Complex64::default(),
         )?;
         let (prow, pcol) = (self.fft.rows(), self.fft.cols());
-        let (dx, dy, e) = (self.spacing_x, self.spacing_y, self.modulus);
+        let (dx, dy, e, kind) = (self.spacing_x, self.spacing_y, self.modulus, self.kind);
         let kernel_rows = self.kernel_rows();
         let offset = |m: usize, n: usize| {
             if m <= n / 2 {
@@ -320,7 +401,7 @@ impl ElasticOperator {
                 // takes |x|, so the values are the same bits).
                 let y = offset(r, prow) * dy;
                 for (c, value) in row[..=pcol / 2].iter_mut().enumerate() {
-                    *value = love_pixel_displacement(offset(c, pcol) * dx, y, dx, dy, e);
+                    *value = kind.pixel(offset(c, pcol) * dx, y, dx, dy, e);
                 }
                 for c in pcol / 2 + 1..pcol {
                     row[c] = row[pcol - c];
@@ -349,11 +430,11 @@ impl ElasticOperator {
         let qy_unit = 2.0 * PI / (prow as f64 * self.spacing_y);
         for kx in 0..half {
             for ky in 0..kernel_rows {
-                let q = (kx as f64 * qx_unit).hypot(ky as f64 * qy_unit);
+                let (qx, qy) = (kx as f64 * qx_unit, ky as f64 * qy_unit);
                 self.kernel[kx * kernel_rows + ky] = if kx == 0 && ky == 0 {
                     0.0
                 } else {
-                    2.0 / (self.modulus * q) * scale
+                    self.kind.spectrum(qx, qy, self.modulus) * scale
                 };
             }
         }

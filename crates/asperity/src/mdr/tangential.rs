@@ -139,7 +139,12 @@ impl PartialSlip {
     /// The springs of `foundation` in contact at `indentation`, with tangential springs of
     /// `ratio` (`G*/E*`, e.g. [`mindlin_ratio`]) times their normal tangent stiffness and a
     /// friction coefficient `friction`. Refuses an indentation with no spring in contact.
-    pub fn new(foundation: &Foundation, indentation: f64, ratio: f64, friction: f64) -> Result<Self> {
+    pub fn new(
+        foundation: &Foundation,
+        indentation: f64,
+        ratio: f64,
+        friction: f64,
+    ) -> Result<Self> {
         check_friction(friction)?;
         if !(crate::is_positive_finite(ratio) && ratio <= 1.0) {
             return Err(Error::invalid(
@@ -320,7 +325,7 @@ impl PartialSlip {
                 format!("a branch needs at least 2 points, got {points}"),
             ));
         }
-        if !(amplitude > 0.0) {
+        if amplitude.is_nan() || amplitude <= 0.0 {
             return Err(Error::invalid(
                 "tangential_force",
                 format!("the cycle's amplitude Q* must be positive, got {amplitude}"),
@@ -338,7 +343,7 @@ impl PartialSlip {
             for i in 0..points {
                 // Distance travelled since the turning point at sign·u*.
                 let travel = 2.0 * top * step(i);
-                let u = sign * (top - travel);
+                let u = sign * (top - travel) + 0.0; // no -0.0
                 let q = sign * (q_top - 2.0 * self.force(0.5 * travel));
                 cycle.push(self.point(branch, u, q, 0.5 * travel));
             }
@@ -373,7 +378,9 @@ mod tests {
         let dx = 1.0 / resolution;
         let d = 1.0; // a = sqrt(R d) = 1
         let n = 2 * (1.2 * resolution) as usize + 1;
-        let profile = Axisymmetric::Sphere { radius: RADIUS }.sample(n, dx).unwrap();
+        let profile = Axisymmetric::Sphere { radius: RADIUS }
+            .sample(n, dx)
+            .unwrap();
         let spring = Spring::linear(dx, MODULUS).unwrap();
         let foundation = Foundation::from_profile(&profile, spring).unwrap();
         let ratio = mindlin_ratio(0.3).unwrap();
@@ -418,10 +425,16 @@ mod tests {
             let u = slip.displacement(q).unwrap();
             assert!((slip.force(u) / q - 1.0).abs() < 1e-12, "inverse");
             let u_exact = exact.displacement(d, fraction * exact.friction * hertz.force(d));
-            assert!((u / u_exact - 1.0).abs() < 1e-3, "Q/μF = {fraction}: u {u} vs {u_exact}");
+            assert!(
+                (u / u_exact - 1.0).abs() < 1e-3,
+                "Q/μF = {fraction}: u {u} vs {u_exact}"
+            );
             let c = (RADIUS * (d - slip.stick_compression(u))).sqrt();
             let c_exact = (1.0 - fraction).cbrt();
-            assert!((c - c_exact).abs() < 1e-3, "Q/μF = {fraction}: c/a {c} vs {c_exact}");
+            assert!(
+                (c - c_exact).abs() < 1e-3,
+                "Q/μF = {fraction}: c/a {c} vs {c_exact}"
+            );
         }
         // Sliding as a whole at μF, refused beyond.
         assert!(slip.displacement(mu_f).is_ok());
@@ -464,7 +477,10 @@ mod tests {
             let w = slip.dissipation(slip.displacement(top).unwrap());
             let w_exact = exact.dissipation(d, exact_top);
             assert!((w / w_exact - 1.0).abs() < 2e-3, "W {w} vs {w_exact}");
-            assert!((area.abs() / w - 1.0).abs() < 1e-3, "loop area {area} vs {w}");
+            assert!(
+                (area.abs() / w - 1.0).abs() < 1e-3,
+                "loop area {area} vs {w}"
+            );
         }
     }
 
@@ -504,7 +520,12 @@ mod tests {
                 *s = (*s + k * du).clamp(-limit, *limit);
                 q += *s;
             }
-            assert!((q - p.force).abs() < 1e-9 * top, "{:?}: {q} vs {}", p.branch, p.force);
+            assert!(
+                (q - p.force).abs() < 1e-9 * top,
+                "{:?}: {q} vs {}",
+                p.branch,
+                p.force
+            );
             let sliding = state
                 .iter()
                 .zip(&elements)
@@ -521,8 +542,11 @@ mod tests {
     fn flat_punch_sticks_until_it_slides_as_a_whole() {
         // Equal compression everywhere: one slip displacement for all springs.
         let dx = 0.01;
-        let profile = Axisymmetric::FlatPunch { radius: 0.505 }.sample(201, dx).unwrap();
-        let foundation = Foundation::from_profile(&profile, Spring::linear(dx, 1.0).unwrap()).unwrap();
+        let profile = Axisymmetric::FlatPunch { radius: 0.505 }
+            .sample(201, dx)
+            .unwrap();
+        let foundation =
+            Foundation::from_profile(&profile, Spring::linear(dx, 1.0).unwrap()).unwrap();
         let slip = PartialSlip::new(&foundation, 0.01, 1.0, 0.5).unwrap();
         let u = slip.displacement(0.5 * slip.friction_limit()).unwrap();
         assert_eq!(slip.stick_springs(u), slip.contacts());
