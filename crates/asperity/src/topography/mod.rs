@@ -29,6 +29,7 @@ pub(crate) mod bytes;
 pub(crate) mod di;
 pub(crate) mod frt;
 pub(crate) mod gwy;
+pub(crate) mod ibw;
 pub mod inpaint;
 pub mod level;
 pub(crate) mod metropro;
@@ -255,6 +256,12 @@ const FORMATS: &[Format] = &[
         extensions: &["bcr", "bcrf"],
         sniff: bcr::sniff,
         read: bcr::read,
+    },
+    Format {
+        name: "ibw",
+        extensions: &["ibw"],
+        sniff: ibw::sniff,
+        read: ibw::read,
     },
     Format {
         name: "mi",
