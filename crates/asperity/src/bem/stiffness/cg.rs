@@ -32,7 +32,7 @@
 //! Cerruti, the Fourier inverse of its symbol, as [`FourierPreconditioner`] is for the
 //! normal kernel's `2/(E*|q|)`); the work fields come from [`CgWork::new`] for its grid:
 //!
-//! ```ignore
+//! ```text
 //! let mut work = CgWork::new(rows, cols, periodic, rings);
 //! let info = conjugate_gradient_on_set(
 //!     &mut cerruti, &mut cerruti_inverse, |i| stuck[i], RightHandSide::Ones,
