@@ -88,6 +88,17 @@ pub struct Indenter {
 }
 
 impl Indenter {
+    /// Its spring foundation: a rough line's gaps from its highest point, or the profile.
+    fn foundation(&self, spring: Spring) -> asperity::Result<Foundation> {
+        if self.is_line {
+            Foundation::from_heights(&self.values, spring)
+        } else {
+            Foundation::from_profile(&self.values, spring)
+        }
+    }
+}
+
+impl Indenter {
     /// A rough line of `heights` over the length `size` (spacing `size / n`); `name` says
     /// where it came from in the description (a file name, or empty).
     pub fn line(heights: Vec<f64>, size: f64, name: &str) -> Result<Indenter, Refusal> {
@@ -505,12 +516,7 @@ impl MdrRequest {
             (1..=curve.len()).for_each(|j| emit(curve.breakpoint(j)));
             return Ok(None);
         }
-        let foundation = if indenter.is_line {
-            Foundation::from_heights(&indenter.values, spring)
-        } else {
-            Foundation::from_profile(&indenter.values, spring)
-        }
-        .map_err(invalid)?;
+        let foundation = indenter.foundation(spring).map_err(invalid)?;
         let levels = self.levels(&foundation, row_bytes)?;
         levels.iter().for_each(|&d| emit(foundation.evaluate(d)));
         Ok(Some(levels))
@@ -564,12 +570,7 @@ impl MdrRequest {
         }
         .map_err(invalid)?;
         let spring = Spring::new(SpringLaw::Linear, spacing, modulus).map_err(invalid)?;
-        let foundation = if indenter.is_line {
-            Foundation::from_heights(&indenter.values, spring)
-        } else {
-            Foundation::from_profile(&indenter.values, spring)
-        }
-        .map_err(invalid)?;
+        let foundation = indenter.foundation(spring).map_err(invalid)?;
         let levels = self.levels(&foundation, row_bytes)?;
         // Each retraction reports two rows per release, at most one release per spring
         // attached before it: one full retraction's rows besides the path's.

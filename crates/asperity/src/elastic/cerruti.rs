@@ -27,6 +27,9 @@
 
 use std::f64::consts::PI;
 
+// Love's cancellation-free logarithm and quadrature rule serve both kernels.
+use super::love::{ln_y_plus_r, GAUSS_NODES, GAUSS_WEIGHTS};
+
 /// Which tangential direction: the traction and the displacement it gives along it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Direction {
@@ -34,16 +37,6 @@ pub enum Direction {
     X,
     /// Along the rows (`y`, spacing `Δy`).
     Y,
-}
-
-/// `ln(y + sqrt(x² + y²))` without cancellation for negative `y`.
-fn ln_y_plus_r(x: f64, y: f64) -> f64 {
-    let r = x.hypot(y);
-    if y >= 0.0 {
-        (y + r).ln()
-    } else {
-        2.0 * x.abs().ln() - (r - y).ln()
-    }
 }
 
 /// `H(X, Y) = (1−ν)·X ln(Y + ρ) + Y ln(X + ρ)`; terms with a zero prefactor are zero.
@@ -62,23 +55,6 @@ fn point_kernel(x: f64, y: f64, poisson: f64) -> f64 {
     let r = x.hypot(y);
     (1.0 - poisson) / r + poisson * x * x / (r * r * r)
 }
-
-const GAUSS_NODES: [f64; 6] = [
-    -0.932_469_514_203_152,
-    -0.661_209_386_466_264_5,
-    -0.238_619_186_083_196_9,
-    0.238_619_186_083_196_9,
-    0.661_209_386_466_264_5,
-    0.932_469_514_203_152,
-];
-const GAUSS_WEIGHTS: [f64; 6] = [
-    0.171_324_492_379_170_3,
-    0.360_761_573_048_138_6,
-    0.467_913_934_572_691,
-    0.467_913_934_572_691,
-    0.360_761_573_048_138_6,
-    0.171_324_492_379_170_3,
-];
 
 /// Tangential displacement along `direction` at `(x, y)` (relative to the pixel centre)
 /// caused by a unit tangential traction along `direction` on a `dx × dy` rectangle centred at

@@ -17,7 +17,7 @@
 use std::f64::consts::PI;
 
 /// `ln(y + sqrt(x² + y²))` without cancellation for negative `y`.
-fn ln_y_plus_r(x: f64, y: f64) -> f64 {
+pub(super) fn ln_y_plus_r(x: f64, y: f64) -> f64 {
     let r = x.hypot(y);
     if y >= 0.0 {
         (y + r).ln()
@@ -36,7 +36,7 @@ fn antiderivative(x: f64, y: f64) -> f64 {
 }
 
 /// Nodes and weights of 6-point Gauss–Legendre quadrature on [−1, 1].
-const GAUSS_NODES: [f64; 6] = [
+pub(super) const GAUSS_NODES: [f64; 6] = [
     -0.932_469_514_203_152,
     -0.661_209_386_466_264_5,
     -0.238_619_186_083_196_9,
@@ -44,7 +44,7 @@ const GAUSS_NODES: [f64; 6] = [
     0.661_209_386_466_264_5,
     0.932_469_514_203_152,
 ];
-const GAUSS_WEIGHTS: [f64; 6] = [
+pub(super) const GAUSS_WEIGHTS: [f64; 6] = [
     0.171_324_492_379_170_3,
     0.360_761_573_048_138_6,
     0.467_913_934_572_691,
