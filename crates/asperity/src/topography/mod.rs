@@ -34,6 +34,7 @@ pub mod inpaint;
 pub mod level;
 pub(crate) mod metropro;
 pub(crate) mod mi;
+pub(crate) mod mnt;
 pub(crate) mod netcdf;
 pub(crate) mod nid;
 pub(crate) mod opd;
@@ -274,6 +275,12 @@ const FORMATS: &[Format] = &[
         extensions: &["nid"],
         sniff: nid::sniff,
         read: nid::read,
+    },
+    Format {
+        name: "mnt",
+        extensions: &["mnt"],
+        sniff: mnt::sniff,
+        read: mnt::read,
     },
     Format {
         name: "plu",
