@@ -49,6 +49,7 @@
 //! points in contact. It is zero exactly when the state solves the problem. The solver stops
 //! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
 
+pub mod adhesion;
 mod bccg;
 pub mod conductance;
 mod full_contact;

@@ -67,7 +67,7 @@ pub fn pixel_mean_compliance() -> f64 {
 /// the work of adhesion of its area, `wΔx²`:
 /// `σ_c = √(2E*w/(c̄Δx)) = √(E*w/(cΔx))` with `c = c̄/2 ≈ 0.4732`.
 /// The interaction with the neighbours' loads is left out, as in the criterion; the BEM
-/// iteration that uses it is not written yet (docs/adhesion.md).
+/// iteration that uses it is [`crate::bem::adhesion::PixelAdhesion`].
 pub fn pixel_critical_stress(modulus: f64, work_of_adhesion: f64, spacing: f64) -> f64 {
     (2.0 * modulus * work_of_adhesion / (pixel_mean_compliance() * spacing)).sqrt()
 }

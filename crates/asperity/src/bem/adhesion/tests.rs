@@ -1,0 +1,202 @@
+//! Oracles of the adhesive BEM: JKR's sphere, Kendall's punch, the non-adhesive limit.
+
+use std::f64::consts::PI;
+
+use ndarray::Array2;
+
+use super::*;
+use crate::bem::HalfSpace;
+use crate::reference::{Jkr, PullOff};
+use crate::surface::Surface;
+
+/// A sphere `h = −r²/2R` on `n × n` pixels of side `dx`, centred on pixel `(n/2, n/2)`.
+fn sphere(n: usize, dx: f64, radius: f64) -> Surface {
+    let c = (n / 2) as f64;
+    let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+        let (y, x) = ((i as f64 - c) * dx, (j as f64 - c) * dx);
+        -(x * x + y * y) / (2.0 * radius)
+    });
+    Surface::new(heights, n as f64 * dx).unwrap()
+}
+
+/// The JKR sphere retracted from a contact `1.25 a_c`: its pull-offs and the largest
+/// distance of a peeling state from JKR's force at its contact radius `√(A/π)`, over
+/// `|F_c|`.
+fn jkr_retraction(pixels_per_radius: f64) -> (f64, f64, f64) {
+    let (radius, modulus, a_c): (f64, f64, f64) = (1.0, 1.0, 0.1);
+    let w = 8.0 * modulus * a_c.powi(3) / (9.0 * PI * radius * radius);
+    let dx = a_c / pixels_per_radius;
+    let n = (2.0 * 1.4 * a_c / dx).ceil() as usize + 4;
+    let mut contact = PixelAdhesion::new(&sphere(n, dx, radius), HalfSpace::default(), w).unwrap();
+    let d0 = (1.25 * a_c).powi(2) / radius;
+    for k in 1..=10 {
+        contact.move_to(d0 * k as f64 / 10.0).unwrap();
+    }
+    let jkr = Jkr::new(radius, modulus, w).unwrap();
+    let f_c = jkr.pull_off_force(PullOff::ForceControlled);
+    let start = contact.summary().attached_points;
+    let mut worst = 0.0f64;
+    let pull = contact
+        .retract(3.0 * d0 / 1000.0, |s| {
+            if s.attached_points < start {
+                let a = (s.attached_points as f64 * dx * dx / PI).sqrt();
+                worst = worst.max((s.force - jkr.force(a)).abs() / f_c.abs());
+            }
+        })
+        .unwrap()
+        .expect("in contact");
+    let f_d = jkr.pull_off_force(PullOff::DisplacementControlled);
+    (
+        pull.force_controlled.force / f_c - 1.0,
+        pull.displacement_controlled.force / f_d - 1.0,
+        worst,
+    )
+}
+
+/// Pohrt–Popov's criterion converges at first order in the pixel on a sphere: the
+/// force-controlled pull-off of JKR (`−(3/2)πwR`) is reached with an error `≈ 1.37 Δx/a_c`
+/// (measured: +13.8 % at `a_c/Δx = 10`, +6.9 % at 20, +3.9 % at 40: the slow test below),
+/// the displacement-controlled one (`−(5/6)πwR`) with `≈ 2.5 Δx/a_c` (+24.9 %, +12.7 %, −0.8 %: it
+/// oscillates with the pixel, as the radius at which the last ring lets go does),
+/// and the peeling states' forces lie within `≈ 2 Δx/a_c · |F_c|` of JKR's at their contact
+/// radius `√(A/π)` (0.189, 0.105, 0.042). (The contact holds too much: the compressive, Hertzian
+/// part of a pixel set's pressure vanishes at its edge pixels' centres, half a pixel inside
+/// the radius `√(A/π)` at which its tensile part lets go — Kendall's punch, with no
+/// Hertzian part, is within 0.7 % and 0.24 %; `3·(Δx/2)/a_c = 1.5 Δx/a_c` is the error
+/// that offset predicts.) Tolerances: halving the pixel at least nearly halves each error
+/// (ratio above 1.75; measured 2.00, 1.97, 1.79), and the first-order (Richardson)
+/// extrapolation of the two pull-offs lands on JKR within 1 % (measured 1e-4 and 4e-3).
+#[test]
+fn jkr_sphere_converges_with_the_pixel() {
+    let coarse = jkr_retraction(10.0);
+    let fine = jkr_retraction(20.0);
+    println!("a_c/dx = 10: {coarse:?}\na_c/dx = 20: {fine:?}");
+    for (c, f) in [(coarse.0, fine.0), (coarse.1, fine.1), (coarse.2, fine.2)] {
+        assert!(c > 0.0 && f > 0.0 && c / f > 1.75, "{c:e} {f:e}");
+    }
+    for (c, f) in [(coarse.0, fine.0), (coarse.1, fine.1)] {
+        assert!((2.0 * f - c).abs() < 1e-2, "extrapolated {:e}", 2.0 * f - c);
+    }
+    assert!(fine.0 < 0.075, "{:e}", fine.0);
+}
+
+/// The JKR sphere at `a_c/Δx = 40` (slow tier, about ten seconds): the force-controlled
+/// pull-off within 4.5 % (measured +3.93 %; first order from 20 would say 3.4 %).
+#[test]
+#[ignore]
+fn jkr_sphere_at_forty_pixels() {
+    let errors = jkr_retraction(40.0);
+    println!("a_c/dx = 40: {errors:?}");
+    assert!(errors.0 > 0.0 && errors.0 < 0.045, "{errors:?}");
+}
+
+/// A flat circular punch of radius `a_px` pixels (profile 0 on the disc, 1 beyond): the
+/// attached disc lets go at Kendall's force `−√(8πwE*a³)`, `a = √(A/π)` of the pixels.
+fn kendall_pull_off(a_px: f64) -> (f64, f64) {
+    let (a, w): (f64, f64) = (0.1, 1e-3);
+    let dx = a / a_px;
+    let n = (2.0 * a_px).ceil() as usize + 8;
+    let c = (n / 2) as f64;
+    let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+        let r = (i as f64 - c).hypot(j as f64 - c);
+        if r <= a_px {
+            0.0
+        } else {
+            -1.0
+        }
+    });
+    let surface = Surface::new(heights, n as f64 * dx).unwrap();
+    let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), w).unwrap();
+    let (pressed, _) = contact.move_to(1e-4).unwrap();
+    let area = pressed.attached_points as f64 * dx * dx;
+    let kendall = -(8.0 * PI * w * (area / PI).powf(1.5)).sqrt();
+    let step = (2.0 * PI * a * w).sqrt() / 200.0;
+    let pull = contact.retract(step, |_| {}).unwrap().expect("in contact");
+    (
+        pull.force_controlled.force / kendall - 1.0,
+        pull.displacement_controlled.force / kendall - 1.0,
+    )
+}
+
+/// Kendall's punch: the pull-off under either control is the force at which the edge
+/// first lets go (the whole face follows). Measured: +0.71 % at `a/Δx = 10`, +0.24 % at
+/// 20 (the staircase edge of a pixelated disc); tolerances 1 % and 0.4 %, and the two
+/// controls agree (one event ends both).
+#[test]
+fn kendall_punch_lets_go_at_kendalls_force() {
+    for a_px in [10.0, 20.0] {
+        let (force, displacement) = kendall_pull_off(a_px);
+        println!("a/dx = {a_px}: force-controlled {force:+.4e}, displacement-controlled {displacement:+.4e}");
+        let tolerance = if a_px < 15.0 { 1e-2 } else { 4e-3 };
+        assert!(force.abs() < tolerance, "{force:e}");
+        assert!(
+            (force - displacement).abs() < 1e-4,
+            "{force:e} {displacement:e}"
+        );
+    }
+}
+
+/// As `w → 0` the adhesive contact is the non-adhesive one: the same force as the BCCG at
+/// the same indentation (to 1e-6, the solvers' tolerances), no pixel in measurable tension,
+/// and a pull-off that vanishes.
+#[test]
+fn vanishing_adhesion_is_the_hard_wall() {
+    let (n, dx, radius) = (48, 0.01, 1.0);
+    let surface = sphere(n, dx, radius);
+    let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), 1e-14).unwrap();
+    let mut solver =
+        crate::bem::ContactSolver::new(&surface, HalfSpace::default(), Default::default()).unwrap();
+    for d in [0.002, 0.008, 0.02] {
+        let (adhesive, info) = contact.move_to(d).unwrap();
+        let (plain, _) = solver.solve(crate::bem::Control::Indentation(d)).unwrap();
+        let error = (adhesive.force / plain.force - 1.0).abs();
+        assert!(error < 1e-6, "d = {d}: {error:e} ({info:?})");
+    }
+    let pull = contact.retract(1e-4, |_| {}).unwrap().expect("in contact");
+    assert!(pull.force_controlled.force.abs() < 1e-6, "{pull:?}");
+}
+
+/// Loading then unloading is a loop: on the way back the contact holds on, so at every
+/// indentation the retraction's force is below the approach's, and tension appears.
+#[test]
+fn retraction_lies_below_the_approach() {
+    let (n, dx, radius, w) = (48, 0.01, 1.0, 2e-3);
+    let mut contact = PixelAdhesion::new(&sphere(n, dx, radius), HalfSpace::default(), w).unwrap();
+    let depths: Vec<f64> = (1..=8).map(|k| 0.0025 * k as f64).collect();
+    let approach: Vec<f64> = depths
+        .iter()
+        .map(|&d| contact.move_to(d).unwrap().0.force)
+        .collect();
+    for (k, &d) in depths.iter().enumerate().rev().skip(1) {
+        let (back, _) = contact.move_to(d).unwrap();
+        assert!(
+            back.force < approach[k],
+            "d = {d}: {} vs {}",
+            back.force,
+            approach[k]
+        );
+        assert!(back.tensile_points > 0);
+    }
+}
+
+#[test]
+fn refuses_meaningless_inputs() {
+    let surface = sphere(16, 0.01, 1.0);
+    for w in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        assert!(
+            PixelAdhesion::new(&surface, HalfSpace::default(), w).is_err(),
+            "{w}"
+        );
+    }
+    let heights = Array2::zeros((8, 16));
+    let rectangular = Surface::with_sizes(heights, 1.0, 1.0).unwrap();
+    let error = PixelAdhesion::new(&rectangular, HalfSpace::default(), 1e-3)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("square pixels"), "{error}");
+    let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), 1e-3).unwrap();
+    assert!(contact.move_to(f64::NAN).is_err());
+    assert!(contact.retract(0.0, |_| {}).is_err());
+    assert_eq!(contact.retract(1e-3, |_| {}).unwrap(), None);
+}
