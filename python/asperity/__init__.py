@@ -1116,24 +1116,24 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
     return json.loads(text)
 
 
-def _columns(rows: List[Dict[str, Any]], names: Sequence[str]) -> Dict[str, np.ndarray]:
+def _table(table: Dict[str, Any]) -> Tuple[Dict[str, np.ndarray], List[Dict[str, Any]]]:
+    """A result table of the front-end layer (``asperity_app::study::rows``: the columns
+    of ``alpha.csv`` or ``curve.csv``, named and typed once) as numpy columns and as rows
+    of dicts; a missing number (an empty CSV cell) is NaN in the columns, None in the
+    rows."""
+    names = [name for name, _ in table["columns"]]
+    rows = [dict(zip(names, row)) for row in table["rows"]]
     columns = {}
-    for name in names:
-        values = [r[name] for r in rows]
-        if name == "method":
+    for i, (name, kind) in enumerate(table["columns"]):
+        values = [row[i] for row in table["rows"]]
+        if kind == "text":
             columns[name] = np.array(values, dtype=object)
-        elif name in ("n", "samples", "samples_fitted"):
+        elif kind == "count":
             columns[name] = np.array(values, dtype=np.int64)
         else:
-            columns[name] = np.array([np.nan if v is None else v for v in values], dtype=np.float64)
-    return columns
-
-
-_ALPHA_COLUMNS = ("method", "n", "hurst", "alpha", "alpha_low", "alpha_high", "samples",
-                  "alpha_fit_low", "alpha_fit_high", "alpha_sample_mean", "samples_fitted",
-                  "alpha_theory")
-_CURVE_COLUMNS = ("method", "n", "hurst", "force", "stiffness", "stiffness_low",
-                  "stiffness_high", "samples", "area_fraction")
+            columns[name] = np.array([np.nan if v is None else v for v in values],
+                                     dtype=np.float64)
+    return columns, rows
 
 
 def study_alpha(
@@ -1182,20 +1182,9 @@ def study_alpha(
     records = _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
                          max_fraction, levels, not full_sweep, force, checkpoint_every, progress,
                          f"{method} study")
-    rows = []
-    for rec in records:
-        r = rec["result"]
-        fit = r["alpha_ensemble"] or {}
-        interval = rec["alpha_sample_interval"] or (None, None)
-        rows.append({
-            "method": r["method"], "n": r["task"]["n"], "hurst": r["task"]["hurst"],
-            "alpha": fit.get("exponent"), "alpha_low": interval[0], "alpha_high": interval[1],
-            "samples": r["samples"], "alpha_fit_low": fit.get("low"),
-            "alpha_fit_high": fit.get("high"), "alpha_sample_mean": rec["alpha_sample_mean"],
-            "samples_fitted": len(r["alpha_samples"]), "alpha_theory": rec["alpha_theory"],
-        })
-    return StudyResult(_columns(rows, _ALPHA_COLUMNS), rows, [rec["result"] for rec in records],
-                       [rec["comparison"] for rec in records], rolloff is not None)
+    columns, rows = _table(records["alpha"])
+    return StudyResult(columns, rows, records["tasks"], records["comparisons"],
+                       rolloff is not None)
 
 
 def study_curve(
@@ -1228,14 +1217,5 @@ def study_curve(
     records = _run_study(method, [n], hurst, samples, out, rolloff, seed, min_contacts,
                          max_fraction, levels, False, force, checkpoint_every, progress,
                          f"{method} study")
-    rows = []
-    for rec in records:
-        r = rec["result"]
-        for p in r["mean_curve"]:
-            rows.append({
-                "method": r["method"], "n": r["task"]["n"], "hurst": r["task"]["hurst"],
-                "force": p["force"], "stiffness": p["stiffness"],
-                "stiffness_low": p["stiffness_low"], "stiffness_high": p["stiffness_high"],
-                "samples": p["samples"], "area_fraction": p["fraction"],
-            })
-    return StudyResult(_columns(rows, _CURVE_COLUMNS), rows, [rec["result"] for rec in records])
+    columns, rows = _table(records["curve"])
+    return StudyResult(columns, rows, records["tasks"])

@@ -34,12 +34,6 @@ pub struct Cancel {
 }
 
 impl Cancel {
-    /// The flag itself, for a contact solver (or a study's BEM sampler) to poll inside its
-    /// iterations.
-    pub fn stop(&self) -> &Stop {
-        &self.flag
-    }
-
     /// Whether the work should stop now.
     pub fn is_set(&self) -> bool {
         self.flag.is_requested()

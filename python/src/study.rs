@@ -1,31 +1,30 @@
 //! Ensemble studies (`asperity study alpha|curve`) in the CLI's checkpoint folders.
 //!
-//! [`run_study`] follows the CLI's `execute` (crates/asperity-cli/src/studies.rs):
-//! validate the spec, check memory, open the folder (same `study.json`, same
-//! `checkpoint/<task>.json`, same checkpoint interval), run every task with the library's
-//! `run_task`. A study started here resumes from the CLI and the other way round. Two
-//! differences: it writes no `alpha.csv`/`curve.csv` or plots (the results are returned),
-//! and its sampler is wrapped by [`Interruptible`], which skips the samples not yet started
-//! once Ctrl-C (or an exception of the progress callback) cancelled the run, so that a
-//! study stops after the samples in flight; the checkpoints already written stay.
+//! [`run_study`] runs the protocol of the front-end layer ([`asperity_app::study`]) that
+//! the CLI's `asperity study` runs: the same validation, the same `study.json` and
+//! `checkpoint/<task>.json`, the same checkpoint interval, the same tasks in the same
+//! order and the same result tables. A study started here resumes from the CLI and the
+//! other way round. It writes no `alpha.csv`/`curve.csv` or plots (the tables are
+//! returned), and Ctrl-C (or an exception of the progress callback) stops it after the
+//! samples in flight; the checkpoints already written stay.
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use asperity::lock::FolderLock;
+use asperity::stop::Stop;
 use asperity::study::compare;
-use asperity::study::samplers::{BemSampler, MdrSampler};
-use asperity::study::theory::alpha_theory;
 use asperity::study::{
-    run_task, FitWindow, Ledger, Method, SampleCurve, Sampler, StudyDir, StudySpec, Task,
-    TaskResult, TaskSamples, DEFAULT_LEVELS, MAX_CHECKPOINT_INTERVAL_SECONDS,
+    FitWindow, Ledger, Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples,
+    DEFAULT_LEVELS,
 };
 use asperity::Error;
+use asperity_app::study::{self, rows, Kind, TaskFailure};
+use asperity_app::Names;
 use pyo3::prelude::*;
 use serde_json::json;
 
-use crate::errors::{from_error, invalid};
-use crate::interrupt::{run_detached, Cancel};
+use crate::errors::{from_error, invalid, refused, request_error};
+use crate::interrupt::{run_detached, run_detached_with, Cancel};
 use asperity_app::range::parse_range;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -36,27 +35,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<StudyLedger>()?;
     m.add_class::<SampleComputer>()?;
     Ok(())
-}
-
-/// A sampler that skips its samples once the run is cancelled.
-struct Interruptible<'a, S> {
-    inner: S,
-    cancel: &'a Cancel,
-}
-
-impl<S: Sampler> Sampler for Interruptible<'_, S> {
-    type Worker = S::Worker;
-
-    fn worker(&self) -> asperity::Result<S::Worker> {
-        self.inner.worker()
-    }
-
-    fn sample(&self, worker: &mut S::Worker, seed: u64) -> asperity::Result<SampleCurve> {
-        if self.cancel.is_set() {
-            return Err(Error::invalid("study", "interrupted"));
-        }
-        self.inner.sample(worker, seed)
-    }
 }
 
 /// `hurst` values from the CLI's syntax: values and ranges `A:B:STEP`, comma-separated.
@@ -82,8 +60,8 @@ fn method(name: &str) -> PyResult<Method> {
     }
 }
 
-/// Runs (or resumes) a study in `out`; returns the task results as JSON text, each with
-/// the CLI's derived columns (`alpha_sample_interval`, `alpha_sample_mean`, `alpha_theory`).
+/// Runs (or resumes) a study in `out`; returns the task results and the result tables
+/// (`alpha.csv`'s and `curve.csv`'s) as JSON text ([`records`]).
 #[pyfunction]
 #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
     max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress))]
@@ -116,19 +94,22 @@ fn run_study(
         max_fraction,
         levels,
         alpha_sweep,
-        checkpoint_every,
     )?;
+    let interval = study::checkpoint_interval(checkpoint_every).map_err(refused)?;
     let spec = resumable(py, spec, &out, force)?;
-    let (_lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
-    let results = run_detached(py, |cancel| {
-        run_tasks(&spec, &store, progress.as_ref(), cancel)
+    study::validate(&spec).map_err(request_error)?;
+    // The flag that Ctrl-C raises: the samples poll it.
+    let stop = Stop::new();
+    let (_lock, store) = open_folder(&spec, out, force, interval, stop.clone())?;
+    let results = run_detached_with(py, &stop, |cancel| {
+        run_tasks(&store, progress.as_ref(), cancel)
     })?
-    .map_err(from_error)?;
+    .map_err(|failure| from_error(failure.into_error()))?;
     Ok(records(&spec, &results))
 }
 
-/// A study's spec from `run_study`'s arguments (`alpha_sweep`: the load sweep of an α
-/// study, [`StudySpec::with_alpha_sweep`]), validated.
+/// A study's spec from `run_study`'s arguments (`alpha_sweep`: an α study's load sweep,
+/// [`Kind::spec`]), not yet validated.
 #[allow(clippy::too_many_arguments)]
 fn make_spec(
     method_name: &str,
@@ -141,14 +122,7 @@ fn make_spec(
     max_fraction: f64,
     levels: Option<usize>,
     alpha_sweep: bool,
-    checkpoint_every: f64,
 ) -> PyResult<StudySpec> {
-    if !(0.0..=MAX_CHECKPOINT_INTERVAL_SECONDS).contains(&checkpoint_every) {
-        return Err(invalid(format!(
-            "checkpoint_every must be between 0 and {MAX_CHECKPOINT_INTERVAL_SECONDS:e} \
-             seconds, got {checkpoint_every}"
-        )));
-    }
     let spec = StudySpec {
         method: method(method_name)?,
         sizes,
@@ -163,37 +137,22 @@ fn make_spec(
         levels: levels.unwrap_or(DEFAULT_LEVELS),
         sweep_end: None,
     };
-    // As `asperity study alpha`: BEM samples stop loading past the fit windows.
-    let spec = if alpha_sweep {
-        spec.with_alpha_sweep()
-    } else {
-        spec
-    };
-    spec.validate().map_err(from_error)?;
-    asperity_app::study::check_min_contacts(&spec).map_err(crate::errors::refused)?;
-    spec.ensure_fits().map_err(from_error)?;
-    Ok(spec)
+    Ok(Kind::Alpha.spec(spec, !alpha_sweep))
 }
 
-/// The study to run in `out`, as the CLI's: `spec`, or the whole-sweep study whose
-/// samples the folder holds ([`StudyDir::resumable`], said by a `UserWarning`); `spec`
-/// when `force` discards it.
+/// The study to run in `out` ([`study::resumable`]): `spec`, or the whole-sweep study
+/// whose samples the folder holds, said by a `UserWarning`; `spec` when `force`.
 fn resumable(
     py: Python<'_>,
     spec: StudySpec,
     out: &std::path::Path,
     force: bool,
 ) -> PyResult<StudySpec> {
-    let run = StudyDir::resumable(out, spec.clone(), force);
-    if run != spec {
-        let message = format!(
-            "{}: resuming its study, which solves every load (as alpha studies did before \
-             they stopped loading past their fit windows, or with full_sweep=True): the same \
-             alpha, its checkpoints kept; force=True discards them",
-            out.display()
-        );
+    let (run, note) = study::resumable(spec, out, force);
+    if let Some(note) = note {
         let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
-        let message = std::ffi::CString::new(message).map_err(|e| invalid(e.to_string()))?;
+        let message = std::ffi::CString::new(note.words(Names::Keywords))
+            .map_err(|e| invalid(e.to_string()))?;
         PyErr::warn(py, category.as_any(), &message, 1)?;
     }
     Ok(run)
@@ -204,44 +163,43 @@ fn open_folder(
     spec: &StudySpec,
     out: PathBuf,
     force: bool,
-    checkpoint_every: f64,
+    interval: std::time::Duration,
+    stop: Stop,
 ) -> PyResult<(FolderLock, StudyDir)> {
-    StudyDir::check(&out, spec, force).map_err(from_error)?;
+    study::check(spec, &out, force).map_err(from_error)?;
     // Held until the study returns: a second process (CLI or Python) on the folder is
     // refused at once, naming this one's PID.
-    let lock = StudyDir::lock(&out).map_err(from_error)?;
-    let store = StudyDir::open(&out, spec, force)
-        .map_err(from_error)?
-        .with_checkpoint_interval(Duration::from_secs_f64(checkpoint_every));
-    Ok((lock, store))
+    study::open(spec, &out, force, interval, stop).map_err(from_error)
 }
 
-/// The task results as JSON text, each with the CLI's derived columns and, for a study
+/// The task results as JSON text: `tasks` (each as its checkpoint stores it), `alpha`
+/// and `curve` (the tables of `alpha.csv` and `curve.csv`, [`asperity_app::study::rows`]:
+/// `columns` as `(name, type)` and `rows` of cells) and `comparisons`: per task of a study
 /// without roll-off, its row of the comparison with the paper (`asperity study compare`:
 /// α beside eq. (6)/(24) with the 95 % interval of the ensemble α and the verdict; a
 /// roll-off study is compared by its steepest slope, which needs the stored sample
 /// curves: `None` here).
 fn records(spec: &StudySpec, results: &[TaskResult]) -> String {
-    let records: Vec<serde_json::Value> = results
+    let comparisons: Vec<serde_json::Value> = results
         .iter()
-        .map(|r| {
-            let comparison = match spec.rolloff {
-                Some(_) => None,
-                None => compare::rows(&compare::Results::Fig1(std::slice::from_ref(r)), &[])
-                    .into_iter()
-                    .next()
-                    .map(|row| json!({"row": row, "verdict": compare::verdict(&row)})),
-            };
-            json!({
-                "result": r,
-                "alpha_sample_interval": r.alpha_sample_interval(),
-                "alpha_sample_mean": r.alpha_sample_mean(),
-                "alpha_theory": alpha_theory(r.task.hurst, r.task.n),
-                "comparison": comparison,
-            })
+        .map(|r| match spec.rolloff {
+            Some(_) => serde_json::Value::Null,
+            None => compare::rows(&compare::Results::Fig1(std::slice::from_ref(r)), &[])
+                .into_iter()
+                .next()
+                .map_or(
+                    serde_json::Value::Null,
+                    |row| json!({"row": row, "verdict": compare::verdict(&row)}),
+                ),
         })
         .collect();
-    serde_json::Value::from(records).to_string()
+    json!({
+        "tasks": results,
+        "alpha": rows::alpha_table(results),
+        "curve": rows::curve_table(results),
+        "comparisons": comparisons,
+    })
+    .to_string()
 }
 
 /// The threads of this process's rayon pool: the samples it computes at once.
@@ -296,10 +254,11 @@ impl StudyLedger {
             max_fraction,
             levels,
             alpha_sweep,
-            checkpoint_every,
         )?;
+        let interval = study::checkpoint_interval(checkpoint_every).map_err(refused)?;
         let spec = resumable(py, spec, &out, force)?;
-        let (lock, store) = open_folder(&spec, out, force, checkpoint_every)?;
+        study::validate(&spec).map_err(request_error)?;
+        let (lock, store) = open_folder(&spec, out, force, interval, Stop::new())?;
         let ledger = Ledger::restore(&store).map_err(from_error)?;
         Ok(StudyLedger {
             spec,
@@ -419,74 +378,25 @@ impl SampleComputer {
     }
 }
 
-/// Every task in order, as the CLI's `execute`; progress counts samples over all tasks.
+/// Every task in order ([`study::run_tasks`]); progress counts samples over all tasks.
 fn run_tasks(
-    spec: &StudySpec,
     store: &StudyDir,
     progress: Option<&Py<PyAny>>,
     cancel: &Cancel,
-) -> asperity::Result<Vec<TaskResult>> {
-    let tasks = spec.tasks();
-    let total = tasks.len() * spec.samples;
-    let mut results = Vec::with_capacity(tasks.len());
-    for (i, &task) in tasks.iter().enumerate() {
-        let offset = i * spec.samples;
-        let report = |done: usize, _: usize| cancel.call(progress, offset + done, total);
-        let result = match spec.method {
-            Method::Bem => run_one(
-                spec,
-                task,
-                // Stops inside a sample's solve, not only between samples.
-                BemSampler::new(spec, task)?.with_stop(cancel.stop().clone()),
-                store,
-                &report,
-                cancel,
-            ),
-            Method::Mdr => run_one(
-                spec,
-                task,
-                MdrSampler::new(spec, task)?,
-                store,
-                &report,
-                cancel,
-            ),
-        };
-        let result = result.map_err(|e| with_task(spec, task, e))?;
-        results.push(result);
-        if cancel.is_set() {
-            break;
-        }
-    }
-    Ok(results)
+) -> Result<Vec<TaskResult>, TaskFailure> {
+    let samples = store.spec().samples;
+    let total = store.spec().tasks().len() * samples;
+    let report = |task: usize, done: usize| cancel.call(progress, task * samples + done, total);
+    study::run_tasks(store, &report, None)
 }
 
 /// A solver error with the CLI's context: `mdr N = 512 H = 0.5: ...`.
-fn with_task(spec: &StudySpec, task: Task, error: Error) -> Error {
-    match error {
-        Error::Solve { context, source } => Error::Solve {
-            context: format!(
-                "{} N = {} H = {}: {context}",
-                spec.method.name(),
-                task.n,
-                task.hurst
-            ),
-            source,
-        },
-        other => other,
+fn with_task(spec: &StudySpec, task: Task, source: Error) -> Error {
+    let method = spec.method;
+    TaskFailure {
+        method,
+        task,
+        source,
     }
-}
-
-fn run_one<S: Sampler>(
-    spec: &StudySpec,
-    task: Task,
-    sampler: S,
-    store: &StudyDir,
-    report: &(dyn Fn(usize, usize) + Sync),
-    cancel: &Cancel,
-) -> asperity::Result<TaskResult> {
-    let sampler = Interruptible {
-        inner: sampler,
-        cancel,
-    };
-    run_task(spec, task, &sampler, store, report)
+    .into_error()
 }

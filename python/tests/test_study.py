@@ -77,6 +77,26 @@ def test_an_mdr_study_equals_the_cli_and_resumes_there(cli, tmp_path):
     assert (tmp_path / "resumed" / "alpha.csv").read_bytes() == (tmp_path / "cli" / "alpha.csv").read_bytes()
 
 
+def test_an_mdr_curve_study_with_rolloff_equals_the_cli(cli, tmp_path):
+    """`study_curve` returns `curve.csv`'s columns (one definition of them, the front-end
+    layer's), value for value, with the types the CLI writes."""
+    flags = ["--method", "mdr", "--n", 512, "--hurst", "-0.5,0.5", "--samples", 10,
+             "--rolloff", 6, "--levels", 20]
+    cli("study", "curve", *flags, "--out", tmp_path / "cli", "--quiet")
+    reference = alpha_csv(tmp_path / "cli" / "curve.csv")
+    ours = asperity.study_curve(method="mdr", n=512, hurst=[-0.5, 0.5], samples=10, rolloff=6,
+                                levels=20, out=tmp_path / "py")
+    assert list(ours.columns) == list(reference[0])
+    assert len(ours.rows) == len(reference) == 40
+    assert ours["n"].dtype == np.int64 and ours["samples"].dtype == np.int64
+    for name in reference[0]:
+        theirs = [r[name] for r in reference]
+        if name == "method":
+            assert ours[name].tolist() == theirs
+        else:
+            assert ours[name].tolist() == [float(v) for v in theirs], name
+
+
 def test_the_comparison_with_the_paper_equals_study_compare(cli, tmp_path):
     """`StudyResult.comparison()` is `asperity study compare`'s comparison.csv, row for row,
     with the verdict that the rule gives (re-derived here from the CSV: the reference
@@ -199,6 +219,13 @@ def test_study_arguments_are_checked_like_the_cli(cli, tmp_path):
         asperity.study_alpha(method="fem", n=512, hurst=0.5, samples=2, out=tmp_path / "c")
     with pytest.raises(ValueError, match="given twice"):
         asperity.study_alpha(method="mdr", n=[512, 512], hurst=0.5, samples=2, out=tmp_path / "d")
+    message = cli("study", "alpha", "--method", "mdr", "--n", 64, "--hurst", 0.5, "--samples",
+                  2, "--checkpoint-every", -1, "--out", tmp_path / "f", ok=False).stderr
+    with pytest.raises(ValueError) as err:
+        asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=2, checkpoint_every=-1,
+                             out=tmp_path / "g")
+    assert str(err.value) == "checkpoint_every must be between 0 and 1e6 seconds, got -1"
+    assert str(err.value).replace("checkpoint_every", "--checkpoint-every") in message
     # Another study's folder is refused, as by the CLI.
     asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=4, out=tmp_path / "e")
     with pytest.raises(ValueError, match="holds the checkpoint of another study"):

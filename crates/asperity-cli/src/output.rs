@@ -21,12 +21,6 @@ impl Table {
         }
     }
 
-    /// An empty table whose header is the CSV line `header` (`"n,hurst,alpha"`), so that
-    /// the code reads as the file's first line.
-    pub fn with_header(header: &str) -> Self {
-        Self::new(&header.split(',').collect::<Vec<_>>())
-    }
-
     /// Appends a row of numbers, printed with full precision (`{:e}` round-trips f64).
     pub fn push_numbers(&mut self, values: &[f64]) {
         self.rows

@@ -7,27 +7,18 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use asperity::study::samplers::{BemSampler, OnLoad};
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
-use asperity::study::{
-    run_any_task_with_loads, sample_cost, Method, StudyDir, StudySpec, TaskResult,
-};
-use serde::Deserialize;
+use asperity::study::{sample_cost, Method, StudyDir, StudySpec, TaskResult};
+use asperity_app::study::{self, rows, rows::Cell};
+use asperity_app::Names;
 
 use crate::output::{format_number, Table};
 use crate::plot::{ordered_color, Chart, Series, Style};
 use crate::progress::Progress;
 
-/// What a study writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Kind {
-    /// α table and plot.
-    Alpha,
-    /// Mean curves table and plot.
-    Curve,
-}
+pub use asperity_app::study::Kind;
 
 /// `", loads up to the first past 8 % contact"` for a BEM study whose samples end their
 /// sweep ([`StudySpec::sweep_end`]), empty for one that solves every load.
@@ -40,17 +31,13 @@ pub fn describe_sweep(spec: &StudySpec) -> String {
     })
 }
 
-/// The study to run in `dir` ([`StudyDir::resumable`]): `spec`, or the whole-sweep study
-/// whose samples the folder holds, said on stderr; always `spec` when `discard` (--force).
+/// The study to run in `dir` ([`asperity_app::study::resumable`]): `spec`, or the
+/// whole-sweep study whose samples the folder holds, said on stderr; always `spec` when
+/// `discard` (--force).
 pub fn resumable(spec: StudySpec, dir: &Path, discard: bool, quiet: bool) -> StudySpec {
-    let run = StudyDir::resumable(dir, spec.clone(), discard);
-    if run != spec && !quiet {
-        eprintln!(
-            "{}: resuming its study, which solves every load (as α studies did before they \
-             stopped loading past their fit windows, or with --full-sweep): the same α, \
-             its checkpoints kept",
-            dir.display()
-        );
+    let (run, note) = asperity_app::study::resumable(spec, dir, discard);
+    if let Some(note) = note.filter(|_| !quiet) {
+        eprintln!("{}", note.words(Names::Flags));
     }
     run
 }
@@ -70,7 +57,7 @@ pub struct RunOptions {
 
 /// The files a study of `kind` writes into `dir`.
 pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
-    let stem = outputs_stem(kind);
+    let stem = kind.stem();
     ["csv", "png", "svg"]
         .iter()
         .map(|ext| dir.join(format!("{stem}.{ext}")))
@@ -99,15 +86,11 @@ pub fn execute(
         checkpoint_every,
         setting,
     } = options;
-    spec.validate()?;
-    asperity_app::study::check_min_contacts(spec)?;
-    spec.ensure_fits()?;
-    StudyDir::check(dir, spec, force)?;
+    study::validate(spec).map_err(crate::request::refused)?;
+    study::check(spec, dir, force)?;
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
-    let _lock = StudyDir::lock(dir)?;
-    let store = StudyDir::open(dir, spec, force)?
-        .with_checkpoint_interval(checkpoint_every)
-        .with_stop(crate::interrupt::stop());
+    let stop = crate::interrupt::stop();
+    let (_lock, store) = study::open(spec, dir, force, checkpoint_every, stop)?;
     let stored = stored_per_task(&store)?;
     let progress = Arc::new(study_progress(spec, &stored, quiet));
     let results = run_tasks(&store, &stored, &progress, quiet);
@@ -118,18 +101,13 @@ pub fn execute(
     }
     let results = results?;
     progress.finish();
-    let (table, chart) = match kind {
-        Kind::Alpha => (
-            alpha_table(&results),
-            alpha_chart(&results, &titled(ALPHA_TITLE, setting)),
-        ),
-        Kind::Curve => (
-            curve_table(&results),
-            curve_chart(&results, &titled(CURVE_TITLE, setting)),
-        ),
+    let title = titled(kind, setting);
+    let chart = match kind {
+        Kind::Alpha => alpha_chart(&results, &title),
+        Kind::Curve => curve_chart(&results, &title),
     };
-    let stem = outputs_stem(kind);
-    write_together(dir, stem, &table, &chart, rewrite, true)?;
+    let table = csv_table(&kind.table(&results));
+    write_together(dir, kind.stem(), &table, &chart, rewrite, true)?;
     Ok(results)
 }
 
@@ -212,7 +190,6 @@ fn run_tasks(
     let _ = quiet;
     // The first Ctrl-C stops the samples and checkpoints the finished ones.
     let _graceful = crate::interrupt::graceful();
-    let tasks = spec.tasks();
     // Every load solved in this run is one step; at the end of a batch of samples the
     // count is set to what the finished samples hold, which all their loads reached.
     let on_load = (steps > 1).then(|| {
@@ -221,18 +198,14 @@ fn run_tasks(
     });
     // Task i's computed samples follow every stored sample and the samples left of the
     // tasks before it (`study_progress`).
-    let mut offset = stored.iter().sum::<usize>() as u64 * steps;
-    let mut results = Vec::with_capacity(tasks.len());
-    for (task, &held) in tasks.iter().zip(stored) {
-        let report = |done: usize, _| {
-            progress.set(offset + done.saturating_sub(held) as u64 * steps);
-        };
-        let result = run_any_task_with_loads(spec, *task, store, &report, on_load.clone())
-            .with_context(|| format!("{} N = {} H = {}", spec.method.name(), task.n, task.hurst))?;
-        results.push(result);
-        offset += (spec.samples - held) as u64 * steps;
-    }
-    Ok(results)
+    let stored_total = stored.iter().sum::<usize>();
+    let report = |i: usize, done: usize| {
+        let held_before = stored[..i].iter().sum::<usize>();
+        let left_before = i * spec.samples - held_before;
+        let computed = done.saturating_sub(stored[i]);
+        progress.set((stored_total + left_before + computed) as u64 * steps);
+    };
+    Ok(study::run_tasks(store, &report, on_load)?)
 }
 
 /// Writes `<stem>.csv`, `.png` and `.svg` (and, with `record`, the record of what was
@@ -265,26 +238,35 @@ pub fn write_together(
     Ok(())
 }
 
-const ALPHA_TITLE: &str = "α of k ∝ F^α vs H";
-const CURVE_TITLE: &str = "Contact stiffness vs force (ensemble mean)";
-
-/// `title` marked with the `reproduce` setting, if any.
-fn titled(title: &str, setting: Option<&str>) -> String {
+/// The title of a study's plot, marked with the `reproduce` setting, if any.
+fn titled(kind: Kind, setting: Option<&str>) -> String {
+    let title = match kind {
+        Kind::Alpha => "α of k ∝ F^α vs H",
+        Kind::Curve => "Contact stiffness vs force (ensemble mean)",
+    };
     match setting {
         Some(name) => format!("{title} ({name} setting)"),
         None => title.to_string(),
     }
 }
 
-fn outputs_stem(kind: Kind) -> &'static str {
-    match kind {
-        Kind::Alpha => "alpha",
-        Kind::Curve => "curve",
+/// The CSV of a result table ([`asperity_app::study::rows`]): numbers as the CLI writes
+/// them ([`format_number`]), a missing one as an empty cell.
+fn csv_table(table: &rows::Table) -> Table {
+    let names: Vec<&str> = table.columns.iter().map(|(name, _)| *name).collect();
+    let mut csv = Table::new(&names);
+    for row in &table.rows {
+        let cells: Vec<String> = row
+            .iter()
+            .map(|cell| match *cell {
+                Cell::Text(text) => text.to_string(),
+                Cell::Count(count) => count.to_string(),
+                Cell::Number(value) => value.map(format_number).unwrap_or_default(),
+            })
+            .collect();
+        csv.push(&cells);
     }
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map(format_number).unwrap_or_default()
+    csv
 }
 
 /// `alpha.csv` (contract columns first, then extras) and the α(H) plot with theory curves,
@@ -296,37 +278,9 @@ pub fn write_alpha(
     force: bool,
     setting: Option<&str>,
 ) -> Result<()> {
-    let chart = alpha_chart(results, &titled(ALPHA_TITLE, setting));
-    write_together(dir, "alpha", &alpha_table(results), &chart, force, false)
-}
-
-/// The rows of `alpha.csv`.
-fn alpha_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::with_header(
-        "method,n,hurst,alpha,alpha_low,alpha_high,samples,alpha_fit_low,alpha_fit_high,\
-         alpha_sample_mean,samples_fitted,alpha_theory",
-    );
-    for r in results {
-        let (lo, hi) = r.alpha_sample_interval().unzip();
-        table.push(&[
-            r.method.name().to_string(),
-            r.task.n.to_string(),
-            format_number(r.task.hurst),
-            opt(r.alpha_ensemble.map(|f| f.exponent)),
-            opt(lo),
-            opt(hi),
-            r.samples.to_string(),
-            opt(r.alpha_ensemble.map(|f| f.low)),
-            opt(r.alpha_ensemble.map(|f| f.high)),
-            opt(r.alpha_sample_mean()),
-            r.alpha_samples.len().to_string(),
-            format_number(asperity::study::theory::alpha_theory(
-                r.task.hurst,
-                r.task.n,
-            )),
-        ]);
-    }
-    table
+    let chart = alpha_chart(results, &titled(Kind::Alpha, setting));
+    let table = csv_table(&rows::alpha_table(results));
+    write_together(dir, "alpha", &table, &chart, force, false)
 }
 
 /// The 95 % interval of each task's per-sample α (`alpha_low`, `alpha_high` of
@@ -493,31 +447,9 @@ pub fn write_curves(
     stem: &str,
     setting: Option<&str>,
 ) -> Result<()> {
-    let chart = curve_chart(results, &titled(CURVE_TITLE, setting));
-    write_together(dir, stem, &curve_table(results), &chart, force, false)
-}
-
-/// The rows of `curve.csv`.
-fn curve_table(results: &[TaskResult]) -> Table {
-    let mut table = Table::with_header(
-        "method,n,hurst,force,stiffness,stiffness_low,stiffness_high,samples,area_fraction",
-    );
-    for r in results {
-        for p in &r.mean_curve {
-            table.push(&[
-                r.method.name().to_string(),
-                r.task.n.to_string(),
-                format_number(r.task.hurst),
-                format_number(p.force),
-                format_number(p.stiffness),
-                format_number(p.stiffness_low),
-                format_number(p.stiffness_high),
-                p.samples.to_string(),
-                format_number(p.fraction),
-            ]);
-        }
-    }
-    table
+    let chart = curve_chart(results, &titled(Kind::Curve, setting));
+    let table = csv_table(&rows::curve_table(results));
+    write_together(dir, stem, &table, &chart, force, false)
 }
 
 /// Log–log k(F), one series per task, coloured by H, with the 95 % interval of the mean

@@ -6,7 +6,6 @@
 //! and writing its tables and plots is shared with `reproduce` ([`crate::studies`]).
 
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 use anyhow::Result;
 use asperity::study::{FitWindow, Method, StudySpec, CHECKPOINT_INTERVAL};
@@ -486,18 +485,8 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
     }
     Ok((
         file.kind,
-        with_sweep(file.kind, spec, file.full_sweep.unwrap_or(false)),
+        file.kind.spec(spec, file.full_sweep.unwrap_or(false)),
     ))
-}
-
-/// The spec with the load sweep of its kind: an α study's BEM samples stop loading past
-/// the fits' windows ([`StudySpec::with_alpha_sweep`]) unless `full_sweep`; a curve study
-/// solves every load.
-fn with_sweep(kind: Kind, spec: StudySpec, full_sweep: bool) -> StudySpec {
-    match kind {
-        Kind::Alpha if !full_sweep => spec.with_alpha_sweep(),
-        _ => spec,
-    }
 }
 
 /// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on
@@ -549,20 +538,13 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
     }
 }
 
-/// The longest `--checkpoint-every`, in seconds (about 11 days).
-const MAX_CHECKPOINT_EVERY: f64 = asperity::study::MAX_CHECKPOINT_INTERVAL_SECONDS;
-
 impl RunOptions {
     fn from_args(run: &RunArgs) -> Result<Self> {
-        anyhow::ensure!(
-            (0.0..=MAX_CHECKPOINT_EVERY).contains(&run.checkpoint_every),
-            "--checkpoint-every must be between 0 and {MAX_CHECKPOINT_EVERY:e} seconds, got {}",
-            asperity::input::short_number(run.checkpoint_every)
-        );
+        let checkpoint_every = asperity_app::study::checkpoint_interval(run.checkpoint_every)?;
         Ok(RunOptions {
             force: run.force,
             quiet: run.quiet,
-            checkpoint_every: Duration::from_secs_f64(run.checkpoint_every),
+            checkpoint_every,
             setting: None,
         })
     }
@@ -573,7 +555,7 @@ pub fn run(args: &StudyArgs) -> Result<()> {
     let (kind, spec, out, options) = match &args.command {
         StudyCommand::Alpha(a) => {
             let spec = spec_from(&a.common, a.n.clone(), parse_range(&a.hurst)?);
-            let spec = with_sweep(Kind::Alpha, spec, a.full_sweep);
+            let spec = Kind::Alpha.spec(spec, a.full_sweep);
             (
                 Kind::Alpha,
                 spec,

@@ -935,6 +935,10 @@ pub fn run_task<S: Sampler>(
         Restored::Partial(samples) => samples,
     };
     progress(samples.len(), spec.samples);
+    let sampler = &UntilStopped {
+        inner: sampler,
+        store,
+    };
     let mut workers = lane_workers(sampler)?;
     let batch = batch_size(spec.method, task.n, workers.len());
     let mut last_save = std::time::Instant::now();
@@ -964,6 +968,32 @@ pub fn run_task<S: Sampler>(
         progress(samples.len(), spec.samples);
     }
     store.finish(task, samples)
+}
+
+/// A sampler that starts no sample once the store's stop is requested (Ctrl-C, or a
+/// front end's cancel): the samples in flight end (a BEM sample's solver polls the same
+/// flag), those not yet started fail as [`Error::Interrupted`], and [`run_task`] keeps
+/// the finished ones before them. Which samples are computed changes, never a number.
+struct UntilStopped<'a, S> {
+    inner: &'a S,
+    store: &'a StudyDir,
+}
+
+impl<S: Sampler> Sampler for UntilStopped<'_, S> {
+    type Worker = S::Worker;
+
+    fn worker(&self) -> Result<S::Worker> {
+        self.inner.worker()
+    }
+
+    fn sample(&self, worker: &mut S::Worker, seed: u64) -> Result<SampleCurve> {
+        if self.store.stop.is_requested() {
+            return Err(Error::Interrupted {
+                dir: self.store.dir.clone(),
+            });
+        }
+        self.inner.sample(worker, seed)
+    }
 }
 
 /// Appends the samples of a batch, in index order, up to the first that failed; returns

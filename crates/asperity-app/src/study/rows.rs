@@ -1,0 +1,190 @@
+//! The result tables of a study, defined once: the rows of `alpha.csv` and `curve.csv`
+//! that the CLI writes and that Python returns as columns.
+
+use asperity::study::theory::alpha_theory;
+use asperity::study::TaskResult;
+use serde::Serialize;
+
+/// What a column holds (how a front end stores it: text, an integer, a float).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColumnType {
+    /// A name (`method`).
+    Text,
+    /// A count or a size (`n`, `samples`).
+    Count,
+    /// A number; a missing one is an empty CSV cell and a NaN in Python's columns.
+    Number,
+}
+
+/// One cell of a row.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Cell {
+    /// A name.
+    Text(&'static str),
+    /// A count.
+    Count(usize),
+    /// A number, or none (no fit, no interval).
+    Number(Option<f64>),
+}
+
+/// A table of results: the columns, named and typed, and the rows of cells.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Table {
+    /// `(name, type)` of each column, in order.
+    pub columns: &'static [(&'static str, ColumnType)],
+    /// The rows, each a cell per column.
+    pub rows: Vec<Vec<Cell>>,
+}
+
+use ColumnType::{Count, Number, Text};
+
+/// The columns of `alpha.csv`: the contract columns first, then the extras.
+pub const ALPHA_COLUMNS: &[(&str, ColumnType)] = &[
+    ("method", Text),
+    ("n", Count),
+    ("hurst", Number),
+    ("alpha", Number),
+    ("alpha_low", Number),
+    ("alpha_high", Number),
+    ("samples", Count),
+    ("alpha_fit_low", Number),
+    ("alpha_fit_high", Number),
+    ("alpha_sample_mean", Number),
+    ("samples_fitted", Count),
+    ("alpha_theory", Number),
+];
+
+/// The columns of `curve.csv`.
+pub const CURVE_COLUMNS: &[(&str, ColumnType)] = &[
+    ("method", Text),
+    ("n", Count),
+    ("hurst", Number),
+    ("force", Number),
+    ("stiffness", Number),
+    ("stiffness_low", Number),
+    ("stiffness_high", Number),
+    ("samples", Count),
+    ("area_fraction", Number),
+];
+
+/// `alpha.csv`: per task, α fitted on the ensemble-mean curve (`alpha`), the 95 %
+/// interval of the per-sample α (`alpha_low`, `alpha_high`), the fit's own interval, the
+/// mean of the per-sample α, how many samples had a fit and eq. (6)/(24)'s α.
+pub fn alpha_table(results: &[TaskResult]) -> Table {
+    let rows = results
+        .iter()
+        .map(|r| {
+            let (low, high) = r.alpha_sample_interval().unzip();
+            let fit = r.alpha_ensemble;
+            vec![
+                Cell::Text(r.method.name()),
+                Cell::Count(r.task.n),
+                Cell::Number(Some(r.task.hurst)),
+                Cell::Number(fit.map(|f| f.exponent)),
+                Cell::Number(low),
+                Cell::Number(high),
+                Cell::Count(r.samples),
+                Cell::Number(fit.map(|f| f.low)),
+                Cell::Number(fit.map(|f| f.high)),
+                Cell::Number(r.alpha_sample_mean()),
+                Cell::Count(r.alpha_samples.len()),
+                Cell::Number(Some(alpha_theory(r.task.hurst, r.task.n))),
+            ]
+        })
+        .collect();
+    Table {
+        columns: ALPHA_COLUMNS,
+        rows,
+    }
+}
+
+/// `curve.csv`: per task and force level, the ensemble-mean stiffness with the 95 %
+/// interval of the mean, the samples that reach the level and the mean contact fraction.
+pub fn curve_table(results: &[TaskResult]) -> Table {
+    let rows = results
+        .iter()
+        .flat_map(|r| {
+            r.mean_curve.iter().map(move |p| {
+                vec![
+                    Cell::Text(r.method.name()),
+                    Cell::Count(r.task.n),
+                    Cell::Number(Some(r.task.hurst)),
+                    Cell::Number(Some(p.force)),
+                    Cell::Number(Some(p.stiffness)),
+                    Cell::Number(Some(p.stiffness_low)),
+                    Cell::Number(Some(p.stiffness_high)),
+                    Cell::Count(p.samples),
+                    Cell::Number(Some(p.fraction)),
+                ]
+            })
+        })
+        .collect();
+    Table {
+        columns: CURVE_COLUMNS,
+        rows,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asperity::fit::PowerLawFit;
+    use asperity::study::{EnsemblePoint, Method, Task};
+
+    fn result(fit: Option<PowerLawFit>, alpha_samples: Vec<f64>) -> TaskResult {
+        let point = EnsemblePoint {
+            force: 2.0,
+            stiffness: 3.0,
+            stiffness_low: 2.5,
+            stiffness_high: 3.5,
+            fraction: 0.1,
+            samples: 4,
+        };
+        TaskResult {
+            method: Method::Bem,
+            task: Task { n: 64, hurst: 0.5 },
+            samples: 4,
+            mean_curve: vec![point; 3],
+            alpha_ensemble: fit,
+            alpha_samples,
+        }
+    }
+
+    #[test]
+    fn every_row_has_a_cell_of_its_columns_type() {
+        let fit = PowerLawFit {
+            exponent: 0.6,
+            low: 0.55,
+            high: 0.65,
+            prefactor: 1.0,
+            stderr: 0.02,
+            points: 9,
+        };
+        let results = [result(Some(fit), vec![0.5, 0.6, 0.7]), result(None, vec![])];
+        for table in [alpha_table(&results), curve_table(&results)] {
+            for row in &table.rows {
+                assert_eq!(row.len(), table.columns.len());
+                for (cell, (name, kind)) in row.iter().zip(table.columns) {
+                    let matches = matches!(
+                        (cell, kind),
+                        (Cell::Text(_), Text) | (Cell::Count(_), Count) | (Cell::Number(_), Number)
+                    );
+                    assert!(matches, "{name}: {cell:?}");
+                }
+            }
+        }
+        let alpha = alpha_table(&results);
+        assert_eq!(alpha.rows[0][3], Cell::Number(Some(0.6)));
+        assert_eq!(alpha.rows[0][10], Cell::Count(3));
+        // No fit: no α, no interval, no mean; the theory is still there.
+        assert_eq!(alpha.rows[1][3], Cell::Number(None));
+        assert_eq!(alpha.rows[1][4], Cell::Number(None));
+        assert!(matches!(alpha.rows[1][11], Cell::Number(Some(_))));
+        assert_eq!(curve_table(&results).rows.len(), 6);
+        // Python reads the cells as JSON: a missing number is null.
+        let json = serde_json::to_string(&alpha.rows[1][..5]).unwrap();
+        assert_eq!(json, r#"["bem",64,0.5,null,null]"#);
+    }
+}
