@@ -38,6 +38,7 @@ pub(crate) mod mnt;
 pub(crate) mod netcdf;
 pub(crate) mod nid;
 pub(crate) mod opd;
+pub(crate) mod opdx;
 pub mod patches;
 pub(crate) mod plu;
 pub(crate) mod sdf;
@@ -215,6 +216,12 @@ const FORMATS: &[Format] = &[
         extensions: &["opd"],
         sniff: opd::sniff,
         read: opd::read,
+    },
+    Format {
+        name: "opdx",
+        extensions: &["opdx"],
+        sniff: opdx::sniff,
+        read: opdx::read,
     },
     Format {
         name: "di",
