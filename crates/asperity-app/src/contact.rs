@@ -32,7 +32,8 @@ pub mod params {
 use params::*;
 
 /// E* from either the effective modulus itself or Young's modulus E and Poisson's ratio ν:
-/// `E* = E/(1 − ν²)`, with ν in `[0, 0.5)`.
+/// `E* = E/(1 − ν²)`, with ν in `[0, 0.5]` (the library's rule,
+/// [`asperity::mdr::tangential::is_poisson_ratio`]).
 pub fn effective_modulus(
     modulus: Option<f64>,
     young: Option<f64>,
@@ -44,9 +45,9 @@ pub fn effective_modulus(
             Ok(m)
         }
         (None, Some(e), Some(nu)) => {
-            if !(nu.is_finite() && (0.0..0.5).contains(&nu)) {
+            if !asperity::mdr::tangential::is_poisson_ratio(nu) {
                 return Err(Refusal::of(POISSON)
-                    .text(format!(" must be in [0, 0.5) (Poisson's ratio), got {nu}")));
+                    .text(format!(" must be in [0, 0.5] (Poisson's ratio), got {nu}")));
             }
             check_modulus(YOUNG, e)?;
             let e_star = e / (1.0 - nu * nu);
@@ -370,10 +371,12 @@ mod tests {
             Ok(210e9 / 0.91)
         );
         assert_eq!(effective_modulus(Some(2.0), None, None), Ok(2.0));
+        // Incompressible (ν = 0.5) is a Poisson's ratio, as for the tangential stiffness.
+        assert_eq!(effective_modulus(None, Some(3.0), Some(0.5)), Ok(4.0));
         let cases = [
             (
-                (None, Some(1.0), Some(0.5)),
-                "poisson must be in [0, 0.5) (Poisson's ratio), got 0.5",
+                (None, Some(1.0), Some(0.6)),
+                "poisson must be in [0, 0.5] (Poisson's ratio), got 0.6",
             ),
             (
                 (None, Some(-1.0), Some(0.3)),

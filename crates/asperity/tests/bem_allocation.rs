@@ -9,6 +9,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use asperity::bem::tangential::TangentialStiffness;
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::spectrum::{LongWavelength, Psd};
@@ -152,5 +153,50 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
             );
             assert_eq!(allocations, 0, "{kind:?} {boundary:?}: {bytes} bytes");
         }
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            tangential_stiffness_allocates_nothing(&surface, boundary);
+        }
     });
+}
+
+/// The tangential frozen-set CGs (`k_x`, `k_y`: Cerruti's operators on the contact set)
+/// work in the fields planned by `TangentialStiffness::new`: a loose and a tight CG cost
+/// the same, zero, allocations.
+fn tangential_stiffness_allocates_nothing(
+    surface: &asperity::surface::Surface,
+    boundary: Boundary,
+) {
+    let half_space = HalfSpace {
+        modulus: 1.0,
+        boundary,
+    };
+    let base = SolverParams::default();
+    let mut solver = ContactSolver::new(surface, half_space, base).unwrap();
+    solver.solve(Control::MeanPressure(0.03)).unwrap();
+    let mut tangential = TangentialStiffness::new(&solver, 0.3).unwrap();
+    tangential.solve(&solver).unwrap(); // warm up
+    let mut run = |tolerance: f64| {
+        let params = SolverParams {
+            stiffness_tolerance: tolerance,
+            stiffness_error: 0.0,
+            ..base
+        };
+        solver.set_params(params).unwrap();
+        let (result, allocations, bytes) = count(|| tangential.solve(&solver));
+        let k = result.unwrap();
+        (
+            k.info_x.iterations + k.info_y.iterations,
+            allocations,
+            bytes,
+        )
+    };
+    let (few, allocations_few, bytes_few) = run(1e-3);
+    let (many, allocations_many, bytes_many) = run(1e-12);
+    eprintln!(
+        "tangential {boundary:?}: {few} and {many} CG iterations: {allocations_few} and \
+         {allocations_many} allocations, {bytes_few} and {bytes_many} bytes"
+    );
+    assert!(many >= 2 * few, "{few} vs {many} iterations");
+    assert_eq!(allocations_few, 0, "{bytes_few} bytes");
+    assert_eq!(allocations_many, 0, "{bytes_many} bytes");
 }

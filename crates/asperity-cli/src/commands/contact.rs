@@ -45,7 +45,7 @@ pub struct ContactArgs {
     /// Young's modulus E in Pa (with --poisson): E* = E/(1 − ν²).
     #[arg(long, allow_negative_numbers = true)]
     pub young: Option<f64>,
-    /// Poisson's ratio ν, in [0, 0.5).
+    /// Poisson's ratio ν, in [0, 0.5].
     #[arg(long, allow_negative_numbers = true)]
     pub poisson: Option<f64>,
     /// Mean pressures over the nominal area, Pa, comma separated.

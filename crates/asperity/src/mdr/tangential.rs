@@ -59,9 +59,15 @@ pub fn mindlin_ratio(poisson: f64) -> Result<f64> {
     Ok(2.0 * (1.0 - poisson) / (2.0 - poisson))
 }
 
+/// Whether `poisson` is a Poisson's ratio the library accepts: finite and in `[0, 0.5]`
+/// (0.5, incompressible, included). The one rule for every quantity that takes ν.
+pub fn is_poisson_ratio(poisson: f64) -> bool {
+    poisson.is_finite() && (0.0..=0.5).contains(&poisson)
+}
+
 /// Refuses a Poisson's ratio outside `[0, 0.5]` (or not finite).
 pub fn check_poisson(poisson: f64) -> Result<()> {
-    if !(poisson.is_finite() && (0.0..=0.5).contains(&poisson)) {
+    if !is_poisson_ratio(poisson) {
         return Err(Error::invalid(
             "poisson",
             format!("Poisson's ratio ν must be in [0, 0.5], got {poisson}"),
