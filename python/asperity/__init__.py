@@ -74,6 +74,7 @@ __all__ = [
     "mdr",
     "mdr_slip",
     "psd",
+    "import_topography",
     "read_topography",
     "stats",
     "study_alpha",
@@ -488,12 +489,7 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
 
         >>> t = asperity.read_topography("scan.x3p", detrend="plane")  # doctest: +SKIP
     """
-    if isinstance(size, (tuple, list)):
-        if len(size) != 2:
-            raise ValueError(f"size: give x or (x, y), got {size!r}")
-        size_x, size_y = _positive(size[0], "size"), _positive(size[1], "size")
-    else:
-        size_x, size_y = _positive(size, "size"), None
+    size_x, size_y = _measured_size(size)
     heights, sizes, provenance, warned = _core.read_topography(
         os.fspath(path), None if channel is None else str(channel), size_x, size_y,
         detrend, fill)
@@ -502,6 +498,44 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
     return Topography(heights=heights, size=float(sizes[0]),
                       size_y=float(sizes[1]) if len(sizes) > 1 else None,
                       provenance=json.loads(provenance))
+
+
+def import_topography(path: Union[str, "os.PathLike[str]"], out: Union[str, "os.PathLike[str]"],
+                      *, channel: Union[None, str, int] = None,
+                      size: Union[None, float, Tuple[float, float]] = None,
+                      detrend: Optional[str] = None, fill: Optional[str] = None,
+                      force: bool = False) -> Topography:
+    """``asperity import``: reads and cleans the measured file ``path`` as
+    :func:`read_topography` (the same keywords; undefined points are refused unless
+    ``fill`` is named, as the CLI refuses them) and writes it to ``out`` by the writer the
+    CLI uses: a float64 ``.npy`` with the import sidecar ``out.json`` (source, format,
+    channel, units, sizes per axis, every cleaning step; asperity reads the sizes back from
+    it), or an ``.x3p`` file (maps only). Both files or neither; an existing output is
+    refused unless ``force``. Returns the topography written.
+
+    Example::
+
+        >>> t = asperity.import_topography("scan.x3p", "s.npy", detrend="plane")  # doctest: +SKIP
+    """
+    size_x, size_y = _measured_size(size)
+    heights, sizes, provenance, warned = _core.import_topography(
+        os.fspath(path), os.fspath(out), None if channel is None else str(channel), size_x,
+        size_y, detrend, fill, bool(force))
+    for category, words in warned:
+        warnings.warn(f"{os.fspath(path)}: {words}", _WARNINGS[category], stacklevel=2)
+    return Topography(heights=heights, size=float(sizes[0]),
+                      size_y=float(sizes[1]) if len(sizes) > 1 else None,
+                      provenance=json.loads(provenance))
+
+
+def _measured_size(size: Union[None, float, Tuple[float, float]]
+                   ) -> Tuple[Optional[float], Optional[float]]:
+    """``size=`` of a measured file: ``x`` or ``(x, y)`` in metres, or None."""
+    if isinstance(size, (tuple, list)):
+        if len(size) != 2:
+            raise ValueError(f"size: give x or (x, y), got {size!r}")
+        return _positive(size[0], "size"), _positive(size[1], "size")
+    return _positive(size, "size"), None
 
 
 def psd(

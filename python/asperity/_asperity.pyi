@@ -113,3 +113,7 @@ def read_topography(
     path: str, channel: Optional[str], size_x: Optional[float], size_y: Optional[float],
     detrend: Optional[str], fill: Optional[str],
 ) -> Tuple[npt.NDArray[np.float64], List[float], str, List[Tuple[str, str]]]: ...
+def import_topography(
+    path: str, out: str, channel: Optional[str], size_x: Optional[float],
+    size_y: Optional[float], detrend: Optional[str], fill: Optional[str], force: bool,
+) -> Tuple[npt.NDArray[np.float64], List[float], str, List[Tuple[str, str]]]: ...

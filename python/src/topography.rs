@@ -7,8 +7,9 @@
 use std::path::PathBuf;
 
 use asperity::topography::{Fill, Heights};
-use asperity_app::measured::{open, MeasuredRequest, WarningKind};
-use asperity_app::Names;
+use asperity_app::import::Import;
+use asperity_app::measured::{open, MeasuredRequest, Opened, WarningKind};
+use asperity_app::{Names, RequestError};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 
@@ -17,6 +18,7 @@ use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_topography, m)?)?;
+    m.add_function(wrap_pyfunction!(import_topography, m)?)?;
     Ok(())
 }
 
@@ -48,6 +50,46 @@ fn read_topography(
     };
     let opened =
         run_detached(py, |_| open(&path, &request, Some(Fill::Keep)))?.map_err(request_error)?;
+    Ok(to_python(py, opened))
+}
+
+/// `asperity import`: reads and cleans a measured file as [`read_topography`] (undefined
+/// points refused unless a filling is named, as the CLI) and writes it into `out` by the
+/// front-end layer's writer ([`Import`]: `.npy` with the import sidecar, or `.x3p`), the
+/// outputs checked before the file is read and written all or nothing; returns what
+/// `read_topography` returns.
+#[pyfunction]
+#[pyo3(signature = (path, out, channel, size_x, size_y, detrend, fill, force))]
+#[allow(clippy::too_many_arguments)]
+fn import_topography(
+    py: Python<'_>,
+    path: PathBuf,
+    out: PathBuf,
+    channel: Option<String>,
+    size_x: Option<f64>,
+    size_y: Option<f64>,
+    detrend: Option<String>,
+    fill: Option<String>,
+    force: bool,
+) -> PyResult<Read> {
+    let request = MeasuredRequest {
+        channel,
+        size: size_x.map(|x| [Some(x), size_y]),
+        detrend,
+        fill,
+    };
+    let opened = run_detached(py, |_| {
+        let import = Import::stage(&path, &out, force)?;
+        let opened = open(&path, &request, None)?;
+        import.write(&path, &opened.topography)?;
+        Ok::<_, RequestError>(opened)
+    })?
+    .map_err(request_error)?;
+    Ok(to_python(py, opened))
+}
+
+/// The heights, sizes, provenance (JSON) and warnings of an opened file.
+fn to_python(py: Python<'_>, opened: Opened) -> Read {
     let warnings = opened
         .warnings
         .iter()
@@ -66,5 +108,5 @@ fn read_topography(
         Heights::Areal(h) => h.into_pyarray(py).into_any().unbind(),
         Heights::Profile(h) => h.into_pyarray(py).into_any().unbind(),
     };
-    Ok((heights, topography.sizes, provenance, warnings))
+    (heights, topography.sizes, provenance, warnings)
 }

@@ -170,3 +170,44 @@ def test_filling_undefined_points_is_the_cli_s(cli, tmp_path):
                             "--json").stdout)
     assert t.provenance["cleaning"] == report["measured"]["cleaning"]
     assert asperity.stats(t)["iso"] == report["iso"]
+
+
+@pytest.mark.parametrize("name,flags,kwargs,ext", [
+    ("x3p-2.x3p", ["--detrend", "plane"], dict(detrend="plane"), "npy"),
+    ("sur-2.sur", ["--detrend", "lines", "--fill", "harmonic"],
+     dict(detrend="lines", fill="harmonic"), "npy"),
+    ("gwyddion-export-english.txt", ["--detrend", "poly2", "--size", "1e-5,2e-5"],
+     dict(detrend="poly2", size=(1e-5, 2e-5)), "x3p"),
+    ("dektak-1.csv", ["--detrend", "mean"], dict(detrend="mean"), "npy"),
+])
+def test_import_topography_writes_what_the_cli_imports(cli, tmp_path, name, flags, kwargs, ext):
+    """The one writer (asperity_app::import): the same heights, X3P and sidecar, byte for
+    byte, and the same refusals."""
+    path = shared(name)
+    cli("import", path, "--out", tmp_path / f"cli.{ext}", *flags)
+    t = asperity.import_topography(path, tmp_path / f"py.{ext}", **kwargs)
+    assert (tmp_path / f"py.{ext}").read_bytes() == (tmp_path / f"cli.{ext}").read_bytes()
+    if ext == "npy":
+        theirs = (tmp_path / "cli.npy.json").read_bytes()
+        assert (tmp_path / "py.npy.json").read_bytes() == theirs
+        assert np.array_equal(np.load(tmp_path / "py.npy"), t.heights)
+        assert json.loads(theirs)["sizes"] == list(t.physical_sizes)
+    # An existing output is refused, as by the CLI, unless forced.
+    theirs = cli_error(cli("import", path, "--out", tmp_path / f"cli.{ext}", *flags, ok=False))
+    with pytest.raises(ValueError) as err:
+        asperity.import_topography(path, tmp_path / f"py.{ext}", **kwargs)
+    # The same words but for how each front end says to overwrite (--force, force=True).
+    assert str(err.value).split(" (")[0] == theirs.replace("cli.", "py.").split(" (")[0]
+    asperity.import_topography(path, tmp_path / f"py.{ext}", force=True, **kwargs)
+
+
+def test_import_topography_refuses_as_the_cli(cli, tmp_path):
+    path = shared("x3p-2.x3p")
+    theirs = cli_error(cli("import", path, "--out", tmp_path / "t.csv", ok=False))
+    with pytest.raises(ValueError) as err:
+        asperity.import_topography(path, tmp_path / "t.csv")
+    assert str(err.value) == theirs.replace("--out", "out")
+    # A profile cannot be an X3P file; nothing is written.
+    with pytest.raises(ValueError, match="a line profile cannot be written as X3P"):
+        asperity.import_topography(shared("dektak-1.csv"), tmp_path / "p.x3p", detrend="mean")
+    assert list(tmp_path.iterdir()) == []

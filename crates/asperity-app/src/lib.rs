@@ -28,6 +28,7 @@
 
 pub mod bem;
 pub mod contact;
+pub mod import;
 pub mod mdr;
 pub mod measured;
 pub mod range;

@@ -4,12 +4,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
-use asperity::io::{sidecar_path, StagedOutputs};
-use asperity::topography::{x3p, Heights};
-use serde_json::json;
+use anyhow::Result;
+use asperity_app::import::Import;
 
-use super::measured::{load, record, MeasuredArgs};
+use super::measured::{load, MeasuredArgs};
+use crate::request::refused;
 
 /// Arguments of `asperity import`.
 #[derive(Debug, clap::Args)]
@@ -39,51 +38,12 @@ pub struct ImportArgs {
     pub force: bool,
 }
 
-/// Runs `asperity import`.
+/// Runs `asperity import`: the outputs staged, the file opened, the outputs written, by
+/// the front-end layer ([`asperity_app::import`]).
 pub fn run(args: &ImportArgs) -> Result<()> {
-    let ext = args
-        .out
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    let x3p_out = match ext.as_deref() {
-        Some("npy") => false,
-        Some("x3p") => true,
-        _ => bail!(
-            "--out {}: the file name must end in .npy or .x3p",
-            args.out.display()
-        ),
-    };
-    let sidecar = sidecar_path(&args.out);
-    let outputs = if x3p_out {
-        vec![args.out.clone()]
-    } else {
-        vec![args.out.clone(), sidecar.clone()]
-    };
-    let mut staged = StagedOutputs::new(&outputs, args.force)?;
-    staged.ensure_not_input(&args.file)?;
+    let import = Import::stage(&args.file, &args.out, args.force).map_err(refused)?;
     let topography = load(&args.file, &args.measured, args.size.as_deref())?;
-    match (&topography.heights, x3p_out) {
-        (Heights::Areal(h), true) => {
-            let bytes = x3p::to_bytes(h.view(), [topography.sizes[0], topography.sizes[1]])?;
-            staged.write_bytes(&args.out, &bytes)?;
-        }
-        (Heights::Profile(_), true) => bail!(
-            "{}: a line profile cannot be written as X3P here (maps only); use --out LINE.npy",
-            args.file.display()
-        ),
-        (Heights::Areal(h), false) => staged.write_npy_2d(&args.out, h)?,
-        (Heights::Profile(p), false) => staged.write_npy_1d(&args.out, p)?,
-    }
-    if !x3p_out {
-        let mut value = record(&topography);
-        value["kind"] = json!(match topography.heights {
-            Heights::Areal(_) => "measured surface",
-            Heights::Profile(_) => "measured line",
-        });
-        value["importer"] = json!(format!("asperity {}", env!("CARGO_PKG_VERSION")));
-        staged.write_json(&sidecar, &value)?;
-    }
-    staged.commit()?;
+    import.write(&args.file, &topography).map_err(refused)?;
     let shape: Vec<String> = topography
         .heights
         .shape()
