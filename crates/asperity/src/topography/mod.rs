@@ -50,6 +50,7 @@ pub(crate) mod text;
 pub(crate) mod tmd;
 pub(crate) mod wsxm;
 pub mod x3p;
+pub(crate) mod xlsx;
 pub(crate) mod xyz;
 
 /// The heights of one channel: a map or a line profile.
@@ -184,6 +185,12 @@ const FORMATS: &[Format] = &[
         extensions: &["x3p"],
         sniff: x3p::sniff,
         read: x3p::read,
+    },
+    Format {
+        name: "mitutoyo",
+        extensions: &["xlsx"],
+        sniff: xlsx::sniff,
+        read: xlsx::read,
     },
     Format {
         name: "gwy",
