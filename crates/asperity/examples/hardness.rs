@@ -3,9 +3,10 @@
 //!    stiffness, permanent displacement): the hysteresis;
 //! 2. the case ContactMechanics' capped Polonsky–Keer is reported not to converge in
 //!    (H = 0.1 E*, rms gradient 0.08, mean pressure beyond 0.07 E*), with iterations;
-//! 3. with `time N`: the time of a capped solve against the elastic one at N².
+//! 3. with `time N`: the time of a capped solve against the elastic one at N² (with
+//!    `time N bccg`, the BCCG only).
 //!
-//! `cargo run --release -p asperity --example hardness [time N]`
+//! `cargo run --release -p asperity --example hardness [time N [bccg]]`
 
 use std::time::Instant;
 
@@ -42,8 +43,8 @@ fn solver_of(kind: SolverKind, s: &Surface, boundary: Boundary, h: Option<f64>) 
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() == 3 && args[1] == "time" {
-        time(args[2].parse().expect("N"));
+    if args.len() >= 3 && args[1] == "time" {
+        time(args[2].parse().expect("N"), args.get(3).map(String::as_str));
         return;
     }
     hysteresis();
@@ -107,7 +108,7 @@ fn open_case() {
 /// Cold solves at p̄ = 0.05 E* (rms slope 0.5), interleaved in 3 rounds, the minimum of
 /// each: BCCG elastic, BCCG capped at H = 0.3 E*, PK capped; and the ratio capped ÷
 /// elastic of the BCCG.
-fn time(n: usize) {
+fn time(n: usize, only: Option<&str>) {
     let s = surface(n, 0.5, 3);
     let cases = [
         ("bccg elastic", None, SolverKind::Bccg),
@@ -118,7 +119,11 @@ fn time(n: usize) {
         let mut best = [f64::INFINITY; 3];
         let mut report = [(); 3].map(|_| String::new());
         // PK (minutes per solve at 1024² on 2 cores) only up to 512².
-        let timed = if n <= 512 { 3 } else { 2 };
+        let timed = if n <= 512 && only != Some("bccg") {
+            3
+        } else {
+            2
+        };
         for _ in 0..3 {
             for (k, &(_, h, kind)) in cases.iter().enumerate().take(timed) {
                 let mut solver = solver_of(kind, &s, boundary, h);
@@ -128,8 +133,12 @@ fn time(n: usize) {
                 if t < best[k] {
                     best[k] = t;
                     report[k] = format!(
-                        "area {:.4} plastic {:.4} iterations {}",
-                        sum.area_fraction, sum.plastic_fraction, info.iterations
+                        "area {:.4} plastic {:.4} iterations {} applications {} energies {}",
+                        sum.area_fraction,
+                        sum.plastic_fraction,
+                        info.iterations,
+                        info.operator_applications,
+                        info.energy_transforms
                     );
                 }
             }

@@ -75,6 +75,7 @@ use rayon::prelude::*;
 
 use super::interface::{restore_capped_load, Interface};
 use super::mean_gap::MeanGapScratch;
+use super::plastic_field::{PlasticField, Restored};
 use super::preconditioner::Real;
 use super::ring_extension::{centre_on_set, RingExtension};
 use super::small_set::SmallSetRun;
@@ -114,12 +115,12 @@ const LOAD_ROUNDING: f64 = 1e-14;
 /// (free boundaries, 1 and 2 threads), the corrections cost as much as an operator
 /// application from 54 cuts at 64² and 128², 62–73 at 256², 75–84 at 512² and 108–128 at
 /// 1024² on: below all of them.
-const CUT_LIMIT: usize = 48;
+pub(super) const CUT_LIMIT: usize = 48;
 
 /// Elements per chunk of the parallel passes. Fixed, never derived from the thread count:
 /// each chunk is summed in index order and the chunks' partial sums are added in chunk
 /// order, so every sum is the same bits for any number of threads.
-const CHUNK: usize = 8192;
+pub(super) const CHUNK: usize = 8192;
 
 /// Partial sums of one chunk of a pass (the meaning of each slot is the pass's).
 #[derive(Clone, Copy, Default)]
@@ -166,7 +167,8 @@ pub(super) struct BccgScratch {
     pub(super) impulse: Vec<f64>,
     /// `(index, correction)` of the pressures cut in a step (capacity [`CUT_LIMIT`]).
     pub(super) cuts: Vec<(usize, f64)>,
-    /// The first [`CUT_LIMIT`] cuts of every chunk of the step pass.
+    /// The first [`CUT_LIMIT`] cuts of every chunk of the step pass, then (under a cap) its
+    /// first [`CUT_LIMIT`] changes of the capped set.
     chunk_cuts: Vec<(usize, f64)>,
     /// One [`Sums`] per chunk.
     partials: Vec<Sums>,
@@ -193,6 +195,9 @@ pub(super) struct BccgScratch {
     /// Under a cap: a step left fewer points in contact than the load needs below the cap
     /// (the solve is then handed to Polonsky–Keer, [`ContactSolver::capped_bccg`]).
     capacity_lost: bool,
+    /// Under a cap: `K 1_C` of the capped set, for load restorations that keep `u`
+    /// (`plastic_field.rs`).
+    plastic: PlasticField,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -237,7 +242,7 @@ impl BccgScratch {
             previous_centre: 0.0,
             impulse,
             cuts: Vec::with_capacity(CUT_LIMIT),
-            chunk_cuts: vec![(0, 0.0); chunks * CUT_LIMIT],
+            chunk_cuts: vec![(0, 0.0); chunks * 2 * CUT_LIMIT],
             partials: vec![Sums::default(); chunks],
             pending_scale: 1.0,
             extra_energies: 0,
@@ -248,6 +253,7 @@ impl BccgScratch {
             single: operator.single_precision()?,
             single_steps: true,
             capacity_lost: false,
+            plastic: PlasticField::default(),
         })
     }
 }
@@ -257,7 +263,7 @@ impl BccgScratch {
 /// `impulse[|Δi|][|Δj|]` (the kernel is even in both), periodic at the offsets modulo the
 /// grid. `grid` is `(rows, cols, periodic)`. `u` is row-major `rows × cols`. One parallel
 /// pass over the rows with all points (each value sums them in their order).
-fn add_point_responses(
+pub(super) fn add_point_responses(
     u: &mut [f64],
     impulse: &[f64],
     (rows, cols, periodic): (usize, usize, bool),
@@ -341,6 +347,8 @@ struct Step {
     stale: bool,
     /// The projection cut more than [`CUT_LIMIT`] pressures.
     cut_many: bool,
+    /// Operator applications besides the step's (`K 1_C` of a capped restoration).
+    applications: usize,
 }
 
 /// The contact rule of a pass, asked of [`Interface`]: the hard wall, or with `CAPPED` the
@@ -555,7 +563,9 @@ fn dot(s: &[f64], w: &[f64], partials: &mut [Sums]) -> f64 {
 /// [`Interface::project`]) and, with `DISPLACEMENT`, `u ← u + α w` (a step after which
 /// `u` is recomputed leaves both alone); sums `x[0] = Σ p`, `x[1] = max p` (`CAPPED`),
 /// `n[0]` = cuts; the first [`CUT_LIMIT`] cuts of each chunk go to its slots of
-/// `chunk_cuts`, each with the part of the step the bound refused.
+/// `chunk_cuts`, each with the part of the step the bound refused. With `CAPPED`, `n[1]`
+/// counts the points that reached (`+1`) or left (`−1`) the cap, the first [`CUT_LIMIT`]
+/// of each chunk in its next slots.
 fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
     (p, u): (&mut [f64], &mut [f64]),
     (s, w): (&[f64], &[f64]),
@@ -565,17 +575,19 @@ fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
     p.par_chunks_mut(CHUNK)
         .zip(u.par_chunks_mut(CHUNK))
         .zip(s.par_chunks(CHUNK).zip(w.par_chunks(CHUNK)))
-        .zip(chunk_cuts.par_chunks_mut(CUT_LIMIT))
+        .zip(chunk_cuts.par_chunks_mut(2 * CUT_LIMIT))
         .zip(partials.par_iter_mut())
         .enumerate()
         .for_each(|(chunk, ((((p, u), (s, w)), slots), out))| {
             let (mut cuts, mut total, mut peak) = (0usize, 0.0, 0.0f64);
+            let mut changes = 0usize;
             for (index, ((pi, ui), (&si, &wi))) in p
                 .iter_mut()
                 .zip(u.iter_mut())
                 .zip(s.iter().zip(w))
                 .enumerate()
             {
+                let was_capped = CAPPED && *pi >= h;
                 let next = *pi + alpha * si;
                 if next < 0.0 {
                     // The step wanted `next`, the bound allows 0: `u` misses `K e (−next)`.
@@ -600,11 +612,18 @@ fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
                 total += *pi;
                 if CAPPED {
                     peak = peak.max(*pi);
+                    if was_capped != (*pi >= h) {
+                        if changes < CUT_LIMIT {
+                            let sign = if was_capped { -1.0 } else { 1.0 };
+                            slots[CUT_LIMIT + changes] = (chunk * CHUNK + index, sign);
+                        }
+                        changes += 1;
+                    }
                 }
             }
             *out = Sums {
                 x: [total, peak, 0.0, 0.0, 0.0, 0.0, 0.0],
-                n: [cuts, 0],
+                n: [cuts, changes],
             };
         });
     Sums::total(partials)
@@ -682,6 +701,7 @@ impl ContactSolver {
             let line = (direction.sg, curvature);
             let step = self.step(target, &gradient, line, !refresh_due, iteration)?;
             (cutting, since_refresh) = (step.cut_many, since_refresh + 1);
+            applications += step.applications;
             u = u.max(Displacement::Recurrence);
             if step.stale || since_refresh >= REFRESH_INTERVAL {
                 self.refresh_displacement(far);
@@ -727,6 +747,9 @@ impl ContactSolver {
         self.bccg_scratch.pending_scale = 1.0;
         self.bccg_scratch.extra_energies = 0;
         self.bccg_scratch.capacity_lost = false;
+        if let Interface::Hardness { .. } = self.interface {
+            self.bccg_scratch.plastic.prepare(self.state.pressure.len());
+        }
         if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
             mean_gap.reset();
         }
@@ -971,46 +994,134 @@ impl ContactSolver {
         // A few cuts are corrected by their point responses (one grid pass, far cheaper
         // than an operator application); more leave `u` stale.
         let cut_many = cuts > CUT_LIMIT;
-        let mut stale = cut_many || !displacement;
+        let stale = cut_many || !displacement;
         if !stale && cuts > 0 {
             let corrections = &mut scratch.cuts;
             corrections.clear();
-            for (slots, partial) in scratch.chunk_cuts.chunks(CUT_LIMIT).zip(&scratch.partials) {
+            for (slots, partial) in scratch
+                .chunk_cuts
+                .chunks(2 * CUT_LIMIT)
+                .zip(&scratch.partials)
+            {
                 corrections.extend_from_slice(&slots[..partial.n[0]]);
             }
             let periodic = self.problem.operator.boundary() == Boundary::Periodic;
             let grid = (self.problem.rows, self.problem.cols, periodic);
             add_point_responses(&mut self.state.gap, &scratch.impulse, grid, corrections);
         }
-        if let Target::MeanPressure(mean_pressure) = target {
-            let n = self.state.pressure.len() as f64;
-            let scale = mean_pressure * n / total;
-            // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
-            let rescaled = (scale - 1.0).abs() > LOAD_ROUNDING;
-            if total > 0.0 && capped && rescaled && (peak >= h || scale * peak > h) {
-                // Scaled, points at the cap would leave it (the whole plastic set released
-                // at every step that overshot the load) or others pass it: the load is
-                // restored by the capped scaling of Polonsky–Keer, the capped points kept
-                // there, after which `u` is recomputed.
-                let (u, f) = (&self.state.gap, &self.problem.profile);
-                let level = |i: usize| u[i] + f[i];
-                let pressure = &mut self.state.pressure;
-                if !restore_capped_load(pressure, (mean_pressure, h), total, level) {
-                    scratch.capacity_lost = true;
-                    return Err(SolveError::NoConvergence {
-                        iterations: iteration,
-                        residual: gradient.residual,
-                    });
-                }
-                stale = true;
-            } else if total > 0.0 && (scale - 1.0).abs() > LOAD_ROUNDING {
-                scratch.pending_scale = scale;
-            } else if total <= 0.0 {
-                self.state.pressure.fill(mean_pressure);
-                stale = true;
-            }
+        if capped {
+            self.follow_capped_set(sums.n[1]);
         }
-        Ok(Step { stale, cut_many })
+        let (stale, applications) = match target {
+            Target::MeanPressure(mean_pressure) => {
+                self.restore_step_load(mean_pressure, (total, peak), stale, (gradient, iteration))?
+            }
+            Target::Indentation(_) => (stale, 0),
+        };
+        Ok(Step {
+            stale,
+            cut_many,
+            applications,
+        })
+    }
+
+    /// Restores the load `n p̄` after a step that left `Σ p = total` (`peak` the largest
+    /// pressure, under a cap): the hard wall's scaling of `p` and `u` (pending, applied by
+    /// the next pass), or under a cap that of [`Self::restore_capped`]. Returns whether `u`
+    /// is now stale (it was with `stale`) and the operator applications it took.
+    fn restore_step_load(
+        &mut self,
+        mean_pressure: f64,
+        (total, peak): (f64, f64),
+        mut stale: bool,
+        (gradient, iteration): (&Gradient, usize),
+    ) -> Result<(bool, usize), SolveError> {
+        let Rule { capped, h } = Rule::of(self.interface);
+        let n = self.state.pressure.len() as f64;
+        let scale = mean_pressure * n / total;
+        // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
+        let rescaled = (scale - 1.0).abs() > LOAD_ROUNDING;
+        let mut applications = 0;
+        if total > 0.0 && capped && rescaled && (peak >= h || scale * peak > h) {
+            // Scaled, points at the cap would leave it (the whole plastic set released at
+            // every step that overshot the load) or others pass it: the load is restored
+            // by the capped scaling of Polonsky–Keer, the capped points kept there, `u`
+            // with them (`plastic_field.rs`) or recomputed.
+            let (restored, applied) = self.restore_capped((mean_pressure, h, total), !stale);
+            if restored == Restored::CapacityLost {
+                self.bccg_scratch.capacity_lost = true;
+                return Err(SolveError::NoConvergence {
+                    iterations: iteration,
+                    residual: gradient.residual,
+                });
+            }
+            stale = restored == Restored::Stale;
+            applications += applied as usize;
+        } else if total > 0.0 && rescaled {
+            self.bccg_scratch.pending_scale = scale;
+        } else if total <= 0.0 {
+            self.state.pressure.fill(mean_pressure);
+            stale = true;
+        }
+        Ok((stale, applications))
+    }
+
+    /// `K 1_C` follows the `changes` the step pass made to the capped set (listed in the
+    /// second half of each chunk's slots).
+    fn follow_capped_set(&mut self, changes: usize) {
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let grid = (self.problem.rows, self.problem.cols, periodic);
+        let scratch = &mut self.bccg_scratch;
+        let listed = scratch
+            .chunk_cuts
+            .chunks(2 * CUT_LIMIT)
+            .zip(&scratch.partials)
+            .flat_map(|(slots, partial)| {
+                slots[CUT_LIMIT..][..partial.n[1].min(CUT_LIMIT)]
+                    .iter()
+                    .copied()
+            });
+        let point_responses = (&scratch.impulse[..], grid);
+        scratch.plastic.follow(listed, changes, point_responses);
+    }
+
+    /// The load restored under the cap `h` with the capped points held
+    /// ([`PlasticField::restore_load`]); with `exact_u`, `u` kept exact. Returns what became
+    /// of `u` and whether `K 1_C` took an operator application (in single precision where
+    /// the steps' `K s` are).
+    fn restore_capped(
+        &mut self,
+        (mean_pressure, h, total): (f64, f64, f64),
+        exact_u: bool,
+    ) -> (Restored, bool) {
+        let single =
+            self.bccg_scratch.single_steps && self.f32_safe(Target::MeanPressure(mean_pressure));
+        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let grid = (self.problem.rows, self.problem.cols, periodic);
+        let scratch = &mut self.bccg_scratch;
+        let (single_operator, operator) = (&mut scratch.single, &mut self.problem.operator);
+        let mut applied = false;
+        let apply = |x: &[f64], y: &mut [f64]| {
+            applied = true;
+            match single {
+                true => single_operator.apply(x, y),
+                false => operator.apply(x, y),
+            }
+        };
+        let fields = (
+            &mut self.state.pressure[..],
+            &mut self.state.gap[..],
+            &self.problem.profile[..],
+        );
+        let restored = scratch.plastic.restore_load(
+            fields,
+            (mean_pressure, h, total),
+            exact_u,
+            &mut scratch.preconditioned,
+            apply,
+            (&scratch.impulse, grid),
+        );
+        (restored, applied)
     }
 
     /// The BCCG under a cap. Near fully plastic contact under load control (measured: H =

@@ -236,9 +236,12 @@ pub(super) fn bearing_start(
 /// `keep_capped`) is `wanted`: Newton's method on this increasing, concave,
 /// piecewise-linear function of `s`, exact once the capped set settles (from below it
 /// stays below and rises; the left slope at a kink, so that a scale that caps every point
-/// still moves down).
-fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64 {
+/// still moves down). A step taken on the same linear piece as the one before (the same
+/// slope) is the last: the root up to rounding (waiting for two equal iterates instead
+/// let rounding run the 64 passes, a quarter of a capped BCCG solve's time at 256²).
+pub(super) fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64 {
     let mut scale = 1.0;
+    let mut previous_slope = f64::NAN;
     for _ in 0..64 {
         let (mut carried, mut slope) = (0.0, 0.0);
         for &p in pressure {
@@ -255,10 +258,12 @@ fn capped_scale(pressure: &[f64], wanted: f64, h: f64, keep_capped: bool) -> f64
             break;
         }
         let next = scale + (wanted - carried) / slope;
-        if next == scale {
+        let settled = slope == previous_slope;
+        if next == scale || settled {
+            scale = next;
             break;
         }
-        scale = next;
+        (scale, previous_slope) = (next, slope);
     }
     scale
 }

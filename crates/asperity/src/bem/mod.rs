@@ -57,6 +57,7 @@ mod interface;
 #[cfg(test)]
 mod interruption;
 mod mean_gap;
+mod plastic_field;
 mod plasticity;
 mod polonsky_keer;
 mod preconditioner;
