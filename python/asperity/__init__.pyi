@@ -224,6 +224,28 @@ def mdr_slip(
     asperity_radius: Optional[float] = ..., work_of_adhesion: Optional[float] = ...,
 ) -> SlipCycle: ...
 
+PERSSON_KAPPA: float
+
+@dataclass
+class PerssonTable:
+    pressure: F64
+    area_fraction: F64
+    mean_gap: F64
+    stiffness_per_area: F64
+    contact_stiffness: F64
+    rms_height: float
+    rms_gradient: float
+    u0: float
+    modulus: float
+    gamma: float
+    kappa: float
+
+def persson(
+    surface: Any, pressures: Optional[Sequence[float]] = ..., *, size: Optional[float] = ...,
+    modulus: float = ..., gamma: float = ..., kappa: float = ..., nloads: Optional[int] = ...,
+    pmin: Optional[float] = ..., pmax: Optional[float] = ...,
+) -> PerssonTable: ...
+
 @dataclass
 class StudyResult:
     columns: Dict[str, np.ndarray]

@@ -84,6 +84,11 @@ def mdr_slip(
     request: str, line: Optional[F64], radial: Optional[F64], tangential_force: float,
     friction: Optional[float], poisson: float, cycle_points: Optional[int],
 ) -> Dict[str, Any]: ...
+def persson_table(
+    array: F64, size_x: float, size_y: Optional[float], modulus: float, gamma: float,
+    kappa: float, pressures: Optional[List[float]], nloads: Optional[int],
+    pmin: Optional[float], pmax: Optional[float],
+) -> Dict[str, Any]: ...
 def run_study(
     method_name: str, sizes: List[int], hursts: List[float], samples: int,
     rolloff: Optional[float], seed: int, min_contacts: int, max_fraction: float, levels: Optional[int],

@@ -13,6 +13,7 @@ mod contact;
 mod errors;
 mod interrupt;
 mod mdr;
+mod persson;
 mod slip;
 mod study;
 mod surface;
@@ -44,6 +45,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bem::register(m)?;
     contact::register(m)?;
     mdr::register(m)?;
+    persson::register(m)?;
     slip::register(m)?;
     study::register(m)?;
     topography::register(m)?;

@@ -198,3 +198,29 @@ def test_mdr_on_a_radial_profile_equals_the_cli(cli, tmp_path):
     curve = asperity.mdr(radial=r**2 / 2, radial_step=1e-2, n=101, dx=1e-2, nloads=10)
     assert curve.force.tolist() == table["force"]
     assert curve.stiffness.tolist() == table["stiffness"]
+
+
+@pytest.mark.parametrize("flags,kwargs", [
+    (["--pressures", "0.001,0.01,0.05"], dict(pressures=[0.001, 0.01, 0.05])),
+    (["--nloads", 5, "--pmin", 1e-4, "--pmax", 0.1, "--gamma", 0.6, "--kappa", 2,
+      "--modulus", 3], dict(nloads=5, pmin=1e-4, pmax=0.1, gamma=0.6, kappa=2, modulus=3)),
+])
+def test_persson_equals_the_cli(cli, tmp_path, flags, kwargs):
+    s = asperity.surface(64, hurst=0.8, rolloff=4, rms_slope=1.0, seed=2, size=2)
+    s.save(tmp_path / "s.npy")
+    cli("persson", tmp_path / "s.npy", *flags, "--out", tmp_path / "p.csv")
+    theirs = read_csv(tmp_path / "p.csv")
+    ours = asperity.persson(s, **kwargs)
+    assert list(theirs) == ["pressure", "area_fraction", "mean_gap", "stiffness_per_area",
+                            "contact_stiffness"]
+    for name, values in theirs.items():
+        assert getattr(ours, name).tolist() == values, name
+    # The same table from the heights with their size, and refusals in Python's words.
+    again = asperity.persson(s.heights, size=2, **kwargs)
+    assert again.mean_gap.tobytes() == ours.mean_gap.tobytes()
+    with pytest.raises(ValueError, match="pressures must be positive and finite, got 0"):
+        asperity.persson(s, [0.0])
+    with pytest.raises(ValueError, match="nloads needs K >= 1 and 0 < pmin <= pmax"):
+        asperity.persson(s, nloads=3, pmin=1.0, pmax=0.1)
+    with pytest.raises(ValueError, match="gamma"):
+        asperity.persson(s, [0.01], gamma=0.0)

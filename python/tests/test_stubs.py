@@ -19,6 +19,8 @@ def stub_names(path):
             names[node.name] = node
         elif isinstance(node, ast.ImportFrom):
             names.update({a.asname or a.name: node for a in node.names})
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            names[node.target.id] = node  # a constant: `NAME: float`
     return names
 
 

@@ -31,6 +31,7 @@ pub mod contact;
 pub mod import;
 pub mod mdr;
 pub mod measured;
+pub mod persson;
 pub mod range;
 pub mod refusal;
 pub mod slip;

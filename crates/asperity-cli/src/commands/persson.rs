@@ -9,11 +9,14 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use asperity::persson::{Persson, PerssonParams, PERSSON_KAPPA};
+use asperity::persson::{PerssonParams, PERSSON_KAPPA};
 use asperity::surface::Surface;
+use asperity_app::persson::{compute, log_pressures, PerssonRequest, COLUMNS};
+use asperity_app::RequestError;
 
 use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
 use crate::output::Table;
+use crate::request::refused;
 
 /// Arguments of `asperity persson`.
 #[derive(Debug, clap::Args)]
@@ -82,71 +85,51 @@ pub struct PerssonArgs {
     pub force: bool,
 }
 
-/// Runs `asperity persson`.
+/// Runs `asperity persson`: the request, the surface, the front-end layer's table.
 pub fn run(args: &PerssonArgs) -> Result<()> {
-    let params = PerssonParams {
-        modulus: args.modulus,
-        gamma: args.gamma,
-        kappa: args.kappa,
+    let request = PerssonRequest {
+        params: PerssonParams {
+            modulus: args.modulus,
+            gamma: args.gamma,
+            kappa: args.kappa,
+        },
+        pressures: pressures(args)?,
     };
-    params.validate()?;
-    let pressures = pressures(args)?;
+    request.validate().map_err(refused)?;
     let surface = read_surface(args)?;
-    let theory = Persson::from_surface(&surface, params)
+    let table = compute(&surface, &request)
+        .map_err(refused)
         .with_context(|| format!("{}", args.surface.display()))?;
-    let mut table = Table::new(&[
-        "pressure",
-        "area_fraction",
-        "mean_gap",
-        "stiffness_per_area",
-        "contact_stiffness",
-    ]);
-    for p in pressures {
-        let point = theory.predict(p)?;
-        table.push_numbers(&[
-            point.pressure,
-            point.area_fraction,
-            point.mean_gap,
-            point.stiffness,
-            point.contact_stiffness,
-        ]);
+    let mut csv = Table::new(&COLUMNS);
+    for row in &table.rows {
+        csv.push_numbers(row);
     }
     match &args.out {
-        Some(path) => table.write(path, args.force)?,
-        None => print!("{}", String::from_utf8(table.to_csv()?)?),
+        Some(path) => csv.write(path, args.force)?,
+        None => print!("{}", String::from_utf8(csv.to_csv()?)?),
     }
+    let (rows, cols) = surface.dim();
     eprintln!(
-        "{}: {}x{}, rms height {:.4e}, rms gradient (spectral) {:.4e}, u0 {:.4e} (γ = {}, κ = {})",
+        "{}: {rows}x{cols}, rms height {:.4e}, rms gradient (spectral) {:.4e}, u0 {:.4e} (γ = {}, κ = {})",
         args.surface.display(),
-        surface.dim().0,
-        surface.dim().1,
-        theory.rms_height(),
-        theory.rms_gradient(),
-        theory.u0(),
-        params.gamma,
-        params.kappa
+        table.rms_height,
+        table.rms_gradient,
+        table.u0,
+        args.gamma,
+        args.kappa
     );
     Ok(())
 }
 
-/// The pressures: the list, or `--nloads` log-spaced ones; each positive and finite.
+/// The pressures: the list, or `--nloads` log-spaced ones (the front-end layer's rule).
 fn pressures(args: &PerssonArgs) -> Result<Vec<f64>> {
-    let list: Vec<f64> = match (&args.pressures, args.nloads, args.pmin, args.pmax) {
-        (Some(list), ..) => list.clone(),
+    match (&args.pressures, args.nloads, args.pmin, args.pmax) {
+        (Some(list), ..) => Ok(list.clone()),
         (None, Some(k), Some(lo), Some(hi)) => {
-            if k == 0 || !(lo > 0.0 && hi >= lo && hi.is_finite()) {
-                bail!(
-                    "--nloads needs K >= 1 and 0 < --pmin <= --pmax, finite; got {k}, {lo}, {hi}"
-                );
-            }
-            asperity::fit::log_levels(lo, hi, k).collect()
+            log_pressures(k, lo, hi).map_err(|r| refused(RequestError::from(r)))
         }
         _ => bail!("give --pressures or --nloads with --pmin and --pmax"),
-    };
-    if let Some(p) = list.iter().find(|p| !(p.is_finite() && **p > 0.0)) {
-        bail!("mean pressures must be positive and finite, got {p}");
     }
-    Ok(list)
 }
 
 /// The surface: a measured file (or an imported .npy) through the topography reader, else
