@@ -26,6 +26,7 @@
 //! assert!(refusal.words(Names::Keywords).starts_with("tolerance must be positive"));
 //! ```
 
+pub mod adhesion;
 pub mod bem;
 pub mod contact;
 pub mod import;

@@ -118,6 +118,17 @@ pub struct BemArgs {
     /// the plastic displacement between loads).
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     pub hardness: Option<f64>,
+    /// Adhesion (work of adhesion Δγ, in the units of the modulus times a length): Pohrt &
+    /// Popov's pixel criterion (docs/adhesion.md) along the path of --indentations
+    /// (negative allowed), then retracted to pull-off; both pull-offs on stderr and in
+    /// OUT.csv.json. Columns indentation, force, mean_pressure, area_fraction,
+    /// tensile_fraction, rounds, cg_iterations, branch (path|retract). Square pixels.
+    #[arg(long, value_name = "DG", allow_hyphen_values = true)]
+    pub work_of_adhesion: Option<f64>,
+    /// The retraction's step in indentation (with --work-of-adhesion; default the deepest
+    /// indentation / 200).
+    #[arg(long, value_name = "STEP", allow_hyphen_values = true)]
+    pub retract_step: Option<f64>,
     /// Output table (CSV); printed to stdout when absent. Its inputs go to OUT.csv.json
     /// beside it (surface, L and its source, E*, boundary, tolerance, loads, columns).
     #[arg(long, value_name = "OUT.csv")]
@@ -495,8 +506,8 @@ fn plan(args: &BemArgs) -> Result<Plan> {
 }
 
 /// The declared outputs: staged, with the field paths of every load (`--fields`).
-struct Outputs {
-    staged: StagedOutputs,
+pub(super) struct Outputs {
+    pub(super) staged: StagedOutputs,
     fields: Option<Vec<(PathBuf, PathBuf)>>,
 }
 
@@ -505,7 +516,7 @@ struct Outputs {
 /// or exists without `--force`, none is the surface or its sidecar, and `--fields DIR` holds
 /// no field files of another run. They are written to temporary files as each load is solved
 /// and renamed into place together at the end.
-fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
+pub(super) fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
     if let Some(dir) = &args.fields {
         ensure_no_stale_fields(dir, loads)?;
     }
@@ -527,6 +538,35 @@ fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
 /// solver is built, plus the per-load bookkeeping); a measured file is read, bounded, by
 /// the topography reader and checked after.
 fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, SizeSource)> {
+    let loads = plan.bem.loads.len();
+    read_surface_with(
+        args,
+        (plan.size, plan.bem.half_space.boundary),
+        (loads, fields),
+    )
+}
+
+/// The surface of a run without a load sweep (`--work-of-adhesion`), with where its side
+/// length came from as the record names it.
+pub(super) fn read_surface_for(
+    args: &BemArgs,
+    boundary: asperity::elastic::Boundary,
+) -> Result<(Surface, &'static str)> {
+    let size = match &args.size {
+        Some(text) => parse_size(text)?,
+        None => [None, None],
+    };
+    let (surface, source) = read_surface_with(args, (size, boundary), (0, false))?;
+    Ok((surface, source.name()))
+}
+
+/// [`read_surface`] for `size` (`--size`) and `boundary`, with the bookkeeping of `loads`
+/// loads (and their fields) in the memory check.
+fn read_surface_with(
+    args: &BemArgs,
+    (size, boundary): ([Option<f64>; 2], asperity::elastic::Boundary),
+    (loads, fields): (usize, bool),
+) -> Result<(Surface, SizeSource)> {
     let measured = !is_npy(&args.surface) || has_import_sidecar(&args.surface);
     if measured {
         let t = load(&args.surface, &args.measured, args.size.as_deref())?;
@@ -534,7 +574,7 @@ fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, S
             .to_surface()
             .with_context(|| format!("{}", args.surface.display()))?;
         let (rows, cols) = surface.dim();
-        ensure_solver_fits(rows, cols, plan.bem.half_space.boundary, Some(0))?;
+        ensure_solver_fits(rows, cols, boundary, Some(0))?;
         let source = match args.size {
             Some(_) => SizeSource::Flag,
             None => SizeSource::File,
@@ -543,11 +583,11 @@ fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, S
     }
     if let [rows, cols] = read_npy_shape(&args.surface)?[..] {
         let extra = array_bytes(&[rows, cols], 8)
-            .zip(bookkeeping_bytes(plan.bem.loads.len(), fields))
+            .zip(bookkeeping_bytes(loads, fields))
             .and_then(|(heights, loads)| heights.checked_add(loads));
-        ensure_solver_fits(rows, cols, plan.bem.half_space.boundary, extra)?;
+        ensure_solver_fits(rows, cols, boundary, extra)?;
     }
-    let [size_x, size_y] = plan.size;
+    let [size_x, size_y] = size;
     let sidecar_size = match size_x {
         Some(_) => None,
         None => asperity::io::sidecar_size(&args.surface)?,
@@ -710,6 +750,12 @@ fn print_stdout(bytes: &[u8]) -> Result<()> {
 
 /// Runs `asperity bem`: plan (every check before the first solve), solve, write.
 pub fn run(args: &BemArgs) -> Result<()> {
+    if let Some(w) = args.work_of_adhesion {
+        return super::bem_adhesion::run(args, w);
+    }
+    if args.retract_step.is_some() {
+        bail!("--retract-step goes with --work-of-adhesion");
+    }
     let plan = plan(args)?;
     let mut outputs = stage_outputs(args, plan.bem.loads.len())?;
     let (surface, source) = read_surface(args, &plan, outputs.fields.is_some())?;

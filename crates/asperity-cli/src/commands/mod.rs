@@ -1,6 +1,7 @@
 //! One module per subcommand; each exposes its clap `Args` and a `run` function.
 
 pub mod bem;
+pub mod bem_adhesion;
 pub mod bench;
 pub mod contact;
 pub mod figures;

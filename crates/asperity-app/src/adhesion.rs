@@ -1,0 +1,293 @@
+//! Adhesive BEM contact for `asperity bem --work-of-adhesion` and Python's `bem_adhesion`:
+//! Pohrt & Popov's pixel criterion ([`asperity::bem::adhesion::PixelAdhesion`]) along a
+//! path of indentations, then retracted to pull-off. One request type, validated once, and
+//! one run, for both front ends.
+
+use asperity::bem::adhesion::{AdhesionInfo, AdhesivePullOff, AdhesiveSummary, PixelAdhesion};
+use asperity::bem::{HalfSpace, SolveError};
+use asperity::surface::Surface;
+use serde::{Deserialize, Serialize};
+
+use crate::bem::{check_modulus, params::INDENTATIONS, params::MODULUS, parse_boundary};
+use crate::refusal::{Param, Refusal};
+
+/// The work of adhesion Δγ.
+pub const WORK_OF_ADHESION: Param = Param::new("--work-of-adhesion", "work_of_adhesion");
+/// The step of the retraction to pull-off.
+pub const RETRACT_STEP: Param = Param::new("--retract-step", "retract_step");
+
+/// Steps of the retraction from the path's deepest indentation to zero when no step is
+/// given: the step is that depth over this.
+pub const DEFAULT_RETRACT_STEPS: f64 = 200.0;
+
+/// A contact radius at pull-off below this many pixels draws a warning: the criterion's
+/// error on a sphere is about `1.4 Δx/a` (docs/adhesion.md), 14 % here.
+pub const COARSE_RADIUS_PIXELS: f64 = 10.0;
+
+/// An adhesive BEM request: the half-space, Δγ, the path and the retraction's step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AdhesionRequest {
+    /// E*.
+    pub modulus: f64,
+    /// `free` or `periodic`.
+    pub boundary: String,
+    /// Δγ, positive and finite.
+    pub work_of_adhesion: f64,
+    /// The indentations in the order visited (negative allowed: pulled back beyond first
+    /// touch); the retraction to pull-off follows the last.
+    pub indentations: Vec<f64>,
+    /// The retraction's step (default: the deepest indentation over
+    /// [`DEFAULT_RETRACT_STEPS`]).
+    pub retract_step: Option<f64>,
+}
+
+/// A validated [`AdhesionRequest`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdhesionPlan {
+    /// The half-space.
+    pub half_space: HalfSpace,
+    /// Δγ.
+    pub work_of_adhesion: f64,
+    /// The path.
+    pub indentations: Vec<f64>,
+    /// The retraction's step.
+    pub retract_step: f64,
+}
+
+/// The part of a run a row belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Branch {
+    /// A point of the given path.
+    Path,
+    /// A step of the retraction to pull-off.
+    Retract,
+}
+
+impl Branch {
+    /// `path` or `retract`, as the CSV and Python write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Branch::Path => "path",
+            Branch::Retract => "retract",
+        }
+    }
+}
+
+/// One settled state of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdhesionRow {
+    /// Where it belongs.
+    pub branch: Branch,
+    /// Its scalars.
+    pub summary: AdhesiveSummary,
+    /// How it was reached (zero for the retraction's steps, whose iteration counts are
+    /// summed in [`AdhesionRun::retract_info`]).
+    pub info: AdhesionInfo,
+}
+
+/// What a run gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdhesionRun {
+    /// The path's states, then the retraction's.
+    pub rows: Vec<AdhesionRow>,
+    /// Both pull-offs, if the path left the surface in contact.
+    pub pull_off: Option<AdhesivePullOff>,
+    /// The critical stress of one pixel.
+    pub critical_stress: f64,
+    /// The pixel side.
+    pub spacing: f64,
+}
+
+impl AdhesionRun {
+    /// The contact radius `√(A/π)` in pixels at the force-controlled pull-off.
+    pub fn pull_off_radius_pixels(&self) -> Option<f64> {
+        let p = self.pull_off?;
+        Some((p.force_controlled.attached_points as f64 / std::f64::consts::PI).sqrt())
+    }
+
+    /// A warning where the contact at pull-off is too few pixels across for the criterion to
+    /// be accurate ([`COARSE_RADIUS_PIXELS`]), else `None`.
+    pub fn resolution_warning(&self) -> Option<String> {
+        let radius = self.pull_off_radius_pixels()?;
+        (radius < COARSE_RADIUS_PIXELS).then(|| {
+            format!(
+                "the contact at pull-off spans {} pixels (radius {radius:.1} pixels): the pixel \
+                 criterion's pull-off is then off by about {:.0} % on a sphere (1.4·Δx/a, \
+                 docs/adhesion.md); a finer grid is more accurate",
+                self.pull_off
+                    .map_or(0, |p| p.force_controlled.attached_points),
+                140.0 / radius.max(1.0)
+            )
+        })
+    }
+}
+
+impl AdhesionRequest {
+    /// The plan, or why not: Δγ positive and finite, a path of finite indentations that
+    /// presses the surface, a step positive and finite, the half-space's options.
+    pub fn validate(&self) -> Result<AdhesionPlan, Refusal> {
+        let w = self.work_of_adhesion;
+        if !(w.is_finite() && w > 0.0) {
+            return Err(Refusal::saying("invalid ")
+                .param(WORK_OF_ADHESION)
+                .text(format!(
+                    ": the work of adhesion Δγ must be positive and finite, got {w}"
+                )));
+        }
+        check_modulus(MODULUS, self.modulus)?;
+        let boundary = parse_boundary(&self.boundary)?;
+        let path = &self.indentations;
+        if path.is_empty() {
+            return Err(Refusal::of(INDENTATIONS).text(": give at least one value"));
+        }
+        if let Some(v) = path.iter().find(|v| !v.is_finite()) {
+            return Err(Refusal::of(INDENTATIONS).text(format!(": {v} is not finite")));
+        }
+        let deepest = path.iter().fold(f64::NEG_INFINITY, |m, &d| m.max(d));
+        if deepest <= 0.0 {
+            return Err(Refusal::of(INDENTATIONS).text(format!(
+                " never press the surface (the deepest is {deepest}): with adhesion of \
+                 vanishing range nothing attaches before the indenter touches"
+            )));
+        }
+        let step = self.retract_step.unwrap_or(deepest / DEFAULT_RETRACT_STEPS);
+        if !(step.is_finite() && step > 0.0) {
+            return Err(
+                Refusal::of(RETRACT_STEP).text(format!(" must be positive and finite, got {step}"))
+            );
+        }
+        Ok(AdhesionPlan {
+            half_space: HalfSpace {
+                modulus: self.modulus,
+                boundary,
+            },
+            work_of_adhesion: w,
+            indentations: path.clone(),
+            retract_step: step,
+        })
+    }
+}
+
+impl AdhesionPlan {
+    /// Runs the path on `surface` (square pixels), then the retraction to pull-off,
+    /// calling `on_row` with each settled state as it comes.
+    pub fn run(
+        &self,
+        surface: &Surface,
+        on_row: &mut dyn FnMut(&AdhesionRow),
+    ) -> Result<AdhesionRun, SolveError> {
+        let mut contact = PixelAdhesion::new(surface, self.half_space, self.work_of_adhesion)?;
+        let mut rows = Vec::with_capacity(self.indentations.len());
+        for &d in &self.indentations {
+            let (summary, info) = contact.move_to(d)?;
+            let row = AdhesionRow {
+                branch: Branch::Path,
+                summary,
+                info,
+            };
+            on_row(&row);
+            rows.push(row);
+        }
+        let pull_off = contact.retract(self.retract_step, |summary| {
+            let row = AdhesionRow {
+                branch: Branch::Retract,
+                summary: *summary,
+                info: AdhesionInfo::default(),
+            };
+            on_row(&row);
+            rows.push(row);
+        })?;
+        Ok(AdhesionRun {
+            rows,
+            pull_off,
+            critical_stress: contact.critical_stress(),
+            spacing: contact.spacing(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::refusal::Names;
+    use ndarray::Array2;
+
+    fn request() -> AdhesionRequest {
+        AdhesionRequest {
+            modulus: 1.0,
+            boundary: "free".into(),
+            work_of_adhesion: 2e-4,
+            indentations: vec![0.004, 0.008],
+            retract_step: None,
+        }
+    }
+
+    #[test]
+    fn refuses_meaningless_requests_in_one_line() {
+        let words = |r: AdhesionRequest| r.validate().unwrap_err().words(Names::Flags);
+        for w in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+            let text = words(AdhesionRequest {
+                work_of_adhesion: w,
+                ..request()
+            });
+            assert!(text.starts_with("invalid --work-of-adhesion"), "{text}");
+        }
+        let text = words(AdhesionRequest {
+            indentations: vec![0.0, -0.01],
+            ..request()
+        });
+        assert!(text.contains("never press the surface"), "{text}");
+        let text = words(AdhesionRequest {
+            retract_step: Some(-1.0),
+            ..request()
+        });
+        assert!(
+            text.starts_with("--retract-step must be positive"),
+            "{text}"
+        );
+        assert!(words(AdhesionRequest {
+            indentations: vec![],
+            ..request()
+        })
+        .contains("at least one"));
+        let python = AdhesionRequest {
+            work_of_adhesion: -1.0,
+            ..request()
+        }
+        .validate()
+        .unwrap_err()
+        .words(Names::Keywords);
+        assert!(python.starts_with("invalid work_of_adhesion"), "{python}");
+    }
+
+    #[test]
+    fn a_sphere_sticks_and_lets_go() {
+        // A coarse sphere (R = 1 on 30² pixels of 1e-2; a_c ≈ 8.9 pixels): the run's rows
+        // follow the path then retract, the least force is the pull-off and is tensile, and
+        // the warning names the coarse contact.
+        let (n, dx) = (30, 1e-2);
+        let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+            let (y, x) = ((i as f64 - 15.0) * dx, (j as f64 - 15.0) * dx);
+            -(x * x + y * y) / 2.0
+        });
+        let surface = Surface::new(heights, n as f64 * dx).unwrap();
+        let plan = AdhesionRequest {
+            indentations: vec![0.005, 0.012],
+            ..request()
+        }
+        .validate()
+        .unwrap();
+        let mut seen = 0;
+        let run = plan.run(&surface, &mut |_| seen += 1).unwrap();
+        assert_eq!(seen, run.rows.len());
+        assert_eq!(run.rows[0].branch, Branch::Path);
+        assert_eq!(run.rows.last().unwrap().branch, Branch::Retract);
+        let pull = run.pull_off.unwrap();
+        let least = run.rows.iter().map(|r| r.summary.force).fold(0.0, f64::min);
+        // The bisection's states (not rows) may only lower it.
+        assert!(pull.force_controlled.force <= least && least < 0.0);
+        let jkr = -1.5 * std::f64::consts::PI * 2e-4;
+        assert!((least / jkr - 1.0).abs() < 0.25, "{least} vs {jkr}");
+        assert!(run.resolution_warning().unwrap().contains("pixels"));
+    }
+}

@@ -1,0 +1,170 @@
+//! `asperity bem --work-of-adhesion`: adhesive contact by Pohrt & Popov's pixel criterion
+//! along the path of `--indentations`, then retracted to pull-off (the front-end layer's
+//! [`AdhesionRequest`], the one Python's `bem_adhesion` runs). Outputs as `asperity bem`'s:
+//! checked before any work, written together at the end.
+
+use anyhow::{bail, Context, Result};
+use asperity::io::sidecar_path;
+use asperity_app::adhesion::{AdhesionRequest, AdhesionRun};
+use serde_json::json;
+
+use super::bem::{read_surface_for, stage_outputs, BemArgs};
+use crate::output::{format_number, Table};
+
+/// The columns of the table.
+pub const COLUMNS: [&str; 8] = [
+    "indentation",
+    "force",
+    "mean_pressure",
+    "area_fraction",
+    "tensile_fraction",
+    "rounds",
+    "cg_iterations",
+    "branch",
+];
+
+/// The options `asperity bem` has that an adhesive run refuses, with the flag named.
+fn refuse_other_options(args: &BemArgs) -> Result<()> {
+    let given = [
+        (args.forces.is_some(), "--forces"),
+        (args.pressures.is_some(), "--pressures"),
+        (args.nloads.is_some(), "--nloads"),
+        (args.pmin.is_some() || args.pmax.is_some(), "--pmin/--pmax"),
+        (args.hardness.is_some(), "--hardness"),
+        (args.solver != "bccg", "--solver"),
+        (args.fd_stiffness, "--fd-stiffness"),
+        (args.fields.is_some(), "--fields"),
+        (args.plot.is_some(), "--plot"),
+        (args.timing || args.no_stiffness, "--timing"),
+    ];
+    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
+        bail!(
+            "--work-of-adhesion takes a path of --indentations (the pixel criterion is solved \
+             under displacement control, both pull-offs reported) and does not go with {flag}"
+        );
+    }
+    if args.indentations.is_none() {
+        bail!("--work-of-adhesion needs --indentations: the path to follow before the retraction");
+    }
+    Ok(())
+}
+
+/// The request of the arguments.
+fn request(args: &BemArgs, w: f64) -> AdhesionRequest {
+    AdhesionRequest {
+        modulus: args.modulus,
+        boundary: args.boundary.clone(),
+        work_of_adhesion: w,
+        indentations: args.indentations.clone().unwrap_or_default(),
+        retract_step: args.retract_step,
+    }
+}
+
+/// Runs `asperity bem --work-of-adhesion`.
+pub fn run(args: &BemArgs, w: f64) -> Result<()> {
+    refuse_other_options(args)?;
+    let request = request(args, w);
+    let plan = request.validate()?;
+    let mut outputs = stage_outputs(args, 0)?;
+    let (surface, size_source) = read_surface_for(args, plan.half_space.boundary)?;
+    let mut table = Table::new(&COLUMNS);
+    let points = surface.dim().0 * surface.dim().1;
+    let run = plan
+        .run(&surface, &mut |row| {
+            let s = &row.summary;
+            table.push(&[
+                format_number(s.indentation),
+                format_number(s.force),
+                format_number(s.mean_pressure),
+                format_number(s.area_fraction),
+                format_number(s.tensile_points as f64 / points as f64),
+                row.info.rounds.to_string(),
+                row.info.cg_iterations.to_string(),
+                row.branch.name().to_string(),
+            ]);
+        })
+        .context("adhesive BEM")?;
+    if let Some(out) = &args.out {
+        table
+            .stage(&mut outputs.staged, out)
+            .with_context(|| format!("writing {}", out.display()))?;
+        let record_path = sidecar_path(out);
+        let record = record(args, &request, (&surface, size_source), &run);
+        outputs
+            .staged
+            .write_json(&record_path, &record)
+            .with_context(|| format!("writing {}", record_path.display()))?;
+    }
+    outputs.staged.commit()?;
+    report(args, &run, &table)
+}
+
+/// The inputs and the pull-offs of a run, for OUT.csv.json.
+fn record(
+    args: &BemArgs,
+    request: &AdhesionRequest,
+    (surface, size_source): (&asperity::surface::Surface, &'static str),
+    run: &AdhesionRun,
+) -> serde_json::Value {
+    let point = |s: &asperity::bem::adhesion::AdhesiveSummary| {
+        json!({ "force": s.force, "indentation": s.indentation,
+                "attached_points": s.attached_points })
+    };
+    json!({
+        "command": "asperity bem --work-of-adhesion",
+        "version": env!("CARGO_PKG_VERSION"),
+        "surface": args.surface,
+        "grid": [surface.dim().0, surface.dim().1],
+        "size": surface.size(),
+        "size_source": size_source,
+        "modulus": request.modulus,
+        "boundary": request.boundary,
+        "adhesion": {
+            "model": "Pohrt–Popov pixel criterion",
+            "work_of_adhesion": request.work_of_adhesion,
+            "critical_stress": run.critical_stress,
+            "indentations": request.indentations,
+            "retract_step": request.retract_step,
+            "pull_off": run.pull_off.map(|p| json!({
+                "force_controlled": point(&p.force_controlled),
+                "displacement_controlled": point(&p.displacement_controlled),
+                "separated_at": p.separated_at,
+            })),
+        },
+        "columns": COLUMNS,
+    })
+}
+
+/// The pull-offs and any resolution warning on stderr; the table on stdout without --out.
+fn report(args: &BemArgs, run: &AdhesionRun, table: &Table) -> Result<()> {
+    match &run.pull_off {
+        Some(p) => eprintln!(
+            "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
+            format_number(p.force_controlled.force),
+            format_number(p.force_controlled.indentation),
+            format_number(p.displacement_controlled.force),
+            format_number(p.displacement_controlled.indentation),
+        ),
+        None => eprintln!("pull-off: nothing attached at the end of the path"),
+    }
+    if let Some(warning) = run.resolution_warning() {
+        eprintln!("warning: {warning}");
+    }
+    match &args.out {
+        Some(out) if !args.quiet => eprintln!(
+            "wrote {} and {} ({} rows)",
+            out.display(),
+            sidecar_path(out).display(),
+            run.rows.len()
+        ),
+        Some(_) => {}
+        None => {
+            use std::io::Write;
+            match std::io::stdout().write_all(&table.to_csv()?) {
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+                other => other?,
+            }
+        }
+    }
+    Ok(())
+}
