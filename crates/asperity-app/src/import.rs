@@ -149,6 +149,9 @@ mod tests {
         let npy = dir.path().join("in.npy");
         std::fs::write(&npy, "").unwrap();
         let err = Import::stage(&npy, &npy, true).unwrap_err();
-        assert!(err.words(Names::Flags).contains("is the input file"), "{err}");
+        assert!(
+            err.words(Names::Flags).contains("is the input file"),
+            "{err}"
+        );
     }
 }

@@ -47,16 +47,16 @@ pub struct CommonArgs {
     #[arg(long, value_name = "Q")]
     pub rolloff: Option<f64>,
     /// Study seed (every sample's seed derives from it, N, H and the sample index).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = StudySpec::default().seed)]
     pub seed: u64,
     /// α fit window: fewest points in contact.
-    #[arg(long, default_value_t = FitWindow::default().min_contacts)]
+    #[arg(long, default_value_t = StudySpec::default().window.min_contacts)]
     pub min_contacts: usize,
     /// α fit window: largest contact fraction.
-    #[arg(long, default_value_t = FitWindow::default().max_fraction)]
+    #[arg(long, default_value_t = StudySpec::default().window.max_fraction)]
     pub max_fraction: f64,
     /// Common force levels of the ensemble-mean curves.
-    #[arg(long, default_value_t = asperity::study::DEFAULT_LEVELS)]
+    #[arg(long, default_value_t = StudySpec::default().levels)]
     pub levels: usize,
     #[command(flatten)]
     pub run: RunArgs,
@@ -454,27 +454,25 @@ struct StudyFile {
     full_sweep: Option<bool>,
 }
 
-/// Default number of common force levels.
-const LEVELS: usize = asperity::study::DEFAULT_LEVELS;
-
 /// Reads a study file's text: the kind and the spec (not yet validated). Errors name the
 /// file, the line and column, and the key concerned, in one line.
 fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
     let file: StudyFile =
         toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", toml_error(path, text, &e)))?;
-    let window = FitWindow::default();
+    // The keys left out take the library's defaults (`StudySpec::default`).
+    let defaults = StudySpec::default();
     let spec = StudySpec {
         method: file.method.into(),
         sizes: file.n.0,
         hursts: file.hurst.0,
         samples: file.samples,
         rolloff: file.rolloff,
-        seed: file.seed.unwrap_or(1),
+        seed: file.seed.unwrap_or(defaults.seed),
         window: FitWindow {
-            min_contacts: file.min_contacts.unwrap_or(window.min_contacts),
-            max_fraction: file.max_fraction.unwrap_or(window.max_fraction),
+            min_contacts: file.min_contacts.unwrap_or(defaults.window.min_contacts),
+            max_fraction: file.max_fraction.unwrap_or(defaults.window.max_fraction),
         },
-        levels: file.levels.unwrap_or(LEVELS),
+        levels: file.levels.unwrap_or(defaults.levels),
         sweep_end: None,
     };
     if file.kind == Kind::Curve && file.full_sweep.is_some() {
