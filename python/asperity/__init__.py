@@ -58,6 +58,7 @@ __all__ = [
     "AsperityWarning",
     "BeyondFullContactError",
     "ContactResult",
+    "BemAdhesion",
     "ConvergenceError",
     "Line",
     "MdrCurve",
@@ -72,6 +73,7 @@ __all__ = [
     "UnitWarning",
     "UnlevelledWarning",
     "contact",
+    "bem_adhesion",
     "line",
     "mdr",
     "mdr_slip",
@@ -1074,6 +1076,63 @@ def mdr_slip(
 # --------------------------------------------------------------------------------------
 # Studies
 # --------------------------------------------------------------------------------------
+
+
+@dataclass
+class BemAdhesion:
+    """An adhesive BEM run (:func:`bem_adhesion`; the columns of ``asperity bem
+    --work-of-adhesion``): per settled state ``indentation``, ``force``, ``mean_pressure``,
+    ``area_fraction`` (attached pixels), ``tensile_fraction``, ``rounds``,
+    ``cg_iterations`` and ``branch`` (``"path"`` or ``"retract"``); ``pull_off`` (both
+    controls: force, indentation, attached_points; ``None`` if nothing stayed attached),
+    the pixel's ``critical_stress`` and a resolution ``warning`` (or ``None``)."""
+
+    indentation: np.ndarray
+    force: np.ndarray
+    mean_pressure: np.ndarray
+    area_fraction: np.ndarray
+    tensile_fraction: np.ndarray
+    rounds: np.ndarray
+    cg_iterations: np.ndarray
+    branch: List[str]
+    pull_off: Optional[Dict[str, Any]]
+    critical_stress: float
+    warning: Optional[str]
+
+    def __repr__(self) -> str:
+        return f"BemAdhesion({len(self.force)} states, critical_stress={self.critical_stress:.4e})"
+
+
+def bem_adhesion(
+    surface: Any,
+    *,
+    work_of_adhesion: float,
+    indentations: Sequence[float],
+    size: Optional[float] = None,
+    modulus: float = 1.0,
+    boundary: str = "free",
+    retract_step: Optional[float] = None,
+) -> BemAdhesion:
+    """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, as ``asperity bem
+    --work-of-adhesion`` (the same code and numbers): the ``indentations`` are a path
+    (negative allowed), then the indenter is retracted in steps of ``retract_step``
+    (default: the deepest indentation / 200) until nothing is attached. Square pixels.
+    See docs/adhesion.md.
+
+    Example::
+
+        >>> x = (np.arange(40) - 20) * 5e-3
+        >>> h = -(x[:, None]**2 + x[None, :]**2) / 2
+        >>> run = asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4,
+        ...                             indentations=[0.002, 0.004, 0.006, 0.008])
+        >>> bool(run.pull_off["force_controlled"]["force"] < 0)
+        True
+    """
+    heights, size_x, size_y = _surface_input(surface, size)
+    path = [float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
+    out = _core.bem_adhesion(heights, size_x, size_y, float(modulus), str(boundary),
+                             float(work_of_adhesion), path, _opt(retract_step))
+    return BemAdhesion(**out)
 
 
 PERSSON_KAPPA = 1.5957691216057307

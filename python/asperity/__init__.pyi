@@ -224,6 +224,26 @@ def mdr_slip(
     asperity_radius: Optional[float] = ..., work_of_adhesion: Optional[float] = ...,
 ) -> SlipCycle: ...
 
+@dataclass
+class BemAdhesion:
+    indentation: F64
+    force: F64
+    mean_pressure: F64
+    area_fraction: F64
+    tensile_fraction: F64
+    rounds: npt.NDArray[np.uint64]
+    cg_iterations: npt.NDArray[np.uint64]
+    branch: List[str]
+    pull_off: Optional[Dict[str, Any]]
+    critical_stress: float
+    warning: Optional[str]
+
+def bem_adhesion(
+    surface: Any, *, work_of_adhesion: float, indentations: Sequence[float],
+    size: Optional[float] = ..., modulus: float = ..., boundary: str = ...,
+    retract_step: Optional[float] = ...,
+) -> BemAdhesion: ...
+
 PERSSON_KAPPA: float
 
 @dataclass

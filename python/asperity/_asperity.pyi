@@ -84,6 +84,10 @@ def mdr_slip(
     request: str, line: Optional[F64], radial: Optional[F64], tangential_force: float,
     friction: Optional[float], poisson: float, cycle_points: Optional[int],
 ) -> Dict[str, Any]: ...
+def bem_adhesion(
+    array: F64, size_x: float, size_y: Optional[float], modulus: float, boundary: str,
+    work_of_adhesion: float, indentations: List[float], retract_step: Optional[float],
+) -> Dict[str, Any]: ...
 def persson_table(
     array: F64, size_x: float, size_y: Optional[float], modulus: float, gamma: float,
     kappa: float, pressures: Optional[List[float]], nloads: Optional[int],

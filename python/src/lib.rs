@@ -7,6 +7,7 @@
 //! with the GIL released ([`interrupt::run_detached`]), maps the library's errors to Python
 //! exceptions ([`errors`]) and hands results back as numpy arrays without copying them.
 
+mod adhesion;
 mod arrays;
 mod bem;
 mod contact;
@@ -43,6 +44,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     surface::register(m)?;
     bem::register(m)?;
+    adhesion::register(m)?;
     contact::register(m)?;
     mdr::register(m)?;
     persson::register(m)?;

@@ -224,3 +224,31 @@ def test_persson_equals_the_cli(cli, tmp_path, flags, kwargs):
         asperity.persson(s, nloads=3, pmin=1.0, pmax=0.1)
     with pytest.raises(ValueError, match="gamma"):
         asperity.persson(s, [0.01], gamma=0.0)
+
+
+def test_bem_adhesion_equals_the_cli(cli, tmp_path):
+    x = (np.arange(40) - 20) * 5e-3
+    h = -(x[:, None]**2 + x[None, :]**2) / 2
+    np.save(tmp_path / "sphere.npy", h)
+    path = [0.002, 0.004, 0.006, 0.008, 0.004]
+    cli("bem", "--surface", tmp_path / "sphere.npy", "--size", 0.2, "--work-of-adhesion", 2e-4,
+        "--indentations", ",".join(map(str, path)), "--retract-step", 1e-4,
+        "--out", tmp_path / "a.csv")
+    with open(tmp_path / "a.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ours = asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                                 retract_step=1e-4)
+    assert ours.branch == [r["branch"] for r in rows]
+    for name in ["indentation", "force", "mean_pressure", "area_fraction", "tensile_fraction"]:
+        assert getattr(ours, name).tolist() == [float(r[name]) for r in rows], name
+    for name in ["rounds", "cg_iterations"]:
+        assert getattr(ours, name).tolist() == [int(r[name]) for r in rows], name
+    record = json.load(open(tmp_path / "a.csv.json"))
+    assert record["adhesion"]["pull_off"]["force_controlled"]["force"] == \
+        ours.pull_off["force_controlled"]["force"]
+    assert ours.pull_off["force_controlled"]["force"] < 0
+    # Refusals in Python's words.
+    with pytest.raises(ValueError, match="invalid work_of_adhesion"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=-1.0, indentations=path)
+    with pytest.raises(ValueError, match="never press the surface"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=1e-3, indentations=[-0.01])

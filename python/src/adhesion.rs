@@ -1,0 +1,94 @@
+//! Python's `bem_adhesion()`: the pixel criterion along a path then retracted to pull-off,
+//! by the front-end layer's one request (`asperity_app::adhesion`), the one `asperity bem
+//! --work-of-adhesion` runs: the same rules, columns and numbers.
+
+use asperity::surface::Surface;
+use asperity_app::adhesion::{AdhesionRequest, AdhesionRow};
+use numpy::{PyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::arrays::owned_2d;
+use crate::errors::{from_error, from_solve, refused};
+use crate::interrupt::run_detached;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(bem_adhesion, m)?)?;
+    Ok(())
+}
+
+/// The columns of `asperity bem --work-of-adhesion` for heights `array` of sizes `size_x`
+/// and `size_y` (`None`: square pixels), with both pull-offs and `σ_c`.
+#[pyfunction]
+#[pyo3(signature = (array, size_x, size_y, modulus, boundary, work_of_adhesion, indentations, retract_step))]
+#[allow(clippy::too_many_arguments)]
+fn bem_adhesion<'py>(
+    py: Python<'py>,
+    array: PyReadonlyArray2<'_, f64>,
+    size_x: f64,
+    size_y: Option<f64>,
+    modulus: f64,
+    boundary: String,
+    work_of_adhesion: f64,
+    indentations: Vec<f64>,
+    retract_step: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let request = AdhesionRequest {
+        modulus,
+        boundary,
+        work_of_adhesion,
+        indentations,
+        retract_step,
+    };
+    let plan = request.validate().map_err(refused)?;
+    let owned = owned_2d(&array);
+    let surface = match size_y {
+        Some(size_y) => Surface::with_sizes(owned, size_x, size_y),
+        None => Surface::new(owned, size_x),
+    }
+    .map_err(from_error)?;
+    let points = (surface.dim().0 * surface.dim().1) as f64;
+    let run = run_detached(py, move |_| plan.run(&surface, &mut |_| {}))?.map_err(from_solve)?;
+    let dict = PyDict::new(py);
+    let rows = &run.rows;
+    let column = |f: &dyn Fn(&AdhesionRow) -> f64| PyArray1::from_iter(py, rows.iter().map(f));
+    dict.set_item("indentation", column(&|r| r.summary.indentation))?;
+    dict.set_item("force", column(&|r| r.summary.force))?;
+    dict.set_item("mean_pressure", column(&|r| r.summary.mean_pressure))?;
+    dict.set_item("area_fraction", column(&|r| r.summary.area_fraction))?;
+    dict.set_item(
+        "tensile_fraction",
+        column(&|r| r.summary.tensile_points as f64 / points),
+    )?;
+    let count = |f: &dyn Fn(&AdhesionRow) -> usize| {
+        PyArray1::from_iter(py, rows.iter().map(|r| f(r) as u64))
+    };
+    dict.set_item("rounds", count(&|r| r.info.rounds))?;
+    dict.set_item("cg_iterations", count(&|r| r.info.cg_iterations))?;
+    let branches: Vec<&str> = rows.iter().map(|r| r.branch.name()).collect();
+    dict.set_item("branch", branches)?;
+    let pull_off = match run.pull_off {
+        Some(p) => {
+            let point = |s: &asperity::bem::adhesion::AdhesiveSummary| -> PyResult<_> {
+                let d = PyDict::new(py);
+                d.set_item("force", s.force)?;
+                d.set_item("indentation", s.indentation)?;
+                d.set_item("attached_points", s.attached_points)?;
+                Ok(d)
+            };
+            let d = PyDict::new(py);
+            d.set_item("force_controlled", point(&p.force_controlled)?)?;
+            d.set_item(
+                "displacement_controlled",
+                point(&p.displacement_controlled)?,
+            )?;
+            d.set_item("separated_at", p.separated_at)?;
+            Some(d)
+        }
+        None => None,
+    };
+    dict.set_item("pull_off", pull_off)?;
+    dict.set_item("critical_stress", run.critical_stress)?;
+    dict.set_item("warning", run.resolution_warning())?;
+    Ok(dict)
+}
