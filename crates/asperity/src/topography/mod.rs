@@ -31,6 +31,7 @@ pub(crate) mod frt;
 pub(crate) mod gwy;
 pub(crate) mod ibw;
 pub mod inpaint;
+pub(crate) mod jpk;
 pub mod level;
 pub(crate) mod metropro;
 pub(crate) mod mi;
@@ -47,6 +48,7 @@ pub(crate) mod sur;
 #[cfg(test)]
 mod testkit;
 pub(crate) mod text;
+pub(crate) mod tiff;
 pub(crate) mod tmd;
 pub(crate) mod wsxm;
 pub mod x3p;
@@ -209,6 +211,12 @@ const FORMATS: &[Format] = &[
         extensions: &["sdf"],
         sniff: sdf::sniff,
         read: sdf::read,
+    },
+    Format {
+        name: "jpk",
+        extensions: &["jpk"],
+        sniff: jpk::sniff,
+        read: jpk::read,
     },
     // The instrument formats, before any text detection (DI and WSxM headers are text);
     // PLU last, its only signature being a date.
