@@ -57,6 +57,14 @@ impl PixelAdhesion {
         }
         let (rows, cols) = surface.dim();
         let dx = surface.spacing();
+        // An upper bound: the contact solver's parts include every field used here.
+        crate::memory::ensure_fits(
+            &format!(
+                "an adhesive BEM contact of a {rows}x{cols} grid ({} boundaries)",
+                half_space.boundary.name()
+            ),
+            super::super::ContactSolver::memory_bytes(rows, cols, half_space.boundary),
+        )?;
         let operator = ElasticOperator::with_spacings(
             rows,
             cols,

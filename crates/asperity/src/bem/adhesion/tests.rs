@@ -59,11 +59,11 @@ fn jkr_retraction(pixels_per_radius: f64) -> (f64, f64, f64) {
 /// the displacement-controlled one (`−(5/6)πwR`) with `≈ 2.5 Δx/a_c` (+24.9 %, +12.7 %, −0.8 %: it
 /// oscillates with the pixel, as the radius at which the last ring lets go does),
 /// and the peeling states' forces lie within `≈ 2 Δx/a_c · |F_c|` of JKR's at their contact
-/// radius `√(A/π)` (0.189, 0.105, 0.042). (The contact holds too much: the compressive, Hertzian
-/// part of a pixel set's pressure vanishes at its edge pixels' centres, half a pixel inside
-/// the radius `√(A/π)` at which its tensile part lets go — Kendall's punch, with no
-/// Hertzian part, is within 0.7 % and 0.24 %; `3·(Δx/2)/a_c = 1.5 Δx/a_c` is the error
-/// that offset predicts.) Tolerances: halving the pixel at least nearly halves each error
+/// radius `√(A/π)` (0.189, 0.105, 0.042). (The contact holds too much; our reading: the
+/// criterion is calibrated on the singular tension alone — Kendall's punch, which has no
+/// other, is within 0.7 % and 0.24 % — while a sphere's edge pixel also carries Hertzian
+/// compression, a share of order `Δx/a_c`; docs/adhesion.md.) Tolerances: halving the
+/// pixel at least nearly halves each error
 /// (ratio above 1.75; measured 2.00, 1.97, 1.79), and the first-order (Richardson)
 /// extrapolation of the two pull-offs lands on JKR within 1 % (measured 1e-4 and 4e-3).
 #[test]

@@ -1,0 +1,82 @@
+//! The adhesive BEM iteration allocates nothing per round or CG iteration: moving a warm
+//! [`PixelAdhesion`] costs the same number of heap allocations whether the move takes few
+//! or many rounds and iterations. (Its own binary, with a counting allocator, as
+//! `bem_allocation.rs`; one test, so that nothing else allocates while it counts.)
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use asperity::bem::adhesion::PixelAdhesion;
+use asperity::bem::HalfSpace;
+use asperity::surface::Surface;
+use ndarray::Array2;
+
+struct Counting;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: forwards every call to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract for `alloc` is passed on.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as for `alloc`.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `System` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as for `dealloc`; `new_size` is the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn moves_allocate_nothing_per_round_or_iteration() {
+    // One rayon thread, as in bem_allocation.rs: the count is then the iteration's own.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    pool.install(|| {
+        let (n, dx) = (48, 5e-3);
+        let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+            let (y, x) = ((i as f64 - 24.0) * dx, (j as f64 - 24.0) * dx);
+            -(x * x + y * y) / 2.0
+        });
+        let surface = Surface::new(heights, n as f64 * dx).unwrap();
+        let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), 2e-4).unwrap();
+        contact.move_to(0.002).unwrap();
+        let mut counted = Vec::new();
+        // A small step (few rounds), a long one (many), a retraction that releases pixels.
+        for d in [0.0021, 0.009, 0.002] {
+            let before = ALLOCATIONS.load(Ordering::SeqCst);
+            let (_, info) = contact.move_to(d).unwrap();
+            let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
+            counted.push((allocations, info.rounds, info.cg_iterations));
+        }
+        let (first, _, _) = counted[0];
+        assert!(
+            counted.iter().all(|&(a, _, _)| a == first),
+            "allocations depend on the work: {counted:?}"
+        );
+        let spread = |f: fn(&(u64, usize, usize)) -> usize| {
+            counted.iter().map(f).max().unwrap() > counted.iter().map(f).min().unwrap()
+        };
+        assert!(spread(|c| c.1) && spread(|c| c.2), "{counted:?}");
+        assert!(first <= 16, "{counted:?}");
+    });
+}
