@@ -1217,8 +1217,8 @@ class StudyResult:
     tasks: List[Dict[str, Any]]
     #: Each task's row of the comparison with the paper (see :meth:`comparison`).
     comparisons: List[Optional[Dict[str, Any]]] = field(default_factory=list, repr=False)
-    #: Whether the study has a roll-off (compared by its steepest slope instead).
-    rolloff: bool = False
+    #: Why the study cannot be compared (a roll-off study whose sweeps ended), or None.
+    comparison_error: Optional[str] = field(default=None, repr=False)
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -1232,16 +1232,19 @@ class StudyResult:
     def comparison(self) -> Dict[str, np.ndarray]:
         """The comparison with the paper, as ``asperity study compare`` writes it to
         ``comparison.csv`` (one definition, the library's ``study::compare``): per task
-        with a fit, ``method``, ``n``, ``hurst``, ``quantity`` (``alpha``), ``ours`` (the
-        ensemble α), ``low``/``high`` (its 95 % interval: ± t·s/√m over the m per-sample
-        α), ``reference`` (eq. (6), eq. (24) or Hertz 1/3), ``source``, ``tolerance`` and
-        the ``verdict``: ``agrees`` (the reference inside the interval), ``close``
-        (within 0.02) or ``differs``. A study with a roll-off is compared by its steepest
-        slope, which needs the folder's sample curves: use ``asperity study compare``."""
+        with a fit, ``method``, ``n``, ``hurst``, ``quantity``, ``ours``, ``low``/``high``
+        (its 95 % interval), ``reference``, ``source``, ``tolerance`` and the ``verdict``:
+        ``agrees`` (the reference inside the interval widened by the tolerance), ``close``
+        (within 0.02) or ``differs``. A study without roll-off compares its ensemble α
+        (``quantity`` ``alpha``, interval ± t·s/√m over the m per-sample α) with eq. (6),
+        eq. (24) or Hertz 1/3; one with a roll-off the steepest log–log slope of its mean
+        curve over a decade (``steepest_slope``; interval: 400 bootstrap resamples of the
+        sample curves its folder keeps) with the paper's "≈ 1" (tolerance 0.1). A roll-off
+        study whose samples ended their sweeps (an α study without ``full_sweep``) cannot
+        be compared: ``ValueError``."""
+        if self.comparison_error is not None:
+            raise ValueError(self.comparison_error)
         found = [c for c in self.comparisons if c is not None]
-        if self.rolloff:
-            raise ValueError("a roll-off study is compared by its steepest slope: run "
-                             "`asperity study compare DIR` on its folder")
         names = ("method", "n", "hurst", "quantity", "ours", "low", "high", "reference",
                  "source", "tolerance")
         columns = {}
@@ -1351,7 +1354,7 @@ def study_alpha(
                          f"{method} study")
     columns, rows = _table(records["alpha"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
-                       rolloff is not None)
+                       records["comparison_error"])
 
 
 def study_curve(
@@ -1385,4 +1388,5 @@ def study_curve(
                          max_fraction, levels, False, force, checkpoint_every, progress,
                          f"{method} study")
     columns, rows = _table(records["curve"])
-    return StudyResult(columns, rows, records["tasks"])
+    return StudyResult(columns, rows, records["tasks"], records["comparisons"],
+                       records["comparison_error"])

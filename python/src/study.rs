@@ -12,7 +12,6 @@ use std::path::PathBuf;
 
 use asperity::lock::FolderLock;
 use asperity::stop::Stop;
-use asperity::study::compare;
 use asperity::study::{
     FitWindow, Ledger, Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples,
     DEFAULT_LEVELS,
@@ -105,7 +104,7 @@ fn run_study(
         run_tasks(&store, progress.as_ref(), cancel)
     })?
     .map_err(|failure| from_error(failure.into_error()))?;
-    Ok(records(&spec, &results))
+    Ok(records(&spec, store.path(), &results))
 }
 
 /// A study's spec from `run_study`'s arguments (`alpha_sweep`: an α study's load sweep,
@@ -174,30 +173,30 @@ fn open_folder(
 
 /// The task results as JSON text: `tasks` (each as its checkpoint stores it), `alpha`
 /// and `curve` (the tables of `alpha.csv` and `curve.csv`, [`asperity_app::study::rows`]:
-/// `columns` as `(name, type)` and `rows` of cells) and `comparisons`: per task of a study
-/// without roll-off, its row of the comparison with the paper (`asperity study compare`:
-/// α beside eq. (6)/(24) with the 95 % interval of the ensemble α and the verdict; a
-/// roll-off study is compared by its steepest slope, which needs the stored sample
-/// curves: `None` here).
-fn records(spec: &StudySpec, results: &[TaskResult]) -> String {
-    let comparisons: Vec<serde_json::Value> = results
-        .iter()
-        .map(|r| match spec.rolloff {
-            Some(_) => serde_json::Value::Null,
-            None => compare::rows(&compare::Results::Fig1(std::slice::from_ref(r)), &[])
-                .into_iter()
-                .next()
-                .map_or(
+/// `columns` as `(name, type)` and `rows` of cells) and `comparisons`: per task, its row
+/// of the comparison with the paper and the verdict (`asperity study compare`,
+/// [`study::comparison`]: α beside eq. (6)/(24), or a roll-off study's steepest slope
+/// beside "≈ 1" with the bootstrap interval over the sample curves in `dir`), or
+/// `comparison_error` where the study cannot be compared (the words).
+fn records(spec: &StudySpec, dir: &std::path::Path, results: &[TaskResult]) -> String {
+    let (comparisons, error) = match study::comparison(spec, dir, results) {
+        Ok(rows) => {
+            let rows = rows.into_iter().map(|row| {
+                row.map_or(
                     serde_json::Value::Null,
-                    |row| json!({"row": row, "verdict": compare::verdict(&row)}),
-                ),
-        })
-        .collect();
+                    |(row, verdict)| json!({"row": row, "verdict": verdict}),
+                )
+            });
+            (rows.collect(), None)
+        }
+        Err(e) => (Vec::new(), Some(e.to_string())),
+    };
     json!({
         "tasks": results,
         "alpha": rows::alpha_table(results),
         "curve": rows::curve_table(results),
         "comparisons": comparisons,
+        "comparison_error": error,
     })
     .to_string()
 }
@@ -317,7 +316,7 @@ impl StudyLedger {
         if !ledger.finished() {
             return Err(invalid("the study is not finished"));
         }
-        Ok(records(&self.spec, &ledger.results()))
+        Ok(records(&self.spec, self.store.path(), &ledger.results()))
     }
 
     /// Releases the folder's lock.

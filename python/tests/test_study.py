@@ -123,6 +123,35 @@ def test_the_comparison_with_the_paper_equals_study_compare(cli, tmp_path):
     assert report.count("| differs |") == list(ours["verdict"]).count("differs")
 
 
+def test_a_rolloff_study_is_compared_by_its_steepest_slope_as_study_compare(cli, tmp_path):
+    """A roll-off study's comparison (Fig. 2: the steepest slope of the mean curve against
+    the paper's "≈ 1", bootstrap interval over the stored BEM sample curves) is
+    `asperity study compare`'s comparison.csv, row for row; an α study that ended its
+    sweeps cannot be compared, in the CLI's words."""
+    flags = ["--method", "bem", "--n", 32, "--hurst", "0.3,0.8", "--samples", 6, "--seed", 2,
+             "--rolloff", 2]
+    cli("study", "curve", *flags, "--out", tmp_path / "cli", "--quiet")
+    cli("study", "compare", tmp_path / "cli")
+    with open(tmp_path / "cli" / "comparison.csv", newline="") as f:
+        theirs = list(csv.DictReader(f))
+    ours = asperity.study_curve(method="bem", n=32, hurst=[0.3, 0.8], samples=6, seed=2,
+                                rolloff=2, out=tmp_path / "py").comparison()
+    assert len(theirs) == len(ours["ours"]) == 2
+    for i, row in enumerate(theirs):
+        assert ours["quantity"][i] == row["quantity"] == "steepest_slope"
+        for name in ("method", "source"):
+            assert ours[name][i] == row[name], name
+        for name in ("n", "hurst", "ours", "low", "high", "reference", "tolerance"):
+            assert ours[name][i] == float(row[name]), name
+        assert ours["low"][i] < ours["ours"][i] < ours["high"][i], "a bootstrap interval"
+    ended = asperity.study_alpha(method="bem", n=32, hurst=[0.8], samples=2, rolloff=2,
+                                 out=tmp_path / "ended")
+    refused = cli("study", "compare", tmp_path / "ended", ok=False).stderr
+    with pytest.raises(ValueError, match="stopped loading past") as err:
+        ended.comparison()
+    assert str(err.value) in refused
+
+
 BEM = dict(method="bem", n=32, hurst=[0.5], samples=16, seed=5)
 BEM_FLAGS = ["--method", "bem", "--n", 32, "--hurst", 0.5, "--samples", 16, "--seed", 5]
 

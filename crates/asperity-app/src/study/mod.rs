@@ -21,6 +21,7 @@ use std::time::Duration;
 
 use asperity::lock::FolderLock;
 use asperity::stop::Stop;
+use asperity::study::compare;
 use asperity::study::samplers::OnLoad;
 use asperity::study::{
     run_any_task_with_loads, Method, StudyDir, StudySpec, Task, TaskResult,
@@ -197,6 +198,38 @@ pub fn run_tasks(
         })?);
     }
     Ok(results)
+}
+
+/// Each task's row of the comparison with the paper and its verdict, as `asperity study
+/// compare` writes them to `comparison.csv` ([`compare::rows`]): a study without roll-off
+/// by its α against eq. (6)/(24) (Fig. 1), one with a roll-off by the steepest slope of its
+/// mean curve against the paper's "≈ 1" (Fig. 2), with the bootstrap interval over the
+/// sample curves that the folder `dir` keeps (BEM; without them the interval is the value
+/// itself). `None` for a task without a fit or a slope. Refused for a roll-off study whose
+/// samples ended their sweeps (an α study's): its curves stop short of the steepest decade.
+pub fn comparison(
+    spec: &StudySpec,
+    dir: &Path,
+    results: &[TaskResult],
+) -> asperity::Result<Vec<Option<(compare::Row, compare::Verdict)>>> {
+    let slopes = match spec.rolloff {
+        Some(_) => {
+            asperity::study::sensitivity::ensure_whole_sweep(spec, dir)?;
+            asperity::study::sensitivity::study_slopes(dir)?
+        }
+        None => Vec::new(),
+    };
+    let row = |r: &TaskResult| {
+        let one = std::slice::from_ref(r);
+        let figure = match spec.rolloff {
+            Some(_) => compare::Results::Fig2(one, spec.window),
+            None => compare::Results::Fig1(one),
+        };
+        let row = compare::rows(&figure, &slopes).into_iter().next()?;
+        let verdict = compare::verdict(&row);
+        Some((row, verdict))
+    };
+    Ok(results.iter().map(row).collect())
 }
 
 /// The smallest number of contacts of the α fit window.
