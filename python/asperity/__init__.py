@@ -846,6 +846,7 @@ def contact(
     map: bool = False,
     resistivity: Optional[Sequence[float]] = None,
     thermal_conductivity: Optional[Sequence[float]] = None,
+    hardness: Optional[float] = None,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -860,12 +861,20 @@ def contact(
     With ``resistivity`` (ρ₁, ρ₂ of the two bodies, Ω·m) also ``electrical_conductance_s``
     = 2k/(E*(ρ₁+ρ₂)); with ``thermal_conductivity`` (κ₁, κ₂, W/(m·K)) also
     ``thermal_conductance_w_per_k`` = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy).
+    With ``hardness`` (Pa) the contact pressure is capped there (elastic–perfectly-plastic
+    contact, docs/hardness.md; each load on the surface as given), adding
+    ``plastic_area_m2`` and ``plastic_fraction`` (the points at the hardness); the
+    stiffness is then that of the elastic set. A hardness that is not positive and finite,
+    or a pressure at or above it, raises ValueError.
 
     Example::
 
         >>> t = asperity.read_topography("scan.x3p", detrend="plane")
         >>> c = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e5, 1e6])
         >>> c.contact_area_m2, c.stiffness_n_per_m
+        >>> capped = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e7],
+        ...                           hardness=2e9)
+        >>> capped.plastic_fraction
     """
     heights, size_x, size_y = _surface_input(surface, size)
     loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
@@ -875,6 +884,7 @@ def contact(
         None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
         None if thermal_conductivity is None
         else [float(v) for v in np.atleast_1d(thermal_conductivity)],
+        _opt(hardness),
     )
     return Sweep(columns)
 

@@ -177,6 +177,7 @@ def contact(
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
+    hardness: Optional[float] = ...,
 ) -> Sweep: ...
 
 @dataclass

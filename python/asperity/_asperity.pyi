@@ -45,6 +45,7 @@ def contact(
     pressures: List[float], modulus: Optional[float], young: Optional[float],
     poisson: Optional[float], boundary: str, tolerance: float, map: bool,
     resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
+    hardness: Optional[float] = ...,
 ) -> Dict[str, Any]: ...
 
 class Solver:

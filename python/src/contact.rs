@@ -25,7 +25,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -41,6 +41,7 @@ fn contact<'py>(
     map: bool,
     resistivity: Option<Vec<f64>>,
     thermal_conductivity: Option<Vec<f64>>,
+    hardness: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ContactRequest {
         modulus,
@@ -51,6 +52,7 @@ fn contact<'py>(
         tolerance,
         resistivity,
         thermal_conductivity,
+        hardness,
     };
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();

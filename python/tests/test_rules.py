@@ -52,6 +52,7 @@ KEYWORDS = {
     "--breakpoints": "breakpoints",
     "--work-of-adhesion": "work_of_adhesion",
     "--min-contacts": "min_contacts",
+    "--hardness": "hardness",
     "--fit-from": "fit_from",
     "--fit-to": "fit_to",
     "--detrend": "detrend",
@@ -138,6 +139,11 @@ CONTACT = [
      dict(modulus=1e9, pressures=[1e5], tolerance=0), "got 0"),
     (["--modulus", "1e9", "--pressures", "1e5", "--boundary", "open"],
      dict(modulus=1e9, pressures=[1e5], boundary="open"), 'boundary must be "free"'),
+    (["--modulus", "1e9", "--pressures", "1e5", "--hardness", "-1"],
+     dict(modulus=1e9, pressures=[1e5], hardness=-1), "hardness must be positive and finite, got -1"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--hardness", "1e5"],
+     dict(modulus=1e9, pressures=[1e5], hardness=1e5),
+     "a mean pressure of 100000 Pa is at or above the hardness 100000 Pa"),
     (["--modulus", "1e9", "--pressures", "1e5", "--resistivity", "1e-8"],
      dict(modulus=1e9, pressures=[1e5], resistivity=[1e-8]),
      "invalid resistivity: give two values, body 1 and body 2, got 1"),
@@ -429,6 +435,36 @@ def test_a_fit_window_above_the_grid_is_refused_alike(cli, tmp_path, method, n, 
     assert ours == theirs
     assert f"min_contacts {min_contacts} is above the number of points" in ours
     assert not (tmp_path / "cli").exists() and not (tmp_path / "py").exists()
+
+
+def test_contact_with_a_hardness_equals_the_cli(cli, tmp_path):
+    """`asperity.contact(hardness=)` gives the CLI's `--hardness` table bit for bit, with
+    the plastic columns: every pressure at most H, so F ≤ H·A; part of the contact plastic
+    (plastic_area_m2 its fraction of the nominal area). Refusals: the CONTACT table."""
+    s = asperity.surface(64, hurst=0.8, rolloff=2, rms_slope=1, seed=2, size=1e-4)
+    heights = s.heights * 1e-6
+    np.save(tmp_path / "h.npy", heights)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none", "--out", tmp_path / "t.npy")
+    t = asperity.read_topography(tmp_path / "t.npy", detrend="none")
+    # The mildest cap (from above) under which both loads are partly plastic.
+    hardness = next(h for h in [3e6, 1e6, 6e5, 4e5, 3e5, 2e5]
+                    if asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e4, 1e5],
+                                        hardness=h).plastic_fraction.min() > 0)
+    cli("contact", tmp_path / "t.npy", "--young", 210e9, "--poisson", 0.3, "--pressures",
+        "1e4,1e5", "--hardness", hardness, "--detrend", "none", "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    assert "plastic_fraction" in theirs.dtype.names and "plastic_area_m2" in theirs.dtype.names
+    ours = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e4, 1e5], hardness=hardness)
+    for name in theirs.dtype.names:
+        assert np.array_equal(ours[name], theirs[name]), name
+    assert np.all(ours.force_n <= hardness * ours.contact_area_m2 * (1 + 1e-12))
+    assert np.all(ours.plastic_fraction > 0) and np.all(ours.plastic_fraction < ours.area_fraction)
+    assert np.allclose(ours.plastic_area_m2, ours.plastic_fraction * 1e-8, rtol=1e-12)
+    elastic = asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e4, 1e5])
+    # The cap spreads the load: never less area than the elastic contact, more where much
+    # of it is plastic.
+    assert np.all(ours.contact_area_m2 >= elastic.contact_area_m2)
+    assert ours.contact_area_m2[-1] > elastic.contact_area_m2[-1]
 
 
 def test_contact_equals_the_cli(cli, tmp_path):

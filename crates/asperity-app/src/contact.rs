@@ -6,7 +6,7 @@ use std::convert::Infallible;
 
 use asperity::bem::conductance::Transport;
 use asperity::bem::sweep::{sweep, SweepError, SweepObserver, SweepParams, SweepRow};
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverParams};
 use asperity::topography::patches::count_patches;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
@@ -27,6 +27,8 @@ pub mod params {
     /// The two bodies' thermal conductivities.
     pub const THERMAL_CONDUCTIVITY: Param =
         Param::new("--thermal-conductivity", "thermal_conductivity");
+    /// The hardness that caps the contact pressure, Pa.
+    pub const HARDNESS: Param = Param::new("--hardness", "hardness");
 }
 
 use params::*;
@@ -85,6 +87,10 @@ pub struct ContactRequest {
     /// Thermal conductivities of body 1 and body 2, W/(m·K).
     #[serde(default)]
     pub thermal_conductivity: Option<Vec<f64>>,
+    /// The hardness, Pa: the contact pressure capped there (elastic–perfectly-plastic
+    /// contact, docs/hardness.md); each load on the surface as measured.
+    #[serde(default)]
+    pub hardness: Option<f64>,
 }
 
 impl Default for ContactRequest {
@@ -99,6 +105,7 @@ impl Default for ContactRequest {
             tolerance: SolverParams::default().tolerance,
             resistivity: None,
             thermal_conductivity: None,
+            hardness: None,
         }
     }
 }
@@ -114,6 +121,8 @@ pub struct ContactPlan {
     pub loads: Vec<Control>,
     /// The bodies' resistivities and conductivities, if given.
     pub transport: Transport,
+    /// The contact law: the hard wall, or the pressure capped at the hardness.
+    pub interface: Interface,
 }
 
 /// Two values, one per body, each positive and finite.
@@ -157,8 +166,10 @@ impl ContactRequest {
             resistivity,
             thermal_conductivity: thermal,
         };
+        let interface = interface(self.hardness, &self.pressures)?;
         Ok(ContactPlan {
             transport,
+            interface,
             half_space: HalfSpace { modulus, boundary },
             params: SolverParams {
                 tolerance: self.tolerance,
@@ -171,6 +182,27 @@ impl ContactRequest {
                 .collect(),
         })
     }
+}
+
+/// The contact law of a hardness (Pa, positive and finite) or none, refused where a
+/// pressure is at or above it (more than a fully plastic contact carries).
+fn interface(hardness: Option<f64>, pressures: &[f64]) -> Result<Interface, Refusal> {
+    let Some(h) = hardness else {
+        return Ok(Interface::HardWall);
+    };
+    if !(h.is_finite() && h > 0.0) {
+        return Err(Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {h}")));
+    }
+    if let Some(p) = pressures.iter().find(|&&p| p >= h) {
+        return Err(Refusal::saying("a mean pressure of ")
+            .text(format!(
+                "{p} Pa is at or above the hardness {h} Pa: more than a fully plastic contact can \
+             carry (lower it or raise "
+            ))
+            .param(HARDNESS)
+            .text(")"));
+    }
+    Ok(Interface::Hardness { h })
 }
 
 /// The columns of `asperity contact`'s table (SI units), in the order of
@@ -215,12 +247,19 @@ pub struct ContactRow {
     pub electrical_conductance: Option<f64>,
     /// Thermal conductance by Barber's analogy, W/K (with conductivities).
     pub thermal_conductance: Option<f64>,
+    /// With a hardness: the plastic contact area (points at the hardness), m², and its
+    /// fraction of the nominal area.
+    pub plastic: Option<(f64, f64)>,
 }
 
-/// The columns of `plan`'s table: [`COLUMNS`], then `electrical_conductance_s` and
+/// The columns of `plan`'s table: [`COLUMNS`], then `plastic_area_m2` and
+/// `plastic_fraction` with a hardness, then `electrical_conductance_s` and
 /// `thermal_conductance_w_per_k` when their bodies' properties are given.
 pub fn columns(plan: &ContactPlan) -> Vec<&'static str> {
     let mut columns = COLUMNS.to_vec();
+    if plan.interface != Interface::HardWall {
+        columns.extend(["plastic_area_m2", "plastic_fraction"]);
+    }
     if plan.transport.resistivity.is_some() {
         columns.push("electrical_conductance_s");
     }
@@ -260,6 +299,9 @@ impl ContactRow {
     /// The row's values in the order of [`columns`] (the conductances that were asked for).
     pub fn all_values(&self) -> Vec<Value> {
         let mut values = self.values().to_vec();
+        if let Some((area, fraction)) = self.plastic {
+            values.extend([Value::Number(area), Value::Number(fraction)]);
+        }
         let conductances = [self.electrical_conductance, self.thermal_conductance];
         values.extend(conductances.into_iter().flatten().map(Value::Number));
         values
@@ -282,6 +324,7 @@ struct Observer<'a> {
     keep_map: bool,
     pixel_area: f64,
     transport: Transport,
+    plastic: bool,
     modulus: f64,
     fields: (f64, usize),
     map: Option<Array2<bool>>,
@@ -307,6 +350,10 @@ impl SweepObserver for Observer<'_> {
         self.rows.push(ContactRow {
             electrical_conductance: self.transport.electrical(stiffness, self.modulus),
             thermal_conductance: self.transport.thermal(stiffness, self.modulus),
+            plastic: self.plastic.then(|| {
+                let area = s.plastic_points as f64 * self.pixel_area;
+                (area, s.plastic_fraction)
+            }),
             pressure: s.mean_pressure,
             force: s.force,
             area: s.contact_points as f64 * self.pixel_area,
@@ -324,7 +371,7 @@ impl SweepObserver for Observer<'_> {
 }
 
 /// Runs the plan's loads on `solver` (the library's sweep: full contact checked before any
-/// solve, warm starts, frozen-set stiffness); `pixel_area` in m², `keep_map`: keep the
+/// solve, warm starts, frozen-set stiffness), with the plan's contact law; `pixel_area` in m², `keep_map`: keep the
 /// contact set of the last load; `on_load` is called after each load is done (progress).
 pub fn run(
     solver: &mut ContactSolver,
@@ -339,11 +386,17 @@ pub fn run(
         keep_map,
         pixel_area,
         transport: plan.transport,
+        plastic: plan.interface != Interface::HardWall,
         modulus: plan.half_space.modulus,
         fields: (f64::NAN, 0),
         map: None,
         rows: Vec::with_capacity(plan.loads.len()),
     };
+    if solver.interface() != plan.interface {
+        solver
+            .set_interface(plan.interface)
+            .map_err(|e| SweepError::Input(asperity::Error::invalid("hardness", e.to_string())))?;
+    }
     let params = SweepParams {
         stiffness: true,
         fd_step: None,
@@ -447,6 +500,79 @@ mod tests {
         assert_eq!(map, by_hand.pressure().mapv(|v| v > 0.0));
         assert_eq!(COLUMNS.len(), run.rows[0].values().len());
         assert_eq!(columns(&plan).len(), run.rows[0].all_values().len());
+    }
+
+    #[test]
+    fn a_hardness_caps_the_pressure_and_adds_the_plastic_columns() {
+        // The run under a hardness is the library's capped solve of each load (the same
+        // numbers as a solver given the interface by hand), every pressure within [0, H],
+        // the plastic columns the points at H; bad hardnesses and loads at or above it
+        // are refused in both front ends' words.
+        use asperity::surface::Surface;
+        let heights = Array2::from_shape_fn((24, 24), |(i, j)| {
+            ((i as f64) * 0.7).sin() * ((j as f64) * 0.4).cos() * 1e-6
+        });
+        let surface = Surface::new(heights, 1e-4).unwrap();
+        let pressures = vec![2e5];
+        // A cap at 0.8 of the elastic peak pressure: partly plastic, well inside what the
+        // capped solvers converge on (far below the peak they may not: docs/hardness.md,
+        // known defect; measured here, 0.6 of the peak at 2e5 Pa failed at 5e5 Pa).
+        let elastic = ContactRequest {
+            modulus: Some(1e9),
+            pressures: pressures.clone(),
+            ..ContactRequest::default()
+        };
+        let plan = elastic.validate().unwrap();
+        let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        solver.solve(plan.loads[0]).unwrap();
+        let h = 0.8 * solver.pressure().fold(0.0f64, |m, &p| m.max(p));
+        assert!(h > pressures[0], "{h}");
+        let request = ContactRequest {
+            hardness: Some(h),
+            ..elastic
+        };
+        let plan = request.validate().unwrap();
+        assert_eq!(plan.interface, Interface::Hardness { h });
+        let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        let pixel = surface.spacing() * surface.spacing_y();
+        let run = run(&mut solver, &plan, pixel, false, &mut || {}).unwrap();
+        assert!(solver.pressure().iter().all(|&p| (0.0..=h).contains(&p)));
+        let mut by_hand = ContactSolver::new(&surface, plan.half_space, plan.params)
+            .unwrap()
+            .with_interface(Interface::Hardness { h })
+            .unwrap();
+        for (row, control) in run.rows.iter().zip(&plan.loads) {
+            let (summary, _) = by_hand.solve(*control).unwrap();
+            assert!(summary.plastic_points > 0);
+            assert_eq!(
+                row.plastic,
+                Some((
+                    summary.plastic_points as f64 * pixel,
+                    summary.plastic_fraction
+                ))
+            );
+            assert_eq!(row.force, summary.force);
+        }
+        let names = columns(&plan);
+        assert_eq!(&names[10..], ["plastic_area_m2", "plastic_fraction"]);
+        assert_eq!(run.rows[0].all_values().len(), names.len());
+        let refused = |hardness: f64, pressure: f64| {
+            let request = ContactRequest {
+                hardness: Some(hardness),
+                pressures: vec![pressure],
+                ..request.clone()
+            };
+            first(&request.validate().unwrap_err())
+        };
+        assert_eq!(
+            refused(-1.0, 1e5),
+            "hardness must be positive and finite, got -1"
+        );
+        assert_eq!(
+            refused(1e5, 1e5),
+            "a mean pressure of 100000 Pa is at or above the hardness 100000 Pa: more than a \
+             fully plastic contact can carry (lower it or raise hardness)"
+        );
     }
 
     #[test]

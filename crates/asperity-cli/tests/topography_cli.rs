@@ -273,16 +273,9 @@ fn mdr_takes_a_measured_profile() {
     assert_eq!(text.lines().count(), 6);
 }
 
-/// A paraboloid z = −(x² + y²)/(2R) in metres (Gwyddion text export with its header),
-/// pressed with a force F: Hertz gives the contact radius a = (3FR/(4E*))^(1/3), area πa²,
-/// stiffness 2aE*, one patch. On 96² pixels with a ≈ 8 and 17 pixels the pixelated
-/// circle's area and stiffness come within 1.5 % (boundary pixels; measured 1.5 % and
-/// 0.8 % at the smaller load): tolerance 3 %.
-#[test]
-fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let (n, side, radius, e_star) = (96usize, 20e-6, 1e-3, 1e9);
+/// The Gwyddion text export of a paraboloid `z = −(x² + y²)/(2R)` on `n²` pixels of a
+/// square of side `side` (metres).
+fn paraboloid(n: usize, side: f64, radius: f64) -> String {
     let dx = side / n as f64;
     let mut text = format!(
         "# Channel: Height\n# Width: {} um\n# Height: {} um\n# Value units: m\n",
@@ -302,7 +295,20 @@ fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
         text += &row.join(" ");
         text += "\n";
     }
-    std::fs::write(d.join("sphere.txt"), text).unwrap();
+    text
+}
+
+/// A paraboloid z = −(x² + y²)/(2R) in metres (Gwyddion text export with its header),
+/// pressed with a force F: Hertz gives the contact radius a = (3FR/(4E*))^(1/3), area πa²,
+/// stiffness 2aE*, one patch. On 96² pixels with a ≈ 8 and 17 pixels the pixelated
+/// circle's area and stiffness come within 1.5 % (boundary pixels; measured 1.5 % and
+/// 0.8 % at the smaller load): tolerance 3 %.
+#[test]
+fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, e_star) = (96usize, 20e-6, 1e-3, 1e9);
+    std::fs::write(d.join("sphere.txt"), paraboloid(n, side, radius)).unwrap();
     let a_target: f64 = 3.5e-6;
     let force = 4.0 * e_star * a_target.powi(3) / (3.0 * radius);
     let pressure = force / (side * side);
@@ -358,6 +364,84 @@ fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
     let record = json(&d.join("c.csv.json"));
     assert!((record["effective_modulus_pa"].as_f64().unwrap() / e_star - 1.0).abs() < 1e-12);
     assert!(d.join("c.png").is_file() && d.join("m.png").is_file());
+}
+
+/// `--hardness` in Pa on the paraboloid: at a hardness of half Hertz's peak pressure
+/// the pressure is capped (p ≤ H, so F ≤ H·A), part of the contact is plastic and the area
+/// exceeds Hertz's; a bad hardness or a load at or above it is refused with one line.
+#[test]
+fn contact_with_a_hardness_caps_the_pressure_in_si_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, e_star) = (64usize, 20e-6, 1e-3, 1e9);
+    std::fs::write(d.join("sphere.txt"), paraboloid(n, side, radius)).unwrap();
+    let a: f64 = 4e-6;
+    let force = 4.0 * e_star * a.powi(3) / (3.0 * radius);
+    let peak = 2.0 * e_star * a / (std::f64::consts::PI * radius);
+    let hardness = peak / 2.0;
+    let (p, h) = (format!("{}", force / (side * side)), format!("{hardness}"));
+    let base = [
+        "contact",
+        "sphere.txt",
+        "--modulus",
+        "1e9",
+        "--detrend",
+        "none",
+    ];
+    let with = |extra: &[&str]| asperity(&[&base[..], extra].concat(), d);
+    ok(&with(&[
+        "--pressures",
+        &p,
+        "--hardness",
+        &h,
+        "--out",
+        "c.csv",
+    ]));
+    let csv = std::fs::read_to_string(d.join("c.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|x| *x == name).unwrap();
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let (f, area) = (row[col("force_n")], row[col("contact_area_m2")]);
+    assert!(
+        f <= hardness * area * (1.0 + 1e-12),
+        "{f} vs {}",
+        hardness * area
+    );
+    assert!(area > std::f64::consts::PI * a * a);
+    let plastic = row[col("plastic_fraction")];
+    assert!(plastic > 0.0 && plastic < row[col("area_fraction")]);
+    // The plastic area is the plastic fraction of the nominal area (whole pixels).
+    let plastic_area = row[col("plastic_area_m2")];
+    assert!((plastic_area / (plastic * side * side) - 1.0).abs() < 1e-9);
+    // The default (BCCG) solver converged: iterations well below the limit.
+    assert!(
+        row[col("iterations")] < 1000.0,
+        "{}",
+        row[col("iterations")]
+    );
+    let record = json(&d.join("c.csv.json"));
+    assert_eq!(record["hardness_pa"].as_f64(), Some(hardness));
+    for (extra, needle) in [
+        (["--pressures", p.as_str(), "--hardness", "-1"], "hardness"),
+        (
+            ["--pressures", &h, "--hardness", &h],
+            "at or above the hardness",
+        ),
+    ] {
+        let out = with(&extra);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(needle) && err.trim().lines().count() == 1,
+            "{err}"
+        );
+    }
 }
 
 #[test]

@@ -31,9 +31,11 @@ use crate::progress::Progress;
 #[command(after_help = "Examples:\n  \
     asperity contact scan.x3p --young 210e9 --poisson 0.3 --pressures 1e5,1e6,1e7 --detrend plane\n  \
     asperity contact scan.x3p --modulus 1e9 --pressures 1e4,1e5 --out contact.csv --plot contact.png --map map.png\n  \
-    asperity contact afm.txt --channel Height --detrend lines --fill harmonic --modulus 70e9 --pressures 1e6\n\n\
+    asperity contact afm.txt --channel Height --detrend lines --fill harmonic --modulus 70e9 --pressures 1e6\n  \
+    asperity contact scan.x3p --young 210e9 --poisson 0.3 --hardness 2e9 --pressures 1e7,1e8\n\n\
 Columns (SI units): mean_pressure_pa, force_n, contact_area_m2, area_fraction, mean_gap_m,\n\
-stiffness_n_per_m, patches, indentation_m, iterations, residual. The surface is rigid and\n\
+stiffness_n_per_m, patches, indentation_m, iterations, residual; with --hardness then\n\
+plastic_area_m2, plastic_fraction (the points at the hardness). The surface is rigid and\n\
 pressed into an elastic half-space of effective modulus E* = E/(1 − ν²); free boundaries\n\
 (the paper's) unless --boundary periodic. Heights and sizes are read in metres.")]
 pub struct ContactArgs {
@@ -94,6 +96,11 @@ pub struct ContactArgs {
         value_name = "K1,K2"
     )]
     pub thermal_conductivity: Option<Vec<f64>>,
+    /// Hardness in Pa: the contact pressure is capped there (elastic–perfectly-plastic
+    /// contact, docs/hardness.md; each load on the surface as measured); adds the columns
+    /// plastic_area_m2 and plastic_fraction, and the stiffness is that of the elastic set.
+    #[arg(long, value_name = "PA", allow_negative_numbers = true)]
+    pub hardness: Option<f64>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -113,6 +120,7 @@ fn request(args: &ContactArgs) -> ContactRequest {
         tolerance: args.tol,
         resistivity: args.resistivity.clone(),
         thermal_conductivity: args.thermal_conductivity.clone(),
+        hardness: args.hardness,
     }
 }
 
@@ -248,6 +256,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
                 "pressures_pa": args.pressures,
                 "resistivity_ohm_m": args.resistivity,
                 "thermal_conductivity_w_per_m_k": args.thermal_conductivity,
+                "hardness_pa": args.hardness,
                 "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
                     2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",
                 "units": "SI: m, Pa, N, m², N/m, S, W/K",
