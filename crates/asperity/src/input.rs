@@ -14,9 +14,16 @@
 
 use std::fs::File;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::{Error, Result};
+
+/// The sidecar path of an array file: `surface.npy` → `surface.npy.json`.
+pub fn sidecar_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_os_string();
+    name.push(".json");
+    PathBuf::from(name)
+}
 
 /// The largest sidecar read, in bytes (asperity writes a few hundred).
 pub const SIDECAR_MAX_BYTES: u64 = 1 << 20;
@@ -83,7 +90,7 @@ pub fn read_text(path: &Path, cap: u64) -> Result<String> {
 
 /// The JSON sidecar of an array file (see the module docs): `Ok(None)` when there is none.
 pub fn read_sidecar(array: &Path) -> Result<Option<serde_json::Value>> {
-    let path = crate::io::sidecar_path(array);
+    let path = sidecar_path(array);
     match std::fs::metadata(&path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         _ => {}
@@ -194,7 +201,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let array = dir.path().join("a.npy");
         assert_eq!(sidecar_size(&array).unwrap(), None, "no sidecar");
-        let side = crate::io::sidecar_path(&array);
+        let side = sidecar_path(&array);
         std::fs::write(&side, r#"{"spec": {"size": 2.5}}"#).unwrap();
         assert_eq!(sidecar_size(&array).unwrap(), Some(2.5));
         std::fs::write(&side, r#"{"spec": {}}"#).unwrap();
@@ -249,7 +256,7 @@ mod tests {
             let mut bytes = format!("{{\"spec\": {{\"size\": {size}, \"psd\": {{}}}}}}").into_bytes();
             bytes.truncate(bytes.len().saturating_sub(cut % 30));
             if cut >= 30 { bytes.extend(&noise); }
-            std::fs::write(crate::io::sidecar_path(&array), &bytes).unwrap();
+            std::fs::write(sidecar_path(&array), &bytes).unwrap();
             match sidecar_size(&array) {
                 Ok(Some(s)) => prop_assert!(s.is_finite() && s > 0.0),
                 Ok(None) => {}

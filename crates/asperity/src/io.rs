@@ -191,12 +191,10 @@ fn process_alive(pid: u32) -> bool {
     }
 }
 
-/// The sidecar path of an array file: `surface.npy` → `surface.npy.json`.
-pub fn sidecar_path(path: &Path) -> PathBuf {
-    let mut name = path.as_os_str().to_os_string();
-    name.push(".json");
-    PathBuf::from(name)
-}
+/// The sidecar path of an array file (defined with the sidecar reader,
+/// [`crate::input::sidecar_path`]: `input` sits below `io` and `npy`, which both read
+/// through it, and imports neither).
+pub use crate::input::sidecar_path;
 
 /// The side length `spec.size` recorded in the JSON sidecar of `path`, if it has a
 /// sidecar that records one; a sidecar that is corrupt, not a regular file, too large, or
