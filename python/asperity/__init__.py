@@ -51,7 +51,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _asperity as _core
-from . import _mpi
+from . import _mpi, reference
 from ._asperity import BeyondFullContactError, ConvergenceError, __version__
 
 __all__ = [
@@ -74,13 +74,19 @@ __all__ = [
     "UnlevelledWarning",
     "contact",
     "bem_adhesion",
+    "effective_modulus",
+    "patches",
+    "Patches",
+    "SlipCycle",
     "line",
+    "load",
     "mdr",
     "mdr_slip",
     "persson",
     "psd",
     "import_topography",
     "read_topography",
+    "reference",
     "stats",
     "study_alpha",
     "study_curve",
@@ -233,9 +239,43 @@ class Surface:
         return self.heights if dtype is None else self.heights.astype(dtype)
 
     def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
-        """Writes ``path`` (.npy, float64) and its sidecar ``path.json``, as the CLI does
-        (both or neither; an existing file is refused unless ``force``)."""
+        """Writes ``path`` (.npy, float64) and its sidecar ``path.json``, as ``asperity
+        surface`` does (both or neither; an existing file is refused unless ``force``):
+        :func:`load` gives back the same surface, and :func:`read_topography` and every
+        CLI command read its size from the sidecar. A path ending in ``.x3p`` writes an
+        ISO 25178-72 X3P file instead (heights and both sizes; the seed and spec are not
+        kept), which :func:`load` reads back as a :class:`Topography`.
+
+        Example::
+
+            >>> s = asperity.surface(32, hurst=0.8, size=2.0, seed=1)
+            >>> s.save("s.npy")
+            >>> back = asperity.load("s.npy")
+            >>> bool((back.heights == s.heights).all()), back.size, back.seed
+            (True, 2.0, 1)
+        """
+        if _is_x3p(path):
+            provenance = _generated_provenance(self.metadata)
+            _core.save_topography(os.fspath(path), self.heights, [self.size, self.size_y],
+                                  json.dumps(provenance), bool(force))
+            return
         _core.save_heights(os.fspath(path), self.heights, json.dumps(self.metadata), force)
+
+    def __repr__(self) -> str:
+        rows, cols = self.heights.shape
+        return f"Surface({rows}x{cols}, size={self.size}, seed={self.seed})"
+
+
+def _is_x3p(path: Union[str, os.PathLike]) -> bool:
+    return os.fspath(path).lower().endswith(".x3p")
+
+
+def _generated_provenance(metadata: Dict[str, Any]) -> Dict[str, Any]:
+    """The provenance record of a generated surface written to a file format that carries
+    no asperity sidecar (X3P)."""
+    return {"source": "", "format": metadata.get("generator", "asperity"),
+            "channel": "heights", "channel_index": 0, "channels": ["heights"],
+            "file_unit": None, "unit": None, "size_source": "given", "cleaning": []}
 
 
 @dataclass
@@ -262,8 +302,12 @@ class Line:
         return self.heights if dtype is None else self.heights.astype(dtype)
 
     def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
-        """Writes ``path`` (.npy) and ``path.json`` as ``asperity line`` does."""
+        """Writes ``path`` (.npy) and ``path.json`` as ``asperity line`` does; :func:`load`
+        gives back the same line."""
         _core.save_heights(os.fspath(path), self.heights, json.dumps(self.metadata), force)
+
+    def __repr__(self) -> str:
+        return f"Line({len(self.heights)}, size={self.size}, seed={self.seed})"
 
 
 def surface(
@@ -365,6 +409,10 @@ def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
                 raise ValueError(f"heights: expected two physical sizes (sx, sy), got {sizes!r}")
             return heights.T, sizes[0], sizes[1], True, None
         return heights, sizes[0], None, True, None
+    if np.asarray(values).dtype == object:
+        raise ValueError(
+            f"values: expected an asperity Surface, Line or Topography, a SurfaceTopography "
+            f"topography or an array of heights, got {type(values).__name__}")
     heights = _float64(values, "heights")
     if isinstance(size, (tuple, list)):
         if len(size) != 2 or heights.ndim != 2:
@@ -373,10 +421,11 @@ def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
     return heights, 1.0 if size is None else float(size), None, False, None
 
 
-def _statistics(values: Any, size, fit_from, fit_to) -> Dict[str, Any]:
+def _statistics(values: Any, size, fit_from, fit_to, window: str = "none",
+                convention: str = "asperity") -> Dict[str, Any]:
     heights, size_x, size_y, measured, metadata = _stats_source(values, size)
     result = _core.statistics(heights, size_x, size_y, measured, metadata,
-                              _opt(fit_from), _opt(fit_to))
+                              _opt(fit_from), _opt(fit_to), str(window), str(convention))
     if result["iso"] is not None:
         result["iso"] = json.loads(result["iso"])
     return result
@@ -386,7 +435,8 @@ _PSD_KEYS = ("q", "psd", "modes", "size", "fit_prefactor", "fit_stderr", "fit_po
 
 
 def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
-          fit_from: Optional[float] = None, fit_to: Optional[float] = None) -> Dict[str, Any]:
+          fit_from: Optional[float] = None, fit_to: Optional[float] = None,
+          window: str = "none") -> Dict[str, Any]:
     """The statistics ``asperity stats`` prints, by the same code: ``rms_height``,
     ``rms_slope`` (forward differences), ``rms_curvature`` (half the rms five-point
     Laplacian; per-axis spacings on rectangular pixels), the PSD's power-law fit
@@ -400,14 +450,15 @@ def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
     are handled), a SurfaceTopography topography, or an array with ``size`` = L along x
     (square pixels; default 1) or ``(x, y)`` for a map with rectangular pixels.
     ``fit_from``/``fit_to`` default to 2 (or the spec's roll-off or cut-off) and Nyquist
-    (or below the spec's short cut-off).
+    (or below the spec's short cut-off). ``window``: the window of the PSD whose slope is
+    fitted (see :func:`psd`; the rms values are of the heights as they are).
 
     Example::
 
         >>> asperity.stats(asperity.line(1024, hurst=0.5, rms_slope=2.0))["rms_slope"]
         2.0...
     """
-    result = _statistics(values, size, fit_from, fit_to)
+    result = _statistics(values, size, fit_from, fit_to, window)
     for key in _PSD_KEYS:
         del result[key]
     return result
@@ -454,6 +505,30 @@ class Topography:
     @property
     def physical_sizes(self) -> Tuple[float, ...]:
         return (self.size,) if self.size_y is None else (self.size, self.size_y)
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes the topography as ``asperity import --out`` does, by the same code:
+        ``path`` ``.npy`` (float64, metres) with the sidecar ``path.json`` (source, format,
+        channel, units, sizes per axis, every cleaning step, and the provenance), or
+        ``.x3p`` (ISO 25178-72; maps only). Both files or neither; an existing one is
+        refused unless ``force``, and the file it was read from is never overwritten.
+        :func:`load` gives back the same topography (heights bit for bit, sizes,
+        provenance); :func:`read_topography` and the CLI read the sizes back.
+
+        Example::
+
+            >>> t = asperity.read_topography("scan.x3p", detrend="plane")  # doctest: +SKIP
+            >>> t.save("scan.npy"); t.save("levelled.x3p")                 # doctest: +SKIP
+        """
+        sizes = list(self.physical_sizes)
+        _core.save_topography(os.fspath(path), self.heights, sizes,
+                              json.dumps(self.provenance), bool(force))
+
+    def __repr__(self) -> str:
+        shape = "x".join(str(n) for n in self.heights.shape)
+        sizes = " x ".join(f"{s:g}" for s in self.physical_sizes)
+        return (f"Topography({shape}, sizes={sizes} m, "
+                f"format={self.provenance.get('format')!r})")
 
 
 class AsperityWarning(UserWarning):
@@ -549,12 +624,25 @@ def psd(
     size: Union[None, float, Tuple[float, float]] = None,
     fit_from: Optional[float] = None,
     fit_to: Optional[float] = None,
+    window: str = "none",
+    convention: str = "asperity",
 ) -> Psd:
     """The PSD of a surface or line, as ``asperity stats --psd``, with the least-squares
     power law ``C ∝ q^p`` over the bins whose rounded q·L/2π lies in ``fit_from`` ..
     ``fit_to`` (the defaults of :func:`stats`: 2, or the spec's roll-off, to Nyquist) and
     the Hurst estimate ``H = -(p + d)/2`` (d = 2 for surfaces, 1 for lines). ``values`` and
     ``size`` as for :func:`stats` (rectangular pixels included).
+
+    Normalisation (``convention``): ``"asperity"`` (the default, the library's and the
+    generators'; Persson's) makes ``∫ C2D d²q = rms²`` on a map and ``∫ C1D dq = rms²``
+    along a line (``C1D`` counts both signs of q); ``"surface-topography"`` reports
+    SurfaceTopography's ``|h̃(q)|²/A`` (``/L``), for which ``∫ C d^dq/(2π)^d = rms²``:
+    asperity's times (2π)² on a map and 2π on a line (the exponent and Hurst estimate do
+    not change). Bins: rings of width 2π/L centred on whole q·L/2π (a map), or each
+    q = 2πk/L (a line). ``window``: ``"none"`` (the scan is one period of a periodic
+    surface: right for generated surfaces) or ``"hann"`` (a non-periodic scan: the heights,
+    mean removed, times a Hann window -- radial on a map -- scaled to keep the power; the
+    window SurfaceTopography uses for non-periodic data), as ``asperity stats --window``.
 
     Example::
 
@@ -563,7 +651,7 @@ def psd(
         >>> abs(spectrum.hurst - 0.8) < 0.1
         True
     """
-    r = _statistics(values, size, fit_from, fit_to)
+    r = _statistics(values, size, fit_from, fit_to, window, convention)
     wavenumber = r["q"] * r["size"] / (2 * np.pi)
     fit = None
     if r["psd_slope"] is not None:
@@ -600,6 +688,27 @@ class ContactResult:
     pressure: Optional[np.ndarray] = None
     gap: Optional[np.ndarray] = None
     displacement: Optional[np.ndarray] = None
+    #: What produced it: the solver's settings, the surface's identity and the load.
+    metadata: Dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (``.npz``: the fields present, float64) and ``path.json`` (the
+        scalars and :attr:`metadata`), both or neither; :func:`load` gives it back."""
+        arrays = {name: getattr(self, name) for name in _CONTACT_FIELDS
+                  if getattr(self, name) is not None}
+        scalars = {name: getattr(self, name) for name in _CONTACT_SCALARS}
+        _save_bundle(path, "contact result", arrays, {"scalars": scalars,
+                                                      "metadata": self.metadata}, force)
+
+    def __repr__(self) -> str:
+        shape = "" if self.pressure is None else ", fields " + "x".join(map(str, self.pressure.shape))
+        return (f"ContactResult(force={self.force:.6g}, area_fraction={self.area_fraction:.6g}, "
+                f"contact_points={self.contact_points}, iterations={self.iterations}{shape})")
+
+
+_CONTACT_FIELDS = ("pressure", "gap", "displacement")
+_CONTACT_SCALARS = ("force", "mean_pressure", "indentation", "area_fraction", "contact_points",
+                    "iterations", "residual")
 
 
 @dataclass
@@ -610,6 +719,10 @@ class Sweep:
     with ``fields=True``, lists ``pressure`` and ``gap`` of the fields of every load."""
 
     columns: Dict[str, Any]
+    #: What produced it: the solver's (or contact request's) settings and the surface's
+    #: identity (a generated surface's sidecar, a measured one's provenance, and the
+    #: SHA-256 of the heights).
+    metadata: Dict[str, Any] = field(default_factory=dict)
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -622,6 +735,30 @@ class Sweep:
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (``.npz``: one array per column; the fields of a sweep with
+        ``fields=True`` as ``pressure``/``gap`` stacks of loads × rows × cols) and
+        ``path.json`` (column names, :attr:`metadata`), both or neither (an existing file
+        is refused unless ``force``). :func:`load` gives back the same sweep."""
+        arrays, stacked, scalars = {}, [], {}
+        for name, value in self.columns.items():
+            if isinstance(value, list):
+                arrays[name] = np.stack(value) if value else np.zeros((0, 0, 0))
+                stacked.append(name)
+            elif isinstance(value, np.ndarray):
+                arrays[name] = value
+            elif isinstance(value, (int, float)) and not isinstance(value, bool):
+                scalars[name] = value
+            else:
+                raise ValueError(f"column {name}: cannot save a {type(value).__name__}")
+        _save_bundle(path, "sweep", arrays, {"columns": list(self.columns),
+                                             "stacked": stacked, "scalars": scalars,
+                                             "metadata": self.metadata}, force)
+
+    def __repr__(self) -> str:
+        names = ", ".join(self.columns)
+        return f"Sweep({len(self)} loads: {names})"
 
 
 _BOUNDARIES = ("free", "periodic")
@@ -642,7 +779,9 @@ class Solver:
     that converts to float64 without loss, any memory order), an :class:`asperity.Surface`,
     or any object with SurfaceTopography's ``heights()`` and ``physical_sizes`` (its
     ``heights()[x, y]`` is transposed to asperity's ``(y, x)``; pixels may be rectangular).
-    ``size``: side L along x (default: the object's, else 1). ``modulus`` E*;
+    ``size``: side L along x (default: the object's, else 1). ``modulus`` E* (default 1),
+    or ``young`` E with ``poisson`` ν for E* = E/(1 − ν²) (:func:`effective_modulus`, the
+    rule of ``asperity contact``);
     ``boundary`` ``"free"`` (zero-padded, the paper's) or ``"periodic"``; ``tolerance``
     (rms gap violation on the contact set over the rms height) and ``max_iterations``;
     ``solver``: ``"bccg"`` (the default: Fourier-preconditioned bound-constrained conjugate
@@ -669,13 +808,18 @@ class Solver:
         surface: Any,
         size: Optional[float] = None,
         *,
-        modulus: float = 1.0,
+        modulus: Optional[float] = None,
+        young: Optional[float] = None,
+        poisson: Optional[float] = None,
         boundary: str = "free",
         tolerance: float = 1e-8,
         max_iterations: int = 10_000,
         solver: str = "bccg",
     ):
         heights, size_x, size_y = _surface_input(surface, size)
+        if modulus is None and young is None and poisson is None:
+            modulus = 1.0
+        modulus = effective_modulus(modulus=modulus, young=young, poisson=poisson)
         if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
             raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
         if max_iterations < 0:
@@ -684,6 +828,15 @@ class Solver:
             heights, size_x, size_y, float(modulus), str(boundary), float(tolerance),
             int(max_iterations), str(solver),
         )
+        self._surface = _surface_identity(surface, heights)
+
+    def _metadata(self, **load: Any) -> Dict[str, Any]:
+        """The identity of a result of this solver: its settings, the surface, the load."""
+        settings = {"shape": list(self.shape), "size": self.size, "modulus": self.modulus,
+                    "boundary": self.boundary, "tolerance": self.tolerance,
+                    "max_iterations": self.max_iterations, "solver": self.solver}
+        return {"generator": f"asperity {__version__}", "solver": settings,
+                "surface": self._surface, **load}
 
     shape = property(lambda self: self._core.shape, doc="(rows, cols)")
     size = property(lambda self: self._core.size, doc="side L along x")
@@ -716,7 +869,9 @@ class Solver:
             >>> r.pressure.sum() * (solver.size / solver.shape[1]) ** 2   # ≈ r.force
         """
         quantity, value = _one_load(pressure, force, indentation, "solve")
-        return ContactResult(**self._core.solve(quantity, value, bool(fields)))
+        result = ContactResult(**self._core.solve(quantity, value, bool(fields)))
+        result.metadata = self._metadata(load={"quantity": quantity, "value": value})
+        return result
 
     def stiffness(self) -> float:
         """Contact stiffness of the last solve by the frozen contact set (the paper's
@@ -774,7 +929,8 @@ class Solver:
             columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields), bar.callback)
         finally:
             bar.close()
-        return Sweep(columns)
+        return Sweep(columns, self._metadata(loads={"quantity": quantity, "values": values},
+                                             stiffness=bool(stiffness), fd_step=fd))
 
     def full_contact_threshold(self) -> Dict[str, Optional[float]]:
         """Mean pressure and indentation from which the gap is closed everywhere. On free
@@ -833,6 +989,22 @@ def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) ->
     )
 
 
+def effective_modulus(*, modulus: Optional[float] = None, young: Optional[float] = None,
+                      poisson: Optional[float] = None) -> float:
+    """E* by the one rule both front ends use (``asperity contact --modulus`` or
+    ``--young`` with ``--poisson``): ``modulus`` itself, or ``young`` E and ``poisson`` ν
+    (in [0, 0.5)) as E/(1 − ν²) -- a rigid counter-body. For two elastic bodies, combine
+    them first: ``1/E* = 1/E*₁ + 1/E*₂`` with ``E*ᵢ = Eᵢ/(1 − νᵢ²)``. Refusals (a ν of 0.5,
+    a negative E, both or neither given) raise ``ValueError`` in the CLI's words.
+
+    Example::
+
+        >>> round(asperity.effective_modulus(young=210e9, poisson=0.3) / 1e9, 3)
+        230.769
+    """
+    return _core.effective_modulus(_opt(modulus), _opt(young), _opt(poisson))
+
+
 def contact(
     surface: Any,
     size: Optional[float] = None,
@@ -857,7 +1029,9 @@ def contact(
     Returns the CLI's columns as numpy arrays: ``mean_pressure_pa``, ``force_n``,
     ``contact_area_m2``, ``area_fraction``, ``mean_gap_m``, ``stiffness_n_per_m``,
     ``patches``, ``indentation_m``, ``iterations``, ``residual``; ``effective_modulus``;
-    with ``map=True`` also ``map``, the contact set (True in contact) of the last load.
+    with ``map=True`` also ``map``, the contact set (True in contact) of the last load,
+    ``patch_labels`` (its 4-connected patches numbered from 1, 0 outside contact: the rule
+    of the ``patches`` column) and ``patch_areas_m2`` (each patch's area, by label).
     With ``resistivity`` (ρ₁, ρ₂ of the two bodies, Ω·m) also ``electrical_conductance_s``
     = 2k/(E*(ρ₁+ρ₂)); with ``thermal_conductivity`` (κ₁, κ₂, W/(m·K)) also
     ``thermal_conductance_w_per_k`` = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy).
@@ -886,7 +1060,78 @@ def contact(
         else [float(v) for v in np.atleast_1d(thermal_conductivity)],
         _opt(hardness),
     )
-    return Sweep(columns)
+    if "map" in columns:
+        dx = size_x / heights.shape[1]
+        dy = dx if size_y is None else size_y / heights.shape[0]
+        found = patches(columns["map"], pixel_area=dx * dy)
+        columns["patch_labels"], columns["patch_areas_m2"] = found.labels, found.areas
+    request = {"pressures": loads, "modulus": _opt(modulus), "young": _opt(young),
+               "poisson": _opt(poisson), "boundary": str(boundary),
+               "tolerance": float(tolerance), "resistivity": _floats(resistivity),
+               "thermal_conductivity": _floats(thermal_conductivity)}
+    return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
+                           "shape": list(heights.shape), "sizes": [size_x, size_y],
+                           "surface": _surface_identity(surface, heights)})
+
+
+@dataclass
+class Patches:
+    """The contact patches of a contact set: ``labels`` (rows × cols, uint32: 0 outside
+    contact, patches numbered 1, 2, ... in the order of their first point, row by row),
+    ``points`` (each patch's number of points, index k for label k + 1) and ``areas``
+    (``points`` times the pixel area)."""
+
+    labels: np.ndarray
+    points: np.ndarray
+    areas: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def __repr__(self) -> str:
+        rows, cols = self.labels.shape
+        return f"Patches({len(self)} patches on {rows}x{cols})"
+
+
+def patches(contact_set: Any, *, pixel_area: float = 1.0) -> Patches:
+    """The 4-connected patches of a contact set (points sharing an edge; no wrap-around),
+    by the library's rule, the one of ``asperity contact``'s ``patches`` column:
+    ``len(patches(c.map))`` is its value at the last load. ``contact_set``: a 2D boolean
+    array (e.g. ``result.pressure > 0`` or the ``map`` of :func:`contact`);
+    ``pixel_area``: the area of one point (Δx·Δy), for ``areas``.
+
+    Example::
+
+        >>> p = asperity.patches(np.array([[1, 1, 0], [0, 0, 1]], dtype=bool))
+        >>> len(p), p.points.tolist()
+        (2, [2, 1])
+    """
+    array = np.asarray(contact_set)
+    if array.dtype != np.bool_ or array.ndim != 2:
+        raise ValueError(f"contact_set: expected a 2D boolean array, got {array.dtype} "
+                         f"of shape {array.shape}")
+    labels, points = _core.label_patches(np.ascontiguousarray(array))
+    area = _positive(pixel_area, "pixel_area")
+    return Patches(labels, points, points * area)
+
+
+def _floats(values: Any) -> Optional[List[float]]:
+    return None if values is None else [float(v) for v in np.atleast_1d(values)]
+
+
+def _surface_identity(surface: Any, heights: np.ndarray) -> Dict[str, Any]:
+    """What a result records of the surface it was computed on: a generated surface's
+    sidecar, a measured one's provenance, and always the SHA-256 of the heights (float64,
+    row-major)."""
+    import hashlib
+
+    digest = hashlib.sha256(np.ascontiguousarray(heights, dtype=np.float64).tobytes())
+    identity: Dict[str, Any] = {"heights_sha256": digest.hexdigest()}
+    if isinstance(surface, Surface):
+        identity["sidecar"] = surface.metadata
+    elif isinstance(surface, Topography):
+        identity["provenance"] = surface.provenance
+    return identity
 
 
 # --------------------------------------------------------------------------------------
@@ -1229,6 +1474,28 @@ class StudyResult:
     comparisons: List[Optional[Dict[str, Any]]] = field(default_factory=list, repr=False)
     #: Why the study cannot be compared (a roll-off study whose sweeps ended), or None.
     comparison_error: Optional[str] = field(default=None, repr=False)
+    #: What produced it: ``study`` (``alpha`` or ``curve``), the ``folder`` and its
+    #: ``spec`` (the folder's ``study.json``).
+    metadata: Dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (``.npz``: the columns) and ``path.json`` (rows, tasks,
+        comparisons, :attr:`metadata`), both or neither; :func:`load` gives it back."""
+        arrays = {name: (v.astype(str) if v.dtype == object else v)
+                  for name, v in self.columns.items()}
+        record = {"columns": list(self.columns), "rows": self.rows, "tasks": self.tasks,
+                  "comparisons": self.comparisons,
+                  "comparison_error": self.comparison_error,
+                  "metadata": self.metadata}
+        _save_bundle(path, "study result", arrays, record, force)
+
+    def __repr__(self) -> str:
+        kind = self.metadata.get("study", "study")
+        tasks = len(self.tasks)
+        hursts = sorted({t["task"]["hurst"] for t in self.tasks if "task" in t})
+        span = f", hurst {hursts[0]:g}..{hursts[-1]:g}" if hursts else ""
+        return (f"StudyResult({kind}: {tasks} tasks{span}, {len(self.rows)} rows; "
+                f"columns {', '.join(self.columns)})")
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -1364,7 +1631,7 @@ def study_alpha(
                          f"{method} study")
     columns, rows = _table(records["alpha"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
-                       records["comparison_error"])
+                       records["comparison_error"], _study_metadata("alpha", out))
 
 
 def study_curve(
@@ -1399,4 +1666,122 @@ def study_curve(
                          f"{method} study")
     columns, rows = _table(records["curve"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
-                       records["comparison_error"])
+                       records["comparison_error"], _study_metadata("curve", out))
+
+
+def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
+    """A study result's identity: which study, its folder and the folder's spec."""
+    folder = os.fspath(out)
+    try:
+        with open(os.path.join(folder, "study.json"), encoding="utf-8") as f:
+            spec = json.load(f)
+    except (OSError, ValueError):
+        spec = None
+    return {"generator": f"asperity {__version__}", "study": kind, "folder": folder,
+            "spec": spec}
+
+
+# --------------------------------------------------------------------------------------
+# Saving and loading
+# --------------------------------------------------------------------------------------
+
+
+def _save_bundle(path: Union[str, os.PathLike], kind: str, arrays: Dict[str, np.ndarray],
+                 record: Dict[str, Any], force: bool) -> None:
+    """Writes a result as ``path`` (``.npz``, numpy's archive of ``.npy`` arrays, no
+    pickles) and its JSON sidecar ``path.json`` (``kind``, generator, ``record``), both or
+    neither, by the library's all-or-nothing writer (the CLI's)."""
+    import io
+
+    path = os.fspath(path)
+    if not path.lower().endswith(".npz"):
+        raise ValueError(f"path {path}: the file name must end in .npz")
+    for name, value in arrays.items():
+        if value.dtype == object:
+            raise ValueError(f"{name}: an array of Python objects cannot be saved")
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    sidecar = {"kind": kind, "generator": f"asperity {__version__}", **record}
+    try:
+        text = json.dumps(sidecar, indent=2, allow_nan=False, default=_json_scalar)
+    except ValueError as e:
+        raise ValueError(f"{path}: the record holds a non-finite number ({e})") from None
+    _core.save_files([(path, buffer.getvalue()), (path + ".json", (text + "\n").encode())],
+                     bool(force))
+
+
+def _json_scalar(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
+def _read_sidecar(path: str) -> Optional[Dict[str, Any]]:
+    try:
+        with open(path + ".json", encoding="utf-8") as f:
+            value = json.load(f)
+    except FileNotFoundError:
+        return None
+    except ValueError as e:
+        raise ValueError(f"{path}.json: not JSON ({e})") from None
+    return value if isinstance(value, dict) else None
+
+
+def _npz(path: str) -> Dict[str, np.ndarray]:
+    with np.load(path, allow_pickle=False) as archive:
+        return {name: archive[name] for name in archive.files}
+
+
+def load(path: Union[str, "os.PathLike[str]"]) -> Any:
+    """Loads what asperity saved, as the object that was saved: a :class:`Surface` or
+    :class:`Line` (``.npy`` with the sidecar of ``asperity surface``/``line`` or
+    :meth:`Surface.save`), a :class:`Topography` (``.npy`` with the sidecar of ``asperity
+    import`` or :meth:`Topography.save`, heights bit for bit with their sizes and
+    provenance; any other file, X3P included, through :func:`read_topography`), a
+    :class:`Sweep`, :class:`ContactResult` or :class:`StudyResult` (``.npz`` + sidecar of
+    their ``save``). Arrays are read without pickles.
+
+    Example::
+
+        >>> sweep = asperity.Solver(asperity.surface(32, hurst=0.8, seed=1)).sweep(
+        ...     nloads=3, pmin=1e-3, pmax=1e-2)
+        >>> sweep.save("sweep.npz")
+        >>> back = asperity.load("sweep.npz")
+        >>> bool((back.force == sweep.force).all()), back.metadata == sweep.metadata
+        (True, True)
+    """
+    path = os.fspath(path)
+    record = _read_sidecar(path)
+    kind = None if record is None else record.get("kind")
+    if kind in ("surface", "line"):
+        heights = np.load(path, allow_pickle=False)
+        size = float(record["spec"]["size"])
+        return (Surface if kind == "surface" else Line)(heights, size, record)
+    if kind in ("measured surface", "measured line") and "provenance" in record:
+        heights = np.load(path, allow_pickle=False)
+        sizes = [float(v) for v in record["sizes"]]
+        return Topography(heights, sizes[0], sizes[1] if len(sizes) > 1 else None,
+                          record["provenance"])
+    if kind == "sweep":
+        arrays = _npz(path)
+        scalars = record.get("scalars", {})
+        columns = {name: (scalars[name] if name in scalars else
+                          list(arrays[name]) if name in record["stacked"] else arrays[name])
+                   for name in record["columns"]}
+        return Sweep(columns, record["metadata"])
+    if kind == "contact result":
+        arrays = _npz(path)
+        return ContactResult(**record["scalars"], **arrays, metadata=record["metadata"])
+    if kind == "study result":
+        arrays = _npz(path)
+        columns = {name: (arrays[name].astype(object) if arrays[name].dtype.kind == "U"
+                          else arrays[name]) for name in record["columns"]}
+        return StudyResult(columns, record["rows"], record["tasks"], record["comparisons"],
+                           record.get("comparison_error"), record["metadata"])
+    return read_topography(path)
+
+
+def __dir__() -> List[str]:
+    """The public names only (``dir(asperity)``, tab completion): the helpers this module
+    imports (numpy as ``np``, ``os``, ``json``, ...) are not part of the package."""
+    return sorted(__all__)

@@ -9,6 +9,7 @@ import numpy.typing as npt
 
 from ._asperity import BeyondFullContactError as BeyondFullContactError
 from ._asperity import ConvergenceError as ConvergenceError
+from . import reference as reference
 
 __version__: str
 __all__: List[str]
@@ -62,7 +63,7 @@ def line(
 ) -> Line: ...
 def stats(
     values: Any, *, size: Union[None, float, Tuple[float, float]] = ...,
-    fit_from: Optional[float] = ..., fit_to: Optional[float] = ...,
+    fit_from: Optional[float] = ..., fit_to: Optional[float] = ..., window: str = ...,
 ) -> Dict[str, Any]: ...
 
 @dataclass
@@ -81,6 +82,8 @@ def psd(
     values: Any, *, size: Union[None, float, Tuple[float, float]] = ...,
     fit_from: Optional[float] = ...,
     fit_to: Optional[float] = ...,
+    window: str = ...,
+    convention: str = ...,
 ) -> Psd: ...
 
 @dataclass
@@ -91,6 +94,7 @@ class Topography:
     provenance: Dict[str, Any] = ...
     @property
     def physical_sizes(self) -> Tuple[float, ...]: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def read_topography(
     path: PathLike, *, channel: Union[None, str, int] = ...,
@@ -120,10 +124,13 @@ class ContactResult:
     pressure: Optional[F64] = ...
     gap: Optional[F64] = ...
     displacement: Optional[F64] = ...
+    metadata: Dict[str, Any] = ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 @dataclass
 class Sweep:
     columns: Dict[str, Any]
+    metadata: Dict[str, Any]
     force: F64
     mean_pressure: F64
     indentation: F64
@@ -137,6 +144,7 @@ class Sweep:
     gap: List[F64]
     def __getitem__(self, name: str) -> Any: ...
     def __len__(self) -> int: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 class Solver:
     shape: Tuple[int, int]
@@ -148,8 +156,8 @@ class Solver:
     solver: str
     nominal_area: float
     def __init__(
-        self, surface: Any, size: Optional[float] = ..., *, modulus: float = ...,
-        boundary: str = ..., tolerance: float = ..., max_iterations: int = ...,
+        self, surface: Any, size: Optional[float] = ..., *, modulus: Optional[float] = ...,
+        young: Optional[float] = ..., poisson: Optional[float] = ..., boundary: str = ..., tolerance: float = ..., max_iterations: int = ...,
         solver: str = ...,
     ) -> None: ...
     def solve(
@@ -170,6 +178,22 @@ class Solver:
     ) -> Sweep: ...
     def full_contact_threshold(self) -> Dict[str, Optional[float]]: ...
     def reset(self) -> None: ...
+
+def effective_modulus(
+    *, modulus: Optional[float] = ..., young: Optional[float] = ...,
+    poisson: Optional[float] = ...,
+) -> float: ...
+
+@dataclass
+class Patches:
+    labels: npt.NDArray[np.uint32]
+    points: npt.NDArray[np.uint64]
+    areas: F64
+    def __len__(self) -> int: ...
+
+def patches(contact_set: Any, *, pixel_area: float = ...) -> Patches: ...
+
+def load(path: PathLike) -> Any: ...
 
 def contact(
     surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
@@ -274,6 +298,8 @@ class StudyResult:
     tasks: List[Dict[str, Any]]
     comparisons: List[Optional[Dict[str, Any]]] = ...
     comparison_error: Optional[str] = ...
+    metadata: Dict[str, Any] = ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
     def comparison(self) -> Dict[str, np.ndarray]: ...
     def __getitem__(self, name: str) -> np.ndarray: ...
     def __getattr__(self, name: str) -> np.ndarray: ...

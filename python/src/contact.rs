@@ -6,9 +6,10 @@ use asperity::bem::sweep::{SweepError, SweepFailure};
 use asperity::bem::ContactSolver;
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
+use asperity::topography::patches;
 use asperity_app::bem::ensure_solver_fits;
 use asperity_app::contact::{self as app, ContactRequest, Value};
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -19,7 +20,34 @@ use crate::interrupt::{run_detached, run_detached_with};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact, m)?)?;
+    m.add_function(wrap_pyfunction!(effective_modulus, m)?)?;
+    m.add_function(wrap_pyfunction!(label_patches, m)?)?;
     Ok(())
+}
+
+/// E* by the front-end layer's one rule (`asperity contact`'s): the modulus itself, or
+/// `E/(1 − ν²)` from Young's modulus and Poisson's ratio.
+#[pyfunction]
+#[pyo3(signature = (modulus, young, poisson))]
+fn effective_modulus(
+    modulus: Option<f64>,
+    young: Option<f64>,
+    poisson: Option<f64>,
+) -> PyResult<f64> {
+    app::effective_modulus(modulus, young, poisson).map_err(refused)
+}
+
+/// The 4-connected contact patches of a contact set (`asperity::topography::patches`, the
+/// rule of `asperity contact`'s `patches` column): a label per point (0: no contact) and
+/// each patch's number of points.
+#[pyfunction]
+fn label_patches<'py>(
+    py: Python<'py>,
+    set: PyReadonlyArray2<'py, bool>,
+) -> (Bound<'py, PyArray2<u32>>, Bound<'py, PyArray1<u64>>) {
+    let (labels, sizes) = patches::label_patches(set.as_array());
+    let sizes = PyArray1::from_iter(py, sizes.into_iter().map(|n| n as u64));
+    (labels.into_pyarray(py), sizes)
 }
 
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of

@@ -15,6 +15,7 @@ mod errors;
 mod interrupt;
 mod mdr;
 mod persson;
+mod reference;
 mod slip;
 mod study;
 mod surface;
@@ -48,6 +49,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     contact::register(m)?;
     mdr::register(m)?;
     persson::register(m)?;
+    reference::register(m)?;
     slip::register(m)?;
     study::register(m)?;
     topography::register(m)?;

@@ -8,7 +8,9 @@ use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::surface::stats::{line_summary, surface_summary};
 use asperity::surface::{LineGenerator, SurfaceGenerator};
 use asperity::topography;
-use asperity_app::stats::{compute, SpectrumHints, Statistics, StatsRequest, StatsSource};
+use asperity_app::stats::{
+    compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
+};
 use asperity_app::surface::{ensure_usable, sidecar, SurfaceRequest};
 use asperity_app::Names;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArrayDyn};
@@ -146,7 +148,7 @@ fn save_heights(
 /// square pixels), which adds the ISO parameters. Returns the CLI's `--json` fields with
 /// the PSD's `q`, `psd` and `modes` as arrays.
 #[pyfunction]
-#[pyo3(signature = (array, size_x, size_y, measured, metadata, fit_from, fit_to))]
+#[pyo3(signature = (array, size_x, size_y, measured, metadata, fit_from, fit_to, window="none", convention="asperity"))]
 #[allow(clippy::too_many_arguments)]
 fn statistics<'py>(
     py: Python<'py>,
@@ -157,8 +159,15 @@ fn statistics<'py>(
     metadata: Option<String>,
     fit_from: Option<f64>,
     fit_to: Option<f64>,
+    window: &str,
+    convention: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let request = StatsRequest { fit_from, fit_to };
+    let request = StatsRequest {
+        fit_from,
+        fit_to,
+        window: parse_window(window).map_err(refused)?,
+        convention: PsdConvention::parse(convention).map_err(refused)?,
+    };
     request.validate().map_err(refused)?;
     let source = match (heights(&array, "heights")?, measured) {
         (Heights::Line(h), true) => StatsSource::Measured {

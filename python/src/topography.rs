@@ -6,19 +6,24 @@
 
 use std::path::PathBuf;
 
-use asperity::topography::{Fill, Heights};
+use asperity::io::StagedOutputs;
+use asperity::topography::{Fill, Heights, Provenance, Topography};
 use asperity_app::import::Import;
 use asperity_app::measured::{open, MeasuredRequest, Opened, WarningKind};
 use asperity_app::{Names, RequestError};
-use numpy::IntoPyArray;
+use numpy::{IntoPyArray, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 
-use crate::errors::request_error;
+use crate::arrays;
+use crate::errors::{from_error, invalid, request_error};
 use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_topography, m)?)?;
     m.add_function(wrap_pyfunction!(import_topography, m)?)?;
+    m.add_function(wrap_pyfunction!(save_topography, m)?)?;
+    m.add_function(wrap_pyfunction!(save_files, m)?)?;
     Ok(())
 }
 
@@ -109,4 +114,58 @@ fn to_python(py: Python<'_>, opened: Opened) -> Read {
         Heights::Profile(h) => h.into_pyarray(py).into_any().unbind(),
     };
     (heights, topography.sizes, provenance, warnings)
+}
+
+/// Writes a topography as `asperity import` does (the front-end layer's one writer,
+/// `asperity_app::import`):
+/// `path` `.npy` with its sidecar, or `.x3p` for a map. `provenance` is the JSON of
+/// `read_topography`'s record.
+#[pyfunction]
+#[pyo3(signature = (path, array, sizes, provenance, force))]
+fn save_topography(
+    py: Python<'_>,
+    path: PathBuf,
+    array: PyReadonlyArrayDyn<'_, f64>,
+    sizes: Vec<f64>,
+    provenance: &str,
+    force: bool,
+) -> PyResult<()> {
+    let provenance: Provenance =
+        serde_json::from_str(provenance).map_err(|e| invalid(format!("provenance: {e}")))?;
+    let heights = match arrays::heights(&array, "heights")? {
+        arrays::Heights::Line(h) => Heights::Profile(h),
+        arrays::Heights::Surface(h) => Heights::Areal(h),
+    };
+    let needed = heights.shape().len();
+    if sizes.len() != needed || !sizes.iter().all(|s| s.is_finite() && *s > 0.0) {
+        return Err(invalid(format!(
+            "sizes: expected {needed} positive finite sizes, got {sizes:?}"
+        )));
+    }
+    let topography = Topography {
+        heights,
+        sizes,
+        provenance,
+    };
+    let input = topography.provenance.source.clone();
+    let import = Import::stage(&input, &path, force).map_err(request_error)?;
+    run_detached(py, |_| import.write(&input, &topography))?.map_err(request_error)
+}
+
+/// Writes files all-or-nothing as the CLI writes its outputs (`asperity::io::StagedOutputs`):
+/// each `(path, bytes)` to a synced temporary file beside it, then all renamed into place;
+/// an existing file is refused unless `force`.
+#[pyfunction]
+#[pyo3(signature = (files, force))]
+fn save_files(files: Vec<(PathBuf, Bound<'_, PyBytes>)>, force: bool) -> PyResult<()> {
+    if files.is_empty() {
+        return Err(invalid("nothing to write"));
+    }
+    let mut staged = StagedOutputs::new(files.iter().map(|(p, _)| p), force).map_err(from_error)?;
+    for (path, bytes) in &files {
+        staged
+            .write_bytes(path, bytes.as_bytes())
+            .map_err(from_error)?;
+    }
+    staged.commit().map_err(from_error)
 }

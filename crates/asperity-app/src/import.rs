@@ -114,7 +114,8 @@ impl Import {
 }
 
 /// The import sidecar of `topography`: its provenance record ([`record`]), its `kind`
-/// (`measured surface` or `measured line`) and the `importer`.
+/// (`measured surface` or `measured line`), the `importer` and the `provenance` itself
+/// (from which Python's `load` gives back the same `Topography`).
 pub fn sidecar_record(topography: &Topography) -> serde_json::Value {
     let mut value = record(topography);
     value["kind"] = json!(match topography.heights {
@@ -122,6 +123,7 @@ pub fn sidecar_record(topography: &Topography) -> serde_json::Value {
         Heights::Profile(_) => "measured line",
     });
     value["importer"] = json!(format!("asperity {}", env!("CARGO_PKG_VERSION")));
+    value["provenance"] = json!(topography.provenance);
     value
 }
 

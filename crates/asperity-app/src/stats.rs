@@ -8,6 +8,7 @@ use asperity::fit::{power_law_fit, PowerLawFit};
 use asperity::surface::stats::{
     line_psd, line_summary, radial_psd_2d, surface_summary, PsdBin, Summary,
 };
+use asperity::surface::window::{windowed_line, windowed_map, Window};
 use asperity::surface::{Line, Surface};
 use asperity::topography::stats as topo_stats;
 use asperity::topography::Heights;
@@ -24,6 +25,10 @@ pub mod params {
     pub const FIT_FROM: Param = Param::new("--fit-from", "fit_from");
     /// The upper end of the PSD fit range, as q·L/2π.
     pub const FIT_TO: Param = Param::new("--fit-to", "fit_to");
+    /// The window applied before the PSD's FFT.
+    pub const WINDOW: Param = Param::new("--window", "window");
+    /// The PSD's normalisation.
+    pub const CONVENTION: Param = Param::new("--psd-convention", "convention");
 }
 
 use params::*;
@@ -33,13 +38,69 @@ use params::*;
 pub const DEFAULT_FIT_FROM: f64 = 2.0;
 
 /// A stats request: the ends of the PSD fit range, as given (`None`: the defaults of
-/// [`fit_range`]).
+/// [`fit_range`]), the window and the PSD's normalisation.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct StatsRequest {
     /// Lower end, q·L/2π.
     pub fit_from: Option<f64>,
     /// Upper end, q·L/2π.
     pub fit_to: Option<f64>,
+    /// The window of the PSD (the statistics are of the heights as they are).
+    #[serde(default)]
+    pub window: Window,
+    /// The normalisation the PSD is reported in.
+    #[serde(default)]
+    pub convention: PsdConvention,
+}
+
+/// How a PSD is normalised. asperity's (the library's, the generators'): `Σ_q C2D(q)
+/// (2π)²/A = rms²` over the modes of a map, `Σ_q C1D(q) 2π/L = rms²` over both signs of q
+/// along a line, so that `∫ C2D d²q = rms²` and `∫ C1D dq = rms²` (Persson's convention).
+/// SurfaceTopography's: `C2D = |h̃(q)|²/A` and `C1D = |h̃(q)|²/L` with `h̃` the
+/// continuous Fourier transform, so that `∫ C d^dq/(2π)^d = rms²`: the same spectrum times
+/// `(2π)²` on a map and `2π` along a line.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PsdConvention {
+    /// asperity's: `∫ C d^dq = rms²`.
+    #[default]
+    Asperity,
+    /// SurfaceTopography's: `∫ C d^dq / (2π)^d = rms²`.
+    SurfaceTopography,
+}
+
+impl PsdConvention {
+    /// The convention named `name` (`asperity` or `surface-topography`), or why not.
+    pub fn parse(name: &str) -> Result<Self, Refusal> {
+        match name {
+            "asperity" => Ok(PsdConvention::Asperity),
+            "surface-topography" => Ok(PsdConvention::SurfaceTopography),
+            _ => Err(Refusal::of(CONVENTION).text(format!(
+                " must be asperity or surface-topography, got {:?}",
+                asperity::input::clip(name)
+            ))),
+        }
+    }
+
+    /// The factor from asperity's PSD of a `dims`-dimensional grid to this convention's.
+    pub fn factor(self, dims: usize) -> f64 {
+        match self {
+            PsdConvention::Asperity => 1.0,
+            PsdConvention::SurfaceTopography => std::f64::consts::TAU.powi(dims as i32),
+        }
+    }
+}
+
+/// The window named `name` (`none` or `hann`), or why not.
+pub fn parse_window(name: &str) -> Result<Window, Refusal> {
+    match name {
+        "none" => Ok(Window::None),
+        "hann" => Ok(Window::Hann),
+        _ => Err(Refusal::of(WINDOW).text(format!(
+            " must be none or hann, got {:?}",
+            asperity::input::clip(name)
+        ))),
+    }
 }
 
 impl StatsRequest {
@@ -169,11 +230,15 @@ pub fn compute(
             heights,
             size,
             hints,
-        } => (hints, grid_inputs(heights, size, about)?),
-        StatsSource::Measured { heights, sizes } => {
-            (SpectrumHints::default(), measured_inputs(heights, &sizes)?)
-        }
+        } => (hints, grid_inputs(heights, size, request.window, about)?),
+        StatsSource::Measured { heights, sizes } => (
+            SpectrumHints::default(),
+            measured_inputs(heights, &sizes, request.window)?,
+        ),
     };
+    let mut inputs = inputs;
+    let factor = request.convention.factor(inputs.dims.len());
+    inputs.bins.iter_mut().for_each(|b| b.psd *= factor);
     ensure_finite(&inputs.summary, &inputs.bins).map_err(about)?;
     let ring = |q: f64| (q * inputs.size / std::f64::consts::TAU).round();
     let nyquist = inputs.bins.last().map_or(0.0, |b| ring(b.q));
@@ -224,19 +289,25 @@ fn library(source: asperity::Error) -> RequestError {
 fn grid_inputs(
     heights: ArrayD<f64>,
     size: f64,
+    window: Window,
     about: impl Fn(Refusal) -> RequestError,
 ) -> Result<Inputs, RequestError> {
     let (summary, bins, dims) = match heights.ndim() {
         1 => {
             let h = heights.into_dimensionality::<Ix1>().expect("1D");
             let line = Line::new(h, size).map_err(library)?;
-            (line_summary(&line), line_psd(&line), vec![line.len()])
+            let bins = windowed_line_psd(&line, window)?;
+            (line_summary(&line), bins, vec![line.len()])
         }
         2 => {
             let h = heights.into_dimensionality::<Ix2>().expect("2D");
             let surface = Surface::new(h, size).map_err(library)?;
             let (r, c) = surface.dim();
-            let bins = radial_psd_2d(&surface).map_err(|e| about(words(e)))?;
+            let bins = match window {
+                Window::None => radial_psd_2d(&surface),
+                _ => windowed_surface(&surface, window).and_then(|w| radial_psd_2d(&w)),
+            }
+            .map_err(|e| about(words(e)))?;
             (surface_summary(&surface), bins, vec![r, c])
         }
         d => {
@@ -254,9 +325,29 @@ fn grid_inputs(
     })
 }
 
+/// The PSD of a line with `window` (none: the library's own PSD, bit for bit).
+fn windowed_line_psd(line: &Line, window: Window) -> Result<Vec<PsdBin>, RequestError> {
+    if window == Window::None {
+        return Ok(line_psd(line));
+    }
+    let w = windowed_line(line.heights().view(), window);
+    Ok(line_psd(&Line::new(w, line.size()).map_err(library)?))
+}
+
+/// A surface's heights with `window` (on its sizes per axis).
+fn windowed_surface(surface: &Surface, window: Window) -> asperity::Result<Surface> {
+    let view = surface.heights().view();
+    let w = windowed_map(view, surface.size(), surface.size_y(), window);
+    Surface::with_sizes(w, surface.size(), surface.size_y())
+}
+
 /// A measured line or map with its ISO parameters; square pixels as [`grid_inputs`] (bit
 /// for bit), rectangular ones with a spacing per axis.
-fn measured_inputs(heights: Heights, sizes: &[f64]) -> Result<Inputs, RequestError> {
+fn measured_inputs(
+    heights: Heights,
+    sizes: &[f64],
+    window: Window,
+) -> Result<Inputs, RequestError> {
     let dims = heights.shape();
     match heights {
         Heights::Profile(h) => {
@@ -265,7 +356,7 @@ fn measured_inputs(heights: Heights, sizes: &[f64]) -> Result<Inputs, RequestErr
                 topo_stats::profile(line.heights().view(), line.spacing()).map_err(library)?;
             Ok(Inputs {
                 summary: line_summary(&line),
-                bins: line_psd(&line),
+                bins: windowed_line_psd(&line, window)?,
                 dims,
                 size: line.size(),
                 iso: Some(serde_json::to_value(iso).expect("serialises")),
@@ -276,8 +367,13 @@ fn measured_inputs(heights: Heights, sizes: &[f64]) -> Result<Inputs, RequestErr
             let (dx, dy) = (surface.spacing(), surface.spacing_y());
             let view = surface.heights().view();
             let iso = topo_stats::areal(view, dx, dy).map_err(library)?;
+            let windowed = match window {
+                Window::None => None,
+                _ => Some(windowed_surface(&surface, window).map_err(library)?),
+            };
+            let spectrum = windowed.as_ref().unwrap_or(&surface);
             let (summary, bins) = if surface.has_square_pixels() {
-                let bins = radial_psd_2d(&surface).map_err(library)?;
+                let bins = radial_psd_2d(spectrum).map_err(library)?;
                 (surface_summary(&surface), bins)
             } else {
                 let summary = Summary {
@@ -285,7 +381,8 @@ fn measured_inputs(heights: Heights, sizes: &[f64]) -> Result<Inputs, RequestErr
                     rms_slope: topo_stats::rms_slope_forward(view, dx, dy),
                     rms_curvature: topo_stats::rms_curvature(view, dx, dy),
                 };
-                let bins = topo_stats::radial_psd(view, surface.size(), surface.size_y())
+                let spectrum_view = spectrum.heights().view();
+                let bins = topo_stats::radial_psd(spectrum_view, surface.size(), surface.size_y())
                     .map_err(library)?;
                 (summary, bins)
             };
@@ -467,6 +564,7 @@ mod tests {
         let request = StatsRequest {
             fit_from: from,
             fit_to: to,
+            ..StatsRequest::default()
         };
         fit_range(&request, &hints, 64.0)
     }
@@ -522,7 +620,7 @@ mod tests {
             .starts_with("no PSD fit"));
         let bad = StatsRequest {
             fit_from: Some(-1.0),
-            fit_to: None,
+            ..StatsRequest::default()
         };
         assert_eq!(
             bad.validate().unwrap_err().words(Names::Keywords),

@@ -7,7 +7,9 @@ use asperity::fit::PowerLawFit;
 use asperity::io::{read_npy, read_npy_shape, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::PsdBin;
-use asperity_app::stats::{compute, SpectrumHints, Statistics, StatsRequest, StatsSource};
+use asperity_app::stats::{
+    compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
+};
 use asperity_app::Names;
 
 use super::measured::{
@@ -48,6 +50,17 @@ pub struct StatsArgs {
     /// wholly below the sidecar's short cut-off q1 (q1 − 1), if lower]. Clamped to Nyquist.
     #[arg(long, value_name = "Q")]
     pub fit_to: Option<f64>,
+    /// Window applied to the heights (mean removed) before the PSD's FFT: none (the scan
+    /// is one period of a periodic surface) or hann (a non-periodic scan: Hann along a
+    /// line, radial Hann on a map, scaled to keep the power; SurfaceTopography's). The
+    /// rms values are of the heights as they are.
+    #[arg(long, value_name = "NAME", default_value = "none")]
+    pub window: String,
+    /// Normalisation of the PSD (--psd, --plot, the fit's prefactor): asperity
+    /// (∫ C d^dq = rms²) or surface-topography (∫ C d^dq/(2π)^d = rms²: asperity's times
+    /// (2π)² on a map, 2π on a line). The slope and Hurst estimate are the same.
+    #[arg(long, value_name = "NAME", default_value = "asperity")]
+    pub psd_convention: String,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -184,9 +197,12 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         Some(text) => parse_size(text)?[0],
         None => None,
     };
+    let named = |r: asperity_app::Refusal| anyhow::anyhow!(r.words(Names::Flags));
     let request = StatsRequest {
         fit_from: args.fit_from,
         fit_to: args.fit_to,
+        window: parse_window(&args.window).map_err(named)?,
+        convention: PsdConvention::parse(&args.psd_convention).map_err(named)?,
     };
     request.validate()?;
     // The outputs are checked before the (possibly large) input is read.

@@ -11,6 +11,7 @@
 
 pub mod generate;
 pub mod stats;
+pub mod window;
 
 use ndarray::{Array1, Array2};
 use serde::{Deserialize, Serialize};

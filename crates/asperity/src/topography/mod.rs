@@ -19,7 +19,7 @@
 use std::path::{Path, PathBuf};
 
 use ndarray::{Array1, Array2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
 
@@ -361,7 +361,7 @@ impl Default for ReadOptions {
 }
 
 /// Where a topography came from and what was done to it (written to sidecars).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
     /// The file read.
     pub source: PathBuf,
@@ -795,7 +795,13 @@ fn read_npy_topography(path: &Path, options: &ReadOptions) -> Result<Topography>
             ))
         }
     };
-    let sidecar = npy_sidecar(path);
+    let mut sidecar = npy_sidecar(path);
+    if let (Heights::Areal(h), [Some(x), None], true) =
+        (&heights, sidecar.sizes, sidecar.square_pixels)
+    {
+        // A generated surface records its side along x; its pixels are square.
+        sidecar.sizes[1] = Some(x * h.nrows() as f64 / h.ncols() as f64);
+    }
     let channel = Channel {
         name: "heights".into(),
         heights,
@@ -825,6 +831,8 @@ fn read_npy_topography(path: &Path, options: &ReadOptions) -> Result<Topography>
 
 struct NpySidecar {
     sizes: [Option<f64>; 2],
+    /// The sidecar of a generated surface: one side, square pixels.
+    square_pixels: bool,
     unit: Option<String>,
     cleaning: Vec<String>,
 }
@@ -832,6 +840,7 @@ struct NpySidecar {
 fn npy_sidecar(path: &Path) -> NpySidecar {
     let mut out = NpySidecar {
         sizes: [None, None],
+        square_pixels: false,
         unit: None,
         cleaning: Vec::new(),
     };
@@ -855,6 +864,7 @@ fn npy_sidecar(path: &Path) -> NpySidecar {
         }
     } else if let Some(size) = value["spec"]["size"].as_f64() {
         out.sizes = [Some(size), None];
+        out.square_pixels = true;
     }
     out
 }
@@ -987,6 +997,22 @@ mod tests {
         assert_eq!(t.sizes, vec![4e-6, 3e-6]); // square pixels
         assert_eq!(t.provenance.size_source, "given");
         assert_eq!(t.provenance.unit, None);
+    }
+
+    #[test]
+    fn a_generated_surface_reads_back_with_both_sizes() {
+        // `asperity surface` records `spec.size` along x; its pixels are square, so y
+        // follows (a 16 x 32 map of side 2 is 2 x 1).
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.npy");
+        let heights = Array2::from_shape_fn((16, 32), |(r, c)| (r * 32 + c) as f64);
+        crate::io::write_npy_2d(&path, false, &heights).unwrap();
+        let sidecar = serde_json::json!({"kind": "surface", "spec": {"size": 2.0}});
+        crate::io::write_json(&crate::io::sidecar_path(&path), false, &sidecar).unwrap();
+        let t = read_file(&path, &ReadOptions::default()).unwrap();
+        assert_eq!(t.sizes, vec![2.0, 1.0]);
+        assert_eq!(t.provenance.size_source, "sidecar");
+        assert_eq!(t.heights, Heights::Areal(heights));
     }
 
     #[test]

@@ -1,0 +1,276 @@
+"""Closed-form reference solutions: the library's ``asperity::reference``, by the same code.
+
+Every model takes the effective modulus ``modulus`` E* (``1/E* = (1−ν₁²)/E₁ +
+(1−ν₂²)/E₂``; :func:`asperity.effective_modulus` gives it from Young's modulus and
+Poisson's ratio) in any consistent units, and its methods work elementwise on numbers or
+numpy arrays (returning a float or an array of the same shape). Indentations ``d`` and
+approaches are positive into the half-space; compressive forces are positive.
+
+* :class:`Hertz` -- a sphere (paraboloid ``r²/2R``): ``F = 4/3 E* R^½ d^{3/2}``;
+* :class:`FlatPunch` -- a flat cylinder of radius a: ``F = 2 E* a d``;
+* :class:`Cone` -- ``f(r) = r tan θ``; :class:`PowerLaw` -- ``f(r) = c rⁿ`` (by the MDR);
+* :class:`Westergaard` -- a periodic sinusoid pressed flat (``p* = π E* Δ/λ``);
+* :class:`CattaneoMindlin` -- a Hertz contact under a tangential force (partial slip);
+* :class:`Jkr`, :class:`Dmt`, :class:`Kendall` -- adhesive sphere and punch.
+
+Example::
+
+    >>> from asperity.reference import Hertz
+    >>> h = Hertz(radius=1.0, modulus=1.0)
+    >>> float(h.force(1e-2)), float(h.stiffness(1e-2))   # 4/3 · 10⁻³, 2 · 0.1
+    (0.0013333333333333333, 0.2)
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as _np
+
+from . import _asperity as _core
+
+__all__ = ["Hertz", "FlatPunch", "Cone", "PowerLaw", "Westergaard", "CattaneoMindlin",
+           "Jkr", "Dmt", "Kendall"]
+
+
+class _Model:
+    _name = ""
+    _params: Sequence[str] = ()
+
+    def __init__(self, *args: float, **kwargs: float):
+        values = dict(zip(self._params, args))
+        values.update(kwargs)
+        missing = [p for p in self._params if p not in values]
+        extra = [k for k in values if k not in self._params]
+        if missing or extra or len(args) > len(self._params):
+            raise TypeError(f"{type(self).__name__}({', '.join(self._params)}): "
+                            f"missing {missing}, unexpected {extra}")
+        for name in self._params:
+            setattr(self, name, float(values[name]))
+        self._eval("__check__", 0.0, check=True)
+
+    def _eval(self, method: str, x: Any, *scalars: float, check: bool = False) -> Any:
+        params = [getattr(self, p) for p in self._params]
+        if check:
+            # The parameters are checked by the library (positive and finite) on any call.
+            method = self._probe
+        array = _np.asarray(x, dtype=_np.float64)
+        out = _core.reference(self._name, params, method, [float(s) for s in scalars], array)
+        return float(out) if array.ndim == 0 else out
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{p}={getattr(self, p)!r}" for p in self._params)
+        return f"{type(self).__name__}({args})"
+
+
+class Hertz(_Model):
+    """A rigid sphere of ``radius`` R (paraboloid ``r²/2R``) on a half-space of ``modulus``
+    E* (Hertz 1882; Johnson, *Contact Mechanics*, §4.2)."""
+
+    _name, _params, _probe = "hertz", ("radius", "modulus"), "force"
+
+    def force(self, indentation: Any) -> Any:
+        """``F = 4/3 E* R^½ d^{3/2}``."""
+        return self._eval("force", indentation)
+
+    def contact_radius(self, indentation: Any) -> Any:
+        """``a = √(R d)``."""
+        return self._eval("contact_radius", indentation)
+
+    def indentation(self, force: Any) -> Any:
+        """``d = (3F / 4E*R^½)^{2/3}``."""
+        return self._eval("indentation", force)
+
+    def stiffness(self, indentation: Any) -> Any:
+        """``k = dF/dd = 2 E* a``."""
+        return self._eval("stiffness", indentation)
+
+    def pressure(self, indentation: float, r: Any) -> Any:
+        """``p(r) = (2E*/πR) √(a² − r²)`` inside the contact, 0 outside."""
+        return self._eval("pressure", r, indentation)
+
+
+class FlatPunch(_Model):
+    """A rigid flat-ended cylinder of ``radius`` a: ``k = 2 E* a`` at any indentation."""
+
+    _name, _params, _probe = "flat_punch", ("radius", "modulus"), "force"
+
+    def force(self, indentation: Any) -> Any:
+        """``F = 2 E* a d``."""
+        return self._eval("force", indentation)
+
+    def stiffness(self) -> float:
+        """``k = 2 E* a``."""
+        return self._eval("stiffness", 0.0)
+
+
+class Cone(_Model):
+    """A rigid cone ``f(r) = r tan θ`` (``slope`` = tan θ)."""
+
+    _name, _params, _probe = "cone", ("slope", "modulus"), "force"
+
+    def force(self, indentation: Any) -> Any:
+        """``F = 2 E* d² / (π tan θ)``."""
+        return self._eval("force", indentation)
+
+    def contact_radius(self, indentation: Any) -> Any:
+        """``a = 2d / (π tan θ)``."""
+        return self._eval("contact_radius", indentation)
+
+    def stiffness(self, indentation: Any) -> Any:
+        """``k = 2 E* a``."""
+        return self._eval("stiffness", indentation)
+
+
+class PowerLaw(_Model):
+    """A power-law indenter ``f(r) = c rⁿ`` (``coefficient`` c, ``exponent`` n > 0), by
+    the MDR (Popov & Heß, ch. 3); Hertz is n = 2, c = 1/2R."""
+
+    _name, _params, _probe = "power_law", ("coefficient", "exponent", "modulus"), "force"
+
+    def force(self, indentation: Any) -> Any:
+        """``F = 2 E* n/(n+1) d a``."""
+        return self._eval("force", indentation)
+
+    def contact_radius(self, indentation: Any) -> Any:
+        """``a`` from ``d = κ(n) c aⁿ``, ``κ(n) = √π Γ(n/2+1)/Γ(n/2+½)``."""
+        return self._eval("contact_radius", indentation)
+
+    def stiffness(self, indentation: Any) -> Any:
+        """``k = 2 E* a``."""
+        return self._eval("stiffness", indentation)
+
+
+class Westergaard(_Model):
+    """Westergaard's periodic contact: a rigid sinusoid ``amplitude · cos(2πx/λ)`` of
+    ``wavelength`` λ pressed with a mean pressure p̄ (Johnson, §13.2)."""
+
+    _name, _params = "westergaard", ("wavelength", "amplitude", "modulus")
+    _probe = "full_contact_pressure"
+
+    def full_contact_pressure(self) -> float:
+        """``p* = π E* Δ / λ``."""
+        return self._eval("full_contact_pressure", 0.0)
+
+    def contact_half_width(self, mean_pressure: Any) -> Any:
+        """``a`` from ``p̄ = p* sin²(πa/λ)``."""
+        return self._eval("contact_half_width", mean_pressure)
+
+    def contact_fraction(self, mean_pressure: Any) -> Any:
+        """``2a/λ``."""
+        return self._eval("contact_fraction", mean_pressure)
+
+    def indentation(self, mean_pressure: Any) -> Any:
+        """``d = Δ r (1 − ln r)``, ``r = p̄/p*`` (relative to the mean elastic displacement,
+        the convention of periodic boundaries)."""
+        return self._eval("indentation", mean_pressure)
+
+    def pressure(self, mean_pressure: float, x: Any) -> Any:
+        """The pressure at distance ``x`` from a crest."""
+        return self._eval("pressure", x, mean_pressure)
+
+
+class CattaneoMindlin(_Model):
+    """A Hertz contact (``radius``, ``modulus``) at indentation d under a tangential force
+    Q ≤ μF: ``ratio`` = G*/E* (``2(1−ν)/(2−ν)`` for one Poisson's ratio), ``friction`` μ
+    (Johnson, §7.2; Mindlin & Deresiewicz)."""
+
+    _name, _params = "cattaneo_mindlin", ("radius", "modulus", "ratio", "friction")
+    _probe = "no_slip_stiffness"
+
+    def _eval(self, method: str, x: Any, *scalars: float, check: bool = False) -> Any:
+        if check:
+            scalars = (1.0,)
+        return super()._eval(method, x, *scalars, check=check)
+
+    def stick_radius(self, indentation: float, force: Any) -> Any:
+        """``c = a (1 − Q/μF)^{1/3}``."""
+        return self._eval("stick_radius", force, indentation)
+
+    def displacement(self, indentation: float, force: Any) -> Any:
+        """``u = μ (E*/G*) d [1 − (1 − Q/μF)^{2/3}]`` on loading."""
+        return self._eval("displacement", force, indentation)
+
+    def unloading_displacement(self, indentation: float, amplitude: float, force: Any) -> Any:
+        """The displacement on unloading from ``amplitude`` Q* to Q."""
+        return self._eval("unloading_displacement", force, indentation, amplitude)
+
+    def no_slip_stiffness(self, indentation: float) -> float:
+        """``2 G* a``."""
+        return self._eval("no_slip_stiffness", 0.0, indentation)
+
+    def dissipation(self, indentation: float, amplitude: Any) -> Any:
+        """Energy dissipated per cycle of ``amplitude`` Q* (Mindlin & Deresiewicz)."""
+        return self._eval("dissipation", amplitude, indentation)
+
+
+class _Adhesive(_Model):
+    _params = ("radius", "modulus", "work_of_adhesion")
+
+
+class Jkr(_Adhesive):
+    """Johnson–Kendall–Roberts: a sphere of ``radius`` R with ``work_of_adhesion`` Δγ,
+    parametrised by the contact radius a (both branches)."""
+
+    _name, _probe = "jkr", "force"
+
+    def approach(self, contact_radius: Any) -> Any:
+        """``δ = a²/R − √(2πaΔγ/E*)``."""
+        return self._eval("approach", contact_radius)
+
+    def force(self, contact_radius: Any) -> Any:
+        """``F = 4E*a³/3R − √(8πΔγE*a³)``."""
+        return self._eval("force", contact_radius)
+
+    def contact_radius_at_force(self, force: Any) -> Any:
+        """The stable branch's a at F (NaN below the force-controlled pull-off)."""
+        return self._eval("contact_radius_at_force", force)
+
+    def zero_force_radius(self) -> float:
+        return self._eval("zero_force_radius", 0.0)
+
+    def pull_off_force(self, control: str = "force") -> float:
+        """``-3/2 πΔγR`` under ``control="force"``, ``-5/6 πΔγR`` under ``"displacement"``."""
+        return self._eval(f"pull_off_force_{_control(control)}", 0.0)
+
+    def pull_off_radius(self, control: str = "force") -> float:
+        """``(9πΔγR²/8E*)^{1/3}`` (force control) or ``(πΔγR²/8E*)^{1/3}``."""
+        return self._eval(f"pull_off_radius_{_control(control)}", 0.0)
+
+
+def _control(control: str) -> str:
+    if control not in ("force", "displacement"):
+        raise ValueError(f"control must be 'force' or 'displacement', got {control!r}")
+    return control
+
+
+class Dmt(_Adhesive):
+    """Derjaguin–Muller–Toporov: Hertz's shape plus the adhesive force ``-2πΔγR``."""
+
+    _name, _probe = "dmt", "force"
+
+    def approach(self, contact_radius: Any) -> Any:
+        return self._eval("approach", contact_radius)
+
+    def force(self, contact_radius: Any) -> Any:
+        return self._eval("force", contact_radius)
+
+    def pull_off_force(self) -> float:
+        """``-2πΔγR``."""
+        return self._eval("pull_off_force", 0.0)
+
+
+class Kendall(_Adhesive):
+    """Kendall's adhesive flat punch of ``radius`` a."""
+
+    _name, _probe = "kendall", "force"
+
+    def force(self, approach: Any) -> Any:
+        return self._eval("force", approach)
+
+    def pull_off_approach(self) -> float:
+        return self._eval("pull_off_approach", 0.0)
+
+    def pull_off_force(self) -> float:
+        """``-√(8πΔγE*a³)``."""
+        return self._eval("pull_off_force", 0.0)

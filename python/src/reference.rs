@@ -1,0 +1,231 @@
+//! `asperity.reference`: the library's closed-form reference solutions
+//! (`asperity::reference`), evaluated elementwise over numpy arrays by the same functions the
+//! library's tests and the CLI's reports use.
+
+use asperity::reference::{
+    CattaneoMindlin, Cone, Dmt, FlatPunch, Hertz, Jkr, Kendall, PowerLaw, PullOff, Westergaard,
+};
+use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn};
+use pyo3::prelude::*;
+
+use crate::errors::{from_error, invalid};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(reference, m)?)?;
+    Ok(())
+}
+
+/// A method of a model: its value at `x` (the array argument) given the scalars before it.
+type Method = Box<dyn Fn(f64) -> f64>;
+
+/// `N` parameters, each positive and finite (the model is named in the error).
+fn positive<const N: usize>(model: &str, names: [&str; N], params: &[f64]) -> PyResult<[f64; N]> {
+    if params.len() != N {
+        return Err(invalid(format!(
+            "{model}: expected {N} parameters ({}), got {}",
+            names.join(", "),
+            params.len()
+        )));
+    }
+    for (name, value) in names.iter().zip(params) {
+        if !(value.is_finite() && *value > 0.0) {
+            return Err(invalid(format!(
+                "{model}: {name} must be positive and finite, got {value}"
+            )));
+        }
+    }
+    Ok(std::array::from_fn(|i| params[i]))
+}
+
+/// `scalars[i]`, or an error naming the method.
+fn scalar(method: &str, scalars: &[f64], i: usize) -> PyResult<f64> {
+    scalars
+        .get(i)
+        .copied()
+        .ok_or_else(|| invalid(format!("{method}: expected {} scalar arguments", i + 1)))
+}
+
+fn unknown(model: &str, method: &str) -> PyErr {
+    invalid(format!("{model} has no method {method:?}"))
+}
+
+/// Axisymmetric indenters without adhesion.
+fn indenter(model: &str, params: &[f64], method: &str, scalars: &[f64]) -> PyResult<Method> {
+    Ok(match model {
+        "hertz" => {
+            let [radius, modulus] = positive(model, ["radius", "modulus"], params)?;
+            let h = Hertz { radius, modulus };
+            match method {
+                "force" => Box::new(move |d| h.force(d)),
+                "contact_radius" => Box::new(move |d| h.contact_radius(d)),
+                "indentation" => Box::new(move |f| h.indentation(f)),
+                "stiffness" => Box::new(move |d| h.stiffness(d)),
+                "pressure" => {
+                    let d = scalar(method, scalars, 0)?;
+                    Box::new(move |r| h.pressure(d, r))
+                }
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "flat_punch" => {
+            let [radius, modulus] = positive(model, ["radius", "modulus"], params)?;
+            let p = FlatPunch { radius, modulus };
+            match method {
+                "force" => Box::new(move |d| p.force(d)),
+                "stiffness" => Box::new(move |_| p.stiffness()),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "cone" => {
+            let [slope, modulus] = positive(model, ["slope", "modulus"], params)?;
+            let c = Cone { slope, modulus };
+            match method {
+                "force" => Box::new(move |d| c.force(d)),
+                "contact_radius" => Box::new(move |d| c.contact_radius(d)),
+                "stiffness" => Box::new(move |d| c.stiffness(d)),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "power_law" => {
+            let names = ["coefficient", "exponent", "modulus"];
+            let [coefficient, exponent, modulus] = positive(model, names, params)?;
+            let p = PowerLaw {
+                coefficient,
+                exponent,
+                modulus,
+            };
+            match method {
+                "force" => Box::new(move |d| p.force(d)),
+                "contact_radius" => Box::new(move |d| p.contact_radius(d)),
+                "stiffness" => Box::new(move |d| p.stiffness(d)),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        _ => return other(model, params, method, scalars),
+    })
+}
+
+/// Westergaard's wavy contact and Cattaneo–Mindlin's partial slip.
+fn other(model: &str, params: &[f64], method: &str, scalars: &[f64]) -> PyResult<Method> {
+    Ok(match model {
+        "westergaard" => {
+            let names = ["wavelength", "amplitude", "modulus"];
+            let [wavelength, amplitude, modulus] = positive(model, names, params)?;
+            let w = Westergaard {
+                wavelength,
+                amplitude,
+                modulus,
+            };
+            match method {
+                "full_contact_pressure" => Box::new(move |_| w.full_contact_pressure()),
+                "contact_half_width" => Box::new(move |p| w.contact_half_width(p)),
+                "contact_fraction" => Box::new(move |p| w.contact_fraction(p)),
+                "indentation" => Box::new(move |p| w.indentation(p)),
+                "pressure" => {
+                    let p = scalar(method, scalars, 0)?;
+                    Box::new(move |x| w.pressure(p, x))
+                }
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "cattaneo_mindlin" => {
+            let names = ["radius", "modulus", "ratio", "friction"];
+            let [radius, modulus, ratio, friction] = positive(model, names, params)?;
+            let c = CattaneoMindlin {
+                radius,
+                modulus,
+                ratio,
+                friction,
+            };
+            let d = scalar(method, scalars, 0)?;
+            match method {
+                "stick_radius" => Box::new(move |q| c.stick_radius(d, q)),
+                "displacement" => Box::new(move |q| c.displacement(d, q)),
+                "unloading_displacement" => {
+                    let top = scalar(method, scalars, 1)?;
+                    Box::new(move |q| c.unloading_displacement(d, top, q))
+                }
+                "no_slip_stiffness" => Box::new(move |_| c.no_slip_stiffness(d)),
+                "dissipation" => Box::new(move |q| c.dissipation(d, q)),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        _ => return adhesive(model, params, method),
+    })
+}
+
+/// JKR, DMT and Kendall's punch (the library refuses non-positive parameters).
+fn adhesive(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
+    let names = ["radius", "modulus", "work_of_adhesion"];
+    let control = |name: &str| match name {
+        "force" => Ok(PullOff::ForceControlled),
+        "displacement" => Ok(PullOff::DisplacementControlled),
+        other => Err(invalid(format!(
+            "control must be 'force' or 'displacement', got {other:?}"
+        ))),
+    };
+    Ok(match model {
+        "jkr" => {
+            let [r, e, w] = positive(model, names, params)?;
+            let j = Jkr::new(r, e, w).map_err(from_error)?;
+            match method {
+                "approach" => Box::new(move |a| j.approach(a)),
+                "force" => Box::new(move |a| j.force(a)),
+                "contact_radius_at_force" => {
+                    Box::new(move |f| j.contact_radius_at_force(f).unwrap_or(f64::NAN))
+                }
+                "zero_force_radius" => Box::new(move |_| j.zero_force_radius()),
+                "pull_off_force_force" | "pull_off_force_displacement" => {
+                    let c = control(&method[15..])?;
+                    Box::new(move |_| j.pull_off_force(c))
+                }
+                "pull_off_radius_force" | "pull_off_radius_displacement" => {
+                    let c = control(&method[16..])?;
+                    Box::new(move |_| j.pull_off_radius(c))
+                }
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "dmt" => {
+            let [r, e, w] = positive(model, names, params)?;
+            let d = Dmt::new(r, e, w).map_err(from_error)?;
+            match method {
+                "approach" => Box::new(move |a| d.approach(a)),
+                "force" => Box::new(move |a| d.force(a)),
+                "pull_off_force" => Box::new(move |_| d.pull_off_force()),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "kendall" => {
+            let [r, e, w] = positive(model, names, params)?;
+            let k = Kendall::new(r, e, w).map_err(from_error)?;
+            match method {
+                "force" => Box::new(move |d| k.force(d)),
+                "pull_off_approach" => Box::new(move |_| k.pull_off_approach()),
+                "pull_off_force" => Box::new(move |_| k.pull_off_force()),
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        _ => return Err(invalid(format!("unknown reference solution {model:?}"))),
+    })
+}
+
+/// `model(params).method(*scalars, x)` elementwise over the array `x`.
+#[pyfunction]
+#[pyo3(signature = (model, params, method, scalars, x))]
+fn reference<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: Vec<f64>,
+    method: &str,
+    scalars: Vec<f64>,
+    x: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    if let Some(bad) = scalars.iter().find(|v| !v.is_finite()) {
+        return Err(invalid(format!(
+            "{method}: arguments must be finite, got {bad}"
+        )));
+    }
+    let f = indenter(model, &params, method, &scalars)?;
+    Ok(x.as_array().mapv(f).into_pyarray(py))
+}

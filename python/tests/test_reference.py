@@ -1,0 +1,114 @@
+"""Reference solutions and E* from Young's modulus and Poisson's ratio: the library's
+closed forms, checked against ContactMechanics' own reference solutions (the peer) and
+against the BEM; E* by the CLI's one rule."""
+
+import math
+
+import numpy as np
+import pytest
+
+import asperity
+from asperity import reference
+
+from conftest import cli_error
+
+
+def test_hertz_equals_contact_mechanics():
+    Hertz = pytest.importorskip("ContactMechanics.ReferenceSolutions.Hertz")
+    h = reference.Hertz(radius=2.5, modulus=3.0)
+    d = np.logspace(-4, -1, 7)
+    np.testing.assert_allclose(h.force(d), Hertz.normal_load(d, 2.5, 3.0), rtol=1e-13)
+    forces = h.force(d)
+    np.testing.assert_allclose(h.indentation(forces), Hertz.penetration(forces, 2.5, 3.0),
+                               rtol=1e-12)
+    a, p0 = Hertz.radius_and_pressure(forces[3], 2.5, 3.0)
+    assert h.contact_radius(d[3]) == pytest.approx(a, rel=1e-12)
+    assert h.pressure(d[3], 0.0) == pytest.approx(p0, rel=1e-12)
+    # Arrays keep their shape; a number gives a float.
+    assert h.force(np.ones((2, 3))).shape == (2, 3) and isinstance(h.force(0.1), float)
+
+
+def test_westergaard_equals_contact_mechanics():
+    W = pytest.importorskip("ContactMechanics.ReferenceSolutions.Westergaard")
+    w = reference.Westergaard(wavelength=2.0, amplitude=0.1, modulus=4.0)
+    pstar = math.pi * 4.0 * 0.1 / 2.0
+    assert w.full_contact_pressure() == pytest.approx(pstar, rel=1e-15)
+    p = np.array([0.01, 0.3, 0.9]) * pstar
+    # ContactMechanics: half-width in units of λ at p̄ in units of p*.
+    np.testing.assert_allclose(w.contact_half_width(p) / 2.0, W.contact_radius(p / pstar),
+                               rtol=1e-13)
+
+
+def test_the_flat_punch_and_hertz_agree_with_the_bem():
+    # The BEM's frozen-set stiffness of a Hertz contact is 2E*a (independent oracle: the
+    # solver), within the discretisation error of a 128² grid (a ≈ 16 pixels: 3 %).
+    n, size, radius = 128, 1.0, 1.0
+    x = (np.arange(n) - n / 2 + 0.5) * size / n
+    heights = -(x[None, :] ** 2 + x[:, None] ** 2) / (2 * radius)
+    solver = asperity.Solver(heights, size, boundary="free")
+    r = solver.solve(indentation=0.015)
+    h = reference.Hertz(radius=radius, modulus=1.0)
+    assert r.force == pytest.approx(h.force(0.015), rel=0.03)
+    assert solver.stiffness() == pytest.approx(h.stiffness(0.015), rel=0.03)
+    punch = reference.FlatPunch(radius=0.2, modulus=2.0)
+    assert punch.stiffness() == pytest.approx(0.8) and punch.force(0.5) == pytest.approx(0.4)
+
+
+def test_adhesive_and_tangential_closed_forms():
+    jkr = reference.Jkr(radius=1.0, modulus=1.0, work_of_adhesion=1e-3)
+    assert jkr.pull_off_force() == pytest.approx(-1.5 * math.pi * 1e-3, rel=1e-15)
+    assert jkr.pull_off_force("displacement") == pytest.approx(-5 / 6 * math.pi * 1e-3)
+    a = jkr.contact_radius_at_force(0.01)
+    assert jkr.force(a) == pytest.approx(0.01, rel=1e-10)
+    assert reference.Dmt(1.0, 1.0, 1e-3).pull_off_force() == pytest.approx(-2 * math.pi * 1e-3)
+    cm = reference.CattaneoMindlin(radius=1.0, modulus=1.0, ratio=0.8, friction=0.5)
+    top = 0.5 * reference.Hertz(1.0, 1.0).force(0.01)  # μF
+    a = reference.Hertz(1.0, 1.0).contact_radius(0.01)
+    assert cm.stick_radius(0.01, top / 2) == pytest.approx(a * 0.5 ** (1 / 3), rel=1e-13)
+    assert cm.no_slip_stiffness(0.01) == pytest.approx(2 * 0.8 * a)
+    # The library refuses meaningless parameters.
+    with pytest.raises(ValueError, match="radius must be positive"):
+        reference.Hertz(radius=-1.0, modulus=1.0)
+    with pytest.raises(ValueError, match="work_of_adhesion"):
+        reference.Jkr(1.0, 1.0, 0.0)
+    with pytest.raises(ValueError, match="control"):
+        jkr.pull_off_force("both")
+
+
+def test_effective_modulus_is_the_cli_rule(cli, tmp_path):
+    e_star = asperity.effective_modulus(young=210e9, poisson=0.3)
+    assert e_star == 210e9 / (1 - 0.3 ** 2)
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_height=1e-6, size=1e-4, seed=1)
+    a = asperity.Solver(s, young=210e9, poisson=0.3, boundary="periodic")
+    b = asperity.Solver(s, modulus=e_star, boundary="periodic")
+    assert a.modulus == b.modulus == e_star
+    assert a.solve(pressure=1e6).force == b.solve(pressure=1e6).force
+    c = asperity.contact(s, young=210e9, poisson=0.3, pressures=[1e6])
+    assert c.effective_modulus == e_star
+    # The same refusal in the same words (flags there, keywords here).
+    s.save(tmp_path / "s.npy")
+    with pytest.raises(ValueError) as error:
+        asperity.Solver(s, young=210e9, poisson=0.5)
+    words = cli_error(cli("contact", tmp_path / "s.npy", "--young", "210e9", "--poisson", "0.5",
+                          "--pressures", "1e6", "--detrend", "none", ok=False))
+    assert str(error.value) == words.replace("--", "")
+    with pytest.raises(ValueError, match="give either modulus"):
+        asperity.Solver(s, modulus=1.0, young=2.0, poisson=0.3)
+
+
+def test_patches_are_the_cli_count_with_their_areas(cli, tmp_path):
+    s = asperity.surface(64, hurst=0.8, rolloff=4, rms_height=1e-6, size=1e-4, seed=3)
+    t_path = tmp_path / "s.npy"
+    s.save(t_path)
+    c = asperity.contact(s, modulus=1e9, pressures=[1e6, 5e6], map=True)
+    p = asperity.patches(c.map, pixel_area=(1e-4 / 64) ** 2)
+    assert len(p) == c.patches[-1] > 1
+    np.testing.assert_array_equal(c.patch_areas_m2, p.areas)
+    assert p.areas.sum() == pytest.approx(c.contact_area_m2[-1], rel=1e-12)
+    assert ((p.labels > 0) == c.map).all() and p.labels.max() == len(p)
+    # The CLI's patches column at the same loads (its surface read from the saved file).
+    out = tmp_path / "c.csv"
+    cli("contact", t_path, "--modulus", "1e9", "--pressures", "1e6,5e6", "--detrend", "none",
+        "--out", out, "--quiet")
+    table = np.genfromtxt(out, delimiter=",", names=True)
+    np.testing.assert_array_equal(table["patches"], c.patches)
