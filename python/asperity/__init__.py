@@ -993,8 +993,8 @@ def effective_modulus(*, modulus: Optional[float] = None, young: Optional[float]
                       poisson: Optional[float] = None) -> float:
     """E* by the one rule both front ends use (``asperity contact --modulus`` or
     ``--young`` with ``--poisson``): ``modulus`` itself, or ``young`` E and ``poisson`` ν
-    (in [0, 0.5)) as E/(1 − ν²) -- a rigid counter-body. For two elastic bodies, combine
-    them first: ``1/E* = 1/E*₁ + 1/E*₂`` with ``E*ᵢ = Eᵢ/(1 − νᵢ²)``. Refusals (a ν of 0.5,
+    (in [0, 0.5]) as E/(1 − ν²) -- a rigid counter-body. For two elastic bodies, combine
+    them first: ``1/E* = 1/E*₁ + 1/E*₂`` with ``E*ᵢ = Eᵢ/(1 − νᵢ²)``. Refusals (a ν of 0.6,
     a negative E, both or neither given) raise ``ValueError`` in the CLI's words.
 
     Example::
