@@ -1068,7 +1068,8 @@ def contact(
     request = {"pressures": loads, "modulus": _opt(modulus), "young": _opt(young),
                "poisson": _opt(poisson), "boundary": str(boundary),
                "tolerance": float(tolerance), "resistivity": _floats(resistivity),
-               "thermal_conductivity": _floats(thermal_conductivity)}
+               "thermal_conductivity": _floats(thermal_conductivity),
+               "hardness": _opt(hardness)}
     return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
                            "shape": list(heights.shape), "sizes": [size_x, size_y],
                            "surface": _surface_identity(surface, heights)})
