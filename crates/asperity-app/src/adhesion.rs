@@ -80,8 +80,8 @@ pub struct AdhesionRow {
     pub branch: Branch,
     /// Its scalars.
     pub summary: AdhesiveSummary,
-    /// How it was reached (zero for the retraction's steps, whose iteration counts are
-    /// summed in [`AdhesionRun::retract_info`]).
+    /// How it was reached (zero for the retraction's steps: the library's retraction
+    /// reports its states, not their iteration counts).
     pub info: AdhesionInfo,
 }
 
