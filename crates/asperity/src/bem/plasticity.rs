@@ -211,6 +211,56 @@ mod tests {
     }
 
     #[test]
+    fn a_capped_full_contact_with_plastic_points_is_solved_not_refused() {
+        // A periodic sinusoid pressed beyond its elastic full-contact load p* (which the
+        // hard wall refuses) under a cap H = 2 p* that the elastic pressure p̄ + p* cos
+        // would pass: every point in contact, the crests at the cap, the rest elastic —
+        // a contact problem still, solved by both solvers to the load, with the conditions
+        // at every point; odd, even and rectangular grids.
+        for (rows, cols) in GRIDS {
+            let heights = ndarray::Array2::from_shape_fn((rows, cols), |(_, j)| {
+                0.05 * (2.0 * std::f64::consts::PI * j as f64 / cols as f64).cos()
+            });
+            let surface = crate::surface::Surface::new(heights, cols as f64).unwrap();
+            let half_space = HalfSpace {
+                modulus: 1.0,
+                boundary: Boundary::Periodic,
+            };
+            for kind in KINDS {
+                let params = SolverParams {
+                    solver: kind,
+                    ..SolverParams::default()
+                };
+                let mut solver = ContactSolver::new(&surface, half_space, params).unwrap();
+                let p_star = solver.full_contact_threshold().unwrap().mean_pressure;
+                let load = Control::MeanPressure(1.2 * p_star);
+                assert!(matches!(
+                    solver.solve(load),
+                    Err(SolveError::BeyondFullContact { .. })
+                ));
+                let h = 2.0 * p_star;
+                solver
+                    .set_interface(Interface::hardness(h).unwrap())
+                    .unwrap();
+                let (summary, info) = solver.solve(load).unwrap();
+                let case = format!("{rows}x{cols} {kind:?}");
+                eprintln!(
+                    "{case}: {} iterations, plastic {:.3}",
+                    info.iterations, summary.plastic_fraction
+                );
+                assert_eq!(summary.contact_points, rows * cols, "{case}");
+                assert!(summary.plastic_points > 0, "{case}");
+                assert!(summary.plastic_points < rows * cols, "{case}");
+                assert!(
+                    (summary.mean_pressure / (1.2 * p_star) - 1.0).abs() < 1e-12,
+                    "{case}"
+                );
+                check_complementarity(&solver, h);
+            }
+        }
+    }
+
+    #[test]
     fn capped_solves_satisfy_the_conditions_at_every_point() {
         for kind in KINDS {
             // Odd, even and non-square grids, free and periodic, load and displacement

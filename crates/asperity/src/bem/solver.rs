@@ -423,6 +423,10 @@ impl ContactSolver {
             // displacements of zero mean, the indentation mean(f).
             let full = self.periodic_full_contact();
             let beyond = match target {
+                // (Not under a cap: the threshold is the elastic one, and a capped contact
+                // may close at a lower load or stay open beyond it; a capped solution in
+                // full contact without plastic points is refused after the solve.)
+                Target::MeanPressure(_) if self.interface != Interface::HardWall => false,
                 Target::MeanPressure(p) => p >= full.mean_pressure,
                 // The mean gap mean(f) − d within the rounding of the sum mean(f) (n ulps)
                 // is no gap: full contact. (Not under a cap: the plastic points stand
@@ -456,7 +460,12 @@ impl ContactSolver {
             // Every point in contact, under load or displacement control: no contact
             // problem is left; refused with the threshold (free boundaries: only known
             // from the solution, periodic: checked above, this is rounding at p ≈ p*).
-            Ok((summary, _)) if summary.contact_points == self.problem.rows * self.problem.cols => {
+            // Under a cap a full contact with points at the cap is a contact problem still
+            // (the plastic points flattened, the rest elastic): kept.
+            Ok((summary, _))
+                if summary.contact_points == self.problem.rows * self.problem.cols
+                    && summary.plastic_points == 0 =>
+            {
                 self.state.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
