@@ -81,6 +81,19 @@ impl Table {
     }
 }
 
+/// The stderr line of an adhesive run's pull-offs (`bem` and `mdr` with
+/// `--work-of-adhesion`): force and indentation `(F, d)` under force control, then under
+/// displacement control.
+pub fn pull_off_line(force_controlled: (f64, f64), displacement_controlled: (f64, f64)) -> String {
+    format!(
+        "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
+        format_number(force_controlled.0),
+        format_number(force_controlled.1),
+        format_number(displacement_controlled.0),
+        format_number(displacement_controlled.1),
+    )
+}
+
 /// Shortest text that parses back to the same f64.
 pub fn format_number(v: f64) -> String {
     format!("{v:?}")

@@ -9,7 +9,7 @@ use asperity_app::adhesion::{AdhesionRequest, AdhesionRun};
 use serde_json::json;
 
 use super::bem::{read_surface_for, stage_outputs, BemArgs};
-use crate::output::{format_number, Table};
+use crate::output::{format_number, pull_off_line, Table};
 
 /// The columns of the table.
 pub const COLUMNS: [&str; 8] = [
@@ -139,11 +139,14 @@ fn record(
 fn report(args: &BemArgs, run: &AdhesionRun, table: &Table) -> Result<()> {
     match &run.pull_off {
         Some(p) => eprintln!(
-            "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
-            format_number(p.force_controlled.force),
-            format_number(p.force_controlled.indentation),
-            format_number(p.displacement_controlled.force),
-            format_number(p.displacement_controlled.indentation),
+            "{}",
+            pull_off_line(
+                (p.force_controlled.force, p.force_controlled.indentation),
+                (
+                    p.displacement_controlled.force,
+                    p.displacement_controlled.indentation
+                ),
+            )
         ),
         None => eprintln!("pull-off: nothing attached at the end of the path"),
     }

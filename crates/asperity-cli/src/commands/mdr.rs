@@ -15,7 +15,7 @@ use asperity_app::mdr::{Branch, Indenter, MdrRequest, ADHESIVE_COLUMNS, COLUMNS}
 
 use crate::request::refused;
 
-use crate::output::{format_number, Table};
+use crate::output::{format_number, pull_off_line, Table};
 use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
 
 /// Arguments of `asperity mdr`.
@@ -563,11 +563,14 @@ fn run_adhesive(
     staged.commit()?;
     match &pull_offs {
         Some(p) => eprintln!(
-            "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
-            format_number(p.force_controlled.force),
-            format_number(p.force_controlled.indentation),
-            format_number(p.displacement_controlled.force),
-            format_number(p.displacement_controlled.indentation),
+            "{}",
+            pull_off_line(
+                (p.force_controlled.force, p.force_controlled.indentation),
+                (
+                    p.displacement_controlled.force,
+                    p.displacement_controlled.indentation
+                ),
+            )
         ),
         None => eprintln!("pull-off: nothing in contact at the end of the path"),
     }
