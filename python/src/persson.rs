@@ -4,13 +4,13 @@
 
 use asperity::persson::PerssonParams;
 use asperity::surface::Surface;
-use asperity_app::persson::{compute, log_pressures, PerssonRequest, COLUMNS};
+use asperity_app::persson::{self, compute, PerssonRequest, COLUMNS};
 use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::arrays::owned_2d;
-use crate::errors::{from_error, invalid, refused, request_error};
+use crate::errors::{from_error, request_error};
 use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -38,11 +38,7 @@ fn persson_table<'py>(
     pmin: Option<f64>,
     pmax: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let pressures = match (pressures, nloads, pmin, pmax) {
-        (Some(list), None, None, None) => list,
-        (None, Some(k), Some(lo), Some(hi)) => log_pressures(k, lo, hi).map_err(refused)?,
-        _ => return Err(invalid("give pressures, or nloads with pmin and pmax")),
-    };
+    let pressures = persson::pressures(pressures, nloads, pmin, pmax).map_err(request_error)?;
     let request = PerssonRequest {
         params: PerssonParams {
             modulus,

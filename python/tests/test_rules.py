@@ -63,6 +63,8 @@ KEYWORDS = {
     "tangential-force": "tangential_force",
     "--friction": "friction",
     "--cycle-points": "cycle_points",
+    "--gamma": "gamma",
+    "--kappa": "kappa",
 }
 
 
@@ -256,7 +258,33 @@ MEASURED = [
      'fill must be harmonic (Laplace inpainting) or refuse, got "zero"'),
 ]
 
-ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED
+# asperity persson: (flags, keywords, expected words in keywords). Its loads follow bem's
+# rules for --pressures and --nloads, word for word.
+PERSSON = [
+    (["--pressures", "0"], dict(pressures=[0]),
+     "pressures: 0 is not allowed (values must be finite and > 0)"),
+    (["--pressures", "0.01,inf"], dict(pressures=[0.01, INF]), "pressures: inf is not allowed"),
+    ([], {}, "give pressures or nloads with pmin and pmax, not both"),
+    (["--pressures", "0.1", "--nloads", "3", "--pmin", "1e-3", "--pmax", "0.1"],
+     dict(pressures=[0.1], nloads=3, pmin=1e-3, pmax=0.1), "give pressures or nloads"),
+    (["--pressures", "0.1", "--pmin", "1e-3"], dict(pressures=[0.1], pmin=1e-3), ", not both"),
+    (["--pmin", "1e-3", "--pmax", "0.1"], dict(pmin=1e-3, pmax=0.1), "give pressures or"),
+    (["--nloads", "3", "--pmax", "0.1"], dict(nloads=3, pmax=0.1), "nloads needs pmin and pmax"),
+    (["--nloads", "0", "--pmin", "1e-3", "--pmax", "1e-2"], dict(nloads=0, pmin=1e-3, pmax=1e-2),
+     "nloads must be at least 1, got 0"),
+    (["--nloads", "3", "--pmin", "0.1", "--pmax", "0.01"], dict(nloads=3, pmin=0.1, pmax=0.01),
+     "pmax (0.01) must not be smaller than pmin (0.1)"),
+    (["--nloads", "3", "--pmin", "0", "--pmax", "0.01"], dict(nloads=3, pmin=0, pmax=0.01),
+     "pmin: 0 is not allowed"),
+    (["--pressures", "0.1", "--gamma", "0"], dict(pressures=[0.1], gamma=0),
+     "invalid gamma: Persson's γ must lie in (0, 1], got 0"),
+    (["--pressures", "0.1", "--kappa", "-1"], dict(pressures=[0.1], kappa=-1),
+     "invalid kappa: κ must be positive and finite, got -1"),
+    (["--pressures", "0.1", "--modulus", "nan"], dict(pressures=[0.1], modulus=NAN),
+     "invalid modulus: E* must be positive and finite, got NaN"),
+]
+
+ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED + PERSSON
 # asperity mdr --tangential-force (Python: mdr_slip): (flags, keywords, expected words in
 # keywords), on a sphere at d = 1 (μF = 2/3 with μ = 0.5).
 SPHERE = (["--profile", "hertz", "--radius", "1", "--n", "401", "--dx", "0.01", "--indentations", "1"],
@@ -402,6 +430,17 @@ def test_mdr_refuses_alike(cli, tmp_path, flags, kwargs, words):
     ours = python_words(lambda: asperity.mdr(**kwargs))
     assert ours == theirs
     assert words in ours
+
+
+@pytest.mark.parametrize("flags,kwargs,words", PERSSON)
+def test_persson_refuses_alike(cli, heights, tmp_path, flags, kwargs, words):
+    array, path = heights
+    out = tmp_path / "p.csv"
+    theirs = in_keywords(cli_error(cli("persson", path, *flags, "--out", out, ok=False)))
+    ours = python_words(lambda: asperity.persson(array, **kwargs))
+    assert ours == theirs
+    assert words in ours
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("flags,kwargs,words", STATS)

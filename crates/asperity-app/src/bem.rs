@@ -267,7 +267,10 @@ impl Loads {
             Loads::Forces(v) => listed(FORCES, v, false, Control::Force),
             Loads::Pressures(v) => listed(PRESSURES, v, false, Control::MeanPressure),
             Loads::Indentations(v) => listed(INDENTATIONS, v, true, Control::Indentation),
-            &Loads::LogPressures { count, min, max } => log_pressures(count, min, max, fields),
+            &Loads::LogPressures { count, min, max } => Ok(log_spaced(count, min, max, fields)?
+                .into_iter()
+                .map(Control::MeanPressure)
+                .collect()),
         }
     }
 
@@ -302,12 +305,16 @@ pub fn check_values(param: Param, values: &[f64], allow_zero: bool) -> Result<()
     Ok(())
 }
 
-fn log_pressures(
+/// `count` mean pressures log-spaced from `min` to `max` (both included; [`log_levels`]),
+/// or why not: at least one, `min` and `max` finite and > 0, `max` not below `min`, and the
+/// bookkeeping of `count` loads (with `fields`, their fields' too) within memory. The rule
+/// of `--nloads` for every command that takes it.
+pub fn log_spaced(
     count: usize,
     min: f64,
     max: f64,
     fields: bool,
-) -> Result<Vec<Control>, RequestError> {
+) -> Result<Vec<f64>, RequestError> {
     if count == 0 {
         return Err(Refusal::of(NLOADS)
             .text(" must be at least 1, got 0")
@@ -331,9 +338,7 @@ fn log_pressures(
             source: Box::new(source),
         }
     })?;
-    Ok(log_levels(min, max, count)
-        .map(Control::MeanPressure)
-        .collect())
+    Ok(log_levels(min, max, count).collect())
 }
 
 /// Checks the relative step of the finite-difference stiffness: in `(0, 1)`.

@@ -5,20 +5,13 @@
 use asperity::persson::{Persson, PerssonParams};
 use asperity::surface::Surface;
 
+use crate::bem::{check_values, log_spaced};
 use crate::refusal::{Refusal, RequestError};
 
-/// The parameters of `asperity persson`.
+/// The parameters of `asperity persson`: the load options of `asperity bem`, by the same
+/// names and rules.
 pub mod params {
-    use crate::refusal::Param;
-
-    /// The mean pressures.
-    pub const PRESSURES: Param = Param::new("--pressures", "pressures");
-    /// The number of log-spaced pressures.
-    pub const NLOADS: Param = Param::new("--nloads", "nloads");
-    /// The smallest of them.
-    pub const PMIN: Param = Param::new("--pmin", "pmin");
-    /// The largest of them.
-    pub const PMAX: Param = Param::new("--pmax", "pmax");
+    pub use crate::bem::params::{NLOADS, PMAX, PMIN, PRESSURES};
 }
 
 use params::*;
@@ -45,37 +38,45 @@ pub struct PerssonRequest {
 }
 
 impl PerssonRequest {
-    /// Refuses parameters the library refuses, no pressure, or one that is not positive.
+    /// Refuses parameters the library refuses, no pressure, or one that is not finite and
+    /// positive (the rule of `asperity bem`'s `--pressures`).
     pub fn validate(&self) -> Result<(), RequestError> {
         self.params
             .validate()
             .map_err(|e| RequestError::Invalid(Box::new(e)))?;
-        if self.pressures.is_empty() {
-            return Err(Refusal::of(PRESSURES).text(": give at least one").into());
-        }
-        if let Some(p) = self
-            .pressures
-            .iter()
-            .find(|p| !(p.is_finite() && **p > 0.0))
-        {
-            let text = format!(" must be positive and finite, got {p}");
-            return Err(Refusal::of(PRESSURES).text(text).into());
-        }
+        check_values(PRESSURES, &self.pressures, false)?;
         Ok(())
     }
 }
 
-/// `count` mean pressures log-spaced from `pmin` to `pmax` (both included).
-pub fn log_pressures(count: usize, pmin: f64, pmax: f64) -> Result<Vec<f64>, Refusal> {
-    if count == 0 || !(pmin > 0.0 && pmax >= pmin && pmax.is_finite()) {
-        return Err(Refusal::of(NLOADS)
-            .text(" needs K >= 1 and 0 < ")
+/// The request's pressures: the `list`, or `nloads` log-spaced from `pmin` to `pmax` by
+/// `asperity bem`'s rule ([`log_spaced`]); exactly one of the two ways.
+pub fn pressures(
+    list: Option<Vec<f64>>,
+    nloads: Option<usize>,
+    pmin: Option<f64>,
+    pmax: Option<f64>,
+) -> Result<Vec<f64>, RequestError> {
+    match (list, nloads, pmin, pmax) {
+        (Some(list), None, None, None) => Ok(list),
+        (None, Some(count), Some(min), Some(max)) => log_spaced(count, min, max, false),
+        (None, Some(_), ..) => Err(Refusal::of(NLOADS)
+            .text(" needs ")
             .param(PMIN)
-            .text(" <= ")
+            .text(" and ")
             .param(PMAX)
-            .text(format!(", finite; got {count}, {pmin}, {pmax}")));
+            .into()),
+        _ => Err(Refusal::saying("give ")
+            .param(PRESSURES)
+            .text(" or ")
+            .param(NLOADS)
+            .text(" with ")
+            .param(PMIN)
+            .text(" and ")
+            .param(PMAX)
+            .text(", not both")
+            .into()),
     }
-    Ok(asperity::fit::log_levels(pmin, pmax, count).collect())
 }
 
 /// The theory's table for one surface.
@@ -166,13 +167,19 @@ mod tests {
             pressures: vec![0.0],
         };
         let (flags, keywords) = words(base.clone());
-        assert_eq!(flags, "--pressures must be positive and finite, got 0");
-        assert_eq!(keywords, "pressures must be positive and finite, got 0");
+        assert_eq!(
+            flags,
+            "--pressures: 0 is not allowed (values must be finite and > 0)"
+        );
+        assert_eq!(
+            keywords,
+            "pressures: 0 is not allowed (values must be finite and > 0)"
+        );
         let (_, keywords) = words(PerssonRequest {
             pressures: vec![],
             ..base.clone()
         });
-        assert_eq!(keywords, "pressures: give at least one");
+        assert_eq!(keywords, "pressures: give at least one value");
         let gamma = PerssonParams {
             gamma: 0.0,
             ..PerssonParams::default()
@@ -182,11 +189,45 @@ mod tests {
             pressures: vec![0.1],
         });
         assert!(keywords.contains("gamma"), "{keywords}");
-        let refusal = log_pressures(0, 1e-3, 1e-1).unwrap_err();
+    }
+
+    #[test]
+    fn the_pressures_are_the_list_or_bem_s_log_spaced_ones() {
+        let list = pressures(Some(vec![0.1, 0.2]), None, None, None).unwrap();
+        assert_eq!(list, vec![0.1, 0.2]);
+        let spaced = pressures(None, Some(3), Some(1e-3), Some(1e-1)).unwrap();
+        let levels: Vec<f64> = asperity::fit::log_levels(1e-3, 1e-1, 3).collect();
+        assert_eq!(spaced, levels);
+        assert_eq!((spaced[0], spaced[2]), (1e-3, 1e-1));
+        let words = |r: Result<Vec<f64>, RequestError>| r.unwrap_err().words(Names::Keywords);
+        let either = "give pressures or nloads with pmin and pmax, not both";
+        assert_eq!(words(pressures(None, None, None, None)), either);
+        let both = pressures(Some(vec![0.1]), Some(3), Some(1e-3), Some(1e-1));
+        assert_eq!(words(both), either);
         assert_eq!(
-            refusal.words(Names::Keywords),
-            "nloads needs K >= 1 and 0 < pmin <= pmax, finite; got 0, 0.001, 0.1"
+            words(pressures(Some(vec![0.1]), None, Some(1.0), None)),
+            either
         );
-        assert_eq!(log_pressures(3, 1e-3, 1e-1).unwrap().len(), 3);
+        assert_eq!(words(pressures(None, None, Some(1e-3), Some(1.0))), either);
+        let half = pressures(None, Some(3), Some(1e-3), None).unwrap_err();
+        assert_eq!(half.words(Names::Flags), "--nloads needs --pmin and --pmax");
+        // The rules of bem's --nloads, word for word.
+        let bem = |count, min, max| {
+            let loads = crate::bem::Loads::LogPressures { count, min, max };
+            loads.controls(false).unwrap_err().words(Names::Keywords)
+        };
+        for (count, min, max) in [
+            (0, 1e-3, 1e-1),
+            (3, -1.0, 1.0),
+            (3, 0.1, 0.01),
+            (3, 1e-3, f64::NAN),
+        ] {
+            let ours = words(pressures(None, Some(count), Some(min), Some(max)));
+            assert_eq!(ours, bem(count, min, max));
+        }
+        assert_eq!(
+            words(pressures(None, Some(0), Some(1.0), Some(2.0))),
+            "nloads must be at least 1, got 0"
+        );
     }
 }

@@ -93,7 +93,43 @@ fn persson_refuses_bad_input_and_keeps_outputs() {
     ));
     refused(
         &asperity(&["persson", "s.npy", "--pressures", "0"], d),
-        "positive",
+        "--pressures: 0 is not allowed (values must be finite and > 0)",
+    );
+    // The load options follow bem's rules and words, from the front-end layer (not clap's).
+    refused(
+        &asperity(&["persson", "s.npy"], d),
+        "give --pressures or --nloads with --pmin and --pmax, not both",
+    );
+    refused(
+        &asperity(
+            &[
+                "persson",
+                "s.npy",
+                "--pressures",
+                "0.1",
+                "--nloads",
+                "2",
+                "--pmin",
+                "1",
+                "--pmax",
+                "2",
+            ],
+            d,
+        ),
+        ", not both",
+    );
+    refused(
+        &asperity(&["persson", "s.npy", "--nloads", "2", "--pmin", "1"], d),
+        "--nloads needs --pmin and --pmax",
+    );
+    refused(
+        &asperity(
+            &[
+                "persson", "s.npy", "--nloads", "2", "--pmin", "2", "--pmax", "1",
+            ],
+            d,
+        ),
+        "--pmax (1) must not be smaller than --pmin (2)",
     );
     refused(
         &asperity(

@@ -8,11 +8,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use asperity::persson::{PerssonParams, PERSSON_KAPPA};
 use asperity::surface::Surface;
-use asperity_app::persson::{compute, log_pressures, PerssonRequest, COLUMNS};
-use asperity_app::RequestError;
+use asperity_app::persson::{compute, pressures, PerssonRequest, COLUMNS};
 
 use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
 use crate::output::Table;
@@ -30,7 +29,6 @@ mean_gap (in the length unit of the surface: metres for a measured file),\n\
 stiffness_per_area (K = -dp/dū, pressure per length), contact_stiffness (K·A0, force per\n\
 length, comparable with `asperity bem`'s stiffness). Equations: Persson 2001 (area),\n\
 Persson 2007 with Yang & Persson 2008's S = γ + (1-γ)P² (separation); see docs/persson.md.")]
-#[command(group(clap::ArgGroup::new("loads").required(true).args(["pressures", "nloads"])))]
 pub struct PerssonArgs {
     /// Surface heights, positive up: a .npy (float64, 2D; L from its sidecar, else 1) or a
     /// measured file (X3P, SDF, text matrix, x y z, ...; sizes and units from the file).
@@ -52,23 +50,13 @@ pub struct PerssonArgs {
     )]
     pub pressures: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
-    #[arg(long, value_name = "K", requires_all = ["pmin", "pmax"])]
+    #[arg(long, value_name = "K")]
     pub nloads: Option<usize>,
     /// Smallest mean pressure for --nloads.
-    #[arg(
-        long,
-        value_name = "P",
-        allow_hyphen_values = true,
-        requires = "nloads"
-    )]
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
     /// Largest mean pressure for --nloads.
-    #[arg(
-        long,
-        value_name = "P",
-        allow_hyphen_values = true,
-        requires = "nloads"
-    )]
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmax: Option<f64>,
     /// Yang & Persson's elastic-energy factor γ, in (0, 1] (1: no correction).
     #[arg(long, default_value_t = PerssonParams::default().gamma, allow_hyphen_values = true)]
@@ -93,7 +81,8 @@ pub fn run(args: &PerssonArgs) -> Result<()> {
             gamma: args.gamma,
             kappa: args.kappa,
         },
-        pressures: pressures(args)?,
+        pressures: pressures(args.pressures.clone(), args.nloads, args.pmin, args.pmax)
+            .map_err(refused)?,
     };
     request.validate().map_err(refused)?;
     let surface = read_surface(args)?;
@@ -119,17 +108,6 @@ pub fn run(args: &PerssonArgs) -> Result<()> {
         args.kappa
     );
     Ok(())
-}
-
-/// The pressures: the list, or `--nloads` log-spaced ones (the front-end layer's rule).
-fn pressures(args: &PerssonArgs) -> Result<Vec<f64>> {
-    match (&args.pressures, args.nloads, args.pmin, args.pmax) {
-        (Some(list), ..) => Ok(list.clone()),
-        (None, Some(k), Some(lo), Some(hi)) => {
-            log_pressures(k, lo, hi).map_err(|r| refused(RequestError::from(r)))
-        }
-        _ => bail!("give --pressures or --nloads with --pmin and --pmax"),
-    }
 }
 
 /// The surface: a measured file (or an imported .npy) through the topography reader, else
