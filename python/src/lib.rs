@@ -53,5 +53,15 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     slip::register(m)?;
     study::register(m)?;
     topography::register(m)?;
+    m.add_function(wrap_pyfunction!(cli, m)?)?;
     Ok(())
+}
+
+/// The `asperity` command line (the `asperity_cli` library the binary runs): runs `argv`
+/// (the program's name first) with the GIL released and returns the exit status. The
+/// package's `asperity` command (`asperity._cli`) calls it in a process of its own; the
+/// command installs its own Ctrl-C handling there.
+#[pyfunction]
+fn cli(py: Python<'_>, argv: Vec<std::ffi::OsString>) -> i32 {
+    py.detach(|| asperity_cli::main_with_args(argv))
 }
