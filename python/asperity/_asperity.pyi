@@ -141,3 +141,8 @@ def label_patches(
 def reference(
     model: str, params: List[float], method: str, scalars: List[float], x: F64,
 ) -> F64: ...
+def cli(argv: List[str]) -> int:
+    """The `asperity` command line (argv with the program's name first) in this process; the
+    exit status. For the package's console script: it installs the command's own Ctrl-C
+    handling in the calling process."""
+    ...
