@@ -1160,6 +1160,34 @@ class MdrCurve:
     pull_off: Optional[Dict[str, Dict[str, float]]] = None
 
 
+def _mdr_request(line: Any, radial: Any, size: Optional[float],
+                 indentations: Optional[Sequence[float]], **options: Any
+                 ) -> Tuple[Dict[str, Any], Optional[np.ndarray], Optional[np.ndarray]]:
+    """The request of :func:`mdr` and :func:`mdr_slip` (the keywords of the front-end
+    layer's ``MdrRequest``) with the line's heights and the radial samples. Keywords left
+    ``None`` are left out and take the request's defaults (the CLI's)."""
+    line_heights = None
+    if line is not None:
+        if isinstance(line, Line):
+            size = line.size if size is None else size
+            line_heights = line.heights
+        else:
+            line_heights = _float64(line, "line")
+        if line_heights.ndim != 1:
+            raise ValueError(f"line: expected a 1D array, got shape {line_heights.shape}")
+    radial_values = None
+    if radial is not None:
+        radial_values = _float64(radial, "radial")
+        if radial_values.ndim != 1:
+            raise ValueError(f"radial: expected a 1D array, got shape {radial_values.shape}")
+    request = {name: value for name, value in options.items() if value is not None}
+    request["size"] = _opt(size)
+    if indentations is not None:
+        request["indentations"] = [
+            float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
+    return request, line_heights, radial_values
+
+
 def mdr(
     *,
     line: Any = None,
@@ -1173,8 +1201,8 @@ def mdr(
     n: Optional[int] = None,
     dx: Optional[float] = None,
     size: Optional[float] = None,
-    modulus: float = 1.0,
-    spring: str = "linear",
+    modulus: Optional[float] = None,
+    spring: Optional[str] = None,
     hurst: Optional[float] = None,
     rms_height: Optional[float] = None,
     asperity_radius: Optional[float] = None,
@@ -1193,9 +1221,10 @@ def mdr(
     (``slope`` tan θ), ``"punch"`` (``radius``) or ``"power"`` (``coefficient``,
     ``exponent``: f = c rⁿ), on ``n`` springs at spacing ``dx``; ``radial`` samples of
     f(r) at steps ``radial_step``, mapped by the MDR transform.
-    Springs: ``"linear"`` (E*·Δx), ``"hertz"`` (15.2, ``asperity_radius``; default
-    ``radius`` for a Hertz profile) or ``"fractal"`` (15.7, ``hurst`` 0 < H < 2,
-    ``rms_height`` default the line's own).
+    Springs: ``"linear"`` (E*·Δx, the default), ``"hertz"`` (15.2, ``asperity_radius``;
+    default ``radius`` for a Hertz profile) or ``"fractal"`` (15.7, ``hurst`` 0 < H < 2,
+    ``rms_height`` default the line's own); ``modulus`` E* (default 1). A keyword left
+    ``None`` takes the CLI's default (the front-end layer's ``MdrRequest``).
     Indentations: a list, or ``nloads`` (default 50) log-spaced from ``dmin`` (default
     dmax·1e-6) to ``dmax`` (default: full contact); or ``breakpoints=True``: the exact
     piecewise-linear curve of linear springs on a line, one row per contact count.
@@ -1215,29 +1244,14 @@ def mdr(
         >>> round(jkr.pull_off["force_controlled"]["force"] / (-1.5 * np.pi * 1e-3), 3)
         1.0
     """
-    line_heights = None
-    if line is not None:
-        if isinstance(line, Line):
-            size = line.size if size is None else size
-            line_heights = line.heights
-        else:
-            line_heights = _float64(line, "line")
-        if line_heights.ndim != 1:
-            raise ValueError(f"line: expected a 1D array, got shape {line_heights.shape}")
-    radial_values = None
-    if radial is not None:
-        radial_values = _float64(radial, "radial")
-        if radial_values.ndim != 1:
-            raise ValueError(f"radial: expected a 1D array, got shape {radial_values.shape}")
-    levels = None
-    if indentations is not None:
-        levels = [float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
-    out = _core.mdr_curve(
-        line_heights, profile, radial_values, _opt(radial_step), _opt(radius), _opt(slope),
-        _opt(coefficient), _opt(exponent), n, _opt(dx), _opt(size), float(modulus), str(spring),
-        _opt(hurst), _opt(rms_height), _opt(asperity_radius), levels, nloads, _opt(dmin),
-        _opt(dmax), bool(breakpoints), _opt(work_of_adhesion),
+    request, line_heights, radial_values = _mdr_request(
+        line, radial, size, indentations, profile=profile, radial_step=radial_step,
+        radius=radius, slope=slope, coefficient=coefficient, exponent=exponent, n=n, dx=dx,
+        modulus=modulus, spring=spring, hurst=hurst, rms_height=rms_height,
+        asperity_radius=asperity_radius, nloads=nloads, dmin=dmin, dmax=dmax,
+        breakpoints=bool(breakpoints), work_of_adhesion=work_of_adhesion,
     )
+    out = _core.mdr_curve(request, line_heights, radial_values)
     return MdrCurve(**out)
 
 
@@ -1262,7 +1276,7 @@ def mdr_slip(
     *,
     tangential_force: float,
     friction: Optional[float] = None,
-    poisson: float = 0.3,
+    poisson: Optional[float] = None,
     cycle_points: Optional[int] = None,
     indentations: Optional[Sequence[float]] = None,
     line: Any = None,
@@ -1276,8 +1290,8 @@ def mdr_slip(
     n: Optional[int] = None,
     dx: Optional[float] = None,
     size: Optional[float] = None,
-    modulus: float = 1.0,
-    spring: str = "linear",
+    modulus: Optional[float] = None,
+    spring: Optional[str] = None,
     hurst: Optional[float] = None,
     rms_height: Optional[float] = None,
     asperity_radius: Optional[float] = None,
@@ -1286,7 +1300,8 @@ def mdr_slip(
     """Partial slip under a tangential force amplitude ``tangential_force`` Q* ≤ μF at the one
     indentation of ``indentations``: loading from rest to Q*, unloading to −Q*, reloading to
     Q* (``asperity mdr --tangential-force``). ``friction`` μ > 0; ``poisson`` ν in [0, 0.5]
-    gives tangential springs G*/E* = 2(1−ν)/(2−ν) times the normal ones. The indenter and
+    (default 0.3, the CLI's) gives tangential springs G*/E* = 2(1−ν)/(2−ν) times the
+    normal ones. The indenter and
     springs take the keywords of :func:`mdr` (``profile``, ``radius``, ``n``, ``dx``,
     ``spring``, ``modulus``, ...).
 
@@ -1297,32 +1312,15 @@ def mdr_slip(
         >>> round(float(c.stick_radius[49]), 3)  # top of the loading branch: 0.5^(1/3)
         0.794
     """
-    import json
-
-    line_heights = None
-    if line is not None:
-        if isinstance(line, Line):
-            size = line.size if size is None else size
-            line_heights = line.heights
-        else:
-            line_heights = _float64(line, "line")
-    radial_values = None if radial is None else _float64(radial, "radial")
-    request = {
-        "line": line_heights is not None, "radial": radial_values is not None,
-        "profile": profile, "radial_step": _opt(radial_step), "radius": _opt(radius),
-        "slope": _opt(slope), "coefficient": _opt(coefficient), "exponent": _opt(exponent),
-        "n": n, "dx": _opt(dx), "size": _opt(size), "modulus": float(modulus),
-        "spring": str(spring), "hurst": _opt(hurst), "rms_height": _opt(rms_height),
-        "asperity_radius": _opt(asperity_radius), "breakpoints": False,
-        "work_of_adhesion": _opt(work_of_adhesion),
-    }
-    if indentations is not None:
-        request["indentations"] = [
-            float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))
-        ]
+    request, line_heights, radial_values = _mdr_request(
+        line, radial, size, indentations, profile=profile, radial_step=radial_step,
+        radius=radius, slope=slope, coefficient=coefficient, exponent=exponent, n=n, dx=dx,
+        modulus=modulus, spring=spring, hurst=hurst, rms_height=rms_height,
+        asperity_radius=asperity_radius, work_of_adhesion=work_of_adhesion,
+    )
     out = _core.mdr_slip(
-        json.dumps(request), line_heights, radial_values, float(tangential_force),
-        _opt(friction), float(poisson), cycle_points,
+        request, line_heights, radial_values, float(tangential_force), _opt(friction),
+        _opt(poisson), cycle_points,
     )
     out["summary"] = json.loads(out["summary"])
     out.setdefault("stick_radius", None)
@@ -1523,13 +1521,10 @@ class StudyResult:
         if self.comparison_error is not None:
             raise ValueError(self.comparison_error)
         found = [c for c in self.comparisons if c is not None]
-        names = ("method", "n", "hurst", "quantity", "ours", "low", "high", "reference",
-                 "source", "tolerance")
         columns = {}
-        for name in names:
+        for name, kind in _core.comparison_columns():
             values = [c["row"][name] for c in found]
-            text = name in ("method", "quantity", "source")
-            columns[name] = np.array(values, dtype=object if text else np.float64)
+            columns[name] = np.array(values, dtype=object if kind == "text" else np.float64)
         columns["verdict"] = np.array([c["verdict"] for c in found], dtype=object)
         return columns
 
@@ -1542,12 +1537,11 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
 
 def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
                levels, alpha_sweep, force, checkpoint_every, progress, description):
-    window = _core.default_window()
+    count = lambda v: None if v is None else int(v)
     args = (
         str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
-        int(seed), window[0] if min_contacts is None else int(min_contacts),
-        window[1] if max_fraction is None else float(max_fraction), None if levels is None else int(levels),
-        bool(alpha_sweep), os.fspath(out), bool(force), float(checkpoint_every),
+        count(seed), count(min_contacts), _opt(max_fraction), count(levels),
+        bool(alpha_sweep), os.fspath(out), bool(force), _opt(checkpoint_every),
     )
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
     comm = _mpi.world()
@@ -1592,13 +1586,13 @@ def study_alpha(
     samples: int,
     out: Union[str, os.PathLike],
     rolloff: Optional[float] = None,
-    seed: int = 1,
+    seed: Optional[int] = None,
     min_contacts: Optional[int] = None,
     max_fraction: Optional[float] = None,
     levels: Optional[int] = None,
     full_sweep: bool = False,
     force: bool = False,
-    checkpoint_every: float = 10.0,
+    checkpoint_every: Optional[float] = None,
     progress: ProgressArg = None,
 ) -> StudyResult:
     """The exponent α of ``k ∝ F^α`` over grid sizes ``n`` and Hurst exponents ``hurst``
@@ -1609,12 +1603,14 @@ def study_alpha(
 
     ``method``: ``"mdr"`` (rough lines, unit rms height) or ``"bem"`` (surfaces, unit rms
     slope, free boundaries); ``rolloff`` q0·L/2π; ``seed`` (study seed); the α window
-    ``min_contacts``, ``max_fraction`` (the CLI's defaults); ``levels`` force levels of the
-    mean curves (default: the library's ``DEFAULT_LEVELS``, 48, as the CLI's); ``full_sweep`` solves every BEM load up to p̄ = 0.2 E* (by default a
-    sample stops loading past 4 times the largest contact fraction an α window ends at, as
-    the CLI's; the fits are the same); ``force`` discards another study's checkpoints in ``out``;
+    ``min_contacts``, ``max_fraction``; ``levels`` force levels of the mean curves;
+    ``full_sweep`` solves every BEM load up to p̄ = 0.2 E* (by default a sample stops
+    loading past 4 times the largest contact fraction an α window ends at, as the CLI's;
+    the fits are the same); ``force`` discards another study's checkpoints in ``out``;
     ``checkpoint_every`` seconds between checkpoints of a task in progress (0: every
-    batch). Ctrl-C stops after the samples in flight (``KeyboardInterrupt``); run again
+    batch). Each keyword left ``None`` takes the CLI's default (the library's
+    ``StudySpec::default``: seed 1, 48 levels, the default α window; checkpoints every
+    10 s). Ctrl-C stops after the samples in flight (``KeyboardInterrupt``); run again
     to resume.
 
     Returns the rows of ``alpha.csv`` (``alpha`` fitted on the ensemble-mean curve,
@@ -1643,12 +1639,12 @@ def study_curve(
     samples: int,
     out: Union[str, os.PathLike],
     rolloff: Optional[float] = None,
-    seed: int = 1,
+    seed: Optional[int] = None,
     min_contacts: Optional[int] = None,
     max_fraction: Optional[float] = None,
     levels: Optional[int] = None,
     force: bool = False,
-    checkpoint_every: float = 10.0,
+    checkpoint_every: Optional[float] = None,
     progress: ProgressArg = None,
 ) -> StudyResult:
     """Ensemble-mean ``k(F)`` curves at one grid size ``n`` over ``hurst``, as

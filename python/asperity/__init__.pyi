@@ -220,8 +220,8 @@ def mdr(
     *, line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
     radial_step: Optional[float] = ..., radius: Optional[float] = ..., slope: Optional[float] = ...,
     coefficient: Optional[float] = ..., exponent: Optional[float] = ..., n: Optional[int] = ...,
-    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: float = ...,
-    spring: str = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
+    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: Optional[float] = ...,
+    spring: Optional[str] = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
     asperity_radius: Optional[float] = ..., indentations: Optional[Sequence[float]] = ...,
     nloads: Optional[int] = ..., dmin: Optional[float] = ..., dmax: Optional[float] = ...,
     breakpoints: bool = ...,
@@ -239,13 +239,13 @@ class SlipCycle:
     description: str
 
 def mdr_slip(
-    *, tangential_force: float, friction: Optional[float] = ..., poisson: float = ...,
+    *, tangential_force: float, friction: Optional[float] = ..., poisson: Optional[float] = ...,
     cycle_points: Optional[int] = ..., indentations: Optional[Sequence[float]] = ...,
     line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
     radial_step: Optional[float] = ..., radius: Optional[float] = ..., slope: Optional[float] = ...,
     coefficient: Optional[float] = ..., exponent: Optional[float] = ..., n: Optional[int] = ...,
-    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: float = ...,
-    spring: str = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
+    dx: Optional[float] = ..., size: Optional[float] = ..., modulus: Optional[float] = ...,
+    spring: Optional[str] = ..., hurst: Optional[float] = ..., rms_height: Optional[float] = ...,
     asperity_radius: Optional[float] = ..., work_of_adhesion: Optional[float] = ...,
 ) -> SlipCycle: ...
 
@@ -306,14 +306,14 @@ class StudyResult:
 
 def study_alpha(
     *, method: str, n: Union[int, Sequence[int]], hurst: Union[str, float, Sequence[float]],
-    samples: int, out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
+    samples: int, out: PathLike, rolloff: Optional[float] = ..., seed: Optional[int] = ...,
     min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
-    full_sweep: bool = ..., force: bool = ..., checkpoint_every: float = ...,
+    full_sweep: bool = ..., force: bool = ..., checkpoint_every: Optional[float] = ...,
     progress: ProgressArg = ...,
 ) -> StudyResult: ...
 def study_curve(
     *, method: str, n: int, hurst: Union[str, float, Sequence[float]], samples: int,
-    out: PathLike, rolloff: Optional[float] = ..., seed: int = ...,
+    out: PathLike, rolloff: Optional[float] = ..., seed: Optional[int] = ...,
     min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
-    force: bool = ..., checkpoint_every: float = ..., progress: ProgressArg = ...,
+    force: bool = ..., checkpoint_every: Optional[float] = ..., progress: ProgressArg = ...,
 ) -> StudyResult: ...

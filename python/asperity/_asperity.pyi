@@ -73,18 +73,12 @@ class Solver:
     ) -> Dict[str, Any]: ...
 
 def mdr_curve(
-    line: Optional[F64], profile: Optional[str], radial: Optional[F64],
-    radial_step: Optional[float], radius: Optional[float], slope: Optional[float],
-    coefficient: Optional[float], exponent: Optional[float], n: Optional[int],
-    dx: Optional[float], size: Optional[float], modulus: float, spring: str,
-    hurst: Optional[float], rms_height: Optional[float], asperity_radius: Optional[float],
-    indentations: Optional[List[float]], nloads: Optional[int], dmin: Optional[float],
-    dmax: Optional[float], breakpoints: bool, work_of_adhesion: Optional[float],
+    request: Dict[str, Any], line: Optional[F64], radial: Optional[F64],
 ) -> Dict[str, Any]: ...
 
 def mdr_slip(
-    request: str, line: Optional[F64], radial: Optional[F64], tangential_force: float,
-    friction: Optional[float], poisson: float, cycle_points: Optional[int],
+    request: Dict[str, Any], line: Optional[F64], radial: Optional[F64], tangential_force: float,
+    friction: Optional[float], poisson: Optional[float], cycle_points: Optional[int],
 ) -> Dict[str, Any]: ...
 def bem_adhesion(
     array: F64, size_x: float, size_y: Optional[float], modulus: float, boundary: str,
@@ -97,17 +91,19 @@ def persson_table(
 ) -> Dict[str, Any]: ...
 def run_study(
     method_name: str, sizes: List[int], hursts: List[float], samples: int,
-    rolloff: Optional[float], seed: int, min_contacts: int, max_fraction: float, levels: Optional[int],
-    alpha_sweep: bool, out: str, force: bool, checkpoint_every: float, progress: Progress,
+    rolloff: Optional[float], seed: Optional[int], min_contacts: Optional[int],
+    max_fraction: Optional[float], levels: Optional[int], alpha_sweep: bool, out: str,
+    force: bool, checkpoint_every: Optional[float], progress: Progress,
 ) -> str: ...
 def hurst_range(text: str) -> List[float]: ...
-def default_window() -> Tuple[int, float]: ...
+def comparison_columns() -> List[Tuple[str, str]]: ...
 def thread_count() -> int: ...
 class StudyLedger:
     def __init__(
         self, method_name: str, sizes: List[int], hursts: List[float], samples: int,
-        rolloff: Optional[float], seed: int, min_contacts: int, max_fraction: float,
-        levels: Optional[int], alpha_sweep: bool, out: str, force: bool, checkpoint_every: float,
+        rolloff: Optional[float], seed: Optional[int], min_contacts: Optional[int],
+        max_fraction: Optional[float], levels: Optional[int], alpha_sweep: bool, out: str,
+        force: bool, checkpoint_every: Optional[float],
     ) -> None: ...
     def spec_json(self) -> str: ...
     def next_work(self, lanes: int) -> Optional[Tuple[int, List[int]]]: ...

@@ -69,18 +69,14 @@ fn bem_adhesion<'py>(
     dict.set_item("branch", branches)?;
     let pull_off = match run.pull_off {
         Some(p) => {
-            let point = |s: &asperity::bem::adhesion::AdhesiveSummary| -> PyResult<_> {
-                let d = PyDict::new(py);
-                d.set_item("force", s.force)?;
-                d.set_item("indentation", s.indentation)?;
-                d.set_item("attached_points", s.attached_points)?;
-                Ok(d)
+            let point = |s: &asperity::bem::adhesion::AdhesiveSummary| {
+                (s.force, s.indentation, s.attached_points)
             };
-            let d = PyDict::new(py);
-            d.set_item("force_controlled", point(&p.force_controlled)?)?;
-            d.set_item(
-                "displacement_controlled",
-                point(&p.displacement_controlled)?,
+            let d = pull_off_dict(
+                py,
+                "attached_points",
+                point(&p.force_controlled),
+                point(&p.displacement_controlled),
             )?;
             d.set_item("separated_at", p.separated_at)?;
             Some(d)
@@ -91,4 +87,26 @@ fn bem_adhesion<'py>(
     dict.set_item("critical_stress", run.critical_stress)?;
     dict.set_item("warning", run.resolution_warning())?;
     Ok(dict)
+}
+
+/// The pull-offs of an adhesive run as Python returns them (`bem_adhesion`, `mdr` with a
+/// work of adhesion): `force_controlled` and `displacement_controlled`, each a dict of
+/// `force`, `indentation` and the count of attached points or springs named `count`.
+pub fn pull_off_dict<'py>(
+    py: Python<'py>,
+    count: &str,
+    force_controlled: (f64, f64, usize),
+    displacement_controlled: (f64, f64, usize),
+) -> PyResult<Bound<'py, PyDict>> {
+    let point = |(force, indentation, attached): (f64, f64, usize)| -> PyResult<_> {
+        let d = PyDict::new(py);
+        d.set_item("force", force)?;
+        d.set_item("indentation", indentation)?;
+        d.set_item(count, attached)?;
+        Ok(d)
+    };
+    let d = PyDict::new(py);
+    d.set_item("force_controlled", point(force_controlled)?)?;
+    d.set_item("displacement_controlled", point(displacement_controlled)?)?;
+    Ok(d)
 }

@@ -9,9 +9,11 @@
 use asperity::mdr::{CurvePoint, Spring, SpringLaw};
 use asperity_app::mdr::{Branch, Indenter, MdrRequest};
 use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::adhesion::pull_off_dict;
 use crate::arrays::owned_1d;
 use crate::errors::{from_error, refused, request_error};
 use crate::interrupt::run_detached;
@@ -22,75 +24,21 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// The force–indentation–stiffness curve of `asperity mdr` as columns, with a description
-/// and the spring law's critical depth.
+/// and the spring law's critical depth; `request`: the keywords of the [`MdrRequest`]
+/// ([`request`]).
 #[pyfunction]
-#[pyo3(signature = (line, profile, radial, radial_step, radius, slope, coefficient, exponent,
-    n, dx, size, modulus, spring, hurst, rms_height, asperity_radius, indentations, nloads,
-    dmin, dmax, breakpoints, work_of_adhesion))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (request, line, radial))]
 fn mdr_curve<'py>(
     py: Python<'py>,
+    request: &Bound<'py, PyDict>,
     line: Option<PyReadonlyArray1<'py, f64>>,
-    profile: Option<String>,
     radial: Option<PyReadonlyArray1<'py, f64>>,
-    radial_step: Option<f64>,
-    radius: Option<f64>,
-    slope: Option<f64>,
-    coefficient: Option<f64>,
-    exponent: Option<f64>,
-    n: Option<usize>,
-    dx: Option<f64>,
-    size: Option<f64>,
-    modulus: f64,
-    spring: &str,
-    hurst: Option<f64>,
-    rms_height: Option<f64>,
-    asperity_radius: Option<f64>,
-    indentations: Option<Vec<f64>>,
-    nloads: Option<usize>,
-    dmin: Option<f64>,
-    dmax: Option<f64>,
-    breakpoints: bool,
-    work_of_adhesion: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let request = MdrRequest {
-        line: line.is_some(),
-        profile,
-        radial: radial.is_some(),
-        radial_step,
-        radius,
-        slope,
-        coefficient,
-        exponent,
-        n,
-        dx,
-        size,
-        modulus,
-        spring: spring.into(),
-        hurst,
-        rms_height,
-        asperity_radius,
-        indentations,
-        nloads,
-        dmin,
-        dmax,
-        breakpoints,
-        work_of_adhesion,
-    };
+    let request = self::request(request, &line, &radial)?;
     request.check().map_err(refused)?;
-    let indenter = match (&line, &radial) {
-        (Some(line), _) => {
-            let heights = owned_1d(line).to_vec();
-            Indenter::line(heights, size.unwrap_or(1.0), "").map_err(refused)?
-        }
-        (None, Some(radial)) => {
-            let samples = owned_1d(radial);
-            let samples = samples.as_slice().expect("contiguous");
-            request.radial(samples, "").map_err(request_error)?
-        }
-        (None, None) => request.closed_form().map_err(request_error)?,
-    };
-    if work_of_adhesion.is_some() {
+    let indenter = indenter(&request, &line, &radial)?;
+    let modulus = request.modulus;
+    if request.work_of_adhesion.is_some() {
         return adhesive_curve(py, &request, indenter);
     }
     let law = request.spring_law(&indenter).map_err(refused)?;
@@ -124,6 +72,71 @@ fn columns<'py>(py: Python<'py>, points: &[CurvePoint]) -> PyResult<Bound<'py, P
     Ok(dict)
 }
 
+/// The [`MdrRequest`] of `mdr` and `mdr_slip` from Python's `_mdr_request`: the keywords
+/// given, by name (those left out take the request's defaults, the CLI's), with `line` and
+/// `radial` set by the arrays given.
+pub fn request<'py>(
+    keywords: &Bound<'py, PyDict>,
+    line: &Option<PyReadonlyArray1<'py, f64>>,
+    radial: &Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<MdrRequest> {
+    fn item<'py, T: FromPyObjectOwned<'py>>(
+        keywords: &Bound<'py, PyDict>,
+        name: &str,
+    ) -> PyResult<Option<T>> {
+        match keywords.get_item(name)? {
+            Some(value) if !value.is_none() => value.extract::<T>().map(Some).map_err(Into::into),
+            _ => Ok(None),
+        }
+    }
+    let defaults = MdrRequest::default();
+    Ok(MdrRequest {
+        line: line.is_some(),
+        profile: item(keywords, "profile")?,
+        radial: radial.is_some(),
+        radial_step: item(keywords, "radial_step")?,
+        radius: item(keywords, "radius")?,
+        slope: item(keywords, "slope")?,
+        coefficient: item(keywords, "coefficient")?,
+        exponent: item(keywords, "exponent")?,
+        n: item(keywords, "n")?,
+        dx: item(keywords, "dx")?,
+        size: item(keywords, "size")?,
+        modulus: item(keywords, "modulus")?.unwrap_or(defaults.modulus),
+        spring: item(keywords, "spring")?.unwrap_or(defaults.spring),
+        hurst: item(keywords, "hurst")?,
+        rms_height: item(keywords, "rms_height")?,
+        asperity_radius: item(keywords, "asperity_radius")?,
+        indentations: item(keywords, "indentations")?,
+        nloads: item(keywords, "nloads")?,
+        dmin: item(keywords, "dmin")?,
+        dmax: item(keywords, "dmax")?,
+        breakpoints: item(keywords, "breakpoints")?.unwrap_or(defaults.breakpoints),
+        work_of_adhesion: item(keywords, "work_of_adhesion")?,
+    })
+}
+
+/// The indenter of a checked `request`: the line's heights, the radial samples mapped by
+/// the MDR transform, or the closed-form profile.
+pub fn indenter(
+    request: &MdrRequest,
+    line: &Option<PyReadonlyArray1<'_, f64>>,
+    radial: &Option<PyReadonlyArray1<'_, f64>>,
+) -> PyResult<Indenter> {
+    match (line, radial) {
+        (Some(line), _) => {
+            let heights = owned_1d(line).to_vec();
+            Indenter::line(heights, request.size.unwrap_or(1.0), "").map_err(refused)
+        }
+        (None, Some(radial)) => {
+            let samples = owned_1d(radial);
+            let samples = samples.as_slice().expect("contiguous");
+            request.radial(samples, "").map_err(request_error)
+        }
+        (None, None) => request.closed_form().map_err(request_error),
+    }
+}
+
 /// `work_of_adhesion` given: the load path and the retraction to pull-off, as
 /// `asperity mdr --work-of-adhesion` computes them.
 fn adhesive_curve<'py>(
@@ -143,25 +156,13 @@ fn adhesive_curve<'py>(
     let dict = columns(py, &points)?;
     let branches: Vec<&str> = rows.iter().map(|(_, b)| b.name()).collect();
     dict.set_item("branch", branches)?;
-    let pull_off = match pull_offs {
-        Some(p) => {
-            let point = |q: &CurvePoint| -> PyResult<Bound<'py, PyDict>> {
-                let d = PyDict::new(py);
-                d.set_item("force", q.force)?;
-                d.set_item("indentation", q.indentation)?;
-                d.set_item("contacts", q.contacts)?;
-                Ok(d)
-            };
-            let d = PyDict::new(py);
-            d.set_item("force_controlled", point(&p.force_controlled)?)?;
-            d.set_item(
-                "displacement_controlled",
-                point(&p.displacement_controlled)?,
-            )?;
-            Some(d)
-        }
-        None => None,
-    };
+    let point = |q: &CurvePoint| (q.force, q.indentation, q.contacts);
+    let pull_off = pull_offs
+        .map(|p| {
+            let (force, displacement) = (&p.force_controlled, &p.displacement_controlled);
+            pull_off_dict(py, "contacts", point(force), point(displacement))
+        })
+        .transpose()?;
     dict.set_item("pull_off", pull_off)?;
     dict.set_item("description", indenter.description)?;
     let spring =

@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use asperity::lock::FolderLock;
 use asperity::stop::Stop;
 use asperity::study::{
-    FitWindow, Ledger, Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples,
-    DEFAULT_LEVELS,
+    Ledger, Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples,
+    CHECKPOINT_INTERVAL,
 };
 use asperity::Error;
 use asperity_app::study::{self, rows, Kind, TaskFailure};
@@ -29,7 +29,7 @@ use asperity_app::range::parse_range;
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(hurst_range, m)?)?;
-    m.add_function(wrap_pyfunction!(default_window, m)?)?;
+    m.add_function(wrap_pyfunction!(comparison_columns, m)?)?;
     m.add_function(wrap_pyfunction!(thread_count, m)?)?;
     m.add_class::<StudyLedger>()?;
     m.add_class::<SampleComputer>()?;
@@ -42,11 +42,17 @@ fn hurst_range(text: &str) -> PyResult<Vec<f64>> {
     parse_range(text).map_err(from_error)
 }
 
-/// The default α window `(min_contacts, max_fraction)`.
+/// The columns of `comparison.csv`, `(name, type)` with type `text`, `count` or `number`
+/// ([`rows::COMPARISON_COLUMNS`]): the names and types of `StudyResult.comparison()`.
 #[pyfunction]
-fn default_window() -> (usize, f64) {
-    let w = FitWindow::default();
-    (w.min_contacts, w.max_fraction)
+fn comparison_columns() -> Vec<(&'static str, String)> {
+    rows::COMPARISON_COLUMNS
+        .iter()
+        .map(|(name, kind)| {
+            let kind = serde_json::to_value(kind).expect("column types serialise");
+            (*name, kind.as_str().unwrap_or_default().to_string())
+        })
+        .collect()
 }
 
 fn method(name: &str) -> PyResult<Method> {
@@ -72,29 +78,25 @@ fn run_study(
     hursts: Vec<f64>,
     samples: usize,
     rolloff: Option<f64>,
-    seed: u64,
-    min_contacts: usize,
-    max_fraction: f64,
+    seed: Option<u64>,
+    min_contacts: Option<usize>,
+    max_fraction: Option<f64>,
     levels: Option<usize>,
     alpha_sweep: bool,
     out: PathBuf,
     force: bool,
-    checkpoint_every: f64,
+    checkpoint_every: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let spec = make_spec(
         method_name,
-        sizes,
-        hursts,
-        samples,
+        (sizes, hursts, samples),
         rolloff,
         seed,
-        min_contacts,
-        max_fraction,
-        levels,
+        (min_contacts, max_fraction, levels),
         alpha_sweep,
     )?;
-    let interval = study::checkpoint_interval(checkpoint_every).map_err(refused)?;
+    let interval = checkpoint_interval(checkpoint_every)?;
     let spec = resumable(py, spec, &out, force)?;
     study::validate(&spec).map_err(request_error)?;
     // The flag that Ctrl-C raises: the samples poll it.
@@ -108,35 +110,42 @@ fn run_study(
 }
 
 /// A study's spec from `run_study`'s arguments (`alpha_sweep`: an α study's load sweep,
-/// [`Kind::spec`]), not yet validated.
-#[allow(clippy::too_many_arguments)]
+/// [`Kind::spec`]), not yet validated: `(sizes, hursts, samples)` as given, and the seed,
+/// the α window and the levels as given or, where `None`, [`StudySpec::default`]'s — the
+/// defaults of `asperity study`, which live there only.
 fn make_spec(
     method_name: &str,
-    sizes: Vec<usize>,
-    hursts: Vec<f64>,
-    samples: usize,
+    (sizes, hursts, samples): (Vec<usize>, Vec<f64>, usize),
     rolloff: Option<f64>,
-    seed: u64,
-    min_contacts: usize,
-    max_fraction: f64,
-    levels: Option<usize>,
+    seed: Option<u64>,
+    (min_contacts, max_fraction, levels): (Option<usize>, Option<f64>, Option<usize>),
     alpha_sweep: bool,
 ) -> PyResult<StudySpec> {
+    let defaults = StudySpec::default();
+    let mut window = defaults.window;
+    window.min_contacts = min_contacts.unwrap_or(window.min_contacts);
+    window.max_fraction = max_fraction.unwrap_or(window.max_fraction);
     let spec = StudySpec {
         method: method(method_name)?,
         sizes,
         hursts,
         samples,
         rolloff,
-        seed,
-        window: FitWindow {
-            min_contacts,
-            max_fraction,
-        },
-        levels: levels.unwrap_or(DEFAULT_LEVELS),
-        sweep_end: None,
+        seed: seed.unwrap_or(defaults.seed),
+        window,
+        levels: levels.unwrap_or(defaults.levels),
+        ..defaults
     };
     Ok(Kind::Alpha.spec(spec, !alpha_sweep))
+}
+
+/// The checkpoint interval: `checkpoint_every` seconds by the front-end layer's rule, or
+/// where `None` the CLI's default ([`CHECKPOINT_INTERVAL`]).
+fn checkpoint_interval(checkpoint_every: Option<f64>) -> PyResult<std::time::Duration> {
+    match checkpoint_every {
+        Some(seconds) => study::checkpoint_interval(seconds).map_err(refused),
+        None => Ok(CHECKPOINT_INTERVAL),
+    }
 }
 
 /// The study to run in `out` ([`study::resumable`]): `spec`, or the whole-sweep study
@@ -233,28 +242,24 @@ impl StudyLedger {
         hursts: Vec<f64>,
         samples: usize,
         rolloff: Option<f64>,
-        seed: u64,
-        min_contacts: usize,
-        max_fraction: f64,
+        seed: Option<u64>,
+        min_contacts: Option<usize>,
+        max_fraction: Option<f64>,
         levels: Option<usize>,
         alpha_sweep: bool,
         out: PathBuf,
         force: bool,
-        checkpoint_every: f64,
+        checkpoint_every: Option<f64>,
     ) -> PyResult<Self> {
         let spec = make_spec(
             method_name,
-            sizes,
-            hursts,
-            samples,
+            (sizes, hursts, samples),
             rolloff,
             seed,
-            min_contacts,
-            max_fraction,
-            levels,
+            (min_contacts, max_fraction, levels),
             alpha_sweep,
         )?;
-        let interval = study::checkpoint_interval(checkpoint_every).map_err(refused)?;
+        let interval = checkpoint_interval(checkpoint_every)?;
         let spec = resumable(py, spec, &out, force)?;
         study::validate(&spec).map_err(request_error)?;
         let (lock, store) = open_folder(&spec, out, force, interval, Stop::new())?;

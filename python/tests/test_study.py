@@ -109,6 +109,8 @@ def test_the_comparison_with_the_paper_equals_study_compare(cli, tmp_path):
     report = (tmp_path / "cli" / "report.md").read_text()
     ours = asperity.study_alpha(**MDR, out=tmp_path / "py").comparison()
     assert len(theirs) == len(ours["ours"]) == 6
+    # The same columns in the same order (one list, the front-end layer's), then the verdict.
+    assert list(ours) == list(theirs[0]) + ["verdict"]
     for i, row in enumerate(theirs):
         for name in ("method", "quantity", "source"):
             assert ours[name][i] == row[name], name
@@ -236,6 +238,25 @@ print("finished", flush=True)
     print(f"study stopped {elapsed:.3f} s after SIGINT")
     assert elapsed < 2.0, f"took {elapsed:.2f} s to stop"
     assert (folder / "study.json").exists() and checkpoint_samples(folder) > 0
+
+
+@pytest.mark.parametrize("kind", ["alpha", "curve"])
+def test_a_study_s_defaults_are_the_cli_s(cli, tmp_path, kind):
+    """Keywords left out take the defaults of `asperity study` (the library's
+    StudySpec::default, written once): the same study.json as the CLI without those flags,
+    and the same numbers."""
+    cli("study", kind, "--method", "mdr", "--n", 64, "--hurst", 0.5, "--samples", 3,
+        "--out", tmp_path / "cli", "--quiet")
+    run = asperity.study_alpha if kind == "alpha" else asperity.study_curve
+    ours = run(method="mdr", n=64, hurst=0.5, samples=3, out=tmp_path / "py")
+    theirs = json.loads((tmp_path / "cli" / "study.json").read_text())
+    mine = json.loads((tmp_path / "py" / "study.json").read_text())
+    assert mine == theirs
+    assert {"seed", "levels", "window"} <= set(mine["spec"])
+    with open(tmp_path / "cli" / f"{kind}.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    name = "alpha" if kind == "alpha" else "stiffness"
+    assert [float(r[name]) for r in rows] == ours[name].tolist()
 
 
 def test_study_arguments_are_checked_like_the_cli(cli, tmp_path):

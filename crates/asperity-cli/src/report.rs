@@ -20,25 +20,14 @@ pub use asperity::study::compare::{rows, steepest_slope, Results, Row, CLOSE};
 use asperity::study::sensitivity::{
     sensitivity_windows, study_sensitivity, study_slopes, TaskSensitivity,
 };
+use asperity_app::study::rows::COMPARISON_COLUMNS;
 
 use crate::output::{format_number, Table};
 
-const HEADER: [&str; 10] = [
-    "method",
-    "n",
-    "hurst",
-    "quantity",
-    "ours",
-    "low",
-    "high",
-    "reference",
-    "source",
-    "tolerance",
-];
-
-/// `comparison.csv` of `rows`.
+/// `comparison.csv` of `rows`, under the front-end layer's header ([`COMPARISON_COLUMNS`]).
 pub fn table(rows: &[Row]) -> Table {
-    let mut table = Table::new(&HEADER);
+    let header: Vec<&str> = COMPARISON_COLUMNS.iter().map(|(name, _)| *name).collect();
+    let mut table = Table::new(&header);
     for r in rows {
         table.push(&[
             r.method.clone(),

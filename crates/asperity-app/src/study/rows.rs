@@ -69,6 +69,21 @@ pub const CURVE_COLUMNS: &[(&str, ColumnType)] = &[
     ("area_fraction", Number),
 ];
 
+/// The columns of `comparison.csv` ([`asperity::study::compare::Row`], in its order): the
+/// CLI's header and the names and types of Python's `StudyResult.comparison()`.
+pub const COMPARISON_COLUMNS: &[(&str, ColumnType)] = &[
+    ("method", Text),
+    ("n", Count),
+    ("hurst", Number),
+    ("quantity", Text),
+    ("ours", Number),
+    ("low", Number),
+    ("high", Number),
+    ("reference", Number),
+    ("source", Text),
+    ("tolerance", Number),
+];
+
 /// `alpha.csv`: per task, α fitted on the ensemble-mean curve (`alpha`), the 95 %
 /// interval of the per-sample α (`alpha_low`, `alpha_high`), the fit's own interval, the
 /// mean of the per-sample α, how many samples had a fit and eq. (6)/(24)'s α.
@@ -186,5 +201,33 @@ mod tests {
         // Python reads the cells as JSON: a missing number is null.
         let json = serde_json::to_string(&alpha.rows[1][..5]).unwrap();
         assert_eq!(json, r#"["bem",64,0.5,null,null]"#);
+    }
+
+    #[test]
+    fn the_comparison_columns_are_the_rows_fields_in_order() {
+        let row = asperity::study::compare::Row {
+            method: "bem".into(),
+            n: 64.0,
+            hurst: 0.5,
+            quantity: "alpha".into(),
+            ours: 0.9,
+            low: 0.8,
+            high: 1.0,
+            reference: 0.95,
+            source: "eq. (6)".into(),
+            tolerance: 0.0,
+        };
+        let text = serde_json::to_string(&row).unwrap();
+        let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(value.as_object().unwrap().len(), COMPARISON_COLUMNS.len());
+        let mut at = 0;
+        for (name, kind) in COMPARISON_COLUMNS {
+            let key = format!("\"{name}\":");
+            let found = text[at..]
+                .find(&key)
+                .unwrap_or_else(|| panic!("{name} in order"));
+            at += found + key.len();
+            assert_eq!(value[name].is_string(), *kind == Text, "{name}");
+        }
     }
 }

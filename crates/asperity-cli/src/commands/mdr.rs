@@ -78,12 +78,12 @@ pub struct MdrArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub size: Option<f64>,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = MdrRequest::default().modulus, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Spring law: linear (stiffness E*·Δx), hertz (the microscale law 15.2; radius from
     /// --asperity-radius, or --radius with --profile hertz) or fractal (15.7, with the
     /// critical depth 15.6; needs --hurst).
-    #[arg(long, default_value = "linear")]
+    #[arg(long, default_value_t = MdrRequest::default().spring)]
     pub spring: String,
     /// Hurst exponent H of the fractal law (15.7), 0 < H < 2.
     #[arg(long, allow_hyphen_values = true)]
