@@ -29,6 +29,7 @@ pub(crate) mod bytes;
 pub(crate) mod di;
 pub(crate) mod frt;
 pub(crate) mod gwy;
+pub(crate) mod hdf5;
 pub(crate) mod ibw;
 pub mod inpaint;
 pub(crate) mod jpk;
@@ -199,6 +200,12 @@ const FORMATS: &[Format] = &[
         extensions: &["gwy"],
         sniff: gwy::sniff,
         read: gwy::read,
+    },
+    Format {
+        name: "hdf5",
+        extensions: &["h5", "hdf5", "hdf"],
+        sniff: hdf5::sniff,
+        read: hdf5::read,
     },
     Format {
         name: "netcdf",
@@ -1159,10 +1166,13 @@ mod every_shared_file {
     //! test checks it against the reference; this one catches a file no reader claims).
 
     /// Files no reader reads yet, with the reason.
+    #[cfg(not(feature = "hdf5"))]
     const NOT_YET: &[(&str, &str)] = &[(
         "multiple_data_sets.h5",
-        "HDF5 needs libhdf5 (an optional feature not built yet)",
+        "HDF5 is read with the optional `hdf5` feature (the HDF5 library)",
     )];
+    #[cfg(feature = "hdf5")]
+    const NOT_YET: &[(&str, &str)] = &[];
 
     #[test]
     fn every_file_of_the_shared_sets_is_read() {
