@@ -4,13 +4,13 @@
 //! A parallel pass started from a thread outside the pool (the program's main thread, a
 //! Python thread) is injected into the pool: the caller sleeps on a latch and a worker is
 //! woken for it, twice per pass. Started from a worker, the pass is forked where it is and
-//! the other workers steal its halves. Measured on the 2-core machine of docs/bem.md
+//! the other workers steal its halves. Measured on the 2-core machine of docs/bem_history.md
 //! (an empty pass over 32 chunks): 12–14 µs from outside against 2 µs from a worker on 2
 //! threads, 70 µs against 0.2 µs on one; a BCCG iteration makes about twenty passes.
 //!
 //! A worker that finds no job yields 32 times and then sleeps on a futex; a pass started
 //! while it sleeps must wake it. A solve's passes are separated by serial stretches just
-//! long enough for that, and on the virtual machine of docs/bem.md a wake is dear: 4–5 % of
+//! long enough for that, and on the virtual machine of docs/bem_history.md a wake is dear: 4–5 % of
 //! the samples of 256² solves on 2 threads fell in the waking thread's `try_to_wake_up`,
 //! and a pass waits for the sleeper to come back. So while a solve with
 //! [`Parallelism::Exclusive`] runs, every other worker runs [`keep_awake`]: it executes

@@ -91,7 +91,7 @@ use crate::Result as CrateResult;
 /// `β = max(0, min(β_PR, β_FR))` (Polak–Ribière+ without). The rings cut the iterations
 /// most where the contact patches span many pixels, and cost per iteration two updates of
 /// the listed ring points and, where the set changed, their recount: measured with the
-/// earlier whole-grid sweeps (docs/bem.md), the solves of a study sample took 6–12 % less
+/// earlier whole-grid sweeps (docs/bem_history.md), the solves of a study sample took 6–12 % less
 /// time at 512² and 1024², about the same at 256², and up to 20 % more at 128² and 64²
 /// (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
 pub(super) const RING_MIN_POINTS: usize = 1 << 18;
@@ -880,7 +880,7 @@ impl ContactSolver {
         // Polak–Ribière+, (z − z̄)ᵀ(Πg − g_old) / z_oldᵀ g_old. With the rings the hybrid
         // max(0, min(PR, FR)), Fletcher–Reeves (z − z̄)ᵀΠg / z_oldᵀ g_old: Fletcher–Reeves
         // never resets the conjugacy and does best on cold solves, Polak–Ribière+ on the
-        // warm ones of a study; the hybrid is within 2 of the better on both (docs/bem.md).
+        // warm ones of a study; the hybrid is within 2 of the better on both (docs/bem_history.md).
         // Periodic displacement control keeps Polak–Ribière+: with the coarse constant in
         // z, Fletcher–Reeves crawls there (131 iterations against 30 near full contact).
         let polak_ribiere = (zg - (z_g_old - z_mean * g_old_sum)) / previous_zg;

@@ -39,7 +39,7 @@ use crate::Result;
 /// The precision the solvers' preconditioner computes in: single. `M` is an approximation
 /// of `K⁻¹` to begin with, and the iterations read `M g` only through the direction it
 /// suggests; their residuals, steps and convergence are all in double precision. Single
-/// precision takes a fifth off the preconditioner's time at 512² (docs/bem.md).
+/// precision takes a fifth off the preconditioner's time at 512² (docs/bem_history.md, "Single precision for the preconditioner").
 pub(super) type Real = f32;
 
 /// `M ≈ K⁻¹` by its Fourier symbol `E*|q|/2` on the unpadded grid (see the module docs),

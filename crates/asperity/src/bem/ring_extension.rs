@@ -32,7 +32,7 @@
 //! edge from the first (transpose), each update in two parallel passes — values from the
 //! neighbours into a scratch field, then written in place. Every value is added from its
 //! neighbours in a fixed order (above, below, left, right), so the results do not depend on
-//! the thread count. Cost (docs/bem.md, "Fewer passes, no transposes"): at 512² and 10 %
+//! the thread count. Cost (docs/bem_history.md, "Fewer passes, no transposes"): at 512² and 10 %
 //! contact about an eighth of an iteration with the recounts, four fifths of the
 //! whole-grid stencil sweeps it replaced. Nothing is allocated after [`RingExtension::new`].
 

@@ -58,7 +58,7 @@ const GAP_SLACK: f64 = 1e-2;
 
 /// The largest set solved directly on a `len`-point grid: `|S|³ = 48 len log₂ len` (the
 /// factor's `|S|³/3` flops against a transform's `len log₂ len`), between 32 and 1024
-/// points. The constant is measured on study samples (docs/bem.md): 48 is about 4 % faster
+/// points. The constant is measured on study samples (docs/bem_history.md): 48 is about 4 % faster
 /// than 24 and as fast as 96 at 64² and 128²; 24 and 96 are alike at 1024².
 pub(super) fn limit(len: usize) -> usize {
     let transform = len as f64 * (len.max(2) as f64).log2();

@@ -2,7 +2,7 @@
 //!
 //! A block of 128 KiB–1 MiB (a 256² field of `f64` is 512 KiB) cannot cover an aligned huge
 //! page alone, and the C allocator maps each afresh (they are above its mapping threshold),
-//! so its every 4 KiB page faults at first touch. On the virtual machine of docs/bem.md a
+//! so its every 4 KiB page faults at first touch. On the virtual machine of docs/bem_history.md a
 //! fault costs about 5 µs: the first 256² BEM solve of a process spent about 7 ms of its
 //! 46 ms faulting in its fields (free boundaries, 2 threads; measured by touching them
 //! beforehand).

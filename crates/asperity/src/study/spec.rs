@@ -84,7 +84,7 @@ impl Default for StudySpec {
 /// fitted on: each sample's curve must reach the ensemble's window end, the median over
 /// samples of their window ends. Measured on `reproduce fig1 --quick` (64², 128², 9 H,
 /// 20 samples each, every sensitivity window): the first load past 4× a window's end
-/// carries at least 3.5 times that window's ensemble end force (docs/bem.md).
+/// carries at least 3.5 times that window's ensemble end force (docs/bem_history.md).
 pub const ALPHA_SWEEP_MARGIN: f64 = 4.0;
 
 impl StudySpec {
