@@ -1,4 +1,4 @@
-//! Sealed checkpoints (study/identity.rs) on arbitrary bytes: never a panic; anything
+//! Sealed checkpoints (study/store/identity.rs) on arbitrary bytes: never a panic; anything
 //! accepted was sealed with the identity asked for and matches its checksum.
 #![no_main]
 use asperity::study::identity::{seal, unseal, TaskIdentity};

@@ -42,14 +42,12 @@
 //! # Files, by concern
 //! `spec.rs` what a study is ([`StudySpec`] with its rules and `Default`, [`Method`],
 //! [`Task`], seeds, costs); `run.rs` how a task runs ([`Sampler`], [`run_task`], lanes,
-//! [`TaskResult`]); `store.rs` the folder ([`StudyDir`], checkpoints, [`Restored`]), sealed
+//! [`TaskResult`]); `store/` the folder ([`StudyDir`], checkpoints, [`Restored`]), sealed
 //! by [`identity`] and shared over processes by [`ledger`]; [`samplers`] (MDR, BEM);
 //! [`curve`] (ensemble means, the α window); [`sensitivity`]; [`theory`]; [`compare`].
 
 pub mod compare;
 pub mod curve;
-pub mod identity;
-pub mod ledger;
 pub mod samplers;
 pub mod sensitivity;
 pub mod theory;
@@ -66,7 +64,6 @@ use serde::{Deserialize, Serialize};
 pub use curve::{
     ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
 };
-pub use ledger::Ledger;
 #[allow(unused_imports)] // the crate-private items of the three, for the tests below
 use run::*;
 pub use run::{run_task, ProgressFn, Sampler, TaskResult};
@@ -77,8 +74,10 @@ pub use spec::{
     sample_cost, sample_seed, Method, StudySpec, Task, ALPHA_SWEEP_MARGIN, DEFAULT_LEVELS,
     MAX_LEVELS, MAX_STUDY_SAMPLES,
 };
+pub use store::ledger::Ledger;
 #[allow(unused_imports)]
 use store::*;
+pub use store::{identity, ledger};
 pub use store::{
     Received, Restored, StudyDir, CHECKPOINT_INTERVAL, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };

@@ -287,13 +287,15 @@ pub(crate) mod imp {
         };
         match raw {
             Some(r) if r <= limit => {}
-            _ => return Err(bad(
-                FORMAT,
-                format!(
+            _ => {
+                return Err(bad(
+                    FORMAT,
+                    format!(
                     "dataset {} claims {shape:?} values, more than its {stored} stored bytes hold",
                     ds.name()
                 ),
-            )),
+                ))
+            }
         }
         crate::memory::ensure_fits(
             &format!("reading HDF5 dataset {}", ds.name()),

@@ -1,5 +1,10 @@
 //! Where a study keeps its spec and checkpoints: the folder ([`StudyDir`]: check, lock,
-//! open, resume), the sealed checkpoint of each task and what it restores.
+//! open, resume), the sealed checkpoint of each task and what it restores; [`identity`]
+//! seals each checkpoint with what produced it, and [`ledger`] shares a study's samples
+//! over processes (MPI).
+
+pub mod identity;
+pub mod ledger;
 
 use super::*;
 

@@ -20,7 +20,7 @@
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use super::{Received, SampleCurve, StudyDir, Task, TaskResult};
+use crate::study::{Received, SampleCurve, StudyDir, Task, TaskResult};
 use crate::{Error, Result};
 
 /// A checkpoint is written at the latest when this many times the last write's duration
@@ -89,7 +89,7 @@ impl Ledger {
         })
     }
 
-    /// Task number `t` (in the order of [`super::StudySpec::tasks`]).
+    /// Task number `t` (in the order of [`crate::study::StudySpec::tasks`]).
     pub fn task(&self, t: usize) -> Task {
         self.entries[t].task
     }
@@ -201,8 +201,8 @@ impl Ledger {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{run_any_task, FitWindow, Method, StudySpec, TaskSamples};
     use super::*;
+    use crate::study::{run_any_task, FitWindow, Method, StudySpec, TaskSamples};
 
     fn spec() -> StudySpec {
         StudySpec {

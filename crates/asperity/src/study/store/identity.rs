@@ -17,8 +17,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::samplers::Scales;
-use super::{FitWindow, Method, StudySpec, Task};
+use crate::study::samplers::Scales;
+use crate::study::{FitWindow, Method, StudySpec, Task};
 
 /// The format tag of sealed checkpoints.
 pub const CHECKPOINT_FORMAT: &str = "asperity-checkpoint/2";
@@ -103,7 +103,9 @@ impl TaskIdentity {
             window: spec.window,
             scales: Scales::of(spec.method),
             solver: match spec.method {
-                Method::Bem => Some(SolverIdentity::from(&super::samplers::bem_solver_params())),
+                Method::Bem => Some(SolverIdentity::from(
+                    &crate::study::samplers::bem_solver_params(),
+                )),
                 Method::Mdr => None,
             },
             sweep_end: spec.sweep_end,
