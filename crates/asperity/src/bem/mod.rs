@@ -67,6 +67,8 @@ mod solver;
 mod stiffness;
 pub mod sweep;
 pub mod tangential;
+#[cfg(test)]
+mod tests;
 
 pub use full_contact::FullContactThreshold;
 pub use interface::Interface;

@@ -5,11 +5,11 @@
 
 use std::f64::consts::PI;
 
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
-use asperity::elastic::Boundary;
-use asperity::reference::Hertz;
-use asperity::spectrum::{LongWavelength, Psd};
-use asperity::surface::{Normalisation, Surface, SurfaceGenerator, SurfaceSpec};
+use crate::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+use crate::elastic::Boundary;
+use crate::reference::Hertz;
+use crate::spectrum::{LongWavelength, Psd};
+use crate::surface::{Normalisation, Surface, SurfaceGenerator, SurfaceSpec};
 use ndarray::Array2;
 
 /// A sphere `h = −r²/2R` centred on pixel `(rows/2, cols/2)` of `Δx × Δy` pixels.

@@ -14,10 +14,10 @@
 //! kernels at run time: the values were recorded on an x86-64 machine with AVX2/FMA. Every
 //! case runs on one and on two threads, which must give the same bits (determinism).
 
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
-use asperity::elastic::Boundary;
-use asperity::spectrum::{LongWavelength, Psd};
-use asperity::surface::{Normalisation, Surface, SurfaceGenerator, SurfaceSpec};
+use crate::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
+use crate::elastic::Boundary;
+use crate::spectrum::{LongWavelength, Psd};
+use crate::surface::{Normalisation, Surface, SurfaceGenerator, SurfaceSpec};
 
 /// FNV-1a over 64-bit words.
 struct Fingerprint(u64);
