@@ -906,6 +906,9 @@ class Solver:
         fd_step: float = 1e-3,
         fields: bool = False,
         progress: ProgressArg = None,
+        poisson: Optional[float] = None,
+        resistivity: Optional[Sequence[float]] = None,
+        thermal_conductivity: Optional[Sequence[float]] = None,
     ) -> Sweep:
         """A load sweep exactly as ``asperity bem`` runs it (same numbers bit for bit):
         ``pressures``, ``forces`` or ``indentations`` in the given order, or ``nloads``
@@ -917,20 +920,35 @@ class Solver:
         a tqdm bar. Ctrl-C stops the sweep within a second, inside a load's solve too
         (``KeyboardInterrupt``).
 
+        ``poisson`` (ν in [0, 0.5], ``asperity bem --poisson``): also the tangential
+        (no-slip) stiffnesses ``stiffness_x``, ``stiffness_y`` of the frozen contact set
+        (Cerruti's kernel; E* stays the solver's modulus) and ``tangential_ratio`` =
+        (k_x + k_y)/(2k), Mindlin's 2(1−ν)/(2−ν) for one circular contact.
+        ``resistivity`` (ρ₁, ρ₂) and ``thermal_conductivity`` (κ₁, κ₂), one value per
+        body: also ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and ``thermal_conductance``
+        = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy). docs/tangential.md.
+
         Example::
 
             >>> sweep = solver.sweep(nloads=20, pmin=1e-4, pmax=1e-1)
             >>> sweep.force, sweep.stiffness, sweep.area_fraction
+            >>> t = solver.sweep(pressures=[0.01], poisson=0.3, resistivity=[1, 1])
+            >>> t.tangential_ratio, t.electrical_conductance
         """
         quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields)
         fd = float(fd_step) if fd_stiffness else None
         bar = _Progress(progress, "bem")
         try:
-            columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields), bar.callback)
+            columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields),
+                                       bar.callback, _opt(poisson), _floats(resistivity),
+                                       _floats(thermal_conductivity))
         finally:
             bar.close()
+        derived = {"poisson": _opt(poisson), "resistivity": _floats(resistivity),
+                   "thermal_conductivity": _floats(thermal_conductivity)}
+        derived = {k: v for k, v in derived.items() if v is not None}
         return Sweep(columns, self._metadata(loads={"quantity": quantity, "values": values},
-                                             stiffness=bool(stiffness), fd_step=fd))
+                                             stiffness=bool(stiffness), fd_step=fd, **derived))
 
     def full_contact_threshold(self) -> Dict[str, Optional[float]]:
         """Mean pressure and indentation from which the gap is closed everywhere. On free
@@ -1019,6 +1037,7 @@ def contact(
     resistivity: Optional[Sequence[float]] = None,
     thermal_conductivity: Optional[Sequence[float]] = None,
     hardness: Optional[float] = None,
+    tangential: bool = False,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -1039,7 +1058,10 @@ def contact(
     contact, docs/hardness.md; each load on the surface as given), adding
     ``plastic_area_m2`` and ``plastic_fraction`` (the points at the hardness); the
     stiffness is then that of the elastic set. A hardness that is not positive and finite,
-    or a pressure at or above it, raises ValueError.
+    or a pressure at or above it, raises ValueError. With ``tangential=True`` (needs
+    ``poisson``: with ``young``, or beside ``modulus`` for Cerruti's kernel alone) also
+    ``stiffness_x_n_per_m``, ``stiffness_y_n_per_m`` (the no-slip tangential stiffness of
+    the frozen contact set) and ``tangential_ratio`` = (k_x + k_y)/(2k).
 
     Example::
 
@@ -1058,7 +1080,7 @@ def contact(
         None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
         None if thermal_conductivity is None
         else [float(v) for v in np.atleast_1d(thermal_conductivity)],
-        _opt(hardness),
+        _opt(hardness), bool(tangential),
     )
     if "map" in columns:
         dx = size_x / heights.shape[1]
@@ -1069,7 +1091,7 @@ def contact(
                "poisson": _opt(poisson), "boundary": str(boundary),
                "tolerance": float(tolerance), "resistivity": _floats(resistivity),
                "thermal_conductivity": _floats(thermal_conductivity),
-               "hardness": _opt(hardness)}
+               "hardness": _opt(hardness), "tangential": bool(tangential)}
     return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
                            "shape": list(heights.shape), "sizes": [size_x, size_y],
                            "surface": _surface_identity(surface, heights)})

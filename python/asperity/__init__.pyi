@@ -174,7 +174,9 @@ class Solver:
         indentations: Optional[Sequence[float]] = ..., nloads: Optional[int] = ...,
         pmin: Optional[float] = ..., pmax: Optional[float] = ..., stiffness: bool = ...,
         fd_stiffness: bool = ..., fd_step: float = ..., fields: bool = ...,
-        progress: ProgressArg = ...,
+        progress: ProgressArg = ..., poisson: Optional[float] = ...,
+        resistivity: Optional[Sequence[float]] = ...,
+        thermal_conductivity: Optional[Sequence[float]] = ...,
     ) -> Sweep: ...
     def full_contact_threshold(self) -> Dict[str, Optional[float]]: ...
     def reset(self) -> None: ...
@@ -201,7 +203,7 @@ def contact(
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
-    hardness: Optional[float] = ...,
+    hardness: Optional[float] = ..., tangential: bool = ...,
 ) -> Sweep: ...
 
 @dataclass

@@ -46,7 +46,7 @@ def contact(
     pressures: List[float], modulus: Optional[float], young: Optional[float],
     poisson: Optional[float], boundary: str, tolerance: float, map: bool,
     resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
-    hardness: Optional[float] = ...,
+    hardness: Optional[float] = ..., tangential: bool = ...,
 ) -> Dict[str, Any]: ...
 
 class Solver:
@@ -69,7 +69,9 @@ class Solver:
     def fd_stiffness(self, quantity: str, value: float, step: float) -> float: ...
     def sweep(
         self, quantity: str, values: List[float], stiffness: bool, fd_step: Optional[float],
-        fields: bool, progress: Progress,
+        fields: bool, progress: Progress, poisson: Optional[float] = ...,
+        resistivity: Optional[List[float]] = ...,
+        thermal_conductivity: Optional[List[float]] = ...,
     ) -> Dict[str, Any]: ...
 
 def mdr_curve(

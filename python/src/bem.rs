@@ -13,6 +13,7 @@ use asperity::elastic::Boundary;
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::{check_fd_step, ensure_solver_fits, Loads, SolverRequest};
+use asperity_app::derived::{Derived, Units};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -309,8 +310,10 @@ impl Solver {
         .map_err(from_solve)
     }
 
-    /// A load sweep as `asperity bem` runs it (module docs); returns the columns.
-    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress))]
+    /// A load sweep as `asperity bem` runs it (module docs); returns the columns. The
+    /// tangential stiffness (`poisson`) and the conductances (`resistivity`,
+    /// `thermal_conductivity`, two bodies each) by the front-end layer's one definition.
+    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None))]
     #[allow(clippy::too_many_arguments)]
     fn sweep<'py>(
         &mut self,
@@ -321,6 +324,9 @@ impl Solver {
         fd_step: Option<f64>,
         fields: bool,
         progress: Option<Py<PyAny>>,
+        poisson: Option<f64>,
+        resistivity: Option<Vec<f64>>,
+        thermal_conductivity: Option<Vec<f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let loads = values
             .iter()
@@ -329,8 +335,14 @@ impl Solver {
         if let Some(step) = fd_step {
             check_fd_step(step).map_err(refused)?;
         }
+        let derived =
+            Derived::validate(poisson, &resistivity, &thermal_conductivity).map_err(refused)?;
         let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
-        let params = SweepParams { stiffness, fd_step };
+        let params = SweepParams {
+            stiffness,
+            fd_step,
+            tangential: derived.tangential,
+        };
         let (rows, observer) = run_detached_with(py, &stop, |cancel| {
             let mut observer = PyObserver {
                 fields,
@@ -345,7 +357,15 @@ impl Solver {
             rows.map(|rows| (rows, (observer.pressures, observer.gaps)))
         })?
         .map_err(sweep_error)?;
-        columns_dict(py, &rows, params, observer)
+        let dict = columns_dict(py, &rows, params, observer)?;
+        for (k, name) in derived.columns(Units::Model).into_iter().enumerate() {
+            let column = rows.iter().map(|r| {
+                let values = derived.values(&derived.row(r, self.modulus));
+                values[k].unwrap_or(f64::NAN)
+            });
+            dict.set_item(name, PyArray1::from_iter(py, column))?;
+        }
+        Ok(dict)
     }
 }
 

@@ -53,7 +53,7 @@ fn label_patches<'py>(
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -70,6 +70,7 @@ fn contact<'py>(
     resistivity: Option<Vec<f64>>,
     thermal_conductivity: Option<Vec<f64>>,
     hardness: Option<f64>,
+    tangential: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ContactRequest {
         modulus,
@@ -81,6 +82,7 @@ fn contact<'py>(
         resistivity,
         thermal_conductivity,
         hardness,
+        tangential,
     };
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();
@@ -117,7 +119,11 @@ fn contact<'py>(
     })?;
     let dict = PyDict::new(py);
     for (k, name) in app::columns(&plan).iter().enumerate() {
-        let column: Vec<Value> = run.rows.iter().map(|row| row.all_values()[k]).collect();
+        let column: Vec<Value> = run
+            .rows
+            .iter()
+            .map(|row| row.all_values(&plan.derived)[k])
+            .collect();
         if column.iter().all(|v| matches!(v, Value::Count(_))) {
             let counts = column.iter().map(|v| match *v {
                 Value::Count(n) => n as u64,

@@ -60,6 +60,7 @@ KEYWORDS = {
     "--tangential-force": "tangential_force",
     "--resistivity": "resistivity",
     "--thermal-conductivity": "thermal_conductivity",
+    "--tangential": "tangential",
     "tangential-force": "tangential_force",
     "--friction": "friction",
     "--cycle-points": "cycle_points",
@@ -112,6 +113,15 @@ BEM = [
     (["--pressures", "0.01", "--modulus", "-1"], dict(modulus=-1), None, "got -1"),
     (["--pressures", "0.01", "--modulus", "inf"], dict(modulus=INF), None, "got inf"),
     (["--pressures", "0.01", "--modulus", "nan"], dict(modulus=NAN), None, "got NaN"),
+    (["--pressures", "0.01", "--poisson", "0.7"], {}, dict(pressures=[0.01], poisson=0.7),
+     "poisson must be in [0, 0.5] (Poisson's ratio), got 0.7"),
+    (["--pressures", "0.01", "--poisson=-0.1"], {}, dict(pressures=[0.01], poisson=-0.1), "got -0.1"),
+    (["--pressures", "0.01", "--resistivity", "1"], {}, dict(pressures=[0.01], resistivity=[1]),
+     "invalid resistivity: give two values, body 1 and body 2, got 1"),
+    (["--pressures", "0.01", "--thermal-conductivity", "1,nan"], {},
+     dict(pressures=[0.01], thermal_conductivity=[1, NAN]),
+     "invalid thermal_conductivity: each body's thermal conductivity must be positive and "
+     "finite, got NaN"),
 ]
 
 # asperity contact: (flags, keywords, expected words in keywords).
@@ -158,6 +168,12 @@ CONTACT = [
      "finite, got inf"),
     (["--modulus", "1e9", "--pressures", "1e5", "--thermal-conductivity", "1,-5"],
      dict(modulus=1e9, pressures=[1e5], thermal_conductivity=[1, -5]), "got -5"),
+    (["--modulus", "1e9", "--pressures", "1e5", "--tangential"],
+     dict(modulus=1e9, pressures=[1e5], tangential=True),
+     "tangential needs poisson ν (of Cerruti's kernel)"),
+    (["--modulus", "1e9", "--poisson", "0.6", "--pressures", "1e5", "--tangential"],
+     dict(modulus=1e9, poisson=0.6, pressures=[1e5], tangential=True),
+     "poisson must be in [0, 0.5] (Poisson's ratio), got 0.6"),
 ]
 
 

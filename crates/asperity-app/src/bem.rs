@@ -9,6 +9,7 @@ use asperity::input::short_number;
 use asperity::memory::{array_bytes, ensure_fits};
 use serde::{Deserialize, Serialize};
 
+use crate::derived::Derived;
 use crate::refusal::{Param, Refusal, RequestError};
 
 /// The parameters of `asperity bem` and Python's `Solver`, as each front end names them.
@@ -362,6 +363,15 @@ pub struct BemRequest {
     pub fd_step: Option<f64>,
     /// Every load's fields are kept (bookkeeping memory).
     pub fields: bool,
+    /// Poisson's ratio of the tangential (no-slip) stiffness of every load, or none.
+    #[serde(default)]
+    pub poisson: Option<f64>,
+    /// The two bodies' electrical resistivities (conductance by Barber's analogy).
+    #[serde(default)]
+    pub resistivity: Option<Vec<f64>>,
+    /// The two bodies' thermal conductivities.
+    #[serde(default)]
+    pub thermal_conductivity: Option<Vec<f64>>,
 }
 
 impl Default for BemRequest {
@@ -373,6 +383,9 @@ impl Default for BemRequest {
             stiffness: true,
             fd_step: None,
             fields: false,
+            poisson: None,
+            resistivity: None,
+            thermal_conductivity: None,
         }
     }
 }
@@ -388,16 +401,21 @@ pub struct BemPlan {
     pub loads: Vec<Control>,
     /// What each load computes besides the solve.
     pub sweep: SweepParams,
+    /// The tangential stiffness and the conductances asked for (their columns).
+    pub derived: Derived,
 }
 
 impl BemRequest {
-    /// The plan, or why not (the loads first, then the solver, then the step).
+    /// The plan, or why not (the loads first, then the solver, then the step, then the
+    /// derived columns).
     pub fn validate(&self) -> Result<BemPlan, RequestError> {
         let loads = self.loads.controls(self.fields)?;
         let (half_space, params) = self.solver.validate()?;
         if let Some(step) = self.fd_step {
             check_fd_step(step)?;
         }
+        let derived =
+            Derived::validate(self.poisson, &self.resistivity, &self.thermal_conductivity)?;
         Ok(BemPlan {
             half_space,
             params,
@@ -405,7 +423,9 @@ impl BemRequest {
             sweep: SweepParams {
                 stiffness: self.stiffness,
                 fd_step: self.fd_step,
+                tangential: derived.tangential,
             },
+            derived,
         })
     }
 }

@@ -4,7 +4,6 @@
 
 use std::convert::Infallible;
 
-use asperity::bem::conductance::Transport;
 use asperity::bem::sweep::{sweep, SweepError, SweepObserver, SweepParams, SweepRow};
 use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverParams};
 use asperity::topography::patches::count_patches;
@@ -12,21 +11,19 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
 use crate::bem::{check_modulus, check_tolerance, check_values, params as bem, parse_boundary};
-use crate::refusal::{Param, Refusal};
+use crate::derived::{check_poisson, Derived, DerivedRow, Units};
+use crate::refusal::Refusal;
 
 /// The parameters of `asperity contact` besides those it shares with `asperity bem`.
 pub mod params {
     use crate::refusal::Param;
 
+    pub use crate::derived::params::{POISSON, RESISTIVITY, THERMAL_CONDUCTIVITY};
+
     /// Young's modulus E.
     pub const YOUNG: Param = Param::new("--young", "young");
-    /// Poisson's ratio ν.
-    pub const POISSON: Param = Param::new("--poisson", "poisson");
-    /// The two bodies' electrical resistivities.
-    pub const RESISTIVITY: Param = Param::new("--resistivity", "resistivity");
-    /// The two bodies' thermal conductivities.
-    pub const THERMAL_CONDUCTIVITY: Param =
-        Param::new("--thermal-conductivity", "thermal_conductivity");
+    /// The tangential (no-slip) stiffness.
+    pub const TANGENTIAL: Param = Param::new("--tangential", "tangential");
     /// The hardness that caps the contact pressure, Pa.
     pub const HARDNESS: Param = Param::new("--hardness", "hardness");
 }
@@ -47,10 +44,7 @@ pub fn effective_modulus(
             Ok(m)
         }
         (None, Some(e), Some(nu)) => {
-            if !asperity::mdr::tangential::is_poisson_ratio(nu) {
-                return Err(Refusal::of(POISSON)
-                    .text(format!(" must be in [0, 0.5] (Poisson's ratio), got {nu}")));
-            }
+            check_poisson(nu)?;
             check_modulus(YOUNG, e)?;
             let e_star = e / (1.0 - nu * nu);
             check_modulus(bem::MODULUS, e_star)?;
@@ -91,6 +85,10 @@ pub struct ContactRequest {
     /// contact, docs/hardness.md); each load on the surface as measured.
     #[serde(default)]
     pub hardness: Option<f64>,
+    /// The tangential (no-slip) stiffnesses `k_x`, `k_y` of every load, with `poisson`'s ν
+    /// (given with `young`, or beside `modulus` for this alone).
+    #[serde(default)]
+    pub tangential: bool,
 }
 
 impl Default for ContactRequest {
@@ -106,6 +104,7 @@ impl Default for ContactRequest {
             resistivity: None,
             thermal_conductivity: None,
             hardness: None,
+            tangential: false,
         }
     }
 }
@@ -119,56 +118,34 @@ pub struct ContactPlan {
     pub params: SolverParams,
     /// The mean pressures, in the given order.
     pub loads: Vec<Control>,
-    /// The bodies' resistivities and conductivities, if given.
-    pub transport: Transport,
+    /// The tangential stiffness and the conductances asked for.
+    pub derived: Derived,
     /// The contact law: the hard wall, or the pressure capped at the hardness.
     pub interface: Interface,
 }
 
-/// Two values, one per body, each positive and finite.
-fn body_pair(
-    param: Param,
-    what: &str,
-    values: &Option<Vec<f64>>,
-) -> Result<Option<[f64; 2]>, Refusal> {
-    let Some(values) = values else {
-        return Ok(None);
-    };
-    let invalid = || Refusal::saying("invalid ").param(param);
-    if values.len() != 2 {
-        return Err(invalid().text(format!(
-            ": give two values, body 1 and body 2, got {}",
-            values.len()
-        )));
-    }
-    if let Some(bad) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-        return Err(invalid().text(format!(
-            ": each body's {what} must be positive and finite, got {bad}"
-        )));
-    }
-    Ok(Some([values[0], values[1]]))
-}
-
 impl ContactRequest {
-    /// The plan, or why not: E*, the boundary, the pressures, the tolerance.
+    /// The plan, or why not: E*, the boundary, the pressures, the tolerance, the derived
+    /// columns.
     pub fn validate(&self) -> Result<ContactPlan, Refusal> {
-        let modulus = effective_modulus(self.modulus, self.young, self.poisson)?;
+        // With --tangential, ν may stand beside E* itself: then it is the kernel's alone.
+        let alone = self.tangential && self.modulus.is_some() && self.young.is_none();
+        let for_modulus = if alone { None } else { self.poisson };
+        let modulus = effective_modulus(self.modulus, self.young, for_modulus)?;
         let boundary = parse_boundary(&self.boundary)?;
         check_values(bem::PRESSURES, &self.pressures, false)?;
         check_tolerance(self.tolerance)?;
-        let resistivity = body_pair(RESISTIVITY, "resistivity", &self.resistivity)?;
-        let thermal = body_pair(
-            THERMAL_CONDUCTIVITY,
-            "thermal conductivity",
-            &self.thermal_conductivity,
-        )?;
-        let transport = Transport {
-            resistivity,
-            thermal_conductivity: thermal,
-        };
+        if self.tangential && self.poisson.is_none() {
+            return Err(Refusal::of(TANGENTIAL)
+                .text(" needs ")
+                .param(POISSON)
+                .text(" ν (of Cerruti's kernel)"));
+        }
+        let poisson = self.poisson.filter(|_| self.tangential);
+        let derived = Derived::validate(poisson, &self.resistivity, &self.thermal_conductivity)?;
         let interface = interface(self.hardness, &self.pressures)?;
         Ok(ContactPlan {
-            transport,
+            derived,
             interface,
             half_space: HalfSpace { modulus, boundary },
             params: SolverParams {
@@ -206,7 +183,7 @@ fn interface(hardness: Option<f64>, pressures: &[f64]) -> Result<Interface, Refu
 }
 
 /// The columns of `asperity contact`'s table (SI units), in the order of
-/// [`ContactRow::values`].
+/// [`ContactRow::values`]; then [`columns`] adds those asked for.
 pub const COLUMNS: [&str; 10] = [
     "mean_pressure_pa",
     "force_n",
@@ -243,29 +220,25 @@ pub struct ContactRow {
     pub iterations: usize,
     /// Solver residual.
     pub residual: f64,
-    /// Electrical conductance by Barber's analogy, S (with resistivities).
-    pub electrical_conductance: Option<f64>,
-    /// Thermal conductance by Barber's analogy, W/K (with conductivities).
-    pub thermal_conductance: Option<f64>,
+    /// The tangential stiffnesses (N/m) and their ratio to the normal one, the electrical
+    /// (S) and thermal (W/K) conductances by Barber's analogy, where asked for.
+    pub derived: DerivedRow,
     /// With a hardness: the plastic contact area (points at the hardness), m², and its
     /// fraction of the nominal area.
     pub plastic: Option<(f64, f64)>,
 }
 
 /// The columns of `plan`'s table: [`COLUMNS`], then `plastic_area_m2` and
-/// `plastic_fraction` with a hardness, then `electrical_conductance_s` and
-/// `thermal_conductance_w_per_k` when their bodies' properties are given.
+/// `plastic_fraction` with a hardness, then the derived ones asked for
+/// ([`Derived::columns`] in SI: `stiffness_x_n_per_m`, `stiffness_y_n_per_m`,
+/// `tangential_ratio` with `tangential`, `electrical_conductance_s` and
+/// `thermal_conductance_w_per_k` when their bodies' properties are given).
 pub fn columns(plan: &ContactPlan) -> Vec<&'static str> {
     let mut columns = COLUMNS.to_vec();
     if plan.interface != Interface::HardWall {
         columns.extend(["plastic_area_m2", "plastic_fraction"]);
     }
-    if plan.transport.resistivity.is_some() {
-        columns.push("electrical_conductance_s");
-    }
-    if plan.transport.thermal_conductivity.is_some() {
-        columns.push("thermal_conductance_w_per_k");
-    }
+    columns.extend(plan.derived.columns(Units::Si));
     columns
 }
 
@@ -296,14 +269,15 @@ impl ContactRow {
         ]
     }
 
-    /// The row's values in the order of [`columns`] (the conductances that were asked for).
-    pub fn all_values(&self) -> Vec<Value> {
+    /// The row's values in the order of [`columns`] under `derived` (the plan's: the
+    /// derived values that were asked for, each computed, since the normal stiffness is).
+    pub fn all_values(&self, derived: &Derived) -> Vec<Value> {
         let mut values = self.values().to_vec();
         if let Some((area, fraction)) = self.plastic {
             values.extend([Value::Number(area), Value::Number(fraction)]);
         }
-        let conductances = [self.electrical_conductance, self.thermal_conductance];
-        values.extend(conductances.into_iter().flatten().map(Value::Number));
+        let asked = derived.values(&self.derived).into_iter();
+        values.extend(asked.map(|v| Value::Number(v.unwrap_or(f64::NAN))));
         values
     }
 }
@@ -323,7 +297,7 @@ struct Observer<'a> {
     on_load: &'a mut dyn FnMut(),
     keep_map: bool,
     pixel_area: f64,
-    transport: Transport,
+    derived: Derived,
     plastic: bool,
     modulus: f64,
     fields: (f64, usize),
@@ -348,8 +322,7 @@ impl SweepObserver for Observer<'_> {
         let s = &row.summary;
         let stiffness = row.stiffness.unwrap_or(f64::NAN);
         self.rows.push(ContactRow {
-            electrical_conductance: self.transport.electrical(stiffness, self.modulus),
-            thermal_conductance: self.transport.thermal(stiffness, self.modulus),
+            derived: self.derived.row(row, self.modulus),
             plastic: self.plastic.then(|| {
                 let area = s.plastic_points as f64 * self.pixel_area;
                 (area, s.plastic_fraction)
@@ -385,7 +358,7 @@ pub fn run(
         on_load,
         keep_map,
         pixel_area,
-        transport: plan.transport,
+        derived: plan.derived,
         plastic: plan.interface != Interface::HardWall,
         modulus: plan.half_space.modulus,
         fields: (f64::NAN, 0),
@@ -400,6 +373,7 @@ pub fn run(
     let params = SweepParams {
         stiffness: true,
         fd_step: None,
+        tangential: plan.derived.tangential,
     };
     sweep(solver, &plan.loads, params, &mut observer)?;
     Ok(ContactRun {
@@ -499,7 +473,10 @@ mod tests {
         let map = run.map.unwrap();
         assert_eq!(map, by_hand.pressure().mapv(|v| v > 0.0));
         assert_eq!(COLUMNS.len(), run.rows[0].values().len());
-        assert_eq!(columns(&plan).len(), run.rows[0].all_values().len());
+        assert_eq!(
+            columns(&plan).len(),
+            run.rows[0].all_values(&plan.derived).len()
+        );
     }
 
     #[test]
@@ -555,7 +532,7 @@ mod tests {
         }
         let names = columns(&plan);
         assert_eq!(&names[10..], ["plastic_area_m2", "plastic_fraction"]);
-        assert_eq!(run.rows[0].all_values().len(), names.len());
+        assert_eq!(run.rows[0].all_values(&plan.derived).len(), names.len());
         let refused = |hardness: f64, pressure: f64| {
             let request = ContactRequest {
                 hardness: Some(hardness),
@@ -595,15 +572,18 @@ mod tests {
             .unwrap()
             .rows[0];
         let k = row.stiffness;
-        assert_eq!(row.electrical_conductance, Some(2.0 * k / (1e9 * 4e-8)));
-        let thermal = row.thermal_conductance.unwrap() / (2.0 * k / 1e9 * 40.0);
+        assert_eq!(
+            row.derived.electrical_conductance,
+            Some(2.0 * k / (1e9 * 4e-8))
+        );
+        let thermal = row.derived.thermal_conductance.unwrap() / (2.0 * k / 1e9 * 40.0);
         assert!((thermal - 1.0).abs() < 1e-15);
         let names = columns(&plan);
         assert_eq!(
             &names[10..],
             ["electrical_conductance_s", "thermal_conductance_w_per_k"]
         );
-        assert_eq!(row.all_values().len(), 12);
+        assert_eq!(row.all_values(&plan.derived).len(), 12);
         let refused = |r: Option<Vec<f64>>, t: Option<Vec<f64>>| {
             let request = ContactRequest {
                 resistivity: r,
@@ -621,5 +601,76 @@ mod tests {
             "invalid thermal_conductivity: each body's thermal conductivity must be positive \
              and finite, got -2"
         );
+    }
+
+    #[test]
+    fn tangential_columns_are_the_librarys_frozen_set_solve() {
+        use asperity::bem::tangential::TangentialStiffness;
+        use asperity::surface::Surface;
+        let heights = Array2::from_shape_fn((24, 24), |(i, j)| {
+            ((i as f64) * 0.7).sin() * ((j as f64) * 0.4).cos() * 1e-6
+        });
+        let surface = Surface::new(heights, 1e-4).unwrap();
+        // ν beside E* itself (the kernel's alone) and ν with E (E* = E/(1 − ν²)).
+        let request = ContactRequest {
+            modulus: Some(1e9),
+            poisson: Some(0.3),
+            tangential: true,
+            pressures: vec![1e5, 3e5],
+            ..ContactRequest::default()
+        };
+        let plan = request.validate().unwrap();
+        assert_eq!(plan.half_space.modulus, 1e9);
+        assert_eq!(plan.derived.tangential, Some(0.3));
+        let with_young = ContactRequest {
+            modulus: None,
+            young: Some(0.91e9),
+            ..request.clone()
+        };
+        assert_eq!(with_young.validate().unwrap().half_space.modulus, 1e9);
+        let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        let run = run(&mut solver, &plan, 1.0, false, &mut || ()).unwrap();
+        let mut by_hand = ContactSolver::new(&surface, plan.half_space, plan.params).unwrap();
+        let mut tangential = TangentialStiffness::new(&by_hand, 0.3).unwrap();
+        for (row, control) in run.rows.iter().zip(&plan.loads) {
+            by_hand.solve(*control).unwrap();
+            let k = by_hand.frozen_set_stiffness().unwrap().0;
+            let t = tangential.solve(&by_hand).unwrap();
+            let d = row.derived;
+            assert_eq!((d.stiffness_x, d.stiffness_y), (Some(t.x), Some(t.y)));
+            assert_eq!(d.tangential_ratio, Some((t.x + t.y) / (2.0 * k)));
+            // Mindlin's 2(1 − ν)/(2 − ν) within a few per cent on this coarse contact.
+            let mindlin = 1.4 / 1.7;
+            assert!((d.tangential_ratio.unwrap() / mindlin - 1.0).abs() < 0.05);
+        }
+        assert_eq!(
+            &columns(&plan)[10..],
+            [
+                "stiffness_x_n_per_m",
+                "stiffness_y_n_per_m",
+                "tangential_ratio"
+            ]
+        );
+        let refused = |request: ContactRequest| first(&request.validate().unwrap_err());
+        assert_eq!(
+            refused(ContactRequest {
+                poisson: None,
+                ..request.clone()
+            }),
+            "tangential needs poisson ν (of Cerruti's kernel)"
+        );
+        assert_eq!(
+            refused(ContactRequest {
+                poisson: Some(0.7),
+                ..request.clone()
+            }),
+            "poisson must be in [0, 0.5] (Poisson's ratio), got 0.7"
+        );
+        // Without tangential, ν beside E* is still ambiguous, as before.
+        assert!(refused(ContactRequest {
+            tangential: false,
+            ..request
+        })
+        .starts_with("give either modulus E*"));
     }
 }

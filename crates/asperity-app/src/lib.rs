@@ -29,6 +29,7 @@
 pub mod adhesion;
 pub mod bem;
 pub mod contact;
+pub mod derived;
 pub mod import;
 pub mod mdr;
 pub mod measured;

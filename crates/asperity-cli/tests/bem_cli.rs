@@ -1324,3 +1324,99 @@ fn hardness_caps_the_pressure_and_adds_the_plastic_fraction() {
         refused(&run(extra), needle);
     }
 }
+
+/// `--poisson`, `--resistivity`, `--thermal-conductivity`: the tangential stiffness and the
+/// conductances of every load as columns after the contract's, before the timing ones; the
+/// contract's columns are those of a run without them, cell for cell (the tangential CGs
+/// do not move the solver); `tangential_ratio` is `(k_x + k_y)/(2k)` near Mindlin's
+/// `2(1−ν)/(2−ν)`; the conductances are `k` times Barber's factors; bad values are refused
+/// with one line and exit 2.
+#[test]
+fn tangential_and_conductance_columns_follow_the_frozen_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let run = |extra: &[&str], name: &str| {
+        let csv = dir.path().join(name);
+        let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
+        let base = [&base[..], &["--quiet", "--pressures", "0.005,0.02,0.08"]].concat();
+        ok(&asperity(&[&base[..], extra].concat()));
+        (std::fs::read_to_string(&csv).unwrap(), read_csv(&csv))
+    };
+    let derived = [
+        "--poisson",
+        "0.3",
+        "--resistivity",
+        "2,3",
+        "--thermal-conductivity",
+        "4,12",
+        "--timing",
+    ];
+    let (text, (header, rows)) = run(&derived, "derived.csv");
+    let names = [
+        "stiffness_x",
+        "stiffness_y",
+        "tangential_ratio",
+        "electrical_conductance",
+        "thermal_conductance",
+        "solve_seconds",
+    ];
+    assert_eq!(header[7..13], names);
+    assert_eq!(header.last().unwrap(), "tangential_seconds");
+    let (plain_text, _) = run(&[], "plain.csv");
+    for (a, b) in text.lines().skip(1).zip(plain_text.lines().skip(1)) {
+        let cells: Vec<&str> = a.split(',').collect();
+        assert_eq!(cells[..7].join(","), b, "the contract's cells");
+    }
+    let at = |row: &[f64], name: &str| row[column(&header, name)];
+    let mindlin = 2.0 * 0.7 / 1.7;
+    for row in &rows {
+        let (k, kx, ky) = (
+            at(row, "stiffness"),
+            at(row, "stiffness_x"),
+            at(row, "stiffness_y"),
+        );
+        assert_eq!(at(row, "tangential_ratio"), (kx + ky) / (2.0 * k));
+        // A 64² rough surface: within 1 % of Mindlin's ratio (0.8235), as docs/tangential.md
+        // measures at 512² and 1024².
+        assert!((at(row, "tangential_ratio") / mindlin - 1.0).abs() < 0.01);
+        // Barber: C = 2k/(E*(ρ₁+ρ₂)) and (2k/E*)·κ₁κ₂/(κ₁+κ₂), E* = 1.
+        assert!((at(row, "electrical_conductance") / (2.0 * k / 5.0) - 1.0).abs() < 1e-15);
+        assert!((at(row, "thermal_conductance") / (2.0 * k * 3.0) - 1.0).abs() < 1e-15);
+        assert!(at(row, "tangential_seconds") >= 0.0);
+    }
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("derived.csv.json")).unwrap())
+            .unwrap();
+    assert_eq!(record["tangential"]["poisson"], 0.3);
+    assert_eq!(record["resistivity"], serde_json::json!([2.0, 3.0]));
+    let bad = |extra: &[&str], needle: &str| {
+        let base = ["bem", "--surface", s, "--pressures", "0.01"];
+        refused(&asperity(&[&base[..], extra].concat()), needle);
+    };
+    bad(
+        &["--poisson", "0.7"],
+        "--poisson must be in [0, 0.5] (Poisson's ratio), got 0.7",
+    );
+    bad(&["--poisson", "nan"], "--poisson must be in [0, 0.5]");
+    bad(
+        &["--resistivity", "1"],
+        "invalid --resistivity: give two values",
+    );
+    bad(
+        &["--thermal-conductivity", "1,-1"],
+        "each body's thermal conductivity must be positive and finite, got -1",
+    );
+    let adhesive = [
+        "bem",
+        "--surface",
+        s,
+        "--indentations",
+        "0.01",
+        "--work-of-adhesion",
+        "0.1",
+        "--poisson",
+        "0.3",
+    ];
+    refused(&asperity(&adhesive), "does not go with --poisson");
+}

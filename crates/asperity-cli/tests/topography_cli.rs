@@ -366,6 +366,78 @@ fn contact_of_a_measured_paraboloid_matches_hertz_in_si_units() {
     assert!(d.join("c.png").is_file() && d.join("m.png").is_file());
 }
 
+/// `--tangential` and the conductances on the measured paraboloid (Hertz, a ≈ 17 pixels):
+/// `k_t/k_n` within 1e-3 of Mindlin's `2(1−ν)/(2−ν)` (the two stiffnesses share their edge
+/// error, docs/tangential.md), the electrical conductance of equal bodies within 3 % of
+/// Holm's `2a/ρ` (the stiffness's own error against `2aE*`, as above) and exactly `k/(E*ρ)`;
+/// `--tangential` without `--poisson` is refused with one line.
+#[test]
+fn contact_gives_mindlins_ratio_and_holms_conductance_in_si_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, e_star, rho) = (96usize, 20e-6, 1e-3, 1e9, 1.7e-8);
+    std::fs::write(d.join("sphere.txt"), paraboloid(n, side, radius)).unwrap();
+    let a: f64 = 3.5e-6;
+    let force = 4.0 * e_star * a.powi(3) / (3.0 * radius);
+    let pressure = format!("{}", force / (side * side));
+    let base = [
+        "contact",
+        "sphere.txt",
+        "--detrend",
+        "none",
+        "--pressures",
+        &pressure,
+    ];
+    let with = |extra: &[&str]| asperity(&[&base[..], extra].concat(), d);
+    ok(&with(&[
+        "--modulus",
+        "1e9",
+        "--poisson",
+        "0.3",
+        "--tangential",
+        "--resistivity",
+        "1.7e-8,1.7e-8",
+        "--out",
+        "c.csv",
+    ]));
+    let csv = std::fs::read_to_string(d.join("c.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header[10..],
+        [
+            "stiffness_x_n_per_m",
+            "stiffness_y_n_per_m",
+            "tangential_ratio",
+            "electrical_conductance_s"
+        ]
+    );
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let mindlin = 2.0 * 0.7 / 1.7;
+    let ratio = row[col("tangential_ratio")];
+    assert!((ratio / mindlin - 1.0).abs() < 1e-3, "k_t/k_n {ratio}");
+    let k = row[col("stiffness_n_per_m")];
+    let c = row[col("electrical_conductance_s")];
+    assert!((c / (k / (e_star * rho)) - 1.0).abs() < 1e-15);
+    let a_hertz = (3.0 * row[col("force_n")] * radius / (4.0 * e_star)).cbrt();
+    assert!((c / (2.0 * a_hertz / rho) - 1.0).abs() < 0.03, "Holm: {c}");
+    let record = json(&d.join("c.csv.json"));
+    assert_eq!(record["tangential"]["poisson"], 0.3);
+    let out = with(&["--modulus", "1e9", "--tangential"]);
+    assert_refused(
+        &out,
+        d,
+        &["sphere.txt", "c.csv", "c.csv.json"],
+        "--tangential needs --poisson",
+    );
+}
+
 /// `--hardness` in Pa on the paraboloid: at a hardness of half Hertz's peak pressure
 /// the pressure is capped (p ≤ H, so F ≤ H·A), part of the contact is plastic and the area
 /// exceeds Hertz's; a bad hardness or a load at or above it is refused with one line.

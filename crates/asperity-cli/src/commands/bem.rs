@@ -18,6 +18,7 @@ use asperity::surface::Surface;
 use asperity_app::bem::{
     bookkeeping_bytes, ensure_solver_fits, BemPlan, BemRequest, Loads, SolverRequest, FD_STEP,
 };
+use asperity_app::derived::{Derived, Units};
 use serde_json::json;
 
 use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
@@ -35,13 +36,16 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --indentations 0.01,0.02,0.04\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --solver pk --out reference.csv\n  \
     asperity bem --surface s.npy --pressures 0.01,0.05 --hardness 0.3\n  \
+    asperity bem --surface s.npy --nloads 10 --pmin 1e-3 --pmax 1e-1 --poisson 0.3 --resistivity 1,1\n  \
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n  \
     asperity bem --surface scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
 (stiffness by the frozen contact set; indentation from the highest point, or with\n\
 periodic boundaries relative to the mean elastic displacement); then plastic_fraction\n\
-with --hardness, stiffness_fd with --fd-stiffness, and solve_seconds, stiffness_seconds, peak_rss_mib with\n\
---timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
+with --hardness, stiffness_fd with --fd-stiffness, stiffness_x, stiffness_y,\n\
+tangential_ratio with --poisson, electrical_conductance with --resistivity,\n\
+thermal_conductance with --thermal-conductivity, and solve_seconds, stiffness_seconds,\n\
+peak_rss_mib (tangential_seconds with --poisson) with --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
 any solve.")]
 pub struct BemArgs {
@@ -150,7 +154,33 @@ pub struct BemArgs {
     /// indentation 0.
     #[arg(long)]
     pub fd_stiffness: bool,
-    /// Add timing columns (solve_seconds, stiffness_seconds, peak_rss_mib), for benchmarks.
+    /// Poisson's ratio ν in [0, 0.5] of the tangential (no-slip) stiffness: adds the
+    /// columns stiffness_x, stiffness_y (k_x, k_y of the frozen contact set with Cerruti's
+    /// kernel, docs/tangential.md) and tangential_ratio = (k_x + k_y)/(2k), Mindlin's
+    /// 2(1−ν)/(2−ν) for one circular contact. About two more stiffness solves per load.
+    /// E* stays --modulus.
+    #[arg(long, value_name = "NU", allow_hyphen_values = true)]
+    pub poisson: Option<f64>,
+    /// Electrical resistivities ρ₁,ρ₂ of the two bodies (units of E*·length/conductance):
+    /// adds the column electrical_conductance = 2k/(E*(ρ₁+ρ₂)) (Barber's analogy).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        value_name = "R1,R2"
+    )]
+    pub resistivity: Option<Vec<f64>>,
+    /// Thermal conductivities κ₁,κ₂ of the two bodies: adds the column
+    /// thermal_conductance = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        value_name = "K1,K2"
+    )]
+    pub thermal_conductivity: Option<Vec<f64>>,
+    /// Add timing columns (solve_seconds, stiffness_seconds, peak_rss_mib, and
+    /// tangential_seconds with --poisson), for benchmarks.
     #[arg(long)]
     pub timing: bool,
     /// Skip the frozen-set stiffness (column left empty); for benchmarks of the solve alone.
@@ -301,6 +331,8 @@ struct Columns {
     fd: bool,
     timing: bool,
     plastic: bool,
+    derived: Derived,
+    modulus: f64,
 }
 
 impl Columns {
@@ -320,8 +352,12 @@ impl Columns {
         if self.fd {
             header.push("stiffness_fd");
         }
+        header.extend(self.derived.columns(Units::Model));
         if self.timing {
             header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
+            if self.derived.tangential.is_some() {
+                header.push("tangential_seconds");
+            }
         }
         header
     }
@@ -346,12 +382,17 @@ impl Columns {
         if self.fd {
             cells.push(number(r.stiffness_fd));
         }
+        let derived = self.derived.row(r, self.modulus);
+        cells.extend(self.derived.values(&derived).into_iter().map(number));
         if self.timing {
             cells.extend([
                 format_number(r.solve_seconds),
                 format_number(r.stiffness_seconds),
                 format_number(row.peak_rss_mib),
             ]);
+            if self.derived.tangential.is_some() {
+                cells.push(format_number(r.tangential_seconds));
+            }
         }
         cells
     }
@@ -461,6 +502,9 @@ fn request(args: &BemArgs) -> Result<BemRequest> {
         stiffness: !args.no_stiffness,
         fd_step: args.fd_stiffness.then_some(FD_STEP),
         fields: args.fields.is_some(),
+        poisson: args.poisson,
+        resistivity: args.resistivity.clone(),
+        thermal_conductivity: args.thermal_conductivity.clone(),
     })
 }
 
@@ -495,6 +539,8 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         fd: args.fd_stiffness,
         timing: args.timing,
         plastic: args.hardness.is_some(),
+        derived: bem.derived,
+        modulus: bem.half_space.modulus,
     };
     Ok(Plan {
         request,
@@ -678,6 +724,12 @@ fn record(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Val
         "loads": plan.request.loads.record(),
         "stiffness": if args.no_stiffness { None } else { Some("frozen contact set") },
         "fd_relative_step": args.fd_stiffness.then_some(FD_STEP),
+        "tangential": plan.bem.derived.tangential.map(|nu| json!({
+            "poisson": nu,
+            "method": "frozen contact set, Cerruti kernel (normal-tangential coupling neglected)",
+        })),
+        "resistivity": args.resistivity,
+        "thermal_conductivity": args.thermal_conductivity,
         "fields": args.fields,
         "columns": plan.columns.header(),
     })

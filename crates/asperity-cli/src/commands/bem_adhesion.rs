@@ -36,6 +36,12 @@ fn refuse_other_options(args: &BemArgs) -> Result<()> {
         (args.fields.is_some(), "--fields"),
         (args.plot.is_some(), "--plot"),
         (args.timing || args.no_stiffness, "--timing"),
+        (args.poisson.is_some(), "--poisson"),
+        (args.resistivity.is_some(), "--resistivity"),
+        (
+            args.thermal_conductivity.is_some(),
+            "--thermal-conductivity",
+        ),
     ];
     if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
         bail!(

@@ -35,7 +35,9 @@ use crate::progress::Progress;
     asperity contact scan.x3p --young 210e9 --poisson 0.3 --hardness 2e9 --pressures 1e7,1e8\n\n\
 Columns (SI units): mean_pressure_pa, force_n, contact_area_m2, area_fraction, mean_gap_m,\n\
 stiffness_n_per_m, patches, indentation_m, iterations, residual; with --hardness then\n\
-plastic_area_m2, plastic_fraction (the points at the hardness). The surface is rigid and\n\
+plastic_area_m2, plastic_fraction (the points at the hardness); with --tangential\n\
+stiffness_x_n_per_m, stiffness_y_n_per_m, tangential_ratio; with --resistivity\n\
+electrical_conductance_s; with --thermal-conductivity thermal_conductance_w_per_k. The surface is rigid and\n\
 pressed into an elastic half-space of effective modulus E* = E/(1 − ν²); free boundaries\n\
 (the paper's) unless --boundary periodic. Heights and sizes are read in metres.")]
 pub struct ContactArgs {
@@ -101,6 +103,13 @@ pub struct ContactArgs {
     /// plastic_area_m2 and plastic_fraction, and the stiffness is that of the elastic set.
     #[arg(long, value_name = "PA", allow_negative_numbers = true)]
     pub hardness: Option<f64>,
+    /// Add the tangential (no-slip) stiffness of every load: columns stiffness_x_n_per_m,
+    /// stiffness_y_n_per_m (k_x, k_y of the frozen contact set with Cerruti's kernel for
+    /// --poisson's ν, docs/tangential.md) and tangential_ratio = (k_x + k_y)/(2k). Needs
+    /// --poisson (with --young, or beside --modulus for the kernel alone). About two more
+    /// stiffness solves per load.
+    #[arg(long)]
+    pub tangential: bool,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -121,6 +130,7 @@ fn request(args: &ContactArgs) -> ContactRequest {
         resistivity: args.resistivity.clone(),
         thermal_conductivity: args.thermal_conductivity.clone(),
         hardness: args.hardness,
+        tangential: args.tangential,
     }
 }
 
@@ -160,7 +170,7 @@ fn table(plan: &ContactPlan, rows: &[ContactRow]) -> Table {
     let mut table = Table::new(&contact::columns(plan));
     for row in rows {
         let cells: Vec<String> = row
-            .all_values()
+            .all_values(&plan.derived)
             .iter()
             .map(|v| match *v {
                 Value::Number(x) => format_number(x),
@@ -257,6 +267,11 @@ pub fn run(args: &ContactArgs) -> Result<()> {
                 "resistivity_ohm_m": args.resistivity,
                 "thermal_conductivity_w_per_m_k": args.thermal_conductivity,
                 "hardness_pa": args.hardness,
+                "tangential": plan.derived.tangential.map(|nu| json!({
+                    "poisson": nu,
+                    "method": "frozen contact set, Cerruti kernel (normal-tangential coupling \
+                        neglected); tangential_ratio = (k_x + k_y)/(2k)",
+                })),
                 "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
                     2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",
                 "units": "SI: m, Pa, N, m², N/m, S, W/K",

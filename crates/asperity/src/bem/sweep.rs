@@ -7,7 +7,9 @@
 //!    (periodic: one FFT pair; free: about one solve) is computed only where it does not.
 //! 2. **Per load, in the given order** (each solve warm-starts from the state left by the
 //!    previous load): the solve; the frozen-set stiffness; [`SweepObserver::solved`], where
-//!    a front end takes the fields; then, with [`SweepParams::fd_step`], `dF/dd` from two
+//!    a front end takes the fields; with [`SweepParams::tangential`] the tangential
+//!    (no-slip) stiffnesses `k_x`, `k_y` of the same frozen set (Cerruti's operators
+//!    planned once per sweep, [`TangentialStiffness`]) just before that hook; then, with [`SweepParams::fd_step`], `dF/dd` from two
 //!    solves at the load × (1 ± step) (none at indentation 0), after which the load is solved
 //!    again (warm, from the upper step) so that the next load warm-starts from it, except
 //!    after the last load; finally [`SweepObserver::finished`] with the load's row.
@@ -18,6 +20,7 @@
 
 use std::time::Instant;
 
+use super::tangential::{Tangential, TangentialStiffness};
 use super::{ContactSolver, ContactSummary, Control, SolveError, SolveInfo};
 use crate::Error;
 
@@ -28,21 +31,28 @@ pub struct SweepParams {
     pub stiffness: bool,
     /// Relative step of the finite-difference stiffness `dF/dd` (in `(0, 1)`), or none.
     pub fd_step: Option<f64>,
+    /// Poisson's ratio (in `[0, 0.5]`) of the tangential (no-slip) frozen-set stiffnesses
+    /// `k_x`, `k_y` of every load ([`TangentialStiffness`]), or none.
+    pub tangential: Option<f64>,
 }
 
 impl Default for SweepParams {
-    /// The frozen-set stiffness, no finite differences.
+    /// The frozen-set stiffness, no finite differences, no tangential stiffness.
     fn default() -> Self {
         SweepParams {
             stiffness: true,
             fd_step: None,
+            tangential: None,
         }
     }
 }
 
 impl SweepParams {
-    /// Checks the finite-difference step: in `(0, 1)`.
+    /// Checks the finite-difference step (in `(0, 1)`) and the Poisson's ratio.
     pub fn validate(&self) -> crate::Result<()> {
+        if let Some(poisson) = self.tangential {
+            crate::mdr::check_poisson(poisson)?;
+        }
         match self.fd_step {
             Some(step) if !(step > 0.0 && step < 1.0) => Err(Error::invalid(
                 "relative step",
@@ -70,6 +80,10 @@ pub struct SweepRow {
     pub solve_seconds: f64,
     /// Wall-clock seconds of the frozen-set stiffness (about 0 when not asked for).
     pub stiffness_seconds: f64,
+    /// The tangential stiffnesses `k_x`, `k_y` (with their CGs), when asked for.
+    pub tangential: Option<Tangential>,
+    /// Wall-clock seconds of both tangential stiffnesses (0 when not asked for).
+    pub tangential_seconds: f64,
 }
 
 /// Where in a sweep a solver error came from.
@@ -81,6 +95,8 @@ pub enum SweepStep {
     Solve,
     /// The load's frozen-set stiffness.
     Stiffness,
+    /// The load's tangential stiffnesses.
+    Tangential,
     /// The load's finite-difference stiffness or the re-solve after it.
     FiniteDifference,
 }
@@ -137,6 +153,7 @@ fn step_context_naming(step: SweepStep, load: usize, control: Control, fd_name: 
     match step {
         SweepStep::FullContactCheck | SweepStep::Solve => load,
         SweepStep::Stiffness => format!("stiffness at {load}"),
+        SweepStep::Tangential => format!("tangential stiffness at {load}"),
         SweepStep::FiniteDifference => format!("{fd_name} at {load}"),
     }
 }
@@ -286,6 +303,11 @@ pub fn sweep<O: SweepObserver>(
 ) -> Result<Vec<SweepRow>, SweepError<O::Error>> {
     params.validate().map_err(SweepError::Input)?;
     check_full_contact(solver, loads, params.fd_step)?;
+    let mut tangential = params
+        .tangential
+        .map(|poisson| TangentialStiffness::new(solver, poisson))
+        .transpose()
+        .map_err(SweepError::Input)?;
     let mut rows = Vec::with_capacity(loads.len());
     for (load, &control) in loads.iter().enumerate() {
         let failed = |step| {
@@ -310,6 +332,12 @@ pub fn sweep<O: SweepObserver>(
             false => None,
         };
         let stiffness_seconds = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let tangential = match &mut tangential {
+            Some(t) => Some(t.solve(solver).map_err(failed(SweepStep::Tangential))?),
+            None => None,
+        };
+        let tangential_seconds = start.elapsed().as_secs_f64();
         observer.solved(load, solver).map_err(SweepError::Stopped)?;
         // The two steps move the solver: the load is solved again (warm, from the upper
         // step) for the next load's warm start, except after the last one.
@@ -334,6 +362,8 @@ pub fn sweep<O: SweepObserver>(
             stiffness_fd,
             solve_seconds,
             stiffness_seconds,
+            tangential,
+            tangential_seconds,
         };
         observer.finished(load, &row).map_err(SweepError::Stopped)?;
         rows.push(row);
@@ -382,20 +412,38 @@ mod tests {
         let params = SweepParams {
             stiffness: true,
             fd_step: Some(1e-3),
+            tangential: Some(0.3),
         };
         let rows = sweep(&mut solver(), &loads, params, &mut ()).unwrap();
         // The same steps by hand, in the same order, give the same numbers bit for bit.
         let mut s = solver();
+        let mut tangential = TangentialStiffness::new(&s, 0.3).unwrap();
         for (row, &control) in rows.iter().zip(&loads) {
             let (summary, info) = s.solve(control).unwrap();
             let k = s.frozen_set_stiffness().unwrap().0;
+            let t = tangential.solve(&s).unwrap();
             let fd = s.finite_difference_stiffness(control, 1e-3).unwrap();
             s.solve(control).unwrap();
             assert_eq!(
                 (row.summary, row.info, row.stiffness, row.stiffness_fd),
                 (summary, info, Some(k), Some(fd))
             );
+            assert_eq!(row.tangential, Some(t));
+            // Mindlin's ratio within a few per cent on a coarse rough contact.
+            let ratio = (t.x + t.y) / (2.0 * k) / (1.4 / 1.7);
+            assert!((ratio - 1.0).abs() < 0.05, "{ratio}");
         }
+        // Without it, no tangential row and no time spent.
+        let plain = sweep(&mut solver(), &loads, SweepParams::default(), &mut ()).unwrap();
+        assert!(plain
+            .iter()
+            .all(|r| r.tangential.is_none() && r.tangential_seconds < 1e-3));
+        let bad = SweepParams {
+            tangential: Some(0.6),
+            ..SweepParams::default()
+        };
+        let e = sweep(&mut solver(), &loads, bad, &mut ()).unwrap_err();
+        assert!(e.to_string().contains("Poisson's ratio"), "{e}");
     }
 
     #[test]

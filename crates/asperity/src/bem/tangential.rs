@@ -70,12 +70,33 @@ pub struct TangentialStiffness {
 }
 
 impl TangentialStiffness {
+    /// Estimated memory of the tangential stiffness of a `rows × cols` grid, in bytes
+    /// (`None` on overflow): two operators, two preconditioners and the CG's fields (five,
+    /// and the rings' bytes counted as four more).
+    pub fn memory_bytes(
+        rows: usize,
+        cols: usize,
+        boundary: crate::elastic::Boundary,
+    ) -> Option<u64> {
+        let operator = ElasticOperator::memory_bytes(rows, cols, boundary)?;
+        let preconditioner = <FourierPreconditioner>::memory_bytes(rows, cols)?;
+        let fields = crate::memory::array_bytes(&[9, rows, cols], 8)?;
+        operator
+            .checked_add(preconditioner)?
+            .checked_mul(2)?
+            .checked_add(fields)
+    }
+
     /// Plans the tangential operators of `solver`'s grid, E* and boundaries for Poisson's
-    /// ratio `poisson` in `[0, 0.5]`.
+    /// ratio `poisson` in `[0, 0.5]`; refuses a grid whose operators would not fit in memory.
     pub fn new(solver: &ContactSolver, poisson: f64) -> Result<Self> {
         crate::mdr::check_poisson(poisson)?;
         let normal = &solver.problem.operator;
         let (rows, cols) = (normal.rows(), normal.cols());
+        crate::memory::ensure_fits(
+            &format!("the tangential stiffness of a {rows}x{cols} grid"),
+            Self::memory_bytes(rows, cols, normal.boundary()),
+        )?;
         let spacings = (normal.spacing(), normal.spacing_y());
         let (modulus, boundary) = (normal.modulus(), normal.boundary());
         let operator = |direction| {

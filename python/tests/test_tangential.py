@@ -1,0 +1,57 @@
+"""The tangential (no-slip) stiffness and the contact conductances as columns: Python's
+``Solver.sweep`` and ``contact`` give the CLI's numbers bit for bit (one definition in the
+front-end layer, crates/asperity-app/src/derived.rs), with Mindlin's ratio and Barber's
+analogy as oracles (docs/tangential.md)."""
+
+import numpy as np
+
+import asperity
+
+MINDLIN = 2 * (1 - 0.3) / (2 - 0.3)
+
+
+def test_bem_sweep_columns_are_the_clis(cli, tmp_path):
+    s = asperity.surface(64, hurst=0.8, rolloff=4, rms_slope=0.5, seed=3)
+    np.save(tmp_path / "s.npy", s.heights)
+    cli("bem", "--surface", tmp_path / "s.npy", "--pressures", "0.005,0.02,0.08", "--poisson", 0.3,
+        "--resistivity", "2,3", "--thermal-conductivity", "4,12", "--modulus", 2,
+        "--out", tmp_path / "c.csv", "--quiet")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    solver = asperity.Solver(s.heights, size=1.0, modulus=2)
+    ours = solver.sweep(pressures=[0.005, 0.02, 0.08], poisson=0.3, resistivity=[2, 3],
+                        thermal_conductivity=[4, 12])
+    names = ["stiffness", "stiffness_x", "stiffness_y", "tangential_ratio",
+             "electrical_conductance", "thermal_conductance"]
+    for name in names:
+        assert np.array_equal(ours[name], theirs[name]), name
+    k = ours.stiffness
+    assert np.array_equal(ours.tangential_ratio, (ours.stiffness_x + ours.stiffness_y) / (2 * k))
+    assert np.allclose(ours.tangential_ratio, MINDLIN, rtol=1e-2)
+    # Barber: 2k/(E*(ρ₁+ρ₂)) and (2k/E*)·κ₁κ₂/(κ₁+κ₂), E* = 2.
+    assert np.allclose(ours.electrical_conductance, 2 * k / (2 * 5), rtol=1e-15, atol=0)
+    assert np.allclose(ours.thermal_conductance, 2 * k / 2 * 3, rtol=1e-15, atol=0)
+    assert ours.metadata["poisson"] == 0.3
+    # Without them: no such columns, the others unchanged bit for bit.
+    plain = asperity.Solver(s.heights, size=1.0, modulus=2).sweep(pressures=[0.005, 0.02, 0.08])
+    assert "stiffness_x" not in plain.columns
+    for name in ["force", "indentation", "area_fraction", "stiffness"]:
+        assert np.array_equal(plain[name], ours[name]), name
+
+
+def test_contact_tangential_is_the_clis(cli, tmp_path):
+    s = asperity.surface(48, hurst=0.8, rolloff=2, rms_slope=1, seed=3, size=1e-4)
+    np.save(tmp_path / "h.npy", s.heights * 1e-6)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none",
+        "--out", tmp_path / "t.npy")
+    cli("contact", tmp_path / "t.npy", "--young", 2e11 * 0.91, "--poisson", 0.3, "--tangential",
+        "--pressures", "1e4,1e5", "--resistivity", "1.7e-8,1.7e-8", "--detrend", "none",
+        "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    t = asperity.read_topography(tmp_path / "t.npy")
+    ours = asperity.contact(t, young=2e11 * 0.91, poisson=0.3, tangential=True,
+                            pressures=[1e4, 1e5], resistivity=[1.7e-8, 1.7e-8])
+    for name in ["stiffness_n_per_m", "stiffness_x_n_per_m", "stiffness_y_n_per_m",
+                 "tangential_ratio", "electrical_conductance_s"]:
+        assert np.array_equal(ours[name], theirs[name]), name
+    assert np.allclose(ours["tangential_ratio"], MINDLIN, rtol=1e-2)
+    assert ours.metadata["contact"]["tangential"] is True
