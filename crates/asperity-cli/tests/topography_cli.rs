@@ -138,6 +138,39 @@ fn stats_of_a_measured_file_prints_iso_parameters() {
 }
 
 #[test]
+fn stats_writes_the_bearing_area_curve() {
+    // Heights 0, 1, ..., 127 (a uniform distribution): the fraction p of them lies at or
+    // above c(p) = 127 (1 − p) exactly, the order statistics being equally spaced.
+    let dir = tempfile::tempdir().unwrap();
+    let h = ndarray::Array2::from_shape_fn((8, 16), |(r, c)| (r * 16 + c) as f64);
+    ndarray_npy::write_npy(dir.path().join("ramp.npy"), &h).unwrap();
+    let args = [
+        "stats",
+        "ramp.npy",
+        "--size",
+        "1",
+        "--bearing-area",
+        "b.csv",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let text = std::fs::read_to_string(dir.path().join("b.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("material_ratio,height"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 101);
+    for (k, row) in rows.iter().enumerate() {
+        let p = k as f64 / 100.0;
+        assert!((row[0] - p).abs() < 1e-12, "{row:?}");
+        assert!((row[1] - 127.0 * (1.0 - p)).abs() < 1e-9, "{row:?}");
+    }
+    // An existing output is kept unless --force.
+    let out = asperity(&args, dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+}
+
+#[test]
 fn bad_files_give_one_line_and_exit_2() {
     let Some(shared) = shared() else { return };
     let dir = tempfile::tempdir().unwrap();

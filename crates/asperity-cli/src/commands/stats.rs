@@ -23,7 +23,7 @@ use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
 #[command(
     allow_negative_numbers = true,
     after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6\n  \
-    asperity stats s.npy --plot psd.png\n  asperity stats scan.x3p --detrend plane\n  \
+    asperity stats s.npy --plot psd.png\n  asperity stats scan.x3p --detrend plane --bearing-area bearing.csv\n  \
     asperity stats profile.csv --detrend mean --json"
 )]
 pub struct StatsArgs {
@@ -61,6 +61,12 @@ pub struct StatsArgs {
     /// (2π)² on a map, 2π on a line). The slope and Hurst estimate are the same.
     #[arg(long, value_name = "NAME", default_value = "asperity")]
     pub psd_convention: String,
+    /// Write the bearing-area (Abbott–Firestone) curve as CSV with columns material_ratio
+    /// (0 to 1 in 101 steps) and height: the height c above which that fraction of the
+    /// defined heights lies (ISO 25178-2's material ratio Smr(c), inverted; linear between
+    /// order statistics), in the heights' unit (metres for a measured file).
+    #[arg(long, value_name = "OUT.csv")]
+    pub bearing_area: Option<PathBuf>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -68,7 +74,7 @@ pub struct StatsArgs {
     /// Print the statistics as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Overwrite existing outputs (--psd, --plot).
+    /// Overwrite existing outputs (--psd, --bearing-area, --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -209,7 +215,8 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
     }
-    let mut staged = StagedOutputs::new(args.psd.iter().chain(&args.plot), args.force)?;
+    let outputs = args.psd.iter().chain(&args.bearing_area).chain(&args.plot);
+    let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     // A measured file's sidecar (if any) is its import record, not a generator's spec.
     let (source, record) = if !is_npy(&args.file) || has_import_sidecar(&args.file) {
@@ -223,9 +230,13 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     } else {
         (npy_source(args, size_x)?, None)
     };
+    let bearing = match &args.bearing_area {
+        Some(_) => Some(bearing_curve(&source)?),
+        None => None,
+    };
     let stats = compute(&request, source, &args.file.display().to_string())
         .map_err(crate::request::refused)?;
-    stage_outputs(args, &mut staged, &stats)?;
+    stage_outputs(args, &mut staged, &stats, bearing.as_deref())?;
     staged.commit()?;
     if args.json {
         print_json(args, &stats, record)
@@ -235,8 +246,38 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
 }
 
-/// Stages the --psd table and the --plot chart (committed together by the caller).
-fn stage_outputs(args: &StatsArgs, staged: &mut StagedOutputs, stats: &Statistics) -> Result<()> {
+/// Rows of the `--bearing-area` table: material ratios 0, 0.01, ..., 1.
+const BEARING_POINTS: usize = 101;
+
+/// The bearing-area curve `(material ratio, height)` of the heights to be analysed.
+fn bearing_curve(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    let values: Box<dyn Iterator<Item = f64> + '_> = match source {
+        StatsSource::Grid { heights, .. } => Box::new(heights.iter().copied()),
+        StatsSource::Measured { heights, .. } => heights.values(),
+    };
+    Ok(asperity::topography::stats::bearing_area_curve(
+        values,
+        BEARING_POINTS,
+    )?)
+}
+
+/// Stages the --psd and --bearing-area tables and the --plot chart (committed together by
+/// the caller).
+fn stage_outputs(
+    args: &StatsArgs,
+    staged: &mut StagedOutputs,
+    stats: &Statistics,
+    bearing: Option<&[(f64, f64)]>,
+) -> Result<()> {
+    if let (Some(path), Some(curve)) = (&args.bearing_area, bearing) {
+        let mut table = Table::new(&["material_ratio", "height"]);
+        for &(p, c) in curve {
+            table.push_numbers(&[p, c]);
+        }
+        table
+            .stage(staged, path)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     let (bins, size) = (&stats.bins, stats.size);
     if let Some(path) = &args.psd {
         let mut table = Table::new(&["q", "psd", "q_l_2pi"]);
