@@ -94,6 +94,9 @@ __all__ = [
     "__version__",
 ]
 
+# The defaults shared with the CLI, written once in the front-end layer (asperity_app):
+# modulus, boundary, solver, tolerance, max_iterations, fd_step, gamma, kappa, size.
+_DEFAULTS: Dict[str, Any] = _core.defaults()
 _EXACT_INT = 2**53  # integers above this do not convert to float64 without loss
 
 
@@ -320,7 +323,7 @@ def surface(
     short_cutoff: Optional[float] = None,
     rms_height: Optional[float] = None,
     rms_slope: Optional[float] = None,
-    size: float = 1.0,
+    size: float = _DEFAULTS["size"],
     seed: int = 0,
 ) -> Surface:
     """A self-affine rough surface, as ``asperity surface`` (bit-identical for a seed).
@@ -352,7 +355,7 @@ def line(
     cutoff: Optional[float] = None,
     rms_height: Optional[float] = None,
     rms_slope: Optional[float] = None,
-    size: float = 1.0,
+    size: float = _DEFAULTS["size"],
     seed: int = 0,
 ) -> Line:
     """A self-affine rough line (``C1D = π q C2D``, paper eqs. 9-11), as ``asperity line``.
@@ -811,10 +814,10 @@ class Solver:
         modulus: Optional[float] = None,
         young: Optional[float] = None,
         poisson: Optional[float] = None,
-        boundary: str = "free",
-        tolerance: float = 1e-8,
-        max_iterations: int = 10_000,
-        solver: str = "bccg",
+        boundary: str = _DEFAULTS["boundary"],
+        tolerance: float = _DEFAULTS["tolerance"],
+        max_iterations: int = _DEFAULTS["max_iterations"],
+        solver: str = _DEFAULTS["solver"],
     ):
         heights, size_x, size_y = _surface_input(surface, size)
         if modulus is None and young is None and poisson is None:
@@ -885,7 +888,7 @@ class Solver:
         pressure: Optional[float] = None,
         force: Optional[float] = None,
         indentation: Optional[float] = None,
-        step: float = 1e-3,
+        step: float = _DEFAULTS["fd_step"],
     ) -> float:
         """``dF/dd`` by central differences: two solves at the load × (1 ± step). Leaves
         the solver in the upper state."""
@@ -903,7 +906,7 @@ class Solver:
         pmax: Optional[float] = None,
         stiffness: bool = True,
         fd_stiffness: bool = False,
-        fd_step: float = 1e-3,
+        fd_step: float = _DEFAULTS["fd_step"],
         fields: bool = False,
         progress: ProgressArg = None,
         poisson: Optional[float] = None,
@@ -1031,8 +1034,8 @@ def contact(
     modulus: Optional[float] = None,
     young: Optional[float] = None,
     poisson: Optional[float] = None,
-    boundary: str = "free",
-    tolerance: float = 1e-8,
+    boundary: str = _DEFAULTS["boundary"],
+    tolerance: float = _DEFAULTS["tolerance"],
     map: bool = False,
     resistivity: Optional[Sequence[float]] = None,
     thermal_conductivity: Optional[Sequence[float]] = None,
@@ -1385,8 +1388,8 @@ def bem_adhesion(
     work_of_adhesion: float,
     indentations: Sequence[float],
     size: Optional[float] = None,
-    modulus: float = 1.0,
-    boundary: str = "free",
+    modulus: float = _DEFAULTS["modulus"],
+    boundary: str = _DEFAULTS["boundary"],
     retract_step: Optional[float] = None,
 ) -> BemAdhesion:
     """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, as ``asperity bem
@@ -1411,7 +1414,7 @@ def bem_adhesion(
     return BemAdhesion(**out)
 
 
-PERSSON_KAPPA = 1.5957691216057307
+PERSSON_KAPPA: float = _DEFAULTS["kappa"]
 """Persson's own small-load area coefficient √(8/π) in A/A₀ = κ p/(E* ḡ) (Persson 2001);
 simulations find about 2."""
 
@@ -1447,8 +1450,8 @@ def persson(
     pressures: Optional[Sequence[float]] = None,
     *,
     size: Optional[float] = None,
-    modulus: float = 1.0,
-    gamma: float = 0.45,
+    modulus: float = _DEFAULTS["modulus"],
+    gamma: float = _DEFAULTS["gamma"],
     kappa: float = PERSSON_KAPPA,
     nloads: Optional[int] = None,
     pmin: Optional[float] = None,

@@ -144,3 +144,7 @@ def cli(argv: List[str]) -> int:
     exit status. For the package's console script: it installs the command's own Ctrl-C
     handling in the calling process."""
     ...
+def defaults() -> Dict[str, Any]:
+    """The defaults shared with the CLI (modulus, boundary, solver, tolerance,
+    max_iterations, fd_step, gamma, kappa, size), from the front-end layer."""
+    ...

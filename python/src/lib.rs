@@ -54,7 +54,29 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     study::register(m)?;
     topography::register(m)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
+    m.add_function(wrap_pyfunction!(defaults, m)?)?;
     Ok(())
+}
+
+/// The defaults of the keywords that both front ends share, from the front-end layer's
+/// `Default`s (the CLI's flags read the same): Python's signatures take them from here, so
+/// that each default is written once.
+#[pyfunction]
+fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+    let solver = asperity_app::bem::SolverRequest::default();
+    let persson = asperity::persson::PerssonParams::default();
+    let surface = asperity_app::surface::SurfaceRequest::default();
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("modulus", solver.modulus)?;
+    d.set_item("boundary", solver.boundary)?;
+    d.set_item("solver", solver.solver)?;
+    d.set_item("tolerance", solver.tolerance)?;
+    d.set_item("max_iterations", solver.max_iterations)?;
+    d.set_item("fd_step", asperity_app::bem::FD_STEP)?;
+    d.set_item("gamma", persson.gamma)?;
+    d.set_item("kappa", persson.kappa)?;
+    d.set_item("size", surface.size)?;
+    Ok(d)
 }
 
 /// The `asperity` command line (the `asperity_cli` library the binary runs): runs `argv`

@@ -537,3 +537,40 @@ def test_contact_equals_the_cli(cli, tmp_path):
         assert np.array_equal(ours[name], theirs[name]), name
     assert ours.map.dtype == bool and ours.map.sum() > 0
     assert ours.effective_modulus == 210e9 / (1 - 0.3**2)
+
+
+# Defaults shared by a CLI flag and a Python keyword (written once, in the front-end layer):
+# (command, flag, the Python callable, keyword).
+SHARED_DEFAULTS = [
+    ("bem", "--modulus", "bem_adhesion", "modulus"),
+    ("bem", "--boundary", "Solver", "boundary"),
+    ("bem", "--tol", "Solver", "tolerance"),
+    ("bem", "--max-iter", "Solver", "max_iterations"),
+    ("bem", "--solver", "Solver", "solver"),
+    ("bem", "--boundary", "bem_adhesion", "boundary"),
+    ("contact", "--boundary", "contact", "boundary"),
+    ("contact", "--tol", "contact", "tolerance"),
+    ("persson", "--modulus", "persson", "modulus"),
+    ("persson", "--gamma", "persson", "gamma"),
+    ("persson", "--kappa", "persson", "kappa"),
+    ("surface", "--size", "surface", "size"),
+    ("surface", "--seed", "surface", "seed"),
+    ("line", "--size", "line", "size"),
+    ("line", "--seed", "line", "seed"),
+]
+
+
+@pytest.mark.parametrize("command,flag,function,keyword", SHARED_DEFAULTS)
+def test_python_defaults_are_the_clis(cli, command, flag, function, keyword):
+    import inspect
+    import re
+
+    lines = [l for l in cli(command, "--help").stdout.splitlines()
+             if re.match(rf"\s+(-\w, )?{flag} ", l)]
+    assert len(lines) == 1, lines
+    theirs = re.findall(r"\[default: ([^\]]+)\]", lines[0])[-1]
+    ours = inspect.signature(getattr(asperity, function)).parameters[keyword].default
+    if isinstance(ours, str):
+        assert ours == theirs
+    else:
+        assert ours == type(ours)(float(theirs)), (ours, theirs)

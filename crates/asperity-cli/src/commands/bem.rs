@@ -62,10 +62,10 @@ pub struct BemArgs {
     #[command(flatten)]
     pub measured: MeasuredArgs,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SolverRequest::default().modulus, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Boundary conditions: free (zero-padded, no periodic images; the paper's) or periodic.
-    #[arg(long, default_value = "free")]
+    #[arg(long, default_value_t = SolverRequest::default().boundary)]
     pub boundary: String,
     /// Total forces (load control), comma separated.
     #[arg(
@@ -110,7 +110,7 @@ pub struct BemArgs {
     /// gradients without restart, tens of iterations) or pk (Polonsky & Keer 1999, the
     /// reference; a few times more iterations, each twice as costly). Both converge to the
     /// same contact to --tol.
-    #[arg(long, default_value = "bccg")]
+    #[arg(long, default_value_t = SolverRequest::default().solver)]
     pub solver: String,
     /// Maximum solver iterations per load.
     #[arg(long, default_value_t = SolverRequest::default().max_iterations, allow_hyphen_values = true)]

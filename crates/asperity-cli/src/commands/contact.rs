@@ -61,7 +61,7 @@ pub struct ContactArgs {
     )]
     pub pressures: Vec<f64>,
     /// Boundary conditions: free (zero-padded) or periodic.
-    #[arg(long, default_value = "free")]
+    #[arg(long, default_value_t = SolverRequest::default().boundary)]
     pub boundary: String,
     /// Physical size X (and Y) in metres, where the file has none or to override it.
     #[arg(long, value_name = "X[,Y]")]

@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use asperity::persson::{PerssonParams, PERSSON_KAPPA};
+use asperity::persson::PerssonParams;
 use asperity::surface::Surface;
 use asperity_app::persson::{compute, pressures, PerssonRequest, COLUMNS};
 
@@ -39,7 +39,7 @@ pub struct PerssonArgs {
     #[command(flatten)]
     pub measured: MeasuredArgs,
     /// Effective modulus E*.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PerssonParams::default().modulus, allow_hyphen_values = true)]
     pub modulus: f64,
     /// Mean pressures, comma separated.
     #[arg(
@@ -63,7 +63,7 @@ pub struct PerssonArgs {
     pub gamma: f64,
     /// Small-load area coefficient κ in A/A0 → κ p/(E* ḡ) [default: √(8/π), Persson 2001;
     /// simulations find about 2].
-    #[arg(long, default_value_t = PERSSON_KAPPA, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = PerssonParams::default().kappa, allow_hyphen_values = true)]
     pub kappa: f64,
     /// Output table (CSV); printed to stdout when absent.
     #[arg(long, value_name = "OUT.csv")]

@@ -23,11 +23,11 @@ pub struct SpectrumArgs {
     #[arg(long, value_name = "Q")]
     pub cutoff: Option<f64>,
     /// Side length L (units of the heights).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = SurfaceRequest::default().size)]
     pub size: f64,
     /// Random seed (a whole number from 0 to 2^64 − 1); the same seed gives bit-identical
     /// heights whatever the thread count.
-    #[arg(long, default_value = "0")]
+    #[arg(long, default_value_t = SurfaceRequest::default().seed)]
     pub seed: String,
     /// Output file (.npy, float64); a JSON sidecar FILE.npy.json records every parameter.
     #[arg(long, value_parser = array_path)]
