@@ -73,6 +73,7 @@
 
 use rayon::prelude::*;
 
+use super::capped_load::LOST_SET_LIMIT;
 use super::interface::{restore_capped_load, Interface};
 use super::mean_gap::MeanGapScratch;
 use super::plastic_field::{PlasticField, Restored};
@@ -192,9 +193,11 @@ pub(super) struct BccgScratch {
     /// Whether the iteration uses `single` (always, but in the test that compares the
     /// solves with and without it).
     single_steps: bool,
-    /// Under a cap: a step left fewer points in contact than the load needs below the cap
-    /// (the solve is then handed to Polonsky–Keer, [`ContactSolver::capped_bccg`]).
-    capacity_lost: bool,
+    /// Under a cap: a step left fewer points in contact than the load needs below the cap,
+    /// or the load restorations released the plastic set more than
+    /// [`LOST_SET_LIMIT`] times: the load restoration is cycling (the solve is then
+    /// finished by displacement control, `capped_load.rs`).
+    pub(super) stalled: bool,
     /// Under a cap: `K 1_C` of the capped set, for load restorations that keep `u`
     /// (`plastic_field.rs`).
     plastic: PlasticField,
@@ -252,7 +255,7 @@ impl BccgScratch {
             energy_steps: true,
             single: operator.single_precision()?,
             single_steps: true,
-            capacity_lost: false,
+            stalled: false,
             plastic: PlasticField::default(),
         })
     }
@@ -746,7 +749,7 @@ impl ContactSolver {
         };
         self.bccg_scratch.pending_scale = 1.0;
         self.bccg_scratch.extra_energies = 0;
-        self.bccg_scratch.capacity_lost = false;
+        self.bccg_scratch.stalled = false;
         if let Interface::Hardness { .. } = self.interface {
             self.bccg_scratch.plastic.prepare(self.state.pressure.len());
         }
@@ -1048,8 +1051,9 @@ impl ContactSolver {
             // by the capped scaling of Polonsky–Keer, the capped points kept there, `u`
             // with them (`plastic_field.rs`) or recomputed.
             let (restored, applied) = self.restore_capped((mean_pressure, h, total), !stale);
-            if restored == Restored::CapacityLost {
-                self.bccg_scratch.capacity_lost = true;
+            let lost = self.bccg_scratch.plastic.lost_sets > LOST_SET_LIMIT;
+            if restored == Restored::CapacityLost || lost {
+                self.bccg_scratch.stalled = true;
                 return Err(SolveError::NoConvergence {
                     iterations: iteration,
                     residual: gradient.residual,
@@ -1122,36 +1126,6 @@ impl ContactSolver {
             (&scratch.impulse, grid),
         );
         (restored, applied)
-    }
-
-    /// The BCCG under a cap. Near fully plastic contact under load control (measured: H =
-    /// 0.1 E*, rms gradient 0.08, p̄ ≥ 0.09 E* on free boundaries), a step can leave fewer
-    /// points in contact than the load needs below the cap, where no scaling restores it;
-    /// the solve then goes on with the capped Polonsky–Keer from cold, which converges
-    /// there, and reports the iterations and applications of both.
-    pub(super) fn capped_bccg(
-        &mut self,
-        target: Target,
-        tolerance: f64,
-        max_iterations: usize,
-    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let result = self.bccg(target, tolerance, max_iterations);
-        let Err(SolveError::NoConvergence { iterations, .. }) = result else {
-            return result;
-        };
-        if !self.bccg_scratch.capacity_lost {
-            return result;
-        }
-        let left = max_iterations.saturating_sub(iterations).max(1);
-        let (summary, info) = self.polonsky_keer(target, tolerance, left)?;
-        Ok((
-            summary,
-            SolveInfo {
-                iterations: iterations + info.iterations,
-                operator_applications: iterations + info.operator_applications,
-                ..info
-            },
-        ))
     }
 
     /// Periodic displacement control: the BCCG with `d` fixed and the constant mode of the

@@ -159,25 +159,25 @@ impl Interface {
 /// `n_H h + Σ min(s p, h) = n p̄` ([`capped_scale`]); if the capped points alone carry more
 /// than the load, every point is scaled. Where the points in contact cannot carry the load
 /// below the cap, the pressure restarts from the bearing area that can
-/// ([`bearing_start`], ordered by `level`, the gap up to a constant). False after such a
-/// restart.
+/// ([`bearing_start`], ordered by `level`, the gap up to a constant). Says which of the
+/// three it did.
 pub(super) fn restore_capped_load(
     pressure: &mut [f64],
     (mean_pressure, h): (f64, f64),
     total: f64,
     level: impl Fn(usize) -> f64,
-) -> bool {
+) -> CappedRestoration {
     let wanted = mean_pressure * pressure.len() as f64;
     let in_contact = pressure.iter().filter(|&&p| p > 0.0).count();
     if (in_contact as f64) * h <= wanted || total <= 0.0 {
         bearing_start(pressure, (mean_pressure, h), level);
-        return false;
+        return CappedRestoration::Restarted;
     }
     let plain = wanted / total;
     let peak = pressure.iter().fold(0.0f64, |m, &p| m.max(p));
     if peak < h && peak * plain < h {
         pressure.iter_mut().for_each(|v| *v *= plain);
-        return true;
+        return CappedRestoration::Held;
     }
     let capped = pressure.iter().filter(|&&p| p >= h).count();
     let keep_capped = (capped as f64) * h < wanted;
@@ -187,7 +187,33 @@ pub(super) fn restore_capped_load(
             *p = (scale * *p).min(h);
         }
     }
-    true
+    match keep_capped {
+        true => CappedRestoration::Held,
+        false => CappedRestoration::Released,
+    }
+}
+
+/// What a capped load restoration ([`restore_capped_load`]) did. Only [`Self::Held`] is a
+/// restoration an iteration converges through: the other two throw away the plastic set
+/// (or the whole pressure), and an iteration that needs them again and again is cycling
+/// (`capped_load.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum CappedRestoration {
+    /// The points at the cap held there (or none at it), the others scaled.
+    Held,
+    /// The capped points alone carried more than the load: every point scaled, the
+    /// plastic set released.
+    Released,
+    /// The points in contact could not carry the load below the cap: the pressure
+    /// restarted from the bearing area ([`bearing_start`]).
+    Restarted,
+}
+
+impl CappedRestoration {
+    /// Whether the restoration threw away the plastic set or the pressure.
+    pub(super) fn lost_the_set(self) -> bool {
+        self != CappedRestoration::Held
+    }
 }
 
 /// A start that carries the load `n p̄` below the cap `h`: the pressure `n p̄ / m`, uniform

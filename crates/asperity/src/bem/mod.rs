@@ -51,6 +51,7 @@
 
 pub mod adhesion;
 mod bccg;
+mod capped_load;
 pub mod conductance;
 mod full_contact;
 mod interface;

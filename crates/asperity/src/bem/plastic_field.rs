@@ -25,7 +25,7 @@
 use rayon::prelude::*;
 
 use super::bccg::{add_point_responses, CHUNK, CUT_LIMIT};
-use super::interface::{capped_scale, restore_capped_load};
+use super::interface::{capped_scale, restore_capped_load, CappedRestoration};
 
 /// `K 1_C` of the capped set `C = {p ≥ h}` of the current iterate, kept through a solve.
 #[derive(Default)]
@@ -44,6 +44,9 @@ pub(super) struct PlasticField {
     /// The changes of the capped set gathered for one grid pass, `(t, ±1)` or
     /// `(t, h − s p_t)`.
     changes: Vec<(usize, f64)>,
+    /// The restorations of this solve that released the plastic set or restarted the
+    /// pressure ([`CappedRestoration::lost_the_set`]).
+    pub(super) lost_sets: usize,
 }
 
 /// The pressures counted against the cap `h` (one chunk's, or the grid's).
@@ -76,7 +79,8 @@ pub(super) type Grid = (usize, usize, bool);
 
 impl PlasticField {
     /// Makes the fields for a grid of `len` points (allocated on the first capped solve
-    /// only) and forgets the capped set: the next restoration computes `K 1_C` afresh.
+    /// only) and forgets the capped set (the next restoration computes `K 1_C` afresh) and
+    /// the count of lost sets.
     pub(super) fn prepare(&mut self, len: usize) {
         if self.response.len() != len {
             let chunks = len.div_ceil(CHUNK);
@@ -87,6 +91,7 @@ impl PlasticField {
             self.changes = Vec::with_capacity(CUT_LIMIT);
         }
         self.valid = false;
+        self.lost_sets = 0;
     }
 
     /// Follows the changes of the capped set made by a step: `changes` are `(t, +1)` for a
@@ -137,9 +142,11 @@ impl PlasticField {
             // not held, `u` is recomputed.
             self.valid = false;
             let level = |i: usize| u[i] + f[i];
-            return match restore_capped_load(pressure, (mean_pressure, h), total, level) {
-                true => Restored::Stale,
-                false => Restored::CapacityLost,
+            let restoration = restore_capped_load(pressure, (mean_pressure, h), total, level);
+            self.lost_sets += restoration.lost_the_set() as usize;
+            return match restoration {
+                CappedRestoration::Restarted => Restored::CapacityLost,
+                _ => Restored::Stale,
             };
         }
         let update_u = exact_u && self.ensure(pressure, h, indicator, apply);

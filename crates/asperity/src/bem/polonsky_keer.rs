@@ -19,7 +19,8 @@
 //! keeps results bit-identical for any thread count (the FFTs are parallel and
 //! independent of it too).
 
-use super::interface::{restore_capped_load, Interface};
+use super::capped_load::LOST_SET_LIMIT;
+use super::interface::{restore_capped_load, CappedRestoration, Interface};
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
 
@@ -29,6 +30,10 @@ use super::{ContactSummary, SolveError, SolveInfo};
 pub(super) struct PkScratch {
     direction: Vec<f64>,
     response: Vec<f64>,
+    /// Under a cap and load control: the last solve stopped because its load
+    /// restorations lost the plastic set more than [`LOST_SET_LIMIT`] times (cycling;
+    /// `capped_load.rs` finishes it by displacement control).
+    pub(super) stalled: bool,
 }
 
 impl ContactSolver {
@@ -45,7 +50,9 @@ impl ContactSolver {
         let mut pk = self.pk_scratch.take().unwrap_or_else(|| PkScratch {
             direction: vec![0.0; len],
             response: vec![0.0; len],
+            stalled: false,
         });
+        pk.stalled = false;
         let result = self.polonsky_keer_in(&mut pk, target, tolerance, max_iterations);
         self.pk_scratch = Some(pk);
         result
@@ -69,7 +76,7 @@ impl ContactSolver {
         };
         let mut g_old = 0.0;
         let mut conjugate = false;
-        let mut iteration = 0;
+        let (mut iteration, mut lost_sets) = (0, 0);
         loop {
             self.check_stop(iteration)?;
             self.problem
@@ -111,7 +118,7 @@ impl ContactSolver {
                 &pk.direction,
                 &pk.response,
                 load_control,
-                pass.elastic_points,
+                pass.moving_points,
             );
             // Penetrating points enter with p = −τ g; before any step exists (empty
             // set), a Jacobi step with the self-influence.
@@ -125,16 +132,26 @@ impl ContactSolver {
                 entry_step,
             );
             // Pass E: the prescribed load (a reset pressure restarts the directions).
-            let kept = self.restore_load(target, total);
-            conjugate = !entered && kept;
+            let restoration = self.restore_load(target, total);
+            conjugate = !entered && restoration != CappedRestoration::Restarted;
+            let capped = matches!(interface, Interface::Hardness { .. });
+            lost_sets += (capped && restoration.lost_the_set()) as usize;
+            if lost_sets > LOST_SET_LIMIT {
+                pk.stalled = true;
+                return Err(SolveError::NoConvergence {
+                    iterations: iteration,
+                    residual,
+                });
+            }
         }
     }
 
     /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
-    /// sum `total` (or reset to uniform if nothing is left). False after a reset.
-    fn restore_load(&mut self, target: Target, total: f64) -> bool {
+    /// sum `total` (or reset to uniform if nothing is left: `Restarted`); under a cap by
+    /// [`restore_capped_load`].
+    fn restore_load(&mut self, target: Target, total: f64) -> CappedRestoration {
         let Target::MeanPressure(mean_pressure) = target else {
-            return true;
+            return CappedRestoration::Held;
         };
         let pressure = &mut self.state.pressure;
         if let Interface::Hardness { h } = self.interface {
@@ -144,10 +161,10 @@ impl ContactSolver {
         if total > 0.0 {
             let scale = mean_pressure * pressure.len() as f64 / total;
             pressure.iter_mut().for_each(|v| *v *= scale);
-            true
+            CappedRestoration::Held
         } else {
             pressure.fill(mean_pressure);
-            false
+            CappedRestoration::Restarted
         }
     }
 }
@@ -156,10 +173,10 @@ impl ContactSolver {
 pub(super) struct GapPass {
     /// Points in contact (`p > 0`).
     pub(super) contact_points: usize,
-    /// Points on the elastic set ([`Interface::elastic`]; the contact points for the hard
+    /// Points the conjugate gradients move ([`moves`]; the contact points for the hard
     /// wall).
-    pub(super) elastic_points: usize,
-    /// `G = Σ g²` on the elastic set.
+    pub(super) moving_points: usize,
+    /// `G = Σ g²` on the points moved.
     pub(super) gap_squared: f64,
     /// The squared violations off it (`Σ_{p=0} min(g, 0)²`, and `Σ_{p=H} max(g, 0)²`).
     pub(super) penetration_squared: f64,
@@ -213,12 +230,13 @@ pub(super) fn gap_and_direction(
         0.0
     };
     let d = *indentation;
-    let (mut gap_squared, mut penetration_squared) = (0.0, 0.0);
+    let (mut gap_squared, mut penetration_squared, mut moving_points) = (0.0, 0.0, 0);
     for ((g, ti), &pi) in gap.iter_mut().zip(t.iter_mut()).zip(p) {
         *g -= d;
-        if interface.elastic(pi) {
+        if moves(interface, pi, *g) {
             gap_squared += *g * *g;
             *ti = *g + beta * *ti;
+            moving_points += 1;
         } else {
             *ti = 0.0;
             let v = interface.violation(pi, *g);
@@ -229,10 +247,21 @@ pub(super) fn gap_and_direction(
     }
     GapPass {
         contact_points,
-        elastic_points,
+        moving_points,
         gap_squared,
         penetration_squared,
     }
+}
+
+/// Whether the conjugate gradients move the point: the elastic set, and under a cap the
+/// capped points whose gap opens (`p = H, g > 0`). Those leave the cap along the
+/// direction, with the step fitted to it: moved by a step of their own (as the points
+/// entering the contact are) they all left the cap at once for zero where the cold start
+/// had put most of the contact at the cap (a paraboloid: 665 of 681 points), the next
+/// steps put them all back, and the iteration alternated between the two for ever.
+#[inline]
+fn moves(interface: Interface, p: f64, g: f64) -> bool {
+    interface.elastic(p) || (interface.plastic(p) && g > 0.0)
 }
 
 /// Pass C: `τ = Σ g t / Σ (r − r̄) t` on the contact set, `r̄` its mean there under load
@@ -248,7 +277,7 @@ fn step_length(
 ) -> f64 {
     let (mut sum_r, mut sum_rt, mut sum_t, mut sum_gt) = (0.0, 0.0, 0.0, 0.0);
     for (((&pi, &gi), &ti), &ri) in p.iter().zip(gap).zip(t).zip(r) {
-        if interface.elastic(pi) {
+        if moves(interface, pi, gi) {
             sum_r += ri;
             sum_rt += ri * ti;
             sum_t += ti;
@@ -280,11 +309,11 @@ fn update_pressure(
 ) -> (f64, bool) {
     let (mut total, mut entered) = (0.0, false);
     for ((pi, &gi), &ti) in p.iter_mut().zip(gap).zip(t) {
-        if interface.elastic(*pi) {
+        if moves(interface, *pi, gi) {
             *pi = interface.project(*pi - tau * ti);
         } else if interface.is_free(*pi, gi) {
-            // Out of contact and penetrating (enters), or at the cap and pulling away
-            // (leaves it): the hard wall's `max(−e g, 0)` is `−e g` itself.
+            // Out of contact and penetrating (enters): the hard wall's `max(−e g, 0)` is
+            // `−e g` itself.
             *pi = interface.project(*pi - entry_step * gi);
             entered = true;
         }

@@ -306,7 +306,11 @@ impl ContactSolver {
             .filter(|&&p| WALL.in_contact(p))
             .count();
         let cold_load = self.state.solved.is_none() && matches!(target, Target::MeanPressure(_));
-        if start > limit && !cold_load {
+        // The direct solve knows the hard wall only: from a start with points at a cap
+        // it would throw the plastic set away (`capped_load.rs` finishes a search there).
+        let cap = self.interface.cap();
+        let plastic_start = self.state.pressure.iter().any(|&p| p >= cap);
+        if (start > limit && !cold_load) || plastic_start {
             return Ok(SmallSetRun {
                 applications: 0,
                 exact: false,

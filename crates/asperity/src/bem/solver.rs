@@ -43,7 +43,7 @@ use ndarray::{Array2, ArrayView2};
 
 use super::bccg::BccgScratch;
 use super::full_contact::{FullContactScratch, FullContactThreshold};
-use super::interface::Interface;
+use super::interface::{restore_capped_load, Interface};
 use super::polonsky_keer::PkScratch;
 use super::preconditioner::{FourierPreconditioner, Real};
 use super::small_set::SmallSet;
@@ -450,8 +450,8 @@ impl ContactSolver {
             (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
                 self.bccg_periodic_indentation(d)
             }
-            (SolverKind::Bccg, _) if self.interface != Interface::HardWall => {
-                self.capped_bccg(target, tolerance, max_iterations)
+            (kind, Target::MeanPressure(p)) if self.interface != Interface::HardWall => {
+                self.capped_load(kind, p, tolerance, max_iterations)
             }
             (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
             (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
@@ -545,6 +545,15 @@ impl ContactSolver {
                 let current = self.state.pressure.iter().sum::<f64>() / n;
                 if warm && current > 0.0 {
                     let (scale, interface) = (mean_pressure / current, self.interface);
+                    let cap = interface.cap();
+                    if self.state.pressure.iter().any(|&p| p >= cap) {
+                        // Points at the cap stay there, the others scaled (scaled down
+                        // with the rest they would all leave the plastic set).
+                        let (pressure, gap) = (&mut self.state.pressure, &self.state.gap);
+                        let total = current * n;
+                        restore_capped_load(pressure, (mean_pressure, cap), total, |i| gap[i]);
+                        return;
+                    }
                     // (The hard wall's projection of p·scale ≥ 0 is the identity.)
                     for p in self.state.pressure.iter_mut() {
                         *p = interface.project(*p * scale);
