@@ -138,7 +138,7 @@ fn stats_of_a_measured_file_prints_iso_parameters() {
 }
 
 #[test]
-fn stats_writes_the_bearing_area_curve() {
+fn stats_writes_the_bearing_area_curve_and_the_acf() {
     // Heights 0, 1, ..., 127 (a uniform distribution): the fraction p of them lies at or
     // above c(p) = 127 (1 − p) exactly, the order statistics being equally spaced.
     let dir = tempfile::tempdir().unwrap();
@@ -168,6 +168,22 @@ fn stats_writes_the_bearing_area_curve() {
     // An existing output is kept unless --force.
     let out = asperity(&args, dir.path());
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    // The height-difference ACF along x: heights rise by 1 per pixel along a row, so
+    // A(k Δx) = k²/2, with Δx = 1/16.
+    let args = ["stats", "ramp.npy", "--size", "1", "--acf", "acf.csv"];
+    ok(&asperity(&args, dir.path()));
+    let text = std::fs::read_to_string(dir.path().join("acf.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("distance,acf"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 16);
+    for (k, row) in rows.iter().enumerate() {
+        let want = 0.5 * (k * k) as f64;
+        assert!((row[0] - k as f64 / 16.0).abs() < 1e-15, "{row:?}");
+        assert!((row[1] - want).abs() <= 1e-9 * want.max(1.0), "{row:?}");
+    }
 }
 
 #[test]

@@ -7,6 +7,7 @@ use asperity::fit::PowerLawFit;
 use asperity::io::{read_npy, read_npy_shape, StagedOutputs};
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::PsdBin;
+use asperity::topography::Heights;
 use asperity_app::stats::{
     compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
 };
@@ -67,6 +68,12 @@ pub struct StatsArgs {
     /// order statistics), in the heights' unit (metres for a measured file).
     #[arg(long, value_name = "OUT.csv")]
     pub bearing_area: Option<PathBuf>,
+    /// Write the height-difference autocorrelation function along x as CSV with columns
+    /// distance (r = kΔx) and acf (A(r) = ½⟨(h(x + r) − h(x))²⟩ over every pair of defined
+    /// points at that distance in a row, pooled over the rows; SurfaceTopography's ACF of a
+    /// non-periodic scan on its grid), in the heights' unit (squared for acf).
+    #[arg(long, value_name = "OUT.csv")]
+    pub acf: Option<PathBuf>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -74,7 +81,7 @@ pub struct StatsArgs {
     /// Print the statistics as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Overwrite existing outputs (--psd, --bearing-area, --plot).
+    /// Overwrite existing outputs (--psd, --bearing-area, --acf, --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -215,7 +222,8 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
     }
-    let outputs = args.psd.iter().chain(&args.bearing_area).chain(&args.plot);
+    let outputs =
+        (args.psd.iter().chain(&args.bearing_area)).chain(args.acf.iter().chain(&args.plot));
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     // A measured file's sidecar (if any) is its import record, not a generator's spec.
@@ -234,9 +242,16 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         Some(_) => Some(bearing_curve(&source)?),
         None => None,
     };
+    let acf = match &args.acf {
+        Some(path) => Some((path, acf_along_x(&source)?)),
+        None => None,
+    };
     let stats = compute(&request, source, &args.file.display().to_string())
         .map_err(crate::request::refused)?;
     stage_outputs(args, &mut staged, &stats, bearing.as_deref())?;
+    if let Some((path, rows)) = &acf {
+        stage_pairs(&mut staged, path, ["distance", "acf"], rows)?;
+    }
     staged.commit()?;
     if args.json {
         print_json(args, &stats, record)
@@ -261,6 +276,50 @@ fn bearing_curve(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
     )?)
 }
 
+/// The height-difference ACF along x as `(distance, A)`: a line is one row.
+fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    use ndarray::{Array2, Axis, Ix1, Ix2};
+    let (rows, size_x): (Array2<f64>, f64) = match source {
+        StatsSource::Grid { heights, size, .. } => match heights.ndim() {
+            1 => (
+                heights
+                    .view()
+                    .into_dimensionality::<Ix1>()?
+                    .insert_axis(Axis(0))
+                    .to_owned(),
+                *size,
+            ),
+            _ => (
+                heights.view().into_dimensionality::<Ix2>()?.to_owned(),
+                *size,
+            ),
+        },
+        StatsSource::Measured { heights, sizes } => match heights {
+            Heights::Areal(h) => (h.clone(), sizes[0]),
+            Heights::Profile(p) => (p.clone().insert_axis(Axis(0)), sizes[0]),
+        },
+    };
+    let dx = size_x / rows.ncols() as f64;
+    let acf = asperity::topography::stats::height_difference_acf(rows.view())?;
+    Ok(acf.into_iter().map(|(k, a)| (k as f64 * dx, a)).collect())
+}
+
+/// Stages a two-column table.
+fn stage_pairs(
+    staged: &mut StagedOutputs,
+    path: &Path,
+    header: [&str; 2],
+    rows: &[(f64, f64)],
+) -> Result<()> {
+    let mut table = Table::new(&header);
+    for &(a, b) in rows {
+        table.push_numbers(&[a, b]);
+    }
+    table
+        .stage(staged, path)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
 /// Stages the --psd and --bearing-area tables and the --plot chart (committed together by
 /// the caller).
 fn stage_outputs(
@@ -270,13 +329,7 @@ fn stage_outputs(
     bearing: Option<&[(f64, f64)]>,
 ) -> Result<()> {
     if let (Some(path), Some(curve)) = (&args.bearing_area, bearing) {
-        let mut table = Table::new(&["material_ratio", "height"]);
-        for &(p, c) in curve {
-            table.push_numbers(&[p, c]);
-        }
-        table
-            .stage(staged, path)
-            .with_context(|| format!("writing {}", path.display()))?;
+        stage_pairs(staged, path, ["material_ratio", "height"], curve)?;
     }
     let (bins, size) = (&stats.bins, stats.size);
     if let Some(path) = &args.psd {

@@ -355,6 +355,72 @@ pub fn material_ratio(heights: impl IntoIterator<Item = f64>, c: f64) -> f64 {
     above as f64 / n.max(1) as f64
 }
 
+/// The height-difference autocorrelation function along x, `A(r_k) = ½⟨(h(x + r_k) −
+/// h(x))²⟩` at `r_k = kΔx` (SurfaceTopography's `autocorrelation_from_profile` of a
+/// non-periodic scan, on the grid): the mean over every pair of defined points at distance
+/// `k` pixels along a row, pooled over the rows of a map (the average of the rows' ACFs
+/// where none is undefined). Returns `(k, A)` for each `k` with at least one such pair, in
+/// the heights' unit squared. From three cross-correlations by zero-padded FFTs
+/// (`Σ m_i m_{i+k}`, `Σ g_i g_{i+k}`, `Σ (s_i m_{i+k} + m_i s_{i+k})` with `g = (h − h̄)m`,
+/// `s = g²`, `m` the defined points), summed over rows in Fourier space: `O(N log N)`.
+pub fn height_difference_acf(rows: ArrayView2<f64>) -> Result<Vec<(usize, f64)>> {
+    let (ny, n) = rows.dim();
+    let defined = rows.iter().filter(|v| !v.is_nan()).count();
+    if n < 2 || defined == 0 {
+        return Err(Error::invalid(
+            "autocorrelation",
+            format!("{n} points per row and {defined} defined heights"),
+        ));
+    }
+    let mean = rows.iter().filter(|v| !v.is_nan()).sum::<f64>() / defined as f64;
+    let len = (2 * n - 1).next_power_of_two();
+    let mut planner = realfft::RealFftPlanner::<f64>::new();
+    let (fwd, inv) = (planner.plan_fft_forward(len), planner.plan_fft_inverse(len));
+    let bins = len / 2 + 1;
+    let zero = num_complex::Complex64::new(0.0, 0.0);
+    let mut sums = vec![vec![zero; bins]; 3]; // mm, gg, sm + ms
+    let mut spectra = vec![vec![zero; bins]; 3]; // m, g, s
+    let mut input = vec![0.0; len];
+    for r in 0..ny {
+        for (which, spectrum) in spectra.iter_mut().enumerate() {
+            input.fill(0.0);
+            for (i, &v) in rows.row(r).iter().enumerate() {
+                if !v.is_nan() {
+                    let g = v - mean;
+                    input[i] = [1.0, g, g * g][which];
+                }
+            }
+            fwd.process(&mut input, spectrum).map_err(fft_error)?;
+        }
+        let [m, g, s] = [&spectra[0], &spectra[1], &spectra[2]];
+        for b in 0..bins {
+            sums[0][b] += m[b].conj() * m[b];
+            sums[1][b] += g[b].conj() * g[b];
+            sums[2][b] += s[b].conj() * m[b] + m[b].conj() * s[b];
+        }
+    }
+    let mut lags = vec![vec![0.0; len]; 3];
+    for (sum, lag) in sums.iter_mut().zip(&mut lags) {
+        sum[0].im = 0.0;
+        sum[bins - 1].im = 0.0;
+        inv.process(sum, lag).map_err(fft_error)?;
+    }
+    let scale = 1.0 / len as f64;
+    Ok((0..n)
+        .filter_map(|k| {
+            let pairs = (lags[0][k] * scale).round();
+            (pairs >= 1.0).then(|| {
+                let a = (0.5 * lags[2][k] - lags[1][k]) * scale / pairs;
+                (k, a.max(0.0))
+            })
+        })
+        .collect())
+}
+
+fn fft_error(e: impl std::fmt::Display) -> Error {
+    Error::invalid("autocorrelation", e.to_string())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -602,6 +668,46 @@ mod tests {
             (flat.sq, flat.ssk, flat.sku, flat.sdr),
             (0.0, 0.0, 0.0, 0.0)
         );
+    }
+
+    #[test]
+    fn height_difference_acf_against_its_definition() {
+        // A ramp h_i = i gives A(k) = k²/2 exactly; random heights with undefined points
+        // give the direct pair average, ½ Σ (h_i − h_{i+k})² / pairs over the rows.
+        let ramp = Array2::from_shape_fn((3, 40), |(_, c)| c as f64 * 0.5);
+        for (k, a) in height_difference_acf(ramp.view()).unwrap() {
+            let want = 0.5 * (0.5 * k as f64).powi(2);
+            assert!(
+                (a - want).abs() <= 1e-9 * want.max(1.0),
+                "{k}: {a} vs {want}"
+            );
+        }
+        let mut h = Array2::from_shape_fn((5, 37), |(r, c)| {
+            ((r * 37 + c) as f64 * 0.7).sin() * 3.0 + ((c * c) as f64 * 0.01).cos() + 1e3
+        });
+        for (r, c) in [(0, 3), (1, 0), (2, 36), (4, 17), (4, 18)] {
+            h[(r, c)] = f64::NAN;
+        }
+        let acf = height_difference_acf(h.view()).unwrap();
+        assert_eq!(acf.len(), 37);
+        for (k, a) in acf {
+            let (mut sum, mut pairs) = (0.0, 0);
+            for row in h.rows() {
+                for i in 0..37 - k {
+                    let d = row[i] - row[i + k];
+                    if !d.is_nan() {
+                        sum += d * d;
+                        pairs += 1;
+                    }
+                }
+            }
+            let want = 0.5 * sum / pairs as f64;
+            assert!(
+                (a - want).abs() <= 1e-9 * want.max(1e-3),
+                "{k}: {a} vs {want}"
+            );
+        }
+        assert!(height_difference_acf(Array2::from_elem((2, 1), 1.0).view()).is_err());
     }
 
     #[test]
