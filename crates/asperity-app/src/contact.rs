@@ -161,16 +161,19 @@ impl ContactRequest {
     }
 }
 
-/// The contact law of a hardness (Pa, positive and finite) or none, refused where a
-/// pressure is at or above it (more than a fully plastic contact carries).
+/// The contact law of a hardness (Pa) or none. The rules are the library's, the one
+/// definition that `asperity bem --hardness` applies too ([`Interface::hardness`]: positive
+/// and finite; [`Interface::check_mean_pressure`]: no mean pressure at or above it, more
+/// than a fully plastic contact carries); the words are the front ends'.
 fn interface(hardness: Option<f64>, pressures: &[f64]) -> Result<Interface, Refusal> {
     let Some(h) = hardness else {
         return Ok(Interface::HardWall);
     };
-    if !(h.is_finite() && h > 0.0) {
+    let Ok(interface) = Interface::hardness(h) else {
         return Err(Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {h}")));
-    }
-    if let Some(p) = pressures.iter().find(|&&p| p >= h) {
+    };
+    let beyond = |p: f64| interface.check_mean_pressure(p).is_err();
+    if let Some(p) = pressures.iter().copied().find(|&p| beyond(p)) {
         return Err(Refusal::saying("a mean pressure of ")
             .text(format!(
                 "{p} Pa is at or above the hardness {h} Pa: more than a fully plastic contact can \
@@ -179,7 +182,7 @@ fn interface(hardness: Option<f64>, pressures: &[f64]) -> Result<Interface, Refu
             .param(HARDNESS)
             .text(")"));
     }
-    Ok(Interface::Hardness { h })
+    Ok(interface)
 }
 
 /// The columns of `asperity contact`'s table (SI units), in the order of
