@@ -1391,12 +1391,14 @@ def bem_adhesion(
     modulus: float = _DEFAULTS["modulus"],
     boundary: str = _DEFAULTS["boundary"],
     retract_step: Optional[float] = None,
+    adhesion_range: Optional[float] = None,
 ) -> BemAdhesion:
-    """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, as ``asperity bem
-    --work-of-adhesion`` (the same code and numbers): the ``indentations`` are a path
-    (negative allowed), then the indenter is retracted in steps of ``retract_step``
-    (default: the deepest indentation / 200) until nothing is attached. Square pixels.
-    See docs/adhesion.md.
+    """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, or a Maugis–Dugdale
+    cohesive zone of range ``adhesion_range`` (stress ``work_of_adhesion / adhesion_range``),
+    as ``asperity bem --work-of-adhesion [--adhesion-range]`` (the same code and numbers):
+    the ``indentations`` are a path (negative allowed), then the indenter is retracted in
+    steps of ``retract_step`` (default: the deepest indentation, plus any range, / 200)
+    until nothing is attached. Square pixels. See docs/adhesion.md.
 
     Example::
 
@@ -1410,7 +1412,8 @@ def bem_adhesion(
     heights, size_x, size_y = _surface_input(surface, size)
     path = [float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
     out = _core.bem_adhesion(heights, size_x, size_y, float(modulus), str(boundary),
-                             float(work_of_adhesion), path, _opt(retract_step))
+                             float(work_of_adhesion), path, _opt(retract_step),
+                             _opt(adhesion_range))
     return BemAdhesion(**out)
 
 

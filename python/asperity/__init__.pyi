@@ -268,7 +268,7 @@ class BemAdhesion:
 def bem_adhesion(
     surface: Any, *, work_of_adhesion: float, indentations: Sequence[float],
     size: Optional[float] = ..., modulus: float = ..., boundary: str = ...,
-    retract_step: Optional[float] = ...,
+    retract_step: Optional[float] = ..., adhesion_range: Optional[float] = ...,
 ) -> BemAdhesion: ...
 
 PERSSON_KAPPA: float

@@ -252,3 +252,33 @@ def test_bem_adhesion_equals_the_cli(cli, tmp_path):
         asperity.bem_adhesion(h, size=0.2, work_of_adhesion=-1.0, indentations=path)
     with pytest.raises(ValueError, match="never press the surface"):
         asperity.bem_adhesion(h, size=0.2, work_of_adhesion=1e-3, indentations=[-0.01])
+
+
+def test_bem_cohesive_zone_equals_the_cli(cli, tmp_path):
+    # The Maugis–Dugdale cohesive zone (--adhesion-range / adhesion_range): same numbers.
+    x = (np.arange(40) - 20) * 5e-3
+    h = -(x[:, None]**2 + x[None, :]**2) / 2
+    np.save(tmp_path / "sphere.npy", h)
+    path = [-1e-3, 0.002, 0.004, 0.006, 0.008, 0.004]
+    cli("bem", "--surface", tmp_path / "sphere.npy", "--size", 0.2, "--work-of-adhesion", 2e-4,
+        "--adhesion-range", 2e-3, "--indentations", ",".join(map(str, path)),
+        "--retract-step", 1e-4, "--out", tmp_path / "md.csv")
+    with open(tmp_path / "md.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ours = asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                                 retract_step=1e-4, adhesion_range=2e-3)
+    assert ours.branch == [r["branch"] for r in rows]
+    for name in ["indentation", "force", "tensile_fraction"]:
+        assert getattr(ours, name).tolist() == [float(r[name]) for r in rows], name
+    # Within the range before touching: attracted.
+    assert ours.force[0] < 0
+    record = json.load(open(tmp_path / "md.csv.json"))
+    assert record["adhesion"]["model"] == "Maugis–Dugdale cohesive zone"
+    assert record["adhesion"]["pull_off"]["force_controlled"]["force"] == \
+        ours.pull_off["force_controlled"]["force"]
+    with pytest.raises(ValueError, match="invalid adhesion_range"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                              adhesion_range=0.0)
+    with pytest.raises(ValueError, match="spans no pixel"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                              adhesion_range=1e-9)

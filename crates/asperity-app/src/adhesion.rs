@@ -1,9 +1,12 @@
 //! Adhesive BEM contact for `asperity bem --work-of-adhesion` and Python's `bem_adhesion`:
-//! Pohrt & Popov's pixel criterion ([`asperity::bem::adhesion::PixelAdhesion`]) along a
-//! path of indentations, then retracted to pull-off. One request type, validated once, and
+//! Pohrt & Popov's pixel criterion, or a Maugis–Dugdale cohesive zone where a range is
+//! given ([`asperity::bem::adhesion::PixelAdhesion`]), along a path of indentations, then
+//! retracted to pull-off. One request type, validated once, and
 //! one run, for both front ends.
 
-use asperity::bem::adhesion::{AdhesionInfo, AdhesivePullOff, AdhesiveSummary, PixelAdhesion};
+use asperity::bem::adhesion::{
+    AdhesionInfo, AdhesionLaw, AdhesivePullOff, AdhesiveSummary, PixelAdhesion,
+};
 use asperity::bem::{HalfSpace, SolveError};
 use asperity::surface::Surface;
 use serde::{Deserialize, Serialize};
@@ -13,12 +16,19 @@ use crate::refusal::{Param, Refusal};
 
 /// The work of adhesion Δγ.
 pub const WORK_OF_ADHESION: Param = Param::new("--work-of-adhesion", "work_of_adhesion");
+/// The range h₀ of a Maugis–Dugdale cohesive zone.
+pub const ADHESION_RANGE: Param = Param::new("--adhesion-range", "adhesion_range");
 /// The step of the retraction to pull-off.
 pub const RETRACT_STEP: Param = Param::new("--retract-step", "retract_step");
 
-/// Steps of the retraction from the path's deepest indentation to zero when no step is
-/// given: the step is that depth over this.
+/// Steps of the retraction from the path's deepest indentation to zero (to `−h₀` with a
+/// cohesive zone of range `h₀`) when no step is given: the step is that distance over this.
 pub const DEFAULT_RETRACT_STEPS: f64 = 200.0;
+
+/// A Maugis–Dugdale range below this many times one pixel's own opening
+/// ([`PixelAdhesion::cohesive_resolution`]) draws a warning: at 4.4 the sphere's pull-off
+/// is off by 3.2 %, at 8.8 by 1.4–4.9 % (docs/adhesion.md); below 1 the run is refused.
+pub const COARSE_ZONE_RESOLUTION: f64 = 10.0;
 
 /// A contact radius at pull-off below this many pixels draws a warning: the criterion's
 /// error on a sphere is about `1.4 Δx/a` (docs/adhesion.md), 14 % here.
@@ -33,11 +43,15 @@ pub struct AdhesionRequest {
     pub boundary: String,
     /// Δγ, positive and finite.
     pub work_of_adhesion: f64,
+    /// The range h₀ of a Maugis–Dugdale cohesive zone (stress Δγ/h₀), positive and finite;
+    /// `None`: the pixel criterion (adhesion of vanishing range).
+    #[serde(default)]
+    pub adhesion_range: Option<f64>,
     /// The indentations in the order visited (negative allowed: pulled back beyond first
     /// touch); the retraction to pull-off follows the last.
     pub indentations: Vec<f64>,
-    /// The retraction's step (default: the deepest indentation over
-    /// [`DEFAULT_RETRACT_STEPS`]).
+    /// The retraction's step (default: the deepest indentation, plus the range of a
+    /// cohesive zone, over [`DEFAULT_RETRACT_STEPS`]).
     pub retract_step: Option<f64>,
 }
 
@@ -48,6 +62,8 @@ pub struct AdhesionPlan {
     pub half_space: HalfSpace,
     /// Δγ.
     pub work_of_adhesion: f64,
+    /// The adhesive law.
+    pub law: AdhesionLaw,
     /// The path.
     pub indentations: Vec<f64>,
     /// The retraction's step.
@@ -96,6 +112,8 @@ pub struct AdhesionRun {
     pub critical_stress: f64,
     /// The pixel side.
     pub spacing: f64,
+    /// [`PixelAdhesion::cohesive_resolution`] (`None` for the pixel criterion).
+    pub zone_resolution: Option<f64>,
 }
 
 impl AdhesionRun {
@@ -106,8 +124,19 @@ impl AdhesionRun {
     }
 
     /// A warning where the contact at pull-off is too few pixels across for the criterion to
-    /// be accurate ([`COARSE_RADIUS_PIXELS`]), else `None`.
+    /// be accurate ([`COARSE_RADIUS_PIXELS`]), or a cohesive zone too coarse
+    /// ([`COARSE_ZONE_RESOLUTION`]), else `None`.
     pub fn resolution_warning(&self) -> Option<String> {
+        if let Some(resolution) = self.zone_resolution {
+            return (resolution < COARSE_ZONE_RESOLUTION).then(|| {
+                format!(
+                    "the cohesive zone is coarse: its range is {resolution:.1} times the \
+                     opening one pixel's Dugdale stress causes (below {COARSE_ZONE_RESOLUTION} \
+                     a sphere's pull-off is off by a few %, docs/adhesion.md); a finer grid \
+                     or a longer range is more accurate"
+                )
+            });
+        }
         let radius = self.pull_off_radius_pixels()?;
         (radius < COARSE_RADIUS_PIXELS).then(|| {
             format!(
@@ -134,6 +163,16 @@ impl AdhesionRequest {
                     ": the work of adhesion Δγ must be positive and finite, got {w}"
                 )));
         }
+        if let Some(h) = self.adhesion_range {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(Refusal::saying("invalid ")
+                    .param(ADHESION_RANGE)
+                    .text(format!(
+                        ": the range h₀ of the Maugis–Dugdale stress must be positive and \
+                         finite, got {h}"
+                    )));
+            }
+        }
         check_modulus(MODULUS, self.modulus)?;
         let boundary = parse_boundary(&self.boundary)?;
         let path = &self.indentations;
@@ -144,13 +183,22 @@ impl AdhesionRequest {
             return Err(Refusal::of(INDENTATIONS).text(format!(": {v} is not finite")));
         }
         let deepest = path.iter().fold(f64::NEG_INFINITY, |m, &d| m.max(d));
-        if deepest <= 0.0 {
-            return Err(Refusal::of(INDENTATIONS).text(format!(
-                " never press the surface (the deepest is {deepest}): with adhesion of \
-                 vanishing range nothing attaches before the indenter touches"
-            )));
+        let reach = self.adhesion_range.unwrap_or(0.0);
+        if deepest <= -reach {
+            return Err(Refusal::of(INDENTATIONS).text(match self.adhesion_range {
+                None => format!(
+                    " never press the surface (the deepest is {deepest}): with adhesion of \
+                     vanishing range nothing attaches before the indenter touches"
+                ),
+                Some(h) => format!(
+                    " never come within the range {h} of the surface (the deepest is \
+                     {deepest}): nothing is attracted"
+                ),
+            }));
         }
-        let step = self.retract_step.unwrap_or(deepest / DEFAULT_RETRACT_STEPS);
+        let step = self
+            .retract_step
+            .unwrap_or((deepest + reach) / DEFAULT_RETRACT_STEPS);
         if !(step.is_finite() && step > 0.0) {
             return Err(
                 Refusal::of(RETRACT_STEP).text(format!(" must be positive and finite, got {step}"))
@@ -162,6 +210,10 @@ impl AdhesionRequest {
                 boundary,
             },
             work_of_adhesion: w,
+            law: match self.adhesion_range {
+                None => AdhesionLaw::PixelCriterion,
+                Some(range) => AdhesionLaw::MaugisDugdale { range },
+            },
             indentations: path.clone(),
             retract_step: step,
         })
@@ -170,13 +222,31 @@ impl AdhesionRequest {
 
 impl AdhesionPlan {
     /// Runs the path on `surface` (square pixels), then the retraction to pull-off,
-    /// calling `on_row` with each settled state as it comes.
+    /// calling `on_row` with each settled state as it comes. A cohesive zone that spans no
+    /// pixel (resolution below 1) is refused before the first solve.
     pub fn run(
         &self,
         surface: &Surface,
         on_row: &mut dyn FnMut(&AdhesionRow),
     ) -> Result<AdhesionRun, SolveError> {
-        let mut contact = PixelAdhesion::new(surface, self.half_space, self.work_of_adhesion)?;
+        let mut contact =
+            PixelAdhesion::with_law(surface, self.half_space, self.work_of_adhesion, self.law)?;
+        let zone_resolution = contact.cohesive_resolution();
+        if let (Some(r), AdhesionLaw::MaugisDugdale { range }) = (zone_resolution, self.law) {
+            if r < 1.0 {
+                let finest = contact.spacing() * r;
+                return Err(asperity::Error::invalid(
+                    "adhesion range",
+                    format!(
+                        "the cohesive zone spans no pixel: one pixel's Dugdale stress opens \
+                         it by {:.3e}, more than the range {range}; use pixels below \
+                         {finest:.3e} or a longer range",
+                        range / r
+                    ),
+                )
+                .into());
+            }
+        }
         let mut rows = Vec::with_capacity(self.indentations.len());
         for &d in &self.indentations {
             let (summary, info) = contact.move_to(d)?;
@@ -202,6 +272,7 @@ impl AdhesionPlan {
             pull_off,
             critical_stress: contact.critical_stress(),
             spacing: contact.spacing(),
+            zone_resolution,
         })
     }
 }
@@ -217,6 +288,7 @@ mod tests {
             modulus: 1.0,
             boundary: "free".into(),
             work_of_adhesion: 2e-4,
+            adhesion_range: None,
             indentations: vec![0.004, 0.008],
             retract_step: None,
         }
@@ -289,5 +361,60 @@ mod tests {
         let jkr = -1.5 * std::f64::consts::PI * 2e-4;
         assert!((least / jkr - 1.0).abs() < 0.25, "{least} vs {jkr}");
         assert!(run.resolution_warning().unwrap().contains("pixels"));
+    }
+
+    #[test]
+    fn a_cohesive_zone_is_checked_and_runs() {
+        let words = |r: AdhesionRequest| r.validate().unwrap_err().words(Names::Flags);
+        for h in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+            let text = words(AdhesionRequest {
+                adhesion_range: Some(h),
+                ..request()
+            });
+            assert!(text.starts_with("invalid --adhesion-range"), "{text}");
+        }
+        // Within the range of the surface without touching it: attracted, so accepted.
+        let near = AdhesionRequest {
+            adhesion_range: Some(1e-3),
+            indentations: vec![-5e-4],
+            ..request()
+        };
+        assert!(near.validate().is_ok());
+        let far = AdhesionRequest {
+            indentations: vec![-2e-3],
+            ..near.clone()
+        };
+        assert!(words(far).contains("never come within the range"));
+        // A sphere at λ = 1 on 30² pixels of 1e-2 (a_c ≈ 8.9 pixels): tensile pull-off near
+        // Maugis's −1.601πwR (within 10 % this coarse; docs/adhesion.md: +4.9 % at 10).
+        let (n, dx) = (30, 1e-2);
+        let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+            let (y, x) = ((i as f64 - 15.0) * dx, (j as f64 - 15.0) * dx);
+            -(x * x + y * y) / 2.0
+        });
+        let surface = Surface::new(heights, n as f64 * dx).unwrap();
+        let w = 2e-4;
+        let unit = asperity::reference::MaugisDugdale::scales(1.0, 1.0, w, 1.0);
+        let plan = AdhesionRequest {
+            adhesion_range: Some(w * unit.lambda),
+            indentations: vec![0.005, 0.012],
+            ..request()
+        }
+        .validate()
+        .unwrap();
+        let run = plan.run(&surface, &mut |_| {}).unwrap();
+        let maugis = -1.601 * std::f64::consts::PI * w;
+        let least = run.pull_off.unwrap().force_controlled.force;
+        assert!((least / maugis - 1.0).abs() < 0.1, "{least} vs {maugis}");
+        assert!(run.zone_resolution.unwrap() > 1.0);
+        // A range a pixel's own tension closes is refused before any solve.
+        let coarse = AdhesionRequest {
+            adhesion_range: Some(1e-9),
+            ..request()
+        }
+        .validate()
+        .unwrap();
+        let error = coarse.run(&surface, &mut |_| {}).unwrap_err().to_string();
+        assert!(error.contains("spans no pixel"), "{error}");
     }
 }

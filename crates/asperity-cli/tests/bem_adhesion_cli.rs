@@ -77,13 +77,55 @@ fn a_sphere_gives_the_loop_and_jkrs_pull_off_to_the_criterions_accuracy() {
 }
 
 #[test]
+fn a_cohesive_zone_gives_maugis_pull_off() {
+    // The sphere of the test above at Maugis parameter λ = 1 (range h₀ = wλ₁, λ₁ the λ of a
+    // unit stress): the library measures +1.78 % against Maugis's −1.6007πwR at 20 pixels
+    // (with a finer retraction step); checked to 3 %, and the record names the model.
+    let dir = tempfile::tempdir().unwrap();
+    let s = sphere(dir.path());
+    let csv = dir.path().join("md.csv");
+    let w = 8.0 * 0.1f64.powi(3) / (9.0 * std::f64::consts::PI);
+    let unit_lambda = 2.0 * (1.0 / (std::f64::consts::PI * w * (4.0f64 / 3.0).powi(2))).cbrt();
+    let path: Vec<String> = (1..=10)
+        .map(|k| format!("{}", 0.015625 * k as f64 / 10.0))
+        .collect();
+    let out = asperity(&[
+        "bem",
+        "--surface",
+        s.to_str().unwrap(),
+        "--size",
+        "0.32",
+        "--work-of-adhesion",
+        &w.to_string(),
+        "--adhesion-range",
+        &(w * unit_lambda).to_string(),
+        "--indentations",
+        &path.join(","),
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    ok(&out);
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("md.csv.json")).unwrap())
+            .unwrap();
+    let adhesion = &record["adhesion"];
+    assert_eq!(adhesion["model"], "Maugis–Dugdale cohesive zone");
+    assert!(adhesion["zone_resolution"].as_f64().unwrap() > 10.0);
+    let force = adhesion["pull_off"]["force_controlled"]["force"]
+        .as_f64()
+        .unwrap();
+    let maugis = -1.6007 * std::f64::consts::PI * w;
+    assert!((force / maugis - 1.0).abs() < 0.03, "{force} vs {maugis}");
+}
+
+#[test]
 fn meaningless_adhesive_requests_are_refused_in_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let s = sphere(dir.path());
     let s = s.to_str().unwrap();
     let csv = dir.path().join("x.csv");
     let out_flag = csv.to_str().unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 9] = [
         (
             &["--work-of-adhesion", "-1e-3", "--indentations", "0.01"],
             "invalid --work-of-adhesion",
@@ -114,6 +156,33 @@ fn meaningless_adhesive_requests_are_refused_in_one_line() {
         (
             &["--retract-step", "1e-3", "--indentations", "0.01"],
             "goes with --work-of-adhesion",
+        ),
+        (
+            &["--adhesion-range", "1e-3", "--indentations", "0.01"],
+            "--adhesion-range goes with --work-of-adhesion",
+        ),
+        (
+            &[
+                "--work-of-adhesion",
+                "1e-3",
+                "--adhesion-range",
+                "-1",
+                "--indentations",
+                "0.01",
+            ],
+            "invalid --adhesion-range",
+        ),
+        (
+            // One pixel's Dugdale stress (1e-3/1e-9) would close far more than the range.
+            &[
+                "--work-of-adhesion",
+                "1e-3",
+                "--adhesion-range",
+                "1e-9",
+                "--indentations",
+                "0.01",
+            ],
+            "spans no pixel",
         ),
     ];
     for (extra, needle) in cases {

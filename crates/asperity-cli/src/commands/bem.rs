@@ -129,8 +129,13 @@ pub struct BemArgs {
     /// tensile_fraction, rounds, cg_iterations, branch (path|retract). Square pixels.
     #[arg(long, value_name = "DG", allow_hyphen_values = true)]
     pub work_of_adhesion: Option<f64>,
+    /// A Maugis–Dugdale cohesive zone of this range h₀ instead of the pixel criterion (with
+    /// --work-of-adhesion): free pixels within h₀ of the indenter carry the stress Δγ/h₀
+    /// (docs/adhesion.md). Refused where one pixel's own stress closes more than h₀.
+    #[arg(long, value_name = "H0", allow_hyphen_values = true)]
+    pub adhesion_range: Option<f64>,
     /// The retraction's step in indentation (with --work-of-adhesion; default the deepest
-    /// indentation / 200).
+    /// indentation, plus any --adhesion-range, / 200).
     #[arg(long, value_name = "STEP", allow_hyphen_values = true)]
     pub retract_step: Option<f64>,
     /// Output table (CSV); printed to stdout when absent. Its inputs go to OUT.csv.json
@@ -807,6 +812,9 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     if args.retract_step.is_some() {
         bail!("--retract-step goes with --work-of-adhesion");
+    }
+    if args.adhesion_range.is_some() {
+        bail!("--adhesion-range goes with --work-of-adhesion");
     }
     let plan = plan(args)?;
     let mut outputs = stage_outputs(args, plan.bem.loads.len())?;

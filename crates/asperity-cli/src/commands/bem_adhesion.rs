@@ -1,5 +1,5 @@
 //! `asperity bem --work-of-adhesion`: adhesive contact by Pohrt & Popov's pixel criterion
-//! along the path of `--indentations`, then retracted to pull-off (the front-end layer's
+//! (or a Maugis–Dugdale cohesive zone with `--adhesion-range`) along the path of `--indentations`, then retracted to pull-off (the front-end layer's
 //! [`AdhesionRequest`], the one Python's `bem_adhesion` runs). Outputs as `asperity bem`'s:
 //! checked before any work, written together at the end.
 
@@ -61,6 +61,7 @@ fn request(args: &BemArgs, w: f64) -> AdhesionRequest {
         modulus: args.modulus,
         boundary: args.boundary.clone(),
         work_of_adhesion: w,
+        adhesion_range: args.adhesion_range,
         indentations: args.indentations.clone().unwrap_or_default(),
         retract_step: args.retract_step,
     }
@@ -126,8 +127,13 @@ fn record(
         "modulus": request.modulus,
         "boundary": request.boundary,
         "adhesion": {
-            "model": "Pohrt–Popov pixel criterion",
+            "model": match request.adhesion_range {
+                None => "Pohrt–Popov pixel criterion",
+                Some(_) => "Maugis–Dugdale cohesive zone",
+            },
             "work_of_adhesion": request.work_of_adhesion,
+            "range": request.adhesion_range,
+            "zone_resolution": run.zone_resolution,
             "critical_stress": run.critical_stress,
             "indentations": request.indentations,
             "retract_step": request.retract_step,

@@ -1,6 +1,7 @@
 //! Adhesive contact on the boundary elements: Pohrt & Popov's mesh-dependent detachment
-//! criterion (Facta Univ. Mech. Eng. 13, 3, 2015), with loading, unloading, hysteresis and
-//! both pull-offs ([`PixelAdhesion`]).
+//! criterion (Facta Univ. Mech. Eng. 13, 3, 2015) or a Maugis–Dugdale cohesive zone
+//! ([`AdhesionLaw`]), with loading, unloading, hysteresis and both pull-offs
+//! ([`PixelAdhesion`]).
 //!
 //! **The model.** A pixel of the half-space is either *attached* to the rigid indenter or
 //! free. On the attached set `S` the gap is held at zero and the pressure may have either
@@ -37,15 +38,32 @@
 //! not an [`super::Interface`] variant because its state remembers its history (which
 //! pixels are attached), which no pointwise law of `(p, g)` can.
 //!
+//! **The Maugis–Dugdale cohesive zone** ([`AdhesionLaw::MaugisDugdale`], range `h₀`,
+//! stress `σ₀ = w/h₀`): the same attached set and the same linear solve, but a free pixel
+//! whose gap is within `h₀` carries the tension `σ₀` (a known load in the solve), and an
+//! attached pixel lets go (keeping `−σ₀`) when its tension exceeds `σ₀`. The law is
+//! reversible (no pixel is locked out across indentations; within one, a pixel that let go
+//! does not come back, so the rounds end), and its energy is not convex: the attach/release
+//! rounds follow the branch the path is on, and where it ends the state jumps (into
+//! contact on approach, off it on retraction). A free pixel is judged at the mean of its
+//! states with and without its own tension, which removes a bias of order `Δx` (the
+//! pixel's own opening would widen the range). The zone must span pixels:
+//! [`PixelAdhesion::cohesive_resolution`] (`E*h₀²/(c̄wΔx)`) is the range over the
+//! opening one pixel's tension causes. Measured on Maugis's sphere (force-controlled
+//! pull-off, `a_c/Δx` = 10, 20, 40): λ = 0.5 +2.4 %, +0.8 %, +0.2 %; λ = 1 +4.9 %, +1.8 %,
+//! +0.6 %; λ = 2 +5.5 %, +3.2 %, +1.4 % (about order 1.5 in `Δx`).
+//!
 //! **Retraction** ([`PixelAdhesion::retract`]): the indentation falls in steps until no
 //! pixel is attached; the force-controlled pull-off is the least force met (beyond it no
 //! state carries the force), the displacement-controlled one the last state before the
 //! contact lets go completely, located by bisection on `d` between the last attached step
-//! and the first free one.
+//! and the first free one (whose force counts for the least too: a cohesive zone may still
+//! pull there).
 //!
 //! **Oracles** (tests in `tests.rs`): JKR's sphere (the contact radius against the force
 //! on retraction and the pull-off `−(3/2)πwR`, converging as the pixel shrinks), Kendall's
-//! flat punch `−√(8πwE*a³)`, and the non-adhesive solver as `w → 0`. The criterion
+//! flat punch `−√(8πwE*a³)`, Maugis's sphere across λ from DMT toward JKR
+//! ([`crate::reference::MaugisDugdale`]), and the non-adhesive solver as `w → 0`. The criterion
 //! converges at first order on a sphere (+6.9 % in the pull-off at `a_c/Δx = 20`, +3.9 % at
 //! 40; docs/adhesion.md has the table and a reading of it).
 //!
@@ -78,6 +96,24 @@ mod pixel;
 mod tests;
 
 pub use pixel::PixelAdhesion;
+
+/// The adhesive law between the indenter and the pixels of the half-space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AdhesionLaw {
+    /// Pohrt & Popov's mesh-dependent criterion: adhesion of vanishing range; an attached
+    /// pixel lets go when its tension exceeds `σ_c = √(E*w/(cΔx))`. Converges at first
+    /// order in `Δx` to JKR.
+    PixelCriterion,
+    /// A Maugis–Dugdale cohesive zone of range `h₀` (`range`): a free pixel whose gap is at
+    /// most `h₀` carries the constant tension `σ₀ = w/h₀`, one farther nothing, and an
+    /// attached pixel lets go when its tension exceeds `σ₀`. Converges to Maugis's sphere
+    /// ([`crate::reference::MaugisDugdale`]) once the cohesive zone spans pixels
+    /// ([`PixelAdhesion::cohesive_resolution`]).
+    MaugisDugdale {
+        /// The range `h₀` of the Dugdale stress.
+        range: f64,
+    },
+}
 
 /// How the adhesive iteration stops (documented defaults).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -138,8 +174,11 @@ pub struct AdhesiveSummary {
     pub attached_points: usize,
     /// Attached pixels over all pixels.
     pub area_fraction: f64,
-    /// Attached pixels in tension (`p < 0`).
+    /// Pixels in tension (`p < 0`): attached ones, and free ones in a cohesive zone.
     pub tensile_points: usize,
+    /// Free pixels that carry the cohesive tension (Maugis–Dugdale; 0 under the pixel
+    /// criterion).
+    pub cohesive_points: usize,
 }
 
 /// How a settled state was reached.

@@ -200,3 +200,128 @@ fn refuses_meaningless_inputs() {
     assert!(contact.retract(0.0, |_| {}).is_err());
     assert_eq!(contact.retract(1e-3, |_| {}).unwrap(), None);
 }
+
+/// Maugis–Dugdale's sphere on the BEM at Maugis parameter `λ`, `a_c/Δx` pixels in JKR's
+/// pull-off radius `a_c` (R = 1, E* = 1, a_c = 0.1), approached to `1.25 a_c` in ten steps
+/// and retracted: the relative errors of the force-controlled pull-off, of the contact
+/// radius there against Maugis's, and the largest distance of a retraction state's force
+/// from Maugis's at its contact radius `√(A/π)`, over `|F_c|`; and the zone's resolution.
+fn maugis_retraction(lambda: f64, pixels_per_radius: f64) -> (f64, f64, f64, f64) {
+    use crate::reference::MaugisDugdale;
+    let (radius, modulus, a_c): (f64, f64, f64) = (1.0, 1.0, 0.1);
+    let w = 8.0 * modulus * a_c.powi(3) / (9.0 * PI * radius * radius);
+    let unit = MaugisDugdale::scales(radius, modulus, w, 1.0);
+    let stress = lambda / unit.lambda;
+    let dx = a_c / pixels_per_radius;
+    let n = (2.0 * 2.0 * a_c / dx).ceil() as usize + 4;
+    let law = AdhesionLaw::MaugisDugdale { range: w / stress };
+    let surface = sphere(n, dx, radius);
+    let mut contact = PixelAdhesion::with_law(&surface, HalfSpace::default(), w, law).unwrap();
+    let d0 = (1.25 * a_c).powi(2) / radius;
+    for k in 1..=10 {
+        contact.move_to(d0 * k as f64 / 10.0).unwrap();
+    }
+    let md = MaugisDugdale::new(lambda).unwrap();
+    let reference = md.pull_off(PullOff::ForceControlled);
+    let f_c = reference.force * unit.force;
+    let start = contact.summary().attached_points;
+    let mut worst = 0.0f64;
+    let pull = contact
+        .retract(3.0 * d0 / 1000.0, |s| {
+            if s.attached_points < start {
+                let a = (s.attached_points as f64 * dx * dx / PI).sqrt();
+                let f = md.at_radius(a / unit.radius).force * unit.force;
+                worst = worst.max((s.force - f).abs() / f_c.abs());
+            }
+        })
+        .unwrap()
+        .expect("in contact");
+    let at = pull.force_controlled;
+    let a = (at.attached_points as f64 * dx * dx / PI).sqrt();
+    (
+        at.force / f_c - 1.0,
+        a / (reference.radius * unit.radius) - 1.0,
+        worst,
+        contact.cohesive_resolution().unwrap(),
+    )
+}
+
+/// The Maugis–Dugdale cohesive zone converges to Maugis's sphere once the zone spans
+/// pixels: at λ = 1 the force-controlled pull-off (`−1.601πwR`) is reached within +4.87 %,
+/// +1.78 % at `a_c/Δx` = 10, 20 (and +2.23 %, +1.32 %, +0.60 % at 14, 30, 40: the slow
+/// test; about order 1.5, `log(4.87/0.60)/log 4 = 1.51`), and the retraction's forces lie
+/// within 0.165, 0.066 of `|F_c|` of Maugis's at their contact radius. Tolerances: the
+/// error falls by more than 2 when the pixel halves (measured 2.7), and within the
+/// issue's 2 % at 20 pixels.
+#[test]
+fn maugis_dugdale_sphere_converges_with_the_pixel() {
+    let coarse = maugis_retraction(1.0, 10.0);
+    let fine = maugis_retraction(1.0, 20.0);
+    println!("lambda = 1, a_c/dx = 10: {coarse:?}\na_c/dx = 20: {fine:?}");
+    assert!(fine.0 > 0.0 && fine.0 < 0.02, "{fine:?}");
+    assert!(coarse.0 / fine.0 > 2.0, "{coarse:?} {fine:?}");
+    assert!(fine.1.abs() < 0.03, "contact radius at pull-off {fine:?}");
+    assert!(
+        fine.2 < 0.08 && coarse.2 / fine.2 > 2.0,
+        "{coarse:?} {fine:?}"
+    );
+    // The zone spans pixels: a pixel's own tension closes a fraction of the range.
+    assert!(fine.3 > 10.0, "{fine:?}");
+}
+
+/// Toward DMT: at λ = 0.5 (cohesive zone 1.4 times the contact radius at pull-off, which
+/// Maugis puts at `−1.718πwR`, between JKR's 1.5 and DMT's 2) the force-controlled
+/// pull-off within +2.38 % and +0.81 % at `a_c/Δx` = 10, 20 (+0.24 % at 40). Tolerances 3 %
+/// and 1.2 %, and the error falls by more than 2.
+#[test]
+fn maugis_dugdale_sphere_toward_dmt() {
+    let coarse = maugis_retraction(0.5, 10.0);
+    let fine = maugis_retraction(0.5, 20.0);
+    println!("lambda = 0.5, a_c/dx = 10: {coarse:?}\na_c/dx = 20: {fine:?}");
+    assert!(coarse.0 > 0.0 && coarse.0 < 0.03, "{coarse:?}");
+    assert!(fine.0 > 0.0 && fine.0 < 0.012, "{fine:?}");
+    assert!(coarse.0 / fine.0 > 2.0, "{coarse:?} {fine:?}");
+}
+
+/// The Tabor/Maugis sweep from DMT toward JKR (slow tier, about four minutes) at
+/// `a_c/Δx = 40`: the force-controlled pull-off `|F|/πwR` lies between JKR's 1.5 and DMT's
+/// 2, falls as λ grows, and is Maugis's within 1.5 % (measured +0.24 %, +0.60 %, +1.35 % at
+/// λ = 0.5, 1, 2; at λ = 2 the zone is 0.14 of the contact radius, 5.8 pixels).
+#[test]
+#[ignore]
+fn maugis_dugdale_sweep_from_dmt_to_jkr() {
+    let mut previous = 2.0;
+    for lambda in [0.5, 1.0, 2.0] {
+        let (error, ..) = maugis_retraction(lambda, 40.0);
+        let md = crate::reference::MaugisDugdale::new(lambda).unwrap();
+        let normalised = -md.pull_off(PullOff::ForceControlled).force * (1.0 + error);
+        println!("lambda = {lambda}: |F|/(pi w R) = {normalised:.4}, error {error:+.4e}");
+        assert!(error.abs() < 0.015, "{error:e}");
+        assert!(normalised > 1.5 && normalised < previous, "{normalised}");
+        previous = normalised;
+    }
+}
+
+/// As `w → 0` at a fixed range the cohesive zone carries nothing: the forces are the
+/// non-adhesive solver's to 1e-6; and a range that is not positive and finite is refused.
+#[test]
+fn vanishing_dugdale_stress_is_the_hard_wall() {
+    let (n, dx, radius) = (48, 0.01, 1.0);
+    let surface = sphere(n, dx, radius);
+    let law = AdhesionLaw::MaugisDugdale { range: 1e-3 };
+    let mut contact = PixelAdhesion::with_law(&surface, HalfSpace::default(), 1e-14, law).unwrap();
+    let mut solver =
+        crate::bem::ContactSolver::new(&surface, HalfSpace::default(), Default::default()).unwrap();
+    for d in [0.002, 0.008, 0.02] {
+        let (adhesive, info) = contact.move_to(d).unwrap();
+        let (plain, _) = solver.solve(crate::bem::Control::Indentation(d)).unwrap();
+        let error = (adhesive.force / plain.force - 1.0).abs();
+        assert!(error < 1e-6, "d = {d}: {error:e} ({info:?})");
+        assert!(adhesive.cohesive_points > 0);
+    }
+    for range in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        let law = AdhesionLaw::MaugisDugdale { range };
+        let refused = PixelAdhesion::with_law(&surface, HalfSpace::default(), 1e-3, law);
+        assert!(refused.is_err(), "{range}");
+    }
+}
