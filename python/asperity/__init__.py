@@ -1504,16 +1504,20 @@ class StudyResult:
     #: What produced it: ``study`` (``alpha`` or ``curve``), the ``folder`` and its
     #: ``spec`` (the folder's ``study.json``).
     metadata: Dict[str, Any] = field(default_factory=dict, repr=False)
+    #: The study's figures as the CLI draws them (``alpha``: α(H) with the theory curves,
+    #: or α(N) for one H; ``curve``: the ensemble k(F)), drawn by :mod:`asperity.plot`.
+    figures: Dict[str, Any] = field(default_factory=dict, repr=False)
 
     def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
         """Writes ``path`` (``.npz``: the columns) and ``path.json`` (rows, tasks,
-        comparisons, :attr:`metadata`), both or neither; :func:`load` gives it back."""
+        comparisons, figures, :attr:`metadata`), both or neither; :func:`load` gives it
+        back."""
         arrays = {name: (v.astype(str) if v.dtype == object else v)
                   for name, v in self.columns.items()}
         record = {"columns": list(self.columns), "rows": self.rows, "tasks": self.tasks,
                   "comparisons": self.comparisons,
                   "comparison_error": self.comparison_error,
-                  "metadata": self.metadata}
+                  "metadata": self.metadata, "figures": self.figures}
         _save_bundle(path, "study result", arrays, record, force)
 
     def __repr__(self) -> str:
@@ -1656,7 +1660,8 @@ def study_alpha(
                          f"{method} study")
     columns, rows = _table(records["alpha"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
-                       records["comparison_error"], _study_metadata("alpha", out))
+                       records["comparison_error"], _study_metadata("alpha", out),
+                       records["figures"])
 
 
 def study_curve(
@@ -1691,7 +1696,8 @@ def study_curve(
                          f"{method} study")
     columns, rows = _table(records["curve"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
-                       records["comparison_error"], _study_metadata("curve", out))
+                       records["comparison_error"], _study_metadata("curve", out),
+                       records["figures"])
 
 
 def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
@@ -1802,7 +1808,8 @@ def load(path: Union[str, "os.PathLike[str]"]) -> Any:
         columns = {name: (arrays[name].astype(object) if arrays[name].dtype.kind == "U"
                           else arrays[name]) for name in record["columns"]}
         return StudyResult(columns, record["rows"], record["tasks"], record["comparisons"],
-                           record.get("comparison_error"), record["metadata"])
+                           record.get("comparison_error"), record["metadata"],
+                           record.get("figures", {}))
     return read_topography(path)
 
 

@@ -149,3 +149,7 @@ def defaults() -> Dict[str, Any]:
     """The defaults shared with the CLI (modulus, boundary, solver, tolerance,
     max_iterations, fd_step, gamma, kappa, size), from the front-end layer."""
     ...
+def sweep_figure(
+    force: List[float], stiffness: List[float], stiffness_fd: Optional[List[float]],
+    area_fraction: List[float], name: str, modulus: float, physical: bool, boundary: str,
+) -> str: ...

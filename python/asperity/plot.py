@@ -13,7 +13,14 @@ returns the ``Axes``:
   ``contact --plot``);
 * :func:`contact_map` -- a contact set with its 4-connected patches coloured
   (``asperity contact --map``);
-* :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``).
+* :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``);
+* :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
+
+The sweep and study figures (:func:`stiffness` and :func:`area` of a ``Solver.sweep``,
+:func:`stiffness` of ``study_curve``, :func:`alpha`) are defined once, in the library's
+front-end layer, for the CLI and the package: the same series, theory curves, intervals,
+labels and titles as the CLI's PNG (``asperity_app::figure``); the package draws that
+definition with matplotlib.
 
 Example::
 
@@ -30,7 +37,7 @@ from typing import Any, Optional
 
 import numpy as _np
 
-__all__ = ["surface", "psd", "stiffness", "area", "contact_map", "alpha"]
+__all__ = ["surface", "psd", "stiffness", "area", "contact_map", "alpha", "figure"]
 
 
 def _pyplot():
@@ -124,8 +131,109 @@ def psd(spectrum: Any, ax=None, *, label: Optional[str] = None):
     return ax
 
 
+def _color(color: Any, index: int):
+    if color is None:
+        return f"C{index % 10}"
+    if "rgb" in color:
+        return tuple(v / 255 for v in color["rgb"])
+    return _pyplot().get_cmap("viridis")(min(max(float(color["ordered"]), 0.0), 1.0))
+
+
+def _pairs(values: Any) -> Any:
+    """``[[x, y], ...]`` with JSON nulls (missing values) as NaN, shape (n, 2)."""
+    rows = [[_np.nan if v is None else v for v in pair] for pair in values]
+    return _np.asarray(rows, dtype=_np.float64).reshape(-1, 2)
+
+
+def _draw_series(ax, chart: dict, s: dict, color) -> None:
+    xy = _pairs(s["points"])
+    x, y = xy[:, 0], xy[:, 1]
+    shown = lambda v, log: _np.isfinite(v) & ((v > 0) if log else True)  # noqa: E731
+    keep = shown(x, chart["log_x"]) & shown(y, chart["log_y"])
+    fmt = {"line": "-", "dashed": "--", "points": "o", "line_points": "-o"}[s["style"]]
+    ax.plot(x[keep], y[keep], fmt, color=color, label=s["label"] or None, markersize=4)
+    if s.get("interval"):
+        bounds = _pairs(s["interval"])
+        lo, hi = bounds[:, 0], bounds[:, 1]
+        ok = keep & shown(lo, chart["log_y"]) & shown(hi, chart["log_y"])
+        if s["style"] in ("points", "line_points"):
+            err = _np.vstack([_np.maximum(y[ok] - lo[ok], 0), _np.maximum(hi[ok] - y[ok], 0)])
+            ax.errorbar(x[ok], y[ok], yerr=err, fmt="none", ecolor=color, alpha=0.5,
+                        capsize=3)
+        else:
+            ax.fill_between(x[ok], lo[ok], hi[ok], color=color, alpha=0.2, linewidth=0)
+    if s.get("tag") and keep.any():
+        ax.annotate(s["tag"], (x[keep][-1], y[keep][-1]), color=color, xytext=(4, 0),
+                    textcoords="offset points", va="center")
+
+
+def _draw(chart: dict, ax=None):
+    """One chart of the library's figure definition (``asperity-figure/1``) on ``ax``."""
+    ax = _axes(ax)
+    for i, s in enumerate(chart["series"]):
+        _draw_series(ax, chart, s, _color(s.get("color"), i))
+    if chart["log_x"]:
+        ax.set_xscale("log")
+    if chart["log_y"]:
+        ax.set_yscale("log")
+    ax.set_title(chart["title"])
+    ax.set_xlabel(chart["x_label"])
+    ax.set_ylabel(chart["y_label"])
+    if any(s["label"] for s in chart["series"]):
+        ax.legend()
+    return ax
+
+
+def _charts(figure_data: Any) -> list:
+    if isinstance(figure_data, (str, bytes)) or hasattr(figure_data, "__fspath__"):
+        import json
+        from pathlib import Path
+
+        figure_data = json.loads(Path(figure_data).read_text())
+    if not isinstance(figure_data, dict) or figure_data.get("format") != "asperity-figure/1":
+        raise ValueError("figure: expected an asperity-figure/1 record (asperity ... "
+                         "--plot FILE.json)")
+    return figure_data["charts"]
+
+
+def figure(figure_data: Any, axes=None):
+    """Draws a figure the CLI wrote as data (``asperity bem … --plot k.json``, any command's
+    ``--plot`` with a ``.json`` name), or such a record as a dict: one panel per chart, side
+    by side (``axes``: a sequence of as many ``Axes``; new ones when None). Returns the
+    list of ``Axes``."""
+    charts = _charts(figure_data)
+    if axes is None:
+        _, made = _pyplot().subplots(1, len(charts), figsize=(6.4 * len(charts), 4.8),
+                                     squeeze=False)
+        axes = list(made[0])
+    if len(axes) != len(charts):
+        raise ValueError(f"figure: {len(charts)} charts, {len(axes)} axes given")
+    return [_draw(chart, ax) for chart, ax in zip(charts, axes)]
+
+
+def _sweep_charts(sweep: Any) -> list:
+    """The CLI's ``bem --plot`` panels of a ``Solver.sweep`` result."""
+    from . import _asperity
+
+    c, solver = sweep.columns, sweep.metadata.get("solver", {})
+    nan = _np.full(len(c["force"]), _np.nan)
+    text = _asperity.sweep_figure(
+        c["force"].tolist(), c.get("stiffness", nan).tolist(),
+        c["stiffness_fd"].tolist() if "stiffness_fd" in c else None,
+        c["area_fraction"].tolist(), "surface", float(solver.get("modulus", 1.0)), False,
+        solver.get("boundary", "free"))
+    return _charts(__import__("json").loads(text))
+
+
+def _study_chart(result: Any, kind: str) -> dict:
+    if not result.figures or kind not in result.figures:
+        raise ValueError(f"this study result has no {kind} figure (a result saved before "
+                         "figures were kept: rerun the study, which resumes from its folder)")
+    return _charts(result.figures[kind])[0]
+
+
 def _curves(result: Any, column: str):
-    """``(label, force, values, low, high)`` per curve of a study or a sweep."""
+    """``(label, force, values, low, high)`` per curve of a study or a contact sweep."""
     from . import StudyResult, Sweep
 
     if isinstance(result, StudyResult):
@@ -162,15 +270,32 @@ def _against_force(result: Any, column: str, ylabel: str, ax):
     return ax
 
 
+def _is_solver_sweep(result: Any) -> bool:
+    from . import Sweep
+
+    return isinstance(result, Sweep) and "force" in result.columns
+
+
 def stiffness(result: Any, ax=None):
-    """k(F), log–log: each curve of a :func:`~asperity.study_curve` result with its 95 %
-    interval of the mean as a band, or a :class:`~asperity.Sweep`'s frozen-set stiffness."""
+    """k(F), log–log: a :func:`~asperity.study_curve` result's ensemble-mean curves with
+    the 95 % interval of the mean as bands and a k ∝ F reference (``asperity study curve``'s
+    figure), or a ``Solver.sweep``'s frozen-set stiffness (and finite difference) as
+    ``asperity bem --plot`` draws it; a :func:`~asperity.contact` sweep's k(F) in N/m."""
+    from . import StudyResult
+
+    if isinstance(result, StudyResult) and result.figures:
+        return _draw(_study_chart(result, "curve"), ax)
+    if _is_solver_sweep(result):
+        return _draw(_sweep_charts(result)[0], ax)
     return _against_force(result, "stiffness", "contact stiffness k", ax)
 
 
 def area(result: Any, ax=None):
-    """The contact fraction A/A₀ against force, log–log (a study's mean curves or a
-    sweep)."""
+    """The contact fraction A/A₀ against force, log–log: a ``Solver.sweep`` as
+    ``asperity bem --plot`` draws it, or a study's mean curves (with their bands) or a
+    :func:`~asperity.contact` sweep."""
+    if _is_solver_sweep(result):
+        return _draw(_sweep_charts(result)[1], ax)
     return _against_force(result, "area_fraction", "contact fraction A/A₀", ax)
 
 
@@ -196,26 +321,12 @@ def contact_map(contact_set: Any, ax=None, *, size: Optional[tuple] = None):
 
 
 def alpha(result: Any, ax=None):
-    """α(H) of a :func:`~asperity.study_alpha` result: per grid size the ensemble α with
-    the 2.5–97.5 % range of the per-sample α as error bars, and the theory (dashed)."""
+    """α(H) of a :func:`~asperity.study_alpha` result as ``asperity study alpha`` draws it:
+    per (method, N) the ensemble α with the 2.5–97.5 % range of the per-sample α as error
+    bars, the theory curves (6), 1/3 (Hertz) and (24) per N; a study of one H over several N
+    as α(log₂ N) beside eq. (24)."""
     from . import StudyResult
 
     if not isinstance(result, StudyResult) or "alpha" not in result.columns:
         raise ValueError("alpha: expected the result of asperity.study_alpha")
-    c = result.columns
-    ax = _axes(ax)
-    for n in dict.fromkeys(c["n"].tolist()):
-        rows = c["n"] == n
-        h, a = c["hurst"][rows], c["alpha"][rows]
-        err = _np.vstack([a - c["alpha_low"][rows], c["alpha_high"][rows] - a])
-        ax.errorbar(h, a, yerr=_np.where(_np.isfinite(err), err, 0.0), fmt="o",
-                    capsize=3, label=f"{c['method'][rows][0]} n={n}")
-    theory = _np.isfinite(c["alpha_theory"])
-    if theory.any():
-        order = _np.argsort(c["hurst"][theory])
-        ax.plot(c["hurst"][theory][order], c["alpha_theory"][theory][order], "--",
-                color="black", label="theory")
-    ax.set_xlabel("Hurst exponent H")
-    ax.set_ylabel("α in k ∝ F^α")
-    ax.legend()
-    return ax
+    return _draw(_study_chart(result, "alpha"), ax)

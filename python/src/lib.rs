@@ -12,6 +12,7 @@ mod arrays;
 mod bem;
 mod contact;
 mod errors;
+mod figure;
 mod interrupt;
 mod mdr;
 mod persson;
@@ -47,6 +48,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bem::register(m)?;
     adhesion::register(m)?;
     contact::register(m)?;
+    figure::register(m)?;
     mdr::register(m)?;
     persson::register(m)?;
     reference::register(m)?;

@@ -206,8 +206,20 @@ fn records(spec: &StudySpec, dir: &std::path::Path, results: &[TaskResult]) -> S
         "curve": rows::curve_table(results),
         "comparisons": comparisons,
         "comparison_error": error,
+        "figures": figures(results),
     })
     .to_string()
+}
+
+/// The study's figures as the CLI draws them ([`asperity_app::figure::study`]): `alpha`
+/// (α(H) with the theory curves, or α(N) for one H) and `curve` (the ensemble k(F)), each
+/// as `asperity-figure/1` JSON.
+fn figures(results: &[TaskResult]) -> serde_json::Value {
+    use asperity_app::figure::{study as charts, to_json};
+    json!({
+        "alpha": to_json(&[charts::alpha_chart(results, &charts::title(Kind::Alpha, None))]),
+        "curve": to_json(&[charts::curve_chart(results, &charts::title(Kind::Curve, None))]),
+    })
 }
 
 /// The threads of this process's rayon pool: the samples it computes at once.

@@ -52,13 +52,16 @@ def test_curves_and_alpha_with_intervals(tmp_path):
                                  out=tmp_path / "curve")
     ax = asperity.plot.stiffness(curve)
     assert len(ax.collections) == 1  # the band of the 95 % interval
-    assert len(ax.get_lines()) == 1
+    # The ensemble curve and the k ∝ F reference, as `asperity study curve` draws them.
+    assert [l.get_label() for l in ax.get_lines()] == ["mdr N = 256 H = 0.5", "slope 1 (k ∝ F)"]
     asperity.plot.area(curve)
     study = asperity.study_alpha(method="mdr", n=[256], hurst=[0.25, 0.75], samples=4,
                                  out=tmp_path / "alpha")
     ax = asperity.plot.alpha(study)
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert labels == ["theory", "mdr n=256"] or labels == ["mdr n=256", "theory"]
+    assert labels == ["mdr N = 256", "1/(1+H) (6)", "1/3 (Hertz)", "(24), N = 256"]
+    # The points are the ensemble α of alpha.csv's rows, shifted by nothing (one N).
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), study.alpha)
     sweep = asperity.Solver(asperity.surface(32, hurst=0.8, seed=1)).sweep(
         nloads=3, pmin=1e-3, pmax=1e-2)
     ax = asperity.plot.stiffness(sweep)

@@ -30,6 +30,7 @@ pub mod adhesion;
 pub mod bem;
 pub mod contact;
 pub mod derived;
+pub mod figure;
 pub mod import;
 pub mod mdr;
 pub mod measured;

@@ -17,91 +17,40 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-/// How a series is drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Style {
-    /// A solid line.
-    Line,
-    /// A dashed line (theory curves, asymptotes).
-    Dashed,
-    /// Markers only (data points).
-    Points,
-    /// A solid line with markers.
-    LinePoints,
-}
-
-/// One labelled series of `(x, y)` points.
-#[derive(Debug, Clone)]
-pub struct Series {
-    /// Legend text.
-    pub label: String,
-    /// The points; on log axes, points with non-positive coordinates are skipped.
-    pub points: Vec<(f64, f64)>,
-    /// Drawing style.
-    pub style: Style,
-    /// Colour; `None` picks from a palette by position.
-    pub color: Option<RGBColor>,
-    /// An interval `(low, high)` per point, drawn in a lighter shade of the colour: error
-    /// bars on markers, a band under a line. Ends a log axis cannot show are left out.
-    pub interval: Option<Vec<(f64, f64)>>,
-    /// Text written beside the last point, in the series' colour (names a line in place
-    /// of a legend entry).
-    pub tag: Option<String>,
-}
-
-impl Series {
-    /// A series with palette colour.
-    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Self {
-        Series {
-            label: label.into(),
-            points,
-            style,
-            color: None,
-            interval: None,
-            tag: None,
-        }
-    }
-
-    /// Sets the interval of each point (same length as the points).
-    pub fn interval(mut self, interval: Vec<(f64, f64)>) -> Self {
-        debug_assert_eq!(interval.len(), self.points.len());
-        self.interval = Some(interval);
-        self
-    }
-
-    /// Sets the text written beside the last point.
-    pub fn tag(mut self, tag: impl Into<String>) -> Self {
-        self.tag = Some(tag.into());
-        self
-    }
-
-    /// Sets the colour.
-    pub fn color(mut self, color: RGBColor) -> Self {
-        self.color = Some(color);
-        self
-    }
-}
+use asperity_app::figure::Color as SeriesColor;
+pub use asperity_app::figure::{Chart, Series, Style};
 
 /// A colour from the Viridis map for `t ∈ [0, 1]` (ordered families such as H values).
-pub fn ordered_color(t: f64) -> RGBColor {
-    ViridisRGB::get_color(t.clamp(0.0, 1.0) as f32)
+pub fn ordered_color(t: f64) -> SeriesColor {
+    SeriesColor::Ordered(t)
 }
 
-/// A chart: title, axis labels, axis scales and series.
-#[derive(Debug, Clone)]
-pub struct Chart {
-    /// Caption above the plot.
-    pub title: String,
-    /// x-axis label.
-    pub x_label: String,
-    /// y-axis label.
-    pub y_label: String,
-    /// Logarithmic x axis.
-    pub log_x: bool,
-    /// Logarithmic y axis.
-    pub log_y: bool,
-    /// The series, drawn in order.
-    pub series: Vec<Series>,
+/// The colour plotters draws for `color`.
+fn rgb(color: SeriesColor) -> RGBColor {
+    match color {
+        SeriesColor::Rgb(r, g, b) => RGBColor(r, g, b),
+        SeriesColor::Ordered(t) => ViridisRGB::get_color(t.clamp(0.0, 1.0) as f32),
+    }
+}
+
+/// Writing a [`Chart`] (defined once for the CLI and Python in [`asperity_app::figure`])
+/// as PNG and SVG files.
+pub trait ChartFiles {
+    /// Writes the chart as PNG and SVG, both or neither.
+    fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()>;
+    /// Stages the chart as the outputs `png` and `svg` of `staged` (renamed into place
+    /// with the others on commit).
+    fn stage(&self, staged: &mut StagedOutputs, png: &Path, svg: &Path) -> Result<()>;
+}
+
+/// A chart being drawn (the drawing code's view of a [`Chart`]).
+struct Drawn<'a>(&'a Chart);
+
+impl std::ops::Deref for Drawn<'_> {
+    type Target = Chart;
+    fn deref(&self) -> &Chart {
+        self.0
+    }
 }
 
 /// The size of one chart in SVG units; a PNG is drawn at [`PNG_SCALE`] times that, with
@@ -175,26 +124,23 @@ fn tick_label(v: f64) -> String {
     }
 }
 
-impl Chart {
-    /// Writes the chart as PNG and SVG, both or neither.
-    pub fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()> {
+impl ChartFiles for Chart {
+    fn save(&self, png: &Path, svg: &Path, force: bool) -> Result<()> {
         let mut staged = StagedOutputs::new([png, svg], force)?;
         self.stage(&mut staged, png, svg)?;
         staged.commit()?;
         Ok(())
     }
 
-    /// Stages the chart as the outputs `png` and `svg` of `staged` (renamed into place
-    /// with the others on commit).
-    pub fn stage(&self, staged: &mut StagedOutputs, png: &Path, svg: &Path) -> Result<()> {
+    fn stage(&self, staged: &mut StagedOutputs, png: &Path, svg: &Path) -> Result<()> {
         register_fonts();
         stage_png(staged, png, scaled(SIZE, PNG_SCALE), |root| {
-            self.render(root, PNG_SCALE)
+            Drawn(self).render(root, PNG_SCALE)
         })?;
         let mut text = String::new();
         {
             let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-            self.render(&root, 1)?;
+            Drawn(self).render(&root, 1)?;
             root.present().map_err(|e| {
                 anyhow!("rendering {}: {}", svg.display(), in_words(&e.to_string()))
             })?;
@@ -202,7 +148,9 @@ impl Chart {
         staged.write_bytes(svg, text.as_bytes())?;
         Ok(())
     }
+}
 
+impl Drawn<'_> {
     /// Whether a log axis can show `(x, y)`.
     fn shows(&self, (x, y): (f64, f64)) -> bool {
         x.is_finite() && y.is_finite() && (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0)
@@ -396,7 +344,7 @@ impl Chart {
     }
 
     fn color_of(&self, i: usize) -> RGBColor {
-        self.series[i].color.unwrap_or_else(|| {
+        self.series[i].color.map(rgb).unwrap_or_else(|| {
             let c = Palette99::pick(i).to_rgba();
             RGBColor(c.0, c.1, c.2)
         })
@@ -531,6 +479,9 @@ pub enum ImageFormat {
     Png,
     /// `.svg`: vector graphics.
     Svg,
+    /// `.json`: what the figure shows, as data ([`asperity_app::figure::to_json`]), to
+    /// draw it elsewhere (the Python package draws the same JSON with matplotlib).
+    Json,
 }
 
 impl ImageFormat {
@@ -544,8 +495,10 @@ impl ImageFormat {
         match ext.as_deref() {
             Some("png") => Ok(ImageFormat::Png),
             Some("svg") => Ok(ImageFormat::Svg),
+            Some("json") => Ok(ImageFormat::Json),
             _ => Err(anyhow!(
-                "{flag} {}: the image format follows the extension, which must be .png or .svg",
+                "{flag} {}: the image format follows the extension, which must be .png or .svg \
+                 (or .json for the figure as data)",
                 path.display()
             )),
         }
@@ -560,7 +513,7 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
         return Err(anyhow!("{}: no chart to draw", path.display()));
     }
     for chart in charts {
-        if chart.bounds().is_err() {
+        if Drawn(chart).bounds().is_err() {
             return Err(anyhow!(
                 "nothing to show in '{}': no point with {} values",
                 chart.title,
@@ -583,7 +536,7 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
         DB::ErrorType: 'static,
     {
         for (chart, panel) in charts.iter().zip(root.split_evenly((1, charts.len()))) {
-            chart.render(&panel, scale)?;
+            Drawn(chart).render(&panel, scale)?;
         }
         Ok(())
     }
@@ -591,6 +544,11 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
         ImageFormat::Png => stage_png(staged, path, scaled(size, PNG_SCALE), |root| {
             draw(root, charts, PNG_SCALE)
         }),
+        ImageFormat::Json => {
+            let json = asperity_app::figure::to_json(charts);
+            staged.write_json(path, &json)?;
+            Ok(())
+        }
         ImageFormat::Svg => {
             let mut text = String::new();
             {
@@ -852,6 +810,7 @@ mod tests {
         let format = |p: &str| ImageFormat::from_path(Path::new(p), "--plot");
         assert_eq!(format("a/k.png").unwrap(), ImageFormat::Png);
         assert_eq!(format("K.SVG").unwrap(), ImageFormat::Svg);
+        assert_eq!(format("k.json").unwrap(), ImageFormat::Json);
         for bad in ["k.jpg", "k", "k.png.csv"] {
             let err = format(bad).unwrap_err().to_string();
             assert!(err.contains(".png or .svg") && err.contains(bad), "{err}");
@@ -900,7 +859,7 @@ mod tests {
                 .interval(vec![(1.0, 4.0), (-1.0, 50.0)])],
         };
         for style in [Style::Points, Style::Line] {
-            let ((_, _), (y0, y1)) = chart(style).bounds().unwrap();
+            let ((_, _), (y0, y1)) = Drawn(&chart(style)).bounds().unwrap();
             // The low end -1 cannot sit on a log axis; 1 and 50 widen it.
             assert!(y0 < 1.0 && y0 > 0.5 && y1 > 50.0 && y1 < 100.0, "{y0} {y1}");
             let dir = tempfile::tempdir().unwrap();
@@ -915,7 +874,7 @@ mod tests {
             series: vec![tagged],
             ..chart(Style::Line)
         };
-        let ((_, x1), _) = chart.bounds().unwrap();
+        let ((_, x1), _) = Drawn(&chart).bounds().unwrap();
         assert!(x1 > 1.1, "{x1}");
     }
 

@@ -23,7 +23,9 @@ use serde_json::json;
 
 use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
 use crate::output::{format_number, Table};
-use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
+use asperity_app::figure::sweep::{SweepColumns, SweepFigure};
+
+use crate::plot::{stage_charts, Chart, ImageFormat};
 use crate::progress::Progress;
 
 /// Arguments of `asperity bem`.
@@ -409,9 +411,9 @@ struct Row {
     peak_rss_mib: f64,
 }
 
-/// The `--plot` panels, log–log: k vs F and area fraction vs F, in N and N/m as the CSV
-/// holds them when the surface came from a measured file (lengths in metres, E* in Pa:
-/// `physical`), else divided by E* (lengths in the surface's own unit).
+/// The `--plot` panels ([`asperity_app::figure::sweep`]): k vs F and area fraction vs F,
+/// in N and N/m as the CSV holds them when the surface came from a measured file (lengths
+/// in metres, E* in Pa: `physical`), else divided by E*.
 fn sweep_charts(
     rows: &[Row],
     fd: bool,
@@ -419,62 +421,29 @@ fn sweep_charts(
     surface: &Path,
     boundary: &str,
 ) -> [Chart; 2] {
-    let per = if physical { 1.0 } else { modulus };
     let name = surface.file_name().map_or_else(
         || surface.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
-    let points = |y: &dyn Fn(&SweepRow) -> f64| {
-        rows.iter()
-            .map(|r| (r.sweep.summary.force / per, y(&r.sweep)))
-            .collect()
+    let column =
+        |y: &dyn Fn(&SweepRow) -> f64| -> Vec<f64> { rows.iter().map(|r| y(&r.sweep)).collect() };
+    let force = column(&|r| r.summary.force);
+    let stiffness = column(&|r| r.stiffness.unwrap_or(f64::NAN));
+    let stiffness_fd = column(&|r| r.stiffness_fd.unwrap_or(f64::NAN));
+    let area_fraction = column(&|r| r.summary.area_fraction);
+    let columns = SweepColumns {
+        force: &force,
+        stiffness: &stiffness,
+        stiffness_fd: fd.then_some(&stiffness_fd[..]),
+        area_fraction: &area_fraction,
     };
-    let (x_label, y_label) = if physical {
-        ("normal force F [N]", "contact stiffness k [N/m]")
-    } else {
-        (
-            "normal force F / E*  [length²]",
-            "contact stiffness k / E*  [length]",
-        )
+    let figure = SweepFigure {
+        name: &name,
+        modulus,
+        physical,
+        boundary,
     };
-    let stiffness_per = |k: Option<f64>| k.unwrap_or(f64::NAN) / per;
-    let mut series = vec![Series::new(
-        "frozen contact set",
-        points(&|r| stiffness_per(r.stiffness)),
-        Style::LinePoints,
-    )];
-    if fd {
-        series.push(Series::new(
-            "finite difference dF/dd",
-            points(&|r| stiffness_per(r.stiffness_fd)),
-            Style::Dashed,
-        ));
-    }
-    let stiffness = Chart {
-        title: format!(
-            "{name}: contact stiffness (E* = {}{}, {boundary} boundaries)",
-            asperity::input::short_number(modulus),
-            if physical { " Pa" } else { "" }
-        ),
-        x_label: x_label.into(),
-        y_label: y_label.into(),
-        log_x: true,
-        log_y: true,
-        series,
-    };
-    let area = Chart {
-        title: format!("{name}: true contact area"),
-        x_label: x_label.into(),
-        y_label: "area fraction A / A0".into(),
-        log_x: true,
-        log_y: true,
-        series: vec![Series::new(
-            "",
-            points(&|r| r.summary.area_fraction),
-            Style::LinePoints,
-        )],
-    };
-    [stiffness, area]
+    asperity_app::figure::sweep::sweep_charts(columns, figure)
 }
 
 /// The checked arguments: everything a solve needs besides the surface.

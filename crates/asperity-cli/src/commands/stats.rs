@@ -137,7 +137,9 @@ fn psd_chart(
             Some(h) => format!("fit: slope {:.3} (H ≈ {h:.3})", f.exponent),
             None => format!("fit: slope {:.3}", f.exponent),
         };
-        series.push(Series::new(label, line, Style::Dashed).color(plotters::style::BLACK));
+        series.push(
+            Series::new(label, line, Style::Dashed).color(asperity_app::figure::Color::BLACK),
+        );
     }
     Chart {
         title: format!("{name}: power spectrum of the {kind} (L = {size})"),

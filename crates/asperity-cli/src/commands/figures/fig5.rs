@@ -11,7 +11,7 @@ use asperity::study::{Method, TaskResult};
 use super::super::setting::Setting;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
-use crate::plot::{Chart, Series, Style};
+use crate::plot::{Chart, ChartFiles, Series, Style};
 use crate::studies::Kind;
 
 /// How a row's N counts modes: the paper plots each BEM grid twice.
@@ -184,17 +184,21 @@ fn write_chart(dir: &Path, rows: &[Row], setting: Setting, force: bool) -> Resul
         log_x: false,
         log_y: false,
         series: vec![
-            Series::new("eq. (24)", theory, Style::Line).color(plotters::style::RED),
-            pick("MDR (N = modes)", Counting::Modes, plotters::style::BLACK),
+            Series::new("eq. (24)", theory, Style::Line).color(asperity_app::figure::Color::RED),
+            pick(
+                "MDR (N = modes)",
+                Counting::Modes,
+                asperity_app::figure::Color::BLACK,
+            ),
             pick(
                 "BEM (N = lines per side)",
                 Counting::Lines,
-                plotters::style::GREEN,
+                asperity_app::figure::Color::Rgb(0, 255, 0),
             ),
             pick(
                 "BEM (N = grid points)",
                 Counting::Points,
-                plotters::style::MAGENTA,
+                asperity_app::figure::Color::Rgb(255, 0, 255),
             ),
         ],
     }

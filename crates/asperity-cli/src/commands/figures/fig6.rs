@@ -15,7 +15,7 @@ use ndarray::Array2;
 use super::super::setting::Setting;
 use super::write_report;
 use crate::output::Table;
-use crate::plot::{greyscale_panel, ordered_color, Chart, Series, Style};
+use crate::plot::{greyscale_panel, ordered_color, Chart, ChartFiles, Series, Style};
 
 /// What Fig. 6 draws: the H values, the surface grid and the line length, one seed.
 struct Plan {

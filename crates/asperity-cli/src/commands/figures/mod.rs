@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use asperity::study::{FitWindow, Method, StudySpec, TaskResult};
 
 use super::setting::Setting;
-use crate::plot::Chart;
+use crate::plot::{Chart, ChartFiles};
 use crate::studies::{execute, Kind, RunOptions};
 
 mod fig1;
@@ -65,10 +65,10 @@ impl Outputs {
     }
 }
 
-const BLUE: plotters::style::RGBColor = plotters::style::RGBColor(31, 119, 180);
-const GREEN: plotters::style::RGBColor = plotters::style::RGBColor(44, 160, 44);
-const BLACK: plotters::style::RGBColor = plotters::style::RGBColor(0, 0, 0);
-const GREY: plotters::style::RGBColor = plotters::style::RGBColor(150, 150, 150);
+const BLUE: asperity_app::figure::Color = asperity_app::figure::Color::Rgb(31, 119, 180);
+const GREEN: asperity_app::figure::Color = asperity_app::figure::Color::Rgb(44, 160, 44);
+const BLACK: asperity_app::figure::Color = asperity_app::figure::Color::Rgb(0, 0, 0);
+const GREY: asperity_app::figure::Color = asperity_app::figure::Color::Rgb(150, 150, 150);
 
 fn study_spec(
     method: Method,

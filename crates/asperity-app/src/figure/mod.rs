@@ -1,0 +1,158 @@
+//! What a figure shows, defined once for every front end: the CLI draws these charts with
+//! plotters (PNG/SVG, or their JSON with `--plot FILE.json`), the Python package with
+//! matplotlib (`asperity.plot`). A [`Chart`] is data only — title, axis labels and scales,
+//! series with their styles, colours, intervals and tags — so that both front ends show the
+//! same curves, theory lines, labels and intervals.
+//!
+//! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`study`] (α(H), α(N) and the
+//! ensemble k(F) of a study).
+
+pub mod study;
+pub mod sweep;
+
+use serde::Serialize;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Style {
+    /// A solid line.
+    Line,
+    /// A dashed line (theory curves, asymptotes).
+    Dashed,
+    /// Markers only (data points).
+    Points,
+    /// A solid line with markers.
+    LinePoints,
+}
+
+/// A series' colour.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Color {
+    /// An sRGB colour.
+    Rgb(u8, u8, u8),
+    /// A position `t ∈ [0, 1]` on the Viridis map, for ordered families (H values, N).
+    Ordered(f64),
+}
+
+impl Color {
+    /// Black: the theory curves.
+    pub const BLACK: Color = Color::Rgb(0, 0, 0);
+    /// Red.
+    pub const RED: Color = Color::Rgb(255, 0, 0);
+    /// Blue (pure, as plotters' `BLUE`).
+    pub const BLUE: Color = Color::Rgb(0, 0, 255);
+    /// Grey: reference lines.
+    pub const GREY: Color = Color::Rgb(120, 120, 120);
+}
+
+/// One labelled series of `(x, y)` points.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Series {
+    /// Legend text (empty: no legend entry).
+    pub label: String,
+    /// The points; on log axes, points with non-positive coordinates are not drawn, nor
+    /// non-finite ones (a missing value is NaN, `null` in JSON).
+    pub points: Vec<(f64, f64)>,
+    /// Drawing style.
+    pub style: Style,
+    /// Colour; `None` lets the renderer pick from its palette by position.
+    pub color: Option<Color>,
+    /// An interval `(low, high)` per point, drawn in a lighter shade of the colour: error
+    /// bars on markers, a band under a line. Ends a log axis cannot show are left out.
+    pub interval: Option<Vec<(f64, f64)>>,
+    /// Text written beside the last point, in the series' colour (names a line in place
+    /// of a legend entry).
+    pub tag: Option<String>,
+}
+
+impl Series {
+    /// A series with the renderer's palette colour.
+    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            style,
+            color: None,
+            interval: None,
+            tag: None,
+        }
+    }
+
+    /// Sets the interval of each point (same length as the points).
+    pub fn interval(mut self, interval: Vec<(f64, f64)>) -> Self {
+        debug_assert_eq!(interval.len(), self.points.len());
+        self.interval = Some(interval);
+        self
+    }
+
+    /// Sets the text written beside the last point.
+    pub fn tag(mut self, tag: impl Into<String>) -> Self {
+        self.tag = Some(tag.into());
+        self
+    }
+
+    /// Sets the colour.
+    pub fn color(mut self, color: Color) -> Self {
+        self.color = Some(color);
+        self
+    }
+}
+
+/// A chart: title, axis labels, axis scales and series.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Chart {
+    /// Caption above the plot.
+    pub title: String,
+    /// x-axis label.
+    pub x_label: String,
+    /// y-axis label.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The series, drawn in order.
+    pub series: Vec<Series>,
+}
+
+/// `charts` as JSON (`{"format": "asperity-figure/1", "charts": [...]}`), what
+/// `--plot FILE.json` writes and what the Python package renders; a missing value (NaN) is
+/// `null`.
+pub fn to_json(charts: &[Chart]) -> serde_json::Value {
+    serde_json::json!({ "format": FORMAT, "charts": charts })
+}
+
+/// The format tag of [`to_json`].
+pub const FORMAT: &str = "asperity-figure/1";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_chart_round_trips_through_json_with_missing_values_as_null() {
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: false,
+            series: vec![
+                Series::new("a", vec![(1.0, 2.0), (2.0, f64::NAN)], Style::LinePoints)
+                    .color(Color::Ordered(0.5))
+                    .interval(vec![(1.5, 2.5), (f64::NAN, f64::NAN)])
+                    .tag("H = 0.5"),
+                Series::new("", vec![(1.0, 1.0)], Style::Dashed).color(Color::BLACK),
+            ],
+        };
+        let json = to_json(std::slice::from_ref(&chart));
+        assert_eq!(json["format"], FORMAT);
+        let first = &json["charts"][0]["series"][0];
+        assert_eq!(first["points"][1][1], serde_json::Value::Null);
+        assert_eq!(first["color"]["ordered"], 0.5);
+        assert_eq!(json["charts"][0]["series"][1]["color"]["rgb"][0], 0);
+        assert_eq!(first["style"], "line_points");
+    }
+}

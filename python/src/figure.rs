@@ -1,0 +1,48 @@
+//! What a figure shows ([`asperity_app::figure`]), for `asperity.plot`: the charts the CLI
+//! draws with `--plot`, as JSON, which the package draws with matplotlib.
+
+use asperity_app::figure::{self, sweep::SweepColumns, sweep::SweepFigure};
+use pyo3::prelude::*;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(sweep_figure, m)?)?;
+    Ok(())
+}
+
+/// The two panels of a load sweep (k(F), A/A₀(F)) as `asperity bem --plot FILE.json`
+/// writes them: columns of equal length (NaN where not computed).
+#[pyfunction]
+#[pyo3(signature = (force, stiffness, stiffness_fd, area_fraction, name, modulus, physical, boundary))]
+#[allow(clippy::too_many_arguments)]
+fn sweep_figure(
+    force: Vec<f64>,
+    stiffness: Vec<f64>,
+    stiffness_fd: Option<Vec<f64>>,
+    area_fraction: Vec<f64>,
+    name: &str,
+    modulus: f64,
+    physical: bool,
+    boundary: &str,
+) -> PyResult<String> {
+    let n = force.len();
+    let lengths = [stiffness.len(), area_fraction.len()];
+    if lengths.iter().chain(stiffness_fd.as_ref().map(Vec::len).iter()).any(|&l| l != n) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "sweep_figure: the columns differ in length",
+        ));
+    }
+    let columns = SweepColumns {
+        force: &force,
+        stiffness: &stiffness,
+        stiffness_fd: stiffness_fd.as_deref(),
+        area_fraction: &area_fraction,
+    };
+    let figure = SweepFigure {
+        name,
+        modulus,
+        physical,
+        boundary,
+    };
+    let charts = figure::sweep::sweep_charts(columns, figure);
+    Ok(figure::to_json(&charts).to_string())
+}
