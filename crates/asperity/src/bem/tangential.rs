@@ -15,6 +15,16 @@
 //! and `1` (across it): `M K^t` keeps a spectrum within a factor `1/(1−ν) ≤ 2` of the normal
 //! one's.
 //!
+//! **Start.** The two operators average to Love's times a constant: their symbols (and the
+//! closed-form pixel kernels) give `(K^x + K^y)/2 = c K` with `c = (2−ν)/(2(1−ν))`, on any
+//! set. So `w = x_n/c`, from the normal frozen-set solution `x_n = K_SS⁻¹ 1_S` that the
+//! solver keeps after [`ContactSolver::frozen_set_stiffness`], solves the mean of the two
+//! problems; it is the start of the `x` CG, and `2w − x` (exact to first order in the
+//! anisotropy `ν/(2−ν)`) that of the `y` CG. Without a frozen-set solution of the solved
+//! state (or with [`TangentialStiffness::with_warm_start`] off) both start from zero. The
+//! same identity bounds the result: `(k_x + k_y)/2 ≥ k/c`, Mindlin's ratio, for every
+//! contact set (the inverse is operator-convex).
+//!
 //! # Example
 //! ```
 //! use asperity::bem::{tangential::TangentialStiffness, ContactSolver, Control, HalfSpace,
@@ -42,7 +52,9 @@
 
 use super::preconditioner::FourierPreconditioner;
 use super::solver::ContactSolver;
-use super::stiffness::cg::{conjugate_gradient_on_set, CgParams, CgWork, RightHandSide};
+use super::stiffness::cg::{
+    conjugate_gradient_on_set_from, CgParams, CgWork, RightHandSide, Start,
+};
 use super::{SolveError, SolveInfo};
 use crate::elastic::{Direction, ElasticOperator};
 use crate::Result;
@@ -66,7 +78,10 @@ pub struct TangentialStiffness {
     operators: [ElasticOperator; 2],
     preconditioners: [FourierPreconditioner; 2],
     work: CgWork,
+    /// The start of a CG (see the module docs), a field of the grid.
+    guess: Vec<f64>,
     poisson: f64,
+    warm_start: bool,
 }
 
 impl TangentialStiffness {
@@ -114,8 +129,17 @@ impl TangentialStiffness {
             operators,
             preconditioners,
             work,
+            guess: vec![0.0; rows * cols],
             poisson,
+            warm_start: true,
         })
+    }
+
+    /// Whether the CGs start from the normal frozen-set solution (the default, module
+    /// docs) or from zero (for comparison: the same stiffnesses to the CG's tolerance).
+    pub fn with_warm_start(mut self, warm_start: bool) -> Self {
+        self.warm_start = warm_start;
+        self
     }
 
     /// Poisson's ratio ν.
@@ -142,38 +166,85 @@ impl TangentialStiffness {
             energy_error: Some(params.stiffness_error).filter(|&e| e > 0.0),
             max_iterations: params.stiffness_max_iterations,
         };
-        let (pressure, interface, stop) = (&solver.state.pressure, solver.interface, &solver.stop);
-        let pixel = normal.spacing() * normal.spacing_y();
-        let mut run = |k: usize| {
-            crate::pool::on_worker(params.parallelism, || {
-                conjugate_gradient_on_set(
-                    &mut self.operators[k],
-                    &mut self.preconditioners[k],
-                    |i| interface.elastic(pressure[i]),
-                    RightHandSide::Ones,
-                    &mut self.work,
-                    (&cg, stop),
-                )
-            })
-            .map(|info| {
-                let solve = SolveInfo {
-                    iterations: info.iterations,
-                    residual: info.residual,
-                    operator_applications: info.iterations,
-                    energy_transforms: 0,
-                };
-                (solve, info.energy * pixel)
-            })
-            .map_err(SolveError::from)
-        };
-        let (info_x, x) = run(0)?;
-        let (info_y, y) = run(1)?;
+        let normal = self
+            .warm_start
+            .then(|| solver.frozen_set_solution())
+            .flatten();
+        let mut guess = std::mem::take(&mut self.guess);
+        let result = self.both(solver, &cg, normal, &mut guess);
+        self.guess = guess;
+        result
+    }
+
+    /// `k_x`, then `k_y`: from the normal frozen-set solution `normal` if given (module
+    /// docs; `guess` holds each start), else from zero.
+    fn both(
+        &mut self,
+        solver: &ContactSolver,
+        cg: &CgParams,
+        normal: Option<&[f64]>,
+        guess: &mut [f64],
+    ) -> std::result::Result<Tangential, SolveError> {
+        // Mindlin's ratio 1/c: w = x_n/c solves the mean problem.
+        let ratio = 2.0 * (1.0 - self.poisson) / (2.0 - self.poisson);
+        if let Some(x_n) = normal {
+            guess.iter_mut().zip(x_n).for_each(|(g, x)| *g = ratio * x);
+        }
+        fn start(warm: bool, guess: &[f64]) -> Start<'_> {
+            if warm {
+                Start::From(guess)
+            } else {
+                Start::Zero
+            }
+        }
+        let warm = normal.is_some();
+        let (info_x, x) = self.direction(0, solver, cg, start(warm, guess))?;
+        if let Some(x_n) = normal {
+            for ((g, x), x_x) in guess.iter_mut().zip(x_n).zip(&self.work.x) {
+                *g = 2.0 * ratio * x - x_x;
+            }
+        }
+        let (info_y, y) = self.direction(1, solver, cg, start(warm, guess))?;
         Ok(Tangential {
             x,
             y,
             info_x,
             info_y,
         })
+    }
+
+    /// `k` along direction `k` (0: x, 1: y) of `solver`'s solved state from `start`.
+    fn direction(
+        &mut self,
+        k: usize,
+        solver: &ContactSolver,
+        cg: &CgParams,
+        start: Start<'_>,
+    ) -> std::result::Result<(SolveInfo, f64), SolveError> {
+        let (pressure, interface, stop) = (&solver.state.pressure, solver.interface, &solver.stop);
+        let normal = &solver.problem.operator;
+        let pixel = normal.spacing() * normal.spacing_y();
+        let warm = matches!(start, Start::From(_)) as usize;
+        crate::pool::on_worker(solver.params.parallelism, || {
+            conjugate_gradient_on_set_from(
+                &mut self.operators[k],
+                &mut self.preconditioners[k],
+                |i| interface.elastic(pressure[i]),
+                (RightHandSide::Ones, start),
+                &mut self.work,
+                (cg, stop),
+            )
+        })
+        .map(|info| {
+            let solve = SolveInfo {
+                iterations: info.iterations,
+                residual: info.residual,
+                operator_applications: info.iterations + warm,
+                energy_transforms: 0,
+            };
+            (solve, info.energy * pixel)
+        })
+        .map_err(SolveError::from)
     }
 }
 
@@ -302,5 +373,68 @@ mod tests {
         }
         let mut t = TangentialStiffness::new(&solver, 0.3).unwrap();
         assert!(t.solve(&solver).is_err());
+    }
+
+    #[test]
+    fn the_two_tangential_kernels_average_to_loves() {
+        // (K^x + K^y)/2 = c K with c = (2 − ν)/(2(1 − ν)), free and periodic, rectangular
+        // pixels: the identity behind the start of the CGs and the bound k_t ≥ Mindlin k.
+        let (rows, cols, spacings, nu) = (20, 24, (0.7, 0.4), 0.3);
+        let c = (2.0 - nu) / (2.0 * (1.0 - nu));
+        let load: Vec<f64> = (0..rows * cols)
+            .map(|i| ((i * 7919) % 113) as f64 / 113.0 - 0.3)
+            .collect();
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            let mut normal =
+                ElasticOperator::with_spacings(rows, cols, spacings.0, spacings.1, 1.3, boundary)
+                    .unwrap();
+            let tangential = |d| {
+                ElasticOperator::tangential((rows, cols), spacings, 1.3, boundary, (nu, d)).unwrap()
+            };
+            let (mut kx, mut ky) = (tangential(Direction::X), tangential(Direction::Y));
+            let mut u = [
+                vec![0.0; rows * cols],
+                vec![0.0; rows * cols],
+                vec![0.0; rows * cols],
+            ];
+            normal.apply(&load, &mut u[0]);
+            kx.apply(&load, &mut u[1]);
+            ky.apply(&load, &mut u[2]);
+            let scale = u[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for ((n, x), y) in u[0].iter().zip(&u[1]).zip(&u[2]) {
+                let mean = 0.5 * (x + y);
+                assert!((mean - c * n).abs() < 1e-12 * scale, "{boundary:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_warm_start_gives_the_cold_stiffnesses_in_fewer_iterations() {
+        let surface = crate::bem::polonsky_keer::tests::rough(64, 5);
+        let half_space = HalfSpace::default();
+        let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+        let mut warm = TangentialStiffness::new(&solver, 0.3).unwrap();
+        let mut cold = TangentialStiffness::new(&solver, 0.3)
+            .unwrap()
+            .with_warm_start(false);
+        let (mut warm_iterations, mut cold_iterations) = (0, 0);
+        for p in [0.005, 0.02, 0.08] {
+            solver.solve(Control::MeanPressure(p)).unwrap();
+            let (k, _) = solver.frozen_set_stiffness().unwrap();
+            let (w, c) = (warm.solve(&solver).unwrap(), cold.solve(&solver).unwrap());
+            assert!((w.x / c.x - 1.0).abs() < 1e-9, "{} {}", w.x, c.x);
+            assert!((w.y / c.y - 1.0).abs() < 1e-9, "{} {}", w.y, c.y);
+            // Mindlin's ratio is a lower bound of the mean (operator convexity).
+            assert!((w.x + w.y) / (2.0 * k) >= mindlin(0.3) * (1.0 - 1e-9));
+            assert_eq!(w.info_x.operator_applications, w.info_x.iterations + 1);
+            warm_iterations += w.info_x.iterations + w.info_y.iterations + 2;
+            cold_iterations += c.info_x.iterations + c.info_y.iterations;
+        }
+        eprintln!("operator applications: warm {warm_iterations}, cold {cold_iterations}");
+        assert!(warm_iterations < cold_iterations);
+        // Without a frozen-set solution of the state (a new solve used it up): from zero.
+        solver.solve(Control::MeanPressure(0.01)).unwrap();
+        let w = warm.solve(&solver).unwrap();
+        assert_eq!(w.info_x.operator_applications, w.info_x.iterations);
     }
 }

@@ -153,6 +153,17 @@ pub(crate) enum RightHandSide<'a> {
     Values(&'a [f64]),
 }
 
+/// Where a CG on a set starts.
+#[derive(Clone, Copy)]
+pub(crate) enum Start<'a> {
+    /// `x₀ = 0` (`r₀ = b`).
+    Zero,
+    /// `x₀` given (read on the set only): one more operator application for
+    /// `r₀ = b − K x₀`; the energy is then `bᵀx₀ + x₀ᵀr₀` plus the CG's sum for the
+    /// correction (`bᵀx = bᵀx₀ + x₀ᵀr₀ + r₀ᵀK⁻¹r₀` with `K` symmetric).
+    From(&'a [f64]),
+}
+
 /// The fields of a CG on a set, allocated once for a grid.
 pub(crate) struct CgWork {
     /// The CG's unknown: the solution, zero off the set, after a solve.
@@ -225,7 +236,8 @@ const ENERGY_DELAY: usize = 4;
 /// needs no more: its CG stops when `k` is known to the estimate's precision, where the
 /// residual criterion would go on until `x` is.
 struct EnergyEstimate {
-    /// `Σ α_i r_iᵀz_i` so far, `bᵀx_j` in exact arithmetic.
+    /// `Σ α_i r_iᵀz_i` so far (after the base of a given start, [`Start::From`]), `bᵀx_j`
+    /// in exact arithmetic.
     total: f64,
     /// The last [`ENERGY_DELAY`] terms (cyclic).
     recent: [f64; ENERGY_DELAY],
@@ -233,9 +245,10 @@ struct EnergyEstimate {
 }
 
 impl EnergyEstimate {
-    fn new() -> Self {
+    /// From `bᵀx₀ + x₀ᵀr₀` (zero from `x₀ = 0`).
+    fn new(base: f64) -> Self {
         EnergyEstimate {
-            total: 0.0,
+            total: base,
             recent: [0.0; ENERGY_DELAY],
             steps: 0,
         }
@@ -253,6 +266,38 @@ impl EnergyEstimate {
     fn converged(&self, relative: f64) -> bool {
         self.steps >= ENERGY_DELAY && self.recent.iter().sum::<f64>() <= relative * self.total.abs()
     }
+}
+
+/// `x = x₀`, `r = b − K x₀` on the set (zero off it), from `x₀` given ([`Start::From`]);
+/// returns `‖b‖²`, `‖r₀‖²` and the energy base `bᵀx₀ + x₀ᵀr₀`.
+fn start_from<A: HalfSpaceOperator + ?Sized>(
+    operator: &mut A,
+    work: &mut CgWork,
+    rhs: RightHandSide<'_>,
+    x0: &[f64],
+) -> (f64, f64, f64) {
+    let bb = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
+    let CgWork {
+        x,
+        residual,
+        response,
+        set,
+        ..
+    } = work;
+    for &i in set.iter() {
+        x[i] = x0[i];
+    }
+    operator.apply(x, response);
+    for &i in set.iter() {
+        residual[i] -= response[i];
+    }
+    let rr = sum4(set.len(), |k| residual[set[k]] * residual[set[k]]);
+    // bᵀx₀ = (r₀ + K x₀)ᵀx₀ on the set.
+    let base = sum4(set.len(), |k| {
+        let i = set[k];
+        x[i] * (2.0 * residual[i] + response[i])
+    });
+    (bb, rr, base)
 }
 
 /// `x = 0`, `r = b` on the set (zero off it); returns `‖b‖²`.
@@ -353,6 +398,31 @@ where
     A: HalfSpaceOperator + ?Sized,
     M: Preconditioner + ?Sized,
 {
+    let problem = (rhs, Start::Zero);
+    conjugate_gradient_on_set_from(
+        operator,
+        preconditioner,
+        in_set,
+        problem,
+        work,
+        (params, stop),
+    )
+}
+
+/// [`conjugate_gradient_on_set`] from `start`: with [`Start::From`] an initial guess `x₀`
+/// (one more operator application; the energy and its estimate as from zero).
+pub(crate) fn conjugate_gradient_on_set_from<A, M>(
+    operator: &mut A,
+    preconditioner: &mut M,
+    in_set: impl Fn(usize) -> bool,
+    (rhs, start): (RightHandSide<'_>, Start<'_>),
+    work: &mut CgWork,
+    (params, stop): (&CgParams, &Stop),
+) -> Result<CgInfo, CgError>
+where
+    A: HalfSpaceOperator + ?Sized,
+    M: Preconditioner + ?Sized,
+{
     let n = work.x.len();
     assert_eq!(n, operator.len(), "the CG's fields are for another grid");
     work.set.clear();
@@ -365,7 +435,13 @@ where
         on_set.fill(false);
         work.set.iter().for_each(|&i| on_set[i] = true);
     }
-    let result = iterate_on_set(operator, (preconditioner, rings), rhs, work, (params, stop));
+    let result = iterate_on_set(
+        operator,
+        (preconditioner, rings),
+        (rhs, start),
+        work,
+        (params, stop),
+    );
     work.rings = taken;
     result
 }
@@ -374,7 +450,7 @@ where
 fn iterate_on_set<A, M>(
     operator: &mut A,
     (preconditioner, mut rings): (&mut M, Option<&mut (RingExtension, Vec<bool>)>),
-    rhs: RightHandSide<'_>,
+    (rhs, start): (RightHandSide<'_>, Start<'_>),
     work: &mut CgWork,
     limits: (&CgParams, &Stop),
 ) -> Result<CgInfo, CgError>
@@ -382,8 +458,14 @@ where
     A: HalfSpaceOperator + ?Sized,
     M: Preconditioner + ?Sized,
 {
-    let mut rr = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
-    let b_norm = rr.sqrt();
+    let (bb, mut rr, base) = match start {
+        Start::Zero => {
+            let bb = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
+            (bb, bb, 0.0)
+        }
+        Start::From(x0) => start_from(operator, work, rhs, x0),
+    };
+    let b_norm = bb.sqrt();
     let mut rz = precondition_on_set(
         preconditioner,
         rings.as_deref_mut(),
@@ -396,7 +478,7 @@ where
         work.direction[i] = work.preconditioned[i];
     }
     let mut iterations = 0;
-    let mut energy = EnergyEstimate::new();
+    let mut energy = EnergyEstimate::new(base);
     loop {
         let relative = if b_norm > 0.0 {
             rr.sqrt() / b_norm

@@ -170,6 +170,14 @@ impl ContactSolver {
         result.map(|(info, ones_x)| (ones_x * dx * dy, info))
     }
 
+    /// The frozen-set solution `x = K_SS⁻¹ 1_S` of the solved state (zero off the set), if
+    /// the last frozen-set stiffness left it and no solve has used it since: the start of
+    /// the tangential CGs (`tangential.rs`).
+    pub(crate) fn frozen_set_solution(&self) -> Option<&[f64]> {
+        let work = self.stiffness_work.as_ref()?;
+        (work.tangent && self.state.solved.is_some()).then_some(&work.cg.x[..])
+    }
+
     /// The continuation predictor of a warm start: if the last frozen-set stiffness left
     /// the tangent `x = dp/dd = K_SS⁻¹ 1_S` of the solved state (and no solve used it
     /// yet), `p ← max(p + Δd x, 0)` with `Δd` the step to `target` (load control: the
