@@ -2,6 +2,7 @@
 //! and pull-offs on a sphere, and its refusals.
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use ndarray::Array2;
 use ndarray_npy::write_npy;
@@ -21,30 +22,35 @@ fn sphere(dir: &Path) -> PathBuf {
     path
 }
 
+/// w for JKR's force-controlled pull-off radius a_c = 0.1 (20 pixels) on the sphere:
+/// w = 8 a_c³ E*/(9π R) with R = E* = 1.
+fn work_of_adhesion() -> f64 {
+    8.0 * 0.1f64.powi(3) / (9.0 * std::f64::consts::PI)
+}
+
+/// `bem --work-of-adhesion` on the sphere along 10 indentations up to 0.015625, with the
+/// `extra` flags, into `csv`.
+fn adhesive_run(dir: &Path, csv: &Path, extra: &[&str]) -> Output {
+    let s = sphere(dir);
+    let path: Vec<String> = (1..=10)
+        .map(|k| format!("{}", 0.015625 * k as f64 / 10.0))
+        .collect();
+    let (w, path) = (work_of_adhesion().to_string(), path.join(","));
+    let mut args = vec!["bem", "--surface", s.to_str().unwrap(), "--size", "0.32"];
+    args.extend(["--work-of-adhesion", &w]);
+    args.extend_from_slice(extra);
+    args.extend(["--indentations", &path, "--out", csv.to_str().unwrap()]);
+    asperity(&args)
+}
+
 #[test]
 fn a_sphere_gives_the_loop_and_jkrs_pull_off_to_the_criterions_accuracy() {
     // w chosen so that JKR's force-controlled pull-off radius is a_c = 0.1 = 20 pixels: the
     // criterion's first-order error there is +6.9 % (library tests), checked here to 8 %.
     let dir = tempfile::tempdir().unwrap();
-    let s = sphere(dir.path());
     let csv = dir.path().join("loop.csv");
-    let w = 8.0 * 0.1f64.powi(3) / (9.0 * std::f64::consts::PI);
-    let path: Vec<String> = (1..=10)
-        .map(|k| format!("{}", 0.015625 * k as f64 / 10.0))
-        .collect();
-    let out = asperity(&[
-        "bem",
-        "--surface",
-        s.to_str().unwrap(),
-        "--size",
-        "0.32",
-        "--work-of-adhesion",
-        &w.to_string(),
-        "--indentations",
-        &path.join(","),
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
+    let w = work_of_adhesion();
+    let out = adhesive_run(dir.path(), &csv, &[]);
     ok(&out);
     assert!(
         stderr(&out).contains("pull-off: force control F = "),
@@ -82,28 +88,11 @@ fn a_cohesive_zone_gives_maugis_pull_off() {
     // unit stress): the library measures +1.78 % against Maugis's −1.6007πwR at 20 pixels
     // (with a finer retraction step); checked to 3 %, and the record names the model.
     let dir = tempfile::tempdir().unwrap();
-    let s = sphere(dir.path());
     let csv = dir.path().join("md.csv");
-    let w = 8.0 * 0.1f64.powi(3) / (9.0 * std::f64::consts::PI);
+    let w = work_of_adhesion();
     let unit_lambda = 2.0 * (1.0 / (std::f64::consts::PI * w * (4.0f64 / 3.0).powi(2))).cbrt();
-    let path: Vec<String> = (1..=10)
-        .map(|k| format!("{}", 0.015625 * k as f64 / 10.0))
-        .collect();
-    let out = asperity(&[
-        "bem",
-        "--surface",
-        s.to_str().unwrap(),
-        "--size",
-        "0.32",
-        "--work-of-adhesion",
-        &w.to_string(),
-        "--adhesion-range",
-        &(w * unit_lambda).to_string(),
-        "--indentations",
-        &path.join(","),
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
+    let range = (w * unit_lambda).to_string();
+    let out = adhesive_run(dir.path(), &csv, &["--adhesion-range", &range]);
     ok(&out);
     let record: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("md.csv.json")).unwrap())

@@ -45,6 +45,16 @@ fn json(path: &Path) -> serde_json::Value {
 
 /// Refused: status 2, one line on stderr containing `needle`, no files left in `dir`
 /// besides `keep`.
+/// The rows of a CSV of numbers whose header is `header`.
+fn numeric_csv(path: &Path, header: &str) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(header));
+    lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
 fn assert_refused(out: &Output, dir: &Path, keep: &[&str], needle: &str) {
     let err = refused(out, needle);
     let left: Vec<String> = names(dir)
@@ -153,12 +163,7 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
         "b.csv",
     ];
     ok(&asperity(&args, dir.path()));
-    let text = std::fs::read_to_string(dir.path().join("b.csv")).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("material_ratio,height"));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let rows = numeric_csv(&dir.path().join("b.csv"), "material_ratio,height");
     assert_eq!(rows.len(), 101);
     for (k, row) in rows.iter().enumerate() {
         let p = k as f64 / 100.0;
@@ -172,12 +177,7 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
     // A(k Δx) = k²/2, with Δx = 1/16.
     let args = ["stats", "ramp.npy", "--size", "1", "--acf", "acf.csv"];
     ok(&asperity(&args, dir.path()));
-    let text = std::fs::read_to_string(dir.path().join("acf.csv")).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("distance,acf"));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let rows = numeric_csv(&dir.path().join("acf.csv"), "distance,acf");
     assert_eq!(rows.len(), 16);
     for (k, row) in rows.iter().enumerate() {
         let want = 0.5 * (k * k) as f64;
