@@ -110,27 +110,7 @@ impl ContactSolver {
             g_old = pass.gap_squared;
             iteration += 1;
 
-            self.problem.operator.apply(&pk.direction, &mut pk.response);
-            let tau = step_length(
-                interface,
-                &self.state.pressure,
-                &self.state.gap,
-                &pk.direction,
-                &pk.response,
-                load_control,
-                pass.moving_points,
-            );
-            // Penetrating points enter with p = −τ g; before any step exists (empty
-            // set), a Jacobi step with the self-influence.
-            let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
-            let (total, entered) = update_pressure(
-                interface,
-                &mut self.state.pressure,
-                &self.state.gap,
-                &pk.direction,
-                tau,
-                entry_step,
-            );
+            let (total, entered) = self.pk_step(pk, load_control, pass.moving_points);
             // Pass E: the prescribed load (a reset pressure restarts the directions).
             let restoration = self.restore_load(target, total);
             conjugate = !entered && restoration != CappedRestoration::Restarted;
@@ -144,6 +124,39 @@ impl ContactSolver {
                 });
             }
         }
+    }
+
+    /// One step along `pk.direction`: its response, the step length τ, and the pressure
+    /// update (penetrating points enter with p = −τ g; before any step exists, the empty
+    /// set, a Jacobi step with the self-influence). Returns the pressures' sum and whether
+    /// points entered.
+    fn pk_step(
+        &mut self,
+        pk: &mut PkScratch,
+        load_control: bool,
+        moving_points: usize,
+    ) -> (f64, bool) {
+        let interface = self.interface;
+        self.problem.operator.apply(&pk.direction, &mut pk.response);
+        let tau = step_length(
+            interface,
+            &self.state.pressure,
+            &self.state.gap,
+            &pk.direction,
+            &pk.response,
+            load_control,
+            moving_points,
+        );
+        let self_influence = self.problem.operator.self_influence();
+        let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
+        update_pressure(
+            interface,
+            &mut self.state.pressure,
+            &self.state.gap,
+            &pk.direction,
+            tau,
+            entry_step,
+        )
     }
 
     /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
