@@ -2,6 +2,7 @@
 repository) and a runner that returns its stdout and stderr."""
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -44,6 +45,18 @@ def cli_error(result) -> str:
     return lines[0][len("error: "):]
 
 
+def _default_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+#: Popen keywords for a child that a test interrupts: it starts with SIGINT at its default,
+#: so that Python installs its KeyboardInterrupt handler even where this suite runs with
+#: SIGINT ignored (a background job of a non-interactive shell, `nohup … &`), which the
+#: child would otherwise inherit and keep.
+INTERRUPTIBLE = {"preexec_fn": _default_sigint}
+
+
 def python_script(code: str, *args, env=None, **kwargs):
-    """Runs `code` in a fresh interpreter (the test's own Python)."""
-    return subprocess.Popen([sys.executable, "-c", code, *map(str, args)], env=env, **kwargs)
+    """Runs `code` in a fresh interpreter (the test's own Python), interruptible by SIGINT."""
+    return subprocess.Popen([sys.executable, "-c", code, *map(str, args)], env=env,
+                            **INTERRUPTIBLE, **kwargs)

@@ -16,7 +16,7 @@ import pytest
 import asperity
 from asperity import _float64
 
-from conftest import cli_error
+from conftest import INTERRUPTIBLE, cli_error
 
 
 @pytest.fixture(scope="module")
@@ -275,7 +275,8 @@ except KeyboardInterrupt:
 print("finished")
 """
     process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+                               stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                               **INTERRUPTIBLE)
     assert process.stdout.readline().strip() == "running", process.stderr.read()
     start = time.monotonic()
     process.send_signal(signal.SIGINT)
@@ -308,7 +309,8 @@ except KeyboardInterrupt:
 print("finished")
 """
     process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+                               stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                               **INTERRUPTIBLE)
     assert process.stdout.readline().strip() == "running", process.stderr.read()
     time.sleep(1.0)  # well inside the solve
     start = time.monotonic()

@@ -17,7 +17,7 @@ import pytest
 
 import asperity
 
-from conftest import cli_path
+from conftest import INTERRUPTIBLE, cli_path
 
 
 def checkpoint_samples(folder: Path) -> int:
@@ -223,7 +223,7 @@ print("finished", flush=True)
 """
     # cwd: not python/, whose asperity/ source folder would shadow the installed package.
     process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, cwd=tmp_path,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True, **INTERRUPTIBLE)
     assert process.stdout.readline().strip() == "running", process.stderr.read()
     assert checkpoint_samples(folder) > 0
     start = time.monotonic()
