@@ -3,37 +3,10 @@
 
 use ndarray::{Array2, ArrayView2};
 
-/// The number of 4-connected components of the `true` points of `set`.
+/// The number of 4-connected components of the `true` points of `set`: the patches that
+/// [`label_patches`] labels.
 pub fn count_patches(set: ArrayView2<bool>) -> usize {
-    let (rows, cols) = set.dim();
-    let mut seen = vec![false; rows * cols];
-    let mut stack = Vec::new();
-    let mut patches = 0;
-    for start in 0..rows * cols {
-        if seen[start] || !set[(start / cols, start % cols)] {
-            continue;
-        }
-        patches += 1;
-        seen[start] = true;
-        stack.push(start);
-        // Depth-first flood fill over the patch (an explicit stack: no recursion depth).
-        while let Some(i) = stack.pop() {
-            let (r, c) = (i / cols, i % cols);
-            let around = [
-                (c > 0).then(|| i - 1),
-                (c + 1 < cols).then(|| i + 1),
-                (r > 0).then(|| i - cols),
-                (r + 1 < rows).then(|| i + cols),
-            ];
-            for j in around.into_iter().flatten() {
-                if !seen[j] && set[(j / cols, j % cols)] {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            }
-        }
-    }
-    patches
+    label_patches(set).1.len()
 }
 
 /// The 4-connected patches of the `true` points of `set`: a label per point (0 outside
@@ -54,6 +27,7 @@ pub fn label_patches(set: ArrayView2<bool>) -> (Array2<u32>, Vec<usize>) {
         let mut size = 0;
         labels[at] = label;
         stack.push(start);
+        // Depth-first flood fill over the patch (an explicit stack: no recursion depth).
         while let Some(i) = stack.pop() {
             size += 1;
             let (r, c) = (i / cols, i % cols);
