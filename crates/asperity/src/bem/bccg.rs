@@ -77,8 +77,8 @@ use super::capped_load::LOST_SET_LIMIT;
 use super::interface::{restore_capped_load, Interface};
 use super::mean_gap::MeanGapScratch;
 use super::plastic_field::{PlasticField, Restored};
-use super::preconditioner::Real;
-use super::ring_extension::{centre_on_set, RingExtension};
+use super::preconditioner::Preconditioner;
+use super::ring_extension::{RingExtension, Ringed};
 use super::small_set::SmallSetRun;
 use super::solver::{ContactSolver, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
@@ -830,26 +830,21 @@ impl ContactSolver {
     }
 
     /// z = P_F M Π g into the preconditioned buffer, or with the rings
-    /// P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`), Π g formed row by row on its way
-    /// into the transform (never stored whole).
+    /// P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`, [`Ringed`] decorating the Fourier
+    /// preconditioner), Π g formed row by row on its way into the transform (never stored
+    /// whole).
     fn precondition_gradient(&mut self, centre: f64) {
         let scratch = &mut self.bccg_scratch;
-        let cols = self.problem.cols;
-        if let Some(rings) = scratch.rings.as_mut() {
-            rings.extend(&scratch.free, &mut scratch.gradient, centre);
-        }
-        let (free, z) = (&scratch.free[..], &mut scratch.preconditioned);
-        let centre = Real::rounded(centre);
-        let centred = |i: usize, row: &mut [Real]| {
-            let free = &free[i * cols..][..cols];
-            for (v, &f) in row.iter_mut().zip(free) {
-                *v -= centre_on_set(centre, f);
+        let (free, gradient) = (&scratch.free[..], &mut scratch.gradient[..]);
+        let (z, centred) = (&mut scratch.preconditioned[..], (free, centre));
+        match scratch.rings.as_mut() {
+            Some(rings) => Ringed {
+                inner: &mut self.preconditioner,
+                rings,
+                set: free,
             }
-        };
-        self.preconditioner
-            .apply_prepared(&scratch.gradient, z, centred);
-        if let Some(rings) = scratch.rings.as_mut() {
-            rings.gather(free, z);
+            .apply_centred(gradient, z, centred),
+            None => self.preconditioner.apply_centred(gradient, z, centred),
         }
     }
 

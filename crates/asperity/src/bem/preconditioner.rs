@@ -29,6 +29,7 @@
 //! nothing and does not depend on the thread count (it runs [`RealFft2`]).
 
 use std::f64::consts::PI;
+use std::ops::SubAssign;
 
 use num_complex::Complex;
 
@@ -112,21 +113,78 @@ impl<T: Precision> FourierPreconditioner<T> {
 /// An approximate inverse `M ≈ K⁻¹` of a [`crate::elastic::HalfSpaceOperator`], as the
 /// conjugate gradients use it: it maps a residual (a displacement) to a search direction (a
 /// load). Symmetric positive definite; allocates nothing; independent of the thread count.
+///
+/// [`FourierPreconditioner`] is the one made from a symbol; the rings around a set
+/// (`ring_extension.rs`, [`super::ring_extension::Ringed`]) decorate any preconditioner,
+/// and the BCCG and the CG on a set take either.
 pub(crate) trait Preconditioner {
     /// `output ← M input` (`rows × cols` row-major fields).
     fn apply_into(&mut self, input: &[f64], output: &mut [f64]);
 
     /// `data ← M data` (overwritten).
     fn apply(&mut self, data: &mut [f64]);
+
+    /// `output ← M x` for the field `x` that is `input − centre` on the set (`set[i]`) and
+    /// `input` off it: the BCCG's centring `Π` on its free set, formed on the way into
+    /// the transform (never stored). A decorator may write into `input` off the set (the
+    /// rings put their extension there); on the set `input` is kept.
+    fn apply_centred(&mut self, input: &mut [f64], output: &mut [f64], centred: (&[bool], f64));
 }
 
-impl<T: Precision> Preconditioner for FourierPreconditioner<T> {
+impl<T: Precision + Masked + SubAssign> Preconditioner for FourierPreconditioner<T> {
     fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
         FourierPreconditioner::apply_into(self, input, output);
     }
 
     fn apply(&mut self, data: &mut [f64]) {
         FourierPreconditioner::apply(self, data);
+    }
+
+    /// The centring is made in `T` row by row on the way into the transform.
+    fn apply_centred(
+        &mut self,
+        input: &mut [f64],
+        output: &mut [f64],
+        (set, centre): (&[bool], f64),
+    ) {
+        let cols = self.fft.cols();
+        let centre = T::rounded(centre);
+        let centred = |i: usize, row: &mut [T]| {
+            let set = &set[i * cols..][..cols];
+            for (v, &on_set) in row.iter_mut().zip(set) {
+                *v -= centre_on_set(centre, on_set);
+            }
+        };
+        self.apply_prepared(input, output, centred);
+    }
+}
+
+/// What the centring `Π` subtracts from a value of a gradient field: `centre` on the set
+/// (`on_set`), +0 off it (`v − 0 = v`), chosen by a mask of its bits, not a branch (which
+/// would be mispredicted at every edge of the set). In double precision, or in the
+/// preconditioner's single.
+#[inline(always)]
+pub(super) fn centre_on_set<T: Masked>(centre: T, on_set: bool) -> T {
+    centre.kept(on_set)
+}
+
+/// Floating-point values that can be kept or zeroed by a mask of their bits.
+pub(super) trait Masked: Copy {
+    /// `self` if `keep`, else +0.
+    fn kept(self, keep: bool) -> Self;
+}
+
+impl Masked for f64 {
+    #[inline(always)]
+    fn kept(self, keep: bool) -> Self {
+        f64::from_bits(self.to_bits() & u64::from(keep).wrapping_neg())
+    }
+}
+
+impl Masked for f32 {
+    #[inline(always)]
+    fn kept(self, keep: bool) -> Self {
+        f32::from_bits(self.to_bits() & u32::from(keep).wrapping_neg())
     }
 }
 

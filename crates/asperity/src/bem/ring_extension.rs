@@ -38,6 +38,7 @@
 
 use rayon::prelude::*;
 
+use super::preconditioner::{centre_on_set, Preconditioner};
 use crate::elastic::{Boundary, ElasticOperator};
 
 /// Weights of the first and the second ring (measured, see the module docs).
@@ -177,35 +178,6 @@ fn within((rows, _, periodic): Grid, i: usize, reach: usize, test: impl Fn(usize
         true if 2 * reach + 1 >= rows => (0..rows).any(test),
         true => (rows + i - reach..=rows + i + reach).any(|r| test(r % rows)),
         false => (i.saturating_sub(reach)..=(i + reach).min(rows - 1)).any(test),
-    }
-}
-
-/// What the centring `Π` subtracts from a value of a gradient field: `centre` on the set
-/// (`on_set`), +0 off it (`v − 0 = v`), chosen by a mask of its bits, not a branch (which
-/// would be mispredicted at every edge of the set). In double precision, or in the
-/// preconditioner's single.
-#[inline(always)]
-pub(super) fn centre_on_set<T: Masked>(centre: T, on_set: bool) -> T {
-    centre.kept(on_set)
-}
-
-/// Floating-point values that can be kept or zeroed by a mask of their bits.
-pub(super) trait Masked: Copy {
-    /// `self` if `keep`, else +0.
-    fn kept(self, keep: bool) -> Self;
-}
-
-impl Masked for f64 {
-    #[inline(always)]
-    fn kept(self, keep: bool) -> Self {
-        f64::from_bits(self.to_bits() & u64::from(keep).wrapping_neg())
-    }
-}
-
-impl Masked for f32 {
-    #[inline(always)]
-    fn kept(self, keep: bool) -> Self {
-        f32::from_bits(self.to_bits() & u32::from(keep).wrapping_neg())
     }
 }
 
@@ -384,6 +356,51 @@ impl RingExtension {
             let ring = |m: usize| if first[m] > 0 { z[m] } else { 0.0 };
             z[i * cols + j] + around(grid, (i, j), ring)
         });
+    }
+}
+
+/// A preconditioner `M` decorated with the rings of a set: `(I + E)ᵀ M (I + E)` on it (the
+/// module docs), itself a [`Preconditioner`]. The BCCG decorates the Fourier
+/// preconditioner with the rings of its free set, the CG on a set with those of its set;
+/// any other preconditioner takes them alike. Nothing is allocated: the decorator borrows
+/// the preconditioner, the rings' fields and the set's mask for one application.
+pub(super) struct Ringed<'a, M: ?Sized> {
+    /// The preconditioner decorated.
+    pub(super) inner: &'a mut M,
+    /// The rings' counts, lists and scratch.
+    pub(super) rings: &'a mut RingExtension,
+    /// The set, as a mask of the grid.
+    pub(super) set: &'a [bool],
+}
+
+impl<M: Preconditioner + ?Sized> Preconditioner for Ringed<'_, M> {
+    /// `output ← input`, then [`Preconditioner::apply`] in place.
+    fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
+        output.copy_from_slice(input);
+        self.apply(output);
+    }
+
+    /// `data ← (I + E)ᵀ M (I + E) data` on the set (`data` zero off it before; read on the
+    /// set only after).
+    fn apply(&mut self, data: &mut [f64]) {
+        self.rings.extend(self.set, data, 0.0);
+        self.inner.apply(data);
+        self.rings.gather(self.set, data);
+    }
+
+    /// `output ← (I + E)ᵀ M (I + E) Π input` on the decorator's set (which `set` must be):
+    /// the extension of the centred field is written into `input` on the rings (zero
+    /// there before), the centring made by `M` on the way into its transform.
+    fn apply_centred(
+        &mut self,
+        input: &mut [f64],
+        output: &mut [f64],
+        (set, centre): (&[bool], f64),
+    ) {
+        debug_assert!(std::ptr::eq(set, self.set), "the rings' own set");
+        self.rings.extend(self.set, input, centre);
+        self.inner.apply_centred(input, output, (self.set, centre));
+        self.rings.gather(self.set, output);
     }
 }
 
@@ -642,6 +659,62 @@ mod tests {
                         "{left} {right}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn the_ringed_preconditioner_is_symmetric_and_centres_like_its_core() {
+        // The decorator of any preconditioner: (I + E)ᵀ M (I + E) on the set. With the
+        // Fourier M (double precision) it is symmetric on the set (xᵀR y = yᵀR x) and at
+        // least as large as M there would be on the set's fields' extension by zero …
+        use super::super::preconditioner::FourierPreconditioner;
+        for (rows, cols, periodic) in [(31, 31, false), (24, 40, true), (50, 72, false)] {
+            let len = rows * cols;
+            let mut m = FourierPreconditioner::<f64>::new(rows, cols, 0.1, 0.1, 1.3).unwrap();
+            let mut rings = RingExtension::new(rows, cols, periodic);
+            let mut state = 5u64;
+            let (set, x, _) = case(len, 0.3, &mut state);
+            let (_, y, _) = case(len, 0.0, &mut state);
+            let y: Vec<f64> = y
+                .iter()
+                .zip(&set)
+                .map(|(_, &f)| if f { random(&mut state) } else { 0.0 })
+                .collect();
+            let on_set_dot = |a: &[f64], b: &[f64]| -> f64 {
+                (0..len).filter(|&k| set[k]).map(|k| a[k] * b[k]).sum()
+            };
+            let mut ringed = Ringed {
+                inner: &mut m,
+                rings: &mut rings,
+                set: &set,
+            };
+            let (mut rx, mut ry) = (vec![0.0; len], vec![0.0; len]);
+            ringed.apply_into(&x, &mut rx);
+            ringed.apply_into(&y, &mut ry);
+            let (xry, yrx) = (on_set_dot(&x, &ry), on_set_dot(&y, &rx));
+            assert!(
+                (xry - yrx).abs() <= 1e-12 * xry.abs().max(1.0),
+                "{xry} {yrx}"
+            );
+            assert!(on_set_dot(&x, &rx) > 0.0);
+            // … and its centred form is its plain form of the centred field, on the set.
+            let centre = 0.37;
+            let centred: Vec<f64> = x
+                .iter()
+                .zip(&set)
+                .map(|(&v, &f)| if f { v - centre } else { v })
+                .collect();
+            let mut plain = vec![0.0; len];
+            ringed.apply_into(&centred, &mut plain);
+            let (mut input, mut output) = (x.clone(), vec![0.0; len]);
+            ringed.apply_centred(&mut input, &mut output, (&set, centre));
+            for k in (0..len).filter(|&k| set[k]) {
+                assert!(
+                    (plain[k] - output[k]).abs() <= 1e-12 * plain[k].abs().max(1.0),
+                    "{k}"
+                );
+                assert_eq!(input[k], x[k], "the input is kept on the set");
             }
         }
     }

@@ -44,7 +44,7 @@
 //! [`FourierPreconditioner`]: super::super::preconditioner::FourierPreconditioner
 
 use super::super::preconditioner::Preconditioner;
-use super::super::ring_extension::RingExtension;
+use super::super::ring_extension::{RingExtension, Ringed};
 use super::super::SolveError;
 use crate::elastic::HalfSpaceOperator;
 use crate::stop::Stop;
@@ -201,9 +201,9 @@ impl CgWork {
     }
 }
 
-/// `z = M r`, or with the rings `(I + E)ᵀ M (I + E) r` (read on the set only: the CG never
-/// uses `z` off it; `r` is zero off the set); returns `rᵀz` on the set (summed by [`sum4`],
-/// in a fixed order).
+/// `z = M r`, or with the rings `(I + E)ᵀ M (I + E) r` ([`Ringed`] decorating `M`; read on
+/// the set only: the CG never uses `z` off it; `r` is zero off the set); returns `rᵀz` on
+/// the set (summed by [`sum4`], in a fixed order).
 fn precondition_on_set<M: Preconditioner + ?Sized>(
     preconditioner: &mut M,
     rings: Option<&mut (RingExtension, Vec<bool>)>,
@@ -211,12 +211,12 @@ fn precondition_on_set<M: Preconditioner + ?Sized>(
     (residual, z): (&[f64], &mut Vec<f64>),
 ) -> f64 {
     match rings {
-        Some((rings, on_set)) => {
-            z.copy_from_slice(residual);
-            rings.extend(on_set, z, 0.0);
-            preconditioner.apply(z);
-            rings.gather(on_set, z);
+        Some((rings, on_set)) => Ringed {
+            inner: preconditioner,
+            rings,
+            set: on_set,
         }
+        .apply_into(residual, z),
         None => preconditioner.apply_into(residual, z),
     }
     sum4(set.len(), |k| residual[set[k]] * z[set[k]])
@@ -557,6 +557,11 @@ mod tests {
             output.copy_from_slice(input);
         }
         fn apply(&mut self, _: &mut [f64]) {}
+        fn apply_centred(&mut self, x: &mut [f64], y: &mut [f64], (set, c): (&[bool], f64)) {
+            y.iter_mut()
+                .zip(x.iter().zip(set))
+                .for_each(|(y, (&x, &on))| *y = if on { x - c } else { x });
+        }
     }
 
     /// Solves the dense `K_SS x = b_S` by Gaussian elimination (the oracle), with `K` the
