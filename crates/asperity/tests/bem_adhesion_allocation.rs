@@ -4,7 +4,7 @@
 //! `bem_allocation.rs`; one test, so that nothing else allocates while it counts.)
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::cell::Cell;
 
 use asperity::bem::adhesion::PixelAdhesion;
 use asperity::bem::HalfSpace;
@@ -13,18 +13,27 @@ use ndarray::Array2;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+thread_local! {
+    // This thread's allocations, as in bem_allocation.rs: counted per thread so that the
+    // test harness's own threads (its "running for over 60 seconds" warning on a busy
+    // machine once added 4) do not count; const, no destructor: allocation-free to touch.
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn note() {
+    ALLOCATIONS.with(|count| count.set(count.get() + 1));
+}
 
 // SAFETY: forwards every call to the system allocator unchanged; only counts.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        note();
         // SAFETY: the caller's contract for `alloc` is passed on.
         unsafe { System.alloc(layout) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        note();
         // SAFETY: as for `alloc`.
         unsafe { System.alloc_zeroed(layout) }
     }
@@ -35,7 +44,7 @@ unsafe impl GlobalAlloc for Counting {
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        note();
         // SAFETY: as for `dealloc`; `new_size` is the caller's.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -52,6 +61,10 @@ fn moves_allocate_nothing_per_round_or_iteration() {
         .build()
         .expect("a one-thread pool");
     pool.install(|| {
+        // A positive control: the counter sees this thread's allocations.
+        let before = ALLOCATIONS.with(Cell::get);
+        std::hint::black_box(Vec::<u8>::with_capacity(24));
+        assert_eq!(ALLOCATIONS.with(Cell::get) - before, 1);
         let (n, dx) = (48, 5e-3);
         let heights = Array2::from_shape_fn((n, n), |(i, j)| {
             let (y, x) = ((i as f64 - 24.0) * dx, (j as f64 - 24.0) * dx);
@@ -63,9 +76,9 @@ fn moves_allocate_nothing_per_round_or_iteration() {
         let mut counted = Vec::new();
         // A small step (few rounds), a long one (many), a retraction that releases pixels.
         for d in [0.0021, 0.009, 0.002] {
-            let before = ALLOCATIONS.load(Ordering::SeqCst);
+            let before = ALLOCATIONS.with(Cell::get);
             let (_, info) = contact.move_to(d).unwrap();
-            let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
+            let allocations = ALLOCATIONS.with(Cell::get) - before;
             counted.push((allocations, info.rounds, info.cg_iterations));
         }
         let (first, _, _) = counted[0];
