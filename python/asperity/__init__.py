@@ -678,7 +678,10 @@ class ContactResult:
     highest point; periodic: relative to the mean elastic displacement),
     ``area_fraction``, ``contact_points``, ``iterations``, ``residual``; ``pressure``
     (≥ 0), ``gap`` (≥ 0) and ``displacement`` (u = K p, positive into the half-space),
-    rows × cols numpy arrays, or None.
+    rows × cols numpy arrays, or None. Under a hardness H (``Solver(hardness=)``):
+    ``plastic_fraction`` and ``plastic_points`` (the points at p = H; zero for the hard
+    wall), and with the fields ``plastic_displacement`` (−g ≥ 0 at those points, zero
+    elsewhere; in the units of the heights; the gap there is −plastic_displacement).
     """
 
     force: float
@@ -691,6 +694,9 @@ class ContactResult:
     pressure: Optional[np.ndarray] = None
     gap: Optional[np.ndarray] = None
     displacement: Optional[np.ndarray] = None
+    plastic_fraction: float = 0.0
+    plastic_points: int = 0
+    plastic_displacement: Optional[np.ndarray] = None
     #: What produced it: the solver's settings, the surface's identity and the load.
     metadata: Dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -709,9 +715,9 @@ class ContactResult:
                 f"contact_points={self.contact_points}, iterations={self.iterations}{shape})")
 
 
-_CONTACT_FIELDS = ("pressure", "gap", "displacement")
+_CONTACT_FIELDS = ("pressure", "gap", "displacement", "plastic_displacement")
 _CONTACT_SCALARS = ("force", "mean_pressure", "indentation", "area_fraction", "contact_points",
-                    "iterations", "residual")
+                    "iterations", "residual", "plastic_fraction", "plastic_points")
 
 
 @dataclass
@@ -792,6 +798,17 @@ class Solver:
     ``asperity bem --solver``; ``"default"`` is an alias of ``"bccg"``. Both converge to
     the same contact to ``tolerance``.
 
+    ``hardness`` H (``asperity bem --hardness``; in the units of the modulus and the
+    pressures: E* units by default, Pa with a modulus in Pa): the contact pressure is
+    capped at H, elastic–perfectly-plastic contact (docs/hardness.md), with either solver.
+    Results then carry ``plastic_fraction`` (the points at H), solves the
+    ``plastic_displacement`` field, sweeps a ``plastic_fraction`` column, and the
+    stiffness is that of the elastic set 0 < p < H (the loading tangent dF/dd).
+    :meth:`load_path` keeps the plastic displacement between loads (loading, unloading,
+    reloading: hysteresis). A hardness that is not positive and finite raises
+    ``ValueError``; so does a mean pressure (or force over the nominal area) at or above
+    it, before any solve: more than a fully plastic contact can carry.
+
     The solver plans its FFTs once and keeps its buffers: each solve starts from the last
     pressure (warm start), so a rising load sweep is cheap.
 
@@ -804,6 +821,8 @@ class Solver:
         >>> sweep = solver.sweep(nloads=5, pmin=1e-3, pmax=1e-1)
         >>> sweep.area_fraction.shape
         (5,)
+        >>> capped = asperity.Solver(s, boundary="periodic", hardness=0.3)
+        >>> capped.sweep(pressures=[0.01, 0.03]).plastic_fraction      # doctest: +SKIP
     """
 
     def __init__(
@@ -818,6 +837,7 @@ class Solver:
         tolerance: float = _DEFAULTS["tolerance"],
         max_iterations: int = _DEFAULTS["max_iterations"],
         solver: str = _DEFAULTS["solver"],
+        hardness: Optional[float] = None,
     ):
         heights, size_x, size_y = _surface_input(surface, size)
         if modulus is None and young is None and poisson is None:
@@ -829,7 +849,7 @@ class Solver:
             raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
         self._core = _core.Solver(
             heights, size_x, size_y, float(modulus), str(boundary), float(tolerance),
-            int(max_iterations), str(solver),
+            int(max_iterations), str(solver), _opt(hardness),
         )
         self._surface = _surface_identity(surface, heights)
 
@@ -838,6 +858,8 @@ class Solver:
         settings = {"shape": list(self.shape), "size": self.size, "modulus": self.modulus,
                     "boundary": self.boundary, "tolerance": self.tolerance,
                     "max_iterations": self.max_iterations, "solver": self.solver}
+        if self.hardness is not None:
+            settings["hardness"] = self.hardness
         return {"generator": f"asperity {__version__}", "solver": settings,
                 "surface": self._surface, **load}
 
@@ -848,6 +870,8 @@ class Solver:
     tolerance = property(lambda self: self._core.tolerance)
     max_iterations = property(lambda self: self._core.max_iterations)
     solver = property(lambda self: self._core.solver, doc="'bccg' or 'pk'")
+    hardness = property(lambda self: self._core.hardness,
+                        doc="the hardness H capping the pressure (units of E*), or None")
     nominal_area = property(lambda self: self._core.nominal_area, doc="rows·cols·Δ²")
 
     def solve(
@@ -937,6 +961,11 @@ class Solver:
             >>> sweep.force, sweep.stiffness, sweep.area_fraction
             >>> t = solver.sweep(pressures=[0.01], poisson=0.3, resistivity=[1, 1])
             >>> t.tangential_ratio, t.electrical_conductance
+
+        With the solver's ``hardness``: also ``plastic_fraction`` (the CLI's column);
+        each load on the surface as given (:meth:`load_path` keeps the plastic
+        displacement); a mean pressure or force at or above H times the nominal area is
+        refused before the first solve.
         """
         quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields)
         fd = float(fd_step) if fd_stiffness else None
@@ -953,6 +982,52 @@ class Solver:
         return Sweep(columns, self._metadata(loads={"quantity": quantity, "values": values},
                                              stiffness=bool(stiffness), fd_step=fd, **derived))
 
+    def load_path(
+        self,
+        *,
+        pressures: Optional[Sequence[float]] = None,
+        forces: Optional[Sequence[float]] = None,
+        indentations: Optional[Sequence[float]] = None,
+    ) -> Sweep:
+        """A load path (the library's ``load_path``): the loads in the given order --
+        loading, then unloading, then reloading -- each solve warm from the last, and the
+        plastic displacement of each step kept (the surface flattened where it yielded).
+        Unloading is then elastic on the flattened surface, reloading is elastic up to the
+        largest load reached before: force, area and stiffness show the hysteresis. With a
+        ``hardness``; without one the path is elastic and reversible.
+
+        Returns a :class:`Sweep` with one value per step (the columns of ``asperity bem
+        --load-path``, bit for bit): ``branch`` (``"loading"`` beyond every earlier load,
+        ``"unloading"``, ``"reloading"``), ``force``, ``mean_pressure``,
+        ``indentation``, ``area_fraction``, ``plastic_fraction``, ``stiffness`` (frozen
+        elastic set), ``iterations``, ``permanent_max`` (the largest permanent
+        displacement so far), ``contact_points``, ``plastic_points``; and
+        ``permanent_displacement``, the rows × cols permanent displacement after the last
+        step (units of the heights). Each load is checked against the hardness before the
+        first solve, as in :meth:`sweep`.
+
+        The solver keeps the permanent displacement: later solves, sweeps and paths are on
+        the deformed surface (:meth:`permanent_displacement`); a new ``Solver`` starts
+        from the surface as given.
+
+        Example::
+
+            >>> solver = asperity.Solver(s, boundary="periodic", hardness=0.3)
+            >>> path = solver.load_path(pressures=[0.01, 0.03, 0.01, 0.03])
+            >>> path.indentation[2] > path.indentation[0]   # deeper after yielding
+            True
+        """
+        quantity, values = _sweep_loads(pressures, forces, indentations, None, None, None, False)
+        columns = self._core.load_path(quantity, values)
+        columns["branch"] = np.array(columns["branch"])
+        return Sweep(columns, self._metadata(loads={"quantity": quantity, "values": values},
+                                             load_path=True))
+
+    def permanent_displacement(self) -> np.ndarray:
+        """The permanent (plastic) displacement kept by :meth:`load_path` so far, rows ×
+        cols (units of the heights; zeros before any)."""
+        return self._core.permanent_displacement()
+
     def full_contact_threshold(self) -> Dict[str, Optional[float]]:
         """Mean pressure and indentation from which the gap is closed everywhere. On free
         boundaries the first call costs about one solve and forgets the warm start."""
@@ -967,7 +1042,8 @@ class Solver:
         rows, cols = self.shape
         return (
             f"Solver({rows}x{cols}, size={self.size}, modulus={self.modulus}, "
-            f"boundary={self.boundary!r}, solver={self.solver!r})"
+            f"boundary={self.boundary!r}, solver={self.solver!r}"
+            + ("" if self.hardness is None else f", hardness={self.hardness}") + ")"
         )
 
 

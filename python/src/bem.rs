@@ -8,11 +8,13 @@
 //! flag that Ctrl-C sets ([`crate::interrupt`]), so one long solve stops too.
 
 use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepParams, SweepRow};
-use asperity::bem::{ContactSolver, Control, SolveError};
+use asperity::bem::{load_path, ContactSolver, Control, Interface, PathPoint, SolveError};
 use asperity::elastic::Boundary;
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
-use asperity_app::bem::{check_fd_step, ensure_solver_fits, Loads, SolverRequest};
+use asperity_app::bem::{
+    branches, check_capped_loads, check_fd_step, ensure_solver_fits, Loads, SolverRequest,
+};
 use asperity_app::derived::{Derived, Units};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -136,7 +138,7 @@ pub struct Solver {
 #[pymethods]
 impl Solver {
     #[new]
-    #[pyo3(signature = (heights, size_x, size_y, modulus, boundary, tolerance, max_iterations, solver))]
+    #[pyo3(signature = (heights, size_x, size_y, modulus, boundary, tolerance, max_iterations, solver, hardness=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -148,6 +150,7 @@ impl Solver {
         tolerance: f64,
         max_iterations: usize,
         solver: &str,
+        hardness: Option<f64>,
     ) -> PyResult<Self> {
         let request = SolverRequest {
             modulus,
@@ -155,8 +158,10 @@ impl Solver {
             solver: solver.into(),
             tolerance,
             max_iterations,
+            hardness,
         };
-        let (half_space, params) = request.validate().map_err(refused)?;
+        let plan = request.validate().map_err(refused)?;
+        let half_space = plan.half_space;
         for (name, size) in [("size", Some(size_x)), ("size_y", size_y)] {
             if let Some(size) = size.filter(|s| !(s.is_finite() && *s > 0.0)) {
                 return Err(invalid(format!(
@@ -183,8 +188,7 @@ impl Solver {
             None => Surface::new(owned, size_x),
         }
         .map_err(from_error)?;
-        let solver = run_detached(py, |_| ContactSolver::new(&surface, half_space, params))?
-            .map_err(from_solve)?;
+        let solver = run_detached(py, |_| plan.solver(&surface))?.map_err(from_solve)?;
         Ok(Solver {
             solver,
             modulus,
@@ -236,6 +240,20 @@ impl Solver {
         self.solver.params().solver.name()
     }
 
+    /// The hardness that caps the pressure, or `None` (the hard wall).
+    #[getter]
+    fn hardness(&self) -> Option<f64> {
+        match self.solver.interface() {
+            Interface::Hardness { h } => Some(h),
+            _ => None,
+        }
+    }
+
+    /// The permanent displacement kept by load paths so far (zeros before any).
+    fn permanent_displacement<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.solver.permanent_displacement().into_pyarray(py)
+    }
+
     /// Forgets the last solution (the next solve starts cold).
     fn reset(&mut self) {
         self.solver.reset();
@@ -260,6 +278,7 @@ impl Solver {
         fields: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let control = control(quantity, value)?;
+        self.check_capped(&[control])?;
         let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         // No up-front full-contact check here (the CLI's is for sweeps): the library's
         // solve refuses such a load itself, with the same threshold, and a single solve
@@ -267,7 +286,11 @@ impl Solver {
         let (summary, info, state) = run_detached_with(py, &stop, |_| {
             let (summary, info) = solver.solve(control)?;
             let state = if fields { solver.state() } else { None };
-            Ok::<_, SolveError>((summary, info, state))
+            let plastic = match solver.interface() {
+                Interface::HardWall => None,
+                _ => solver.plastic_displacement().filter(|_| fields),
+            };
+            Ok::<_, SolveError>((summary, info, state.map(|s| (s, plastic))))
         })?
         .map_err(from_solve)?;
         let dict = PyDict::new(py);
@@ -276,14 +299,43 @@ impl Solver {
         dict.set_item("indentation", summary.indentation)?;
         dict.set_item("area_fraction", summary.area_fraction)?;
         dict.set_item("contact_points", summary.contact_points)?;
+        dict.set_item("plastic_fraction", summary.plastic_fraction)?;
+        dict.set_item("plastic_points", summary.plastic_points)?;
         dict.set_item("iterations", info.iterations)?;
         dict.set_item("residual", info.residual)?;
-        if let Some(state) = state {
+        if let Some((state, plastic)) = state {
             dict.set_item("pressure", state.pressure.into_pyarray(py))?;
             dict.set_item("gap", state.gap.into_pyarray(py))?;
             dict.set_item("displacement", state.displacement.into_pyarray(py))?;
+            if let Some(w) = plastic {
+                dict.set_item("plastic_displacement", w.into_pyarray(py))?;
+            }
         }
         Ok(dict)
+    }
+
+    /// The library's load path ([`load_path`]): the loads in order (loading, unloading,
+    /// reloading), each warm from the last, the plastic displacement of each kept (the
+    /// solver's surface stays deformed afterwards). Returns the columns and the permanent
+    /// displacement after the last step.
+    fn load_path<'py>(
+        &mut self,
+        py: Python<'py>,
+        quantity: &str,
+        values: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let loads = values
+            .iter()
+            .map(|&v| control(quantity, v))
+            .collect::<PyResult<Vec<_>>>()?;
+        self.check_capped(&loads)?;
+        let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
+        let (points, permanent) = run_detached_with(py, &stop, |_| {
+            let points = load_path(solver, &loads)?;
+            Ok::<_, SolveError>((points, solver.permanent_displacement()))
+        })?
+        .map_err(from_solve)?;
+        path_dict(py, (&values, &points), permanent)
     }
 
     /// Frozen-set stiffness of the last solve: `(k, iterations, residual)`.
@@ -337,6 +389,7 @@ impl Solver {
         }
         let derived =
             Derived::validate(poisson, &resistivity, &thermal_conductivity).map_err(refused)?;
+        self.check_capped(&loads)?;
         let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         let params = SweepParams {
             stiffness,
@@ -357,7 +410,8 @@ impl Solver {
             rows.map(|rows| (rows, (observer.pressures, observer.gaps)))
         })?
         .map_err(sweep_error)?;
-        let dict = columns_dict(py, &rows, params, observer)?;
+        let plastic = self.hardness().is_some();
+        let dict = columns_dict(py, &rows, (params, plastic), observer)?;
         for (k, name) in derived.columns(Units::Model).into_iter().enumerate() {
             let column = rows.iter().map(|r| {
                 let values = derived.values(&derived.row(r, self.modulus));
@@ -369,11 +423,50 @@ impl Solver {
     }
 }
 
+impl Solver {
+    /// Refuses, before any solve, the loads the solver's hardness cannot carry: the rule
+    /// and words of `asperity bem --hardness` ([`check_capped_loads`]), forces over this
+    /// surface's nominal area.
+    fn check_capped(&self, loads: &[Control]) -> PyResult<()> {
+        let area = Some(self.solver.nominal_area());
+        check_capped_loads(self.solver.interface(), loads, area, "").map_err(refused)
+    }
+}
+
+/// A load path's columns ([`PathPoint`]s; the front-end layer's `PATH_COLUMNS`, with
+/// `branch` a list of names, plus `contact_points` and `plastic_points`) and the permanent
+/// displacement after its last step, as numpy arrays.
+fn path_dict<'py>(
+    py: Python<'py>,
+    (values, points): (&[f64], &[PathPoint]),
+    permanent: ndarray::Array2<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    let names: Vec<&str> = branches(values).into_iter().map(|b| b.name()).collect();
+    dict.set_item("branch", names)?;
+    let column = |f: &dyn Fn(&PathPoint) -> f64| PyArray1::from_iter(py, points.iter().map(f));
+    let count = |f: &dyn Fn(&PathPoint) -> usize| {
+        PyArray1::from_iter(py, points.iter().map(|p| f(p) as u64))
+    };
+    dict.set_item("force", column(&|p| p.summary.force))?;
+    dict.set_item("mean_pressure", column(&|p| p.summary.mean_pressure))?;
+    dict.set_item("indentation", column(&|p| p.summary.indentation))?;
+    dict.set_item("area_fraction", column(&|p| p.summary.area_fraction))?;
+    dict.set_item("plastic_fraction", column(&|p| p.summary.plastic_fraction))?;
+    dict.set_item("stiffness", column(&|p| p.stiffness))?;
+    dict.set_item("iterations", count(&|p| p.iterations))?;
+    dict.set_item("permanent_max", column(&|p| p.permanent_max))?;
+    dict.set_item("contact_points", count(&|p| p.summary.contact_points))?;
+    dict.set_item("plastic_points", count(&|p| p.summary.plastic_points))?;
+    dict.set_item("permanent_displacement", permanent.into_pyarray(py))?;
+    Ok(dict)
+}
+
 /// The sweep's columns (as the CLI's CSV, plus `contact_points`) as numpy arrays.
 fn columns_dict<'py>(
     py: Python<'py>,
     rows: &[SweepRow],
-    params: SweepParams,
+    (params, plastic): (SweepParams, bool),
     (pressures, gaps): (Vec<ndarray::Array2<f64>>, Vec<ndarray::Array2<f64>>),
 ) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
@@ -389,6 +482,9 @@ fn columns_dict<'py>(
     }
     dict.set_item("iterations", count(&|r| r.info.iterations))?;
     dict.set_item("residual", column(&|r| r.info.residual))?;
+    if plastic {
+        dict.set_item("plastic_fraction", column(&|r| r.summary.plastic_fraction))?;
+    }
     if params.fd_step.is_some() {
         // NaN at indentation 0 (no central difference there), as the CLI's empty cell.
         dict.set_item(

@@ -122,6 +122,25 @@ BEM = [
      dict(pressures=[0.01], thermal_conductivity=[1, NAN]),
      "invalid thermal_conductivity: each body's thermal conductivity must be positive and "
      "finite, got NaN"),
+    # The hardness (Solver(hardness=)): positive and finite; no load at or above it, the
+    # mean pressures and (over the 1×1 nominal area) the forces, before any solve.
+    (["--pressures", "0.01", "--hardness", "0"], dict(hardness=0), None,
+     "hardness must be positive and finite, got 0"),
+    (["--pressures", "0.01", "--hardness=-1"], dict(hardness=-1), None, "got -1"),
+    (["--pressures", "0.01", "--hardness", "nan"], dict(hardness=NAN), None, "got NaN"),
+    (["--pressures", "0.01", "--hardness", "inf"], dict(hardness=INF), None, "got inf"),
+    (["--pressures", "0.01,0.3", "--hardness", "0.3"], dict(hardness=0.3),
+     dict(pressures=[0.01, 0.3]),
+     "a mean pressure of 0.3 is at or above the hardness 0.3: more than a fully plastic "
+     "contact can carry (lower it or raise hardness)"),
+    (["--nloads", "3", "--pmin", "0.1", "--pmax", "0.5", "--hardness", "0.4"],
+     dict(hardness=0.4), dict(nloads=3, pmin=0.1, pmax=0.5), "a mean pressure of 0.5 is"),
+    (["--forces", "0.01,0.5", "--hardness", "0.3"], dict(hardness=0.3),
+     dict(forces=[0.01, 0.5]),
+     "a force of 0.5 (a mean pressure of 0.5) is at or above the hardness 0.3"),
+    (["--pressures", "0.01", "--hardness", "0.3", "--solver", "pk", "--poisson", "0.7"],
+     dict(hardness=0.3, solver="pk"), dict(pressures=[0.01], poisson=0.7),
+     "poisson must be in [0, 0.5]"),
 ]
 
 # asperity contact: (flags, keywords, expected words in keywords).

@@ -2,7 +2,7 @@
 //! of a sweep ([`Loads`]) and the whole request ([`BemRequest`]), each validated once.
 
 use asperity::bem::sweep::SweepParams;
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
+use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverKind, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::fit::log_levels;
 use asperity::input::short_number;
@@ -42,6 +42,8 @@ pub mod params {
     pub const FD_STIFFNESS: Param = Param::new("--fd-stiffness", "fd_stiffness");
     /// Its relative step (the CLI's is [`super::FD_STEP`]).
     pub const STEP: Param = Param::new("--fd-step", "fd_step");
+    /// The hardness that caps the contact pressure (in the units of the pressures).
+    pub const HARDNESS: Param = Param::new("--hardness", "hardness");
 }
 
 use params::*;
@@ -118,10 +120,15 @@ pub struct SolverRequest {
     pub tolerance: f64,
     /// Iterations per solve.
     pub max_iterations: usize,
+    /// The hardness that caps the contact pressure (elastic–perfectly-plastic contact,
+    /// docs/hardness.md), in the units of E* and the pressures; none: the hard wall.
+    #[serde(default)]
+    pub hardness: Option<f64>,
 }
 
 impl Default for SolverRequest {
-    /// E* = 1, free boundaries, the library's solver and its tolerance and iteration limit.
+    /// E* = 1, free boundaries, the library's solver and its tolerance and iteration limit,
+    /// no hardness.
     fn default() -> Self {
         let params = SolverParams::default();
         SolverRequest {
@@ -130,13 +137,37 @@ impl Default for SolverRequest {
             solver: params.solver.name().into(),
             tolerance: params.tolerance,
             max_iterations: params.max_iterations,
+            hardness: None,
         }
     }
 }
 
+/// A validated [`SolverRequest`]: what [`ContactSolver::new`] and
+/// [`ContactSolver::set_interface`] take.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverPlan {
+    /// E* and the boundary conditions.
+    pub half_space: HalfSpace,
+    /// The iteration, its tolerance and its iteration limit.
+    pub params: SolverParams,
+    /// The contact law: the hard wall, or the pressure capped at the hardness.
+    pub interface: Interface,
+}
+
+impl SolverPlan {
+    /// The solver of this plan on `surface`, with its interface.
+    pub fn solver(
+        &self,
+        surface: &asperity::surface::Surface,
+    ) -> Result<ContactSolver, asperity::bem::SolveError> {
+        ContactSolver::new(surface, self.half_space, self.params)?.with_interface(self.interface)
+    }
+}
+
 impl SolverRequest {
-    /// The half-space and the solver's parameters, or why not.
-    pub fn validate(&self) -> Result<(HalfSpace, SolverParams), Refusal> {
+    /// The half-space, the solver's parameters and the interface, or why not (the
+    /// boundary, E*, the solver's name, the tolerance, the iteration limit, the hardness).
+    pub fn validate(&self) -> Result<SolverPlan, Refusal> {
         let boundary = parse_boundary(&self.boundary)?;
         check_modulus(MODULUS, self.modulus)?;
         let solver = parse_solver(&self.solver)?;
@@ -154,8 +185,62 @@ impl SolverRequest {
             modulus: self.modulus,
             boundary,
         };
-        Ok((half_space, params))
+        Ok(SolverPlan {
+            half_space,
+            params,
+            interface: hardness_interface(self.hardness)?,
+        })
     }
+}
+
+/// The contact law of a hardness or none: the hard wall without one, else the pressure
+/// capped at `h`. The rule is the library's ([`Interface::hardness`]: positive and finite),
+/// the words the front ends'; one definition for `asperity bem`, `asperity contact` and
+/// Python's `Solver` and `contact`.
+pub fn hardness_interface(hardness: Option<f64>) -> Result<Interface, Refusal> {
+    let Some(h) = hardness else {
+        return Ok(Interface::HardWall);
+    };
+    Interface::hardness(h)
+        .map_err(|_| Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {h}")))
+}
+
+/// Refuses the loads that `interface` cannot carry: a mean pressure at or above the
+/// hardness ([`Interface::check_mean_pressure`]: more than a fully plastic contact carries)
+/// and, where the `nominal_area` is known, a force whose mean pressure is (without it forces
+/// are left to the library's check at their solve). `unit` follows each pressure in the
+/// words (`" Pa"` for `asperity contact`, empty where pressures are in the units of E*).
+/// Indentations are not limited: a capped contact carries less than `H` times the nominal
+/// area at any approach.
+pub fn check_capped_loads(
+    interface: Interface,
+    loads: &[Control],
+    nominal_area: Option<f64>,
+    unit: &str,
+) -> Result<(), Refusal> {
+    let h = interface.cap();
+    for &load in loads {
+        let (what, mean) = match (load, nominal_area) {
+            (Control::MeanPressure(p), _) => (format!("a mean pressure of {p}{unit}"), p),
+            (Control::Force(f), Some(area)) => (
+                format!(
+                    "a force of {f} (a mean pressure of {}{unit})",
+                    short_number(f / area)
+                ),
+                f / area,
+            ),
+            _ => continue,
+        };
+        if interface.check_mean_pressure(mean).is_err() {
+            return Err(Refusal::saying(format!(
+                "{what} is at or above the hardness {h}{unit}: more than a fully plastic \
+                 contact can carry (lower it or raise "
+            ))
+            .param(HARDNESS)
+            .text(")"));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a solve of a `rows`×`cols` surface that does not fit in memory (`extra`: bytes
@@ -350,6 +435,65 @@ pub fn check_fd_step(step: f64) -> Result<(), Refusal> {
     Err(Refusal::of(STEP).text(format!(" must lie in (0, 1), got {step}")))
 }
 
+/// The columns of a load path's table (`asperity bem --load-path`, Python's
+/// `Solver.load_path`), one row per step ([`asperity::bem::PathPoint`]): its [`Branch`],
+/// the solved scalars, the frozen-set stiffness (on the elastic set under a hardness), the
+/// solve's iterations and the largest permanent displacement so far.
+pub const PATH_COLUMNS: [&str; 9] = [
+    "branch",
+    "force",
+    "mean_pressure",
+    "indentation",
+    "area_fraction",
+    "plastic_fraction",
+    "stiffness",
+    "iterations",
+    "permanent_max",
+];
+
+/// Which way a step of a load path goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Branch {
+    /// Beyond every earlier load (the first step too): the surface may yield.
+    Loading,
+    /// Below the step before: elastic on the flattened surface.
+    Unloading,
+    /// Above the step before but not beyond the largest earlier load: elastic.
+    Reloading,
+}
+
+impl Branch {
+    /// `loading`, `unloading` or `reloading`, as the tables write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Branch::Loading => "loading",
+            Branch::Unloading => "unloading",
+            Branch::Reloading => "reloading",
+        }
+    }
+}
+
+/// The branch of each step of a path of `values` (loads or indentations, in order).
+pub fn branches(values: &[f64]) -> Vec<Branch> {
+    let mut largest = f64::NEG_INFINITY;
+    let mut previous = f64::NEG_INFINITY;
+    values
+        .iter()
+        .map(|&v| {
+            let branch = if v > largest {
+                Branch::Loading
+            } else if v < previous {
+                Branch::Unloading
+            } else {
+                Branch::Reloading
+            };
+            largest = largest.max(v);
+            previous = v;
+            branch
+        })
+        .collect()
+}
+
 /// A whole `asperity bem` request: the solver, the loads and what each load computes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BemRequest {
@@ -403,22 +547,56 @@ pub struct BemPlan {
     pub sweep: SweepParams,
     /// The tangential stiffness and the conductances asked for (their columns).
     pub derived: Derived,
+    /// The contact law: the hard wall, or the pressure capped at the hardness.
+    pub interface: Interface,
+}
+
+impl BemPlan {
+    /// The plan's solver on `surface`, with its interface.
+    pub fn solver(
+        &self,
+        surface: &asperity::surface::Surface,
+    ) -> Result<ContactSolver, asperity::bem::SolveError> {
+        ContactSolver::new(surface, self.half_space, self.params)?.with_interface(self.interface)
+    }
+
+    /// Refuses the forces the hardness cannot carry over the surface's `nominal_area`
+    /// ([`check_capped_loads`]; the mean pressures were checked by
+    /// [`BemRequest::validate`]), before any solve.
+    pub fn check_forces(&self, nominal_area: f64) -> Result<(), Refusal> {
+        check_capped_loads(self.interface, &self.loads, Some(nominal_area), "")
+    }
+
+    /// The hardness where the pressure is capped (the plastic column, the record's
+    /// hardness), else none.
+    pub fn hardness(&self) -> Option<f64> {
+        match self.interface {
+            Interface::Hardness { h } => Some(h),
+            _ => None,
+        }
+    }
 }
 
 impl BemRequest {
-    /// The plan, or why not (the loads first, then the solver, then the step, then the
-    /// derived columns).
+    /// The plan, or why not (the loads first, then the solver with its hardness, then the
+    /// step, then the derived columns, then the mean pressures against the hardness).
     pub fn validate(&self) -> Result<BemPlan, RequestError> {
         let loads = self.loads.controls(self.fields)?;
-        let (half_space, params) = self.solver.validate()?;
+        let SolverPlan {
+            half_space,
+            params,
+            interface,
+        } = self.solver.validate()?;
         if let Some(step) = self.fd_step {
             check_fd_step(step)?;
         }
         let derived =
             Derived::validate(self.poisson, &self.resistivity, &self.thermal_conductivity)?;
+        check_capped_loads(interface, &loads, None, "")?;
         Ok(BemPlan {
             half_space,
             params,
+            interface,
             loads,
             sweep: SweepParams {
                 stiffness: self.stiffness,
@@ -532,17 +710,84 @@ mod tests {
     }
 
     #[test]
+    fn a_hardness_is_one_rule_for_every_front_end() {
+        let capped = |hardness, loads| BemRequest {
+            solver: SolverRequest {
+                hardness: Some(hardness),
+                ..SolverRequest::default()
+            },
+            loads,
+            ..BemRequest::default()
+        };
+        // The plan carries the library's interface; forces wait for the nominal area.
+        let plan = capped(0.3, Loads::Forces(vec![0.1, 0.5]))
+            .validate()
+            .unwrap();
+        assert_eq!(plan.interface, Interface::Hardness { h: 0.3 });
+        assert_eq!(plan.hardness(), Some(0.3));
+        assert!(plan.check_forces(2.0).is_ok());
+        assert_eq!(
+            plan.check_forces(1.0).unwrap_err().words(Names::Keywords),
+            "a force of 0.5 (a mean pressure of 0.5) is at or above the hardness 0.3: more \
+             than a fully plastic contact can carry (lower it or raise hardness)"
+        );
+        let words = refused(&capped(0.3, Loads::Pressures(vec![0.01, 0.3])));
+        assert_eq!(
+            words,
+            "a mean pressure of 0.3 is at or above the hardness 0.3: more than a fully \
+             plastic contact can carry (lower it or raise --hardness)"
+        );
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let words = refused(&capped(bad, Loads::Pressures(vec![0.01])));
+            assert_eq!(
+                words,
+                format!("--hardness must be positive and finite, got {bad}")
+            );
+        }
+        // Indentations are not limited; no hardness is the hard wall.
+        assert!(capped(0.3, Loads::Indentations(vec![10.0]))
+            .validate()
+            .is_ok());
+        let plan = BemRequest::default().validate().unwrap();
+        assert_eq!(
+            (plan.interface, plan.hardness()),
+            (Interface::HardWall, None)
+        );
+    }
+
+    #[test]
+    fn a_path_names_its_branches() {
+        let names: Vec<&str> = branches(&[0.01, 0.04, 0.02, 0.01, 0.03, 0.04, 0.05, 0.05])
+            .into_iter()
+            .map(Branch::name)
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "loading",
+                "loading",
+                "unloading",
+                "unloading",
+                "reloading",
+                "reloading",
+                "loading",
+                "reloading"
+            ]
+        );
+    }
+
+    #[test]
     fn solver_and_boundary_names() {
         let solver = |name: &str| SolverRequest {
             solver: name.into(),
             ..SolverRequest::default()
         };
         assert_eq!(
-            solver("default").validate().unwrap().1.solver,
+            solver("default").validate().unwrap().params.solver,
             SolverKind::Bccg
         );
         assert_eq!(
-            solver("pk").validate().unwrap().1.solver,
+            solver("pk").validate().unwrap().params.solver,
             SolverKind::PolonskyKeer
         );
         let err = solver("cg").validate().unwrap_err().words(Names::Keywords);

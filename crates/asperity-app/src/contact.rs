@@ -10,7 +10,10 @@ use asperity::topography::patches::count_patches;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use crate::bem::{check_modulus, check_tolerance, check_values, params as bem, parse_boundary};
+use crate::bem::{
+    check_capped_loads, check_modulus, check_tolerance, check_values, hardness_interface,
+    params as bem, parse_boundary,
+};
 use crate::derived::{check_poisson, Derived, DerivedRow, Units};
 use crate::refusal::Refusal;
 
@@ -24,8 +27,8 @@ pub mod params {
     pub const YOUNG: Param = Param::new("--young", "young");
     /// The tangential (no-slip) stiffness.
     pub const TANGENTIAL: Param = Param::new("--tangential", "tangential");
-    /// The hardness that caps the contact pressure, Pa.
-    pub const HARDNESS: Param = Param::new("--hardness", "hardness");
+    /// The hardness that caps the contact pressure, Pa (`asperity bem`'s parameter).
+    pub use crate::bem::params::HARDNESS;
 }
 
 use params::*;
@@ -143,7 +146,14 @@ impl ContactRequest {
         }
         let poisson = self.poisson.filter(|_| self.tangential);
         let derived = Derived::validate(poisson, &self.resistivity, &self.thermal_conductivity)?;
-        let interface = interface(self.hardness, &self.pressures)?;
+        // The hardness by `asperity bem`'s rules, in Pa.
+        let interface = hardness_interface(self.hardness)?;
+        let loads: Vec<Control> = self
+            .pressures
+            .iter()
+            .map(|&p| Control::MeanPressure(p))
+            .collect();
+        check_capped_loads(interface, &loads, None, " Pa")?;
         Ok(ContactPlan {
             derived,
             interface,
@@ -152,37 +162,9 @@ impl ContactRequest {
                 tolerance: self.tolerance,
                 ..SolverParams::default()
             },
-            loads: self
-                .pressures
-                .iter()
-                .map(|&p| Control::MeanPressure(p))
-                .collect(),
+            loads,
         })
     }
-}
-
-/// The contact law of a hardness (Pa) or none. The rules are the library's, the one
-/// definition that `asperity bem --hardness` applies too ([`Interface::hardness`]: positive
-/// and finite; [`Interface::check_mean_pressure`]: no mean pressure at or above it, more
-/// than a fully plastic contact carries); the words are the front ends'.
-fn interface(hardness: Option<f64>, pressures: &[f64]) -> Result<Interface, Refusal> {
-    let Some(h) = hardness else {
-        return Ok(Interface::HardWall);
-    };
-    let Ok(interface) = Interface::hardness(h) else {
-        return Err(Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {h}")));
-    };
-    let beyond = |p: f64| interface.check_mean_pressure(p).is_err();
-    if let Some(p) = pressures.iter().copied().find(|&p| beyond(p)) {
-        return Err(Refusal::saying("a mean pressure of ")
-            .text(format!(
-                "{p} Pa is at or above the hardness {h} Pa: more than a fully plastic contact can \
-             carry (lower it or raise "
-            ))
-            .param(HARDNESS)
-            .text(")"));
-    }
-    Ok(interface)
 }
 
 /// The columns of `asperity contact`'s table (SI units), in the order of

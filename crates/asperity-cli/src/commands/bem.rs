@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepRow};
-use asperity::bem::{ContactSolver, Control, Interface};
+use asperity::bem::ContactSolver;
 use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
@@ -124,6 +124,14 @@ pub struct BemArgs {
     /// the plastic displacement between loads).
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
     pub hardness: Option<f64>,
+    /// Walk the loads in the given order as one load path (loading, unloading,
+    /// reloading: e.g. --pressures 0.01,0.04,0.01,0.04 --hardness 0.3), each step warm from
+    /// the last and its plastic displacement kept (the library's load_path), so the table
+    /// shows the hysteresis. Columns branch, force, mean_pressure, indentation,
+    /// area_fraction, plastic_fraction, stiffness, iterations, permanent_max; --fields DIR
+    /// writes permanent.npy (the permanent displacement after the last step).
+    #[arg(long)]
+    pub load_path: bool,
     /// Adhesion (work of adhesion Δγ, in the units of the modulus times a length): Pohrt &
     /// Popov's pixel criterion (docs/adhesion.md) along the path of --indentations
     /// (negative allowed), then retracted to pull-off; both pull-offs on stderr and in
@@ -452,11 +460,10 @@ struct Plan {
     bem: BemPlan,
     size: [Option<f64>; 2],
     columns: Columns,
-    interface: Interface,
 }
 
 /// The request of the arguments: the loads, the solver and what each load computes.
-fn request(args: &BemArgs) -> Result<BemRequest> {
+pub(super) fn request(args: &BemArgs) -> Result<BemRequest> {
     let loads = Loads::from_options(
         args.forces.clone(),
         args.pressures.clone(),
@@ -471,6 +478,7 @@ fn request(args: &BemArgs) -> Result<BemRequest> {
             solver: args.solver.clone(),
             tolerance: args.tol,
             max_iterations: args.max_iter,
+            hardness: args.hardness,
         },
         loads,
         stiffness: !args.no_stiffness,
@@ -500,19 +508,10 @@ fn plan(args: &BemArgs) -> Result<Plan> {
             bail!("--plot draws the stiffness: drop --no-stiffness");
         }
     }
-    let interface = match args.hardness {
-        Some(h) => Interface::hardness(h).context("--hardness")?,
-        None => Interface::HardWall,
-    };
-    for load in &bem.loads {
-        if let Control::MeanPressure(p) = *load {
-            interface.check_mean_pressure(p).context("--hardness")?;
-        }
-    }
     let columns = Columns {
         fd: args.fd_stiffness,
         timing: args.timing,
-        plastic: args.hardness.is_some(),
+        plastic: bem.hardness().is_some(),
         derived: bem.derived,
         modulus: bem.half_space.modulus,
     };
@@ -521,7 +520,6 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         bem,
         size,
         columns,
-        interface,
     })
 }
 
@@ -680,8 +678,17 @@ fn solve(
         .collect())
 }
 
-/// The inputs of a run, for OUT.csv.json.
+/// The inputs of a run, for OUT.csv.json (`hardness` only where the pressure is capped).
 fn record(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Value {
+    let mut record = inputs(args, plan, surface);
+    if let (Some(h), Some(fields)) = (plan.bem.hardness(), record.as_object_mut()) {
+        fields.insert("hardness".into(), json!(h));
+    }
+    record
+}
+
+/// The inputs of every run, for OUT.csv.json.
+fn inputs(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Value {
     json!({
         "command": "asperity bem",
         "version": env!("CARGO_PKG_VERSION"),
@@ -785,6 +792,9 @@ pub fn run(args: &BemArgs) -> Result<()> {
     if args.adhesion_range.is_some() {
         bail!("--adhesion-range goes with --work-of-adhesion");
     }
+    if args.load_path {
+        return super::bem_path::run(args);
+    }
     let plan = plan(args)?;
     let mut outputs = stage_outputs(args, plan.bem.loads.len())?;
     let (surface, source) = read_surface(args, &plan, outputs.fields.is_some())?;
@@ -795,10 +805,10 @@ pub fn run(args: &BemArgs) -> Result<()> {
         square_pixels: surface.has_square_pixels(),
         source,
     };
-    let mut solver = ContactSolver::new(&surface, plan.bem.half_space, plan.bem.params)?
-        .with_interface(plan.interface)?;
+    let mut solver = plan.bem.solver(&surface)?;
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
+    plan.bem.check_forces(solver.nominal_area())?;
     let rows = solve(args, &plan, &mut solver, &mut outputs)?;
     write(args, &plan, &info, &rows, outputs.staged)
 }

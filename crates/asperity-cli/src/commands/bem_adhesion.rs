@@ -31,6 +31,7 @@ fn refuse_other_options(args: &BemArgs) -> Result<()> {
         (args.nloads.is_some(), "--nloads"),
         (args.pmin.is_some() || args.pmax.is_some(), "--pmin/--pmax"),
         (args.hardness.is_some(), "--hardness"),
+        (args.load_path, "--load-path"),
         (args.solver != "bccg", "--solver"),
         (args.fd_stiffness, "--fd-stiffness"),
         (args.fields.is_some(), "--fields"),

@@ -2,6 +2,7 @@
 
 pub mod bem;
 pub mod bem_adhesion;
+pub mod bem_path;
 pub mod bench;
 pub mod contact;
 pub mod figures;

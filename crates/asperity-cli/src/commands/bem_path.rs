@@ -1,0 +1,145 @@
+//! `asperity bem --load-path`: the loads walked in the given order as one load path
+//! (loading, unloading, reloading), each step warm from the last and its plastic
+//! displacement kept (the library's [`load_path`], the one Python's `Solver.load_path`
+//! runs), so a table shows the hysteresis of force, area and stiffness under a hardness.
+//! The request is `asperity bem`'s ([`BemRequest`]); outputs as `asperity bem`'s: checked
+//! before any work, written together at the end.
+
+use anyhow::{bail, Context, Result};
+use asperity::bem::{load_path, PathPoint};
+use std::path::Path;
+
+use asperity::io::{sidecar_path, StagedOutputs};
+use asperity_app::bem::{branches, BemPlan, BemRequest, Branch, PATH_COLUMNS};
+use serde_json::json;
+
+use super::bem::{read_surface_for, request, BemArgs};
+use crate::output::{format_number, Table};
+
+/// The options of `asperity bem` that a load path refuses, with the flag named.
+fn refuse_other_options(args: &BemArgs) -> Result<()> {
+    let given = [
+        (args.fd_stiffness, "--fd-stiffness"),
+        (args.plot.is_some(), "--plot"),
+        (args.timing, "--timing"),
+        (args.no_stiffness, "--no-stiffness"),
+        (args.poisson.is_some(), "--poisson"),
+        (args.resistivity.is_some(), "--resistivity"),
+        (
+            args.thermal_conductivity.is_some(),
+            "--thermal-conductivity",
+        ),
+    ];
+    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
+        bail!("--load-path does not go with {flag} (a path reports the frozen-set stiffness of each step)");
+    }
+    Ok(())
+}
+
+/// The outputs, checked before any work (as `asperity bem`'s): the table, its record and
+/// `permanent` (in `--fields DIR`, made here and removed again on any error).
+fn stage(args: &BemArgs, permanent: Option<&Path>) -> Result<StagedOutputs> {
+    let record_path = args.out.as_deref().map(sidecar_path);
+    let paths = args
+        .out
+        .as_deref()
+        .into_iter()
+        .chain(record_path.as_deref())
+        .chain(permanent);
+    let staged = StagedOutputs::in_new_folders(&args.fields, paths, args.force)?;
+    staged.ensure_not_input(&args.surface)?;
+    Ok(staged)
+}
+
+/// One step's CSV cells, in the order of [`PATH_COLUMNS`].
+fn cells(branch: Branch, point: &PathPoint) -> Vec<String> {
+    let s = &point.summary;
+    vec![
+        branch.name().to_string(),
+        format_number(s.force),
+        format_number(s.mean_pressure),
+        format_number(s.indentation),
+        format_number(s.area_fraction),
+        format_number(s.plastic_fraction),
+        format_number(point.stiffness),
+        point.iterations.to_string(),
+        format_number(point.permanent_max),
+    ]
+}
+
+/// Runs `asperity bem --load-path`: plan (every check before the first solve), the path,
+/// then the table, its record and `--fields DIR/permanent.npy`, written together.
+pub fn run(args: &BemArgs) -> Result<()> {
+    refuse_other_options(args)?;
+    let request = request(args)?;
+    let plan = request.validate()?;
+    let permanent_path = args.fields.as_ref().map(|dir| dir.join("permanent.npy"));
+    let mut staged = stage(args, permanent_path.as_deref())?;
+    let (surface, size_source) = read_surface_for(args, plan.half_space.boundary)?;
+    let mut solver = plan.solver(&surface)?;
+    plan.check_forces(solver.nominal_area())?;
+    let values: Vec<f64> = plan.loads.iter().map(|c| c.value()).collect();
+    let points = load_path(&mut solver, &plan.loads).context("load path")?;
+    let mut table = Table::new(&PATH_COLUMNS);
+    for (branch, point) in branches(&values).into_iter().zip(&points) {
+        table.push(&cells(branch, point));
+    }
+    if let Some(path) = &permanent_path {
+        staged.write_npy_2d(path, &solver.permanent_displacement())?;
+    }
+    if let Some(out) = &args.out {
+        table
+            .stage(&mut staged, out)
+            .with_context(|| format!("writing {}", out.display()))?;
+        let record_path = sidecar_path(out);
+        let record = record(args, (&request, &plan), (&surface, size_source));
+        staged
+            .write_json(&record_path, &record)
+            .with_context(|| format!("writing {}", record_path.display()))?;
+    }
+    staged.commit()?;
+    match &args.out {
+        Some(out) if !args.quiet => eprintln!(
+            "wrote {} and {} ({} steps)",
+            out.display(),
+            sidecar_path(out).display(),
+            points.len()
+        ),
+        Some(_) => {}
+        None => {
+            use std::io::Write;
+            match std::io::stdout().write_all(&table.to_csv()?) {
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+                other => other?,
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The inputs of a path, for OUT.csv.json.
+fn record(
+    args: &BemArgs,
+    (request, plan): (&BemRequest, &BemPlan),
+    (surface, size_source): (&asperity::surface::Surface, &'static str),
+) -> serde_json::Value {
+    json!({
+        "command": "asperity bem --load-path",
+        "version": env!("CARGO_PKG_VERSION"),
+        "surface": args.surface,
+        "grid": [surface.dim().0, surface.dim().1],
+        "size": surface.size(),
+        "size_y": surface.size_y(),
+        "size_source": size_source,
+        "modulus": plan.half_space.modulus,
+        "boundary": plan.half_space.boundary.name(),
+        "solver": plan.params.solver.name(),
+        "tolerance": plan.params.tolerance,
+        "max_iterations": plan.params.max_iterations,
+        "hardness": plan.hardness(),
+        "loads": request.loads.record(),
+        "stiffness": "frozen contact set (the elastic set 0 < p < H under a hardness)",
+        "fields": args.fields,
+        "columns": PATH_COLUMNS,
+    })
+}
