@@ -211,7 +211,7 @@ class Surface:
     """
 
     heights: np.ndarray
-    size: float = 1.0
+    size: float = _DEFAULTS["size"]
     metadata: Dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -287,7 +287,7 @@ class Line:
     ``asperity line`` (see :class:`Surface`)."""
 
     heights: np.ndarray
-    size: float = 1.0
+    size: float = _DEFAULTS["size"]
     metadata: Dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -324,7 +324,7 @@ def surface(
     rms_height: Optional[float] = None,
     rms_slope: Optional[float] = None,
     size: float = _DEFAULTS["size"],
-    seed: int = 0,
+    seed: int = _DEFAULTS["seed"],
 ) -> Surface:
     """A self-affine rough surface, as ``asperity surface`` (bit-identical for a seed).
 
@@ -356,7 +356,7 @@ def line(
     rms_height: Optional[float] = None,
     rms_slope: Optional[float] = None,
     size: float = _DEFAULTS["size"],
-    seed: int = 0,
+    seed: int = _DEFAULTS["seed"],
 ) -> Line:
     """A self-affine rough line (``C1D = π q C2D``, paper eqs. 9-11), as ``asperity line``.
 
@@ -421,11 +421,11 @@ def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
         if len(size) != 2 or heights.ndim != 2:
             raise ValueError(f"size: give L, or (x, y) for a 2D map, got {size!r}")
         return heights, _positive(size[0], "size"), _positive(size[1], "size"), True, None
-    return heights, 1.0 if size is None else float(size), None, False, None
+    return heights, _DEFAULTS["size"] if size is None else float(size), None, False, None
 
 
-def _statistics(values: Any, size, fit_from, fit_to, window: str = "none",
-                convention: str = "asperity") -> Dict[str, Any]:
+def _statistics(values: Any, size, fit_from, fit_to, window: str = _DEFAULTS["window"],
+                convention: str = _DEFAULTS["convention"]) -> Dict[str, Any]:
     heights, size_x, size_y, measured, metadata = _stats_source(values, size)
     result = _core.statistics(heights, size_x, size_y, measured, metadata,
                               _opt(fit_from), _opt(fit_to), str(window), str(convention))
@@ -439,7 +439,7 @@ _PSD_KEYS = ("q", "psd", "modes", "size", "fit_prefactor", "fit_stderr", "fit_po
 
 def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
           fit_from: Optional[float] = None, fit_to: Optional[float] = None,
-          window: str = "none") -> Dict[str, Any]:
+          window: str = _DEFAULTS["window"]) -> Dict[str, Any]:
     """The statistics ``asperity stats`` prints, by the same code: ``rms_height``,
     ``rms_slope`` (forward differences), ``rms_curvature`` (half the rms five-point
     Laplacian; per-axis spacings on rectangular pixels), the PSD's power-law fit
@@ -627,8 +627,8 @@ def psd(
     size: Union[None, float, Tuple[float, float]] = None,
     fit_from: Optional[float] = None,
     fit_to: Optional[float] = None,
-    window: str = "none",
-    convention: str = "asperity",
+    window: str = _DEFAULTS["window"],
+    convention: str = _DEFAULTS["convention"],
 ) -> Psd:
     """The PSD of a surface or line, as ``asperity stats --psd``, with the least-squares
     power law ``C ∝ q^p`` over the bins whose rounded q·L/2π lies in ``fit_from`` ..
@@ -841,7 +841,7 @@ class Solver:
     ):
         heights, size_x, size_y = _surface_input(surface, size)
         if modulus is None and young is None and poisson is None:
-            modulus = 1.0
+            modulus = _DEFAULTS["modulus"]
         modulus = effective_modulus(modulus=modulus, young=young, poisson=poisson)
         if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
             raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
@@ -1072,7 +1072,7 @@ def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, flo
     heights = _float64(surface, "surface")
     if heights.ndim != 2:
         raise ValueError(f"surface: expected a 2D array of heights (rows, cols), got shape {heights.shape}")
-    return heights, 1.0 if size is None else float(size), None
+    return heights, _DEFAULTS["size"] if size is None else float(size), None
 
 
 def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) -> Tuple[str, List[float]]:

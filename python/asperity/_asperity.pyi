@@ -33,7 +33,7 @@ def save_heights(path: str, array: F64, metadata: str, force: bool) -> None: ...
 def statistics(
     array: npt.NDArray[np.float64], size_x: float, size_y: Optional[float], measured: bool,
     metadata: Optional[str], fit_from: Optional[float], fit_to: Optional[float],
-    window: str = ..., convention: str = ...,
+    window: str, convention: str,
 ) -> Dict[str, Any]: ...
 def sweep_loads(
     forces: Optional[List[float]], pressures: Optional[List[float]],
@@ -151,7 +151,8 @@ def cli(argv: List[str]) -> int:
     ...
 def defaults() -> Dict[str, Any]:
     """The defaults shared with the CLI (modulus, boundary, solver, tolerance,
-    max_iterations, fd_step, gamma, kappa, size), from the front-end layer."""
+    max_iterations, fd_step, gamma, kappa, size, seed, window, convention), from the
+    front-end layer."""
     ...
 def sweep_figure(
     force: List[float], stiffness: List[float], stiffness_fd: Optional[List[float]],

@@ -78,6 +78,10 @@ fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     d.set_item("gamma", persson.gamma)?;
     d.set_item("kappa", persson.kappa)?;
     d.set_item("size", surface.size)?;
+    let seed = asperity_app::surface::parse_seed(&surface.seed).expect("the default seed parses");
+    d.set_item("seed", seed)?;
+    d.set_item("window", asperity_app::stats::DEFAULT_WINDOW)?;
+    d.set_item("convention", asperity_app::stats::DEFAULT_CONVENTION)?;
     Ok(d)
 }
 

@@ -148,7 +148,7 @@ fn save_heights(
 /// square pixels), which adds the ISO parameters. Returns the CLI's `--json` fields with
 /// the PSD's `q`, `psd` and `modes` as arrays.
 #[pyfunction]
-#[pyo3(signature = (array, size_x, size_y, measured, metadata, fit_from, fit_to, window="none", convention="asperity"))]
+#[pyo3(signature = (array, size_x, size_y, measured, metadata, fit_from, fit_to, window, convention))]
 #[allow(clippy::too_many_arguments)]
 fn statistics<'py>(
     py: Python<'py>,

@@ -1,5 +1,5 @@
-//! Measured topographies through the front-end layer's one call
-//! (`asperity_app::measured::open`, the one `asperity import` / `stats FILE` use): X3P, SDF,
+//! Measured topographies through the front-end layer's one call for any surface argument
+//! (`asperity_app::argument::open`, the one every CLI command uses): X3P, SDF,
 //! text and Gwyddion matrices, x y z lists, profiles, SUR, PLU, OPD, DI, AL3D, MetroPro,
 //! FRT, WSxM, TMD and `.npy`, detected by content first, then by extension; levelled and
 //! filled as asked, with the CLI's warnings.
@@ -8,8 +8,9 @@ use std::path::PathBuf;
 
 use asperity::io::StagedOutputs;
 use asperity::topography::{Fill, Heights, Provenance, Topography};
+use asperity_app::argument::{open, Arrays, Input};
 use asperity_app::import::Import;
-use asperity_app::measured::{open, MeasuredRequest, Opened, WarningKind};
+use asperity_app::measured::{MeasuredRequest, WarningKind};
 use asperity_app::{Names, RequestError};
 use numpy::{IntoPyArray, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -53,8 +54,10 @@ fn read_topography(
         detrend,
         fill,
     };
-    let opened =
-        run_detached(py, |_| open(&path, &request, Some(Fill::Keep)))?.map_err(request_error)?;
+    let opened = run_detached(py, |_| {
+        open(&path, &request, Arrays::Measured, Some(Fill::Keep))
+    })?
+    .map_err(request_error)?;
     Ok(to_python(py, opened))
 }
 
@@ -85,7 +88,7 @@ fn import_topography(
     };
     let opened = run_detached(py, |_| {
         let import = Import::stage(&path, &out, force)?;
-        let opened = open(&path, &request, None)?;
+        let opened = open(&path, &request, Arrays::Measured, None)?;
         import.write(&path, &opened.topography)?;
         Ok::<_, RequestError>(opened)
     })?
@@ -94,7 +97,7 @@ fn import_topography(
 }
 
 /// The heights, sizes, provenance (JSON) and warnings of an opened file.
-fn to_python(py: Python<'_>, opened: Opened) -> Read {
+fn to_python(py: Python<'_>, opened: Input) -> Read {
     let warnings = opened
         .warnings
         .iter()

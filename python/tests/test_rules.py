@@ -576,6 +576,11 @@ SHARED_DEFAULTS = [
     ("surface", "--seed", "surface", "seed"),
     ("line", "--size", "line", "size"),
     ("line", "--seed", "line", "seed"),
+    ("surface", "--size", "Surface", "size"),
+    ("line", "--size", "Line", "size"),
+    ("stats", "--window", "stats", "window"),
+    ("stats", "--window", "psd", "window"),
+    ("stats", "--psd-convention", "psd", "convention"),
 ]
 
 

@@ -27,6 +27,7 @@
 //! ```
 
 pub mod adhesion;
+pub mod argument;
 pub mod bem;
 pub mod contact;
 pub mod derived;

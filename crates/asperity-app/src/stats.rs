@@ -37,6 +37,12 @@ use params::*;
 /// (one wavelength per side) holds the fewest modes and the window's edge.
 pub const DEFAULT_FIT_FROM: f64 = 2.0;
 
+/// The window when none is named (`--window`, `window=`): none, the scan is one period.
+pub const DEFAULT_WINDOW: &str = "none";
+
+/// The PSD's normalisation when none is named (`--psd-convention`, `convention=`).
+pub const DEFAULT_CONVENTION: &str = "asperity";
+
 /// A stats request: the ends of the PSD fit range, as given (`None`: the defaults of
 /// [`fit_range`]), the window and the PSD's normalisation.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]

@@ -76,6 +76,10 @@ pub struct SurfaceRequest {
     pub seed: String,
 }
 
+/// The side length L when none is given: of a generated surface or line, and of a plain
+/// array with no sidecar (`--size`, `size=`).
+pub const DEFAULT_SIZE: f64 = 1.0;
+
 impl Default for SurfaceRequest {
     /// 256 points, H = 0.8, no cut-offs, unit rms height, L = 1, seed 0.
     fn default() -> Self {
@@ -88,7 +92,7 @@ impl Default for SurfaceRequest {
             short_cutoff: None,
             rms_height: None,
             rms_slope: None,
-            size: 1.0,
+            size: DEFAULT_SIZE,
             seed: "0".into(),
         }
     }

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use asperity::bem::sweep::{sweep, SweepError, SweepFailure, SweepObserver, SweepRow};
 use asperity::bem::ContactSolver;
-use asperity::io::{read_npy_2d, read_npy_shape, sidecar_path, StagedOutputs};
+use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::{
@@ -21,8 +21,9 @@ use asperity_app::bem::{
 use asperity_app::derived::{Derived, Units};
 use serde_json::json;
 
-use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
+use super::measured::{open_argument, parse_size, MeasuredArgs};
 use crate::output::{format_number, Table};
+use asperity_app::argument::{Arrays, Dims, SizeSource};
 use asperity_app::figure::sweep::{SweepColumns, SweepFigure};
 
 use crate::plot::{stage_charts, Chart, ImageFormat};
@@ -309,33 +310,13 @@ fn sweep_error(error: SweepError<anyhow::Error>) -> anyhow::Error {
     }
 }
 
-/// Where L came from.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum SizeSource {
-    Flag,
-    Sidecar,
-    File,
-    Default,
-}
-
-impl SizeSource {
-    fn name(self) -> &'static str {
-        match self {
-            SizeSource::Flag => "--size",
-            SizeSource::Sidecar => "sidecar",
-            SizeSource::File => "file",
-            SizeSource::Default => "default",
-        }
-    }
-
-    /// As the stderr line states it: `from --size`, `from sidecar`, `default`.
-    fn phrase(self) -> &'static str {
-        match self {
-            SizeSource::Flag => "from --size",
-            SizeSource::Sidecar => "from sidecar",
-            SizeSource::File => "from the measured file",
-            SizeSource::Default => "default",
-        }
+/// As the stderr line states where L came from: `from --size`, `from sidecar`, `default`.
+fn size_phrase(source: SizeSource) -> &'static str {
+    match source {
+        SizeSource::Flag => "from --size",
+        SizeSource::Sidecar => "from sidecar",
+        SizeSource::File => "from the measured file",
+        SizeSource::Default => "default",
     }
 }
 
@@ -585,50 +566,37 @@ fn read_surface_with(
     (size, boundary): ([Option<f64>; 2], asperity::elastic::Boundary),
     (loads, fields): (usize, bool),
 ) -> Result<(Surface, SizeSource)> {
-    let measured = !is_npy(&args.surface) || has_import_sidecar(&args.surface);
-    if measured {
-        let t = load(&args.surface, &args.measured, args.size.as_deref())?;
-        let surface = t
-            .to_surface()
-            .with_context(|| format!("{}", args.surface.display()))?;
+    let fits = |shape: &[usize]| match *shape {
+        [rows, cols] => {
+            let extra = array_bytes(&[rows, cols], 8)
+                .zip(bookkeeping_bytes(loads, fields))
+                .and_then(|(heights, loads)| heights.checked_add(loads));
+            ensure_solver_fits(rows, cols, boundary, extra)
+        }
+        _ => Ok(()),
+    };
+    let size = (size != [None, None]).then_some(size);
+    let input = open_argument(
+        &args.surface,
+        &args.measured,
+        size,
+        Arrays::Plain(Dims::Map, &fits),
+    )?;
+    let surface = input.topography.to_surface().with_context(|| {
+        match (input.size_source, &input.topography.sizes[..]) {
+            (SizeSource::Sidecar, [size, ..]) => format!(
+                "{} (L = {size} from its sidecar {})",
+                args.surface.display(),
+                sidecar_path(&args.surface).display()
+            ),
+            _ => format!("{}", args.surface.display()),
+        }
+    })?;
+    if input.measured {
         let (rows, cols) = surface.dim();
         ensure_solver_fits(rows, cols, boundary, Some(0))?;
-        let source = match args.size {
-            Some(_) => SizeSource::Flag,
-            None => SizeSource::File,
-        };
-        return Ok((surface, source));
     }
-    if let [rows, cols] = read_npy_shape(&args.surface)?[..] {
-        let extra = array_bytes(&[rows, cols], 8)
-            .zip(bookkeeping_bytes(loads, fields))
-            .and_then(|(heights, loads)| heights.checked_add(loads));
-        ensure_solver_fits(rows, cols, boundary, extra)?;
-    }
-    let [size_x, size_y] = size;
-    let sidecar_size = match size_x {
-        Some(_) => None,
-        None => asperity::io::sidecar_size(&args.surface)?,
-    };
-    let (size, size_source) = match (size_x, sidecar_size) {
-        (Some(size), _) => (size, SizeSource::Flag),
-        (None, Some(size)) => (size, SizeSource::Sidecar),
-        (None, None) => (1.0, SizeSource::Default),
-    };
-    let heights = read_npy_2d(&args.surface)?;
-    let surface = match size_y {
-        Some(size_y) => Surface::with_sizes(heights, size, size_y),
-        None => Surface::new(heights, size),
-    };
-    let surface = surface.with_context(|| match size_source {
-        SizeSource::Sidecar => format!(
-            "{} (L = {size} from its sidecar {})",
-            args.surface.display(),
-            sidecar_path(&args.surface).display()
-        ),
-        _ => format!("{}", args.surface.display()),
-    })?;
-    Ok((surface, size_source))
+    Ok((surface, input.size_source))
 }
 
 /// The surface as the record and the stderr line state it.
@@ -756,7 +724,7 @@ fn write(
         eprintln!(
             "L = {} ({})",
             surface.sizes_shown(),
-            surface.source.phrase()
+            size_phrase(surface.source)
         );
     }
     match &args.out {

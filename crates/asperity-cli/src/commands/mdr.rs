@@ -8,9 +8,11 @@ use anyhow::{bail, Context, Result};
 use asperity::io::{read_npy_1d, sidecar_path, StagedOutputs};
 use serde_json::json;
 
-use super::measured::{has_import_sidecar, is_npy, load, record, MeasuredArgs};
+use super::measured::{open_argument, record, MeasuredArgs};
 use asperity::mdr::{CurvePoint, PullOffs, Spring, SpringLaw};
 use asperity::reference::Jkr;
+use asperity::topography::Heights;
+use asperity_app::argument::{Arrays, Dims};
 use asperity_app::mdr::{Branch, Indenter, MdrRequest, ADHESIVE_COLUMNS, COLUMNS};
 
 use crate::request::refused;
@@ -188,10 +190,31 @@ fn request(args: &MdrArgs) -> MdrRequest {
     }
 }
 
-/// A measured profile (any readable format, or a `.npy` with an import sidecar).
-fn measured_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
-    let size = args.size.map(|x| x.to_string());
-    let t = load(path, &args.measured, size.as_deref())?;
+/// The line of `--line` through the front-end layer's one call: a measured profile (any
+/// readable format, or a `.npy` with an import sidecar), else a 1D `.npy` with L from
+/// `--size`, else its sidecar, else 1.
+fn line_indenter(args: &MdrArgs, path: &Path) -> Result<Indenter> {
+    let no_check = |_: &[usize]| Ok(());
+    let size = args.size.map(|x| [Some(x), None]);
+    let input = open_argument(
+        path,
+        &args.measured,
+        size,
+        Arrays::Plain(Dims::Line, &no_check),
+    )?;
+    let t = input.topography;
+    if !input.measured {
+        let Heights::Profile(heights) = t.heights else {
+            unreachable!("a plain line is 1D")
+        };
+        let name = path.display().to_string();
+        let mut line = Indenter::line(heights.to_vec(), t.sizes[0], &name)?;
+        line.source = json!({
+            "kind": "line", "file": path, "points": line.values.len(),
+            "size_source": input.size_source.name(),
+        });
+        return Ok(line);
+    }
     let line = t.to_line().with_context(|| format!("{}", path.display()))?;
     let size = line.size();
     Ok(Indenter {
@@ -209,32 +232,11 @@ fn measured_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
     })
 }
 
-/// A line from a 1D `.npy`: L from `--size`, else its sidecar, else 1.
-fn npy_line(args: &MdrArgs, path: &Path) -> Result<Indenter> {
-    let heights = read_npy_1d(path)?.to_vec();
-    let (size, size_source) = match args.size {
-        Some(size) => (size, "--size"),
-        None => match asperity::io::sidecar_size(path)? {
-            Some(size) => (size, "sidecar"),
-            None => (1.0, "default"),
-        },
-    };
-    let mut line = Indenter::line(heights, size, &path.display().to_string())?;
-    line.source = json!({
-        "kind": "line", "file": path, "points": line.values.len(), "size_source": size_source,
-    });
-    Ok(line)
-}
-
 /// The indenter of the request: a line or radial samples read from their file, or a
 /// closed form.
 pub(super) fn load_indenter(args: &MdrArgs, request: &MdrRequest) -> Result<Indenter> {
     if let Some(path) = &args.line {
-        return if !is_npy(path) || has_import_sidecar(path) {
-            measured_line(args, path)
-        } else {
-            npy_line(args, path)
-        };
+        return line_indenter(args, path);
     }
     if let Some(path) = &args.radial {
         let samples = read_npy_1d(path)?;

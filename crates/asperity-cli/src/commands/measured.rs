@@ -1,12 +1,13 @@
-//! Measured topographies in every command: the shared options (`--channel`, `--detrend`,
-//! `--fill`, `--size`) turned into the front-end layer's request, opened by its one call
-//! ([`asperity_app::measured::open`]). Warnings (a tilt left in place) go to stderr.
+//! Surface and line arguments in every command: the shared options (`--channel`,
+//! `--detrend`, `--fill`, `--size`) turned into the front-end layer's request, opened by its
+//! one call ([`asperity_app::argument::open`]). Warnings (a tilt left in place) go to stderr.
 
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use asperity::topography::Topography;
-use asperity_app::measured::{open, parse_detrend, parse_fill, MeasuredRequest};
+use asperity_app::argument::{open, Arrays, Input};
+use asperity_app::measured::{parse_detrend, parse_fill, MeasuredRequest};
 use asperity_app::Names;
 
 pub use asperity_app::measured::record;
@@ -66,43 +67,36 @@ pub fn parse_size(text: &str) -> Result<[Option<f64>; 2]> {
     Ok(out)
 }
 
-/// Whether `path` is a NumPy `.npy` file (by its magic bytes; unreadable files are not).
-pub fn is_npy(path: &Path) -> bool {
-    use std::io::Read;
-    let mut head = [0u8; 6];
-    // Only a regular file is opened (a FIFO would block): anything else is not an array,
-    // and the reader it is handed to refuses it in one line.
-    asperity::input::open_regular(path).is_ok_and(|(mut f, _)| f.read_exact(&mut head).is_ok())
-        && &head == b"\x93NUMPY"
-}
-
-/// Whether the `.npy` at `path` has an import sidecar (with `sizes` per axis): such arrays
-/// go through the measured path, which reads both sizes.
-pub fn has_import_sidecar(path: &Path) -> bool {
-    // A sidecar that cannot be read is reported by the `.npy` path, which reads it again.
-    asperity::input::read_sidecar(path)
-        .ok()
-        .flatten()
-        .is_some_and(|v| v["sizes"].is_array())
-}
-
-/// Reads `path` (any supported format) and cleans it as the options say (undefined points
-/// without `--fill` are refused); prints the warnings to stderr. `size` is `--size` as
-/// given.
-pub fn load(path: &Path, args: &MeasuredArgs, size: Option<&str>) -> Result<Topography> {
+/// Opens a surface or line argument by the front-end layer's one call
+/// ([`asperity_app::argument::open`]): a measured file (or an imported `.npy`) read and
+/// cleaned as the options say (undefined points without `--fill` are refused), a plain
+/// `.npy` as `arrays` says; prints the warnings to stderr. `size` is `--size`, parsed.
+pub fn open_argument(
+    path: &Path,
+    args: &MeasuredArgs,
+    size: Option<[Option<f64>; 2]>,
+    arrays: Arrays<'_>,
+) -> Result<Input> {
     let request = MeasuredRequest {
         channel: args.channel.clone(),
-        size: size.map(parse_size).transpose()?,
+        size,
         detrend: args.detrend.clone(),
         fill: args.fill.clone(),
     };
-    let opened = open(path, &request, None).map_err(crate::request::refused)?;
-    for w in &opened.warnings {
+    let input = open(path, &request, arrays, None).map_err(crate::request::refused)?;
+    for w in &input.warnings {
         eprintln!(
             "warning: {}: {}",
             path.display(),
             w.words.words(Names::Flags)
         );
     }
-    Ok(opened.topography)
+    Ok(input)
+}
+
+/// Reads `path` (any supported format, a `.npy` included) through the measured reader, as
+/// [`open_argument`] does; `size` is `--size` as given.
+pub fn load(path: &Path, args: &MeasuredArgs, size: Option<&str>) -> Result<Topography> {
+    let size = size.map(parse_size).transpose()?;
+    Ok(open_argument(path, args, size, Arrays::Measured)?.topography)
 }

@@ -13,9 +13,10 @@ use asperity::persson::PerssonParams;
 use asperity::surface::Surface;
 use asperity_app::persson::{compute, pressures, PerssonRequest, COLUMNS};
 
-use super::measured::{has_import_sidecar, is_npy, load, parse_size, MeasuredArgs};
+use super::measured::{open_argument, parse_size, MeasuredArgs};
 use crate::output::Table;
 use crate::request::refused;
+use asperity_app::argument::{Arrays, Dims};
 
 /// Arguments of `asperity persson`.
 #[derive(Debug, clap::Args)]
@@ -111,26 +112,19 @@ pub fn run(args: &PerssonArgs) -> Result<()> {
 }
 
 /// The surface: a measured file (or an imported .npy) through the topography reader, else
-/// a .npy with its side length from --size, its sidecar or 1.
+/// a .npy with its side length from --size, its sidecar or 1 (the front-end layer's one
+/// call).
 fn read_surface(args: &PerssonArgs) -> Result<Surface> {
-    if !is_npy(&args.surface) || has_import_sidecar(&args.surface) {
-        let t = load(&args.surface, &args.measured, args.size.as_deref())?;
-        return t
-            .to_surface()
-            .with_context(|| format!("{}", args.surface.display()));
-    }
-    let [x, y] = match args.size.as_deref() {
-        Some(text) => parse_size(text)?,
-        None => [None, None],
-    };
-    let size_x = match x {
-        Some(size) => size,
-        None => asperity::io::sidecar_size(&args.surface)?.unwrap_or(1.0),
-    };
-    let heights = asperity::io::read_npy_2d(&args.surface)?;
-    let surface = match y {
-        Some(size_y) => Surface::with_sizes(heights, size_x, size_y),
-        None => Surface::new(heights, size_x),
-    };
-    surface.with_context(|| format!("{}", args.surface.display()))
+    let size = args.size.as_deref().map(parse_size).transpose()?;
+    let no_check = |_: &[usize]| Ok(());
+    let input = open_argument(
+        &args.surface,
+        &args.measured,
+        size,
+        Arrays::Plain(Dims::Map, &no_check),
+    )?;
+    input
+        .topography
+        .to_surface()
+        .with_context(|| format!("{}", args.surface.display()))
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use asperity::fit::PowerLawFit;
-use asperity::io::{read_npy, read_npy_shape, StagedOutputs};
+use asperity::io::StagedOutputs;
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::surface::stats::PsdBin;
 use asperity::topography::Heights;
@@ -13,11 +13,10 @@ use asperity_app::stats::{
 };
 use asperity_app::Names;
 
-use super::measured::{
-    has_import_sidecar, is_npy, load, parse_size, record as measured_record, MeasuredArgs,
-};
+use super::measured::{open_argument, parse_size, record as measured_record, MeasuredArgs};
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
+use asperity_app::argument::{Arrays, Dims};
 
 /// Arguments of `asperity stats`.
 #[derive(Debug, clap::Args)]
@@ -55,12 +54,12 @@ pub struct StatsArgs {
     /// is one period of a periodic surface) or hann (a non-periodic scan: Hann along a
     /// line, radial Hann on a map, scaled to keep the power; SurfaceTopography's). The
     /// rms values are of the heights as they are.
-    #[arg(long, value_name = "NAME", default_value = "none")]
+    #[arg(long, value_name = "NAME", default_value = asperity_app::stats::DEFAULT_WINDOW)]
     pub window: String,
     /// Normalisation of the PSD (--psd, --plot, the fit's prefactor): asperity
     /// (∫ C d^dq = rms²) or surface-topography (∫ C d^dq/(2π)^d = rms²: asperity's times
     /// (2π)² on a map, 2π on a line). The slope and Hurst estimate are the same.
-    #[arg(long, value_name = "NAME", default_value = "asperity")]
+    #[arg(long, value_name = "NAME", default_value = asperity_app::stats::DEFAULT_CONVENTION)]
     pub psd_convention: String,
     /// Write the bearing-area (Abbott–Firestone) curve as CSV with columns material_ratio
     /// (0 to 1 in 101 steps) and height: the height c above which that fraction of the
@@ -151,30 +150,54 @@ fn psd_chart(
     }
 }
 
-/// A `.npy` array, its side length from --size, the sidecar, else 1, with what the
-/// sidecar says of its spectrum.
-fn npy_source(args: &StatsArgs, size_x: Option<f64>) -> Result<StatsSource> {
+/// The file through the front-end layer's one call: a measured file (or an imported
+/// `.npy`) with its record, else a plain `.npy` (1D or 2D), its side length from --size, the
+/// sidecar, else 1, with what the sidecar says of its spectrum.
+fn open_source(
+    args: &StatsArgs,
+    size: Option<[Option<f64>; 2]>,
+) -> Result<(StatsSource, Option<serde_json::Value>)> {
     // The array, its centred copy, the half spectrum and the FFT's work buffer: about 4×
     // the file; the PSD's ring sums up to 12 bytes a point more (their parallel blocks hold
     // at most about as many entries as the half spectrum): checked from the header before
     // the data are read.
-    let shape = read_npy_shape(&args.file)?;
-    ensure_fits(
-        &format!(
-            "computing the statistics of {} (shape {shape:?})",
-            args.file.display()
-        ),
-        array_bytes(&shape, 4 * 8 + 12),
-    )?;
-    // A corrupt sidecar, or one that is not a regular file or too large, is an error.
-    let hints = asperity::input::read_sidecar(&args.file)?
-        .map_or_else(SpectrumHints::default, |v| SpectrumHints::from_sidecar(&v));
-    let size = size_x.or(hints.size).unwrap_or(1.0);
-    Ok(StatsSource::Grid {
-        heights: read_npy(&args.file)?,
+    let fits = |shape: &[usize]| {
+        ensure_fits(
+            &format!(
+                "computing the statistics of {} (shape {shape:?})",
+                args.file.display()
+            ),
+            array_bytes(shape, 4 * 8 + 12),
+        )
+    };
+    let input = open_argument(
+        &args.file,
+        &args.measured,
         size,
+        Arrays::Plain(Dims::Either, &fits),
+    )?;
+    let t = input.topography;
+    if input.measured {
+        // A measured file's sidecar (if any) is its import record, not a generator's spec.
+        let record = measured_record(&t);
+        let source = StatsSource::Measured {
+            heights: t.heights,
+            sizes: t.sizes,
+        };
+        return Ok((source, Some(record)));
+    }
+    let heights = match t.heights {
+        Heights::Areal(h) => h.into_dyn(),
+        Heights::Profile(h) => h.into_dyn(),
+    };
+    let hints =
+        (input.sidecar.as_ref()).map_or_else(SpectrumHints::default, SpectrumHints::from_sidecar);
+    let source = StatsSource::Grid {
+        heights,
+        size: t.sizes[0],
         hints,
-    })
+    };
+    Ok((source, None))
 }
 
 /// Prints the ISO parameters, if any, one per line with their units.
@@ -208,10 +231,7 @@ fn capitalised(name: &str) -> String {
 /// statistics computed and the PSD fitted by the front-end layer, the outputs written
 /// together, then the statistics printed.
 pub fn run(args: &StatsArgs) -> Result<()> {
-    let size_x = match &args.size {
-        Some(text) => parse_size(text)?[0],
-        None => None,
-    };
+    let size = args.size.as_deref().map(parse_size).transpose()?;
     let named = |r: asperity_app::Refusal| anyhow::anyhow!(r.words(Names::Flags));
     let request = StatsRequest {
         fit_from: args.fit_from,
@@ -228,18 +248,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         (args.psd.iter().chain(&args.bearing_area)).chain(args.acf.iter().chain(&args.plot));
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
-    // A measured file's sidecar (if any) is its import record, not a generator's spec.
-    let (source, record) = if !is_npy(&args.file) || has_import_sidecar(&args.file) {
-        let t = load(&args.file, &args.measured, args.size.as_deref())?;
-        let record = measured_record(&t);
-        let source = StatsSource::Measured {
-            heights: t.heights,
-            sizes: t.sizes,
-        };
-        (source, Some(record))
-    } else {
-        (npy_source(args, size_x)?, None)
-    };
+    let (source, record) = open_source(args, size)?;
     let bearing = match &args.bearing_area {
         Some(_) => Some(bearing_curve(&source)?),
         None => None,
