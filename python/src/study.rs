@@ -17,6 +17,7 @@ use asperity::study::{
     CHECKPOINT_INTERVAL,
 };
 use asperity::Error;
+use asperity_app::study::progress::StudyProgress;
 use asperity_app::study::{self, rows, Kind, TaskFailure};
 use asperity_app::Names;
 use pyo3::prelude::*;
@@ -102,8 +103,9 @@ fn run_study(
     // The flag that Ctrl-C raises: the samples poll it.
     let stop = Stop::new();
     let (_lock, store) = open_folder(&spec, out, force, interval, stop.clone())?;
+    let plan = StudyProgress::of(&store).map_err(from_error)?;
     let results = run_detached_with(py, &stop, |cancel| {
-        run_tasks(&store, progress.as_ref(), cancel)
+        run_tasks(&store, &plan, progress.as_ref(), cancel)
     })?
     .map_err(|failure| from_error(failure.into_error()))?;
     Ok(records(&spec, store.path(), &results))
@@ -394,15 +396,16 @@ impl SampleComputer {
     }
 }
 
-/// Every task in order ([`study::run_tasks`]); progress counts samples over all tasks.
+/// Every task in order ([`study::run_tasks`]); progress counts the samples held over all
+/// tasks, as the CLI's bar does ([`StudyProgress`]).
 fn run_tasks(
     store: &StudyDir,
+    plan: &StudyProgress,
     progress: Option<&Py<PyAny>>,
     cancel: &Cancel,
 ) -> Result<Vec<TaskResult>, TaskFailure> {
-    let samples = store.spec().samples;
-    let total = store.spec().tasks().len() * samples;
-    let report = |task: usize, done: usize| cancel.call(progress, task * samples + done, total);
+    let report =
+        |task: usize, done: usize| cancel.call(progress, plan.held(task, done), plan.total());
     study::run_tasks(store, &report, None)
 }
 

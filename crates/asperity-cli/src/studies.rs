@@ -8,8 +8,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Result;
-use asperity::study::samplers::{BemSampler, OnLoad};
-use asperity::study::{sample_cost, Method, StudyDir, StudySpec, TaskResult};
+use asperity::study::samplers::OnLoad;
+use asperity::study::{Method, StudyDir, StudySpec, TaskResult};
+use asperity_app::study::progress::StudyProgress;
 use asperity_app::study::{self, rows, rows::Cell};
 use asperity_app::Names;
 
@@ -73,7 +74,7 @@ pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
 /// task order.
 ///
 /// The progress bar counts samples (MDR) or solved loads (BEM, so that it moves within a
-/// sample); its ETA weighs each by [`sample_cost`] and leaves out samples read back from
+/// sample); its ETA weighs each by [`asperity::study::sample_cost`] and leaves out samples read back from
 /// checkpoints (see [`crate::progress`]).
 pub fn execute(
     spec: &StudySpec,
@@ -92,9 +93,9 @@ pub fn execute(
     let rewrite = crate::rerun::may_rewrite(dir, &outputs(kind, dir), force)?;
     let stop = crate::interrupt::stop();
     let (_lock, store) = study::open(spec, dir, force, checkpoint_every, stop)?;
-    let stored = stored_per_task(&store)?;
-    let progress = Arc::new(study_progress(spec, &stored, quiet));
-    let results = run_tasks(&store, &stored, &progress, quiet);
+    let plan = StudyProgress::of(&store)?;
+    let progress = Arc::new(study_progress(spec, &plan, quiet));
+    let results = run_tasks(&store, &plan, &progress, quiet);
     if crate::interrupt::stop_requested() {
         // The study checkpointed what it finished (Ctrl-C): exit as an interrupt does.
         progress.finish();
@@ -112,55 +113,18 @@ pub fn execute(
     Ok(results)
 }
 
-/// The progress steps of one sample: a BEM sample reports each of its loads (a 512²
-/// sample takes minutes), an MDR sample (milliseconds) only itself.
-fn steps_per_sample(method: Method) -> u64 {
-    match method {
-        Method::Bem => BemSampler::LOADS as u64,
-        Method::Mdr => 1,
-    }
-}
-
-/// The samples of each task of `store`'s study that its checkpoints hold, in task order:
-/// what [`run_any_task_with_loads`] will restore instead of computing.
-fn stored_per_task(store: &StudyDir) -> Result<Vec<usize>> {
-    let spec = store.spec();
-    spec.tasks()
-        .iter()
-        .map(|&task| Ok(store.samples_held(task, spec.samples)?))
-        .collect()
-}
-
-/// The progress of a study: in samples, or in loads for BEM ([`steps_per_sample`]), each
-/// step weighed by its cost ([`sample_cost`] shared by a sample's steps). The steps of the
-/// samples already `stored` (per task) come first and are counted as restored at once, so
-/// that a resumed study shows all it holds and its ETA covers only the samples left; then
-/// the samples left, task by task.
-fn study_progress(spec: &StudySpec, stored: &[usize], quiet: bool) -> Progress {
-    let steps = steps_per_sample(spec.method);
-    let segments = progress_segments(spec, stored);
+/// The progress bar of a study: in samples, or in loads for BEM, each step weighed by its
+/// cost, the samples already stored counted as restored at once, so that a resumed study
+/// shows all it holds and its ETA covers only the samples left (the front-end layer's
+/// [`StudyProgress`]).
+fn study_progress(spec: &StudySpec, plan: &StudyProgress, quiet: bool) -> Progress {
     let name = match spec.method {
         Method::Bem => "bem study (loads)",
         Method::Mdr => "mdr study",
     };
-    let progress = Progress::weighted(name, &segments, quiet);
-    progress.restore(stored.iter().sum::<usize>() as u64 * steps);
+    let progress = Progress::weighted(name, &plan.segments(), quiet);
+    progress.restore(plan.restored() as u64 * plan.steps_per_sample());
     progress
-}
-
-/// The `(steps, cost of each)` runs of [`study_progress`]: the stored samples of every
-/// task, then the samples left of every task.
-fn progress_segments(spec: &StudySpec, stored: &[usize]) -> Vec<(u64, f64)> {
-    let steps = steps_per_sample(spec.method);
-    let tasks = spec.tasks();
-    let cost = |t: &asperity::study::Task| sample_cost(spec.method, t.n) / steps as f64;
-    let held = tasks
-        .iter()
-        .zip(stored)
-        .map(|(t, &s)| (s as u64 * steps, cost(t)));
-    let left =
-        (tasks.iter().zip(stored)).map(|(t, &s)| ((spec.samples - s) as u64 * steps, cost(t)));
-    held.chain(left).collect()
 }
 
 /// Runs (or resumes) every task of the study in `store`, in this process or, on rank 0 of
@@ -169,12 +133,11 @@ fn progress_segments(spec: &StudySpec, stored: &[usize]) -> Vec<(u64, f64)> {
 /// computed here.
 fn run_tasks(
     store: &StudyDir,
-    stored: &[usize],
+    plan: &StudyProgress,
     progress: &Arc<Progress>,
     quiet: bool,
 ) -> Result<Vec<TaskResult>> {
-    let spec = store.spec();
-    let steps = steps_per_sample(spec.method);
+    let steps = plan.steps_per_sample();
     #[cfg(feature = "mpi")]
     if crate::distributed::active() {
         // The ledger counts samples held in all: the restored ones first, as the bar does.
@@ -197,15 +160,8 @@ fn run_tasks(
         let progress = Arc::clone(progress);
         OnLoad::new(move || progress.inc())
     });
-    // Task i's computed samples follow every stored sample and the samples left of the
-    // tasks before it (`study_progress`).
-    let stored_total = stored.iter().sum::<usize>();
-    let report = |i: usize, done: usize| {
-        let held_before = stored[..i].iter().sum::<usize>();
-        let left_before = i * spec.samples - held_before;
-        let computed = done.saturating_sub(stored[i]);
-        progress.set((stored_total + left_before + computed) as u64 * steps);
-    };
+    // Every sample held in all, whichever task holds it (`study_progress`).
+    let report = |i: usize, done: usize| progress.set(plan.held(i, done) as u64 * steps);
     Ok(study::run_tasks(store, &report, on_load)?)
 }
 
@@ -289,7 +245,8 @@ pub fn write_curves(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use asperity::study::{EnsemblePoint, Task};
+    use asperity::study::samplers::BemSampler;
+    use asperity::study::{sample_cost, EnsemblePoint, Task};
 
     #[test]
     fn a_resumed_study_counts_what_its_checkpoints_hold_and_times_only_what_is_left() {
@@ -307,7 +264,7 @@ mod tests {
             levels: 48,
             sweep_end: None,
         };
-        let segments = progress_segments(&spec, &[0, 3]);
+        let segments = StudyProgress::new(&spec, vec![0, 3]).segments();
         let mut eta = crate::progress::Eta::weighted(&segments);
         let loads = BemSampler::LOADS as u64;
         assert_eq!(eta.total(), 8 * loads);
@@ -323,7 +280,7 @@ mod tests {
             describe_sweep(&alpha),
             ", loads up to the first past 8 % contact"
         );
-        assert_eq!(progress_segments(&alpha, &[0, 3]), segments);
+        assert_eq!(StudyProgress::new(&alpha, vec![0, 3]).segments(), segments);
         // One sample of N = 64 computed in 10 s: 10 s per `small`, the rest in proportion.
         let eta_s = eta.remaining(4 * loads, 10.0).unwrap();
         assert!((eta_s - 10.0 * (3.0 * small + large) / small).abs() < 1e-9 * eta_s);
