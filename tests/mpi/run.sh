@@ -17,6 +17,8 @@
 # Needs an MPI implementation with mpirun (Debian: libopenmpi-dev openmpi-bin) and libclang
 # (libclang-dev) for the build; without mpirun it fails at once, saying what to install.
 # Usage: tests/mpi/run.sh [--no-build] [--no-python]
+#   ASPERITY_BIN=PATH: the serial binary to compare with (else built here); --no-build takes
+#   both binaries from ASPERITY_SERIAL and ASPERITY_MPI.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if ! command -v mpirun >/dev/null 2>&1; then
@@ -52,8 +54,14 @@ for arg in "$@"; do
     esac
 done
 if [ "$build" = 1 ]; then
-    cargo build --release -p asperity-cli --quiet
-    cp target/release/asperity "$work/serial"
+    # The serial binary: ASPERITY_BIN where given (.ci/run passes the one its tests built:
+    # the same code, and no second build of the workspace with other dependency features).
+    if [ -n "${ASPERITY_BIN:-}" ] && [ -x "$ASPERITY_BIN" ]; then
+        cp "$ASPERITY_BIN" "$work/serial"
+    else
+        cargo build --release -p asperity-cli --quiet
+        cp target/release/asperity "$work/serial"
+    fi
     cargo build --release -p asperity-cli --features mpi --quiet
     cp target/release/asperity "$work/mpi"
 else
