@@ -73,14 +73,15 @@
 
 use rayon::prelude::*;
 
-use super::capped_load::LOST_SET_LIMIT;
-use super::interface::{restore_capped_load, Interface};
+use super::context::{Context, Target};
+use super::grid_pass::{add_point_responses, CHUNK, CUT_LIMIT};
+use super::interface::{restore_capped_load, Interface, LOST_SET_LIMIT};
+use super::iteration::{Iteration, Limits};
 use super::mean_gap::MeanGapScratch;
 use super::plastic_field::{PlasticField, Restored};
 use super::preconditioner::Preconditioner;
 use super::ring_extension::{RingExtension, Ringed};
-use super::small_set::SmallSetRun;
-use super::solver::{ContactSolver, Target};
+use super::small_set::{small_set_start, SmallSet, SmallSetRun};
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 use crate::fft::Precision;
@@ -110,18 +111,6 @@ pub(super) const SINGLE_PRECISION_ABOVE: f64 = 1e-4;
 /// Relative load error below which the rescaling of `p` and `u` is skipped: a step that
 /// cut nothing keeps `Σ p` up to rounding (the direction sums to zero on the free set).
 const LOAD_ROUNDING: f64 = 1e-14;
-
-/// Pressures cut by the projection in one step that are corrected in `u` by their point
-/// responses (each one pass over the grid); beyond this many `u` is recomputed. Measured
-/// (free boundaries, 1 and 2 threads), the corrections cost as much as an operator
-/// application from 54 cuts at 64² and 128², 62–73 at 256², 75–84 at 512² and 108–128 at
-/// 1024² on: below all of them.
-pub(super) const CUT_LIMIT: usize = 48;
-
-/// Elements per chunk of the parallel passes. Fixed, never derived from the thread count:
-/// each chunk is summed in index order and the chunks' partial sums are added in chunk
-/// order, so every sum is the same bits for any number of threads.
-pub(super) const CHUNK: usize = 8192;
 
 /// Partial sums of one chunk of a pass (the meaning of each slot is the pass's).
 #[derive(Clone, Copy, Default)]
@@ -184,7 +173,7 @@ pub(super) struct BccgScratch {
     pub(super) mean_gap: Option<MeanGapScratch>,
     /// The rings around the free set that extend the gradient before the preconditioner
     /// (grids of at least [`RING_MIN_POINTS`] points).
-    rings: Option<RingExtension>,
+    pub(super) rings: Option<RingExtension>,
     /// Whether a step expected to end in a refresh takes `sᵀK s` from the forward
     /// transform alone (always, but in the test that compares it with forming `K s`).
     energy_steps: bool,
@@ -201,6 +190,9 @@ pub(super) struct BccgScratch {
     /// Under a cap: `K 1_C` of the capped set, for load restorations that keep `u`
     /// (`plastic_field.rs`).
     plastic: PlasticField,
+    /// The dense fields of the direct solve of small contact sets (`small_set.rs`),
+    /// allocated on first use.
+    pub(super) small_set: Option<SmallSet>,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -257,46 +249,9 @@ impl BccgScratch {
             single_steps: true,
             stalled: false,
             plastic: PlasticField::default(),
+            small_set: None,
         })
     }
-}
-
-/// Adds `c K e_t` to `u` for every `(t, c)` of `points`, from the operator's response to a
-/// unit pressure on pixel `(0, 0)`, `impulse`: free boundaries `K(Δi, Δj)` at
-/// `impulse[|Δi|][|Δj|]` (the kernel is even in both), periodic at the offsets modulo the
-/// grid. `grid` is `(rows, cols, periodic)`. `u` is row-major `rows × cols`. One parallel
-/// pass over the rows with all points (each value sums them in their order).
-pub(super) fn add_point_responses(
-    u: &mut [f64],
-    impulse: &[f64],
-    (rows, cols, periodic): (usize, usize, bool),
-    points: &[(usize, f64)],
-) {
-    u.par_chunks_mut(cols).enumerate().for_each(|(i, row)| {
-        for &(t, c) in points {
-            let (ti, tj) = (t / cols, t % cols);
-            let di = if periodic {
-                (i + rows - ti) % rows
-            } else {
-                i.abs_diff(ti)
-            };
-            let kernel = &impulse[di * cols..(di + 1) * cols];
-            // Columns j ≥ tj: offset j − tj.
-            for (uj, &k) in row[tj..].iter_mut().zip(&kernel[..cols - tj]) {
-                *uj += c * k;
-            }
-            // Columns j < tj: offset tj − j (free) or j − tj + cols (periodic).
-            if periodic {
-                for (uj, &k) in row[..tj].iter_mut().zip(&kernel[cols - tj..]) {
-                    *uj += c * k;
-                }
-            } else {
-                for (uj, &k) in row[..tj].iter_mut().rev().zip(&kernel[1..=tj]) {
-                    *uj += c * k;
-                }
-            }
-        }
-    });
 }
 
 /// What the gradient pass found.
@@ -632,27 +587,23 @@ fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
     Sums::total(partials)
 }
 
-impl ContactSolver {
-    /// The BCCG iteration for `target` to `tolerance` in at most `max_iterations`
-    /// iterations, from the current pressure (see the module docs).
-    pub(super) fn bccg(
+impl Iteration for BccgScratch {
+    /// The BCCG iteration for `target` to the tolerance in at most the iterations of
+    /// `limits`, from the solver's start in `cx` (see the module docs).
+    fn solve(
         &mut self,
+        cx: &mut Context,
         target: Target,
-        tolerance: f64,
-        max_iterations: usize,
+        limits: Limits,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let Limits {
+            tolerance,
+            max_iterations,
+        } = limits;
         // Single-precision energies only where the problem's scales keep them inside f32's
         // range (heights ×1e17 overflowed `sᵀK s` to infinity: issue 33, item 12).
-        let single_steps = self.bccg_scratch.single_steps && self.f32_safe(target);
-        let mut indentation = self.bccg_start(target);
-        // Small contact sets: solved directly (`small_set.rs`), then only checked here.
-        let small = self.small_set_start(target, max_iterations)?;
-        let small = self.cap_small_set(target, small);
-        if !small.exact {
-            self.problem
-                .operator
-                .apply(&self.state.pressure, &mut self.state.gap);
-        }
+        let single_steps = self.single_steps && Self::f32_safe(cx, target);
+        let (mut indentation, small) = self.bccg_start(cx, target, max_iterations)?;
         let mut applications = small.applications + usize::from(!small.exact);
         let (mut u, mut since_refresh, mut energy_transforms) = (Displacement::Exact, 0, 0);
         // Whether the last step cut more pressures than the point responses correct (the
@@ -661,27 +612,27 @@ impl ContactSolver {
         let mut previous_zg = 0.0;
         let mut iteration = small.applications;
         loop {
-            self.check_stop(iteration)?;
-            let gradient = self.gradient_pass(target, indentation);
+            cx.check_stop(iteration)?;
+            let gradient = self.gradient_pass(cx, target, indentation);
             indentation = gradient.indentation;
             if gradient.residual < tolerance && u == Displacement::Exact {
-                self.write_gap(indentation);
+                self.write_gap(cx, indentation);
                 let info = SolveInfo {
                     iterations: iteration,
                     residual: gradient.residual,
                     operator_applications: applications,
-                    energy_transforms: energy_transforms + self.bccg_scratch.extra_energies,
+                    energy_transforms: energy_transforms + self.extra_energies,
                 };
-                return Ok((self.finish(indentation, gradient.contact_points), info));
+                return Ok((cx.finish(indentation, gradient.contact_points), info));
             }
             let far = single_steps && gradient.residual > SINGLE_PRECISION_ABOVE;
-            let refresh_due = self.bccg_scratch.energy_steps
-                && (cutting || since_refresh + 1 >= REFRESH_INTERVAL);
+            let refresh_due =
+                self.energy_steps && (cutting || since_refresh + 1 >= REFRESH_INTERVAL);
             let leaving_single = u == Displacement::Single && !far && !refresh_due;
             if gradient.residual < tolerance || leaving_single {
                 // Converged on the recurrence, or near enough to need double precision
                 // (and no recomputation of `u` due after the step): the exact displacement.
-                self.refresh_displacement(false);
+                self.refresh_displacement(cx, false);
                 (applications, u, since_refresh) = (applications + 1, Displacement::Exact, 0);
                 continue;
             }
@@ -692,44 +643,55 @@ impl ContactSolver {
                 });
             }
             iteration += 1;
-            let direction = self.direction(target, &gradient, previous_zg);
+            let direction = self.direction(cx, target, &gradient, previous_zg);
             previous_zg = direction.zg;
             // Energies in single precision while far; every `K s` (`far` implies single steps).
             let single = far || (!refresh_due && single_steps);
-            let curvature = self.curvature(refresh_due, single);
+            let curvature = self.curvature(cx, refresh_due, single);
             (applications, energy_transforms) = match refresh_due {
                 true => (applications, energy_transforms + 1),
                 false => (applications + 1, energy_transforms),
             };
             let line = (direction.sg, curvature);
-            let step = self.step(target, &gradient, line, !refresh_due, iteration)?;
+            let step = self.step(cx, target, &gradient, line, !refresh_due, iteration)?;
             (cutting, since_refresh) = (step.cut_many, since_refresh + 1);
             applications += step.applications;
             u = u.max(Displacement::Recurrence);
             if step.stale || since_refresh >= REFRESH_INTERVAL {
-                self.refresh_displacement(far);
+                self.refresh_displacement(cx, far);
                 (applications, u) = (applications + 1, Displacement::recomputed(far));
                 since_refresh = 0;
             }
         }
     }
 
+    fn stalled(&self) -> bool {
+        self.stalled
+    }
+}
+
+impl BccgScratch {
     /// Under a cap: the direct solve of a small set (`small_set.rs`) knows the hard wall
     /// only; where its pressure passes the cap, it is projected onto `[0, h]`, the load
     /// restored, and the BCCG goes on from there (`u` then recomputed). Where it does not,
     /// it is the capped solution as well.
-    fn cap_small_set(&mut self, target: Target, small: SmallSetRun) -> SmallSetRun {
-        let Interface::Hardness { h } = self.interface else {
+    fn cap_small_set(
+        &mut self,
+        cx: &mut Context,
+        target: Target,
+        small: SmallSetRun,
+    ) -> SmallSetRun {
+        let Interface::Hardness { h } = cx.interface else {
             return small;
         };
-        let pressure = &mut self.state.pressure;
+        let pressure = &mut cx.state.pressure;
         if !pressure.iter().any(|&p| p > h) {
             return small;
         }
         pressure.iter_mut().for_each(|p| *p = p.min(h));
         if let Target::MeanPressure(mean_pressure) = target {
             let total = pressure.iter().sum::<f64>();
-            let (u, f) = (&self.state.gap, &self.problem.profile);
+            let (u, f) = (&cx.state.gap, &cx.problem.profile);
             restore_capped_load(pressure, (mean_pressure, h), total, |i| u[i] + f[i]);
         }
         SmallSetRun {
@@ -738,40 +700,58 @@ impl ContactSolver {
         }
     }
 
-    /// The start of a solve of `target`: the initial pressure, the iteration's scalars
-    /// reset; returns the first `d` (the last solve's under load control).
-    fn bccg_start(&mut self, target: Target) -> f64 {
-        let self_influence = self.problem.operator.self_influence();
-        self.initialise(target, self_influence);
+    /// The start of a solve of `target` (from the initial pressure the solver set): the
+    /// iteration's scalars reset, the direct solve of a small set; returns the first `d`
+    /// (the last solve's under load control) and what the direct solve did.
+    fn bccg_start(
+        &mut self,
+        cx: &mut Context,
+        target: Target,
+        max_iterations: usize,
+    ) -> Result<(f64, SmallSetRun), SolveError> {
         let indentation = match target {
             Target::Indentation(d) => d,
-            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
+            Target::MeanPressure(_) => cx.state.solved.map_or(0.0, |s| s.indentation),
         };
-        self.bccg_scratch.pending_scale = 1.0;
-        self.bccg_scratch.extra_energies = 0;
-        self.bccg_scratch.stalled = false;
-        if let Interface::Hardness { .. } = self.interface {
-            self.bccg_scratch.plastic.prepare(self.state.pressure.len());
+        self.pending_scale = 1.0;
+        self.extra_energies = 0;
+        self.stalled = false;
+        if let Interface::Hardness { .. } = cx.interface {
+            self.plastic.prepare(cx.state.pressure.len());
         }
-        if let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() {
+        if let Some(mean_gap) = self.mean_gap.as_mut() {
             mean_gap.reset();
         }
-        indentation
+        // Small contact sets: solved directly (`small_set.rs`), then only checked by the
+        // iteration; `u = K p` of the start unless the direct solve left it exact.
+        let small = small_set_start(
+            &mut self.small_set,
+            &self.impulse,
+            cx,
+            (target, max_iterations),
+        )?;
+        let small = self.cap_small_set(cx, target, small);
+        if !small.exact {
+            cx.problem
+                .operator
+                .apply(&cx.state.pressure, &mut cx.state.gap);
+        }
+        Ok((indentation, small))
     }
 
     /// Passes over the grid: `d` (load control, the mean of `u + f` on the contact set),
     /// the residual, the free set and its mean gradient; writes `Π g` on the free set (zero
     /// elsewhere) into the preconditioner's field and the gradient field.
-    fn gradient_pass(&mut self, target: Target, previous: f64) -> Gradient {
-        let scratch = &mut self.bccg_scratch;
-        let Rule { capped, h } = Rule::of(self.interface);
+    fn gradient_pass(&mut self, cx: &mut Context, target: Target, previous: f64) -> Gradient {
+        let scratch = &mut *self;
+        let Rule { capped, h } = Rule::of(cx.interface);
         let indentation = match target {
             Target::Indentation(d) => d,
             Target::MeanPressure(_) => {
                 let fields = (
-                    &mut self.state.gap[..],
-                    &mut self.state.pressure[..],
-                    &self.problem.profile[..],
+                    &mut cx.state.gap[..],
+                    &mut cx.state.pressure[..],
+                    &cx.problem.profile[..],
                 );
                 let scale = std::mem::replace(&mut scratch.pending_scale, 1.0);
                 let partials = &mut scratch.partials;
@@ -782,9 +762,9 @@ impl ContactSolver {
             }
         };
         let fields = (
-            &self.state.gap[..],
-            &self.problem.profile[..],
-            &self.state.pressure[..],
+            &cx.state.gap[..],
+            &cx.problem.profile[..],
+            &cx.state.pressure[..],
         );
         let out = (&mut scratch.gradient[..], &mut scratch.free[..]);
         let sums = match capped {
@@ -792,7 +772,7 @@ impl ContactSolver {
             true => gap_pass::<true>(fields, (indentation, h), out, &mut scratch.partials),
         };
         let [contact_points, free_points] = sums.n;
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
         let mode = MeanMode::of(target, periodic);
         let centre = if mode != MeanMode::Plain && free_points > 0 {
             sums.x[2] / free_points as f64
@@ -806,7 +786,7 @@ impl ContactSolver {
             centre
         };
         let residual = ((sums.x[0] + sums.x[1]) / contact_points.max(1) as f64).sqrt()
-            / self.problem.height_scale;
+            / cx.problem.height_scale;
         Gradient {
             indentation,
             free_points,
@@ -820,12 +800,12 @@ impl ContactSolver {
     /// Under displacement control with the mean gap deflated: the coarse curvature of the
     /// free set, for the coarse constant of the preconditioned gradient. False where the
     /// solve carries no mean-gap scratch (no deflation then).
-    fn deflate_mean(&mut self) -> bool {
-        let Some(mean_gap) = self.bccg_scratch.mean_gap.as_mut() else {
+    fn deflate_mean(&mut self, cx: &mut Context) -> bool {
+        let Some(mean_gap) = self.mean_gap.as_mut() else {
             return false;
         };
-        let (_, applied) = mean_gap.curvature(&mut self.problem.operator, &self.bccg_scratch.free);
-        self.bccg_scratch.extra_energies += applied as usize;
+        let (_, applied) = mean_gap.curvature(&mut cx.problem.operator, &self.free);
+        self.extra_energies += applied as usize;
         true
     }
 
@@ -833,31 +813,37 @@ impl ContactSolver {
     /// P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`, [`Ringed`] decorating the Fourier
     /// preconditioner), Π g formed row by row on its way into the transform (never stored
     /// whole).
-    fn precondition_gradient(&mut self, centre: f64) {
-        let scratch = &mut self.bccg_scratch;
+    fn precondition_gradient(&mut self, cx: &mut Context, centre: f64) {
+        let scratch = &mut *self;
         let (free, gradient) = (&scratch.free[..], &mut scratch.gradient[..]);
         let (z, centred) = (&mut scratch.preconditioned[..], (free, centre));
         match scratch.rings.as_mut() {
             Some(rings) => Ringed {
-                inner: &mut self.preconditioner,
+                inner: &mut cx.preconditioner,
                 rings,
                 set: free,
             }
             .apply_centred(gradient, z, centred),
-            None => self.preconditioner.apply_centred(gradient, z, centred),
+            None => cx.preconditioner.apply_centred(gradient, z, centred),
         }
     }
 
     /// Preconditions the gradient and makes the new direction `s` (in the direction
     /// buffer, zero off the free set, centred on it under load control). The sums of the
     /// new direction follow from those of the old one (one pass of sums, one of writes).
-    fn direction(&mut self, target: Target, gradient: &Gradient, previous_zg: f64) -> Direction {
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+    fn direction(
+        &mut self,
+        cx: &mut Context,
+        target: Target,
+        gradient: &Gradient,
+        previous_zg: f64,
+    ) -> Direction {
+        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
         let mode = MeanMode::of(target, periodic);
         let load_control = mode == MeanMode::Projected;
-        let deflated = mode == MeanMode::Deflated && self.deflate_mean();
-        self.precondition_gradient(gradient.centre);
-        let scratch = &mut self.bccg_scratch;
+        let deflated = mode == MeanMode::Deflated && self.deflate_mean(cx);
+        self.precondition_gradient(cx, gradient.centre);
+        let scratch = &mut *self;
         let (free, z) = (&scratch.free[..], &scratch.preconditioned[..]);
         let [z_sum, zg, s_sum, s_g, g_sum, z_g_old, g_old_sum] = direction_sums(
             (z, &scratch.gradient, &scratch.previous_gradient),
@@ -927,21 +913,21 @@ impl ContactSolver {
     /// points then stay far inside f32's range (`3.4e38` down to `1.2e-38`). Outside, the
     /// energies are computed in double precision (as PK's always are): the result is the
     /// same, only slower, whatever the units.
-    fn f32_safe(&self, target: Target) -> bool {
+    fn f32_safe(cx: &Context, target: Target) -> bool {
         let inside = |x: f64| x == 0.0 || (x.abs() > 2f64.powi(-40) && x.abs() < 2f64.powi(40));
         let load = match target {
             Target::MeanPressure(p) => p,
             Target::Indentation(d) => d,
         };
-        inside(self.problem.height_scale) && inside(load)
+        inside(cx.problem.height_scale) && inside(load)
     }
 
     /// `sᵀK s` of the direction (with `single`, in single precision). A step whose `u` is
     /// recomputed afterwards needs no more: with `energy_only`, from the forward transform
     /// of `s` alone (Parseval, about half an application); else with `w = K s` in the
     /// response field, for the step's `u`.
-    fn curvature(&mut self, energy_only: bool, single: bool) -> f64 {
-        let scratch = &mut self.bccg_scratch;
+    fn curvature(&mut self, cx: &mut Context, energy_only: bool, single: bool) -> f64 {
+        let scratch = &mut *self;
         let fields = (
             &scratch.direction[..],
             &mut scratch.response[..],
@@ -949,7 +935,7 @@ impl ContactSolver {
         );
         match single {
             true => curvature_with(&mut scratch.single, fields, energy_only),
-            false => curvature_with(&mut self.problem.operator, fields, energy_only),
+            false => curvature_with(&mut cx.problem.operator, fields, energy_only),
         }
     }
 
@@ -958,13 +944,14 @@ impl ContactSolver {
     /// `p` and `u` (in the next pass). `(sg, curvature)` is `(sᵀΠg, sᵀK s)`.
     fn step(
         &mut self,
+        cx: &mut Context,
         target: Target,
         gradient: &Gradient,
         (sg, curvature): (f64, f64),
         displacement: bool,
         iteration: usize,
     ) -> Result<Step, SolveError> {
-        let scratch = &mut self.bccg_scratch;
+        let scratch = &mut *self;
         if !crate::is_positive_finite(curvature) {
             // K is positive on every direction but the constant one of a periodic grid,
             // which the free set excludes short of full contact: rounding only.
@@ -974,10 +961,10 @@ impl ContactSolver {
             });
         }
         let alpha = -sg / curvature;
-        let fields = (&mut self.state.pressure[..], &mut self.state.gap[..]);
+        let fields = (&mut cx.state.pressure[..], &mut cx.state.gap[..]);
         let directions = (&scratch.direction[..], &scratch.response[..]);
         let slots = (&mut scratch.chunk_cuts[..], &mut scratch.partials[..]);
-        let Rule { capped, h } = Rule::of(self.interface);
+        let Rule { capped, h } = Rule::of(cx.interface);
         let sums = match (displacement, capped) {
             (true, false) => step_pass::<true, false>(fields, directions, (alpha, h), slots),
             (false, false) => step_pass::<false, false>(fields, directions, (alpha, h), slots),
@@ -1003,17 +990,21 @@ impl ContactSolver {
             {
                 corrections.extend_from_slice(&slots[..partial.n[0]]);
             }
-            let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-            let grid = (self.problem.rows, self.problem.cols, periodic);
-            add_point_responses(&mut self.state.gap, &scratch.impulse, grid, corrections);
+            let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
+            let grid = (cx.problem.rows, cx.problem.cols, periodic);
+            add_point_responses(&mut cx.state.gap, &scratch.impulse, grid, corrections);
         }
         if capped {
-            self.follow_capped_set(sums.n[1]);
+            self.follow_capped_set(cx, sums.n[1]);
         }
         let (stale, applications) = match target {
-            Target::MeanPressure(mean_pressure) => {
-                self.restore_step_load(mean_pressure, (total, peak), stale, (gradient, iteration))?
-            }
+            Target::MeanPressure(mean_pressure) => self.restore_step_load(
+                cx,
+                mean_pressure,
+                (total, peak),
+                stale,
+                (gradient, iteration),
+            )?,
             Target::Indentation(_) => (stale, 0),
         };
         Ok(Step {
@@ -1029,13 +1020,14 @@ impl ContactSolver {
     /// is now stale (it was with `stale`) and the operator applications it took.
     fn restore_step_load(
         &mut self,
+        cx: &mut Context,
         mean_pressure: f64,
         (total, peak): (f64, f64),
         mut stale: bool,
         (gradient, iteration): (&Gradient, usize),
     ) -> Result<(bool, usize), SolveError> {
-        let Rule { capped, h } = Rule::of(self.interface);
-        let n = self.state.pressure.len() as f64;
+        let Rule { capped, h } = Rule::of(cx.interface);
+        let n = cx.state.pressure.len() as f64;
         let scale = mean_pressure * n / total;
         // A step that cut nothing keeps Σ p up to rounding: the scaling is skipped.
         let rescaled = (scale - 1.0).abs() > LOAD_ROUNDING;
@@ -1045,10 +1037,10 @@ impl ContactSolver {
             // every step that overshot the load) or others pass it: the load is restored
             // by the capped scaling of Polonsky–Keer, the capped points kept there, `u`
             // with them (`plastic_field.rs`) or recomputed.
-            let (restored, applied) = self.restore_capped((mean_pressure, h, total), !stale);
-            let lost = self.bccg_scratch.plastic.lost_sets > LOST_SET_LIMIT;
+            let (restored, applied) = self.restore_capped(cx, (mean_pressure, h, total), !stale);
+            let lost = self.plastic.lost_sets > LOST_SET_LIMIT;
             if restored == Restored::CapacityLost || lost {
-                self.bccg_scratch.stalled = true;
+                self.stalled = true;
                 return Err(SolveError::NoConvergence {
                     iterations: iteration,
                     residual: gradient.residual,
@@ -1057,9 +1049,9 @@ impl ContactSolver {
             stale = restored == Restored::Stale;
             applications += applied as usize;
         } else if total > 0.0 && rescaled {
-            self.bccg_scratch.pending_scale = scale;
+            self.pending_scale = scale;
         } else if total <= 0.0 {
-            self.state.pressure.fill(mean_pressure);
+            cx.state.pressure.fill(mean_pressure);
             stale = true;
         }
         Ok((stale, applications))
@@ -1067,10 +1059,10 @@ impl ContactSolver {
 
     /// `K 1_C` follows the `changes` the step pass made to the capped set (listed in the
     /// second half of each chunk's slots).
-    fn follow_capped_set(&mut self, changes: usize) {
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-        let grid = (self.problem.rows, self.problem.cols, periodic);
-        let scratch = &mut self.bccg_scratch;
+    fn follow_capped_set(&mut self, cx: &mut Context, changes: usize) {
+        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
+        let grid = (cx.problem.rows, cx.problem.cols, periodic);
+        let scratch = &mut *self;
         let listed = scratch
             .chunk_cuts
             .chunks(2 * CUT_LIMIT)
@@ -1090,15 +1082,15 @@ impl ContactSolver {
     /// the steps' `K s` are).
     fn restore_capped(
         &mut self,
+        cx: &mut Context,
         (mean_pressure, h, total): (f64, f64, f64),
         exact_u: bool,
     ) -> (Restored, bool) {
-        let single =
-            self.bccg_scratch.single_steps && self.f32_safe(Target::MeanPressure(mean_pressure));
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-        let grid = (self.problem.rows, self.problem.cols, periodic);
-        let scratch = &mut self.bccg_scratch;
-        let (single_operator, operator) = (&mut scratch.single, &mut self.problem.operator);
+        let single = self.single_steps && Self::f32_safe(cx, Target::MeanPressure(mean_pressure));
+        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
+        let grid = (cx.problem.rows, cx.problem.cols, periodic);
+        let scratch = &mut *self;
+        let (single_operator, operator) = (&mut scratch.single, &mut cx.problem.operator);
         let mut applied = false;
         let apply = |x: &[f64], y: &mut [f64]| {
             applied = true;
@@ -1108,9 +1100,9 @@ impl ContactSolver {
             }
         };
         let fields = (
-            &mut self.state.pressure[..],
-            &mut self.state.gap[..],
-            &self.problem.profile[..],
+            &mut cx.state.pressure[..],
+            &mut cx.state.gap[..],
+            &cx.problem.profile[..],
         );
         let restored = scratch.plastic.restore_load(
             fields,
@@ -1123,49 +1115,28 @@ impl ContactSolver {
         (restored, applied)
     }
 
-    /// Periodic displacement control: the BCCG with `d` fixed and the constant mode of the
-    /// free set deflated (`mean_gap.rs`).
-    pub(super) fn bccg_periodic_indentation(
-        &mut self,
-        indentation: f64,
-    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
-        self.bccg(Target::Indentation(indentation), tolerance, max_iterations)
-    }
-
     /// `u = K p` (in the gap buffer; with `single`, in single precision), after the pending
     /// load restoration of `p` (that of `u` is moot).
-    fn refresh_displacement(&mut self, single: bool) {
-        let scale = std::mem::replace(&mut self.bccg_scratch.pending_scale, 1.0);
+    fn refresh_displacement(&mut self, cx: &mut Context, single: bool) {
+        let scale = std::mem::replace(&mut self.pending_scale, 1.0);
         if scale != 1.0 {
-            self.state
+            cx.state
                 .pressure
                 .par_chunks_mut(CHUNK)
                 .for_each(|p| p.iter_mut().for_each(|v| *v *= scale));
         }
-        let (pressure, gap) = (&self.state.pressure, &mut self.state.gap);
+        let (pressure, gap) = (&cx.state.pressure, &mut cx.state.gap);
         match single {
-            true => self.bccg_scratch.single.apply(pressure, gap),
-            false => self.problem.operator.apply(pressure, gap),
+            true => self.single.apply(pressure, gap),
+            false => cx.problem.operator.apply(pressure, gap),
         }
     }
 
     /// Turns the displacement in the gap buffer into the gap `u + f − d`.
-    fn write_gap(&mut self, indentation: f64) {
-        for (g, &f) in self.state.gap.iter_mut().zip(&self.problem.profile) {
+    fn write_gap(&mut self, cx: &mut Context, indentation: f64) {
+        for (g, &f) in cx.state.gap.iter_mut().zip(&cx.problem.profile) {
             *g += f - indentation;
         }
-    }
-}
-
-#[cfg(test)]
-impl ContactSolver {
-    /// Switches the rings of the BCCG and of the frozen-set CG on or off whatever the grid's
-    /// size (to test the solver both ways on small grids).
-    pub(super) fn set_edge_rings(&mut self, on: bool) {
-        let operator = &self.problem.operator;
-        self.bccg_scratch.rings = on.then(|| RingExtension::on_grid_of(operator));
-        self.stiffness_work = Some(super::stiffness::StiffnessWork::new(operator, on));
     }
 }
 
@@ -1202,7 +1173,7 @@ mod tests {
             assert!(d.abs() < 1e-6, "{heights:e} {modulus:e}: {d:e}");
         }
     }
-    use super::super::{Control, HalfSpace, Parallelism, SolverKind, SolverParams};
+    use super::super::{ContactSolver, Control, HalfSpace, Parallelism, SolverKind, SolverParams};
     use super::*;
     use crate::elastic::Boundary;
     use crate::surface::Surface;

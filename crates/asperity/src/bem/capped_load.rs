@@ -20,7 +20,7 @@
 //! nondecreasing (its slope is the frozen-set stiffness `1ᵀ K_EE⁻¹ 1 ≥ 0` of the elastic
 //! set `E`), zero at `d = 0` (the highest point just touches) and tends to `n H` (every
 //! point at the cap), so the load `n p̄ < n H` is carried at some `d`. Where an iteration
-//! has lost the set more than [`LOST_SET_LIMIT`] times in a solve, [`ContactSolver::capped_load`]
+//! has lost the set more than `LOST_SET_LIMIT` (`interface.rs`) times in a solve, [`ContactSolver::capped_load`]
 //! finds that `d` by regula falsi (Illinois) on `F(d) − n p̄` from the bracket
 //! `[0, d₁]`, `d₁` doubled from the bearing area's indentation until it carries more than
 //! the load, each solve warm from the last; within [`LOAD_HANDOVER`] of the load the load
@@ -28,16 +28,10 @@
 //! `1 ± LOAD_HANDOVER`, holding the sets), so the load is exact as in any load-controlled
 //! solve and convergence is judged by the same residual.
 
+use super::context::Target;
 use super::interface::{bearing_start, Interface};
-use super::solver::{ContactSolver, Target};
+use super::solver::ContactSolver;
 use super::{ContactSummary, SolveError, SolveInfo, SolverKind};
-
-/// The restorations that may lose the plastic set (release it or restart the pressure) in
-/// one load-controlled solve before it counts as cycling. The rough surfaces of the tests
-/// converge with at most a few (near fully plastic contact the bearing restart is what
-/// brings the iteration to the right contact size); the cycling paraboloid loses it at
-/// every step.
-pub(super) const LOST_SET_LIMIT: usize = 8;
 
 /// The relative load error of a displacement-controlled solve at which the root search
 /// hands over to the load iteration: well above the load's noise from the solves'
@@ -90,14 +84,11 @@ impl ContactSolver {
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let target = Target::MeanPressure(mean_pressure);
-        let result = self.iteration_of(kind, target, tolerance, max_iterations);
+        let result = self.iterate(kind, target, tolerance, max_iterations);
         let Err(SolveError::NoConvergence { iterations, .. }) = result else {
             return result;
         };
-        let stalled = match kind {
-            SolverKind::Bccg => self.bccg_scratch.stalled,
-            SolverKind::PolonskyKeer => self.pk_scratch.as_ref().is_some_and(|pk| pk.stalled),
-        };
+        let stalled = self.stalled(kind);
         if !stalled {
             return result;
         }
@@ -111,7 +102,7 @@ impl ContactSolver {
             .map_err(|e| spent.error(e))?;
         let left = max_iterations.saturating_sub(spent.iterations).max(1);
         let (summary, info) = self
-            .iteration_of(kind, target, tolerance, left)
+            .iterate(kind, target, tolerance, left)
             .map_err(|e| spent.error(e))?;
         spent.add(&info);
         Ok((
@@ -122,20 +113,6 @@ impl ContactSolver {
                 ..info
             },
         ))
-    }
-
-    /// The iteration of `kind` for `target`.
-    fn iteration_of(
-        &mut self,
-        kind: SolverKind,
-        target: Target,
-        tolerance: f64,
-        max_iterations: usize,
-    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        match kind {
-            SolverKind::Bccg => self.bccg(target, tolerance, max_iterations),
-            SolverKind::PolonskyKeer => self.polonsky_keer(target, tolerance, max_iterations),
-        }
     }
 
     /// Leaves the solver in the displacement-controlled solution whose load is within
@@ -150,7 +127,7 @@ impl ContactSolver {
         spent: &mut Spent,
     ) -> Result<(), SolveError> {
         let mut d = self.bearing_indentation(mean_pressure);
-        self.state.solved = None;
+        self.cx.state.solved = None;
         // Brackets (d, F(d) − p̄): F(0) = 0 below the load; `above` once found. Illinois:
         // the value kept at an end that stays twice in a row is halved.
         let mut below = (0.0, -mean_pressure);
@@ -158,10 +135,9 @@ impl ContactSolver {
         let (mut last_side, mut load_error) = (0i8, f64::INFINITY);
         for _ in 0..MAX_SOLVES {
             let left = max_iterations.saturating_sub(spent.iterations).max(1);
-            let (summary, info) =
-                self.iteration_of(kind, Target::Indentation(d), tolerance, left)?;
+            let (summary, info) = self.iterate(kind, Target::Indentation(d), tolerance, left)?;
             spent.add(&info);
-            self.state.solved = Some(summary);
+            self.cx.state.solved = Some(summary);
             let excess = summary.mean_pressure - mean_pressure;
             load_error = (excess / mean_pressure).abs();
             if load_error < LOAD_HANDOVER {
@@ -206,12 +182,15 @@ impl ContactSolver {
     /// positive one where that is the top itself. Overwrites the pressure (the solve that
     /// follows starts cold).
     fn bearing_indentation(&mut self, mean_pressure: f64) -> f64 {
-        let Interface::Hardness { h } = self.interface else {
+        let Interface::Hardness { h } = self.cx.interface else {
             unreachable!("the root search runs under a cap only")
         };
-        let profile = &self.problem.profile;
-        bearing_start(&mut self.state.pressure, (mean_pressure, h), |i| profile[i]);
+        let profile = &self.cx.problem.profile;
+        bearing_start(&mut self.cx.state.pressure, (mean_pressure, h), |i| {
+            profile[i]
+        });
         let d = self
+            .cx
             .state
             .pressure
             .iter()
@@ -220,7 +199,7 @@ impl ContactSolver {
             .fold(0.0f64, |m, (_, &f)| m.max(f));
         match d > 0.0 {
             true => d,
-            false => 1e-3 * self.problem.height_scale,
+            false => 1e-3 * self.cx.problem.height_scale,
         }
     }
 }

@@ -24,50 +24,9 @@
 //! fields.
 
 use super::solver::ContactSolver;
-use super::{Control, SolveError};
+use super::threshold::{FullContactScratch, FullContactThreshold};
+use super::SolveError;
 use crate::elastic::Boundary;
-
-/// Where the gap closes everywhere: the mean pressure and the indentation, as
-/// [`ContactSolver::full_contact_threshold`] computes them; or bounds below them
-/// ([`ContactSolver::full_contact_lower_bound`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FullContactThreshold {
-    /// Mean pressure over the nominal area.
-    pub mean_pressure: f64,
-    /// Indentation of the highest point: free boundaries `d* = max(K⁻¹f / K⁻¹1)`;
-    /// periodic boundaries, with displacements of zero mean, `max(h) − mean(h)` (see
-    /// [`Control::Indentation`]). `None` where unknown.
-    pub indentation: Option<f64>,
-}
-
-impl FullContactThreshold {
-    /// The threshold in the quantity `control` prescribes (mean pressure, force or
-    /// indentation), where known; `nominal_area` converts a mean pressure to a force.
-    pub fn in_units_of(&self, control: Control, nominal_area: f64) -> Option<f64> {
-        match control {
-            Control::MeanPressure(_) => Some(self.mean_pressure),
-            Control::Force(_) => Some(self.mean_pressure * nominal_area),
-            Control::Indentation(_) => self.indentation,
-        }
-    }
-}
-
-/// The fields of the periodic threshold (`K⁺f`) and of the lower bound (the weights `v`
-/// and `K v`), owned by the solver and allocated on first use.
-pub(super) struct FullContactScratch {
-    weights: Vec<f64>,
-    response: Vec<f64>,
-}
-
-impl FullContactScratch {
-    /// The fields in `slot`, allocated there for `len` points on first use.
-    fn lend(slot: &mut Option<Self>, len: usize) -> &mut Self {
-        slot.get_or_insert_with(|| FullContactScratch {
-            weights: vec![0.0; len],
-            response: vec![0.0; len],
-        })
-    }
-}
 
 /// The weightings of the lower bound (module docs).
 #[derive(Debug, Clone, Copy)]
@@ -84,15 +43,21 @@ impl ContactSolver {
     /// `u + f` on the contact set and `u + f ≥ d` elsewhere). Computed once per surface, in
     /// the full-contact fields.
     pub(super) fn periodic_full_contact(&mut self) -> FullContactThreshold {
-        if let Some(full) = self.state.full_contact.filter(|f| f.indentation.is_some()) {
+        if let Some(full) = self
+            .cx
+            .state
+            .full_contact
+            .filter(|f| f.indentation.is_some())
+        {
             return full;
         }
-        let len = self.problem.profile.len();
+        let len = self.cx.problem.profile.len();
         let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, len);
         if self
+            .cx
             .problem
             .operator
-            .apply_pseudo_inverse(&self.problem.profile, &mut scratch.weights)
+            .apply_pseudo_inverse(&self.cx.problem.profile, &mut scratch.weights)
             .is_err()
         {
             // Free boundaries have no spectral inverse (callers check the boundary).
@@ -103,12 +68,12 @@ impl ContactSolver {
         }
         let mean_pressure = scratch.weights.iter().fold(0.0f64, |m, &v| m.max(v));
         let indentation =
-            self.problem.profile.iter().sum::<f64>() / self.problem.profile.len() as f64;
+            self.cx.problem.profile.iter().sum::<f64>() / self.cx.problem.profile.len() as f64;
         let full = FullContactThreshold {
             mean_pressure,
             indentation: Some(indentation),
         };
-        self.state.full_contact = Some(full);
+        self.cx.state.full_contact = Some(full);
         full
     }
 
@@ -118,11 +83,11 @@ impl ContactSolver {
     /// two preconditioned conjugate-gradient solves on the full grid, computed once per
     /// surface. Either way the last solved state and its warm start are kept.
     pub fn full_contact_threshold(&mut self) -> Result<FullContactThreshold, SolveError> {
-        match self.problem.operator.boundary() {
+        match self.cx.problem.operator.boundary() {
             Boundary::Periodic => Ok(self.periodic_full_contact()),
             // Two CG solves: on a worker of the pool, as the solves (`pool.rs`).
             Boundary::Free => {
-                crate::pool::on_worker(self.params.parallelism, || self.free_full_contact())
+                crate::pool::on_worker(self.cx.params.parallelism, || self.free_full_contact())
             }
         }
     }
@@ -133,13 +98,18 @@ impl ContactSolver {
     /// applications) and `max f` (the depth of the deepest point) for the indentation.
     /// Works in the full-contact fields only: the last solved state is kept.
     pub fn full_contact_lower_bound(&mut self) -> Result<FullContactThreshold, SolveError> {
-        if self.problem.operator.boundary() == Boundary::Periodic {
+        if self.cx.problem.operator.boundary() == Boundary::Periodic {
             return self.full_contact_threshold();
         }
-        let n = self.problem.profile.len() as f64;
-        let deepest = self.problem.profile.iter().fold(0.0f64, |m, &f| m.max(f));
+        let n = self.cx.problem.profile.len() as f64;
+        let deepest = self
+            .cx
+            .problem
+            .profile
+            .iter()
+            .fold(0.0f64, |m, &f| m.max(f));
         let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, n as usize);
-        let problem = &mut self.problem;
+        let problem = &mut self.cx.problem;
         let mut bound = 0.0f64;
         for weights in [Weights::Depth, Weights::Laplacian] {
             let grid = (problem.rows, problem.cols);
@@ -205,7 +175,7 @@ fn fill_weights(
 #[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::{rough, rough_grid, sphere};
-    use super::super::{HalfSpace, SolverParams};
+    use super::super::{Control, HalfSpace, SolverParams};
     use super::*;
 
     fn solver(surface: &crate::surface::Surface, boundary: Boundary) -> ContactSolver {

@@ -53,10 +53,13 @@ pub mod adhesion;
 mod bccg;
 mod capped_load;
 pub mod conductance;
+mod context;
 mod full_contact;
+mod grid_pass;
 mod interface;
 #[cfg(test)]
 mod interruption;
+mod iteration;
 mod mean_gap;
 mod plastic_field;
 mod plasticity;
@@ -70,11 +73,13 @@ pub mod sweep;
 pub mod tangential;
 #[cfg(test)]
 mod tests;
+mod threshold;
 
-pub use full_contact::FullContactThreshold;
+pub use context::ContactProblem;
 pub use interface::Interface;
 pub use plasticity::{load_path, PathPoint};
-pub use solver::{ContactProblem, ContactSolver};
+pub use solver::ContactSolver;
+pub use threshold::FullContactThreshold;
 
 use ndarray::Array2;
 

@@ -24,7 +24,7 @@
 
 use rayon::prelude::*;
 
-use super::bccg::{add_point_responses, CHUNK, CUT_LIMIT};
+use super::grid_pass::{add_point_responses, CHUNK, CUT_LIMIT};
 use super::interface::{capped_scale, restore_capped_load, CappedRestoration};
 
 /// `K 1_C` of the capped set `C = {p ≥ h}` of the current iterate, kept through a solve.

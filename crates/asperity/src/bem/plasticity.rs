@@ -36,7 +36,7 @@ impl ContactSolver {
     /// next solve starts cold; a kept plastic displacement stays.
     pub fn set_interface(&mut self, interface: Interface) -> Result<(), SolveError> {
         interface.validate()?;
-        self.interface = interface;
+        self.cx.interface = interface;
         self.reset();
         Ok(())
     }
@@ -49,20 +49,21 @@ impl ContactSolver {
 
     /// The interface in use.
     pub fn interface(&self) -> Interface {
-        self.interface
+        self.cx.interface
     }
 
     /// The plastic displacement of the last solve, `−g ≥ 0` where the pressure is at the
     /// hardness, zero elsewhere (`rows × cols`). `None` before a successful solve.
     pub fn plastic_displacement(&self) -> Option<Array2<f64>> {
-        self.state.solved?;
+        self.cx.state.solved?;
         let (rows, cols) = self.dim();
-        let interface = self.interface;
+        let interface = self.cx.interface;
         let w = self
+            .cx
             .state
             .pressure
             .iter()
-            .zip(&self.state.gap)
+            .zip(&self.cx.state.gap)
             .map(|(&p, &g)| match interface.plastic(p) {
                 true => (-g).max(0.0),
                 false => 0.0,
@@ -76,19 +77,20 @@ impl ContactSolver {
     /// solved state stays a solution of the new profile. Returns the largest `w` added.
     /// Without a solved state nothing changes.
     pub fn keep_plastic_displacement(&mut self) -> f64 {
-        if self.state.solved.is_none() {
+        if self.cx.state.solved.is_none() {
             return 0.0;
         }
-        let len = self.problem.profile.len();
+        let len = self.cx.problem.profile.len();
         let permanent = self.permanent.get_or_insert_with(|| vec![0.0; len]);
-        let interface = self.interface;
+        let interface = self.cx.interface;
         let mut largest = 0.0f64;
         for (((f, g), &p), total) in self
+            .cx
             .problem
             .profile
             .iter_mut()
-            .zip(self.state.gap.iter_mut())
-            .zip(&self.state.pressure)
+            .zip(self.cx.state.gap.iter_mut())
+            .zip(&self.cx.state.pressure)
             .zip(permanent.iter_mut())
         {
             if interface.plastic(p) && *g < 0.0 {
@@ -313,7 +315,9 @@ mod tests {
                         // control (local springs (d − f)/K₀₀): no iterate reaches it.
                         let peak = wall.pressure().fold(0.0f64, |m, &p| m.max(p));
                         let springs = match control {
-                            Control::Indentation(d) => d / wall.problem.operator.self_influence(),
+                            Control::Indentation(d) => {
+                                d / wall.cx.problem.operator.self_influence()
+                            }
                             _ => 0.0,
                         };
                         let peak = peak.max(springs);
@@ -601,7 +605,7 @@ mod tests {
             * SolverParams::default().tolerance
             * elastic.problem().height_scale()
             * (bccg.contact_points as f64).sqrt()
-            / elastic.problem.operator.self_influence();
+            / elastic.cx.problem.operator.self_influence();
         let gap = bccg_p
             .iter()
             .zip(pk_p)

@@ -19,9 +19,9 @@
 //! keeps results bit-identical for any thread count (the FFTs are parallel and
 //! independent of it too).
 
-use super::capped_load::LOST_SET_LIMIT;
-use super::interface::{restore_capped_load, CappedRestoration, Interface};
-use super::solver::{ContactSolver, Target};
+use super::context::{Context, Target};
+use super::interface::{restore_capped_load, CappedRestoration, Interface, LOST_SET_LIMIT};
+use super::iteration::{Iteration, Limits};
 use super::{ContactSummary, SolveError, SolveInfo};
 
 /// The iteration's own fields: the conjugate direction `t` and its response `K t`. Owned
@@ -36,62 +36,57 @@ pub(super) struct PkScratch {
     pub(super) stalled: bool,
 }
 
-impl ContactSolver {
-    /// The Polonsky–Keer iteration for `target` to `tolerance` in at most `max_iterations`
-    /// iterations, from the current pressure (see [`ContactSolver::solve`]), in its own
-    /// fields.
-    pub(super) fn polonsky_keer(
-        &mut self,
-        target: Target,
-        tolerance: f64,
-        max_iterations: usize,
-    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
-        let len = self.problem.profile.len();
-        let mut pk = self.pk_scratch.take().unwrap_or_else(|| PkScratch {
+impl PkScratch {
+    /// The fields for a grid of `len` points.
+    pub(super) fn new(len: usize) -> Self {
+        PkScratch {
             direction: vec![0.0; len],
             response: vec![0.0; len],
             stalled: false,
-        });
-        pk.stalled = false;
-        let result = self.polonsky_keer_in(&mut pk, target, tolerance, max_iterations);
-        self.pk_scratch = Some(pk);
-        result
+        }
     }
+}
 
-    /// [`ContactSolver::polonsky_keer`] in the fields `pk`.
-    fn polonsky_keer_in(
+impl Iteration for PkScratch {
+    /// The Polonsky–Keer iteration for `target` to the tolerance in at most the iterations
+    /// of `limits`, from the solver's start in `cx` (see [`super::ContactSolver::solve`]),
+    /// in its own fields.
+    fn solve(
         &mut self,
-        pk: &mut PkScratch,
+        cx: &mut Context,
         target: Target,
-        tolerance: f64,
-        max_iterations: usize,
+        limits: Limits,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        self.stalled = false;
+        let Limits {
+            tolerance,
+            max_iterations,
+        } = limits;
+        let pk = self;
         let load_control = matches!(target, Target::MeanPressure(_));
-        let interface = self.interface;
-        let self_influence = self.problem.operator.self_influence();
-        self.initialise(target, self_influence);
+        let interface = cx.interface;
         let mut indentation = match target {
             Target::Indentation(d) => d,
-            Target::MeanPressure(_) => self.state.solved.map_or(0.0, |s| s.indentation),
+            Target::MeanPressure(_) => cx.state.solved.map_or(0.0, |s| s.indentation),
         };
         let mut g_old = 0.0;
         let mut conjugate = false;
         let (mut iteration, mut lost_sets) = (0, 0);
         loop {
-            self.check_stop(iteration)?;
-            self.problem
+            cx.check_stop(iteration)?;
+            cx.problem
                 .operator
-                .apply(&self.state.pressure, &mut self.state.gap);
+                .apply(&cx.state.pressure, &mut cx.state.gap);
             let pass = gap_and_direction(
                 interface,
-                (&self.state.pressure, &self.problem.profile),
-                &mut self.state.gap,
+                (&cx.state.pressure, &cx.problem.profile),
+                &mut cx.state.gap,
                 &mut pk.direction,
                 load_control,
                 &mut indentation,
                 if conjugate { g_old } else { 0.0 },
             );
-            let residual = pass.residual(self.problem.height_scale);
+            let residual = pass.residual(cx.problem.height_scale);
             if residual < tolerance {
                 let info = SolveInfo {
                     iterations: iteration,
@@ -99,7 +94,7 @@ impl ContactSolver {
                     operator_applications: 2 * iteration + 1,
                     energy_transforms: 0,
                 };
-                return Ok((self.finish(indentation, pass.contact_points), info));
+                return Ok((cx.finish(indentation, pass.contact_points), info));
             }
             if iteration >= max_iterations || !residual.is_finite() {
                 return Err(SolveError::NoConvergence {
@@ -110,9 +105,9 @@ impl ContactSolver {
             g_old = pass.gap_squared;
             iteration += 1;
 
-            let (total, entered) = self.pk_step(pk, load_control, pass.moving_points);
+            let (total, entered) = pk_step(cx, pk, load_control, pass.moving_points);
             // Pass E: the prescribed load (a reset pressure restarts the directions).
-            let restoration = self.restore_load(target, total);
+            let restoration = restore_load(cx, target, total);
             conjugate = !entered && restoration != CappedRestoration::Restarted;
             let capped = matches!(interface, Interface::Hardness { .. });
             lost_sets += (capped && restoration.lost_the_set()) as usize;
@@ -126,59 +121,63 @@ impl ContactSolver {
         }
     }
 
-    /// One step along `pk.direction`: its response, the step length τ, and the pressure
-    /// update (penetrating points enter with p = −τ g; before any step exists, the empty
-    /// set, a Jacobi step with the self-influence). Returns the pressures' sum and whether
-    /// points entered.
-    fn pk_step(
-        &mut self,
-        pk: &mut PkScratch,
-        load_control: bool,
-        moving_points: usize,
-    ) -> (f64, bool) {
-        let interface = self.interface;
-        self.problem.operator.apply(&pk.direction, &mut pk.response);
-        let tau = step_length(
-            interface,
-            &self.state.pressure,
-            &self.state.gap,
-            &pk.direction,
-            &pk.response,
-            load_control,
-            moving_points,
-        );
-        let self_influence = self.problem.operator.self_influence();
-        let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
-        update_pressure(
-            interface,
-            &mut self.state.pressure,
-            &self.state.gap,
-            &pk.direction,
-            tau,
-            entry_step,
-        )
+    fn stalled(&self) -> bool {
+        self.stalled
     }
+}
 
-    /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
-    /// sum `total` (or reset to uniform if nothing is left: `Restarted`); under a cap by
-    /// [`restore_capped_load`].
-    fn restore_load(&mut self, target: Target, total: f64) -> CappedRestoration {
-        let Target::MeanPressure(mean_pressure) = target else {
-            return CappedRestoration::Held;
-        };
-        let pressure = &mut self.state.pressure;
-        if let Interface::Hardness { h } = self.interface {
-            let gap = &self.state.gap;
-            return restore_capped_load(pressure, (mean_pressure, h), total, |i| gap[i]);
-        }
-        if total > 0.0 {
-            let scale = mean_pressure * pressure.len() as f64 / total;
-            pressure.iter_mut().for_each(|v| *v *= scale);
-            CappedRestoration::Held
-        } else {
-            pressure.fill(mean_pressure);
-            CappedRestoration::Restarted
-        }
+/// One step along `pk.direction`: its response, the step length τ, and the pressure
+/// update (penetrating points enter with p = −τ g; before any step exists, the empty
+/// set, a Jacobi step with the self-influence). Returns the pressures' sum and whether
+/// points entered.
+fn pk_step(
+    cx: &mut Context,
+    pk: &mut PkScratch,
+    load_control: bool,
+    moving_points: usize,
+) -> (f64, bool) {
+    let interface = cx.interface;
+    cx.problem.operator.apply(&pk.direction, &mut pk.response);
+    let tau = step_length(
+        interface,
+        &cx.state.pressure,
+        &cx.state.gap,
+        &pk.direction,
+        &pk.response,
+        load_control,
+        moving_points,
+    );
+    let self_influence = cx.problem.operator.self_influence();
+    let entry_step = if tau > 0.0 { tau } else { 1.0 / self_influence };
+    update_pressure(
+        interface,
+        &mut cx.state.pressure,
+        &cx.state.gap,
+        &pk.direction,
+        tau,
+        entry_step,
+    )
+}
+
+/// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
+/// sum `total` (or reset to uniform if nothing is left: `Restarted`); under a cap by
+/// [`restore_capped_load`].
+fn restore_load(cx: &mut Context, target: Target, total: f64) -> CappedRestoration {
+    let Target::MeanPressure(mean_pressure) = target else {
+        return CappedRestoration::Held;
+    };
+    let pressure = &mut cx.state.pressure;
+    if let Interface::Hardness { h } = cx.interface {
+        let gap = &cx.state.gap;
+        return restore_capped_load(pressure, (mean_pressure, h), total, |i| gap[i]);
+    }
+    if total > 0.0 {
+        let scale = mean_pressure * pressure.len() as f64 / total;
+        pressure.iter_mut().for_each(|v| *v *= scale);
+        CappedRestoration::Held
+    } else {
+        pressure.fill(mean_pressure);
+        CappedRestoration::Restarted
     }
 }
 
@@ -337,7 +336,7 @@ fn update_pressure(
 
 #[cfg(test)]
 pub(super) mod tests {
-    use super::super::{Control, HalfSpace, SolverParams};
+    use super::super::{ContactSolver, Control, HalfSpace, SolverParams};
     use super::*;
     use crate::elastic::Boundary;
     use crate::reference::{Hertz, Westergaard};

@@ -25,17 +25,17 @@
 //! factorisations, if the factor breaks down, or at once when more than
 //! [`GIVE_UP_ENTERING`] limits' worth of points have a negative gap (a load far too large
 //! for a small set; from cold a bound tells that before the check's operator
-//! application, `ContactSolver::highest_point_gives_up`). Its result is only a start: the
+//! application, `highest_point_gives_up`). Its result is only a start: the
 //! BCCG's own residual, on an exact `u`, decides convergence, and a converged dense
 //! solution passes it with no iteration.
 //!
 //! The factor also holds the frozen-set stiffness of the solved state: `x` is `K_SS⁻¹ 1_S`
-//! exactly, and [`ContactSolver::small_set_tangent`] hands it to the stiffness code when
+//! exactly, and `tangent` hands it to the stiffness code when
 //! the set is still the solved state's (its residual checked against the stiffness
 //! tolerance).
 
+use super::context::{Context, Target};
 use super::interface::Interface;
-use super::solver::{ContactSolver, Target};
 use super::SolveError;
 
 /// The contact rule of the direct solve (it serves the BCCG, which solves the hard wall).
@@ -287,187 +287,190 @@ fn highest_point(profile: &[f64]) -> usize {
     (0..profile.len()).fold(0, |t, k| if profile[k] < profile[t] { k } else { t })
 }
 
-impl ContactSolver {
-    /// Runs the direct iteration from the start [`ContactSolver::initialise`] left, if its
-    /// set is small (module docs); leaves a pressure for the BCCG to finish.
-    /// At most `max_iterations` operator applications.
-    pub(super) fn small_set_start(
-        &mut self,
-        target: Target,
-        max_iterations: usize,
-    ) -> Result<SmallSetRun, SolveError> {
-        let (rows, cols) = (self.problem.rows, self.problem.cols);
-        let len = rows * cols;
-        let limit = limit(len);
-        let start = self
-            .state
-            .pressure
-            .iter()
-            .filter(|&&p| WALL.in_contact(p))
-            .count();
-        let cold_load = self.state.solved.is_none() && matches!(target, Target::MeanPressure(_));
-        // The direct solve knows the hard wall only: from a start with points at a cap
-        // it would throw the plastic set away (`capped_load.rs` finishes a search there).
-        let cap = self.interface.cap();
-        let plastic_start = self.state.pressure.iter().any(|&p| p >= cap);
-        if (start > limit && !cold_load) || plastic_start {
+/// Runs the direct iteration from the start the solver left in `cx`, if its set is small
+/// (module docs), in the fields of `slot` (allocated there on first use) with the operator's
+/// impulse response `impulse`; leaves a pressure for the BCCG to finish. At most
+/// `max_iterations` operator applications.
+pub(super) fn small_set_start(
+    slot: &mut Option<SmallSet>,
+    impulse: &[f64],
+    cx: &mut Context,
+    (target, max_iterations): (Target, usize),
+) -> Result<SmallSetRun, SolveError> {
+    let (rows, cols) = (cx.problem.rows, cx.problem.cols);
+    let len = rows * cols;
+    let limit = limit(len);
+    let start = cx
+        .state
+        .pressure
+        .iter()
+        .filter(|&&p| WALL.in_contact(p))
+        .count();
+    let cold_load = cx.state.solved.is_none() && matches!(target, Target::MeanPressure(_));
+    // The direct solve knows the hard wall only: from a start with points at a cap
+    // it would throw the plastic set away (`capped_load.rs` finishes a search there).
+    let cap = cx.interface.cap();
+    let plastic_start = cx.state.pressure.iter().any(|&p| p >= cap);
+    if (start > limit && !cold_load) || plastic_start {
+        return Ok(SmallSetRun {
+            applications: 0,
+            exact: false,
+        });
+    }
+    if let Target::MeanPressure(p) = target {
+        if start > limit && highest_point_gives_up(impulse, cx, (p, limit)) {
+            // The first solve would give up: straight to the uniform start.
+            cx.state.pressure.fill(p);
             return Ok(SmallSetRun {
                 applications: 0,
                 exact: false,
             });
         }
-        if let Target::MeanPressure(p) = target {
-            if start > limit && self.highest_point_gives_up(p, limit) {
-                // The first solve would give up: straight to the uniform start.
-                self.state.pressure.fill(p);
-                return Ok(SmallSetRun {
-                    applications: 0,
-                    exact: false,
-                });
+    }
+    let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
+    let small = slot.get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
+    small.clear();
+    if start > limit {
+        small.push(highest_point(&cx.problem.profile));
+    } else {
+        for (k, &p) in cx.state.pressure.iter().enumerate() {
+            if WALL.in_contact(p) {
+                small.push(k);
             }
-        }
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
-        let small = self
-            .small_set
-            .get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
-        small.clear();
-        if start > limit {
-            small.push(highest_point(&self.problem.profile));
-        } else {
-            for (k, &p) in self.state.pressure.iter().enumerate() {
-                if WALL.in_contact(p) {
-                    small.push(k);
-                }
-            }
-        }
-        let run = self.small_set_iterate(target, max_iterations)?;
-        let solved = self.small_set.as_ref().is_some_and(|s| s.solved);
-        match target {
-            // Gave up from cold (a load too large for a small set): back to the uniform
-            // start, a better one for the BCCG than a few loaded points.
-            Target::MeanPressure(p) if start > limit && !solved => {
-                self.state.pressure.fill(p);
-                Ok(SmallSetRun {
-                    applications: run.applications,
-                    exact: false,
-                })
-            }
-            _ => Ok(run),
         }
     }
-
-    /// Whether the direct iteration from cold would give up at its first check, known
-    /// without it: the whole load `P = n p̄` on the highest point (`f = 0`) indents it by
-    /// `d = K₀₀ P` and opens the gap `f(x) − P (K₀₀ − K(x))` elsewhere, which is below
-    /// `f(x) − P (K₀₀ − K_max)` with `K_max` the largest response off the loaded pixel. The
-    /// points where that bound is below the entering slack (less a margin for the rounding
-    /// of the transforms) would all enter: more than [`GIVE_UP_ENTERING`] limits of them
-    /// and the check, an operator application, would give up.
-    fn highest_point_gives_up(&self, mean_pressure: f64, limit: usize) -> bool {
-        let impulse = &self.bccg_scratch.impulse;
-        let load = mean_pressure * impulse.len() as f64;
-        let largest_off = impulse[1..]
-            .iter()
-            .fold(f64::NEG_INFINITY, |m, &k| m.max(k));
-        let opened = load * (impulse[0] - largest_off);
-        let slack = GAP_SLACK * self.params.tolerance * self.problem.height_scale;
-        let below = opened - slack - 1e-9 * load * impulse[0];
-        let entering = self.problem.profile.iter().filter(|&&f| f < below).count();
-        // The highest point itself (f = 0) is on the set, not entering.
-        entering.saturating_sub(1) > GIVE_UP_ENTERING * limit
-    }
-
-    /// The iteration of the module docs from the set in `small_set`.
-    fn small_set_iterate(
-        &mut self,
-        target: Target,
-        max_iterations: usize,
-    ) -> Result<SmallSetRun, SolveError> {
-        let mut run = SmallSetRun {
-            applications: 0,
-            exact: false,
-        };
-        let slack = GAP_SLACK * self.params.tolerance * self.problem.height_scale;
-        let len = self.problem.rows * self.problem.cols;
-        let impulse = &self.bccg_scratch.impulse;
-        let Some(small) = self.small_set.as_mut() else {
-            return Ok(run);
-        };
-        for _ in 0..MAX_SOLVES {
-            if self.stop.is_requested() {
-                return Err(SolveError::Interrupted {
-                    iterations: run.applications,
-                });
-            }
-            let spent = run.applications == max_iterations;
-            if spent || small.set.is_empty() || !small.factorise(impulse) {
-                return Ok(run);
-            }
-            let d = small.pressures(target, &self.problem.profile, len);
-            if small.drop_unloaded() > 0 {
-                continue;
-            }
-            // All loaded: this pressure keeps the load; check the gap everywhere.
-            self.state.pressure.fill(0.0);
-            for (&k, &p) in small.set.iter().zip(&small.pressure) {
-                self.state.pressure[k] = p;
-            }
-            self.problem
-                .operator
-                .apply(&self.state.pressure, &mut self.state.gap);
-            run = SmallSetRun {
-                applications: run.applications + 1,
-                exact: true,
-            };
-            let gap = |k: usize| self.state.gap[k] + self.problem.profile[k] - d;
-            if !small.enter(gap, slack) || small.solved {
-                return Ok(run);
-            }
+    let run = small_set_iterate(slot, impulse, cx, (target, max_iterations))?;
+    let solved = slot.as_ref().is_some_and(|s| s.solved);
+    match target {
+        // Gave up from cold (a load too large for a small set): back to the uniform
+        // start, a better one for the BCCG than a few loaded points.
+        Target::MeanPressure(p) if start > limit && !solved => {
+            cx.state.pressure.fill(p);
+            Ok(SmallSetRun {
+                applications: run.applications,
+                exact: false,
+            })
         }
-        Ok(run)
+        _ => Ok(run),
     }
 }
 
-impl ContactSolver {
-    /// The frozen-set solution `x = K_SS⁻¹ 1_S` from the factor of the last direct solve,
-    /// written into `x_field` (zero off the set), if the current pressure's contact set is
-    /// that solve's set and `x` solves the system to `tolerance` (relative residual,
-    /// computed here from the kernel); returns the residual.
-    pub(super) fn small_set_tangent(&self, tolerance: f64, x_field: &mut [f64]) -> Option<f64> {
-        let small = self.small_set.as_ref().filter(|s| s.solved)?;
-        let pressure = &self.state.pressure;
-        let (set, n) = (&small.set, small.set.len());
-        let loaded = pressure.iter().filter(|&&p| WALL.in_contact(p)).count();
-        if loaded != n || set.iter().any(|&k| !WALL.in_contact(pressure[k])) {
-            return None;
+/// Whether the direct iteration from cold would give up at its first check, known
+/// without it: the whole load `P = n p̄` on the highest point (`f = 0`) indents it by
+/// `d = K₀₀ P` and opens the gap `f(x) − P (K₀₀ − K(x))` elsewhere, which is below
+/// `f(x) − P (K₀₀ − K_max)` with `K_max` the largest response off the loaded pixel. The
+/// points where that bound is below the entering slack (less a margin for the rounding
+/// of the transforms) would all enter: more than [`GIVE_UP_ENTERING`] limits of them
+/// and the check, an operator application, would give up.
+fn highest_point_gives_up(
+    impulse: &[f64],
+    cx: &Context,
+    (mean_pressure, limit): (f64, usize),
+) -> bool {
+    let load = mean_pressure * impulse.len() as f64;
+    let largest_off = impulse[1..]
+        .iter()
+        .fold(f64::NEG_INFINITY, |m, &k| m.max(k));
+    let opened = load * (impulse[0] - largest_off);
+    let slack = GAP_SLACK * cx.params.tolerance * cx.problem.height_scale;
+    let below = opened - slack - 1e-9 * load * impulse[0];
+    let entering = cx.problem.profile.iter().filter(|&&f| f < below).count();
+    // The highest point itself (f = 0) is on the set, not entering.
+    entering.saturating_sub(1) > GIVE_UP_ENTERING * limit
+}
+
+/// The iteration of the module docs from the set in `small_set`.
+fn small_set_iterate(
+    slot: &mut Option<SmallSet>,
+    impulse: &[f64],
+    cx: &mut Context,
+    (target, max_iterations): (Target, usize),
+) -> Result<SmallSetRun, SolveError> {
+    let mut run = SmallSetRun {
+        applications: 0,
+        exact: false,
+    };
+    let slack = GAP_SLACK * cx.params.tolerance * cx.problem.height_scale;
+    let len = cx.problem.rows * cx.problem.cols;
+    let Some(small) = slot.as_mut() else {
+        return Ok(run);
+    };
+    for _ in 0..MAX_SOLVES {
+        if cx.stop.is_requested() {
+            return Err(SolveError::Interrupted {
+                iterations: run.applications,
+            });
         }
-        let impulse = &self.bccg_scratch.impulse;
-        let squares: f64 = set
-            .iter()
-            .map(|&a| {
-                let row = set.iter().zip(&small.x[..n]);
-                let kx: f64 = row
-                    .map(|(&b, x)| kernel(impulse, small.grid, a, b) * x)
-                    .sum();
-                (1.0 - kx).powi(2)
-            })
-            .sum();
-        let residual = (squares / n as f64).sqrt();
-        if residual.is_nan() || residual > tolerance {
-            return None;
+        let spent = run.applications == max_iterations;
+        if spent || small.set.is_empty() || !small.factorise(impulse) {
+            return Ok(run);
         }
-        x_field.fill(0.0);
-        for (&k, &x) in set.iter().zip(&small.x[..n]) {
-            x_field[k] = x;
+        let d = small.pressures(target, &cx.problem.profile, len);
+        if small.drop_unloaded() > 0 {
+            continue;
         }
-        Some(residual)
+        // All loaded: this pressure keeps the load; check the gap everywhere.
+        cx.state.pressure.fill(0.0);
+        for (&k, &p) in small.set.iter().zip(&small.pressure) {
+            cx.state.pressure[k] = p;
+        }
+        cx.problem
+            .operator
+            .apply(&cx.state.pressure, &mut cx.state.gap);
+        run = SmallSetRun {
+            applications: run.applications + 1,
+            exact: true,
+        };
+        let gap = |k: usize| cx.state.gap[k] + cx.problem.profile[k] - d;
+        if !small.enter(gap, slack) || small.solved {
+            return Ok(run);
+        }
     }
+    Ok(run)
+}
+
+/// The frozen-set solution `x = K_SS⁻¹ 1_S` from the factor of the last direct solve
+/// in `slot` (with the operator's impulse response `impulse`), written into `x_field`
+/// (zero off the set), if the contact set of `pressure` is that solve's set and `x`
+/// solves the system to `tolerance` (relative residual, computed here from the
+/// kernel); returns the residual.
+pub(super) fn tangent(
+    slot: Option<&SmallSet>,
+    impulse: &[f64],
+    pressure: &[f64],
+    (tolerance, x_field): (f64, &mut [f64]),
+) -> Option<f64> {
+    let small = slot.filter(|s| s.solved)?;
+    let (set, n) = (&small.set, small.set.len());
+    let loaded = pressure.iter().filter(|&&p| WALL.in_contact(p)).count();
+    if loaded != n || set.iter().any(|&k| !WALL.in_contact(pressure[k])) {
+        return None;
+    }
+    let squares: f64 = set
+        .iter()
+        .map(|&a| {
+            let row = set.iter().zip(&small.x[..n]);
+            let kx: f64 = row
+                .map(|(&b, x)| kernel(impulse, small.grid, a, b) * x)
+                .sum();
+            (1.0 - kx).powi(2)
+        })
+        .sum();
+    let residual = (squares / n as f64).sqrt();
+    if residual.is_nan() || residual > tolerance {
+        return None;
+    }
+    x_field.fill(0.0);
+    for (&k, &x) in set.iter().zip(&small.x[..n]) {
+        x_field[k] = x;
+    }
+    Some(residual)
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::polonsky_keer::tests::rough_grid;
-    use super::super::{Control, HalfSpace, SolverKind, SolverParams};
+    use super::super::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
     use super::*;
     use crate::elastic::ElasticOperator;
 
@@ -628,18 +631,20 @@ mod tests {
                 // closely (a bound that ignores the response off the loaded point predicts
                 // give-ups a step or more early).
                 for p in (0..=24).map(|e| 1e-4 * 10f64.powf(e as f64 / 8.0)) {
-                    let shortcut = solver.highest_point_gives_up(p, limit);
-                    let top = highest_point(&solver.problem.profile);
+                    let ContactSolver {
+                        cx, bccg_scratch, ..
+                    } = &mut solver;
+                    let impulse = &bccg_scratch.impulse;
+                    let shortcut = highest_point_gives_up(impulse, cx, (p, limit));
+                    let top = highest_point(&cx.problem.profile);
                     let periodic = boundary == Boundary::Periodic;
-                    let small = solver
-                        .small_set
-                        .get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
+                    let slot = &mut bccg_scratch.small_set;
+                    let small = slot.get_or_insert_with(|| SmallSet::new(rows, cols, periodic));
                     small.clear();
                     small.push(top);
-                    let run = solver
-                        .small_set_iterate(Target::MeanPressure(p), 100)
-                        .unwrap();
-                    let solved = solver.small_set.as_ref().unwrap().solved;
+                    let target = (Target::MeanPressure(p), 100);
+                    let run = small_set_iterate(slot, impulse, cx, target).unwrap();
+                    let solved = slot.as_ref().unwrap().solved;
                     let gave_up = run.applications == 1 && !solved;
                     let what = format!("{rows}x{cols} {boundary:?} p = {p}");
                     assert!(!shortcut || gave_up, "{what}: predicted a give-up");

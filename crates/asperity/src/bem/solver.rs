@@ -1,53 +1,56 @@
 //! [`ContactSolver`]: the solver core shared by the iterations of [`crate::bem`].
 //!
 //! A solver is made of named parts, each owned by one piece of code:
-//! * [`ContactProblem`] — what is solved: the indenter profile `f = max(h) − h` of one
-//!   surface and its height scale, the half-space (the [`ElasticOperator`], with its
-//!   boundary, spacings and modulus) and the grid. Only [`ContactSolver::set_surface`]
-//!   changes it; every other piece of code reads it (and applies its operator).
-//! * `SolverState` — the state of the last solve: pressure, gap, the solved summary and
-//!   the cached full-contact threshold. Its fields are written by the iterations only; the
-//!   stiffness and threshold code reads them and keeps them intact (and caches the
-//!   threshold).
-//! * One scratch struct per algorithm, in its own file and used by no other:
-//!   `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs`), `PkScratch`
-//!   (`polonsky_keer.rs`), `StiffnessWork` (`stiffness/`: the frozen-set CG and the
-//!   free-boundary threshold's CG) and `FullContactScratch` (`full_contact.rs`: the
-//!   periodic threshold and the lower bound). Scratch that not every solver needs is
-//!   allocated on first use and kept, so warm solves allocate nothing.
-//! * The settings ([`SolverParams`]), the Fourier preconditioner shared read-only by the
-//!   BCCG and the CGs, and the stop flag.
+//! * the [`Context`] (`context.rs`) that every iteration works on:
+//!   - [`ContactProblem`] — what is solved: the indenter profile `f = max(h) − h` of one
+//!     surface and its height scale, the half-space (the [`ElasticOperator`], with its
+//!     boundary, spacings and modulus) and the grid. Only [`ContactSolver::set_surface`]
+//!     changes it; every other piece of code reads it (and applies its operator);
+//!   - `SolverState` — the state of the last solve: pressure, gap, the solved summary and
+//!     the cached full-contact threshold. Its fields are written by the iterations only;
+//!     the stiffness and threshold code reads them and keeps them intact (and caches the
+//!     threshold);
+//!   - the settings ([`SolverParams`]), the Fourier preconditioner shared by the BCCG and
+//!     the CGs, the stop flag and the contact law ([`Interface`]);
+//! * one scratch struct per algorithm, in its own file and used by no other: the
+//!   iterations' `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs` and
+//!   the direct solve of small sets of `small_set.rs`) and `PkScratch`
+//!   (`polonsky_keer.rs`), each an [`Iteration`] (`iteration.rs`); `StiffnessWork`
+//!   (`stiffness/work.rs`: the frozen-set CG and the free-boundary threshold's CG) and
+//!   `FullContactScratch` (`threshold.rs`, used by `full_contact.rs`: the periodic threshold
+//!   and the lower bound). Scratch that not every solver needs is allocated on first use and
+//!   kept, so warm solves allocate nothing.
 //!
 //! [`ContactSolver::solve`] validates the control, refuses a periodic load or indentation
-//! beyond full contact before solving, and dispatches to the chosen iteration
-//! ([`SolverKind`]): `bccg.rs` or `polonsky_keer.rs`, each `(target, tolerance,
-//! max_iterations)` in, `(ContactSummary, SolveInfo)` or a typed [`SolveError`] out. Shared
-//! by both: the initial pressure (warm or cold start, `initialise`) and
-//! the summary of a converged state (`finish`).
+//! beyond full contact before solving, sets the initial pressure (warm or cold start,
+//! `initialise`) and runs the chosen iteration ([`SolverKind`], mapped to its [`Iteration`]
+//! in one place, `ContactSolver::iteration`) on the context: `(target, limits)` in,
+//! `(ContactSummary, SolveInfo)` or a typed [`SolveError`] out, the summary of a converged
+//! state made by [`Context::finish`].
 //!
 //! **The contact law** is the solver's [`Interface`] (`interface.rs`, set by
 //! [`ContactSolver::set_interface`]): every rule of what "in contact" means is asked of it
 //! (the BCCG asks the constant hard wall). A new law that the existing iterations can solve
-//! (as Polonsky–Keer solves the hardness cap, `plasticity.rs`) is a new variant there.
+//! (as both solve the hardness cap, `plasticity.rs`) is a new variant there.
 //!
-//! **Extending the core** (an adhesive contact, say, which needs its own iteration): put the new
-//! iteration in a file of its own with its scratch struct (`struct AdhesionScratch`), add
-//! one `Option<AdhesionScratch>` field to [`ContactSolver`] allocated on the iteration's
-//! first use (as `pk_scratch` is), a [`SolverKind`] variant dispatched in
-//! [`ContactSolver::solve`], and the fields to [`ContactSolver::memory_bytes`]. The
-//! iteration reads [`ContactProblem`], writes `SolverState` through `initialise`, its own
-//! loop and `finish`, and works in its own scratch only: no other algorithm's fields change
-//! meaning, and the stiffness and threshold code applies to its solved state unchanged.
+//! **Extending the core** (an adhesive contact, say, which needs its own iteration): a new
+//! file with the iteration's scratch struct implementing [`Iteration`] (`iteration.rs` says
+//! what it may read and write), one `Option<…>` field for it in [`ContactSolver`] allocated
+//! on first use (as `pk_scratch` is), a [`SolverKind`] variant and its arm in
+//! `ContactSolver::iteration`, and its fields in [`ContactSolver::memory_bytes`]. No other
+//! algorithm's fields change meaning, and the stiffness and threshold code applies to its
+//! solved state unchanged.
 
 use ndarray::{Array2, ArrayView2};
 
 use super::bccg::BccgScratch;
-use super::full_contact::{FullContactScratch, FullContactThreshold};
+use super::context::{ContactProblem, Context, SolverState, Target};
 use super::interface::{restore_capped_load, Interface};
+use super::iteration::{Iteration, Limits};
 use super::polonsky_keer::PkScratch;
 use super::preconditioner::{FourierPreconditioner, Real};
-use super::small_set::SmallSet;
-use super::stiffness::StiffnessWork;
+use super::stiffness::work::StiffnessWork;
+use super::threshold::FullContactScratch;
 use super::{
     ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
     SolverParams,
@@ -58,150 +61,15 @@ use crate::stop::Stop;
 use crate::surface::Surface;
 use crate::{memory, Error};
 
-/// What an iteration holds fixed (a force is turned into its mean pressure).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Target {
-    MeanPressure(f64),
-    Indentation(f64),
-}
-
-/// What is solved: the indenter profile of one surface on a half-space, on a grid. Read by
-/// every iteration; changed only by [`ContactSolver::set_surface`] (a new profile on the same
-/// grid). The operator applies `K` in place of the half-space (its FFT buffers are its own).
-pub struct ContactProblem {
-    /// The half-space (modulus, boundary) on the grid and spacings of the surface.
-    pub(super) operator: ElasticOperator,
-    pub(super) rows: usize,
-    pub(super) cols: usize,
-    /// Indenter profile `f = max(h) − h ≥ 0`, row-major.
-    pub(super) profile: Vec<f64>,
-    /// rms height about the mean (1 for a flat surface), the residual's scale.
-    pub(super) height_scale: f64,
-}
-
-impl ContactProblem {
-    /// The problem of `surface` on `half_space` (plans the operator).
-    fn new(surface: &Surface, half_space: HalfSpace) -> Result<Self, SolveError> {
-        let (rows, cols) = surface.dim();
-        let operator = ElasticOperator::with_spacings(
-            rows,
-            cols,
-            surface.spacing(),
-            surface.spacing_y(),
-            half_space.modulus,
-            half_space.boundary,
-        )?;
-        let mut profile = Vec::with_capacity(rows * cols);
-        let height_scale = fill_profile(surface, &mut profile);
-        Ok(ContactProblem {
-            operator,
-            rows,
-            cols,
-            profile,
-            height_scale,
-        })
-    }
-
-    /// Swaps in the profile of `surface`, which must have the grid and spacings of the
-    /// problem (the operator is kept).
-    fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
-        if surface.dim() != (self.rows, self.cols)
-            || surface.spacing() != self.operator.spacing()
-            || surface.spacing_y() != self.operator.spacing_y()
-        {
-            return Err(Error::invalid(
-                "surface",
-                format!(
-                    "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
-                    self.rows,
-                    self.cols,
-                    self.operator.spacing(),
-                    self.operator.spacing_y(),
-                    surface.dim(),
-                    surface.spacing(),
-                    surface.spacing_y()
-                ),
-            )
-            .into());
-        }
-        self.height_scale = fill_profile(surface, &mut self.profile);
-        Ok(())
-    }
-
-    /// `(rows, cols)` of the grid.
-    pub fn dim(&self) -> (usize, usize) {
-        (self.rows, self.cols)
-    }
-
-    /// Pixel spacings `(Δx, Δy)`.
-    pub fn spacings(&self) -> (f64, f64) {
-        (self.operator.spacing(), self.operator.spacing_y())
-    }
-
-    /// The half-space: effective modulus and boundary.
-    pub fn half_space(&self) -> HalfSpace {
-        HalfSpace {
-            modulus: self.operator.modulus(),
-            boundary: self.operator.boundary(),
-        }
-    }
-
-    /// Nominal (projected) area `rows · cols · Δx · Δy`.
-    pub fn nominal_area(&self) -> f64 {
-        // Multiplied in this order so that square pixels give today's value bit for bit.
-        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
-    }
-
-    /// The indenter profile `f = max(h) − h`, `rows × cols`.
-    pub fn profile(&self) -> ArrayView2<'_, f64> {
-        ArrayView2::from_shape((self.rows, self.cols), &self.profile)
-            .expect("buffer has the grid's shape")
-    }
-
-    /// rms of the profile about its mean (1 for a flat surface): the scale of the
-    /// residual.
-    pub fn height_scale(&self) -> f64 {
-        self.height_scale
-    }
-}
-
-/// The state of the last solve: its fields and scalars, and the full-contact threshold of
-/// the surface once known. Written by the iterations (through [`ContactSolver::initialise`]
-/// and [`ContactSolver::finish`]); the stiffness and threshold code reads the fields and
-/// only caches the threshold.
-pub(super) struct SolverState {
-    pub(super) pressure: Vec<f64>,
-    /// `u` during an iteration, the gap `g` after a solve.
-    pub(super) gap: Vec<f64>,
-    /// The last solved state, if any (its pressure is in `pressure`).
-    pub(super) solved: Option<ContactSummary>,
-    /// Where the surface comes into full contact (computed once per surface, when first
-    /// needed).
-    pub(super) full_contact: Option<FullContactThreshold>,
-}
-
-impl SolverState {
-    fn new(len: usize) -> Self {
-        SolverState {
-            pressure: vec![0.0; len],
-            gap: vec![0.0; len],
-            solved: None,
-            full_contact: None,
-        }
-    }
-}
-
 /// A contact solver for one surface: the problem, the state of the last solve, and the
 /// scratch of each algorithm, each its own (module docs); successive solves allocate
 /// nothing and start from the previous pressure.
 pub struct ContactSolver {
-    pub(super) problem: ContactProblem,
-    pub(super) params: SolverParams,
-    pub(super) state: SolverState,
-    /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG (read-only but for
-    /// its own FFT buffer).
-    pub(super) preconditioner: FourierPreconditioner,
-    /// The BCCG's own fields (`bccg.rs`, with the coarse correction of `mean_gap.rs`).
+    /// The problem, settings, state, preconditioner, stop flag and contact law that every
+    /// iteration works on (`context.rs`).
+    pub(super) cx: Context,
+    /// The BCCG's own fields (`bccg.rs`, with the coarse correction of `mean_gap.rs` and
+    /// the direct solve of small sets of `small_set.rs`).
     pub(super) bccg_scratch: BccgScratch,
     /// The Polonsky–Keer iteration's own fields (`polonsky_keer.rs`), allocated on its
     /// first solve.
@@ -212,35 +80,10 @@ pub struct ContactSolver {
     /// The fields of the periodic threshold and of the lower bound (`full_contact.rs`),
     /// allocated on first use.
     pub(super) full_contact_scratch: Option<FullContactScratch>,
-    /// The dense fields of the direct solve of small contact sets (`small_set.rs`),
-    /// allocated on first use.
-    pub(super) small_set: Option<SmallSet>,
-    /// Polled once per iteration of every loop ([`ContactSolver::with_stop`]).
-    pub(super) stop: Stop,
-    /// What "in contact" means ([`ContactSolver::set_interface`]; the hard wall by
-    /// default).
-    pub(super) interface: Interface,
     /// The permanent (plastic) displacement kept by
     /// [`ContactSolver::keep_plastic_displacement`], added to the profile; allocated on
     /// first use.
     pub(super) permanent: Option<Vec<f64>>,
-}
-
-/// Writes the indenter profile `f = h_max − h` (≥ 0, zero at the highest point) into
-/// `profile` and returns its rms, the scale of the solver's height tolerances.
-fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
-    let heights = surface.heights();
-    let top = heights.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h));
-    profile.clear();
-    profile.extend(heights.iter().map(|&h| top - h));
-    let n = profile.len() as f64;
-    let mean = profile.iter().sum::<f64>() / n;
-    let rms = (profile.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n).sqrt();
-    if rms > 0.0 {
-        rms
-    } else {
-        1.0
-    }
 }
 
 impl ContactSolver {
@@ -299,18 +142,20 @@ impl ContactSolver {
             half_space.modulus,
         )?;
         let bccg_scratch = BccgScratch::new(&mut problem.operator)?;
-        Ok(ContactSolver {
+        let cx = Context {
             problem,
             params,
             state: SolverState::new(rows * cols),
             preconditioner,
+            stop: Stop::new(),
+            interface: Interface::HardWall,
+        };
+        Ok(ContactSolver {
+            cx,
             bccg_scratch,
             pk_scratch: None,
             stiffness_work: None,
             full_contact_scratch: None,
-            small_set: None,
-            stop: Stop::new(),
-            interface: Interface::HardWall,
             permanent: None,
         })
     }
@@ -329,71 +174,61 @@ impl ContactSolver {
     /// threshold keeps the solved state. A solver starts with a flag of its own that
     /// nothing sets.
     pub fn set_stop(&mut self, stop: Stop) {
-        self.stop = stop;
+        self.cx.stop = stop;
     }
 
     /// The stop flag polled by this solver (a clone shares it).
     pub fn stop(&self) -> &Stop {
-        &self.stop
-    }
-
-    /// [`SolveError::Interrupted`] after `iterations` if a stop is requested.
-    #[inline]
-    pub(super) fn check_stop(&self, iterations: usize) -> Result<(), SolveError> {
-        if self.stop.is_requested() {
-            Err(SolveError::Interrupted { iterations })
-        } else {
-            Ok(())
-        }
+        &self.cx.stop
     }
 
     /// Swaps in another surface with the same grid and spacing, keeping the operator (FFT
     /// plans, kernel spectrum) and all buffers: how an ensemble solves many realisations.
     /// The next solve starts cold, exactly as with a new solver.
     pub fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
-        self.problem.set_surface(surface)?;
+        self.cx.problem.set_surface(surface)?;
         self.permanent = None;
-        self.state.pressure.fill(0.0);
-        self.state.solved = None;
-        self.state.full_contact = None;
+        self.cx.state.pressure.fill(0.0);
+        self.cx.state.solved = None;
+        self.cx.state.full_contact = None;
         Ok(())
     }
 
     /// The parameters in use.
     pub fn params(&self) -> &SolverParams {
-        &self.params
+        &self.cx.params
     }
 
     /// Replaces the parameters (validated).
     pub fn set_params(&mut self, params: SolverParams) -> Result<(), SolveError> {
         validate_params(&params)?;
-        self.params = params;
+        self.cx.params = params;
         Ok(())
     }
 
     /// `(rows, cols)` of the grid.
     pub fn dim(&self) -> (usize, usize) {
-        self.problem.dim()
+        self.cx.problem.dim()
     }
 
     /// Nominal (projected) area `rows · cols · Δx · Δy`.
     pub fn nominal_area(&self) -> f64 {
-        self.problem.nominal_area()
+        self.cx.problem.nominal_area()
     }
 
     /// What is solved: the surface's profile on the half-space, on the grid.
     pub fn problem(&self) -> &ContactProblem {
-        &self.problem
+        &self.cx.problem
     }
 
     /// Forgets the previous solution: the next solve starts cold.
     pub fn reset(&mut self) {
-        self.state.solved = None;
+        self.cx.state.solved = None;
     }
 
     /// The last solved state's scalars, if any.
     pub fn summary(&self) -> Option<ContactSummary> {
-        self.state.solved
+        self.cx.state.solved
     }
 
     /// Solves the contact under `control`, starting from the previous solution when there
@@ -417,7 +252,7 @@ impl ContactSolver {
             }
         };
         self.check_interface(target)?;
-        let periodic = self.problem.operator.boundary() == Boundary::Periodic;
+        let periodic = self.cx.problem.operator.boundary() == Boundary::Periodic;
         if periodic {
             // Exact thresholds, known before solving: the mean pressure max(K⁺f) and, with
             // displacements of zero mean, the indentation mean(f).
@@ -426,35 +261,31 @@ impl ContactSolver {
                 // (Not under a cap: the threshold is the elastic one, and a capped contact
                 // may close at a lower load or stay open beyond it; a capped solution in
                 // full contact without plastic points is refused after the solve.)
-                Target::MeanPressure(_) if self.interface != Interface::HardWall => false,
+                Target::MeanPressure(_) if self.cx.interface != Interface::HardWall => false,
                 Target::MeanPressure(p) => p >= full.mean_pressure,
                 // The mean gap mean(f) − d within the rounding of the sum mean(f) (n ulps)
                 // is no gap: full contact. (Not under a cap: the plastic points stand
                 // below the indenter, so the mean gap may be negative short of full
                 // contact; a solution in full contact is refused after the solve.)
-                Target::Indentation(_) if self.interface != Interface::HardWall => false,
+                Target::Indentation(_) if self.cx.interface != Interface::HardWall => false,
                 Target::Indentation(d) => full.indentation.is_some_and(|d_full| {
-                    d >= d_full * (1.0 - self.problem.profile.len() as f64 * f64::EPSILON)
+                    d >= d_full * (1.0 - self.cx.problem.profile.len() as f64 * f64::EPSILON)
                 }),
             };
             if beyond {
-                self.state.solved = None;
+                self.cx.state.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
         }
-        let (tolerance, max_iterations) = (self.params.tolerance, self.params.max_iterations);
+        let (tolerance, max_iterations) = (self.cx.params.tolerance, self.cx.params.max_iterations);
         // On a worker of the pool: the iteration's parallel passes are then forked, not
         // injected one by one, and the other workers wait for them awake (`pool.rs`).
-        let parallelism = self.params.parallelism;
-        let result = on_worker(parallelism, || match (self.params.solver, target) {
-            (SolverKind::Bccg, Target::Indentation(d)) if periodic => {
-                self.bccg_periodic_indentation(d)
-            }
-            (kind, Target::MeanPressure(p)) if self.interface != Interface::HardWall => {
+        let (parallelism, kind) = (self.cx.params.parallelism, self.cx.params.solver);
+        let result = on_worker(parallelism, || match target {
+            Target::MeanPressure(p) if self.cx.interface != Interface::HardWall => {
                 self.capped_load(kind, p, tolerance, max_iterations)
             }
-            (SolverKind::Bccg, _) => self.bccg(target, tolerance, max_iterations),
-            (SolverKind::PolonskyKeer, _) => self.polonsky_keer(target, tolerance, max_iterations),
+            _ => self.iterate(kind, target, tolerance, max_iterations),
         });
         match result {
             // Every point in contact, under load or displacement control: no contact
@@ -463,14 +294,14 @@ impl ContactSolver {
             // Under a cap a full contact with points at the cap is a contact problem still
             // (the plastic points flattened, the rest elastic): kept.
             Ok((summary, _))
-                if summary.contact_points == self.problem.rows * self.problem.cols
+                if summary.contact_points == self.cx.problem.rows * self.cx.problem.cols
                     && summary.plastic_points == 0 =>
             {
-                self.state.solved = None;
+                self.cx.state.solved = None;
                 return Err(self.beyond_full_contact(control));
             }
-            Ok((summary, _)) => self.state.solved = Some(summary),
-            Err(_) => self.state.solved = None,
+            Ok((summary, _)) => self.cx.state.solved = Some(summary),
+            Err(_) => self.cx.state.solved = None,
         }
         result
     }
@@ -478,7 +309,7 @@ impl ContactSolver {
     /// Refuses what the interface cannot solve: a mean pressure at or above the hardness.
     fn check_interface(&self, target: Target) -> Result<(), SolveError> {
         if let Target::MeanPressure(p) = target {
-            self.interface.check_mean_pressure(p)?;
+            self.cx.interface.check_mean_pressure(p)?;
         }
         Ok(())
     }
@@ -486,7 +317,7 @@ impl ContactSolver {
     /// The error for a `requested` load or indentation that closes the gap everywhere, with
     /// the threshold in the same quantity where it is known.
     fn beyond_full_contact(&mut self, requested: Control) -> SolveError {
-        let threshold = match self.problem.operator.boundary() {
+        let threshold = match self.cx.problem.operator.boundary() {
             Boundary::Periodic => Some(self.periodic_full_contact()),
             Boundary::Free => self.free_full_contact().ok(),
         };
@@ -503,25 +334,31 @@ impl ContactSolver {
 
     /// Pressure of the last solve, `rows × cols`.
     pub fn pressure(&self) -> ArrayView2<'_, f64> {
-        ArrayView2::from_shape((self.problem.rows, self.problem.cols), &self.state.pressure)
-            .expect("buffer has the grid's shape")
+        ArrayView2::from_shape(
+            (self.cx.problem.rows, self.cx.problem.cols),
+            &self.cx.state.pressure,
+        )
+        .expect("buffer has the grid's shape")
     }
 
     /// Gap of the last solve, `rows × cols` (≥ 0, zero on the contact set).
     pub fn gap(&self) -> ArrayView2<'_, f64> {
-        ArrayView2::from_shape((self.problem.rows, self.problem.cols), &self.state.gap)
-            .expect("buffer has the grid's shape")
+        ArrayView2::from_shape(
+            (self.cx.problem.rows, self.cx.problem.cols),
+            &self.cx.state.gap,
+        )
+        .expect("buffer has the grid's shape")
     }
 
     /// The last solved state with owned copies of its fields; the displacement is computed
     /// afresh (one operator application). `None` before a successful solve.
     pub fn state(&mut self) -> Option<ContactState> {
-        let summary = self.state.solved?;
-        let mut displacement = Array2::zeros((self.problem.rows, self.problem.cols));
+        let summary = self.cx.state.solved?;
+        let mut displacement = Array2::zeros((self.cx.problem.rows, self.cx.problem.cols));
         let out = displacement
             .as_slice_mut()
             .expect("a fresh array is contiguous");
-        self.problem.operator.apply(&self.state.pressure, out);
+        self.cx.problem.operator.apply(&self.cx.state.pressure, out);
         Some(ContactState {
             summary,
             pressure: self.pressure().to_owned(),
@@ -530,71 +367,110 @@ impl ContactSolver {
         })
     }
 
+    /// The iteration of `kind` (`bccg.rs`, `polonsky_keer.rs`; Polonsky–Keer's fields
+    /// allocated on its first use) and the context it works on: the one place that maps a
+    /// [`SolverKind`] to its [`Iteration`].
+    pub(super) fn iteration(&mut self, kind: SolverKind) -> (&mut dyn Iteration, &mut Context) {
+        match kind {
+            SolverKind::Bccg => (&mut self.bccg_scratch, &mut self.cx),
+            SolverKind::PolonskyKeer => {
+                let len = self.cx.problem.profile.len();
+                let pk = self.pk_scratch.get_or_insert_with(|| PkScratch::new(len));
+                (pk, &mut self.cx)
+            }
+        }
+    }
+
+    /// Whether the last solve of the iteration of `kind` stalled ([`Iteration::stalled`]).
+    pub(super) fn stalled(&mut self, kind: SolverKind) -> bool {
+        self.iteration(kind).0.stalled()
+    }
+
+    /// Solves for `target` by the iteration of `kind` to `tolerance` in at most
+    /// `max_iterations` iterations, from the start of [`Self::initialise`] (warm, predicted
+    /// or cold).
+    pub(super) fn iterate(
+        &mut self,
+        kind: SolverKind,
+        target: Target,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        let self_influence = self.cx.problem.operator.self_influence();
+        self.initialise(target, self_influence);
+        let (iteration, cx) = self.iteration(kind);
+        let limits = Limits {
+            tolerance,
+            max_iterations,
+        };
+        iteration.solve(cx, target, limits)
+    }
+
     /// Initial pressure: the continuation predictor when the last solve's frozen-set
     /// stiffness left its tangent (`stiffness/`), else the previous solution (rescaled to
     /// the new load) or a cold start (uniform pressure under load control; local springs
     /// `max(d − f, 0)/K₀₀` under displacement control).
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
-        let n = (self.problem.rows * self.problem.cols) as f64;
-        let warm = self.state.solved.is_some();
+        let n = (self.cx.problem.rows * self.cx.problem.cols) as f64;
+        let warm = self.cx.state.solved.is_some();
         if self.predict_from_tangent(target) {
             return;
         }
         match target {
             Target::MeanPressure(mean_pressure) => {
-                let current = self.state.pressure.iter().sum::<f64>() / n;
+                let current = self.cx.state.pressure.iter().sum::<f64>() / n;
                 if warm && current > 0.0 {
-                    let (scale, interface) = (mean_pressure / current, self.interface);
+                    let (scale, interface) = (mean_pressure / current, self.cx.interface);
                     let cap = interface.cap();
-                    if self.state.pressure.iter().any(|&p| p >= cap) {
+                    if self.cx.state.pressure.iter().any(|&p| p >= cap) {
                         // Points at the cap stay there, the others scaled (scaled down
                         // with the rest they would all leave the plastic set).
-                        let (pressure, gap) = (&mut self.state.pressure, &self.state.gap);
+                        let (pressure, gap) = (&mut self.cx.state.pressure, &self.cx.state.gap);
                         let total = current * n;
                         restore_capped_load(pressure, (mean_pressure, cap), total, |i| gap[i]);
                         return;
                     }
                     // (The hard wall's projection of p·scale ≥ 0 is the identity.)
-                    for p in self.state.pressure.iter_mut() {
+                    for p in self.cx.state.pressure.iter_mut() {
                         *p = interface.project(*p * scale);
                     }
                 } else {
-                    self.state.pressure.fill(mean_pressure);
+                    self.cx.state.pressure.fill(mean_pressure);
                 }
             }
             Target::Indentation(d) => {
-                let interface = self.interface;
-                let any = self.state.pressure.iter().any(|&p| interface.in_contact(p));
+                let interface = self.cx.interface;
+                let any = self
+                    .cx
+                    .state
+                    .pressure
+                    .iter()
+                    .any(|&p| interface.in_contact(p));
                 if !(warm && any) {
-                    for (p, f) in self.state.pressure.iter_mut().zip(&self.problem.profile) {
+                    for (p, f) in self
+                        .cx
+                        .state
+                        .pressure
+                        .iter_mut()
+                        .zip(&self.cx.problem.profile)
+                    {
                         *p = interface.project((d - f).max(0.0) / self_influence);
                     }
                 }
             }
         }
     }
+}
 
-    /// Scalars of the converged state; the gap buffer is cleaned by the interface
-    /// ([`Interface::clean_gap`]: `g ≥ 0`, zero on the contact set, its residual there
-    /// being below the tolerance; at a hardness `g ≤ 0` on the capped points).
-    pub(super) fn finish(&mut self, indentation: f64, contact_points: usize) -> ContactSummary {
-        let interface = self.interface;
-        let mut plastic_points = 0;
-        for (g, &p) in self.state.gap.iter_mut().zip(&self.state.pressure) {
-            *g = interface.clean_gap(p, *g);
-            plastic_points += interface.plastic(p) as usize;
-        }
-        let n = self.problem.rows * self.problem.cols;
-        let mean_pressure = self.state.pressure.iter().sum::<f64>() / n as f64;
-        ContactSummary {
-            mean_pressure,
-            force: mean_pressure * self.nominal_area(),
-            indentation,
-            area_fraction: contact_points as f64 / n as f64,
-            contact_points,
-            plastic_fraction: plastic_points as f64 / n as f64,
-            plastic_points,
-        }
+#[cfg(test)]
+impl ContactSolver {
+    /// Switches the rings of the BCCG and of the frozen-set CG on or off whatever the grid's
+    /// size (to test the solver both ways on small grids).
+    pub(super) fn set_edge_rings(&mut self, on: bool) {
+        let operator = &self.cx.problem.operator;
+        self.bccg_scratch.rings =
+            on.then(|| super::ring_extension::RingExtension::on_grid_of(operator));
+        self.stiffness_work = Some(StiffnessWork::new(operator, on));
     }
 }
 

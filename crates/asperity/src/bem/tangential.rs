@@ -106,7 +106,7 @@ impl TangentialStiffness {
     /// ratio `poisson` in `[0, 0.5]`; refuses a grid whose operators would not fit in memory.
     pub fn new(solver: &ContactSolver, poisson: f64) -> Result<Self> {
         crate::mdr::check_poisson(poisson)?;
-        let normal = &solver.problem.operator;
+        let normal = &solver.cx.problem.operator;
         let (rows, cols) = (normal.rows(), normal.cols());
         crate::memory::ensure_fits(
             &format!("the tangential stiffness of a {rows}x{cols} grid"),
@@ -150,17 +150,17 @@ impl TangentialStiffness {
     /// `k_x` and `k_y` of `solver`'s solved state (its grid must be the one planned for),
     /// by CG on its contact set to the solver's stiffness tolerance and energy estimate.
     pub fn solve(&mut self, solver: &ContactSolver) -> std::result::Result<Tangential, SolveError> {
-        if solver.state.solved.is_none() {
+        if solver.cx.state.solved.is_none() {
             let reason = "no solved contact state yet";
             return Err(crate::Error::invalid("stiffness", reason).into());
         }
-        let normal = &solver.problem.operator;
+        let normal = &solver.cx.problem.operator;
         if (normal.rows(), normal.cols()) != (self.operators[0].rows(), self.operators[0].cols()) {
             let reason =
                 "the solver's grid is not the one the tangential operators were planned for";
             return Err(crate::Error::invalid("stiffness", reason).into());
         }
-        let params = &solver.params;
+        let params = &solver.cx.params;
         let cg = CgParams {
             tolerance: params.stiffness_tolerance,
             energy_error: Some(params.stiffness_error).filter(|&e| e > 0.0),
@@ -221,11 +221,15 @@ impl TangentialStiffness {
         cg: &CgParams,
         start: Start<'_>,
     ) -> std::result::Result<(SolveInfo, f64), SolveError> {
-        let (pressure, interface, stop) = (&solver.state.pressure, solver.interface, &solver.stop);
-        let normal = &solver.problem.operator;
+        let (pressure, interface, stop) = (
+            &solver.cx.state.pressure,
+            solver.cx.interface,
+            &solver.cx.stop,
+        );
+        let normal = &solver.cx.problem.operator;
         let pixel = normal.spacing() * normal.spacing_y();
         let warm = matches!(start, Start::From(_)) as usize;
-        crate::pool::on_worker(solver.params.parallelism, || {
+        crate::pool::on_worker(solver.cx.params.parallelism, || {
             conjugate_gradient_on_set_from(
                 &mut self.operators[k],
                 &mut self.preconditioners[k],

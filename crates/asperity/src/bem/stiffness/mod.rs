@@ -40,40 +40,18 @@
 //! state exactly as long as the set does not change.
 
 pub(crate) mod cg;
+pub(super) mod work;
 
 use super::bccg::RING_MIN_POINTS;
-use super::full_contact::FullContactThreshold;
+use super::context::Target;
 use super::interface::Interface;
-use super::solver::{ContactSolver, Target};
+use super::small_set;
+use super::solver::ContactSolver;
+use super::threshold::FullContactThreshold;
 use super::{Control, SolveError, SolveInfo};
-use crate::elastic::ElasticOperator;
 use crate::Error;
-use cg::{conjugate_gradient_on_set, CgInfo, CgParams, CgWork, RightHandSide};
-
-/// The fields of the stiffness and full-contact CGs, owned by the solver and allocated on
-/// first use: never the solved state's.
-pub(super) struct StiffnessWork {
-    /// The CG's fields; its unknown `cg.x` holds the pressures on the set.
-    cg: CgWork,
-    /// `K⁻¹f` of the full-contact threshold.
-    profile_pressure: Vec<f64>,
-    /// Whether `cg.x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
-    /// tangent `dp/dd` of its pressure), not yet used by a solve.
-    tangent: bool,
-}
-
-impl StiffnessWork {
-    /// The fields for the grid of `operator`, with the rings around the set (as in the
-    /// BCCG, `ring_extension.rs`) if `rings`.
-    pub(super) fn new(operator: &ElasticOperator, rings: bool) -> Self {
-        let len = operator.rows() * operator.cols();
-        StiffnessWork {
-            cg: CgWork::for_operator(operator, rings),
-            profile_pressure: vec![0.0; len],
-            tangent: false,
-        }
-    }
-}
+use cg::{conjugate_gradient_on_set, CgInfo, CgParams, RightHandSide};
+use work::StiffnessWork;
 
 /// The CG's info as the solver reports it.
 fn solve_info(info: &CgInfo) -> SolveInfo {
@@ -87,7 +65,7 @@ fn solve_info(info: &CgInfo) -> SolveInfo {
 
 impl ContactSolver {
     fn stiffness_work(&mut self) -> StiffnessWork {
-        let operator = &self.problem.operator;
+        let operator = &self.cx.problem.operator;
         let rings = operator.rows() * operator.cols() >= RING_MIN_POINTS;
         self.stiffness_work
             .take()
@@ -98,15 +76,15 @@ impl ContactSolver {
     /// (see the module docs), with the CG's iterations and relative residual. Zero when
     /// nothing is in contact.
     pub fn frozen_set_stiffness(&mut self) -> Result<(f64, SolveInfo), SolveError> {
-        if self.state.solved.is_none() {
+        if self.cx.state.solved.is_none() {
             return Err(Error::invalid("stiffness", "no solved contact state yet").into());
         }
         let (tolerance, max_iterations) = (
-            self.params.stiffness_tolerance,
-            self.params.stiffness_max_iterations,
+            self.cx.params.stiffness_tolerance,
+            self.cx.params.stiffness_max_iterations,
         );
         // On a worker of the pool, as the solves (`pool.rs`).
-        crate::pool::on_worker(self.params.parallelism, || {
+        crate::pool::on_worker(self.cx.params.parallelism, || {
             self.set_stiffness(tolerance, max_iterations)
         })
     }
@@ -122,12 +100,17 @@ impl ContactSolver {
         // A set solved directly (`small_set.rs`) has its x already (a stop request goes to
         // the CG, which reports it).
         // (The direct solve knows the hard wall's set only: not where a point is plastic.)
-        let interface = self.interface;
+        let interface = self.cx.interface;
         let plastic = interface != Interface::HardWall
-            && self.state.pressure.iter().any(|&p| interface.plastic(p));
-        let direct = match self.stop.is_requested() || plastic {
+            && self.cx.state.pressure.iter().any(|&p| interface.plastic(p));
+        let direct = match self.cx.stop.is_requested() || plastic {
             true => None,
-            false => self.small_set_tangent(tolerance, &mut work.cg.x),
+            false => small_set::tangent(
+                self.bccg_scratch.small_set.as_ref(),
+                &self.bccg_scratch.impulse,
+                &self.cx.state.pressure,
+                (tolerance, &mut work.cg.x),
+            ),
         };
         // k = 1ᵀx: from a CG its energy, which converges with the square of the residual
         // where 1ᵀx_j, summed, carries an error of the order of the residual (measured at
@@ -145,25 +128,25 @@ impl ContactSolver {
             None => {
                 let params = CgParams {
                     tolerance,
-                    energy_error: Some(self.params.stiffness_error).filter(|&e| e > 0.0),
+                    energy_error: Some(self.cx.params.stiffness_error).filter(|&e| e > 0.0),
                     max_iterations,
                 };
-                let (pressure, interface) = (&self.state.pressure, self.interface);
+                let (pressure, interface) = (&self.cx.state.pressure, self.cx.interface);
                 conjugate_gradient_on_set(
-                    &mut self.problem.operator,
-                    &mut self.preconditioner,
+                    &mut self.cx.problem.operator,
+                    &mut self.cx.preconditioner,
                     |i| interface.elastic(pressure[i]),
                     RightHandSide::Ones,
                     &mut work.cg,
-                    (&params, &self.stop),
+                    (&params, &self.cx.stop),
                 )
                 .map(|info| (solve_info(&info), info.energy))
                 .map_err(SolveError::from)
             }
         };
         let (dx, dy) = (
-            self.problem.operator.spacing(),
-            self.problem.operator.spacing_y(),
+            self.cx.problem.operator.spacing(),
+            self.cx.problem.operator.spacing_y(),
         );
         work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
@@ -175,7 +158,7 @@ impl ContactSolver {
     /// the tangential CGs (`tangential.rs`).
     pub(crate) fn frozen_set_solution(&self) -> Option<&[f64]> {
         let work = self.stiffness_work.as_ref()?;
-        (work.tangent && self.state.solved.is_some()).then_some(&work.cg.x[..])
+        (work.tangent && self.cx.state.solved.is_some()).then_some(&work.cg.x[..])
     }
 
     /// The continuation predictor of a warm start: if the last frozen-set stiffness left
@@ -189,19 +172,19 @@ impl ContactSolver {
         let Some(work) = self.stiffness_work.as_mut() else {
             return false;
         };
-        let (Some(solved), true) = (self.state.solved, std::mem::take(&mut work.tangent)) else {
+        let (Some(solved), true) = (self.cx.state.solved, std::mem::take(&mut work.tangent)) else {
             return false;
         };
         // Under a cap the tangent holds while no point reaches it or leaves it: the
         // previous pressure is the safer start.
-        if self.interface != Interface::HardWall {
+        if self.cx.interface != Interface::HardWall {
             return false;
         }
-        let n = self.state.pressure.len() as f64;
+        let n = self.cx.state.pressure.len() as f64;
         let step = match target {
             Target::MeanPressure(mean_pressure) => {
                 let x_sum: f64 = work.cg.x.iter().sum();
-                let p_sum: f64 = self.state.pressure.iter().sum();
+                let p_sum: f64 = self.cx.state.pressure.iter().sum();
                 if !crate::is_positive_finite(x_sum) {
                     return false;
                 }
@@ -210,7 +193,7 @@ impl ContactSolver {
             Target::Indentation(d) => d - solved.indentation,
         };
         let mut total = 0.0;
-        for (p, &x) in self.state.pressure.iter_mut().zip(&work.cg.x) {
+        for (p, &x) in self.cx.state.pressure.iter_mut().zip(&work.cg.x) {
             *p = (*p + step * x).max(0.0);
             total += *p;
         }
@@ -219,7 +202,7 @@ impl ContactSolver {
                 return false;
             }
             let scale = mean_pressure * n / total;
-            self.state.pressure.iter_mut().for_each(|p| *p *= scale);
+            self.cx.state.pressure.iter_mut().for_each(|p| *p *= scale);
         }
         true
     }
@@ -252,16 +235,21 @@ impl ContactSolver {
     /// contact (two CG solves on the full grid, see the module docs); computed once per
     /// surface. Works in the CG's own fields: the solved state is kept.
     pub(super) fn free_full_contact(&mut self) -> Result<FullContactThreshold, SolveError> {
-        if let Some(full) = self.state.full_contact.filter(|f| f.indentation.is_some()) {
+        if let Some(full) = self
+            .cx
+            .state
+            .full_contact
+            .filter(|f| f.indentation.is_some())
+        {
             return Ok(full);
         }
-        let n = self.problem.rows * self.problem.cols;
+        let n = self.cx.problem.rows * self.cx.problem.cols;
         let mut work = self.stiffness_work();
         // The threshold's CGs overwrite the frozen-set solution.
         work.tangent = false;
         let (tolerance, max_iterations) = (
-            self.params.stiffness_tolerance,
-            self.params.stiffness_max_iterations,
+            self.cx.params.stiffness_tolerance,
+            self.cx.params.stiffness_max_iterations,
         );
         // The threshold reads q and y point by point: the residual criterion only.
         let params = CgParams {
@@ -269,21 +257,21 @@ impl ContactSolver {
             energy_error: None,
             max_iterations,
         };
-        let limits = (&params, &self.stop);
+        let limits = (&params, &self.cx.stop);
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
-            &mut self.problem.operator,
-            &mut self.preconditioner,
+            &mut self.cx.problem.operator,
+            &mut self.cx.preconditioner,
             |_| true,
-            RightHandSide::Values(&self.problem.profile),
+            RightHandSide::Values(&self.cx.problem.profile),
             &mut work.cg,
             limits,
         )
         .and_then(|_| {
             std::mem::swap(&mut work.cg.x, &mut work.profile_pressure);
             conjugate_gradient_on_set(
-                &mut self.problem.operator,
-                &mut self.preconditioner,
+                &mut self.cx.problem.operator,
+                &mut self.cx.preconditioner,
                 |_| true,
                 RightHandSide::Ones,
                 &mut work.cg,
@@ -304,7 +292,7 @@ impl ContactSolver {
         });
         self.stiffness_work = Some(work);
         if let Ok(full) = result {
-            self.state.full_contact = Some(full);
+            self.cx.state.full_contact = Some(full);
         }
         result
     }
