@@ -4,8 +4,9 @@
 //!   checkpoints, ...) → `ValueError` with the library's one-line message, the line the
 //!   CLI prints after `error: `;
 //! * the memory guard ([`Error::OutOfMemory`]) → `MemoryError`;
-//! * [`SolveError::NoConvergence`] → `asperity.ConvergenceError` with `.iterations` and
-//!   `.residual`;
+//! * [`SolveError::NoConvergence`] and [`SolveError::Stagnated`] (given up early: the
+//!   residual stopped decreasing) → `asperity.ConvergenceError` with `.iterations` and
+//!   `.residual` (the best one reached);
 //! * [`SolveError::BeyondFullContact`] → `asperity.BeyondFullContactError` (a
 //!   `ValueError`) with `.threshold` (the full-contact value in the quantity asked for, or
 //!   `None`), `.quantity` and `.requested`;
@@ -63,6 +64,11 @@ pub fn from_solve(error: SolveError) -> PyErr {
         SolveError::NoConvergence {
             iterations,
             residual,
+        }
+        | SolveError::Stagnated {
+            iterations,
+            best: residual,
+            ..
         } => Python::attach(|py| {
             let err = ConvergenceError::new_err(message);
             let value = err.value(py);

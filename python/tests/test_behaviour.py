@@ -283,9 +283,10 @@ print("finished")
     code = process.wait(timeout=60)
     elapsed = time.monotonic() - start
     assert code == 130 and "KeyboardInterrupt" in process.stdout.read()
-    # One warm 256² load takes well under a second; allow for the loaded machine.
+    # One warm 256² load takes well under a second, the sweep minutes; the bound tells
+    # "stopped" from "ran on" and leaves room for a busy machine (issue 33 item 16).
     print(f"sweep stopped {elapsed:.3f} s after SIGINT")
-    assert elapsed < 3.0, f"took {elapsed:.2f} s to stop"
+    assert elapsed < 20.0, f"took {elapsed:.2f} s to stop"
 
 
 def test_ctrl_c_stops_a_single_long_solve_within_a_second(tmp_path):
@@ -320,8 +321,10 @@ print("finished")
     code = process.wait(timeout=120)
     assert line == "KeyboardInterrupt", (line, process.stderr.read())
     assert process.stdout.read().strip() == "usable" and code == 130
+    # Within an iteration (well under a second when idle) against hours without the
+    # stop: 20 s leave room for a busy machine (issue 33 item 16).
     print(f"solve stopped {elapsed:.3f} s after SIGINT")
-    assert elapsed < 1.0, f"took {elapsed:.2f} s to stop"
+    assert elapsed < 20.0, f"took {elapsed:.2f} s to stop"
 
 
 def test_progress_callbacks_and_their_exceptions(rough):
@@ -357,3 +360,18 @@ def test_adhesive_mdr_is_the_clis_loop_and_jkrs_pull_off(cli, tmp_path):
     assert pull == ours.force.min()
     record = __import__("json").loads((tmp_path / "c.csv.json").read_text())
     assert record["adhesion"]["pull_off"]["force_controlled"]["force"] == pull
+
+
+def test_a_solve_that_stops_improving_raises_convergence_error_early():
+    """Issue 33 item 13: a solve whose residual stops decreasing (here a tolerance below the
+    rounding floor) raises ConvergenceError after about 1000 iterations without progress, not
+    after its limit of a million; .residual is the best reached, the message says why."""
+    s = asperity.surface(32, hurst=0.8, rolloff=4, rms_slope=0.5, seed=7)
+    for solver in ["bccg", "pk"]:
+        with pytest.raises(asperity.ConvergenceError) as caught:
+            asperity.Solver(s, solver=solver, tolerance=1e-300,
+                            max_iterations=10**6).solve(pressure=0.02)
+        e = caught.value
+        assert 1000 <= e.iterations < 2000, (solver, e.iterations)
+        assert 0 < e.residual < 1e-12, (solver, e.residual)
+        assert "stopped decreasing" in str(e) and "rounding floor" in str(e), str(e)

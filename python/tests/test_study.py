@@ -234,9 +234,10 @@ print("finished", flush=True)
     assert code == 130 and "KeyboardInterrupt" in out, (code, out, process.stderr.read())
     # One BEM sample of 256² (24 solves and stiffnesses) takes seconds; the samples in
     # flight stop inside their solves (the sampler's solver polls the same stop flag), so
-    # the study ends within a second; 2 s allow for a loaded test machine.
+    # the study ends within a second when idle, against hours without the stop; 20 s
+    # allow for a busy machine (issue 33 item 16).
     print(f"study stopped {elapsed:.3f} s after SIGINT")
-    assert elapsed < 2.0, f"took {elapsed:.2f} s to stop"
+    assert elapsed < 20.0, f"took {elapsed:.2f} s to stop"
     assert (folder / "study.json").exists() and checkpoint_samples(folder) > 0
 
 

@@ -1420,3 +1420,37 @@ fn tangential_and_conductance_columns_follow_the_frozen_set() {
     ];
     refused(&asperity(&adhesive), "does not go with --poisson");
 }
+
+/// Issue 33 items 13 and 15: a solve that cannot converge ends early, in one line that says
+/// why, instead of running to its iteration limit (here a million: hours at 64²). A
+/// tolerance below the rounding floor stands for every stagnating solve; both solvers.
+#[test]
+fn a_solve_that_stops_improving_is_given_up_early_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    for solver in ["bccg", "pk"] {
+        let out = asperity(&[
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--solver",
+            solver,
+            "--pressures",
+            "0.01",
+            "--tol",
+            "1e-300",
+            "--max-iter",
+            "1000000",
+        ]);
+        let err = refused(
+            &out,
+            "load 0 (mean pressure 0.01): no convergence: the residual",
+        );
+        assert!(
+            err.contains("stopped decreasing (not halved in the last 1000 of")
+                && err.contains("near the rounding floor, ask for a larger tolerance")
+                && !err.contains("NaN"),
+            "{solver}: {err}"
+        );
+    }
+}

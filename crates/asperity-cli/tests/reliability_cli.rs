@@ -102,7 +102,9 @@ fn hostile_npy_headers_are_refused_by_every_command() {
     ] {
         refused(&asperity(&args, d), needle);
     }
-    assert!(start.elapsed() < Duration::from_secs(30));
+    // Refused before any work (the 1e9-element arrays would take minutes); room for a
+    // busy machine (issue 33 item 16).
+    assert!(start.elapsed() < Duration::from_secs(120));
     assert_eq!(files(d), before, "nothing written");
     // mdr's input honours the memory guard: a real 8 MiB line under a 2 MiB cap.
     let line: Vec<u8> = (0..1 << 20)
@@ -327,7 +329,8 @@ fn a_study_folder_is_locked_while_a_run_works_in_it() {
         let t = Instant::now();
         let out = asperity(&[&long[..], extra].concat(), d);
         refused(&out, &format!("PID {}", child.id()));
-        assert!(t.elapsed() < Duration::from_secs(10), "refused at once");
+        // At once, not after the holder's long study; room for a busy machine.
+        assert!(t.elapsed() < Duration::from_secs(60), "refused at once");
     }
     child.kill().unwrap(); // SIGKILL: no handler runs
     child.wait().unwrap();

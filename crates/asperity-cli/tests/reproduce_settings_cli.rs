@@ -84,8 +84,10 @@ fn the_test_setting_writes_a_complete_recorded_folder_and_resumes_identically() 
     let o = asperity(&args_b.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(results(&a), results(&b));
+    // Seconds when idle; the bound only catches a test setting grown by mistake and leaves
+    // room for a busy machine (issue 33 item 16).
     assert!(
-        full < Duration::from_secs(120),
+        full < Duration::from_secs(600),
         "the test setting took {full:?}"
     );
 }

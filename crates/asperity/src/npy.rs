@@ -773,6 +773,7 @@ mod tests {
         bytes.extend(dict.as_bytes());
         let start = std::time::Instant::now();
         assert!(parse_header(&bytes).is_err());
-        assert!(start.elapsed() < std::time::Duration::from_secs(1));
+        // Microseconds when linear, forever when exponential; room for a busy machine.
+        assert!(start.elapsed() < std::time::Duration::from_secs(20));
     }
 }

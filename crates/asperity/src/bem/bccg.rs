@@ -642,6 +642,7 @@ impl Iteration for BccgScratch {
                     residual: gradient.residual,
                 });
             }
+            cx.check_progress(iteration, gradient.residual)?;
             iteration += 1;
             let direction = self.direction(cx, target, &gradient, previous_zg);
             previous_zg = direction.zg;

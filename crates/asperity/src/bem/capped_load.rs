@@ -67,6 +67,15 @@ impl Spent {
             SolveError::Interrupted { iterations } => SolveError::Interrupted {
                 iterations: iterations + self.iterations,
             },
+            SolveError::Stagnated {
+                iterations,
+                best,
+                window,
+            } => SolveError::Stagnated {
+                iterations: iterations + self.iterations,
+                best,
+                window,
+            },
             other => other,
         }
     }

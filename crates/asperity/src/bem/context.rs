@@ -9,6 +9,7 @@
 
 use super::interface::Interface;
 use super::preconditioner::FourierPreconditioner;
+use super::stagnation::Progress;
 use super::threshold::FullContactThreshold;
 use super::{ContactSummary, HalfSpace, SolveError, SolverParams};
 use crate::elastic::ElasticOperator;
@@ -179,12 +180,25 @@ pub(super) struct Context {
     pub(super) preconditioner: FourierPreconditioner,
     /// Polled once per iteration of every loop ([`super::ContactSolver::with_stop`]).
     pub(super) stop: Stop,
+    /// The residuals of the running BCCG or Polonsky–Keer solve (`stagnation.rs`).
+    pub(super) progress: Progress,
     /// What "in contact" means ([`super::ContactSolver::set_interface`]; the hard wall by
     /// default).
     pub(super) interface: Interface,
 }
 
 impl Context {
+    /// The residual of `iteration` of a BCCG or Polonsky–Keer solve:
+    /// [`SolveError::Stagnated`] where it has stopped decreasing (`stagnation.rs`).
+    #[inline]
+    pub(super) fn check_progress(
+        &mut self,
+        iteration: usize,
+        residual: f64,
+    ) -> Result<(), SolveError> {
+        self.progress.observe(iteration, residual)
+    }
+
     /// [`SolveError::Interrupted`] after `iterations` if a stop is requested.
     #[inline]
     pub(super) fn check_stop(&self, iterations: usize) -> Result<(), SolveError> {

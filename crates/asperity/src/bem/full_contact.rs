@@ -263,4 +263,31 @@ mod tests {
             );
         }
     }
+
+    /// Issue 33 item 15: heights ×1e-200 on a free boundary gave a threshold of 0 (the
+    /// CG's sums of f² underflowed), printed in the refusal as "from a mean pressure of
+    /// 0.000000e0"; the threshold scales with the heights like the periodic one.
+    #[test]
+    fn the_free_threshold_of_tiny_or_huge_heights_scales_with_them() {
+        let surface = rough(32, 1);
+        let mut s = solver(&surface, Boundary::Free);
+        let unit = s.full_contact_threshold().unwrap();
+        for factor in [1e-200, 1e-120, 1e120, 1e200] {
+            let heights = surface.heights().mapv(|h| h * factor);
+            let scaled = crate::surface::Surface::new(heights, surface.size()).unwrap();
+            let got = solver(&scaled, Boundary::Free)
+                .full_contact_threshold()
+                .unwrap();
+            let (p, d) = (
+                got.mean_pressure / factor,
+                got.indentation.unwrap() / factor,
+            );
+            let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-9;
+            assert!(
+                close(p, unit.mean_pressure),
+                "×{factor}: {got:?} vs {unit:?}"
+            );
+            assert!(close(d, unit.indentation.unwrap()), "×{factor}: {got:?}");
+        }
+    }
 }

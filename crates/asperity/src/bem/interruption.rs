@@ -22,7 +22,10 @@ fn solver(surface: &Surface, boundary: Boundary, kind: SolverKind, tol: f64) -> 
         max_iterations: usize::MAX / 4,
         ..SolverParams::default()
     };
-    ContactSolver::new(surface, half_space, params).unwrap()
+    let mut solver = ContactSolver::new(surface, half_space, params).unwrap();
+    // The unreachable tolerances below stagnate at the rounding floor: not given up here.
+    solver.cx.progress.set_window(usize::MAX);
+    solver
 }
 
 /// Every (solver, boundary, control) path: a load and an indentation below it.
@@ -113,10 +116,12 @@ fn a_stop_during_a_solve_ends_it_within_an_iteration() {
             Err(SolveError::Interrupted { iterations }) => assert!(iterations > 0, "{what}"),
             other => panic!("{what}: {other:?}"),
         }
-        // One iteration at 128² takes about a millisecond; allow for a loaded machine.
+        // One iteration at 128² takes about a millisecond; without the stop the solve
+        // would not end at all. The bound only tells "polled" from "not polled": a busy
+        // machine (load 20 on 2 cores) may hold the thread for seconds (issue 33 item 16).
         let late = ended.saturating_duration_since(requested);
         assert!(
-            late < Duration::from_millis(500),
+            late < Duration::from_secs(60),
             "{what}: stopped {late:?} late"
         );
         stop.clear();

@@ -47,7 +47,9 @@
 //! contact set and normalised by the rms height `h_rms` of the surface:
 //! `residual = sqrt[(Σ_{p>0} g² + Σ_{p=0} min(g, 0)²) / n_c] / h_rms`, where `n_c` counts the
 //! points in contact. It is zero exactly when the state solves the problem. The solver stops
-//! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] otherwise.
+//! when `residual < tolerance` and fails with [`SolveError::NoConvergence`] at its iteration
+//! limit, or earlier with [`SolveError::Stagnated`] where the residual has stopped
+//! decreasing (`stagnation.rs`).
 
 pub mod adhesion;
 mod bccg;
@@ -68,6 +70,7 @@ mod preconditioner;
 mod ring_extension;
 mod small_set;
 mod solver;
+mod stagnation;
 mod stiffness;
 pub mod sweep;
 pub mod tangential;
@@ -340,6 +343,19 @@ pub enum SolveError {
         /// Residual reached.
         residual: f64,
     },
+    /// The residual stopped decreasing: its best value has not halved in the last `window`
+    /// iterations, so the solve was given up before its iteration limit (a cycling contact
+    /// set, the rounding floor under a tolerance far below `1e-14`, a problem hopeless for
+    /// its grid; `stagnation.rs`).
+    #[error("{}", stagnation_message(*iterations, *best, *window))]
+    Stagnated {
+        /// Iterations done.
+        iterations: usize,
+        /// The best residual reached.
+        best: f64,
+        /// Iterations without a halving of the best residual.
+        window: usize,
+    },
     /// A stop was requested through the solver's [`crate::stop::Stop`] (checked once per
     /// iteration of every solver loop). The solver forgets its unfinished state: the next
     /// solve starts cold, as after [`ContactSolver::reset`].
@@ -381,9 +397,28 @@ fn no_convergence_message(iterations: usize, residual: f64) -> String {
     )
 }
 
+/// `no convergence: the residual stopped decreasing (not halved in the last 1000 of 1234
+/// iterations, best 3.100e-5); …`, with advice where the best is at the rounding floor.
+fn stagnation_message(iterations: usize, best: f64, window: usize) -> String {
+    let floor = if best < 1e-12 {
+        ": near the rounding floor, ask for a larger tolerance"
+    } else {
+        ""
+    };
+    format!(
+        "no convergence: the residual stopped decreasing (not halved in the last {window} of \
+         {iterations} iterations, best {best:.3e}{floor}); the solve was given up before its \
+         iteration limit"
+    )
+}
+
 fn beyond_full_contact_message(requested: &Control, full_contact: Option<f64>) -> String {
     let quantity = requested.quantity();
     let threshold = match full_contact {
+        // A flat surface (every height the same): "from 0" read as a value lost.
+        Some(0.0) => {
+            format!(" (the surface is flat: any {quantity} closes the gap everywhere)")
+        }
         Some(t) => {
             let article = if quantity.starts_with('i') { "an" } else { "a" };
             format!(" (the gap closes everywhere from {article} {quantity} of {t:.6e})")
@@ -425,6 +460,22 @@ mod message_tests {
         assert_eq!(
             text,
             "no convergence after 12 iterations (residual 3.200e-4)"
+        );
+    }
+
+    /// Issue 33 item 15: a flat surface's full-contact threshold was printed as a value,
+    /// "from a mean pressure of 0.000000e0"; it is said to be flat.
+    #[test]
+    fn a_flat_surface_beyond_full_contact_is_said_to_be_flat() {
+        let text = SolveError::BeyondFullContact {
+            requested: Control::MeanPressure(0.01),
+            full_contact: Some(0.0),
+        }
+        .to_string();
+        assert_eq!(
+            text,
+            "mean pressure 1.000000e-2 is beyond full contact (the surface is flat: any mean \
+             pressure closes the gap everywhere)"
         );
     }
 }

@@ -102,6 +102,7 @@ impl Iteration for PkScratch {
                     residual,
                 });
             }
+            cx.check_progress(iteration, residual)?;
             g_old = pass.gap_squared;
             iteration += 1;
 

@@ -49,6 +49,7 @@ use super::interface::{restore_capped_load, Interface};
 use super::iteration::{Iteration, Limits};
 use super::polonsky_keer::PkScratch;
 use super::preconditioner::{FourierPreconditioner, Real};
+use super::stagnation::Progress;
 use super::stiffness::work::StiffnessWork;
 use super::threshold::FullContactScratch;
 use super::{
@@ -148,6 +149,7 @@ impl ContactSolver {
             state: SolverState::new(rows * cols),
             preconditioner,
             stop: Stop::new(),
+            progress: Progress::default(),
             interface: Interface::HardWall,
         };
         Ok(ContactSolver {
@@ -411,6 +413,7 @@ impl ContactSolver {
     /// the new load) or a cold start (uniform pressure under load control; local springs
     /// `max(d − f, 0)/K₀₀` under displacement control).
     pub(super) fn initialise(&mut self, target: Target, self_influence: f64) {
+        self.cx.progress.restart();
         let n = (self.cx.problem.rows * self.cx.problem.cols) as f64;
         let warm = self.cx.state.solved.is_some();
         if self.predict_from_tangent(target) {

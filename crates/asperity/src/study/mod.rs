@@ -641,8 +641,10 @@ mod tests {
         s.hursts = hursts;
         let start = std::time::Instant::now();
         s.validate().unwrap();
+        // Milliseconds when linear, minutes when quadratic; the bound leaves room for a
+        // busy machine (issue 33 item 16).
         assert!(
-            start.elapsed() < std::time::Duration::from_secs(2),
+            start.elapsed() < std::time::Duration::from_secs(20),
             "{:?}",
             start.elapsed()
         );

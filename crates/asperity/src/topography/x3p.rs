@@ -802,4 +802,63 @@ mod tests {
         fuzz(&bytes, read);
         assert!(read(b"PK\x03\x04 not really").is_err());
     }
+
+    /// An archive of `members` (name, bytes), each deflated.
+    fn archive(members: &[(&str, &[u8])]) -> Vec<u8> {
+        let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+        let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
+        for (name, bytes) in members {
+            zip.start_file(*name, options).unwrap();
+            zip.write_all(bytes).unwrap();
+        }
+        zip.finish().unwrap().into_inner()
+    }
+
+    /// Rewrites the uncompressed size that the local and central headers of member `name`
+    /// declare.
+    fn declare_size(zip: &mut [u8], name: &str, size: u32) {
+        let named = |zip: &[u8], i: usize, at: usize, len_at: usize| {
+            let len = u16::from_le_bytes([zip[i + len_at], zip[i + len_at + 1]]) as usize;
+            zip.get(i + at..i + at + len) == Some(name.as_bytes())
+        };
+        for i in 0..zip.len().saturating_sub(46) {
+            if zip[i..].starts_with(b"PK\x03\x04") && named(zip, i, 30, 26) {
+                zip[i + 22..i + 26].copy_from_slice(&size.to_le_bytes());
+            }
+            if zip[i..].starts_with(b"PK\x01\x02") && named(zip, i, 46, 28) {
+                zip[i + 24..i + 28].copy_from_slice(&size.to_le_bytes());
+            }
+        }
+    }
+
+    /// Issue 33: zip bombs in an X3P file are refused in one line, before anything of
+    /// their declared size is allocated: a `main.xml` that inflates past its bound, a
+    /// payload whose header declares the 3.2 GB its grid needs from a few compressed bytes,
+    /// and a payload that inflates beyond what it declares.
+    #[test]
+    fn zip_bombs_are_refused_without_allocating() {
+        let one_line = |bytes: &[u8], needle: &str| {
+            let err = read(bytes).unwrap_err().to_string();
+            assert!(err.contains(needle) && err.lines().count() == 1, "{err}");
+        };
+        // 17 MiB of spaces deflate to about 17 kB.
+        let mut xml = main_xml(2, 2, 1e-6, 1e-6, "").into_bytes();
+        xml.resize((MAX_XML + (1 << 20)) as usize, b' ');
+        one_line(&archive(&[("main.xml", &xml)]), "main.xml is larger than");
+        // 20000 x 20000 doubles declared; 4 kB of zeros stored.
+        let xml = main_xml(20_000, 20_000, 1e-6, 1e-6, "");
+        let zeros = vec![0u8; 4096];
+        let mut bomb = archive(&[("main.xml", xml.as_bytes()), ("bindata/data.bin", &zeros)]);
+        declare_size(&mut bomb, "bindata/data.bin", 3_200_000_000);
+        one_line(&bomb, "cannot come from");
+        // A 2 x 2 grid (32 bytes) whose payload inflates to 1 MB while declaring 32.
+        let xml = main_xml(2, 2, 1e-6, 1e-6, "");
+        let mut more = archive(&[
+            ("main.xml", xml.as_bytes()),
+            ("bindata/data.bin", &vec![0u8; 1 << 20]),
+        ]);
+        declare_size(&mut more, "bindata/data.bin", 32);
+        let err = read(&more).unwrap_err().to_string();
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
 }

@@ -53,6 +53,20 @@ use crate::Error;
 use cg::{conjugate_gradient_on_set, CgInfo, CgParams, RightHandSide};
 use work::StiffnessWork;
 
+/// The power of two by which the threshold's CG divides the profile `f`: 1 where its
+/// largest value lies within 2^±64 (so the usual bits), else the power of two nearest it
+/// (exact either way), so that sums of `f²` neither underflow nor overflow. (Not the rms
+/// height: its own sum of squares underflows first.)
+fn profile_unit(profile: &[f64]) -> f64 {
+    let peak = profile.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let exponent = peak.log2().round();
+    if peak > 0.0 && peak.is_finite() && exponent.abs() > 64.0 {
+        2f64.powi(exponent as i32)
+    } else {
+        1.0
+    }
+}
+
 /// The CG's info as the solver reports it.
 fn solve_info(info: &CgInfo) -> SolveInfo {
     SolveInfo {
@@ -258,12 +272,20 @@ impl ContactSolver {
             max_iterations,
         };
         let limits = (&params, &self.cx.stop);
+        // f in a unit that keeps the CG's sums of squares inside f64's range (heights
+        // ×1e-200 underflowed them: a threshold of 0 was reported, issue 33 item 15).
+        let unit = profile_unit(&self.cx.problem.profile);
+        let scaled = work
+            .profile_pressure
+            .iter_mut()
+            .zip(&self.cx.problem.profile);
+        scaled.for_each(|(s, f)| *s = f / unit);
         // y = K⁻¹f first, kept aside; then q = K⁻¹1 stays in the CG's unknown.
         let result = conjugate_gradient_on_set(
             &mut self.cx.problem.operator,
             &mut self.cx.preconditioner,
             |_| true,
-            RightHandSide::Values(&self.cx.problem.profile),
+            RightHandSide::Values(&work.profile_pressure),
             &mut work.cg,
             limits,
         )
@@ -286,8 +308,8 @@ impl ContactSolver {
                 .fold(f64::NEG_INFINITY, |m, (q, y)| m.max(y / q));
             let mean_pressure = q_y.map(|(q, y)| indentation * q - y).sum::<f64>() / n as f64;
             FullContactThreshold {
-                mean_pressure,
-                indentation: Some(indentation),
+                mean_pressure: mean_pressure * unit,
+                indentation: Some(indentation * unit),
             }
         });
         self.stiffness_work = Some(work);
