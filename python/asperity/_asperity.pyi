@@ -158,3 +158,8 @@ def sweep_figure(
     force: List[float], stiffness: List[float], stiffness_fd: Optional[List[float]],
     area_fraction: List[float], name: str, modulus: float, physical: bool, boundary: str,
 ) -> str: ...
+def path_figure(
+    values: List[float], indentation: List[float], force: List[float],
+    area_fraction: List[float], stiffness: List[float], name: str, boundary: str,
+    hardness: Optional[float],
+) -> str: ...

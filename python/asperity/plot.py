@@ -14,6 +14,8 @@ returns the ``Axes``:
 * :func:`contact_map` -- a contact set with its 4-connected patches coloured
   (``asperity contact --map``);
 * :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``);
+* :func:`load_path` -- a load path's loading–unloading loop (``bem --load-path --plot``);
+  :func:`field` -- a field (the plastic or permanent displacement) as an image;
 * :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
 
 The sweep and study figures (:func:`stiffness` and :func:`area` of a ``Solver.sweep``,
@@ -223,6 +225,40 @@ def _sweep_charts(sweep: Any) -> list:
         c["area_fraction"].tolist(), "surface", float(solver.get("modulus", 1.0)), False,
         solver.get("boundary", "free"))
     return _charts(__import__("json").loads(text))
+
+
+def load_path(path: Any, axes=None):
+    """The loading–unloading loop of a ``Solver.load_path`` result as ``asperity bem
+    --load-path --plot`` draws it (one figure definition, ``asperity_app::figure::path``):
+    force against indentation, the contact fraction against indentation and the stiffness
+    against force, each step marked by its branch. ``axes``: three matplotlib axes, or
+    None for a new figure. Returns the axes."""
+    from . import _asperity
+
+    c, solver, loads = path.columns, path.metadata.get("solver", {}), path.metadata.get("loads", {})
+    text = _asperity.path_figure(
+        [float(v) for v in loads.get("values", c["indentation"])], c["indentation"].tolist(),
+        c["force"].tolist(), c["area_fraction"].tolist(), c["stiffness"].tolist(), "surface",
+        solver.get("boundary", "free"), solver.get("hardness"))
+    return figure(__import__("json").loads(text), axes)
+
+
+def field(values: Any, ax=None, *, size: Optional[tuple] = None, label: str = "",
+          cmap: str = "magma"):
+    """A rows × cols field (the ``plastic_displacement`` of a capped solve, the
+    ``permanent_displacement`` of a load path, a pressure or a gap) as an image with y up
+    and a colour bar named ``label``; ``size``: (L_x, L_y) for the axes' extent."""
+    data = _np.asarray(values, dtype=float)
+    if data.ndim != 2:
+        raise ValueError(f"field: expected a 2D array, got shape {data.shape}")
+    ax = _axes(ax)
+    rows, cols = data.shape
+    extent = (0, size[0], 0, size[1]) if size is not None else (0, cols, 0, rows)
+    image = ax.imshow(data, origin="lower", extent=extent, cmap=cmap, interpolation="nearest")
+    ax.figure.colorbar(image, ax=ax, label=label)
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    return ax
 
 
 def _study_chart(result: Any, kind: str) -> dict:

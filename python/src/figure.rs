@@ -1,11 +1,14 @@
 //! What a figure shows ([`asperity_app::figure`]), for `asperity.plot`: the charts the CLI
 //! draws with `--plot`, as JSON, which the package draws with matplotlib.
 
+use asperity_app::bem::branches;
+use asperity_app::figure::path::{PathColumns, PathFigure};
 use asperity_app::figure::{self, sweep::SweepColumns, sweep::SweepFigure};
 use pyo3::prelude::*;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(path_figure, m)?)?;
     Ok(())
 }
 
@@ -26,7 +29,11 @@ fn sweep_figure(
 ) -> PyResult<String> {
     let n = force.len();
     let lengths = [stiffness.len(), area_fraction.len()];
-    if lengths.iter().chain(stiffness_fd.as_ref().map(Vec::len).iter()).any(|&l| l != n) {
+    if lengths
+        .iter()
+        .chain(stiffness_fd.as_ref().map(Vec::len).iter())
+        .any(|&l| l != n)
+    {
         return Err(pyo3::exceptions::PyValueError::new_err(
             "sweep_figure: the columns differ in length",
         ));
@@ -44,5 +51,50 @@ fn sweep_figure(
         boundary,
     };
     let charts = figure::sweep::sweep_charts(columns, figure);
+    Ok(figure::to_json(&charts).to_string())
+}
+
+/// The three panels of a load path (F(d), A/A₀(d), k(F), steps marked by branch) as
+/// `asperity bem --load-path --plot FILE.json` writes them; `values`: the path's loads or
+/// indentations in order (their branches), the columns one value per step.
+#[pyfunction]
+#[pyo3(signature = (values, indentation, force, area_fraction, stiffness, name, boundary, hardness))]
+#[allow(clippy::too_many_arguments)]
+fn path_figure(
+    values: Vec<f64>,
+    indentation: Vec<f64>,
+    force: Vec<f64>,
+    area_fraction: Vec<f64>,
+    stiffness: Vec<f64>,
+    name: &str,
+    boundary: &str,
+    hardness: Option<f64>,
+) -> PyResult<String> {
+    let n = values.len();
+    let lengths = [
+        indentation.len(),
+        force.len(),
+        area_fraction.len(),
+        stiffness.len(),
+    ];
+    if lengths.iter().any(|&l| l != n) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "path_figure: the columns differ in length",
+        ));
+    }
+    let branch = branches(&values);
+    let columns = PathColumns {
+        branch: &branch,
+        indentation: &indentation,
+        force: &force,
+        area_fraction: &area_fraction,
+        stiffness: &stiffness,
+    };
+    let figure = PathFigure {
+        name,
+        boundary,
+        hardness,
+    };
+    let charts = figure::path::path_charts(columns, figure);
     Ok(figure::to_json(&charts).to_string())
 }

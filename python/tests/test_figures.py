@@ -87,3 +87,31 @@ def test_a_figure_that_is_not_ours_is_refused(tmp_path):
     (tmp_path / "x.json").write_text('{"charts": []}')
     with pytest.raises(ValueError, match="asperity-figure/1"):
         asperity.plot.figure(tmp_path / "x.json")
+
+
+def test_a_load_paths_figure_is_the_clis_and_draws_the_loop(cli, tmp_path):
+    """`bem --load-path --plot FILE.json` and `asperity.plot.load_path` of the same path:
+    the same three charts (F(d), A/A₀(d), k(F); titles aside, which name the file), and
+    matplotlib draws the loop's points; the permanent displacement draws as an image."""
+    cli("surface", "--n", "48", "--hurst", "0.8", "--rolloff", "3", "--rms-slope", "0.5",
+        "--seed", "7", "--out", tmp_path / "s.npy")
+    loads = [0.01, 0.03, 0.01, 0.02, 0.03]
+    cli("bem", "--surface", tmp_path / "s.npy", "--boundary", "periodic", "--hardness", "0.2",
+        "--load-path", "--pressures", ",".join(map(str, loads)), "--quiet",
+        "--out", tmp_path / "p.csv", "--plot", tmp_path / "p.json")
+    theirs = json.loads((tmp_path / "p.json").read_text())["charts"]
+    solver = asperity.Solver(asperity.load(tmp_path / "s.npy"), boundary="periodic",
+                             hardness=0.2)
+    path = solver.load_path(pressures=loads)
+    axes = asperity.plot.load_path(path)
+    assert len(axes) == len(theirs) == 3
+    for ax, chart in zip(axes, theirs):
+        assert ax.get_xlabel() == chart["x_label"] and ax.get_ylabel() == chart["y_label"]
+        labels = [s["label"] for s in chart["series"]]
+        assert labels == ["path", "loading", "unloading", "reloading"]
+        drawn = np.array(ax.lines[0].get_xydata())
+        assert np.array_equal(drawn, np.array(chart["series"][0]["points"]))
+    assert theirs[0]["series"][0]["points"] == [list(p) for p in zip(path.indentation, path.force)]
+    assert "H = 0.2" in theirs[0]["title"]
+    ax = asperity.plot.field(path.permanent_displacement, label="permanent displacement")
+    assert ax.images[0].get_array().shape == path.permanent_displacement.shape

@@ -4,9 +4,10 @@
 //! series with their styles, colours, intervals and tags — so that both front ends show the
 //! same curves, theory lines, labels and intervals.
 //!
-//! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`study`] (α(H), α(N) and the
-//! ensemble k(F) of a study).
+//! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`path`] (a load path's
+//! loading–unloading loop), [`study`] (α(H), α(N) and the ensemble k(F) of a study).
 
+pub mod path;
 pub mod study;
 pub mod sweep;
 

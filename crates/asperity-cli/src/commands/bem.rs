@@ -130,7 +130,8 @@ pub struct BemArgs {
     /// the last and its plastic displacement kept (the library's load_path), so the table
     /// shows the hysteresis. Columns branch, force, mean_pressure, indentation,
     /// area_fraction, plastic_fraction, stiffness, iterations, permanent_max; --fields DIR
-    /// writes permanent.npy (the permanent displacement after the last step).
+    /// writes permanent.npy (the permanent displacement after the last step); --plot
+    /// draws the loop: F and A/A0 against d, k against F, the steps marked by branch.
     #[arg(long)]
     pub load_path: bool,
     /// Adhesion (work of adhesion Δγ, in the units of the modulus times a length): Pohrt &

@@ -11,16 +11,17 @@ use std::path::Path;
 
 use asperity::io::{sidecar_path, StagedOutputs};
 use asperity_app::bem::{branches, BemPlan, BemRequest, Branch, PATH_COLUMNS};
+use asperity_app::figure::path::{PathColumns, PathFigure};
 use serde_json::json;
 
 use super::bem::{read_surface_for, request, BemArgs};
 use crate::output::{format_number, Table};
+use crate::plot::{stage_charts, Chart, ImageFormat};
 
 /// The options of `asperity bem` that a load path refuses, with the flag named.
 fn refuse_other_options(args: &BemArgs) -> Result<()> {
     let given = [
         (args.fd_stiffness, "--fd-stiffness"),
-        (args.plot.is_some(), "--plot"),
         (args.timing, "--timing"),
         (args.no_stiffness, "--no-stiffness"),
         (args.poisson.is_some(), "--poisson"),
@@ -33,11 +34,48 @@ fn refuse_other_options(args: &BemArgs) -> Result<()> {
     if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
         bail!("--load-path does not go with {flag} (a path reports the frozen-set stiffness of each step)");
     }
+    if let Some(plot) = &args.plot {
+        ImageFormat::from_path(plot, "--plot")?;
+    }
     Ok(())
 }
 
-/// The outputs, checked before any work (as `asperity bem`'s): the table, its record and
-/// `permanent` (in `--fields DIR`, made here and removed again on any error).
+/// The `--plot` panels ([`asperity_app::figure::path`]): F(d), A/A₀(d) and k(F), each
+/// step marked by its branch.
+fn path_charts(
+    args: &BemArgs,
+    plan: &BemPlan,
+    branch: &[Branch],
+    points: &[PathPoint],
+) -> [Chart; 3] {
+    let column = |f: &dyn Fn(&PathPoint) -> f64| -> Vec<f64> { points.iter().map(f).collect() };
+    let (indentation, force) = (
+        column(&|p| p.summary.indentation),
+        column(&|p| p.summary.force),
+    );
+    let area_fraction = column(&|p| p.summary.area_fraction);
+    let stiffness = column(&|p| p.stiffness);
+    let name = args.surface.file_name().map_or_else(
+        || args.surface.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let columns = PathColumns {
+        branch,
+        indentation: &indentation,
+        force: &force,
+        area_fraction: &area_fraction,
+        stiffness: &stiffness,
+    };
+    let figure = PathFigure {
+        name: &name,
+        boundary: plan.half_space.boundary.name(),
+        hardness: plan.hardness(),
+    };
+    asperity_app::figure::path::path_charts(columns, figure)
+}
+
+/// The outputs, checked before any work (as `asperity bem`'s): the table, its record, the
+/// plot and `permanent` (in `--fields DIR`, made here and removed again on any error).
 fn stage(args: &BemArgs, permanent: Option<&Path>) -> Result<StagedOutputs> {
     let record_path = args.out.as_deref().map(sidecar_path);
     let paths = args
@@ -45,6 +83,7 @@ fn stage(args: &BemArgs, permanent: Option<&Path>) -> Result<StagedOutputs> {
         .as_deref()
         .into_iter()
         .chain(record_path.as_deref())
+        .chain(args.plot.as_deref())
         .chain(permanent);
     let staged = StagedOutputs::in_new_folders(&args.fields, paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
@@ -78,11 +117,20 @@ pub fn run(args: &BemArgs) -> Result<()> {
     let (surface, size_source) = read_surface_for(args, plan.half_space.boundary)?;
     let mut solver = plan.solver(&surface)?;
     plan.check_forces(solver.nominal_area())?;
+    if args.plot.is_some() && plan.loads.len() < 2 {
+        bail!("--plot needs at least 2 loads (a path), got 1");
+    }
     let values: Vec<f64> = plan.loads.iter().map(|c| c.value()).collect();
     let points = load_path(&mut solver, &plan.loads).context("load path")?;
+    let branch = branches(&values);
     let mut table = Table::new(&PATH_COLUMNS);
-    for (branch, point) in branches(&values).into_iter().zip(&points) {
-        table.push(&cells(branch, point));
+    for (&b, point) in branch.iter().zip(&points) {
+        table.push(&cells(b, point));
+    }
+    if let Some(plot) = &args.plot {
+        let charts = path_charts(args, &plan, &branch, &points);
+        stage_charts(&mut staged, plot, &charts)
+            .with_context(|| format!("writing {}", plot.display()))?;
     }
     if let Some(path) = &permanent_path {
         staged.write_npy_2d(path, &solver.permanent_displacement())?;
