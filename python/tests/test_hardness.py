@@ -231,6 +231,6 @@ def test_a_load_path_refuses_what_it_cannot_carry_alike(cli, rough):
         asperity.Solver(s, hardness=h).load_path(pressures=[0.01, h])
     assert str(refused.value) == in_keywords(cli_error(theirs))
     assert "is at or above the hardness" in str(refused.value)
-    theirs = cli("bem", "--surface", path, "--pressures", "0.01", "--load-path", "--plot",
-                 "x.png", ok=False)
-    assert cli_error(theirs).startswith("--load-path does not go with --plot")
+    theirs = cli("bem", "--surface", path, "--pressures", "0.01", "--load-path",
+                 "--fd-stiffness", ok=False)
+    assert cli_error(theirs).startswith("--load-path does not go with --fd-stiffness")
