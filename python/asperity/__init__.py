@@ -936,6 +936,9 @@ class Solver:
         poisson: Optional[float] = None,
         resistivity: Optional[Sequence[float]] = None,
         thermal_conductivity: Optional[Sequence[float]] = None,
+        persson: bool = False,
+        gamma: Optional[float] = None,
+        kappa: Optional[float] = None,
     ) -> Sweep:
         """A load sweep exactly as ``asperity bem`` runs it (same numbers bit for bit):
         ``pressures``, ``forces`` or ``indentations`` in the given order, or ``nloads``
@@ -955,29 +958,45 @@ class Solver:
         body: also ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and ``thermal_conductance``
         = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy). docs/tangential.md.
 
+        ``persson`` (``asperity bem --persson``): also the BEM's ``mean_gap`` (with
+        periodic boundaries Persson's mean separation) and Persson's theory from the
+        surface's own PSD at each load's mean pressure: ``area_fraction_persson``,
+        ``mean_gap_persson``, ``stiffness_persson`` (interfacial K·A₀), with ``gamma``
+        (default 0.45) and ``kappa`` (default √(8/π)). docs/persson.md.
+
         Example::
 
             >>> sweep = solver.sweep(nloads=20, pmin=1e-4, pmax=1e-1)
             >>> sweep.force, sweep.stiffness, sweep.area_fraction
             >>> t = solver.sweep(pressures=[0.01], poisson=0.3, resistivity=[1, 1])
             >>> t.tangential_ratio, t.electrical_conductance
+            >>> u = solver.sweep(pressures=[1e-3, 1e-2], persson=True, gamma=0.4)
+            >>> u.mean_gap, u.mean_gap_persson
 
         With the solver's ``hardness``: also ``plastic_fraction`` (the CLI's column);
         each load on the surface as given (:meth:`load_path` keeps the plastic
         displacement); a mean pressure or force at or above H times the nominal area is
         refused before the first solve.
         """
+        if not persson and (gamma is not None or kappa is not None):
+            raise ValueError("gamma and kappa go with persson=True")
+        theory = None
+        if persson:
+            theory = (float(_DEFAULTS["gamma"] if gamma is None else gamma),
+                      float(PERSSON_KAPPA if kappa is None else kappa))
         quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields)
         fd = float(fd_step) if fd_stiffness else None
         bar = _Progress(progress, "bem")
         try:
             columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields),
                                        bar.callback, _opt(poisson), _floats(resistivity),
-                                       _floats(thermal_conductivity))
+                                       _floats(thermal_conductivity), theory)
         finally:
             bar.close()
         derived = {"poisson": _opt(poisson), "resistivity": _floats(resistivity),
                    "thermal_conductivity": _floats(thermal_conductivity)}
+        if theory is not None:
+            derived["persson"] = {"gamma": theory[0], "kappa": theory[1]}
         derived = {k: v for k, v in derived.items() if v is not None}
         return Sweep(columns, self._metadata(loads={"quantity": quantity, "values": values},
                                              stiffness=bool(stiffness), fd_step=fd, **derived))

@@ -181,6 +181,7 @@ class Solver:
         progress: ProgressArg = ..., poisson: Optional[float] = ...,
         resistivity: Optional[Sequence[float]] = ...,
         thermal_conductivity: Optional[Sequence[float]] = ...,
+        persson: bool = ..., gamma: Optional[float] = ..., kappa: Optional[float] = ...,
     ) -> Sweep: ...
     def load_path(
         self, *, pressures: Optional[Sequence[float]] = ..., forces: Optional[Sequence[float]] = ...,

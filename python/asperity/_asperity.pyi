@@ -76,6 +76,7 @@ class Solver:
         fields: bool, progress: Progress, poisson: Optional[float] = ...,
         resistivity: Optional[List[float]] = ...,
         thermal_conductivity: Optional[List[float]] = ...,
+        persson: Optional[Tuple[float, float]] = ...,
     ) -> Dict[str, Any]: ...
 
 def mdr_curve(

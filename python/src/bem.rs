@@ -16,6 +16,7 @@ use asperity_app::bem::{
     branches, check_capped_loads, check_fd_step, ensure_solver_fits, Loads, SolverRequest,
 };
 use asperity_app::derived::{Derived, Units};
+use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -101,6 +102,7 @@ struct PyObserver<'a> {
     fields: bool,
     pressures: Vec<ndarray::Array2<f64>>,
     gaps: Vec<ndarray::Array2<f64>>,
+    mean_gaps: Option<Vec<f64>>,
     progress: Option<&'a Py<PyAny>>,
     cancel: &'a Cancel,
     total: usize,
@@ -113,6 +115,9 @@ impl SweepObserver for PyObserver<'_> {
         if self.fields {
             self.pressures.push(solver.pressure().to_owned());
             self.gaps.push(solver.gap().to_owned());
+        }
+        if let Some(gaps) = &mut self.mean_gaps {
+            gaps.push(bem_mean_gap(solver));
         }
         Ok(())
     }
@@ -364,8 +369,10 @@ impl Solver {
 
     /// A load sweep as `asperity bem` runs it (module docs); returns the columns. The
     /// tangential stiffness (`poisson`) and the conductances (`resistivity`,
-    /// `thermal_conductivity`, two bodies each) by the front-end layer's one definition.
-    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None))]
+    /// `thermal_conductivity`, two bodies each) by the front-end layer's one definition;
+    /// `persson` = `(gamma, kappa)`: the BEM's mean gap and Persson's columns
+    /// (`asperity bem --persson`).
+    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None, persson=None))]
     #[allow(clippy::too_many_arguments)]
     fn sweep<'py>(
         &mut self,
@@ -379,6 +386,7 @@ impl Solver {
         poisson: Option<f64>,
         resistivity: Option<Vec<f64>>,
         thermal_conductivity: Option<Vec<f64>>,
+        persson: Option<(f64, f64)>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let loads = values
             .iter()
@@ -390,26 +398,33 @@ impl Solver {
         let derived =
             Derived::validate(poisson, &resistivity, &thermal_conductivity).map_err(refused)?;
         self.check_capped(&loads)?;
+        let theory = persson
+            .map(|(gamma, kappa)| SweepTheory::new(&self.solver, SweepPersson { gamma, kappa }))
+            .transpose()
+            .map_err(request_error)?;
         let (stop, solver) = (self.solver.stop().clone(), &mut self.solver);
         let params = SweepParams {
             stiffness,
             fd_step,
             tangential: derived.tangential,
         };
-        let (rows, observer) = run_detached_with(py, &stop, |cancel| {
+        let rows = run_detached_with(py, &stop, |cancel| {
             let mut observer = PyObserver {
                 fields,
                 pressures: Vec::new(),
                 gaps: Vec::new(),
+                mean_gaps: theory.as_ref().map(|_| Vec::new()),
                 progress: progress.as_ref(),
                 cancel,
                 total: loads.len(),
             };
             cancel.call(observer.progress, 0, loads.len());
             let rows = sweep(solver, &loads, params, &mut observer);
-            rows.map(|rows| (rows, (observer.pressures, observer.gaps)))
+            let mean_gaps = observer.mean_gaps.unwrap_or_default();
+            rows.map(|rows| (rows, (observer.pressures, observer.gaps), mean_gaps))
         })?
         .map_err(sweep_error)?;
+        let (rows, observer, mean_gaps) = rows;
         let plastic = self.hardness().is_some();
         let dict = columns_dict(py, &rows, (params, plastic), observer)?;
         for (k, name) in derived.columns(Units::Model).into_iter().enumerate() {
@@ -418,6 +433,9 @@ impl Solver {
                 values[k].unwrap_or(f64::NAN)
             });
             dict.set_item(name, PyArray1::from_iter(py, column))?;
+        }
+        if let Some(theory) = &theory {
+            persson_columns(py, &dict, theory, &rows, &mean_gaps)?;
         }
         Ok(dict)
     }
@@ -460,6 +478,30 @@ fn path_dict<'py>(
     dict.set_item("plastic_points", count(&|p| p.summary.plastic_points))?;
     dict.set_item("permanent_displacement", permanent.into_pyarray(py))?;
     Ok(dict)
+}
+
+/// The BEM's mean gap and Persson's columns ([`SWEEP_COLUMNS`]; NaN where the CLI leaves
+/// the cell empty: a mean pressure of 0).
+fn persson_columns(
+    py: Python<'_>,
+    dict: &Bound<'_, PyDict>,
+    theory: &SweepTheory,
+    rows: &[SweepRow],
+    mean_gaps: &[f64],
+) -> PyResult<()> {
+    let mut columns = vec![mean_gaps.to_vec(), Vec::new(), Vec::new(), Vec::new()];
+    for row in rows {
+        let predicted = theory
+            .row(row.summary.mean_pressure)
+            .map_err(request_error)?;
+        for (column, value) in columns[1..].iter_mut().zip(predicted) {
+            column.push(value.unwrap_or(f64::NAN));
+        }
+    }
+    for (name, column) in SWEEP_COLUMNS.into_iter().zip(columns) {
+        dict.set_item(name, PyArray1::from_vec(py, column))?;
+    }
+    Ok(())
 }
 
 /// The sweep's columns (as the CLI's CSV, plus `contact_points`) as numpy arrays.

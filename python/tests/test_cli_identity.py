@@ -226,6 +226,35 @@ def test_persson_equals_the_cli(cli, tmp_path, flags, kwargs):
         asperity.persson(s, [0.01], gamma=0.0)
 
 
+@pytest.mark.parametrize("boundary", ["periodic", "free"])
+def test_bem_persson_columns_equal_the_cli(cli, tmp_path, boundary):
+    s = asperity.surface(64, hurst=0.8, rolloff=4, rms_slope=0.5, seed=3, size=2)
+    s.save(tmp_path / "s.npy")
+    cli("bem", "--surface", tmp_path / "s.npy", "--pressures", "0.005,0.02,0.08", "--boundary",
+        boundary, "--modulus", 2, "--persson", "--gamma", 0.4, "--kappa", 2, "--quiet",
+        "--out", tmp_path / "c.csv")
+    theirs = read_csv(tmp_path / "c.csv")
+    solver = asperity.Solver(s.heights, size=2, modulus=2, boundary=boundary)
+    ours = solver.sweep(pressures=[0.005, 0.02, 0.08], persson=True, gamma=0.4, kappa=2)
+    names = ["mean_gap", "area_fraction_persson", "mean_gap_persson", "stiffness_persson"]
+    assert list(theirs)[-4:] == names
+    for name, values in theirs.items():
+        assert ours[name].tolist() == values, name
+    assert ours.metadata["persson"] == {"gamma": 0.4, "kappa": 2.0}
+    # The theory beside the sweep is asperity.persson's of the same surface (to the rounding
+    # of the profile max(h) − h whose PSD the sweep takes).
+    theory = asperity.persson(s, [0.005, 0.02, 0.08], modulus=2, gamma=0.4, kappa=2)
+    assert np.allclose(ours.mean_gap_persson, theory.mean_gap, rtol=1e-12, atol=0)
+    assert np.allclose(ours.stiffness_persson, theory.contact_stiffness, rtol=1e-12, atol=0)
+    plain = asperity.Solver(s.heights, size=2, modulus=2, boundary=boundary).sweep(
+        pressures=[0.005, 0.02, 0.08])
+    assert "mean_gap" not in plain.columns
+    with pytest.raises(ValueError, match="gamma and kappa go with persson=True"):
+        solver.sweep(pressures=[0.01], gamma=0.4)
+    with pytest.raises(ValueError, match=r"γ must lie in \(0, 1\]"):
+        solver.sweep(pressures=[0.01], persson=True, gamma=1.5)
+
+
 def test_bem_adhesion_equals_the_cli(cli, tmp_path):
     x = (np.arange(40) - 20) * 5e-3
     h = -(x[:, None]**2 + x[None, :]**2) / 2

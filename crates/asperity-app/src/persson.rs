@@ -2,6 +2,7 @@
 //! (the library's [`asperity::persson`], docs/persson.md) by one path for both front ends —
 //! the request's rules, the pressures, the table's columns and its rows.
 
+use asperity::bem::ContactSolver;
 use asperity::persson::{Persson, PerssonParams};
 use asperity::surface::Surface;
 
@@ -121,6 +122,112 @@ pub fn compute(surface: &Surface, request: &PerssonRequest) -> Result<PerssonTab
     })
 }
 
+/// The columns `asperity bem --persson` and `Solver.sweep(persson=True)` add beside a
+/// sweep, in order: the BEM's own `mean_gap` (the mean of the gap field: with periodic
+/// boundaries Persson's ū, the separation of the mean planes; with free ones the mean over
+/// the window, which is not), then Persson's `area_fraction_persson`, `mean_gap_persson`
+/// and `stiffness_persson` (the interfacial `K·A₀`; the BEM's stiffness of free boundaries
+/// also holds the bulk under the window, docs/persson.md) at each row's mean pressure.
+pub const SWEEP_COLUMNS: [&str; 4] = [
+    "mean_gap",
+    "area_fraction_persson",
+    "mean_gap_persson",
+    "stiffness_persson",
+];
+
+/// Persson's theory beside a BEM sweep: γ and κ (E* is the solver's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SweepPersson {
+    /// Yang & Persson's γ, in (0, 1].
+    pub gamma: f64,
+    /// The small-load area coefficient κ.
+    pub kappa: f64,
+}
+
+impl Default for SweepPersson {
+    /// The library's defaults (γ = 0.45, κ = √(8/π)).
+    fn default() -> Self {
+        let params = PerssonParams::default();
+        SweepPersson {
+            gamma: params.gamma,
+            kappa: params.kappa,
+        }
+    }
+}
+
+impl SweepPersson {
+    /// The theory's parameters on a half-space of effective modulus `modulus`, or why not
+    /// (the library's rules for γ and κ), before any solve.
+    pub fn params(self, modulus: f64) -> Result<PerssonParams, RequestError> {
+        let params = PerssonParams {
+            modulus,
+            gamma: self.gamma,
+            kappa: self.kappa,
+        };
+        params
+            .validate()
+            .map_err(|e| RequestError::Invalid(Box::new(e)))?;
+        Ok(params)
+    }
+}
+
+/// Persson's theory for the surface a BEM solver holds: from the PSD of its profile
+/// `max(h) − h` (the heights' PSD, the sign aside), at the solver's E*. One path for both
+/// front ends, so their columns agree bit for bit.
+#[derive(Debug, Clone)]
+pub struct SweepTheory(Persson);
+
+impl SweepTheory {
+    /// The theory of `solver`'s surface; refuses rectangular pixels (the radial PSD
+    /// assumes square ones) and a flat surface.
+    pub fn new(solver: &ContactSolver, options: SweepPersson) -> Result<Self, RequestError> {
+        let problem = solver.problem();
+        let params = options.params(problem.half_space().modulus)?;
+        let (dx, dy) = problem.spacings();
+        if dx != dy {
+            return Err(Refusal::saying(
+                "Persson's columns need square pixels (the radially averaged PSD assumes them)",
+            )
+            .into());
+        }
+        let (_, cols) = problem.dim();
+        let library = |e| RequestError::Invalid(Box::new(e));
+        let surface =
+            Surface::new(problem.profile().to_owned(), dx * cols as f64).map_err(library)?;
+        Ok(SweepTheory(
+            Persson::from_surface(&surface, params).map_err(library)?,
+        ))
+    }
+
+    /// The library's theory.
+    pub fn theory(&self) -> &Persson {
+        &self.0
+    }
+
+    /// Persson's three columns at `mean_pressure` (none at a pressure that is not positive:
+    /// an indentation of 0).
+    pub fn row(&self, mean_pressure: f64) -> Result<[Option<f64>; 3], RequestError> {
+        if mean_pressure.is_nan() || mean_pressure <= 0.0 {
+            return Ok([None; 3]);
+        }
+        let point = self
+            .0
+            .predict(mean_pressure)
+            .map_err(|e| RequestError::Invalid(Box::new(e)))?;
+        Ok([
+            Some(point.area_fraction),
+            Some(point.mean_gap),
+            Some(point.contact_stiffness),
+        ])
+    }
+}
+
+/// The BEM's mean gap of the solver's current contact (the first of [`SWEEP_COLUMNS`]),
+/// taken where a sweep's observer sees each load solved.
+pub fn bem_mean_gap(solver: &ContactSolver) -> f64 {
+    solver.gap().mean().unwrap_or(f64::NAN)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,5 +336,90 @@ mod tests {
             words(pressures(None, Some(0), Some(1.0), Some(2.0))),
             "nloads must be at least 1, got 0"
         );
+    }
+
+    fn solver(surface: &Surface, boundary: asperity::elastic::Boundary) -> ContactSolver {
+        let half_space = asperity::bem::HalfSpace {
+            modulus: 2.0,
+            boundary,
+        };
+        ContactSolver::new(surface, half_space, Default::default()).unwrap()
+    }
+
+    #[test]
+    fn sweep_columns_are_the_theory_of_the_solver_s_surface() {
+        let s = surface();
+        let options = SweepPersson {
+            gamma: 0.4,
+            kappa: 2.0,
+        };
+        let sweep =
+            SweepTheory::new(&solver(&s, asperity::elastic::Boundary::Free), options).unwrap();
+        // The profile max(h) − h has the heights' PSD: the theory of the surface itself,
+        // to rounding (the subtraction), at the solver's E* = 2.
+        let params = PerssonParams {
+            modulus: 2.0,
+            gamma: 0.4,
+            kappa: 2.0,
+        };
+        let direct = Persson::from_surface(&s, params).unwrap();
+        assert_eq!(sweep.theory().params(), params);
+        for p in [1e-4, 1e-2, 0.3] {
+            let row = sweep.row(p).unwrap();
+            let point = direct.predict(p).unwrap();
+            let expected = [point.area_fraction, point.mean_gap, point.contact_stiffness];
+            for (got, want) in row.iter().zip(expected) {
+                let got = got.unwrap();
+                assert!((got - want).abs() <= 1e-12 * want.abs(), "{got} vs {want}");
+            }
+        }
+        assert_eq!(sweep.row(0.0).unwrap(), [None; 3]);
+    }
+
+    #[test]
+    fn periodic_mean_gap_is_the_mean_profile_less_the_indentation() {
+        // Periodic: the displacement has zero mean, so mean(g) = mean(f) − d exactly (to
+        // rounding): the BEM's ū is the separation of the mean planes, Persson's.
+        let s = surface();
+        let mut solver = solver(&s, asperity::elastic::Boundary::Periodic);
+        let mean_f = solver.problem().profile().mean().unwrap();
+        for p in [1e-3, 3e-2] {
+            let (summary, _) = solver
+                .solve(asperity::bem::Control::MeanPressure(p))
+                .unwrap();
+            let gap = bem_mean_gap(&solver);
+            let expected = mean_f - summary.indentation;
+            assert!(
+                (gap - expected).abs() <= 1e-9 * mean_f,
+                "{gap} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn sweep_persson_refuses_what_the_library_refuses() {
+        let s = surface();
+        let words = |options: SweepPersson| {
+            SweepTheory::new(&solver(&s, asperity::elastic::Boundary::Free), options)
+                .unwrap_err()
+                .words(Names::Keywords)
+        };
+        let gamma = words(SweepPersson {
+            gamma: 1.5,
+            ..SweepPersson::default()
+        });
+        assert!(gamma.contains("γ must lie in (0, 1]"), "{gamma}");
+        let kappa = words(SweepPersson {
+            kappa: f64::NAN,
+            ..SweepPersson::default()
+        });
+        assert!(kappa.contains("κ must be positive"), "{kappa}");
+        let rectangular = Surface::with_sizes(s.heights().to_owned(), 1.0, 2.0).unwrap();
+        let e = SweepTheory::new(
+            &solver(&rectangular, asperity::elastic::Boundary::Free),
+            SweepPersson::default(),
+        )
+        .unwrap_err();
+        assert!(e.words(Names::Flags).contains("square pixels"));
     }
 }

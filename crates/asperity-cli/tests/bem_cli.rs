@@ -1454,3 +1454,103 @@ fn a_solve_that_stops_improving_is_given_up_early_in_one_line() {
         );
     }
 }
+
+/// `--persson`: the BEM's mean gap and Persson's three columns after the contract's; the
+/// contract's cells are those of a run without it; the theory's cells are `asperity
+/// persson`'s for the same surface, pressures, E*, γ and κ (to the rounding of the profile
+/// `max(h) − h` the sweep takes its PSD from); with periodic boundaries the mean gap is
+/// `mean(max(h) − h) − indentation` (zero-mean displacement); bad values are refused before
+/// any solve.
+#[test]
+fn persson_columns_beside_the_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let pressures = "0.005,0.02,0.08";
+    let run = |extra: &[&str], name: &str| {
+        let csv = dir.path().join(name);
+        let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
+        let common = [
+            "--quiet",
+            "--pressures",
+            pressures,
+            "--boundary",
+            "periodic",
+        ];
+        let common = [&common[..], &["--modulus", "2"]].concat();
+        ok(&asperity(&[&base[..], &common, extra].concat()));
+        (std::fs::read_to_string(&csv).unwrap(), read_csv(&csv))
+    };
+    let options = ["--persson", "--gamma", "0.4", "--kappa", "2"];
+    let (text, (header, rows)) = run(&options, "persson.csv");
+    let names = [
+        "mean_gap",
+        "area_fraction_persson",
+        "mean_gap_persson",
+        "stiffness_persson",
+    ];
+    assert_eq!(header[7..], names);
+    let (plain_text, _) = run(&[], "plain.csv");
+    for (a, b) in text.lines().skip(1).zip(plain_text.lines().skip(1)) {
+        let cells: Vec<&str> = a.split(',').collect();
+        assert_eq!(cells[..7].join(","), b, "the contract's cells");
+    }
+    let theory = dir.path().join("theory.csv");
+    ok(&asperity(&[
+        "persson",
+        s,
+        "--pressures",
+        pressures,
+        "--modulus",
+        "2",
+        "--gamma",
+        "0.4",
+        "--kappa",
+        "2",
+        "--out",
+        theory.to_str().unwrap(),
+    ]));
+    let (theory_header, theory_rows) = read_csv(&theory);
+    let heights: Array2<f64> = read_npy(s).unwrap();
+    let top = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let mean_profile = heights.mapv(|h| top - h).mean().unwrap();
+    let at = |row: &[f64], name: &str| row[column(&header, name)];
+    for (row, expected) in rows.iter().zip(&theory_rows) {
+        let want = |name: &str| expected[column(&theory_header, name)];
+        for (ours, theirs) in [
+            ("area_fraction_persson", "area_fraction"),
+            ("mean_gap_persson", "mean_gap"),
+            ("stiffness_persson", "contact_stiffness"),
+        ] {
+            let (a, b) = (at(row, ours), want(theirs));
+            assert!((a / b - 1.0).abs() < 1e-12, "{ours}: {a} vs {b}");
+        }
+        let gap = mean_profile - at(row, "indentation");
+        assert!((at(row, "mean_gap") - gap).abs() < 1e-9 * mean_profile);
+    }
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("persson.csv.json")).unwrap())
+            .unwrap();
+    assert_eq!(record["persson"]["gamma"], 0.4);
+    assert_eq!(record["persson"]["kappa"], 2.0);
+    assert!(record["persson"]["u0"].as_f64().unwrap() > 0.0);
+    let bad = |extra: &[&str], needle: &str| {
+        let base = ["bem", "--surface", s, "--pressures", "0.01"];
+        refused(&asperity(&[&base[..], extra].concat()), needle);
+    };
+    bad(
+        &["--persson", "--gamma", "1.5"],
+        "γ must lie in (0, 1], got 1.5",
+    );
+    bad(
+        &["--persson", "--kappa", "-1"],
+        "κ must be positive and finite",
+    );
+    bad(&["--gamma", "0.4"], "--gamma goes with --persson");
+    let adhesive = ["--indentations", "0.01", "--work-of-adhesion", "0.1"];
+    let base = ["bem", "--surface", s, "--persson"];
+    refused(
+        &asperity(&[&base[..], &adhesive].concat()),
+        "--persson goes with a load sweep",
+    );
+}

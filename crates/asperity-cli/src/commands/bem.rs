@@ -19,6 +19,7 @@ use asperity_app::bem::{
     bookkeeping_bytes, ensure_solver_fits, BemPlan, BemRequest, Loads, SolverRequest, FD_STEP,
 };
 use asperity_app::derived::{Derived, Units};
+use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
 use serde_json::json;
 
 use super::measured::{open_argument, parse_size, MeasuredArgs};
@@ -28,6 +29,7 @@ use asperity_app::figure::sweep::{SweepColumns, SweepFigure};
 
 use crate::plot::{stage_charts, Chart, ImageFormat};
 use crate::progress::Progress;
+use crate::request::refused;
 
 /// Arguments of `asperity bem`.
 #[derive(Debug, clap::Args)]
@@ -41,13 +43,15 @@ use crate::progress::Progress;
     asperity bem --surface s.npy --pressures 0.01,0.05 --hardness 0.3\n  \
     asperity bem --surface s.npy --nloads 10 --pmin 1e-3 --pmax 1e-1 --poisson 0.3 --resistivity 1,1\n  \
     asperity bem --surface s.npy --nloads 20 --pmin 1e-4 --pmax 1e-1 --out sweep.csv --plot sweep.png\n  \
+    asperity bem --surface s.npy --boundary periodic --nloads 10 --pmin 1e-4 --pmax 1e-1 --persson --gamma 0.4\n  \
     asperity bem --surface scan.x3p --detrend plane --modulus 1e9 --pressures 1e5,1e6\n\n\
 Columns: force, mean_pressure, indentation, area_fraction, stiffness, iterations, residual\n\
 (stiffness by the frozen contact set; indentation from the highest point, or with\n\
 periodic boundaries relative to the mean elastic displacement); then plastic_fraction\n\
 with --hardness, stiffness_fd with --fd-stiffness, stiffness_x, stiffness_y,\n\
 tangential_ratio with --poisson, electrical_conductance with --resistivity,\n\
-thermal_conductance with --thermal-conductivity, and solve_seconds, stiffness_seconds,\n\
+thermal_conductance with --thermal-conductivity, mean_gap, area_fraction_persson,\n\
+mean_gap_persson, stiffness_persson with --persson, and solve_seconds, stiffness_seconds,\n\
 peak_rss_mib (tangential_seconds with --poisson) with --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
 any solve.")]
@@ -196,6 +200,21 @@ pub struct BemArgs {
         value_name = "K1,K2"
     )]
     pub thermal_conductivity: Option<Vec<f64>>,
+    /// Persson's theory beside every load (docs/persson.md): adds the columns mean_gap (the
+    /// BEM's mean gap; with periodic boundaries Persson's mean separation ū) and
+    /// area_fraction_persson, mean_gap_persson, stiffness_persson (the interfacial K·A0),
+    /// computed from the surface's own PSD at each load's mean pressure and E*. Square
+    /// pixels. Milliseconds besides the solves.
+    #[arg(long)]
+    pub persson: bool,
+    /// γ of Persson's mean separation (Yang & Persson 2008), in (0, 1] [default: 0.45]
+    /// (with --persson).
+    #[arg(long, value_name = "G", allow_hyphen_values = true)]
+    pub gamma: Option<f64>,
+    /// κ of Persson's contact area, A/A0 → κ p/(E* ḡ) at small load [default: √(8/π),
+    /// Persson 2001; simulations find about 2] (with --persson).
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub kappa: Option<f64>,
     /// Add timing columns (solve_seconds, stiffness_seconds, peak_rss_mib, and
     /// tangential_seconds with --poisson), for benchmarks.
     #[arg(long)]
@@ -278,6 +297,7 @@ struct CliObserver<'a> {
     fields: Option<&'a [(PathBuf, PathBuf)]>,
     progress: Progress,
     peak_rss: Option<Vec<f64>>,
+    mean_gaps: Option<Vec<f64>>,
 }
 
 impl SweepObserver for CliObserver<'_> {
@@ -287,6 +307,9 @@ impl SweepObserver for CliObserver<'_> {
         if let Some((p_path, g_path)) = self.fields.map(|f| &f[load]) {
             self.staged.write_npy_2d(p_path, &solver.pressure())?;
             self.staged.write_npy_2d(g_path, &solver.gap())?;
+        }
+        if let Some(gaps) = &mut self.mean_gaps {
+            gaps.push(bem_mean_gap(solver));
         }
         Ok(())
     }
@@ -330,6 +353,7 @@ struct Columns {
     plastic: bool,
     derived: Derived,
     modulus: f64,
+    persson: bool,
 }
 
 impl Columns {
@@ -350,6 +374,9 @@ impl Columns {
             header.push("stiffness_fd");
         }
         header.extend(self.derived.columns(Units::Model));
+        if self.persson {
+            header.extend(SWEEP_COLUMNS);
+        }
         if self.timing {
             header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
             if self.derived.tangential.is_some() {
@@ -381,6 +408,9 @@ impl Columns {
         }
         let derived = self.derived.row(r, self.modulus);
         cells.extend(self.derived.values(&derived).into_iter().map(number));
+        if self.persson {
+            cells.extend(row.persson.iter().map(|&v| number(v)));
+        }
         if self.timing {
             cells.extend([
                 format_number(r.solve_seconds),
@@ -395,10 +425,12 @@ impl Columns {
     }
 }
 
-/// One load's results: the library's row, and the peak memory after it (`--timing`).
+/// One load's results: the library's row, the peak memory after it (`--timing`), and with
+/// `--persson` the BEM's mean gap and Persson's three columns.
 struct Row {
     sweep: SweepRow,
     peak_rss_mib: f64,
+    persson: Vec<Option<f64>>,
 }
 
 /// The `--plot` panels ([`asperity_app::figure::sweep`]): k vs F and area fraction vs F,
@@ -442,6 +474,7 @@ struct Plan {
     bem: BemPlan,
     size: [Option<f64>; 2],
     columns: Columns,
+    persson: Option<SweepPersson>,
 }
 
 /// The request of the arguments: the loads, the solver and what each load computes.
@@ -496,12 +529,26 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         plastic: bem.hardness().is_some(),
         derived: bem.derived,
         modulus: bem.half_space.modulus,
+        persson: args.persson,
     };
+    for (flag, given) in [("--gamma", args.gamma), ("--kappa", args.kappa)] {
+        if given.is_some() && !args.persson {
+            bail!("{flag} goes with --persson");
+        }
+    }
+    let persson = args.persson.then(|| SweepPersson {
+        gamma: args.gamma.unwrap_or(SweepPersson::default().gamma),
+        kappa: args.kappa.unwrap_or(SweepPersson::default().kappa),
+    });
+    if let Some(options) = persson {
+        options.params(bem.half_space.modulus).map_err(refused)?;
+    }
     Ok(Plan {
         request,
         bem,
         size,
         columns,
+        persson,
     })
 }
 
@@ -624,7 +671,7 @@ impl SurfaceInfo {
 fn solve(
     args: &BemArgs,
     plan: &Plan,
-    solver: &mut ContactSolver,
+    (solver, theory): (&mut ContactSolver, Option<&SweepTheory>),
     outputs: &mut Outputs,
 ) -> Result<Vec<Row>> {
     let loads = &plan.bem.loads;
@@ -633,27 +680,61 @@ fn solve(
         fields: outputs.fields.as_deref(),
         progress: Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2),
         peak_rss: args.timing.then(Vec::new),
+        mean_gaps: theory.map(|_| Vec::new()),
     };
     let solved = sweep(solver, loads, plan.bem.sweep, &mut observer).map_err(sweep_error)?;
     observer.progress.finish();
     let peak_rss = observer.peak_rss.take().unwrap_or_default();
-    Ok(solved
-        .into_iter()
-        .enumerate()
-        .map(|(k, sweep)| Row {
+    let mean_gaps = observer.mean_gaps.take().unwrap_or_default();
+    let mut rows = Vec::with_capacity(solved.len());
+    for (k, sweep) in solved.into_iter().enumerate() {
+        let persson = match theory {
+            Some(theory) => {
+                let predicted = theory.row(sweep.summary.mean_pressure).map_err(refused)?;
+                std::iter::once(mean_gaps.get(k).copied())
+                    .chain(predicted)
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        rows.push(Row {
             sweep,
             peak_rss_mib: peak_rss.get(k).copied().unwrap_or(f64::NAN),
-        })
-        .collect())
+            persson,
+        });
+    }
+    Ok(rows)
 }
 
-/// The inputs of a run, for OUT.csv.json (`hardness` only where the pressure is capped).
-fn record(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Value {
+/// The inputs of a run, for OUT.csv.json (`hardness` only where the pressure is capped,
+/// `persson` only with `--persson`).
+fn record(
+    args: &BemArgs,
+    plan: &Plan,
+    surface: &SurfaceInfo,
+    theory: Option<&SweepTheory>,
+) -> serde_json::Value {
     let mut record = inputs(args, plan, surface);
     if let (Some(h), Some(fields)) = (plan.bem.hardness(), record.as_object_mut()) {
         fields.insert("hardness".into(), json!(h));
     }
+    if let (Some(t), Some(fields)) = (theory, record.as_object_mut()) {
+        fields.insert("persson".into(), persson_record(t));
+    }
     record
+}
+
+/// Persson's theory beside the sweep, for OUT.csv.json.
+fn persson_record(theory: &SweepTheory) -> serde_json::Value {
+    let theory = theory.theory();
+    json!({
+        "gamma": theory.params().gamma,
+        "kappa": theory.params().kappa,
+        "rms_gradient": theory.rms_gradient(),
+        "rms_height": theory.rms_height(),
+        "u0": theory.u0(),
+        "source": "the surface's radially averaged PSD (docs/persson.md)",
+    })
 }
 
 /// The inputs of every run, for OUT.csv.json.
@@ -689,7 +770,7 @@ fn inputs(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Val
 /// commit) and the plot, renamed into place with the fields.
 fn write(
     args: &BemArgs,
-    plan: &Plan,
+    (plan, theory): (&Plan, Option<&SweepTheory>),
     surface: &SurfaceInfo,
     rows: &[Row],
     mut staged: StagedOutputs,
@@ -704,7 +785,7 @@ fn write(
             .with_context(|| format!("writing {}", out.display()))?;
         let record_path = sidecar_path(out);
         staged
-            .write_json(&record_path, &record(args, plan, surface))
+            .write_json(&record_path, &record(args, plan, surface, theory))
             .with_context(|| format!("writing {}", record_path.display()))?;
     }
     if let Some(plot) = &args.plot {
@@ -752,6 +833,13 @@ fn print_stdout(bytes: &[u8]) -> Result<()> {
 
 /// Runs `asperity bem`: plan (every check before the first solve), solve, write.
 pub fn run(args: &BemArgs) -> Result<()> {
+    if args.persson && (args.work_of_adhesion.is_some() || args.load_path) {
+        let other = match args.load_path {
+            true => "--load-path",
+            false => "--work-of-adhesion",
+        };
+        bail!("--persson goes with a load sweep, not with {other}");
+    }
     if let Some(w) = args.work_of_adhesion {
         return super::bem_adhesion::run(args, w);
     }
@@ -778,6 +866,11 @@ pub fn run(args: &BemArgs) -> Result<()> {
     // The solver keeps its own copy of the profile: free the heights (peak memory).
     drop(surface);
     plan.bem.check_forces(solver.nominal_area())?;
-    let rows = solve(args, &plan, &mut solver, &mut outputs)?;
-    write(args, &plan, &info, &rows, outputs.staged)
+    let theory = plan
+        .persson
+        .map(|options| SweepTheory::new(&solver, options))
+        .transpose()
+        .map_err(refused)?;
+    let rows = solve(args, &plan, (&mut solver, theory.as_ref()), &mut outputs)?;
+    write(args, (&plan, theory.as_ref()), &info, &rows, outputs.staged)
 }
