@@ -431,10 +431,12 @@ def _statistics(values: Any, size, fit_from, fit_to, window: str = _DEFAULTS["wi
                               _opt(fit_from), _opt(fit_to), str(window), str(convention))
     if result["iso"] is not None:
         result["iso"] = json.loads(result["iso"])
+    result["ndim"] = heights.ndim
     return result
 
 
-_PSD_KEYS = ("q", "psd", "modes", "size", "fit_prefactor", "fit_stderr", "fit_points")
+_PSD_KEYS = ("q", "psd", "modes", "size", "ndim", "fit_prefactor", "fit_stderr",
+             "fit_points")
 
 
 def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
@@ -472,7 +474,8 @@ class Psd:
     """A power spectrum: wavenumbers ``q`` (rad/length), values ``psd`` (C2D for a surface,
     radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; the
     power law ``fit`` (exponent, prefactor, stderr, low, high, points) over the rings
-    ``fit_from`` .. ``fit_to`` and ``hurst``, or ``None`` with the reason in ``fit_note``."""
+    ``fit_from`` .. ``fit_to`` and ``hurst``, or ``None`` with the reason in ``fit_note``;
+    ``size`` is the side length L along x and ``ndim`` 2 for a surface, 1 for a line."""
 
     q: np.ndarray
     psd: np.ndarray
@@ -483,6 +486,8 @@ class Psd:
     fit_from: Optional[float] = None
     fit_to: Optional[float] = None
     fit_note: Optional[str] = None
+    size: float = 1.0
+    ndim: int = 2
 
 
 @dataclass
@@ -662,7 +667,7 @@ def psd(
                "stderr": r["fit_stderr"], "low": r["psd_slope_low"],
                "high": r["psd_slope_high"], "points": r["fit_points"]}
     return Psd(r["q"], r["psd"], r["modes"], wavenumber, fit, r["hurst_estimate"],
-               r["fit_from"], r["fit_to"], r["fit_note"])
+               r["fit_from"], r["fit_to"], r["fit_note"], float(r["size"]), int(r["ndim"]))
 
 
 # --------------------------------------------------------------------------------------
@@ -1105,20 +1110,24 @@ def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) ->
     )
 
 
-def effective_modulus(*, modulus: Optional[float] = None, young: Optional[float] = None,
-                      poisson: Optional[float] = None) -> float:
-    """E* by the one rule both front ends use (``asperity contact --modulus`` or
-    ``--young`` with ``--poisson``): ``modulus`` itself, or ``young`` E and ``poisson`` ν
-    (in [0, 0.5]) as E/(1 − ν²) -- a rigid counter-body. For two elastic bodies, combine
-    them first: ``1/E* = 1/E*₁ + 1/E*₂`` with ``E*ᵢ = Eᵢ/(1 − νᵢ²)``. Refusals (a ν of 0.6,
-    a negative E, both or neither given) raise ``ValueError`` in the CLI's words.
+def effective_modulus(*, modulus: Optional[float] = None,
+                      young: Union[None, float, Sequence[float]] = None,
+                      poisson: Union[None, float, Sequence[float]] = None) -> float:
+    """E* by the one rule both front ends use (``asperity contact --modulus``, or
+    ``--young`` with ``--poisson``): ``modulus`` itself; or ``young`` E and ``poisson`` ν
+    (in [0, 0.5]) as E/(1 − ν²) -- a rigid counter-body; or two elastic bodies, ``young``
+    (E₁, E₂) and ``poisson`` (ν₁, ν₂), as ``1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂``
+    (``--young E1,E2 --poisson NU1,NU2``). Refusals (a ν of 0.6, a negative E, both or
+    neither given, one ν for two bodies) raise ``ValueError`` in the CLI's words.
 
-    Example::
-
-        >>> round(asperity.effective_modulus(young=210e9, poisson=0.3) / 1e9, 3)
-        230.769
+    Examples
+    --------
+    >>> round(asperity.effective_modulus(young=210e9, poisson=0.3) / 1e9, 3)
+    230.769
+    >>> round(asperity.effective_modulus(young=(210e9, 210e9), poisson=(0.3, 0.3)) / 1e9, 3)
+    115.385
     """
-    return _core.effective_modulus(_opt(modulus), _opt(young), _opt(poisson))
+    return _core.effective_modulus(_opt(modulus), _floats(young), _floats(poisson))
 
 
 def contact(
@@ -1127,8 +1136,8 @@ def contact(
     *,
     pressures: Sequence[float],
     modulus: Optional[float] = None,
-    young: Optional[float] = None,
-    poisson: Optional[float] = None,
+    young: Union[None, float, Sequence[float]] = None,
+    poisson: Union[None, float, Sequence[float]] = None,
     boundary: str = _DEFAULTS["boundary"],
     tolerance: float = _DEFAULTS["tolerance"],
     map: bool = False,
@@ -1139,7 +1148,9 @@ def contact(
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
-    ``modulus`` or from ``young`` E and ``poisson`` ν as E/(1 − ν²). The same request,
+    ``modulus`` or from ``young`` E and ``poisson`` ν as E/(1 − ν²), or of two elastic
+    bodies from ``young=(E₁, E₂)`` and ``poisson=(ν₁, ν₂)`` as 1/E* = (1 − ν₁²)/E₁ +
+    (1 − ν₂²)/E₂ (:func:`effective_modulus`). The same request,
     rules and load sweep as the CLI (warm starts, full contact checked before any solve,
     frozen-set stiffness), so the same numbers bit for bit.
 
@@ -1173,7 +1184,7 @@ def contact(
     heights, size_x, size_y = _surface_input(surface, size)
     loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
     columns = _core.contact(
-        heights, size_x, size_y, loads, _opt(modulus), _opt(young), _opt(poisson),
+        heights, size_x, size_y, loads, _opt(modulus), _floats(young), _floats(poisson),
         str(boundary), float(tolerance), bool(map),
         None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
         None if thermal_conductivity is None
@@ -1185,8 +1196,8 @@ def contact(
         dy = dx if size_y is None else size_y / heights.shape[0]
         found = patches(columns["map"], pixel_area=dx * dy)
         columns["patch_labels"], columns["patch_areas_m2"] = found.labels, found.areas
-    request = {"pressures": loads, "modulus": _opt(modulus), "young": _opt(young),
-               "poisson": _opt(poisson), "boundary": str(boundary),
+    request = {"pressures": loads, "modulus": _opt(modulus), "young": _one_or_both(young),
+               "poisson": _one_or_both(poisson), "boundary": str(boundary),
                "tolerance": float(tolerance), "resistivity": _floats(resistivity),
                "thermal_conductivity": _floats(thermal_conductivity),
                "hardness": _opt(hardness), "tangential": bool(tangential)}
@@ -1238,6 +1249,12 @@ def patches(contact_set: Any, *, pixel_area: float = 1.0) -> Patches:
 
 def _floats(values: Any) -> Optional[List[float]]:
     return None if values is None else [float(v) for v in np.atleast_1d(values)]
+
+
+def _one_or_both(values: Any) -> Union[None, float, List[float]]:
+    """A value given once as a float, per body (two) as a list, as the CLI's record."""
+    given = _floats(values)
+    return given[0] if given is not None and len(given) == 1 else given
 
 
 def _surface_identity(surface: Any, heights: np.ndarray) -> Dict[str, Any]:

@@ -77,6 +77,8 @@ class Psd:
     fit_from: Optional[float] = ...
     fit_to: Optional[float] = ...
     fit_note: Optional[str] = ...
+    size: float = ...
+    ndim: int = ...
 
 def psd(
     values: Any, *, size: Union[None, float, Tuple[float, float]] = ...,
@@ -192,8 +194,9 @@ class Solver:
     def reset(self) -> None: ...
 
 def effective_modulus(
-    *, modulus: Optional[float] = ..., young: Optional[float] = ...,
-    poisson: Optional[float] = ...,
+    *, modulus: Optional[float] = ...,
+    young: Union[None, float, Sequence[float]] = ...,
+    poisson: Union[None, float, Sequence[float]] = ...,
 ) -> float: ...
 
 @dataclass
@@ -209,7 +212,8 @@ def load(path: PathLike) -> Any: ...
 
 def contact(
     surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
-    modulus: Optional[float] = ..., young: Optional[float] = ..., poisson: Optional[float] = ...,
+    modulus: Optional[float] = ..., young: Union[None, float, Sequence[float]] = ...,
+    poisson: Union[None, float, Sequence[float]] = ...,
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,

@@ -43,8 +43,8 @@ def sweep_loads(
 
 def contact(
     heights: npt.NDArray[np.float64], size_x: float, size_y: Optional[float],
-    pressures: List[float], modulus: Optional[float], young: Optional[float],
-    poisson: Optional[float], boundary: str, tolerance: float, map: bool,
+    pressures: List[float], modulus: Optional[float], young: Optional[List[float]],
+    poisson: Optional[List[float]], boundary: str, tolerance: float, map: bool,
     resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
     hardness: Optional[float] = ..., tangential: bool = ...,
 ) -> Dict[str, Any]: ...
@@ -137,7 +137,7 @@ def save_topography(
 ) -> None: ...
 def save_files(files: List[Tuple[str, bytes]], force: bool) -> None: ...
 def effective_modulus(
-    modulus: Optional[float], young: Optional[float], poisson: Optional[float],
+    modulus: Optional[float], young: Optional[List[float]], poisson: Optional[List[float]],
 ) -> float: ...
 def label_patches(
     set: npt.NDArray[np.bool_],
@@ -163,4 +163,15 @@ def path_figure(
     values: List[float], indentation: List[float], force: List[float],
     area_fraction: List[float], stiffness: List[float], name: str, boundary: str,
     hardness: Optional[float],
+) -> str: ...
+def surface_figure(
+    heights: npt.NDArray[np.float64], size_x: float, size_y: float, metres: bool, name: str,
+) -> str: ...
+def contact_map_figure(
+    set: npt.NDArray[np.bool_], size_x: float, size_y: float, metres: bool, name: str,
+) -> str: ...
+def psd_figure(
+    q: List[float], psd: List[float], size: float, ndim: int,
+    range: Optional[Tuple[float, float]], fit: Optional[Tuple[float, float]],
+    hurst: Optional[float], name: str,
 ) -> str: ...

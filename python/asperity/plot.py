@@ -5,7 +5,7 @@ the package returns, onto a matplotlib ``Axes`` (a new figure when ``ax`` is Non
 returns the ``Axes``:
 
 * :func:`surface` -- a height map in physical units, with a scale bar and a colour bar
-  (``asperity surface --png``, ``import``);
+  (``asperity surface --plot``);
 * :func:`psd` -- the PSD against q·L/2π, log–log, with the fitted power law over its fit
   range (``asperity stats --plot``);
 * :func:`stiffness`, :func:`area` -- k(F) and the contact fraction against force, with the
@@ -18,11 +18,12 @@ returns the ``Axes``:
   :func:`field` -- a field (the plastic or permanent displacement) as an image;
 * :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
 
-The sweep and study figures (:func:`stiffness` and :func:`area` of a ``Solver.sweep``,
-:func:`stiffness` of ``study_curve``, :func:`alpha`) are defined once, in the library's
-front-end layer, for the CLI and the package: the same series, theory curves, intervals,
-labels and titles as the CLI's PNG (``asperity_app::figure``); the package draws that
-definition with matplotlib.
+The figures (:func:`surface`, :func:`psd`, :func:`contact_map`, :func:`stiffness` and
+:func:`area` of a ``Solver.sweep``, :func:`stiffness` of ``study_curve``, :func:`alpha`) are
+defined once, in the library's front-end layer, for the CLI and the package: the same
+series, theory curves, intervals, images, scale bars, labels and titles as the CLI's PNG
+(``asperity_app::figure``; ``--plot FILE.json`` writes that definition); the package draws
+it with matplotlib.
 
 Example::
 
@@ -57,30 +58,16 @@ def _axes(ax):
     return ax
 
 
-def _round_length(length: float) -> float:
-    """The largest 1, 2 or 5 × 10^k not above ``length``."""
-    exponent = math.floor(math.log10(length))
-    for mantissa in (5, 2, 1):
-        if mantissa * 10 ** exponent <= length:
-            return mantissa * 10 ** exponent
-    return 10 ** exponent
+def _record(text: str) -> list:
+    import json
+
+    return _charts(json.loads(text))
 
 
-def _length_label(length: float, metres: bool) -> str:
-    if not metres:
-        return f"{length:g}"
-    for unit, scale in (("m", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9)):
-        if length >= scale:
-            return f"{length / scale:g} {unit}"
-    return f"{length / 1e-12:g} pm"
-
-
-def surface(values: Any, ax=None, *, cmap: str = "viridis", scale_bar: bool = True):
-    """The height map of a :class:`~asperity.Surface` or :class:`~asperity.Topography`
-    (rows along y, drawn with y up), in physical units (``extent``), with a scale bar of
-    a round length about a fifth of the width (metres named for a measured topography)
-    and a colour bar of the heights."""
-    from . import Surface, Topography
+def _surface_charts(values: Any, name: str = "surface") -> list:
+    """``asperity surface --plot``'s chart of a :class:`~asperity.Surface` or
+    :class:`~asperity.Topography` (the library's definition)."""
+    from . import Surface, Topography, _asperity
 
     if isinstance(values, Surface):
         heights, (sx, sy), metres = values.heights, values.physical_sizes, False
@@ -90,47 +77,47 @@ def surface(values: Any, ax=None, *, cmap: str = "viridis", scale_bar: bool = Tr
         heights, (sx, sy), metres = values.heights, values.physical_sizes, True
     else:
         raise ValueError("surface: expected an asperity.Surface or asperity.Topography")
-    ax = _axes(ax)
-    image = ax.imshow(heights, origin="lower", extent=(0, sx, 0, sy), cmap=cmap,
-                      interpolation="nearest")
-    ax.figure.colorbar(image, ax=ax, label="height" + (" (m)" if metres else ""))
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    if scale_bar:
-        from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
-
-        length = _round_length(sx / 5)
-        bar = AnchoredSizeBar(ax.transData, length, _length_label(length, metres),
-                              "lower left", pad=0.4, color="white", frameon=False,
-                              size_vertical=sy / 100)
-        ax.add_artist(bar)
-        ax.set_xticks([])
-        ax.set_yticks([])
-    return ax
+    heights = _np.ascontiguousarray(heights, dtype=_np.float64)
+    return _record(_asperity.surface_figure(heights, float(sx), float(sy), metres, name))
 
 
-def psd(spectrum: Any, ax=None, *, label: Optional[str] = None):
-    """A :class:`~asperity.Psd` (or anything :func:`asperity.psd` takes) against q·L/2π,
-    log–log, with the fitted power law drawn over its fit range and its exponent and Hurst
-    estimate in the legend."""
+def surface(values: Any, ax=None, *, cmap: Optional[str] = None, scale_bar: bool = True,
+            name: str = "surface"):
+    """The height map of a :class:`~asperity.Surface` or :class:`~asperity.Topography`
+    as ``asperity surface --plot`` draws it (one definition): rows along y, drawn with y
+    up, in physical units (metres for a measured topography), a scale bar of a round
+    length about a fifth of the width and a colour bar of the heights; undefined heights
+    white. Maps above 512 points a side are sampled at every k-th point. ``cmap``: another
+    matplotlib colour map than the definition's Viridis; ``name``: the title's name."""
+    charts = _surface_charts(values, name)
+    return _draw(charts[0], ax, cmap=cmap, scale_bar=scale_bar)
+
+
+def _psd_charts(spectrum: Any, name: str = "surface") -> list:
+    """``asperity stats --plot``'s chart of a :class:`~asperity.Psd`."""
+    from . import _asperity
+
+    fit = spectrum.fit
+    fitted = None if fit is None else (float(fit["prefactor"]), float(fit["exponent"]))
+    span = None if spectrum.fit_from is None else (float(spectrum.fit_from),
+                                                   float(spectrum.fit_to))
+    return _record(_asperity.psd_figure(
+        spectrum.q.tolist(), spectrum.psd.tolist(), float(spectrum.size), int(spectrum.ndim),
+        span, fitted, spectrum.hurst, name))
+
+
+def psd(spectrum: Any, ax=None, *, name: Optional[str] = None):
+    """A :class:`~asperity.Psd` (or anything :func:`asperity.psd` takes) as ``asperity
+    stats --plot`` draws it (one definition): the PSD against q·L/2π, log–log, with the
+    fitted power law over its fit range, its slope and Hurst estimate in the legend.
+    ``name``: the title's name (default ``surface``, or ``line`` for a line)."""
     from . import Psd, psd as compute
 
     if not isinstance(spectrum, Psd):
         spectrum = compute(spectrum)
-    ax = _axes(ax)
-    keep = spectrum.psd > 0
-    ax.loglog(spectrum.wavenumber[keep], spectrum.psd[keep], ".", label=label or "PSD")
-    if spectrum.fit is not None:
-        k = spectrum.wavenumber
-        inside = (_np.rint(k) >= spectrum.fit_from) & (_np.rint(k) <= spectrum.fit_to)
-        q = spectrum.q[inside]
-        fit = spectrum.fit["prefactor"] * q ** spectrum.fit["exponent"]
-        ax.loglog(k[inside], fit, "--", color="black",
-                  label=f"fit: slope {spectrum.fit['exponent']:.3f}, H ≈ {spectrum.hurst:.3f}")
-    ax.set_xlabel("q·L/2π (wavelengths per side)")
-    ax.set_ylabel("PSD C(q)")
-    ax.legend()
-    return ax
+    if name is None:
+        name = "line" if spectrum.ndim == 1 else "surface"
+    return _draw(_psd_charts(spectrum, name)[0], ax)
 
 
 def _color(color: Any, index: int):
@@ -169,10 +156,41 @@ def _draw_series(ax, chart: dict, s: dict, color) -> None:
                     textcoords="offset points", va="center")
 
 
-def _draw(chart: dict, ax=None):
+def _draw_image(ax, image: dict, cmap: Optional[str], scale_bar: bool) -> None:
+    """An image series: cells over its extent, row 0 at the bottom; on the Viridis map
+    with a colour bar, or as categories (0 the first colour, k ≥ 1 cycling through the
+    rest); its scale bar in the lower left."""
+    values = _np.array([_np.nan if v is None else v for v in image["values"]],
+                       dtype=_np.float64).reshape(image["rows"], image["cols"])
+    width, height = image["extent"]
+    extent = (0, width, 0, height)
+    colors = image["colors"]
+    if "viridis" in colors:
+        scale = colors["viridis"]
+        drawn = ax.imshow(values, origin="lower", extent=extent, cmap=cmap or "viridis",
+                          vmin=scale["low"], vmax=scale["high"], interpolation="nearest")
+        ax.figure.colorbar(drawn, ax=ax, label=scale["label"])
+    else:
+        palette = _np.array([_color(c, 0) for c in colors["categories"]["colors"]])
+        k = _np.nan_to_num(values).astype(_np.int64)
+        index = _np.where(k <= 0, 0, 1 + (k - 1) % max(len(palette) - 1, 1))
+        ax.imshow(palette[index], origin="lower", extent=extent, interpolation="nearest")
+    bar = image.get("scale_bar")
+    if bar and scale_bar:
+        from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
+
+        ax.add_artist(AnchoredSizeBar(ax.transData, bar["length"], bar["label"],
+                                      "lower left", pad=0.4, color="black", frameon=True,
+                                      size_vertical=height / 100))
+
+
+def _draw(chart: dict, ax=None, *, cmap: Optional[str] = None, scale_bar: bool = True):
     """One chart of the library's figure definition (``asperity-figure/1``) on ``ax``."""
     ax = _axes(ax)
     for i, s in enumerate(chart["series"]):
+        if s.get("image") is not None:
+            _draw_image(ax, s["image"], cmap, scale_bar)
+            continue
         _draw_series(ax, chart, s, _color(s.get("color"), i))
     if chart["log_x"]:
         ax.set_xscale("log")
@@ -335,25 +353,43 @@ def area(result: Any, ax=None):
     return _against_force(result, "area_fraction", "contact fraction A/A₀", ax)
 
 
-def contact_map(contact_set: Any, ax=None, *, size: Optional[tuple] = None):
-    """A contact set (2D boolean array, e.g. ``sweep.map`` of :func:`asperity.contact` or
-    ``result.pressure > 0``) with each 4-connected patch in its own colour (free surface
-    white) and the patch count in the title; ``size`` ``(x, y)`` sets the axes' extent."""
-    from . import patches
+def _contact_map_charts(contact_set: Any, size: Optional[tuple] = None,
+                        metres: Optional[bool] = None, name: str = "contact set") -> list:
+    """``asperity contact --map``'s chart of a contact set (or a contact sweep's ``map``)."""
+    from . import Sweep, _asperity
 
-    found = patches(_np.asarray(contact_set, dtype=bool))
-    ax = _axes(ax)
-    plt = _pyplot()
-    rng = _np.random.default_rng(0)  # distinct, repeatable colours per patch
-    colours = _np.vstack([[1.0, 1.0, 1.0], plt.get_cmap("tab20")(
-        rng.integers(0, 20, size=len(found)))[:, :3] if len(found) else _np.zeros((0, 3))])
-    image = colours[found.labels]
-    rows, cols = found.labels.shape
-    extent = (0, cols, 0, rows) if size is None else (0, size[0], 0, size[1])
-    ax.imshow(image, origin="lower", extent=extent, interpolation="nearest")
-    ax.set_title(f"{len(found)} contact patches, {found.points.sum() / found.labels.size:.2%} "
-                 "in contact")
-    return ax
+    if isinstance(contact_set, Sweep):
+        if "map" not in contact_set.columns:
+            raise ValueError("contact_map: the sweep has no map (asperity.contact(..., "
+                             "map=True))")
+        sizes = contact_set.metadata.get("sizes", [None, None])
+        rows, cols = contact_set.map.shape
+        if size is None and sizes[0] is not None:
+            sx = float(sizes[0])
+            size = (sx, sx * rows / cols if sizes[1] is None else float(sizes[1]))
+        metres = True if metres is None else metres
+        contact_set = contact_set.map
+    array = _np.asarray(contact_set)
+    if array.dtype != _np.bool_ or array.ndim != 2:
+        raise ValueError(f"contact_map: expected a 2D boolean array, got {array.dtype} of "
+                         f"shape {array.shape}")
+    rows, cols = array.shape
+    sx, sy = (float(cols), float(rows)) if size is None else (float(size[0]), float(size[1]))
+    return _record(_asperity.contact_map_figure(_np.ascontiguousarray(array), sx, sy,
+                                                bool(metres), name))
+
+
+def contact_map(contact_set: Any, ax=None, *, size: Optional[tuple] = None,
+                metres: Optional[bool] = None, name: str = "contact set"):
+    """A contact set as ``asperity contact --map`` draws it (one definition): each
+    4-connected patch (the rule of :func:`asperity.patches` and the ``patches`` column) in
+    a colour of its own, free surface white, the patch count and the share in contact in
+    the title, and a scale bar. ``contact_set``: a 2D boolean array (e.g. ``result.pressure
+    > 0``) or a :func:`asperity.contact` sweep with ``map=True`` (its sizes, in metres);
+    ``size`` ``(x, y)``: the extent (default: the sweep's sizes, or one unit a point);
+    ``metres``: name the scale bar's unit (default: for a contact sweep)."""
+    charts = _contact_map_charts(contact_set, size, metres, name)
+    return _draw(charts[0], ax)
 
 
 def alpha(result: Any, ax=None):

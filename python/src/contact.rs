@@ -31,10 +31,12 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyo3(signature = (modulus, young, poisson))]
 fn effective_modulus(
     modulus: Option<f64>,
-    young: Option<f64>,
-    poisson: Option<f64>,
+    young: Option<Vec<f64>>,
+    poisson: Option<Vec<f64>>,
 ) -> PyResult<f64> {
-    app::effective_modulus(modulus, young, poisson).map_err(refused)
+    let young = young.unwrap_or_default();
+    let poisson = poisson.unwrap_or_default();
+    app::modulus_of(modulus, &young, &poisson).map_err(refused)
 }
 
 /// The 4-connected contact patches of a contact set (`asperity::topography::patches`, the
@@ -62,8 +64,8 @@ fn contact<'py>(
     size_y: Option<f64>,
     pressures: Vec<f64>,
     modulus: Option<f64>,
-    young: Option<f64>,
-    poisson: Option<f64>,
+    young: Option<Vec<f64>>,
+    poisson: Option<Vec<f64>>,
     boundary: &str,
     tolerance: f64,
     map: bool,
@@ -72,10 +74,17 @@ fn contact<'py>(
     hardness: Option<f64>,
     tangential: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let (young, young_2) =
+        app::one_or_two(app::params::YOUNG, young.as_deref().unwrap_or(&[])).map_err(refused)?;
+    let (poisson, poisson_2) =
+        app::one_or_two(app::params::POISSON, poisson.as_deref().unwrap_or(&[]))
+            .map_err(refused)?;
     let request = ContactRequest {
         modulus,
         young,
         poisson,
+        young_2,
+        poisson_2,
         pressures,
         boundary: boundary.into(),
         tolerance,

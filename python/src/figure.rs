@@ -3,13 +3,88 @@
 
 use asperity_app::bem::branches;
 use asperity_app::figure::path::{PathColumns, PathFigure};
+use asperity_app::figure::map::{contact_map_chart, surface_chart, MapFigure};
+use asperity_app::figure::psd::{psd_chart, PsdFigure};
 use asperity_app::figure::{self, sweep::SweepColumns, sweep::SweepFigure};
+use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_figure, m)?)?;
     m.add_function(wrap_pyfunction!(path_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(surface_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_map_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(psd_figure, m)?)?;
     Ok(())
+}
+
+/// The height map's figure as `asperity surface --plot FILE.json` writes it (heights rows
+/// × cols, row 0 at y = 0; sizes along x and y; lengths in metres or the surface's unit).
+#[pyfunction]
+fn surface_figure(
+    heights: PyReadonlyArray2<'_, f64>,
+    size_x: f64,
+    size_y: f64,
+    metres: bool,
+    name: &str,
+) -> String {
+    let figure = MapFigure {
+        name,
+        size: (size_x, size_y),
+        metres,
+    };
+    figure::to_json(&[surface_chart(heights.as_array(), figure)]).to_string()
+}
+
+/// The contact map's figure as `asperity contact --map FILE.json` writes it.
+#[pyfunction]
+fn contact_map_figure(
+    set: PyReadonlyArray2<'_, bool>,
+    size_x: f64,
+    size_y: f64,
+    metres: bool,
+    name: &str,
+) -> String {
+    let figure = MapFigure {
+        name,
+        size: (size_x, size_y),
+        metres,
+    };
+    figure::to_json(&[contact_map_chart(set.as_array(), figure)]).to_string()
+}
+
+/// The PSD's figure as `asperity stats --plot FILE.json` writes it: bins (q, psd), the
+/// side length, 1 or 2 dimensions, the fit range in q·L/2π, the fit (prefactor,
+/// exponent) and the Hurst estimate.
+#[pyfunction]
+#[pyo3(signature = (q, psd, size, ndim, range, fit, hurst, name))]
+#[allow(clippy::too_many_arguments)]
+fn psd_figure(
+    q: Vec<f64>,
+    psd: Vec<f64>,
+    size: f64,
+    ndim: usize,
+    range: Option<(f64, f64)>,
+    fit: Option<(f64, f64)>,
+    hurst: Option<f64>,
+    name: &str,
+) -> PyResult<String> {
+    if q.len() != psd.len() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "psd_figure: q and psd differ in length",
+        ));
+    }
+    let figure = PsdFigure {
+        name,
+        q: &q,
+        psd: &psd,
+        size,
+        ndim,
+        range,
+        fit,
+        hurst,
+    };
+    Ok(figure::to_json(&[psd_chart(figure)]).to_string())
 }
 
 /// The two panels of a load sweep (k(F), A/A₀(F)) as `asperity bem --plot FILE.json`

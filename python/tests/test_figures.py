@@ -115,3 +115,86 @@ def test_a_load_paths_figure_is_the_clis_and_draws_the_loop(cli, tmp_path):
     assert "H = 0.2" in theirs[0]["title"]
     ax = asperity.plot.field(path.permanent_displacement, label="permanent displacement")
     assert ax.images[0].get_array().shape == path.permanent_displacement.shape
+
+
+def _same_but_the_name(mine, theirs):
+    """The charts are equal once the titles' names (a file name in the CLI, what the caller
+    calls it in Python) are set aside."""
+    assert len(mine) == len(theirs)
+    for a, b in zip(mine, theirs):
+        assert a["title"].split(": ", 1)[1] == b["title"].split(": ", 1)[1]
+        a["title"] = b["title"] = ""
+    assert _nan_to_none(mine) == theirs
+
+
+def test_a_surfaces_image_is_the_clis_bit_for_bit(cli, tmp_path):
+    # A rectangular map (y 24 rows, x 40 columns) in its own unit: heights, extent, colour
+    # range, scale bar and words are the CLI's `surface --plot FILE.json`.
+    cli("surface", "--n", "40", "--m", "24", "--hurst", "0.7", "--size", "2", "--seed", "3",
+        "--out", tmp_path / "s.npy", "--plot", tmp_path / "s.json")
+    theirs = json.loads((tmp_path / "s.json").read_text())["charts"]
+    surface = asperity.load(tmp_path / "s.npy")
+    mine = asperity.plot._surface_charts(surface)
+    image = mine[0]["series"][0]["image"]
+    assert (image["rows"], image["cols"], image["extent"]) == (24, 40, [2.0, 1.2])
+    assert image["scale_bar"] == {"length": 0.2, "label": "0.2"}
+    np.testing.assert_array_equal(np.reshape(image["values"], (24, 40)), surface.heights)
+    _same_but_the_name(mine, theirs)
+    # matplotlib draws the definition's cells over its extent, with its colour range.
+    ax = asperity.plot.surface(surface)
+    drawn = ax.get_images()[0]
+    assert drawn.get_extent() == [0, 2.0, 0, 1.2]
+    np.testing.assert_array_equal(drawn.get_array(), surface.heights)
+    assert drawn.get_clim() == (surface.heights.min(), surface.heights.max())
+    assert ax.get_title() == "surface: heights (24×40, 2 × 1.2)"
+
+
+def test_a_psd_figure_is_the_clis_bit_for_bit(cli, tmp_path):
+    cli("surface", "--n", "64", "--hurst", "0.8", "--rolloff", "4", "--seed", "2",
+        "--out", tmp_path / "s.npy")
+    cli("stats", tmp_path / "s.npy", "--plot", tmp_path / "p.json")
+    theirs = json.loads((tmp_path / "p.json").read_text())["charts"]
+    spectrum = asperity.psd(asperity.load(tmp_path / "s.npy"))
+    mine = asperity.plot._psd_charts(spectrum)
+    assert [s["label"] for s in mine[0]["series"]][1].startswith("fit: slope")
+    _same_but_the_name(mine, theirs)
+    # A line: C1D, same fit range words.
+    cli("line", "--n", "1024", "--hurst", "0.5", "--seed", "4", "--out", tmp_path / "l.npy")
+    cli("stats", tmp_path / "l.npy", "--plot", tmp_path / "l.json")
+    theirs = json.loads((tmp_path / "l.json").read_text())["charts"]
+    mine = asperity.plot._psd_charts(asperity.psd(asperity.load(tmp_path / "l.npy")))
+    assert mine[0]["y_label"] == "PSD C1D(q)  [length³]"
+    _same_but_the_name(mine, theirs)
+
+
+def test_a_contact_map_is_the_clis_bit_for_bit(cli, tmp_path):
+    # A measured map in metres (rectangular pixels), pressed by the CLI and by Python: the
+    # patches of the last load, their count in the title, the extent and scale bar in m.
+    rng = np.random.default_rng(0)
+    heights = rng.standard_normal((30, 44)).cumsum(0).cumsum(1) * 1e-9
+    np.savetxt(tmp_path / "m.txt", heights)
+    cli("import", tmp_path / "m.txt", "--size", "8e-6,6e-6", "--detrend", "plane",
+        "--out", tmp_path / "m.npy")
+    cli("contact", tmp_path / "m.npy", "--modulus", "1e9", "--pressures", "1e6,1e7",
+        "--quiet", "--out", tmp_path / "c.csv", "--map", tmp_path / "map.json")
+    theirs = json.loads((tmp_path / "map.json").read_text())["charts"]
+    sweep = asperity.contact(asperity.load(tmp_path / "m.npy"), modulus=1e9,
+                             pressures=[1e6, 1e7], map=True)
+    mine = asperity.plot._contact_map_charts(sweep)
+    image = mine[0]["series"][0]["image"]
+    assert image["extent"] == [8e-6, 6e-6]
+    assert image["scale_bar"]["label"] == "1 µm"
+    np.testing.assert_array_equal(np.reshape(image["values"], (30, 44)),
+                                  asperity.patches(sweep.map).labels)
+    assert f"{int(sweep.patches[-1])} contact patches" in mine[0]["title"]
+    _same_but_the_name(mine, theirs)
+    # Drawn: one colour per patch, the definition's; free surface white.
+    ax = asperity.plot.contact_map(sweep)
+    rgb = ax.get_images()[0].get_array()
+    labels = asperity.patches(sweep.map).labels
+    palette = image["colors"]["categories"]["colors"]
+    for label in range(1, labels.max() + 1):
+        colour = palette[1 + (label - 1) % (len(palette) - 1)]["rgb"]
+        drawn = np.asarray(rgb[labels == label])
+        np.testing.assert_allclose(drawn, np.broadcast_to(np.array(colour) / 255, drawn.shape))
+    assert (rgb[labels == 0] == 1.0).all()

@@ -44,7 +44,7 @@ def test_contact_map_colours_each_patch():
         colours = {tuple(c) for c in rgb[labels == label]}
         assert len(colours) == 1  # one colour per patch
     assert (rgb[labels == 0] == 1.0).all()  # free surface white
-    assert ax.get_title().startswith("4 contact patches")
+    assert ax.get_title().startswith("contact set: 4 contact patches")
 
 
 def test_curves_and_alpha_with_intervals(tmp_path):

@@ -2,6 +2,7 @@
 closed forms, checked against ContactMechanics' own reference solutions (the peer) and
 against the BEM; E* by the CLI's one rule."""
 
+import json
 import math
 
 import numpy as np
@@ -94,6 +95,33 @@ def test_effective_modulus_is_the_cli_rule(cli, tmp_path):
     assert str(error.value) == words.replace("--", "")
     with pytest.raises(ValueError, match="give either modulus"):
         asperity.Solver(s, modulus=1.0, young=2.0, poisson=0.3)
+
+
+def test_two_bodies_give_the_closed_form_e_star_in_both_front_ends(cli, tmp_path):
+    # Steel on aluminium: 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂, the CLI's record and
+    # Python's E* the same double; the contact itself then bit for bit the same.
+    closed = 1 / ((1 - 0.3 ** 2) / 210e9 + (1 - 0.33 ** 2) / 70e9)
+    e_star = asperity.effective_modulus(young=(210e9, 70e9), poisson=(0.3, 0.33))
+    assert e_star == pytest.approx(closed, rel=1e-15)
+    # Two equal bodies: half of one body's E/(1 − ν²).
+    one = asperity.effective_modulus(young=210e9, poisson=0.3)
+    both = asperity.effective_modulus(young=[210e9, 210e9], poisson=[0.3, 0.3])
+    assert both == pytest.approx(one / 2, rel=1e-15)
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_height=1e-6, size=1e-4, seed=1)
+    s.save(tmp_path / "s.npy")
+    c = asperity.contact(s, young=(210e9, 70e9), poisson=(0.3, 0.33), pressures=[1e6, 1e7])
+    assert c.effective_modulus == e_star
+    assert c.metadata["contact"]["young"] == [210e9, 70e9]
+    cli("contact", tmp_path / "s.npy", "--young", "210e9,70e9", "--poisson", "0.3,0.33",
+        "--pressures", "1e6,1e7", "--detrend", "none", "--quiet", "--out", tmp_path / "c.csv")
+    record = json.loads((tmp_path / "c.csv.json").read_text())
+    assert record["effective_modulus_pa"] == e_star
+    assert record["young_pa"] == [210e9, 70e9] and record["poisson"] == [0.3, 0.33]
+    rows = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    np.testing.assert_array_equal(rows["stiffness_n_per_m"], c.stiffness_n_per_m)
+    # The Solver takes the same keywords.
+    solver = asperity.Solver(s, young=(210e9, 70e9), poisson=(0.3, 0.33))
+    assert solver.modulus == e_star
 
 
 def test_patches_are_the_cli_count_with_their_areas(cli, tmp_path):

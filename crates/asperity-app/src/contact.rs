@@ -15,7 +15,7 @@ use crate::bem::{
     params as bem, parse_boundary,
 };
 use crate::derived::{check_poisson, Derived, DerivedRow, Units};
-use crate::refusal::Refusal;
+use crate::refusal::{Param, Refusal};
 
 /// The parameters of `asperity contact` besides those it shares with `asperity bem`.
 pub mod params {
@@ -63,15 +63,67 @@ pub fn effective_modulus(
     }
 }
 
+/// One value, or two (one per body: `--young E1,E2`, `young=(E1, E2)`): the first body's
+/// and the second's.
+pub fn one_or_two(param: Param, values: &[f64]) -> Result<(Option<f64>, Option<f64>), Refusal> {
+    match *values {
+        [] => Ok((None, None)),
+        [a] => Ok((Some(a), None)),
+        [a, b] => Ok((Some(a), Some(b))),
+        _ => Err(Refusal::of(param).text(format!(
+            " takes one value, or two (one per body), got {}",
+            values.len()
+        ))),
+    }
+}
+
+/// E* of two elastic bodies, each given by Young's modulus E and Poisson's ratio ν:
+/// `1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂` (Hertz; Johnson, *Contact Mechanics*, 1985, ch. 4).
+/// The contact of two elastic rough bodies maps onto a rigid rough surface (the combined
+/// roughness) pressed into one half-space of this modulus.
+pub fn two_body_modulus(first: (f64, f64), second: (f64, f64)) -> Result<f64, Refusal> {
+    for (e, nu) in [first, second] {
+        check_poisson(nu)?;
+        check_modulus(YOUNG, e)?;
+    }
+    let compliance = |(e, nu): (f64, f64)| (1.0 - nu * nu) / e;
+    let e_star = 1.0 / (compliance(first) + compliance(second));
+    check_modulus(bem::MODULUS, e_star)?;
+    Ok(e_star)
+}
+
+/// E* by the rule of `asperity contact`: `--modulus` itself, or `--young E --poisson ν`
+/// (one body on a rigid one), or `--young E1,E2 --poisson ν1,ν2` (two elastic bodies).
+pub fn modulus_of(modulus: Option<f64>, young: &[f64], poisson: &[f64]) -> Result<f64, Refusal> {
+    let (young, young_2) = one_or_two(YOUNG, young)?;
+    let (poisson, poisson_2) = one_or_two(POISSON, poisson)?;
+    let request = ContactRequest {
+        modulus,
+        young,
+        poisson,
+        young_2,
+        poisson_2,
+        ..ContactRequest::default()
+    };
+    request.modulus()
+}
+
 /// An `asperity contact` request (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactRequest {
     /// E*, Pa (or `young` with `poisson`).
     pub modulus: Option<f64>,
-    /// Young's modulus E, Pa.
+    /// Young's modulus E, Pa (of the first body, with `young_2`).
     pub young: Option<f64>,
-    /// Poisson's ratio ν.
+    /// Poisson's ratio ν (of the first body, with `poisson_2`).
     pub poisson: Option<f64>,
+    /// The second body's Young's modulus E₂, Pa: with `poisson_2`, E* of the two bodies
+    /// ([`two_body_modulus`]).
+    #[serde(default)]
+    pub young_2: Option<f64>,
+    /// The second body's Poisson's ratio ν₂.
+    #[serde(default)]
+    pub poisson_2: Option<f64>,
     /// Mean pressures over the nominal area, Pa.
     pub pressures: Vec<f64>,
     /// `free` or `periodic`.
@@ -101,6 +153,8 @@ impl Default for ContactRequest {
             modulus: None,
             young: None,
             poisson: None,
+            young_2: None,
+            poisson_2: None,
             pressures: Vec::new(),
             boundary: "free".into(),
             tolerance: SolverParams::default().tolerance,
@@ -131,10 +185,7 @@ impl ContactRequest {
     /// The plan, or why not: E*, the boundary, the pressures, the tolerance, the derived
     /// columns.
     pub fn validate(&self) -> Result<ContactPlan, Refusal> {
-        // With --tangential, ν may stand beside E* itself: then it is the kernel's alone.
-        let alone = self.tangential && self.modulus.is_some() && self.young.is_none();
-        let for_modulus = if alone { None } else { self.poisson };
-        let modulus = effective_modulus(self.modulus, self.young, for_modulus)?;
+        let modulus = self.modulus()?;
         let boundary = parse_boundary(&self.boundary)?;
         check_values(bem::PRESSURES, &self.pressures, false)?;
         check_tolerance(self.tolerance)?;
@@ -164,6 +215,47 @@ impl ContactRequest {
             },
             loads,
         })
+    }
+}
+
+impl ContactRequest {
+    /// E*: `modulus`, or one body's E and ν, or two bodies' ([`two_body_modulus`]).
+    fn modulus(&self) -> Result<f64, Refusal> {
+        if self.young_2.is_some() || self.poisson_2.is_some() {
+            return self.two_bodies();
+        }
+        // With --tangential, ν may stand beside E* itself: then it is the kernel's alone.
+        let alone = self.tangential && self.modulus.is_some() && self.young.is_none();
+        let for_modulus = if alone { None } else { self.poisson };
+        effective_modulus(self.modulus, self.young, for_modulus)
+    }
+
+    /// E* of the two bodies, or why not: both E and both ν, no E*; with `tangential` the
+    /// same ν (Cerruti's kernel has one).
+    fn two_bodies(&self) -> Result<f64, Refusal> {
+        let given = (self.modulus, self.young, self.poisson);
+        let (None, Some(e1), Some(nu1)) = given else {
+            return Err(Refusal::saying("two bodies take ")
+                .param(YOUNG)
+                .text(" E₁,E₂ with ")
+                .param(POISSON)
+                .text(" ν₁,ν₂ and no ")
+                .param(bem::MODULUS));
+        };
+        let (Some(e2), Some(nu2)) = (self.young_2, self.poisson_2) else {
+            return Err(Refusal::saying("give each body's ")
+                .param(YOUNG)
+                .text(" E and ")
+                .param(POISSON)
+                .text(" ν: two values each (E₁,E₂ and ν₁,ν₂)"));
+        };
+        if self.tangential && nu1 != nu2 {
+            return Err(Refusal::of(TANGENTIAL)
+                .text(" needs one Poisson's ratio (Cerruti's kernel): the two bodies' ")
+                .param(POISSON)
+                .text(format!(" differ ({nu1}, {nu2})")));
+        }
+        two_body_modulus((e1, nu1), (e2, nu2))
     }
 }
 
@@ -406,6 +498,64 @@ mod tests {
         for ((m, e, nu), words) in cases {
             assert_eq!(first(&effective_modulus(m, e, nu).unwrap_err()), words);
         }
+    }
+
+    #[test]
+    fn two_bodies_combine_their_compliances() {
+        // Steel on aluminium: the closed form, and the request's E* equals it.
+        let (steel, aluminium) = ((210e9, 0.3), (70e9, 0.33));
+        let e_star = 1.0 / ((1.0 - 0.09) / 210e9 + (1.0 - 0.33 * 0.33) / 70e9);
+        assert_eq!(two_body_modulus(steel, aluminium), Ok(e_star));
+        // Equal bodies: half of one body's E/(1 − ν²).
+        let one = effective_modulus(None, Some(210e9), Some(0.3)).unwrap();
+        let two = two_body_modulus(steel, steel).unwrap();
+        assert!((two / (one / 2.0) - 1.0).abs() < 1e-15);
+        let request = ContactRequest {
+            young: Some(210e9),
+            poisson: Some(0.3),
+            young_2: Some(70e9),
+            poisson_2: Some(0.33),
+            pressures: vec![1e5],
+            ..ContactRequest::default()
+        };
+        assert_eq!(request.validate().unwrap().half_space.modulus, e_star);
+        let refused = |r: ContactRequest| first(&r.validate().unwrap_err());
+        let words = refused(ContactRequest {
+            poisson_2: None,
+            ..request.clone()
+        });
+        assert_eq!(
+            words,
+            "give each body's young E and poisson ν: two values each (E₁,E₂ and ν₁,ν₂)"
+        );
+        let words = refused(ContactRequest {
+            modulus: Some(1e9),
+            ..request.clone()
+        });
+        assert_eq!(
+            words,
+            "two bodies take young E₁,E₂ with poisson ν₁,ν₂ and no modulus"
+        );
+        let words = refused(ContactRequest {
+            tangential: true,
+            ..request.clone()
+        });
+        assert!(words.contains("differ (0.3, 0.33)"), "{words}");
+        let words = refused(ContactRequest {
+            poisson_2: Some(0.6),
+            ..request.clone()
+        });
+        assert_eq!(
+            words,
+            "poisson must be in [0, 0.5] (Poisson's ratio), got 0.6"
+        );
+        assert_eq!(
+            first(&one_or_two(YOUNG, &[1.0, 2.0, 3.0]).unwrap_err()),
+            "young takes one value, or two (one per body), got 3"
+        );
+        assert_eq!(one_or_two(YOUNG, &[1.0, 2.0]), Ok((Some(1.0), Some(2.0))));
+        assert_eq!(modulus_of(None, &[210e9, 70e9], &[0.3, 0.33]), Ok(e_star));
+        assert_eq!(modulus_of(None, &[210e9], &[0.3]), Ok(one));
     }
 
     #[test]

@@ -17,8 +17,11 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+pub use asperity_app::figure::psd::thin_log;
 use asperity_app::figure::Color as SeriesColor;
 pub use asperity_app::figure::{Chart, Series, Style};
+
+mod image;
 
 /// A colour from the Viridis map for `t ∈ [0, 1]` (ordered families such as H values).
 pub fn ordered_color(t: f64) -> SeriesColor {
@@ -169,6 +172,9 @@ impl Drawn<'_> {
     }
 
     fn bounds(&self) -> Result<((f64, f64), (f64, f64))> {
+        if let Some(image) = image::image_of(self) {
+            return Ok(((0.0, image.extent.0), (0.0, image.extent.1)));
+        }
         let pts = self.extent();
         if self
             .series
@@ -269,6 +275,9 @@ impl Drawn<'_> {
     where
         DB::ErrorType: 'static,
     {
+        if let Some(picture) = image::image_of(self) {
+            return image::render(self, picture, root, scale);
+        }
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
         let ((x0, x1), (y0, y1)) = self.bounds()?;
         // Log axes get their own ticks: plotters' own leave a short range with one label.
@@ -440,6 +449,8 @@ impl Drawn<'_> {
                 chart.draw_series(LineSeries::new(pts.clone(), line))?;
                 chart.draw_series(dots(pts.clone()))?
             }
+            // Drawn by `image::render`, never here.
+            Style::Image => return Ok(()),
         };
         if !s.label.is_empty() {
             let (width, dashed) = (24 * scale as i32, s.style == Style::Dashed);
@@ -562,34 +573,6 @@ pub fn stage_charts(staged: &mut StagedOutputs, path: &Path, charts: &[Chart]) -
             Ok(())
         }
     }
-}
-
-/// The points of a log–log series thinned to about `keep` per x range: a point is kept
-/// when ln x moved by at least 1/`keep` of the range since the last one kept (the last
-/// point is always kept). Points that log axes cannot show are dropped.
-pub fn thin_log(points: impl Iterator<Item = (f64, f64)>, keep: usize) -> Vec<(f64, f64)> {
-    let shown: Vec<(f64, f64)> = points
-        .filter(|(x, y)| x.is_finite() && y.is_finite() && *x > 0.0 && *y > 0.0)
-        .collect();
-    if shown.len() <= keep {
-        return shown;
-    }
-    let (lo, hi) = shown
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.0.ln()), hi.max(p.0.ln()))
-        });
-    let step = (hi - lo) / keep as f64;
-    let mut kept: Vec<(f64, f64)> = Vec::with_capacity(keep + 1);
-    for (i, &p) in shown.iter().enumerate() {
-        let far = kept
-            .last()
-            .is_none_or(|last: &(f64, f64)| (p.0.ln() - last.0.ln()).abs() >= step);
-        if far || i + 1 == shown.len() {
-            kept.push(p);
-        }
-    }
-    kept
 }
 
 /// A drawing error in words. Plotters prints its bitmap errors with `{:?}` (e.g.
@@ -876,18 +859,6 @@ mod tests {
         };
         let ((_, x1), _) = Drawn(&chart).bounds().unwrap();
         assert!(x1 > 1.1, "{x1}");
-    }
-
-    #[test]
-    fn thinning_keeps_log_spread_points_and_the_ends() {
-        let dense: Vec<(f64, f64)> = (1..=100_000).map(|i| (i as f64, 1.0)).collect();
-        let thin = thin_log(dense.iter().copied(), 100);
-        assert!(thin.len() <= 102 && thin.len() > 50, "{}", thin.len());
-        assert_eq!(thin.first(), Some(&(1.0, 1.0)));
-        assert_eq!(thin.last(), Some(&(100_000.0, 1.0)));
-        // Few points stay as they are, less those log axes cannot show.
-        let few = [(0.0, 1.0), (1.0, 2.0), (2.0, -1.0), (3.0, 4.0)];
-        assert_eq!(thin_log(few.into_iter(), 100), [(1.0, 2.0), (3.0, 4.0)]);
     }
 
     #[test]

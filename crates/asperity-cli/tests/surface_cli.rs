@@ -738,3 +738,52 @@ fn stats_fit_range_is_clamped_and_an_empty_default_is_no_error() {
         stderr(&out)
     );
 }
+
+/// `surface --plot`: the height map's figure (one definition with Python's
+/// `asperity.plot.surface`): as data, the cells are the heights written, over the
+/// surface's sizes, with a scale bar; as PNG and SVG, drawn; any other extension refused
+/// before anything is written.
+#[test]
+fn surface_plot_is_the_height_map_with_its_scale_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = [
+        "surface", "--n", "40", "--m", "24", "--hurst", "0.7", "--size", "2", "--seed", "3",
+    ];
+    ok(&asperity(
+        &[&base[..], &["--out", "s.npy", "--plot", "s.json"]].concat(),
+        d,
+    ));
+    let heights: Array2<f64> = read_npy(d.join("s.npy")).unwrap();
+    let figure: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("s.json")).unwrap()).unwrap();
+    assert_eq!(figure["format"], "asperity-figure/1");
+    let image = &figure["charts"][0]["series"][0]["image"];
+    assert_eq!(
+        (image["rows"].as_u64(), image["cols"].as_u64()),
+        (Some(24), Some(40))
+    );
+    assert_eq!(image["extent"], serde_json::json!([2.0, 1.2]));
+    let cells: Vec<f64> = image["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(cells, heights.iter().copied().collect::<Vec<f64>>());
+    assert_eq!(image["scale_bar"]["label"], "0.2");
+    for plot in ["p.png", "p.svg"] {
+        let out = asperity(
+            &[&base[..], &["--out", "t.npy", "--plot", plot, "--force"]].concat(),
+            d,
+        );
+        ok(&out);
+        assert!(std::fs::metadata(d.join(plot)).unwrap().len() > 1000);
+    }
+    let before = std::fs::read_dir(d).unwrap().count();
+    let out = asperity(
+        &[&base[..], &["--out", "u.npy", "--plot", "u.jpg"]].concat(),
+        d,
+    );
+    assert_refused(&out, d, before, "--plot u.jpg");
+}

@@ -5,11 +5,17 @@
 //! same curves, theory lines, labels and intervals.
 //!
 //! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`path`] (a load path's
-//! loading–unloading loop), [`study`] (α(H), α(N) and the ensemble k(F) of a study).
+//! loading–unloading loop), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
+//! [`psd`] (a PSD with its fitted power law), [`map`] (a height map with scale and colour
+//! bars, a contact set with its patches: a series that is an [`Image`]).
 
+pub mod map;
 pub mod path;
+pub mod psd;
 pub mod study;
 pub mod sweep;
+
+pub use map::Image;
 
 use serde::Serialize;
 
@@ -25,6 +31,8 @@ pub enum Style {
     Points,
     /// A solid line with markers.
     LinePoints,
+    /// The series' [`Image`] (it has no points).
+    Image,
 }
 
 /// A series' colour.
@@ -66,6 +74,10 @@ pub struct Series {
     /// Text written beside the last point, in the series' colour (names a line in place
     /// of a legend entry).
     pub tag: Option<String>,
+    /// A grid of values drawn as coloured cells ([`Style::Image`]; left out of the JSON
+    /// when absent).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub image: Option<Image>,
 }
 
 impl Series {
@@ -78,6 +90,7 @@ impl Series {
             color: None,
             interval: None,
             tag: None,
+            image: None,
         }
     }
 

@@ -23,7 +23,9 @@ use serde_json::json;
 
 use super::measured::{load, record, MeasuredArgs};
 use crate::output::{format_number, Table};
-use crate::plot::{greyscale_png, stage_charts, Chart, ImageFormat, Series, Style};
+use asperity_app::figure::map::{contact_map_chart, MapFigure};
+
+use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
 use crate::progress::Progress;
 
 /// Arguments of `asperity contact`.
@@ -32,7 +34,8 @@ use crate::progress::Progress;
     asperity contact scan.x3p --young 210e9 --poisson 0.3 --pressures 1e5,1e6,1e7 --detrend plane\n  \
     asperity contact scan.x3p --modulus 1e9 --pressures 1e4,1e5 --out contact.csv --plot contact.png --map map.png\n  \
     asperity contact afm.txt --channel Height --detrend lines --fill harmonic --modulus 70e9 --pressures 1e6\n  \
-    asperity contact scan.x3p --young 210e9 --poisson 0.3 --hardness 2e9 --pressures 1e7,1e8\n\n\
+    asperity contact scan.x3p --young 210e9 --poisson 0.3 --hardness 2e9 --pressures 1e7,1e8\n  \
+    asperity contact scan.x3p --young 210e9,70e9 --poisson 0.3,0.33 --pressures 1e6   # steel on aluminium\n\n\
 Columns (SI units): mean_pressure_pa, force_n, contact_area_m2, area_fraction, mean_gap_m,\n\
 stiffness_n_per_m, patches, indentation_m, iterations, residual; with --hardness then\n\
 plastic_area_m2, plastic_fraction (the points at the hardness); with --tangential\n\
@@ -46,12 +49,23 @@ pub struct ContactArgs {
     /// Effective modulus E* in Pa.
     #[arg(long, allow_negative_numbers = true)]
     pub modulus: Option<f64>,
-    /// Young's modulus E in Pa (with --poisson): E* = E/(1 − ν²).
-    #[arg(long, allow_negative_numbers = true)]
-    pub young: Option<f64>,
-    /// Poisson's ratio ν, in [0, 0.5].
-    #[arg(long, allow_negative_numbers = true)]
-    pub poisson: Option<f64>,
+    /// Young's modulus E in Pa (with --poisson): E* = E/(1 − ν²); two values E₁,E₂ (with
+    /// ν₁,ν₂) for two elastic bodies: 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "E[,E2]"
+    )]
+    pub young: Vec<f64>,
+    /// Poisson's ratio ν, in [0, 0.5] (two values ν₁,ν₂ with two --young values).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "NU[,NU2]"
+    )]
+    pub poisson: Vec<f64>,
     /// Mean pressures over the nominal area, Pa, comma separated.
     #[arg(
         long,
@@ -77,8 +91,10 @@ pub struct ContactArgs {
     /// Plot (.png or .svg): contact stiffness, contact area and mean gap against force.
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub plot: Option<PathBuf>,
-    /// Contact map at the largest load (.png): contact black, free surface white.
-    #[arg(long, value_name = "FILE.png")]
+    /// Contact map at the largest load (.png, .svg, or .json for the figure as data, as
+    /// asperity.plot.contact_map draws it): each 4-connected patch (the patches column's
+    /// rule) in a colour of its own, free surface white, axes in metres with a scale bar.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub map: Option<PathBuf>,
     /// Electrical resistivities ρ₁,ρ₂ of the two bodies, Ω·m: adds the column
     /// electrical_conductance_s, C = 2k/(E*(ρ₁+ρ₂)) (Barber's analogy).
@@ -119,11 +135,15 @@ pub struct ContactArgs {
 }
 
 /// The request of the arguments.
-fn request(args: &ContactArgs) -> ContactRequest {
-    ContactRequest {
+fn request(args: &ContactArgs) -> Result<ContactRequest> {
+    let (young, young_2) = contact::one_or_two(contact::params::YOUNG, &args.young)?;
+    let (poisson, poisson_2) = contact::one_or_two(contact::params::POISSON, &args.poisson)?;
+    Ok(ContactRequest {
         modulus: args.modulus,
-        young: args.young,
-        poisson: args.poisson,
+        young,
+        poisson,
+        young_2,
+        poisson_2,
         pressures: args.pressures.clone(),
         boundary: args.boundary.clone(),
         tolerance: args.tol,
@@ -131,13 +151,13 @@ fn request(args: &ContactArgs) -> ContactRequest {
         thermal_conductivity: args.thermal_conductivity.clone(),
         hardness: args.hardness,
         tangential: args.tangential,
-    }
+    })
 }
 
 /// Step 1: the request (the front-end layer's rules) and the image outputs, checked before
 /// any file is read.
 fn check_args(args: &ContactArgs) -> Result<ContactPlan> {
-    let plan = request(args).validate()?;
+    let plan = request(args)?.validate()?;
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
         if args.pressures.len() < 2 {
@@ -145,12 +165,7 @@ fn check_args(args: &ContactArgs) -> Result<ContactPlan> {
         }
     }
     if let Some(map) = &args.map {
-        if !map
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-        {
-            bail!("--map {}: the file name must end in .png", map.display());
-        }
+        ImageFormat::from_path(map, "--map")?;
     }
     Ok(plan)
 }
@@ -182,12 +197,25 @@ fn table(plan: &ContactPlan, rows: &[ContactRow]) -> Table {
     table
 }
 
+/// A value given once as a number, twice (one per body) as a list, none as null.
+fn one_or_both(values: &[f64]) -> serde_json::Value {
+    match values {
+        [] => serde_json::Value::Null,
+        [one] => json!(one),
+        both => json!(both),
+    }
+}
+
+/// The surface's file name, for titles.
+fn file_name(args: &ContactArgs) -> String {
+    args.file
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into())
+}
+
 /// The `--plot` panels: stiffness, contact area and mean gap against force, log–log.
 fn charts(args: &ContactArgs, rows: &[ContactRow], e_star: f64) -> [Chart; 3] {
-    let name = args
-        .file
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into());
+    let name = file_name(args);
     let points = |y: &dyn Fn(&ContactRow) -> f64| -> Vec<(f64, f64)> {
         rows.iter().map(|r| (r.force, y(r))).collect()
     };
@@ -216,6 +244,34 @@ fn charts(args: &ContactArgs, rows: &[ContactRow], e_star: f64) -> [Chart; 3] {
     ]
 }
 
+/// What `OUT.csv.json` records of the inputs.
+fn inputs_record(
+    args: &ContactArgs,
+    plan: &ContactPlan,
+    surface: serde_json::Value,
+) -> serde_json::Value {
+    json!({
+        "surface": surface,
+        "effective_modulus_pa": plan.half_space.modulus,
+        "young_pa": one_or_both(&args.young),
+        "poisson": one_or_both(&args.poisson),
+        "boundary": plan.half_space.boundary.name(),
+        "tolerance": args.tol,
+        "pressures_pa": args.pressures,
+        "resistivity_ohm_m": args.resistivity,
+        "thermal_conductivity_w_per_m_k": args.thermal_conductivity,
+        "hardness_pa": args.hardness,
+        "tangential": plan.derived.tangential.map(|nu| json!({
+            "poisson": nu,
+            "method": "frozen contact set, Cerruti kernel (normal-tangential coupling \
+                neglected); tangential_ratio = (k_x + k_y)/(2k)",
+        })),
+        "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
+            2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",
+        "units": "SI: m, Pa, N, m², N/m, S, W/K",
+    })
+}
+
 /// Runs `asperity contact`: check, read, solve (the library's load sweep), then write
 /// every output together.
 pub fn run(args: &ContactArgs) -> Result<()> {
@@ -240,6 +296,10 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params)
         .with_context(|| format!("{}", args.file.display()))?;
     let pixel_area = surface.spacing() * surface.spacing_y();
+    let sizes = (
+        surface.spacing() * cols as f64,
+        surface.spacing_y() * rows as f64,
+    );
     drop(surface);
     let loads = plan.loads.len();
     let progress = Progress::new("contact", loads as u64, args.quiet || loads < 2);
@@ -256,26 +316,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     match &record_path {
         Some(record_path) => {
             table.stage(&mut staged, args.out.as_deref().expect("with its record"))?;
-            let inputs = json!({
-                "surface": record(&topography),
-                "effective_modulus_pa": e_star,
-                "young_pa": args.young,
-                "poisson": args.poisson,
-                "boundary": boundary.name(),
-                "tolerance": args.tol,
-                "pressures_pa": args.pressures,
-                "resistivity_ohm_m": args.resistivity,
-                "thermal_conductivity_w_per_m_k": args.thermal_conductivity,
-                "hardness_pa": args.hardness,
-                "tangential": plan.derived.tangential.map(|nu| json!({
-                    "poisson": nu,
-                    "method": "frozen contact set, Cerruti kernel (normal-tangential coupling \
-                        neglected); tangential_ratio = (k_x + k_y)/(2k)",
-                })),
-                "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
-                    2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",
-                "units": "SI: m, Pa, N, m², N/m, S, W/K",
-            });
+            let inputs = inputs_record(args, &plan, record(&topography));
             staged.write_json(record_path, &inputs)?;
         }
         None => print!("{}", String::from_utf8(table.to_csv()?)?),
@@ -284,9 +325,17 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         stage_charts(&mut staged, plot, &charts(args, &solved.rows, e_star))?;
     }
     if let (Some(map), Some(contact)) = (&args.map, &solved.map) {
-        // Contact black (0), free surface white (1).
-        let values = contact.mapv(|c| if c { 0.0 } else { 1.0 });
-        greyscale_png(&mut staged, map, values.view())?;
+        let name = file_name(args);
+        let figure = MapFigure {
+            name: &name,
+            size: sizes,
+            metres: true,
+        };
+        stage_charts(
+            &mut staged,
+            map,
+            &[contact_map_chart(contact.view(), figure)],
+        )?;
     }
     staged.commit()?;
     Ok(())

@@ -3,10 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use asperity::fit::PowerLawFit;
 use asperity::io::StagedOutputs;
 use asperity::memory::{array_bytes, ensure_fits};
-use asperity::surface::stats::PsdBin;
 use asperity::topography::Heights;
 use asperity_app::stats::{
     compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
@@ -15,8 +13,10 @@ use asperity_app::Names;
 
 use super::measured::{open_argument, parse_size, record as measured_record, MeasuredArgs};
 use crate::output::{format_number, Table};
-use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
 use asperity_app::argument::{Arrays, Dims};
+use asperity_app::figure::psd::{self, PsdFigure};
+
+use crate::plot::{stage_charts, Chart, ImageFormat};
 
 /// Arguments of `asperity stats`.
 #[derive(Debug, clap::Args)]
@@ -85,69 +85,25 @@ pub struct StatsArgs {
     pub force: bool,
 }
 
-/// The `--plot` chart: the PSD against q·L/2π, log–log, with the fitted power law drawn
-/// over the fit range `[from, to]` (in q·L/2π).
-fn psd_chart(
-    file: &Path,
-    bins: &[PsdBin],
-    size: f64,
-    ndim: usize,
-    (from, to): (f64, f64),
-    fit: Option<PowerLawFit>,
-    hurst: Option<f64>,
-) -> Chart {
-    let wavelengths = |q: f64| q * size / std::f64::consts::TAU;
+/// The `--plot` chart ([`asperity_app::figure::psd::psd_chart`]): the PSD against q·L/2π,
+/// log–log, with the fitted power law drawn over the fit range.
+fn psd_chart(file: &Path, stats: &Statistics) -> Chart {
     let name = file.file_name().map_or_else(
         || file.display().to_string(),
         |n| n.to_string_lossy().into(),
     );
-    let (kind, psd_name, unit) = if ndim == 1 {
-        ("line", "C1D(q)", "length³")
-    } else {
-        ("surface", "C2D(q)", "length⁴")
-    };
-    // Every ring of a surface; a line's many noisy bins as points, thinned to what a
-    // figure shows.
-    let points = thin_log(bins.iter().map(|b| (wavelengths(b.q), b.psd)), 5000);
-    let style = if points.len() <= 300 {
-        Style::LinePoints
-    } else {
-        Style::Points
-    };
-    let mut series = vec![Series::new("PSD", points, style)];
-    if let Some(f) = fit {
-        // The fit is C = A q^p in physical q; drawn from the first to the last bin fitted.
-        let fitted: Vec<f64> = bins
-            .iter()
-            .filter(|b| b.psd > 0.0)
-            .map(|b| wavelengths(b.q))
-            .filter(|k| (from..=to).contains(&k.round()))
-            .collect();
-        let ends = [fitted.first(), fitted.last()];
-        let line = ends
-            .into_iter()
-            .flatten()
-            .map(|&k| {
-                let q = k * std::f64::consts::TAU / size;
-                (k, f.prefactor * q.powf(f.exponent))
-            })
-            .collect();
-        let label = match hurst {
-            Some(h) => format!("fit: slope {:.3} (H ≈ {h:.3})", f.exponent),
-            None => format!("fit: slope {:.3}", f.exponent),
-        };
-        series.push(
-            Series::new(label, line, Style::Dashed).color(asperity_app::figure::Color::BLACK),
-        );
-    }
-    Chart {
-        title: format!("{name}: power spectrum of the {kind} (L = {size})"),
-        x_label: "wavenumber q·L/2π".into(),
-        y_label: format!("PSD {psd_name}  [{unit}]"),
-        log_x: true,
-        log_y: true,
-        series,
-    }
+    let q: Vec<f64> = stats.bins.iter().map(|b| b.q).collect();
+    let psd: Vec<f64> = stats.bins.iter().map(|b| b.psd).collect();
+    psd::psd_chart(PsdFigure {
+        name: &name,
+        q: &q,
+        psd: &psd,
+        size: stats.size,
+        ndim: stats.dims.len(),
+        range: stats.plan.range,
+        fit: stats.fit.map(|f| (f.prefactor, f.exponent)),
+        hurst: stats.hurst,
+    })
 }
 
 /// The file through the front-end layer's one call: a measured file (or an imported
@@ -353,9 +309,7 @@ fn stage_outputs(
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let range = stats.plan.range.unwrap_or((0.0, 0.0));
-        let dims = stats.dims.len();
-        let chart = psd_chart(&args.file, bins, size, dims, range, stats.fit, stats.hurst);
+        let chart = psd_chart(&args.file, stats);
         stage_charts(staged, path, &[chart])
             .with_context(|| format!("writing {}", path.display()))?;
     }

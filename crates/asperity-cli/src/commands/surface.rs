@@ -6,6 +6,7 @@ use anyhow::Result;
 use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::surface::stats::{line_summary, surface_summary};
 use asperity::surface::{LineGenerator, SurfaceGenerator};
+use asperity_app::figure::map::{surface_chart, MapFigure};
 use asperity_app::surface::{ensure_usable, sidecar as generated_sidecar, SurfaceRequest};
 
 use crate::request::refused;
@@ -82,9 +83,14 @@ pub struct SurfaceArgs {
     /// Scale to this rms slope (forward differences).
     #[arg(long)]
     pub rms_slope: Option<f64>,
-    /// Also write a grey-scale image (black low, white high).
+    /// Also write a grey-scale image (black low, white high), one pixel per point.
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// Also write the figure of the height map (.png, .svg, or .json for the figure as
+    /// data, as asperity.plot.surface draws it): axes in the surface's unit, a scale bar
+    /// and a colour bar of the heights.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Arguments of `asperity line`.
@@ -140,6 +146,7 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let sidecar = sidecar_path(&s.out);
     let mut outputs = vec![s.out.as_path(), sidecar.as_path()];
     outputs.extend(args.png.as_deref());
+    outputs.extend(args.plot.as_deref());
     // All outputs are checked now and written all-or-nothing after the work.
     let mut staged = StagedOutputs::new(&outputs, s.force)?;
     if let Some(png) = &args.png {
@@ -149,6 +156,9 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
         if !is_png {
             anyhow::bail!("--png {}: the file name must end in .png", png.display());
         }
+    }
+    if let Some(plot) = &args.plot {
+        crate::plot::ImageFormat::from_path(plot, "--plot")?;
     }
     let start = std::time::Instant::now();
     let surface = SurfaceGenerator::new(&spec)?.try_generate(seed)?;
@@ -160,6 +170,19 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     staged.write_json(&sidecar, &record)?;
     if let Some(png) = &args.png {
         crate::plot::greyscale_png(&mut staged, png, surface.heights().view())?;
+    }
+    if let Some(plot) = &args.plot {
+        let name = s
+            .out
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into());
+        let figure = MapFigure {
+            name: &name,
+            size: (s.size, s.size * rows as f64 / args.n as f64),
+            metres: false,
+        };
+        let chart = surface_chart(surface.heights().view(), figure);
+        crate::plot::stage_charts(&mut staged, plot, &[chart])?;
     }
     staged.commit()?;
     eprintln!(
