@@ -61,6 +61,15 @@ fn run(args: &[OsString]) -> i32 {
             return 2;
         }
     };
+    // Room for the threads first: a thread whose stack was mapped but whose signal stack
+    // then finds no address space aborts the process (issue 33, item 11).
+    let threads = match threads_that_fit() {
+        Ok(threads) => threads,
+        Err(message) => {
+            eprintln!("error: {message}");
+            return 2;
+        }
+    };
     // Ctrl-C, SIGTERM or SIGHUP: unfinished outputs are removed, status 130.
     interrupt::install();
     // The command runs on a thread of a rayon pool, so that its parallel loops (FFT
@@ -68,7 +77,7 @@ fn run(args: &[OsString]) -> i32 {
     // the main thread, every one of them would be handed to the pool and waited for (two
     // thread switches per loop; measured: a one-thread BEM study ran 3.9× slower than on
     // two threads).
-    let pool = match worker_pool() {
+    let pool = match worker_pool(threads) {
         Ok(pool) => pool,
         Err(message) => {
             eprintln!("error: {message}");
@@ -100,10 +109,13 @@ fn run(args: &[OsString]) -> i32 {
 /// stacks) the command runs on one thread, with a warning, instead of panicking in rayon's
 /// global pool (issue 33, item 11); if even that fails, a one-line error. Under such a
 /// limit the C allocator shares one arena between threads first (`asperity::memory`).
-fn worker_pool() -> Result<rayon::ThreadPool, String> {
-    asperity::memory::fit_allocator_to_address_space_limit();
+fn worker_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
     let named = |i: usize| format!("asperity-{i}");
-    match rayon::ThreadPoolBuilder::new().thread_name(named).build() {
+    let mut builder = rayon::ThreadPoolBuilder::new().thread_name(named);
+    if let Some(threads) = threads {
+        builder = builder.num_threads(threads);
+    }
+    match builder.build() {
         Ok(pool) => Ok(pool),
         Err(first) => {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -120,6 +132,39 @@ fn worker_pool() -> Result<rayon::ThreadPool, String> {
             Ok(pool)
         }
     }
+}
+
+/// The address space one started thread may take: its 2 MiB stack, the guard page, its
+/// signal stack and thread-local storage, with room to spare.
+const THREAD_SPACE: u64 = 4 << 20;
+
+/// How many workers an address-space limit (`ulimit -v`) leaves room for, where that is
+/// fewer than the pool would start (`RAYON_NUM_THREADS`, else one per core): `None` for no
+/// cap (the pool then runs on fewer threads silently: a refusal that follows must stay one
+/// line). Every thread the command starts (the interrupt handler's and the workers) is
+/// counted before any starts, so none can find the address space spent by the others while
+/// it starts (a `ulimit -v` run aborted so: "failed to allocate an alternative stack").
+/// Too little room for even one worker is refused in one line. Call before any thread.
+fn threads_that_fit() -> Result<Option<usize>, String> {
+    asperity::memory::fit_allocator_to_address_space_limit();
+    let Some(available) = asperity::memory::address_space_headroom() else {
+        return Ok(None);
+    };
+    // The interrupt handler's thread and at least one worker.
+    let room = (available / THREAD_SPACE).saturating_sub(1) as usize;
+    if room == 0 {
+        return Err(format!(
+            "only {} MiB of address space are free: too little to start (is ulimit -v too low?)",
+            available >> 20
+        ));
+    }
+    let wanted = std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|n| n.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .or_else(|| std::thread::available_parallelism().ok().map(|n| n.get()))
+        .unwrap_or(1);
+    Ok((wanted > room).then_some(room))
 }
 
 /// A refusal of the first argument that is not UTF-8 (a file name in another encoding):

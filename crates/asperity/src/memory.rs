@@ -275,8 +275,9 @@ fn one_malloc_arena() -> bool {
     false
 }
 
-/// `RLIMIT_AS` less the address space already in use (`VmSize`), if a limit is set.
-fn address_space_headroom() -> Option<u64> {
+/// `RLIMIT_AS` less the address space already in use (`VmSize`), if a limit is set: the
+/// room left for new mappings, thread stacks included.
+pub fn address_space_headroom() -> Option<u64> {
     let limit = address_space_limit()?;
     let in_use = read("/proc/self/status")
         .and_then(|t| parse_status_kib(&t, "VmSize:"))
