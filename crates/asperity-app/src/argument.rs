@@ -202,23 +202,12 @@ fn read_heights(path: &Path, dims: Dims) -> Result<Heights, RequestError> {
         Dims::Line => Heights::Profile(asperity::io::read_npy_1d(path).map_err(library)?),
         Dims::Either => {
             let array = asperity::io::read_npy(path).map_err(library)?;
-            match array.ndim() {
-                1 => Heights::Profile(array.into_dimensionality().expect("1D")),
-                2 => Heights::Areal(
-                    array
-                        .into_dimensionality::<ndarray::Ix2>()
-                        .expect("2D")
-                        .as_standard_layout()
-                        .into_owned(),
-                ),
-                d => {
-                    return Err(Refusal::saying(format!(
-                        "{}: expected a 1D line or 2D surface, found {d} dimensions",
-                        path.display()
-                    ))
-                    .into())
-                }
-            }
+            Heights::from_array(array).map_err(|d| {
+                Refusal::saying(format!(
+                    "{}: expected a 1D line or 2D surface, found {d} dimensions",
+                    path.display()
+                ))
+            })?
         }
     })
 }

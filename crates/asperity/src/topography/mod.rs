@@ -66,6 +66,22 @@ pub enum Heights {
 }
 
 impl Heights {
+    /// A line (an array of one dimension) or a map (two, in standard layout) from an array
+    /// read from a file; any other number of dimensions comes back as the error.
+    pub fn from_array(array: ndarray::ArrayD<f64>) -> std::result::Result<Heights, usize> {
+        match array.ndim() {
+            1 => Ok(Heights::Profile(array.into_dimensionality().expect("1D"))),
+            2 => Ok(Heights::Areal(
+                array
+                    .into_dimensionality::<ndarray::Ix2>()
+                    .expect("2D")
+                    .as_standard_layout()
+                    .into_owned(),
+            )),
+            d => Err(d),
+        }
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         match self {
@@ -786,22 +802,12 @@ fn sizes_for(
 /// (`sizes` of an import, or `spec.size` of a generated surface with square pixels).
 fn read_npy_topography(path: &Path, options: &ReadOptions) -> Result<Topography> {
     let array = crate::io::read_npy(path)?;
-    let heights = match array.ndim() {
-        1 => Heights::Profile(array.into_dimensionality().expect("1D")),
-        2 => Heights::Areal(
-            array
-                .into_dimensionality::<ndarray::Ix2>()
-                .expect("2D")
-                .as_standard_layout()
-                .into_owned(),
-        ),
-        d => {
-            return Err(bad_file(
-                path,
-                format!("expected a 1D line or 2D map, found {d} dimensions"),
-            ))
-        }
-    };
+    let heights = Heights::from_array(array).map_err(|d| {
+        bad_file(
+            path,
+            format!("expected a 1D line or 2D map, found {d} dimensions"),
+        )
+    })?;
     let mut sidecar = npy_sidecar(path);
     if let (Heights::Areal(h), [Some(x), None], true) =
         (&heights, sidecar.sizes, sidecar.square_pixels)
