@@ -98,3 +98,12 @@ pub fn pull_off_line(force_controlled: (f64, f64), displacement_controlled: (f64
 pub fn format_number(v: f64) -> String {
     format!("{v:?}")
 }
+
+/// Writes `bytes` to standard output; a closed pipe (`| head`) is not an error of ours.
+pub fn print_stdout(bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().write_all(bytes) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => Ok(other?),
+    }
+}

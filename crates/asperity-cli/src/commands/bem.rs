@@ -23,7 +23,7 @@ use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUM
 use serde_json::json;
 
 use super::measured::{open_argument, parse_size, MeasuredArgs};
-use crate::output::{format_number, Table};
+use crate::output::{format_number, print_stdout, Table};
 use asperity_app::argument::{Arrays, Dims, SizeSource};
 use asperity_app::figure::sweep::{SweepColumns, SweepFigure};
 
@@ -820,15 +820,6 @@ fn write(
         None => print_stdout(&table.to_csv()?)?,
     }
     Ok(())
-}
-
-/// Writes `bytes` to standard output; a closed pipe (`| head`) is not an error of ours.
-fn print_stdout(bytes: &[u8]) -> Result<()> {
-    use std::io::Write;
-    match std::io::stdout().write_all(bytes) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => Ok(other?),
-    }
 }
 
 /// Runs `asperity bem`: plan (every check before the first solve), solve, write.

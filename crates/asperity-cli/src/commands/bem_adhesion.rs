@@ -174,13 +174,7 @@ fn report(args: &BemArgs, run: &AdhesionRun, table: &Table) -> Result<()> {
             run.rows.len()
         ),
         Some(_) => {}
-        None => {
-            use std::io::Write;
-            match std::io::stdout().write_all(&table.to_csv()?) {
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-                other => other?,
-            }
-        }
+        None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
 }

@@ -154,13 +154,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
             points.len()
         ),
         Some(_) => {}
-        None => {
-            use std::io::Write;
-            match std::io::stdout().write_all(&table.to_csv()?) {
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-                other => other?,
-            }
-        }
+        None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
 }

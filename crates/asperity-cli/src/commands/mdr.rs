@@ -1,7 +1,6 @@
 //! `asperity mdr`: force, stiffness and contacts of a rough line or an axisymmetric
 //! indenter on the MDR spring foundation (linear, Hertz 15.2 or fractal 15.7 springs).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -436,11 +435,7 @@ pub fn run(args: &MdrArgs) -> Result<()> {
             law.name(),
             spring.critical_depth()
         ),
-        None => match std::io::stdout().write_all(&table.to_csv()?) {
-            // A closed pipe (`| head`) is not an error of ours.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-            other => other?,
-        },
+        None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
 }
@@ -586,10 +581,7 @@ fn run_adhesive(
             table.len(),
             indenter.description
         ),
-        None => match std::io::stdout().write_all(&table.to_csv()?) {
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-            other => other?,
-        },
+        None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
 }

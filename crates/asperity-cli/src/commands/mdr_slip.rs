@@ -2,8 +2,6 @@
 //! indentation (the rules and the cycle are the front-end layer's,
 //! [`asperity_app::slip::SlipRequest`]).
 
-use std::io::Write;
-
 use anyhow::{Context, Result};
 use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::mdr::Spring;
@@ -134,10 +132,7 @@ pub fn run(args: &MdrArgs, request: &MdrRequest) -> Result<()> {
             out.display(),
             sidecar_path(out).display()
         ),
-        None => match std::io::stdout().write_all(&table.to_csv()?) {
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-            other => other?,
-        },
+        None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
 }
