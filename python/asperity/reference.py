@@ -11,7 +11,9 @@ approaches are positive into the half-space; compressive forces are positive.
 * :class:`Cone` -- ``f(r) = r tan θ``; :class:`PowerLaw` -- ``f(r) = c rⁿ`` (by the MDR);
 * :class:`Westergaard` -- a periodic sinusoid pressed flat (``p* = π E* Δ/λ``);
 * :class:`CattaneoMindlin` -- a Hertz contact under a tangential force (partial slip);
-* :class:`Jkr`, :class:`Dmt`, :class:`Kendall` -- adhesive sphere and punch.
+* :class:`Jkr`, :class:`Dmt`, :class:`Kendall` -- adhesive sphere and punch;
+* :class:`MaugisDugdale` -- the adhesive sphere between DMT and JKR (a Dugdale cohesive
+  zone), dimensionless, with the units of a given sphere (:meth:`MaugisDugdale.scales`).
 
 Example::
 
@@ -30,7 +32,7 @@ import numpy as _np
 from . import _asperity as _core
 
 __all__ = ["Hertz", "FlatPunch", "Cone", "PowerLaw", "Westergaard", "CattaneoMindlin",
-           "Jkr", "Dmt", "Kendall"]
+           "Jkr", "Dmt", "Kendall", "MaugisDugdale"]
 
 
 class _Model:
@@ -274,3 +276,69 @@ class Kendall(_Adhesive):
     def pull_off_force(self) -> float:
         """``-√(8πΔγE*a³)``."""
         return self._eval("pull_off_force", 0.0)
+
+
+class MaugisDugdale(_Model):
+    """Maugis–Dugdale (Maugis 1992; Johnson & Greenwood 1997): a sphere with a constant
+    adhesive stress σ₀ acting over the range h₀ = Δγ/σ₀ outside the contact, spanning DMT
+    (λ → 0) and JKR (λ → ∞) by the Maugis parameter ``maugis_parameter`` λ = 2σ₀
+    (R/πΔγK²)^{1/3}, K = 4E*/3. Dimensionless, as the library's
+    ``asperity::reference::MaugisDugdale`` (the closed form the adhesive BEM is checked
+    against): contact radius Ā = a (K/πΔγR²)^{1/3}, force P̄ = F/(πΔγR), approach
+    Δ̄ = δ (K²/π²Δγ²R)^{1/3}; :meth:`scales` gives the units of a sphere.
+
+    Examples
+    --------
+    >>> from asperity.reference import MaugisDugdale
+    >>> round(MaugisDugdale(1e4).pull_off_force(), 2)     # JKR: -3/2
+    -1.5
+    >>> round(MaugisDugdale(1e-8).pull_off_force(), 3)    # DMT: -2
+    -2.0
+    """
+
+    _name, _params, _probe = "maugis_dugdale", ("maugis_parameter",), "zone_ratio"
+
+    def _curve(self, method: str, contact_radius: Any) -> Any:
+        a = _np.asarray(contact_radius, dtype=_np.float64)
+        if not (_np.isfinite(a).all() and (a > 0).all()):
+            raise ValueError("contact_radius must be positive and finite")
+        return self._eval(method, a)
+
+    def force(self, contact_radius: Any) -> Any:
+        """``P̄ = Ā³ − λĀ²[s + m² atan s]``, ``s = √(m² − 1)``, m = c/a from Maugis' energy
+        balance."""
+        return self._curve("force", contact_radius)
+
+    def approach(self, contact_radius: Any) -> Any:
+        """``Δ̄ = Ā² − (4/3)λĀs``."""
+        return self._curve("approach", contact_radius)
+
+    def zone_ratio(self, contact_radius: Any) -> Any:
+        """m = c/a ≥ 1: the cohesive zone's outer radius over the contact radius."""
+        return self._curve("zone_ratio", contact_radius)
+
+    def pull_off_force(self, control: str = "force") -> float:
+        """P̄ at pull-off: the least force (``control="force"``) or the force at the least
+        approach (``"displacement"``); between −2 (DMT) and −3/2 (JKR, force control)."""
+        return self._eval(f"pull_off_force_{_control(control)}", 0.0)
+
+    def pull_off_radius(self, control: str = "force") -> float:
+        """Ā at pull-off."""
+        return self._eval(f"pull_off_radius_{_control(control)}", 0.0)
+
+    def pull_off_approach(self, control: str = "force") -> float:
+        """Δ̄ at pull-off."""
+        return self._eval(f"pull_off_approach_{_control(control)}", 0.0)
+
+    @staticmethod
+    def scales(radius: float, modulus: float, work_of_adhesion: float,
+               stress: float) -> dict:
+        """The units of a sphere of ``radius`` R, ``modulus`` E*, ``work_of_adhesion`` Δγ
+        and Dugdale ``stress`` σ₀: ``radius`` (πΔγR²/K)^{1/3} (multiplies Ā), ``force``
+        πΔγR (P̄), ``approach`` (π²Δγ²R/K²)^{1/3} (Δ̄) and its ``maugis_parameter`` λ."""
+        params = [float(radius), float(modulus), float(work_of_adhesion), float(stress)]
+        zero = _np.zeros(())
+        value = {name: float(_core.reference("maugis_scales", params, name, [], zero))
+                 for name in ("radius", "force", "approach", "lambda")}
+        value["maugis_parameter"] = value.pop("lambda")
+        return value

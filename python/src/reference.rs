@@ -3,7 +3,8 @@
 //! library's tests and the CLI's reports use.
 
 use asperity::reference::{
-    CattaneoMindlin, Cone, Dmt, FlatPunch, Hertz, Jkr, Kendall, PowerLaw, PullOff, Westergaard,
+    CattaneoMindlin, Cone, Dmt, FlatPunch, Hertz, Jkr, Kendall, MaugisDugdale, PowerLaw, PullOff,
+    Westergaard,
 };
 use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -154,16 +155,64 @@ fn other(model: &str, params: &[f64], method: &str, scalars: &[f64]) -> PyResult
     })
 }
 
-/// JKR, DMT and Kendall's punch (the library refuses non-positive parameters).
-fn adhesive(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
-    let names = ["radius", "modulus", "work_of_adhesion"];
-    let control = |name: &str| match name {
+/// The pull-off's control by its name.
+fn control(name: &str) -> PyResult<PullOff> {
+    match name {
         "force" => Ok(PullOff::ForceControlled),
         "displacement" => Ok(PullOff::DisplacementControlled),
         other => Err(invalid(format!(
             "control must be 'force' or 'displacement', got {other:?}"
         ))),
-    };
+    }
+}
+
+/// Maugis–Dugdale's sphere, dimensionless (`maugis_dugdale`: its curve against Ā and its
+/// pull-off), and the units of a given sphere (`maugis_scales`).
+fn maugis(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
+    Ok(match model {
+        "maugis_dugdale" => {
+            let [lambda] = positive(model, ["maugis_parameter"], params)?;
+            let md = MaugisDugdale::new(lambda).map_err(from_error)?;
+            let pull_off = |rest: &str| control(rest).map(|c| md.pull_off(c));
+            match method {
+                "force" => Box::new(move |a| md.at_radius(a).force),
+                "approach" => Box::new(move |a| md.at_radius(a).approach),
+                "zone_ratio" => Box::new(move |a| md.at_radius(a).zone_ratio),
+                _ if method.starts_with("pull_off_force_") => {
+                    let point = pull_off(&method[15..])?;
+                    Box::new(move |_| point.force)
+                }
+                _ if method.starts_with("pull_off_radius_") => {
+                    let point = pull_off(&method[16..])?;
+                    Box::new(move |_| point.radius)
+                }
+                _ if method.starts_with("pull_off_approach_") => {
+                    let point = pull_off(&method[18..])?;
+                    Box::new(move |_| point.approach)
+                }
+                _ => return Err(unknown(model, method)),
+            }
+        }
+        "maugis_scales" => {
+            let names = ["radius", "modulus", "work_of_adhesion", "stress"];
+            let [r, e, w, stress] = positive(model, names, params)?;
+            let scales = MaugisDugdale::scales(r, e, w, stress);
+            let value = match method {
+                "radius" => scales.radius,
+                "force" => scales.force,
+                "approach" => scales.approach,
+                "lambda" => scales.lambda,
+                _ => return Err(unknown(model, method)),
+            };
+            Box::new(move |_| value)
+        }
+        _ => return Err(invalid(format!("unknown reference solution {model:?}"))),
+    })
+}
+
+/// JKR, DMT and Kendall's punch (the library refuses non-positive parameters).
+fn adhesive(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
+    let names = ["radius", "modulus", "work_of_adhesion"];
     Ok(match model {
         "jkr" => {
             let [r, e, w] = positive(model, names, params)?;
@@ -206,7 +255,7 @@ fn adhesive(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
                 _ => return Err(unknown(model, method)),
             }
         }
-        _ => return Err(invalid(format!("unknown reference solution {model:?}"))),
+        _ => return maugis(model, params, method),
     })
 }
 

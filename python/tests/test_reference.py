@@ -140,3 +140,44 @@ def test_patches_are_the_cli_count_with_their_areas(cli, tmp_path):
         "--out", out, "--quiet")
     table = np.genfromtxt(out, delimiter=",", names=True)
     np.testing.assert_array_equal(table["patches"], c.patches)
+
+
+def test_maugis_dugdale_is_the_librarys_curve_between_dmt_and_jkr():
+    md = reference.MaugisDugdale(1.0)
+    a = np.array([0.2, 0.5, 1.0, 2.0])
+    m = md.zone_ratio(a)
+    s = np.sqrt(m ** 2 - 1)
+    lam = 1.0
+    # Oracle: Maugis' energy balance holds at the m returned (bisected to rounding), and the
+    # force and approach are its closed forms at that m (Johnson & Greenwood 1997).
+    balance = (lam * a ** 2 / 2 * (s + (m ** 2 - 2) * np.arctan(s))
+               + 4 * lam ** 2 * a / 3 * (s * np.arctan(s) - m + 1))
+    np.testing.assert_allclose(balance, 1.0, rtol=1e-12)
+    np.testing.assert_allclose(md.force(a), a ** 3 - lam * a ** 2 * (s + m ** 2 * np.arctan(s)),
+                               rtol=1e-12)
+    np.testing.assert_allclose(md.approach(a), a ** 2 - 4 / 3 * lam * a * s, rtol=1e-12)
+    # The limits (the library's own test bounds): JKR -3/2 and -5/6, DMT -2.
+    assert reference.MaugisDugdale(1e4).pull_off_force() == pytest.approx(-1.5, abs=2e-3)
+    assert (reference.MaugisDugdale(1e4).pull_off_force("displacement")
+            == pytest.approx(-5 / 6, abs=2e-3))
+    assert reference.MaugisDugdale(1e-8).pull_off_force() == pytest.approx(-2.0, abs=1e-3)
+    forces = [reference.MaugisDugdale(lam).pull_off_force() for lam in (0.1, 1.0, 10.0)]
+    assert forces == sorted(forces) and -2 < forces[0] and forces[-1] < -1.5
+    # The pull-off point lies on the curve.
+    point = md.pull_off_radius()
+    assert md.force(point) == pytest.approx(md.pull_off_force(), rel=1e-14)
+    assert md.approach(point) == pytest.approx(md.pull_off_approach(), rel=1e-14)
+    # Units of a sphere, closed form; its λ.
+    r, e, w, sigma = 1e-3, 1e9, 0.05, 1e7
+    k = 4 * e / 3
+    units = reference.MaugisDugdale.scales(r, e, w, sigma)
+    assert units["force"] == pytest.approx(math.pi * w * r, rel=1e-15)
+    assert units["radius"] == pytest.approx((math.pi * w * r * r / k) ** (1 / 3), rel=1e-15)
+    assert units["approach"] == pytest.approx((math.pi ** 2 * w * w * r / k ** 2) ** (1 / 3),
+                                              rel=1e-15)
+    assert units["maugis_parameter"] == pytest.approx(
+        2 * sigma * (r / (math.pi * w * k * k)) ** (1 / 3), rel=1e-15)
+    with pytest.raises(ValueError, match="maugis_parameter must be positive"):
+        reference.MaugisDugdale(0.0)
+    with pytest.raises(ValueError, match="contact_radius must be positive"):
+        md.force(0.0)
