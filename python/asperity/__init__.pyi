@@ -1,4 +1,4 @@
-"""Type stubs of the public API of asperity (see the docstrings in __init__.py)."""
+"""Type stubs of the public API of asperity (see the docstrings in _api.py, re-exported by __init__.py)."""
 
 import os
 from dataclasses import dataclass

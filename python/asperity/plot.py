@@ -40,7 +40,13 @@ from typing import Any, Optional
 
 import numpy as _np
 
-__all__ = ["surface", "psd", "stiffness", "area", "contact_map", "alpha", "figure"]
+__all__ = ["surface", "psd", "stiffness", "area", "contact_map", "alpha", "figure", "load_path",
+           "field"]
+
+
+def __dir__() -> list:
+    """The public names only: the helpers this module imports are not part of it."""
+    return sorted(__all__)
 
 
 def _pyplot():

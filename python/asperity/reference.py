@@ -35,6 +35,11 @@ __all__ = ["Hertz", "FlatPunch", "Cone", "PowerLaw", "Westergaard", "CattaneoMin
            "Jkr", "Dmt", "Kendall", "MaugisDugdale"]
 
 
+def __dir__() -> list:
+    """The public names only: the helpers this module imports are not part of it."""
+    return sorted(__all__)
+
+
 class _Model:
     _name = ""
     _params: Sequence[str] = ()

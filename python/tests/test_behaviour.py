@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import asperity
-from asperity import _float64
+from asperity._api import _float64
 
 from conftest import INTERRUPTIBLE, cli_error
 

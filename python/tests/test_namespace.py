@@ -1,6 +1,9 @@
 """The package's face: only public names in `dir(asperity)`, every `__all__` name real,
 short reprs (a study shows its shape, not its rows), and `stats` naming what it takes."""
 
+import importlib
+import inspect
+
 import numpy as np
 import pytest
 
@@ -11,11 +14,33 @@ from test_topography import shared
 
 def test_only_public_names_are_listed():
     names = dir(asperity)
-    for helper in ("np", "os", "json", "sys", "warnings", "dataclass", "field", "Any"):
+    for helper in ("np", "os", "json", "sys", "warnings", "dataclass", "field", "Any",
+                   "annotations", "List"):
         assert helper not in names, helper
+        assert not hasattr(asperity, helper), helper
     for name in asperity.__all__:
         assert hasattr(asperity, name), name
-    assert set(names) == set(asperity.__all__)
+    assert names == sorted(asperity.__all__)
+    # Not only hidden from dir(): the package's namespace holds nothing public but
+    # __all__ (the implementation and its imports live in the private asperity._api),
+    # and the plot submodule once imported.
+    importlib.import_module("asperity.plot")
+    public = {n for n in vars(asperity) if not n.startswith("_")}
+    assert public - set(asperity.__all__) == {"plot"}
+
+
+@pytest.mark.parametrize("module", ["reference", "plot"])
+def test_submodules_list_every_public_object_and_nothing_else(module):
+    if module == "plot":
+        pytest.importorskip("matplotlib")
+    mod = importlib.import_module(f"asperity.{module}")
+    assert dir(mod) == sorted(mod.__all__)
+    assert all(hasattr(mod, n) for n in mod.__all__)
+    # Every function and class the module defines without a leading underscore is public.
+    defined = {n for n, v in vars(mod).items()
+               if not n.startswith("_") and getattr(v, "__module__", None) == mod.__name__
+               and (inspect.isfunction(v) or inspect.isclass(v))}
+    assert defined == set(mod.__all__)
 
 
 def test_reprs_show_shapes_not_contents(tmp_path):
