@@ -338,6 +338,71 @@ mod tests {
         }
     }
 
+    /// Records the pressure of every load of a sweep.
+    struct Fields(Vec<Vec<f64>>);
+
+    impl crate::bem::sweep::SweepObserver for Fields {
+        type Error = std::convert::Infallible;
+        fn solved(&mut self, _load: usize, solver: &ContactSolver) -> Result<(), Self::Error> {
+            self.0.push(solver.pressure().iter().copied().collect());
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_warm_sweep_under_a_cap_no_point_reaches_is_the_hard_walls() {
+        use crate::bem::sweep::{sweep, SweepParams};
+        // Up, down and up again: every warm solve after the first starts from the
+        // continuation predictor of the frozen-set stiffness before it.
+        let sweeps = [
+            [0.01, 0.02, 0.04, 0.03, 0.05].map(Control::MeanPressure),
+            [0.005, 0.01, 0.02, 0.015, 0.025].map(Control::Indentation),
+        ];
+        for kind in KINDS {
+            for (rows, cols) in GRIDS {
+                for boundary in BOUNDARIES {
+                    for loads in &sweeps {
+                        let case = format!("{kind:?} {rows}x{cols} {boundary:?} {:?}", loads[0]);
+                        let mut wall = solver_of(kind, (rows, cols, 5), boundary);
+                        let mut wall_fields = Fields(Vec::new());
+                        let want =
+                            sweep(&mut wall, loads, SweepParams::default(), &mut wall_fields)
+                                .unwrap();
+                        // Above every solution's peak and the cold start of displacement
+                        // control (local springs (d − f)/K₀₀): a predicted peak above the
+                        // cap would fall back to the previous pressure, and differ.
+                        let peak = wall_fields
+                            .0
+                            .iter()
+                            .flatten()
+                            .fold(0.0f64, |m, &p| m.max(p));
+                        let springs = 0.025 / wall.cx.problem.operator.self_influence();
+                        let h = 1.5 * peak.max(springs);
+                        let mut capped = solver_of(kind, (rows, cols, 5), boundary)
+                            .with_interface(Interface::hardness(h).unwrap())
+                            .unwrap();
+                        let mut capped_fields = Fields(Vec::new());
+                        let got = sweep(
+                            &mut capped,
+                            loads,
+                            SweepParams::default(),
+                            &mut capped_fields,
+                        )
+                        .unwrap();
+                        for (w, g) in want.iter().zip(&got) {
+                            assert_eq!(
+                                (w.summary, w.info, w.stiffness),
+                                (g.summary, g.info, g.stiffness),
+                                "{case}"
+                            );
+                        }
+                        assert!(wall_fields.0 == capped_fields.0, "{case}: pressures differ");
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn a_vanishing_hardness_gives_the_bearing_area_fully_plastic() {
         for kind in KINDS {

@@ -180,8 +180,9 @@ impl ContactSolver {
     /// yet), `p ← max(p + Δd x, 0)` with `Δd` the step to `target` (load control: the
     /// step that carries `Σ p` to the load, then `p` rescaled to it exactly). Exact for the
     /// next state as long as the contact set does not change, far closer than the
-    /// previous pressure where it does. Returns whether it predicted; the tangent is used
-    /// up either way (the solve replaces the state it belongs to).
+    /// previous pressure where it does. Under a cap it predicts only while the predicted
+    /// peak stays below it ([`predicted_below_cap`]). Returns whether it predicted; the
+    /// tangent is used up either way (the solve replaces the state it belongs to).
     pub(super) fn predict_from_tangent(&mut self, target: Target) -> bool {
         let Some(work) = self.stiffness_work.as_mut() else {
             return false;
@@ -189,11 +190,7 @@ impl ContactSolver {
         let (Some(solved), true) = (self.cx.state.solved, std::mem::take(&mut work.tangent)) else {
             return false;
         };
-        // Under a cap the tangent holds while no point reaches it or leaves it: the
-        // previous pressure is the safer start.
-        if self.cx.interface != Interface::HardWall {
-            return false;
-        }
+        let cap = self.cx.interface.cap();
         let n = self.cx.state.pressure.len() as f64;
         let step = match target {
             Target::MeanPressure(mean_pressure) => {
@@ -206,6 +203,13 @@ impl ContactSolver {
             }
             Target::Indentation(d) => d - solved.indentation,
         };
+        // Under a cap the tangent holds while no point reaches it: where the predicted peak
+        // would (or a point is at it already), the previous pressure is the safer start.
+        if cap.is_finite()
+            && !predicted_below_cap(&self.cx.state.pressure, &work.cg.x, step, (target, cap))
+        {
+            return false;
+        }
         let mut total = 0.0;
         for (p, &x) in self.cx.state.pressure.iter_mut().zip(&work.cg.x) {
             *p = (*p + step * x).max(0.0);
@@ -318,6 +322,29 @@ impl ContactSolver {
         }
         result
     }
+}
+
+/// Whether the continuation predictor's pressure `max(p + step x, 0)` (under load control
+/// rescaled to `target`'s load, as [`ContactSolver::predict_from_tangent`] does) stays below
+/// `cap` at every point; false where it cannot be rescaled. Writes nothing.
+fn predicted_below_cap(
+    pressure: &[f64],
+    x: &[f64],
+    step: f64,
+    (target, cap): (Target, f64),
+) -> bool {
+    let (mut total, mut peak) = (0.0, 0.0f64);
+    for (&p, &x) in pressure.iter().zip(x) {
+        let predicted = (p + step * x).max(0.0);
+        total += predicted;
+        peak = peak.max(predicted);
+    }
+    let scale = match target {
+        Target::MeanPressure(mean_pressure) => mean_pressure * pressure.len() as f64 / total,
+        Target::Indentation(_) => 1.0,
+    };
+    // (Rounding is monotone: the largest scaled pressure is the scaled peak.)
+    scale.is_finite() && peak * scale < cap
 }
 
 #[cfg(test)]
