@@ -79,6 +79,7 @@ class Psd:
     fit_note: Optional[str] = ...
     size: float = ...
     ndim: int = ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def psd(
     values: Any, *, size: Union[None, float, Tuple[float, float]] = ...,
@@ -205,6 +206,7 @@ class Patches:
     points: npt.NDArray[np.uint64]
     areas: F64
     def __len__(self) -> int: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def patches(contact_set: Any, *, pixel_area: float = ...) -> Patches: ...
 
@@ -231,6 +233,7 @@ class MdrCurve:
     critical_depth: float
     branch: Optional[List[str]] = ...
     pull_off: Optional[Dict[str, Dict[str, float]]] = ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def mdr(
     *, line: Any = ..., profile: Optional[str] = ..., radial: Any = ...,
@@ -253,6 +256,7 @@ class SlipCycle:
     stick_radius: Optional[F64]
     summary: Dict[str, Any]
     description: str
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def mdr_slip(
     *, tangential_force: float, friction: Optional[float] = ..., poisson: Optional[float] = ...,
@@ -278,6 +282,7 @@ class BemAdhesion:
     pull_off: Optional[Dict[str, Any]]
     critical_stress: float
     warning: Optional[str]
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def bem_adhesion(
     surface: Any, *, work_of_adhesion: float, indentations: Sequence[float],
@@ -300,6 +305,7 @@ class PerssonTable:
     modulus: float
     gamma: float
     kappa: float
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def persson(
     surface: Any, pressures: Optional[Sequence[float]] = ..., *, size: Optional[float] = ...,

@@ -50,6 +50,30 @@ def _positive(value: Optional[float], name: str) -> Optional[float]:
     return value
 
 
+class _Saved:
+    """``save`` for a result dataclass: its numpy arrays as ``.npy`` members of ``path``
+    (``.npz``) and every other field (numbers, strings, lists, dicts, None) in the JSON
+    sidecar, both or neither; :func:`load` gives back the same object (arrays bit for bit,
+    dtypes kept). A non-finite number outside the arrays is refused (JSON has none)."""
+
+    _kind = ""
+
+    def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
+        """Writes ``path`` (``.npz``: the arrays) and ``path.json`` (the other fields),
+        both or neither (an existing file is refused unless ``force``); :func:`load`
+        gives back the same object."""
+        import dataclasses
+
+        arrays, values = {}, {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, np.ndarray):
+                arrays[f.name] = value
+            else:
+                values[f.name] = value
+        _save_bundle(path, self._kind, arrays, {"values": values}, force)
+
+
 # --------------------------------------------------------------------------------------
 # Progress
 # --------------------------------------------------------------------------------------
@@ -395,7 +419,7 @@ def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
 
 
 @dataclass
-class Psd:
+class Psd(_Saved):
     """A power spectrum: wavenumbers ``q`` (rad/length), values ``psd`` (C2D for a surface,
     radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; the
     power law ``fit`` (exponent, prefactor, stderr, low, high, points) over the rings
@@ -1163,7 +1187,7 @@ def contact(
 
 
 @dataclass
-class Patches:
+class Patches(_Saved):
     """The contact patches of a contact set: ``labels`` (rows × cols, uint32: 0 outside
     contact, patches numbered 1, 2, ... in the order of their first point, row by row),
     ``points`` (each patch's number of points, index k for label k + 1) and ``areas``
@@ -1234,7 +1258,7 @@ def _surface_identity(surface: Any, heights: np.ndarray) -> Dict[str, Any]:
 
 
 @dataclass
-class MdrCurve:
+class MdrCurve(_Saved):
     """An MDR curve (``asperity mdr``): ``indentation`` (from first contact), ``force``,
     ``stiffness`` (dF/dd), ``contacts`` (springs compressed), with a ``description`` of the
     indenter, the ``spring`` law and its ``critical_depth`` u0. With a work of adhesion,
@@ -1349,7 +1373,7 @@ def mdr(
 
 
 @dataclass
-class SlipCycle:
+class SlipCycle(_Saved):
     """A tangential cycle (``asperity mdr --tangential-force``): ``branch`` (``loading``,
     ``unloading``, ``reloading``), ``tangential_displacement``, ``tangential_force``,
     ``stick_springs`` and, for axisymmetric indenters, ``stick_radius`` (else None); the
@@ -1426,7 +1450,7 @@ def mdr_slip(
 
 
 @dataclass
-class BemAdhesion:
+class BemAdhesion(_Saved):
     """An adhesive BEM run (:func:`bem_adhesion`; the columns of ``asperity bem
     --work-of-adhesion``): per settled state ``indentation``, ``force``, ``mean_pressure``,
     ``area_fraction`` (attached pixels), ``tensile_fraction``, ``rounds``,
@@ -1491,7 +1515,7 @@ simulations find about 2."""
 
 
 @dataclass
-class PerssonTable:
+class PerssonTable(_Saved):
     """Persson's theory for one surface (:func:`persson`; the columns of ``asperity
     persson``): ``pressure`` (mean pressure, in the unit of ``modulus``), ``area_fraction``
     (A/A₀), ``mean_gap`` (ū, in the surface's length unit), ``stiffness_per_area``
@@ -1837,14 +1861,25 @@ def _npz(path: str) -> Dict[str, np.ndarray]:
         return {name: archive[name] for name in archive.files}
 
 
+Psd._kind = "psd"
+Patches._kind = "patches"
+MdrCurve._kind = "mdr curve"
+SlipCycle._kind = "slip cycle"
+BemAdhesion._kind = "bem adhesion"
+PerssonTable._kind = "persson table"
+_SAVED = {cls._kind: cls for cls in (Psd, Patches, MdrCurve, SlipCycle, BemAdhesion, PerssonTable)}
+
+
 def load(path: Union[str, "os.PathLike[str]"]) -> Any:
     """Loads what asperity saved, as the object that was saved: a :class:`Surface` or
     :class:`Line` (``.npy`` with the sidecar of ``asperity surface``/``line`` or
     :meth:`Surface.save`), a :class:`Topography` (``.npy`` with the sidecar of ``asperity
     import`` or :meth:`Topography.save`, heights bit for bit with their sizes and
     provenance; any other file, X3P included, through :func:`read_topography`), a
-    :class:`Sweep`, :class:`ContactResult` or :class:`StudyResult` (``.npz`` + sidecar of
-    their ``save``). Arrays are read without pickles.
+    :class:`Sweep`, :class:`ContactResult`, :class:`StudyResult`, :class:`Psd`,
+    :class:`Patches`, :class:`MdrCurve`, :class:`SlipCycle`, :class:`BemAdhesion` or
+    :class:`PerssonTable` (``.npz`` + sidecar of their ``save``). Arrays are read without
+    pickles.
 
     Example::
 
@@ -1884,5 +1919,6 @@ def load(path: Union[str, "os.PathLike[str]"]) -> Any:
         return StudyResult(columns, record["rows"], record["tasks"], record["comparisons"],
                            record.get("comparison_error"), record["metadata"],
                            record.get("figures", {}))
+    if kind in _SAVED:
+        return _SAVED[kind](**_npz(path), **record["values"])
     return read_topography(path)
-

@@ -181,3 +181,30 @@ def test_maugis_dugdale_is_the_librarys_curve_between_dmt_and_jkr():
         reference.MaugisDugdale(0.0)
     with pytest.raises(ValueError, match="contact_radius must be positive"):
         md.force(0.0)
+
+
+def test_the_jkr_curve_the_cli_draws_is_asperity_reference_jkr(cli, tmp_path):
+    """Issue 36 item 1, reference solutions: `asperity mdr --profile hertz
+    --work-of-adhesion` draws JKR's equilibrium curve beside its loop (--plot FILE.json);
+    its points are asperity.reference.Jkr's approach and force at the same contact radii
+    (800 up to 2√(R d_max), cut at the deepest approach), bit for bit; and the pull-off
+    the CLI records is within 1e-4 of Jkr's."""
+    radius, w = 1.0, 1e-3
+    cli("mdr", "--profile", "hertz", "--radius", radius, "--n", 1001, "--dx", 1e-3,
+        "--work-of-adhesion", w, "--indentations", "0.02,0.09,0.05",
+        "--out", tmp_path / "c.csv", "--plot", tmp_path / "c.json")
+    charts = json.loads((tmp_path / "c.json").read_text())["charts"]
+    theirs = next(s for c in charts for s in c["series"] if s["label"].startswith("JKR"))
+    ours = asperity.mdr(profile="hertz", radius=radius, n=1001, dx=1e-3,
+                        work_of_adhesion=w, indentations=[0.02, 0.09, 0.05])
+    deepest = float(ours.indentation.max())
+    a_top = 2.0 * math.sqrt(radius * deepest)
+    a = np.array([a_top * i / 800.0 for i in range(1, 801)])
+    jkr = reference.Jkr(radius=radius, modulus=1.0, work_of_adhesion=w)
+    d, f = jkr.approach(a), jkr.force(a)
+    keep = d <= deepest
+    assert 100 < keep.sum() < 800
+    assert theirs["points"] == [[x, y] for x, y in zip(d[keep], f[keep])]
+    record = json.loads((tmp_path / "c.csv.json").read_text())
+    pull = record["adhesion"]["pull_off"]["force_controlled"]["force"]
+    assert abs(pull / jkr.pull_off_force("force") - 1) < 1e-4

@@ -118,6 +118,113 @@ def test_sweeps_and_contact_results_load_back_identical(tmp_path):
     assert again.metadata["load"] == {"quantity": "pressure", "value": 5e-3}
 
 
+def _same_columns(back, saved):
+    """Every column of a loaded sweep is the saved one: same names in the same order,
+    same dtype, same values bit for bit (lists of fields element by element)."""
+    assert list(back.columns) == list(saved.columns)
+    for name, value in saved.columns.items():
+        if isinstance(value, list):
+            assert len(back[name]) == len(value), name
+            for a, b in zip(back[name], value):
+                assert a.dtype == b.dtype, name
+                np.testing.assert_array_equal(a, b)
+        elif isinstance(value, np.ndarray):
+            assert back[name].dtype == value.dtype, name
+            assert back[name].shape == value.shape, name
+            np.testing.assert_array_equal(back[name], value)
+        else:
+            assert back[name] == value and type(back[name]) is type(value), name
+    assert back.metadata == saved.metadata
+
+
+def test_contact_fields_load_back_identical(tmp_path):
+    """The contact fields (issue 36 item 3): pressure, gap, displacement and the plastic
+    displacement of a capped solve; the field stacks of a sweep; a load path's permanent
+    displacement and branch names; an SI contact's contact set, patch labels and patch
+    areas. Each saved (.npz of .npy arrays + JSON sidecar) and loaded back identical."""
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_slope=1.0, seed=4)
+    capped = asperity.Solver(s, boundary="periodic", hardness=0.3)
+    result = capped.solve(pressure=0.03)
+    assert result.plastic_points > 0 and result.plastic_displacement.max() > 0
+    result.save(tmp_path / "r.npz")
+    back = asperity.load(tmp_path / "r.npz")
+    assert isinstance(back, asperity.ContactResult)
+    for name in ("pressure", "gap", "displacement", "plastic_displacement"):
+        saved, loaded = getattr(result, name), getattr(back, name)
+        assert loaded.dtype == saved.dtype and loaded.shape == (32, 32), name
+        np.testing.assert_array_equal(loaded, saved)
+    for name in ("force", "mean_pressure", "indentation", "area_fraction", "contact_points",
+                 "iterations", "residual", "plastic_fraction", "plastic_points"):
+        assert getattr(back, name) == getattr(result, name), name
+    assert back.metadata == result.metadata and back.metadata["solver"]["hardness"] == 0.3
+
+    sweep = capped.sweep(pressures=[0.01, 0.03], fields=True)
+    sweep.save(tmp_path / "fields.npz")
+    _same_columns(asperity.load(tmp_path / "fields.npz"), sweep)
+
+    path = asperity.Solver(s, boundary="periodic", hardness=0.3).load_path(
+        pressures=[0.01, 0.03, 0.01])
+    assert path.permanent_displacement.max() > 0
+    path.save(tmp_path / "path.npz")
+    _same_columns(asperity.load(tmp_path / "path.npz"), path)
+
+    c = asperity.contact(s.heights * 1e-6, 1e-4, young=210e9, poisson=0.3,
+                         pressures=[1e6, 1e7], map=True, hardness=3e9)
+    assert c.map.dtype == np.bool_ and c.patch_labels.max() == c.patches[-1]
+    c.save(tmp_path / "c.npz")
+    _same_columns(asperity.load(tmp_path / "c.npz"), c)
+    # The arrays are plain .npy members (no pickles): numpy alone reads them.
+    with np.load(tmp_path / "c.npz", allow_pickle=False) as archive:
+        np.testing.assert_array_equal(archive["patch_labels"], c.patch_labels)
+
+
+def _results():
+    """One of every other result object the package returns."""
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_slope=1.0, seed=4)
+    x = (np.arange(40) - 20) * 5e-3
+    sphere = -(x[:, None] ** 2 + x[None, :] ** 2) / 2
+    hertz = dict(profile="hertz", radius=1.0, n=401, dx=0.01)
+    return {
+        "psd": asperity.psd(s),
+        "patches": asperity.patches(asperity.Solver(s).solve(pressure=0.02).pressure > 0,
+                                    pixel_area=1 / 32**2),
+        "mdr": asperity.mdr(**hertz, nloads=5),
+        "adhesive mdr": asperity.mdr(profile="hertz", radius=1.0, n=1001, dx=1e-3,
+                                     work_of_adhesion=1e-3, indentations=[0.02, 0.09, 0.05]),
+        "mdr slip": asperity.mdr_slip(**hertz, indentations=[1], tangential_force=1 / 3,
+                                      friction=0.5, cycle_points=9),
+        "bem adhesion": asperity.bem_adhesion(sphere, size=0.2, work_of_adhesion=2e-4,
+                                              indentations=[0.002, 0.006, 0.004],
+                                              retract_step=1e-4),
+        "persson": asperity.persson(s, [0.005, 0.02]),
+    }
+
+
+def test_every_other_result_loads_back_identical(tmp_path):
+    """The PSD, patches, MDR curves (adhesive with branches and pull-offs), slip cycles,
+    adhesive BEM paths and Persson tables save too, and load back as the same object:
+    every array bit for bit with its dtype, every other field equal."""
+    import dataclasses
+
+    for name, result in _results().items():
+        path = tmp_path / (name.replace(" ", "_") + ".npz")
+        result.save(path)
+        back = asperity.load(path)
+        assert type(back) is type(result), name
+        arrays = 0
+        for f in dataclasses.fields(result):
+            mine, theirs = getattr(result, f.name), getattr(back, f.name)
+            if isinstance(mine, np.ndarray):
+                arrays += 1
+                assert theirs.dtype == mine.dtype and theirs.shape == mine.shape, (name, f.name)
+                assert theirs.tobytes() == mine.tobytes(), (name, f.name)
+            else:
+                assert theirs == mine, (name, f.name)
+        assert arrays >= 2, name
+        with pytest.raises(ValueError, match="exists"):
+            result.save(path)
+
+
 def test_contact_sweeps_carry_their_request(tmp_path):
     s = asperity.surface(32, hurst=0.8, rolloff=2, rms_height=1e-6, size=1e-4, seed=1)
     c = asperity.contact(s, young=210e9, poisson=0.3, pressures=[1e5, 1e6], boundary="periodic")

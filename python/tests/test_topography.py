@@ -130,6 +130,36 @@ def test_rms_slope_and_curvature_per_axis_equal_surface_topography():
     assert whole["rms_curvature"] == asperity.stats(t.heights, size=t.physical_sizes)["rms_curvature"]
 
 
+def test_sdq_and_sdr_on_rectangular_pixels_are_iso_25178s_cell_gradients(cli):
+    """Issue 36 item 2, Sdq and Sdr: on the measured map with rectangular pixels (Δy/Δx =
+    2.46), ISO 25178-2's discrete definitions, written out here in numpy (the gradient of
+    each cell as the mean of its two edge differences per axis, each divided by its own
+    spacing; Sdq the rms of its length, Sdr the mean of √(1 + |∇z|²) − 1), are asperity's,
+    the CLI's and Python's alike. SurfaceTopography has no Sdr; its rms gradient (forward
+    differences) is within 2 % of the cell-centred Sdq. Read with one size (square pixels)
+    the map's Sdq would be far off: the wrong number of issue 36."""
+    path = shared("x3p-2.x3p")
+    t = asperity.read_topography(path, detrend="plane")
+    h = t.heights
+    dx, dy = t.size / h.shape[1], t.size_y / h.shape[0]
+    assert dy / dx > 2
+    gx = (h[:-1, 1:] - h[:-1, :-1] + h[1:, 1:] - h[1:, :-1]) / (2 * dx)
+    gy = (h[1:, :-1] - h[:-1, :-1] + h[1:, 1:] - h[:-1, 1:]) / (2 * dy)
+    sdq = np.sqrt(np.mean(gx**2 + gy**2))
+    sdr = np.mean(np.sqrt(1 + gx**2 + gy**2) - 1)
+    iso = asperity.stats(t)["iso"]
+    assert iso["sdq"] == pytest.approx(sdq, rel=1e-12)
+    assert iso["sdr"] == pytest.approx(sdr, rel=1e-12)
+    report = json.loads(cli("stats", path, "--detrend", "plane", "--json").stdout)
+    assert (report["iso"]["sdq"], report["iso"]["sdr"]) == (iso["sdq"], iso["sdr"])
+    ST = pytest.importorskip("SurfaceTopography")
+    theirs = ST.Topography(h.T.copy(), physical_sizes=t.physical_sizes, periodic=False)
+    assert iso["sdq"] == pytest.approx(theirs.rms_gradient(), rel=2e-2)
+    square = (h[:-1, 1:] - h[:-1, :-1] + h[1:, 1:] - h[1:, :-1]) / (2 * dx), \
+        (h[1:, :-1] - h[:-1, :-1] + h[1:, 1:] - h[:-1, 1:]) / (2 * dx)
+    assert np.sqrt(np.mean(square[0]**2 + square[1]**2)) > 1.3 * iso["sdq"]
+
+
 def tilted_text_map(tmp_path):
     """A tilted map in a text matrix (no unit, no size in the file)."""
     rng = np.random.default_rng(5)
@@ -170,6 +200,31 @@ def test_filling_undefined_points_is_the_cli_s(cli, tmp_path):
                             "--json").stdout)
     assert t.provenance["cleaning"] == report["measured"]["cleaning"]
     assert asperity.stats(t)["iso"] == report["iso"]
+
+
+@pytest.mark.parametrize("name,detrend,prefix", [
+    ("x3p-2.x3p", "plane", "s"),        # a map: ISO 25178-2
+    ("sur-2.sur", "poly2", "s"),
+    ("dektak-1.csv", "mean", "r"),      # a profile: ISO 4287
+    ("dektak-1.csv", "plane", "r"),
+])
+def test_iso_parameters_of_maps_and_profiles_equal_the_cli(cli, name, detrend, prefix):
+    """Issue 36 item 1: the ISO parameters are one call in both front ends, after the same
+    levelling: Sa/Sq/Ssk/Sku/Sz/Sdq/Sdr of a map, Ra/Rq/Rsk/Rku/Rz/Rdq of a profile, bit
+    for bit (the CLI's --json against asperity.stats of the Topography)."""
+    path = shared(name)
+    fill = ["--fill", "harmonic"] if name == "sur-2.sur" else []
+    report = json.loads(cli("stats", path, "--detrend", detrend, *fill, "--json").stdout)
+    t = asperity.read_topography(path, detrend=detrend,
+                                 fill="harmonic" if fill else None)
+    ours = asperity.stats(t)
+    assert report["iso"], "the CLI reports ISO parameters for a measured file"
+    names = {"s": ["sa", "sq", "ssk", "sku", "sz", "sdq", "sdr"],
+             "r": ["ra", "rq", "rsk", "rku", "rz", "rdq"]}[prefix]
+    assert sorted(report["iso"]) == sorted(names)
+    assert ours["iso"] == report["iso"]
+    assert ours["iso"][prefix + "q"] > 0
+    assert t.provenance["cleaning"] == report["measured"]["cleaning"]
 
 
 @pytest.mark.parametrize("name,flags,kwargs,ext", [
