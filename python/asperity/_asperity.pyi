@@ -175,3 +175,7 @@ def psd_figure(
     range: Optional[Tuple[float, float]], fit: Optional[Tuple[float, float]],
     hurst: Optional[float], name: str,
 ) -> str: ...
+def contact_figure(
+    force: List[float], stiffness: List[float], area: List[float], mean_gap: List[float],
+    modulus: float, name: str,
+) -> str: ...

@@ -8,7 +8,7 @@ returns the ``Axes``:
   (``asperity surface --plot``);
 * :func:`psd` -- the PSD against q·L/2π, log–log, with the fitted power law over its fit
   range (``asperity stats --plot``);
-* :func:`stiffness`, :func:`area` -- k(F) and the contact fraction against force, with the
+* :func:`stiffness`, :func:`area` -- k(F) and the contact area against force, k with the
   95 % interval of an ensemble mean as a band (``asperity study curve``, ``bem --plot``,
   ``contact --plot``);
 * :func:`contact_map` -- a contact set with its 4-connected patches coloured
@@ -18,12 +18,12 @@ returns the ``Axes``:
   :func:`field` -- a field (the plastic or permanent displacement) as an image;
 * :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
 
-The figures (:func:`surface`, :func:`psd`, :func:`contact_map`, :func:`stiffness` and
-:func:`area` of a ``Solver.sweep``, :func:`stiffness` of ``study_curve``, :func:`alpha`) are
-defined once, in the library's front-end layer, for the CLI and the package: the same
-series, theory curves, intervals, images, scale bars, labels and titles as the CLI's PNG
-(``asperity_app::figure``; ``--plot FILE.json`` writes that definition); the package draws
-it with matplotlib.
+Every figure here but :func:`field` is defined once, in the library's front-end layer,
+for the CLI and the package: the same series, theory curves, intervals, images, scale
+bars, labels and titles as the CLI's PNG (``asperity_app::figure``; ``--plot FILE.json``
+writes that definition); the package draws it with matplotlib. (The ensemble-mean A/A₀(F)
+of a study, :func:`area` of a ``study_curve`` result, is defined there too, though the CLI
+tabulates it in ``curve.csv`` without drawing it.)
 
 Example::
 
@@ -36,6 +36,7 @@ Example::
 from __future__ import annotations
 
 import math
+import os
 from typing import Any, Optional
 
 import numpy as _np
@@ -292,42 +293,29 @@ def _study_chart(result: Any, kind: str) -> dict:
     return _charts(result.figures[kind])[0]
 
 
-def _curves(result: Any, column: str):
-    """``(label, force, values, low, high)`` per curve of a study or a contact sweep."""
-    from . import StudyResult, Sweep
+def _is_contact_sweep(result: Any) -> bool:
+    from . import Sweep
 
-    if isinstance(result, StudyResult):
-        keys = list(zip(result.columns["method"], result.columns["n"], result.columns["hurst"]))
-        out = []
-        for key in dict.fromkeys(keys):
-            rows = _np.array([k == key for k in keys])
-            low = result.columns.get(f"{column}_low")
-            high = result.columns.get(f"{column}_high")
-            out.append((f"{key[0]} n={key[1]} H={key[2]:g}", result.columns["force"][rows],
-                        result.columns[column][rows],
-                        None if low is None else low[rows], None if high is None else high[rows]))
-        return out
-    if isinstance(result, Sweep):
-        force = result.columns.get("force", result.columns.get("force_n"))
-        names = {"stiffness": ("stiffness", "stiffness_n_per_m"),
-                 "area_fraction": ("area_fraction",)}[column]
-        values = next(result.columns[n] for n in names if n in result.columns)
-        return [(column, force, values, None, None)]
-    raise ValueError(f"expected a StudyResult (study_curve) or a Sweep, got {type(result).__name__}")
+    return isinstance(result, Sweep) and "force_n" in result.columns
 
 
-def _against_force(result: Any, column: str, ylabel: str, ax):
-    ax = _axes(ax)
-    for label, force, values, low, high in _curves(result, column):
-        keep = (force > 0) & (values > 0)
-        (line,) = ax.loglog(force[keep], values[keep], "-", label=label)
-        if low is not None and high is not None:
-            ax.fill_between(force[keep], low[keep], high[keep], color=line.get_color(),
-                            alpha=0.25, linewidth=0)
-    ax.set_xlabel("force F")
-    ax.set_ylabel(ylabel)
-    ax.legend()
-    return ax
+def _contact_charts(sweep: Any) -> list:
+    """``asperity contact --plot``'s panels of an :func:`asperity.contact` sweep: k(F), A(F)
+    and the mean gap, in N, N/m, m² and m; titled by the measured file's name."""
+    from . import _asperity
+
+    c = sweep.columns
+    source = sweep.metadata.get("surface", {}).get("provenance", {}).get("source")
+    name = os.path.basename(source) if source else "surface"
+    text = _asperity.contact_figure(
+        c["force_n"].tolist(), c["stiffness_n_per_m"].tolist(), c["contact_area_m2"].tolist(),
+        c["mean_gap_m"].tolist(), float(c["effective_modulus"]), name)
+    return _record(text)
+
+
+def _unplottable(result: Any, what: str) -> ValueError:
+    return ValueError(f"{what}: expected a study_curve result, a Solver.sweep or an "
+                      f"asperity.contact sweep, got {type(result).__name__}")
 
 
 def _is_solver_sweep(result: Any) -> bool:
@@ -337,26 +325,39 @@ def _is_solver_sweep(result: Any) -> bool:
 
 
 def stiffness(result: Any, ax=None):
-    """k(F), log–log: a :func:`~asperity.study_curve` result's ensemble-mean curves with
-    the 95 % interval of the mean as bands and a k ∝ F reference (``asperity study curve``'s
-    figure), or a ``Solver.sweep``'s frozen-set stiffness (and finite difference) as
-    ``asperity bem --plot`` draws it; a :func:`~asperity.contact` sweep's k(F) in N/m."""
+    """k(F), log–log, as the CLI draws it (one definition, ``asperity_app::figure``): a
+    :func:`~asperity.study_curve` result's ensemble-mean curves with the 95 % interval of
+    the mean as bands and a k ∝ F reference (``asperity study curve``'s figure), a
+    ``Solver.sweep``'s frozen-set stiffness (and finite difference) as ``asperity bem
+    --plot`` draws it, or an :func:`~asperity.contact` sweep's k(F) in N/m as ``asperity
+    contact --plot`` draws it."""
     from . import StudyResult
 
-    if isinstance(result, StudyResult) and result.figures:
+    if isinstance(result, StudyResult):
         return _draw(_study_chart(result, "curve"), ax)
     if _is_solver_sweep(result):
         return _draw(_sweep_charts(result)[0], ax)
-    return _against_force(result, "stiffness", "contact stiffness k", ax)
+    if _is_contact_sweep(result):
+        return _draw(_contact_charts(result)[0], ax)
+    raise _unplottable(result, "stiffness")
 
 
 def area(result: Any, ax=None):
-    """The contact fraction A/A₀ against force, log–log: a ``Solver.sweep`` as
-    ``asperity bem --plot`` draws it, or a study's mean curves (with their bands) or a
-    :func:`~asperity.contact` sweep."""
+    """The contact area against force, log–log, by the library's figure definitions: a
+    ``Solver.sweep``'s fraction A/A₀ as ``asperity bem --plot`` draws it, an
+    :func:`~asperity.contact` sweep's true area in m² as ``asperity contact --plot`` draws
+    it, or a :func:`~asperity.study_curve` result's ensemble-mean A/A₀ per task (the
+    ``area_fraction`` column of ``curve.csv``; no band: the study records no interval of
+    the fraction)."""
+    from . import StudyResult
+
+    if isinstance(result, StudyResult):
+        return _draw(_study_chart(result, "area"), ax)
     if _is_solver_sweep(result):
         return _draw(_sweep_charts(result)[1], ax)
-    return _against_force(result, "area_fraction", "contact fraction A/A₀", ax)
+    if _is_contact_sweep(result):
+        return _draw(_contact_charts(result)[1], ax)
+    raise _unplottable(result, "area")
 
 
 def _contact_map_charts(contact_set: Any, size: Optional[tuple] = None,

@@ -2,8 +2,9 @@
 //! draws with `--plot`, as JSON, which the package draws with matplotlib.
 
 use asperity_app::bem::branches;
-use asperity_app::figure::path::{PathColumns, PathFigure};
+use asperity_app::figure::contact::{contact_charts, ContactColumns};
 use asperity_app::figure::map::{contact_map_chart, surface_chart, MapFigure};
+use asperity_app::figure::path::{PathColumns, PathFigure};
 use asperity_app::figure::psd::{psd_chart, PsdFigure};
 use asperity_app::figure::{self, sweep::SweepColumns, sweep::SweepFigure};
 use numpy::PyReadonlyArray2;
@@ -15,6 +16,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(surface_figure, m)?)?;
     m.add_function(wrap_pyfunction!(contact_map_figure, m)?)?;
     m.add_function(wrap_pyfunction!(psd_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_figure, m)?)?;
     Ok(())
 }
 
@@ -172,4 +174,33 @@ fn path_figure(
     };
     let charts = figure::path::path_charts(columns, figure);
     Ok(figure::to_json(&charts).to_string())
+}
+
+/// The three panels of an SI contact sweep (k(F), A(F), mean gap against F; N, N/m, m², m)
+/// as `asperity contact --plot FILE.json` writes them; `modulus`: E* in Pa.
+#[pyfunction]
+fn contact_figure(
+    force: Vec<f64>,
+    stiffness: Vec<f64>,
+    area: Vec<f64>,
+    mean_gap: Vec<f64>,
+    modulus: f64,
+    name: &str,
+) -> PyResult<String> {
+    let n = force.len();
+    if [stiffness.len(), area.len(), mean_gap.len()]
+        .iter()
+        .any(|&l| l != n)
+    {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "contact_figure: the columns differ in length",
+        ));
+    }
+    let columns = ContactColumns {
+        force: &force,
+        stiffness: &stiffness,
+        area: &area,
+        mean_gap: &mean_gap,
+    };
+    Ok(figure::to_json(&contact_charts(columns, name, modulus)).to_string())
 }

@@ -214,13 +214,14 @@ fn records(spec: &StudySpec, dir: &std::path::Path, results: &[TaskResult]) -> S
 }
 
 /// The study's figures as the CLI draws them ([`asperity_app::figure::study`]): `alpha`
-/// (α(H) with the theory curves, or α(N) for one H) and `curve` (the ensemble k(F)), each
-/// as `asperity-figure/1` JSON.
+/// (α(H) with the theory curves, or α(N) for one H), `curve` (the ensemble k(F)) and
+/// `area` (the ensemble A/A₀(F)), each as `asperity-figure/1` JSON.
 fn figures(results: &[TaskResult]) -> serde_json::Value {
     use asperity_app::figure::{study as charts, to_json};
     json!({
         "alpha": to_json(&[charts::alpha_chart(results, &charts::title(Kind::Alpha, None))]),
         "curve": to_json(&[charts::curve_chart(results, &charts::title(Kind::Curve, None))]),
+        "area": to_json(&[charts::area_chart(results, "Contact fraction vs force (ensemble mean)")]),
     })
 }
 

@@ -198,3 +198,67 @@ def test_a_contact_map_is_the_clis_bit_for_bit(cli, tmp_path):
         drawn = np.asarray(rgb[labels == label])
         np.testing.assert_allclose(drawn, np.broadcast_to(np.array(colour) / 255, drawn.shape))
     assert (rgb[labels == 0] == 1.0).all()
+
+
+def test_a_contact_sweeps_panels_are_the_clis_bit_for_bit(cli, tmp_path):
+    # `asperity contact --plot FILE.json` and asperity.plot.stiffness / area of the same
+    # contact sweep (SI units, E* from E and ν): k(F), A(F) and the mean gap, one definition
+    # (asperity_app::figure::contact).
+    rng = np.random.default_rng(1)
+    heights = rng.standard_normal((32, 32)).cumsum(0).cumsum(1) * 1e-9
+    np.savetxt(tmp_path / "m.txt", heights)
+    cli("import", tmp_path / "m.txt", "--size", "8e-6,8e-6", "--detrend", "plane",
+        "--out", tmp_path / "m.npy")
+    loads = [1e6, 3e6, 1e7]
+    cli("contact", tmp_path / "m.npy", "--young", "210e9", "--poisson", "0.3",
+        "--pressures", ",".join(map(str, loads)), "--quiet", "--out", tmp_path / "c.csv",
+        "--plot", tmp_path / "c.json")
+    theirs = json.loads((tmp_path / "c.json").read_text())["charts"]
+    sweep = asperity.contact(asperity.load(tmp_path / "m.npy"), young=210e9, poisson=0.3,
+                             pressures=loads)
+    mine = asperity.plot._contact_charts(sweep)
+    assert [c["y_label"] for c in mine] == ["stiffness k  [N/m]", "contact area A  [m²]",
+                                           "mean gap  [m]"]
+    assert mine[1]["series"][0]["points"] == [list(p) for p in zip(sweep.force_n,
+                                                                  sweep.contact_area_m2)]
+    _same_but_the_name(mine, theirs)
+    # matplotlib draws those points on log axes.
+    for draw, column, chart in ((asperity.plot.stiffness, "stiffness_n_per_m", theirs[0]),
+                                (asperity.plot.area, "contact_area_m2", theirs[1])):
+        ax = draw(sweep)
+        assert (ax.get_xscale(), ax.get_yscale()) == ("log", "log")
+        assert ax.get_ylabel() == chart["y_label"]
+        np.testing.assert_array_equal(ax.get_lines()[0].get_xydata(),
+                                      np.column_stack([sweep.force_n, sweep[column]]))
+
+
+def test_a_study_curves_k_and_area_are_curve_csv_with_its_intervals(cli, tmp_path):
+    # The Python study's k(F) and A/A₀(F) are built by the CLI's builder module from the
+    # task results; the CLI resuming the same folder writes curve.csv from the same
+    # results: the drawn points, the bands (95 % interval of the mean) and the area are
+    # that table's columns.
+    study = asperity.study_curve(method="mdr", n=256, hurst=[0.25, 0.75], samples=3,
+                                 out=tmp_path / "c")
+    cli("study", "curve", "--method", "mdr", "--n", "256", "--hurst", "0.25,0.75",
+        "--samples", "3", "--out", tmp_path / "c")
+    lines = (tmp_path / "c" / "curve.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
+    k_chart = study.figures["curve"]["charts"][0]
+    area_chart = study.figures["area"]["charts"][0]
+    for h, k_series, a_series in zip(("0.25", "0.75"), k_chart["series"], area_chart["series"]):
+        mine = [r for r in rows if float(r["hurst"]) == float(h)]
+        assert k_series["label"] == a_series["label"] == f"mdr N = 256 H = {h}"
+        assert k_series["points"] == [[float(r["force"]), float(r["stiffness"])] for r in mine]
+        assert k_series["interval"] == [[float(r["stiffness_low"]), float(r["stiffness_high"])]
+                                        for r in mine]
+        assert a_series["points"] == [[float(r["force"]), float(r["area_fraction"])]
+                                      for r in mine]
+    assert k_chart["series"][-1]["label"] == "slope 1 (k ∝ F)"
+    # Drawn: one band per curve under k(F); the area's lines are the fractions.
+    ax = asperity.plot.stiffness(study)
+    assert len(ax.collections) == 2
+    ax = asperity.plot.area(study)
+    assert ax.get_yscale() == "log" and ax.get_ylabel() == area_chart["y_label"]
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(),
+                                  [p[1] for p in area_chart["series"][0]["points"]])

@@ -4,11 +4,13 @@
 //! series with their styles, colours, intervals and tags — so that both front ends show the
 //! same curves, theory lines, labels and intervals.
 //!
-//! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`path`] (a load path's
+//! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`contact`] (an SI contact
+//! sweep's k(F), A(F) and mean gap), [`path`] (a load path's
 //! loading–unloading loop), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
 //! [`psd`] (a PSD with its fitted power law), [`map`] (a height map with scale and colour
 //! bars, a contact set with its patches: a series that is an [`Image`]).
 
+pub mod contact;
 pub mod map;
 pub mod path;
 pub mod psd;

@@ -1,6 +1,8 @@
 //! The figures of an ensemble study (`asperity study`, `asperity reproduce`, and
 //! `asperity.plot.alpha` / `asperity.plot.stiffness` of a Python study result): α(H) with
-//! the theory curves, α(N) for a study of one H, and the ensemble-mean k(F).
+//! the theory curves, α(N) for a study of one H, and the ensemble-mean k(F); and
+//! `asperity.plot.area` of a Python study result: the ensemble-mean contact fraction
+//! against F (which the CLI's `curve.csv` tabulates but does not draw).
 
 use asperity::study::theory::{alpha_pohrt_popov, alpha_white_noise, ALPHA_HERTZ};
 use asperity::study::{Method, TaskResult};
@@ -218,6 +220,46 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
         title: title.into(),
         x_label: format!("normal force F ({scale})"),
         y_label: "contact stiffness k (band: 95 % interval of the mean)".into(),
+        log_x: true,
+        log_y: true,
+        series,
+    }
+}
+
+/// Log–log A/A₀(F): the ensemble-mean contact fraction of each task against the force,
+/// coloured by H as [`curve_chart`] (no band: the study records no interval of the
+/// fraction).
+pub fn area_chart(results: &[TaskResult], title: &str) -> Chart {
+    let (hmin, hmax) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            (a.min(r.task.hurst), b.max(r.task.hurst))
+        });
+    let series = results
+        .iter()
+        .map(|r| {
+            let t = if hmax > hmin {
+                (r.task.hurst - hmin) / (hmax - hmin)
+            } else {
+                0.5
+            };
+            let points = r.mean_curve.iter().map(|p| (p.force, p.fraction));
+            Series::new(
+                format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
+                points.collect(),
+                Style::Line,
+            )
+            .color(Color::Ordered(t * 0.9))
+        })
+        .collect();
+    let scale = match results.first().map(|r| r.method) {
+        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
+        _ => "L = 1, E* = 1, unit rms height",
+    };
+    Chart {
+        title: title.into(),
+        x_label: format!("normal force F ({scale})"),
+        y_label: "contact fraction A/A₀ (ensemble mean)".into(),
         log_x: true,
         log_y: true,
         series,

@@ -23,9 +23,10 @@ use serde_json::json;
 
 use super::measured::{load, record, MeasuredArgs};
 use crate::output::{format_number, Table};
+use asperity_app::figure::contact::{contact_charts, ContactColumns};
 use asperity_app::figure::map::{contact_map_chart, MapFigure};
 
-use crate::plot::{stage_charts, Chart, ImageFormat, Series, Style};
+use crate::plot::{stage_charts, Chart, ImageFormat};
 use crate::progress::Progress;
 
 /// Arguments of `asperity contact`.
@@ -213,35 +214,19 @@ fn file_name(args: &ContactArgs) -> String {
         .map_or_else(String::new, |n| n.to_string_lossy().into())
 }
 
-/// The `--plot` panels: stiffness, contact area and mean gap against force, log–log.
+/// The `--plot` panels: stiffness, contact area and mean gap against force, log–log, as
+/// `asperity.plot` draws them ([`contact_charts`]).
 fn charts(args: &ContactArgs, rows: &[ContactRow], e_star: f64) -> [Chart; 3] {
-    let name = file_name(args);
-    let points = |y: &dyn Fn(&ContactRow) -> f64| -> Vec<(f64, f64)> {
-        rows.iter().map(|r| (r.force, y(r))).collect()
+    let column = |y: fn(&ContactRow) -> f64| -> Vec<f64> { rows.iter().map(y).collect() };
+    let (force, stiffness) = (column(|r| r.force), column(|r| r.stiffness));
+    let (area, mean_gap) = (column(|r| r.area), column(|r| r.mean_gap));
+    let columns = ContactColumns {
+        force: &force,
+        stiffness: &stiffness,
+        area: &area,
+        mean_gap: &mean_gap,
     };
-    let chart = |title: String, y_label: &str, y: &dyn Fn(&ContactRow) -> f64| Chart {
-        title,
-        x_label: "normal force F  [N]".into(),
-        y_label: y_label.into(),
-        log_x: true,
-        log_y: true,
-        series: vec![Series::new("", points(y), Style::LinePoints)],
-    };
-    [
-        chart(
-            format!("{name}: contact stiffness (E* = {e_star:.3e} Pa)"),
-            "stiffness k  [N/m]",
-            &|r| r.stiffness,
-        ),
-        chart(
-            format!("{name}: true contact area"),
-            "contact area A  [m²]",
-            &|r| r.area,
-        ),
-        chart(format!("{name}: mean gap"), "mean gap  [m]", &|r| {
-            r.mean_gap
-        }),
-    ]
+    contact_charts(columns, &file_name(args), e_star)
 }
 
 /// What `OUT.csv.json` records of the inputs.
