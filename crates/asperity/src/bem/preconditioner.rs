@@ -64,6 +64,19 @@ impl<T: Precision> FourierPreconditioner<T> {
     /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of pixels
     /// `dx × dy` on a half-space of modulus `modulus`.
     pub(super) fn new(rows: usize, cols: usize, dx: f64, dy: f64, modulus: f64) -> Result<Self> {
+        Self::with_symbol(rows, cols, (dx, dy), |_, _, q| 0.5 * modulus * q)
+    }
+
+    /// Plans the transforms and tabulates `symbol(qx, qy, q)`, an approximate inverse of an
+    /// operator's Fourier symbol, for a `rows × cols` grid of pixels `dx × dy`: `q` is
+    /// `|(qx, qy)|`, or at `qx = qy = 0` the smallest non-zero wavenumber of the grid
+    /// (module docs).
+    pub(super) fn with_symbol(
+        rows: usize,
+        cols: usize,
+        (dx, dy): (f64, f64),
+        symbol_at: impl Fn(f64, f64, f64) -> f64,
+    ) -> Result<Self> {
         let fft = RealFft2::<T>::planned(rows, cols, rows, cols)?;
         let (half, len) = (fft.half_cols(), fft.spectrum_len());
         let mut symbol = try_vec("the preconditioner's symbol", len, T::default())?;
@@ -74,9 +87,10 @@ impl<T: Precision> FourierPreconditioner<T> {
         for kx in 0..half {
             for ky in 0..rows {
                 let ky_folded = ky.min(rows - ky);
-                let q = (kx as f64 * qx_unit).hypot(ky_folded as f64 * qy_unit);
+                let (qx, qy) = (kx as f64 * qx_unit, ky_folded as f64 * qy_unit);
+                let q = qx.hypot(qy);
                 let q = if q > 0.0 { q } else { q_lowest };
-                symbol[kx * rows + ky] = T::rounded(0.5 * modulus * q * normalisation);
+                symbol[kx * rows + ky] = T::rounded(symbol_at(qx, qy, q) * normalisation);
             }
         }
         Ok(FourierPreconditioner { fft, symbol })
