@@ -30,8 +30,8 @@
 
 use super::context::Target;
 use super::interface::{bearing_start, Interface};
-use super::solver::ContactSolver;
-use super::{ContactSummary, SolveError, SolveInfo, SolverKind};
+use super::solver::{ContactSolver, Runner};
+use super::{ContactSummary, SolveError, SolveInfo};
 
 /// The relative load error of a displacement-controlled solve at which the root search
 /// hands over to the load iteration: well above the load's noise from the solves'
@@ -82,36 +82,36 @@ impl Spent {
 }
 
 impl ContactSolver {
-    /// Load control at the mean pressure `mean_pressure` under a cap, by `kind`: its load
+    /// Load control at the mean pressure `mean_pressure` under a cap, by the iteration of `runner`: its load
     /// iteration, and where that cycles the root search of the module docs. The
     /// iterations and applications reported are those of all the parts.
     pub(super) fn capped_load(
         &mut self,
-        kind: SolverKind,
+        runner: &mut Runner<'_>,
         mean_pressure: f64,
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let target = Target::MeanPressure(mean_pressure);
-        let result = self.iterate(kind, target, tolerance, max_iterations);
+        let result = self.iterate(runner, target, tolerance, max_iterations);
         let Err(SolveError::NoConvergence { iterations, .. }) = result else {
             return result;
         };
-        let stalled = self.stalled(kind);
+        let stalled = self.stalled(runner);
         if !stalled {
             return result;
         }
         // (The cycling part's applications: one per BCCG step, two per PK step.)
-        let per_step = if kind == SolverKind::Bccg { 1 } else { 2 };
+        let per_step = self.iteration(runner).0.applications_per_iteration();
         let mut spent = Spent {
             iterations,
             applications: per_step * iterations,
         };
-        self.indentation_for_load(kind, mean_pressure, tolerance, max_iterations, &mut spent)
+        self.indentation_for_load(runner, mean_pressure, tolerance, max_iterations, &mut spent)
             .map_err(|e| spent.error(e))?;
         let left = max_iterations.saturating_sub(spent.iterations).max(1);
         let (summary, info) = self
-            .iterate(kind, target, tolerance, left)
+            .iterate(runner, target, tolerance, left)
             .map_err(|e| spent.error(e))?;
         spent.add(&info);
         Ok((
@@ -129,7 +129,7 @@ impl ContactSolver {
     /// the regula falsi of the module docs; adds what it spent to `spent`.
     fn indentation_for_load(
         &mut self,
-        kind: SolverKind,
+        runner: &mut Runner<'_>,
         mean_pressure: f64,
         tolerance: f64,
         max_iterations: usize,
@@ -144,7 +144,7 @@ impl ContactSolver {
         let (mut last_side, mut load_error) = (0i8, f64::INFINITY);
         for _ in 0..MAX_SOLVES {
             let left = max_iterations.saturating_sub(spent.iterations).max(1);
-            let (summary, info) = self.iterate(kind, Target::Indentation(d), tolerance, left)?;
+            let (summary, info) = self.iterate(runner, Target::Indentation(d), tolerance, left)?;
             spent.add(&info);
             self.cx.state.solved = Some(summary);
             let excess = summary.mean_pressure - mean_pressure;

@@ -22,9 +22,11 @@
 //! `small_set.rs`, and the coarse correction of periodic displacement control,
 //! `mean_gap.rs`) and Polonsky–Keer's constrained conjugate gradients (`polonsky_keer.rs`).
 //! A new one (an adhesive iteration, say) is a new file with `struct AdhesiveScratch` and
-//! `impl Iteration for AdhesiveScratch`; the core's other files stay as they are but for
-//! the two lines that name it: a [`super::SolverKind`] variant and its arm in
-//! `ContactSolver::iteration` (with its field in the solver, allocated on first use).
+//! `impl Iteration for AdhesiveScratch`, which `ContactSolver::solve_with(control, &mut
+//! scratch)` runs with no edit of the core (the caller owns its fields); to make it a
+//! choice of [`super::SolverParams`] as well, two lines name it: a [`super::SolverKind`]
+//! variant and its arm in `ContactSolver::iteration` (with its field in the solver,
+//! allocated on first use).
 
 use super::context::{Context, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
@@ -39,8 +41,9 @@ pub(super) struct Limits {
     pub(super) max_iterations: usize,
 }
 
-/// An algorithm that solves the contact problem of a [`Context`] (module docs).
-pub(super) trait Iteration {
+/// An algorithm that solves the contact problem of a [`Context`] (module docs). `Send`: a
+/// solve runs on a worker of the thread pool.
+pub(super) trait Iteration: Send {
     /// Solves for `target` within `limits` from the initial pressure in `cx.state`; on
     /// success `cx.state` holds the solved pressure and gap and the summary comes from
     /// [`Context::finish`]. Allocates nothing once its fields exist.
@@ -56,5 +59,11 @@ pub(super) trait Iteration {
     /// control and finishes from there). False for an iteration that never stalls.
     fn stalled(&self) -> bool {
         false
+    }
+
+    /// Operator applications (FFT pairs) per iteration, for the accounting of a stalled
+    /// part of a solve whose error carries only its iterations: one by default (the BCCG).
+    fn applications_per_iteration(&self) -> usize {
+        1
     }
 }

@@ -125,6 +125,11 @@ impl Iteration for PkScratch {
     fn stalled(&self) -> bool {
         self.stalled
     }
+
+    /// Two: the step's response and the refreshed displacement.
+    fn applications_per_iteration(&self) -> usize {
+        2
+    }
 }
 
 /// One step along `pk.direction`: its response, the step length τ, and the pressure

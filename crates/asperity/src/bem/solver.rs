@@ -24,19 +24,22 @@
 //! [`ContactSolver::solve`] validates the control, refuses a periodic load or indentation
 //! beyond full contact before solving, sets the initial pressure (warm or cold start,
 //! `initialise`) and runs the chosen iteration ([`SolverKind`], mapped to its [`Iteration`]
-//! in one place, `ContactSolver::iteration`) on the context: `(target, limits)` in,
+//! in one place, `ContactSolver::iteration`; or one plugged by `solve_with`) on the context: `(target, limits)` in,
 //! `(ContactSummary, SolveInfo)` or a typed [`SolveError`] out, the summary of a converged
 //! state made by [`Context::finish`].
 //!
 //! **The contact law** is the solver's [`Interface`] (`interface.rs`, set by
 //! [`ContactSolver::set_interface`]): every rule of what "in contact" means is asked of it
-//! (the BCCG asks the constant hard wall). A new law that the existing iterations can solve
+//! (the BCCG picks the pass compiled for it, hard wall or cap). A new law that the existing iterations can solve
 //! (as both solve the hardness cap, `plasticity.rs`) is a new variant there.
 //!
 //! **Extending the core** (an adhesive contact, say, which needs its own iteration): a new
 //! file with the iteration's scratch struct implementing [`Iteration`] (`iteration.rs` says
-//! what it may read and write), one `Option<…>` field for it in [`ContactSolver`] allocated
-//! on first use (as `pk_scratch` is), a [`SolverKind`] variant and its arm in
+//! what it may read and write), which `ContactSolver::solve_with(control, &mut scratch)`
+//! runs as it stands (the caller owns its fields; the solver's validation, start, capped
+//! root search and solved state are those of every solve). To make it a choice of
+//! [`SolverParams`]: one `Option<…>` field for it in [`ContactSolver`] allocated on first
+//! use (as `pk_scratch` is), a [`SolverKind`] variant and its arm in
 //! `ContactSolver::iteration`, and its fields in [`ContactSolver::memory_bytes`]. No other
 //! algorithm's fields change meaning, and the stiffness and threshold code applies to its
 //! solved state unchanged.
@@ -61,6 +64,15 @@ use crate::pool::on_worker;
 use crate::stop::Stop;
 use crate::surface::Surface;
 use crate::{memory, Error};
+
+/// Which iteration a solve runs: that of a [`SolverKind`] (its fields the solver's), or one
+/// the caller plugs in ([`ContactSolver::solve_with`]).
+pub(super) enum Runner<'a> {
+    Kind(SolverKind),
+    // (No iteration of the library is plugged yet: the seam's test plugs two.)
+    #[cfg_attr(not(test), allow(dead_code))]
+    Plugged(&'a mut dyn Iteration),
+}
 
 /// A contact solver for one surface: the problem, the state of the last solve, and the
 /// scratch of each algorithm, each its own (module docs); successive solves allocate
@@ -237,6 +249,29 @@ impl ContactSolver {
     /// is one (warm start). Fields of the result: [`ContactSolver::pressure`],
     /// [`ContactSolver::gap`], [`ContactSolver::state`].
     pub fn solve(&mut self, control: Control) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        self.solve_by(control, Runner::Kind(self.cx.params.solver))
+    }
+
+    /// [`ContactSolver::solve`] by an iteration that is not a [`SolverKind`] (a new
+    /// algorithm in a file of `bem/`, before or without a variant of its own): everything
+    /// around the iteration — validation, refusals beyond full contact, the start, the root
+    /// search of a capped load, the solved state for the stiffness and thresholds — is the
+    /// solver's, as for the built-in iterations.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(super) fn solve_with(
+        &mut self,
+        control: Control,
+        iteration: &mut dyn Iteration,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+        self.solve_by(control, Runner::Plugged(iteration))
+    }
+
+    /// [`ContactSolver::solve`] by the iteration of `runner`.
+    fn solve_by(
+        &mut self,
+        control: Control,
+        mut runner: Runner<'_>,
+    ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let target = match control {
             Control::MeanPressure(p) => Target::MeanPressure(check_load("mean pressure", p)?),
             Control::Force(f) => {
@@ -282,12 +317,12 @@ impl ContactSolver {
         let (tolerance, max_iterations) = (self.cx.params.tolerance, self.cx.params.max_iterations);
         // On a worker of the pool: the iteration's parallel passes are then forked, not
         // injected one by one, and the other workers wait for them awake (`pool.rs`).
-        let (parallelism, kind) = (self.cx.params.parallelism, self.cx.params.solver);
+        let parallelism = self.cx.params.parallelism;
         let result = on_worker(parallelism, || match target {
             Target::MeanPressure(p) if self.cx.interface != Interface::HardWall => {
-                self.capped_load(kind, p, tolerance, max_iterations)
+                self.capped_load(&mut runner, p, tolerance, max_iterations)
             }
-            _ => self.iterate(kind, target, tolerance, max_iterations),
+            _ => self.iterate(&mut runner, target, tolerance, max_iterations),
         });
         match result {
             // Every point in contact, under load or displacement control: no contact
@@ -369,38 +404,43 @@ impl ContactSolver {
         })
     }
 
-    /// The iteration of `kind` (`bccg.rs`, `polonsky_keer.rs`; Polonsky–Keer's fields
-    /// allocated on its first use) and the context it works on: the one place that maps a
-    /// [`SolverKind`] to its [`Iteration`].
-    pub(super) fn iteration(&mut self, kind: SolverKind) -> (&mut dyn Iteration, &mut Context) {
-        match kind {
-            SolverKind::Bccg => (&mut self.bccg_scratch, &mut self.cx),
-            SolverKind::PolonskyKeer => {
+    /// The iteration `runner` names (for a [`SolverKind`]: `bccg.rs`, `polonsky_keer.rs`;
+    /// Polonsky–Keer's fields allocated on its first use) and the context it works on: the
+    /// one place that maps a [`SolverKind`] to its [`Iteration`].
+    pub(super) fn iteration<'s>(
+        &'s mut self,
+        runner: &'s mut Runner<'_>,
+    ) -> (&'s mut dyn Iteration, &'s mut Context) {
+        match runner {
+            Runner::Kind(SolverKind::Bccg) => (&mut self.bccg_scratch, &mut self.cx),
+            Runner::Kind(SolverKind::PolonskyKeer) => {
                 let len = self.cx.problem.profile.len();
                 let pk = self.pk_scratch.get_or_insert_with(|| PkScratch::new(len));
                 (pk, &mut self.cx)
             }
+            Runner::Plugged(iteration) => (&mut **iteration, &mut self.cx),
         }
     }
 
-    /// Whether the last solve of the iteration of `kind` stalled ([`Iteration::stalled`]).
-    pub(super) fn stalled(&mut self, kind: SolverKind) -> bool {
-        self.iteration(kind).0.stalled()
+    /// Whether the last solve of the iteration of `runner` stalled
+    /// ([`Iteration::stalled`]).
+    pub(super) fn stalled(&mut self, runner: &mut Runner<'_>) -> bool {
+        self.iteration(runner).0.stalled()
     }
 
-    /// Solves for `target` by the iteration of `kind` to `tolerance` in at most
+    /// Solves for `target` by the iteration of `runner` to `tolerance` in at most
     /// `max_iterations` iterations, from the start of [`Self::initialise`] (warm, predicted
     /// or cold).
     pub(super) fn iterate(
         &mut self,
-        kind: SolverKind,
+        runner: &mut Runner<'_>,
         target: Target,
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let self_influence = self.cx.problem.operator.self_influence();
         self.initialise(target, self_influence);
-        let (iteration, cx) = self.iteration(kind);
+        let (iteration, cx) = self.iteration(runner);
         let limits = Limits {
             tolerance,
             max_iterations,
@@ -583,6 +623,102 @@ mod tests {
                 used.reset();
                 let got = (used.solve(load).unwrap(), used.pressure().to_owned());
                 assert_eq!(got, want, "{boundary:?}: {first:?} then {then:?}");
+            }
+        }
+    }
+
+    /// An iteration from outside the [`SolverKind`]s: the BCCG's own fields, owned by the
+    /// caller, behind a counter of its solves.
+    struct Counted {
+        inner: BccgScratch,
+        solves: usize,
+    }
+
+    impl Iteration for Counted {
+        fn solve(
+            &mut self,
+            cx: &mut Context,
+            target: Target,
+            limits: Limits,
+        ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+            self.solves += 1;
+            self.inner.solve(cx, target, limits)
+        }
+
+        fn stalled(&self) -> bool {
+            self.inner.stalled()
+        }
+    }
+
+    /// An iteration that gives up at once.
+    struct GivesUp;
+
+    impl Iteration for GivesUp {
+        fn solve(
+            &mut self,
+            _cx: &mut Context,
+            _target: Target,
+            _limits: Limits,
+        ) -> Result<(ContactSummary, SolveInfo), SolveError> {
+            Err(SolveError::NoConvergence {
+                iterations: 0,
+                residual: f64::INFINITY,
+            })
+        }
+    }
+
+    #[test]
+    fn an_iteration_outside_the_solver_kinds_plugs_in() {
+        // Run by `solve_with`, the BCCG's fields held by the caller give the built-in
+        // BCCG's results bit for bit, warm and capped (the capped load's solver logic runs
+        // around the plugged iteration as around its own); its failure is the solve's.
+        let surface = rough_grid(40, 48, 7);
+        for boundary in [Boundary::Free, Boundary::Periodic] {
+            for interface in [Interface::HardWall, Interface::hardness(0.08).unwrap()] {
+                let half_space = HalfSpace {
+                    modulus: 1.0,
+                    boundary,
+                };
+                let new = || {
+                    ContactSolver::new(&surface, half_space, SolverParams::default())
+                        .unwrap()
+                        .with_interface(interface)
+                        .unwrap()
+                };
+                let (mut built_in, mut plugged) = (new(), new());
+                let mut counted = Counted {
+                    inner: BccgScratch::new(&mut plugged.cx.problem.operator).unwrap(),
+                    solves: 0,
+                };
+                let loads = [0.02, 0.04, 0.03].map(Control::MeanPressure);
+                let mut plastic = 0;
+                for (k, control) in loads
+                    .into_iter()
+                    .chain([Control::Indentation(0.03)])
+                    .enumerate()
+                {
+                    let want = built_in.solve(control).unwrap();
+                    plastic = plastic.max(want.0.plastic_points);
+                    let got = plugged.solve_with(control, &mut counted).unwrap();
+                    let case = format!("{boundary:?} {interface:?} {control:?}");
+                    assert_eq!(got, want, "{case}");
+                    assert_eq!(plugged.pressure(), built_in.pressure(), "{case}");
+                    assert_eq!(plugged.gap(), built_in.gap(), "{case}");
+                    assert!(counted.solves > k, "{case}");
+                    assert_eq!(
+                        plugged.frozen_set_stiffness().unwrap().0,
+                        built_in.frozen_set_stiffness().unwrap().0,
+                        "{case}"
+                    );
+                }
+                assert_eq!(
+                    plastic > 0,
+                    interface != Interface::HardWall,
+                    "{interface:?}"
+                );
+                let e = plugged.solve_with(Control::MeanPressure(0.02), &mut GivesUp);
+                assert!(matches!(e, Err(SolveError::NoConvergence { .. })), "{e:?}");
+                assert!(plugged.summary().is_none());
             }
         }
     }
