@@ -1676,7 +1676,7 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
         if comm is None:
             text = _core.run_study(*args, bar.callback)
         else:
-            text = _mpi.run_study(comm, lambda: _core.StudyLedger(*args), bar.callback)
+            text = _mpi.run_study(comm, lambda job: job.begin(*args), bar.callback)
     finally:
         bar.close()
     return json.loads(text)

@@ -5,11 +5,13 @@ the script, and so calls :func:`asperity.study_alpha` / :func:`asperity.study_cu
 the same arguments. This module makes those K calls one study, as the CLI's MPI build does
 (crates/asperity-cli/src/distributed.rs):
 
-* Rank 0 alone checks, locks and opens the folder, and keeps the study in the library's
-  ``Ledger`` (``_asperity.StudyLedger``): it hands out samples not yet computed (task
-  order, then index order; as many at once as a rank has threads), checkpoints every
-  sample received soon after it arrives (out of index order too), and ends each task with
-  its samples in index order, as the serial run does. Hence the checkpoints and results
+* Rank 0 alone checks, locks and opens the folder, and drives the front-end layer's
+  coordinator (``_asperity.StudyCoordinator``: ``asperity_app::study::distributed``, the
+  state machine the CLI's MPI build drives too; this module only carries messages): it
+  hands out samples not yet computed (task order, then index order; as many at once as a
+  rank has threads), checkpoints every sample received soon after it arrives (out of index
+  order too, in the library's ``Ledger``), and ends each task with its samples in index
+  order, as the serial run does. Hence the checkpoints and results
   are the serial run's, byte for byte, for any K, and either kind of run resumes the other.
 * Every rank computes samples (``_asperity.SampleComputer``: the library's ``TaskSamples``);
   rank 0 on a thread beside its coordinating loop (the computation releases the GIL).
@@ -101,14 +103,15 @@ def _portable(error: BaseException) -> BaseException:
         return RuntimeError(f"{type(error).__name__}: {error}")
 
 
-def run_study(world_comm, open_ledger: Callable[[], Any],
+def run_study(world_comm, begin: Callable[[Any], Any],
               progress: Optional[Callable[[int, int], Any]]) -> str:
     """Runs the study over the ranks of `world_comm` (module docs); rank 0 opens it with
-    `open_ledger()`. Returns the results as JSON text on every rank."""
+    `begin(coordinator)` (``_asperity.StudyCoordinator.begin``: its first actions).
+    Returns the results as JSON text on every rank."""
     comm = world_comm.Dup()
     try:
         if comm.Get_rank() == 0:
-            return _coordinate(comm, open_ledger, progress)
+            return _coordinate(comm, begin, progress)
         return _serve(comm)
     finally:
         comm.Free()
@@ -120,11 +123,11 @@ def _serve(comm) -> str:
     computer = None
     while True:
         message = _receive(comm, 0)[1]
-        if message[0] == "spec":
-            computer = _core.SampleComputer(message[1])
-        elif message[0] == "assign":
-            _, t, indices = message
+        if message[0] == "assign":
+            _, t, indices, spec = message
             try:
+                if spec is not None:
+                    computer = _core.SampleComputer(spec)
                 reply = ("done", computer.compute(t, indices))
             except Exception as error:  # reported to rank 0, which ends the study
                 reply = ("failed", f"{type(error).__name__}: {error}")
@@ -141,15 +144,16 @@ def _serve(comm) -> str:
 class _Local:
     """Rank 0's own computing: a thread running SampleComputer.compute."""
 
-    def __init__(self, spec_json: str):
+    def __init__(self):
         self.jobs: "queue.Queue" = queue.Queue()
         self.results: "queue.Queue" = queue.Queue()
-        self.busy = None
-        computer = _core.SampleComputer(spec_json)
 
         def loop():
-            for t, indices in iter(self.jobs.get, None):
+            computer = None
+            for t, indices, spec in iter(self.jobs.get, None):
                 try:
+                    if spec is not None:
+                        computer = _core.SampleComputer(spec)
                     self.results.put(("done", computer.compute(t, indices)))
                 except BaseException as error:
                     self.results.put(("failed", f"{type(error).__name__}: {error}"))
@@ -157,118 +161,137 @@ class _Local:
         self.thread = threading.Thread(target=loop, name="asperity-rank0-samples", daemon=True)
         self.thread.start()
 
-    def stop(self) -> None:
+    def stop(self) -> list:
+        """Ends the thread once its assignment, if any, is computed: what it left."""
         self.jobs.put(None)
         self.thread.join()
+        left = []
+        while not self.results.empty():
+            left.append(self.results.get_nowait())
+        return left
 
 
-def _end(comm, ready, records, error) -> None:
-    """Tells every other rank that the study ended (after its `ready`, so that no message
-    is left unmatched)."""
-    for rank in range(1, comm.Get_size()):
-        if rank not in ready:
-            got, message = _receive(comm, rank)
-            if message[0] != "ready":
-                raise RuntimeError(f"unexpected message {message[0]!r} from rank {got}")
-        comm.send(("end", records, error), dest=rank, tag=_TAG)
+def _stop(comm, coordinator, records, error) -> None:
+    """Tells every other rank that the study ended, with its records or its error (a rank
+    whose `ready` has not arrived is told once it does, so that no message is left
+    unmatched)."""
+    from mpi4py import MPI
+
+    actions = coordinator.stop()
+    while True:
+        for action in actions:
+            if action[0] == "stop":
+                comm.send(("end", records, error), dest=action[1], tag=_TAG)
+        if coordinator.stopped():
+            return
+        rank, message = _receive(comm, MPI.ANY_SOURCE)
+        if message[0] != "ready":
+            raise RuntimeError(f"unexpected message {message[0]!r} from rank {rank}")
+        actions = coordinator.on_ready(rank, int(message[1]))
 
 
-def _coordinate(comm, open_ledger, progress) -> str:
-    """Rank 0: opens the study, hands out its samples, takes in and checkpoints theirs."""
+def _coordinate(comm, begin, progress) -> str:
+    """Rank 0: opens the study and drives the coordinator of the front-end layer
+    (``asperity_app::study::distributed``, the CLI's MPI build's too): each message is an
+    event, each of its actions a message."""
+    coordinator = _core.StudyCoordinator(comm.Get_size(), _core.thread_count())
     try:
-        ledger = open_ledger()
+        actions = begin(coordinator)
     except BaseException as error:
-        _end(comm, {}, None, _portable(error))
+        coordinator.close()
+        _stop(comm, coordinator, None, _portable(error))
         raise
     try:
-        return _coordinate_open(comm, ledger, progress)
+        error = _drive(comm, coordinator, actions, progress)
+        records = None
+        if error is None:
+            try:
+                records = coordinator.finish()
+            except Exception as failure:
+                error = failure
     finally:
-        ledger.close()
+        coordinator.close()
+    _stop(comm, coordinator, records, None if error is None else _portable(error))
+    if error is not None:
+        raise error
+    return records
 
 
-def _coordinate_open(comm, ledger, progress) -> str:
-    spec = ledger.spec_json()
-    for rank in range(1, comm.Get_size()):
-        comm.send(("spec", spec), dest=rank, tag=_TAG)
-    local = _Local(spec)
-    ready = {}  # rank -> threads
-    busy = {}  # rank -> (task, indices); rank 0 is the local thread
+def _drive(comm, coordinator, actions, progress) -> Optional[BaseException]:
+    """Carries out the coordinator's actions and feeds it the messages until the study
+    ends: None, or an error of this process's own (e.g. of the progress callback), which
+    ends the study once no sample is in flight."""
+    local = _Local()
     error = None
     try:
+        ended = _carry_out(comm, local, actions)
         if progress is not None:
-            progress(*ledger.progress())
+            progress(*coordinator.progress())
         sleep = _sleeper()
-        while busy or (error is None and not ledger.finished()):
-            if error is None:
-                _assign(comm, ledger, local, ready, busy)
+        while not ended:
+            got = _collect(comm, coordinator, local)
+            ended = _carry_out(comm, local, (got or []) + coordinator.save_due())
             try:
-                got = _collect(comm, ledger, local, ready, busy)
-                ledger.save_due()
-                if got and progress is not None:
-                    progress(*ledger.progress())
+                if got is not None and progress is not None:
+                    progress(*coordinator.progress())
             except Exception as failure:  # the samples in flight are let finish first
-                if error is None:
-                    error = failure
-                got = True
-            sleep(reset=True) if got else sleep()
+                error = error or failure
+                ended = _carry_out(comm, local, coordinator.halt(f"{failure}")) or ended
+            sleep(reset=True) if got is not None else sleep()
     except BaseException as failure:
         # Not a failure of the study's own (e.g. KeyboardInterrupt): with samples in
         # flight on other ranks the job cannot end cleanly.
-        if any(rank != 0 for rank in busy):
+        if any(rank != 0 for rank in coordinator.busy()):
             print(f"asperity: rank 0: {type(failure).__name__}: {failure}; ending every rank",
                   file=sys.stderr, flush=True)
             comm.Abort(2)
         error = failure
     finally:
-        local.stop()
-    if error is not None:
-        _end(comm, ready, None, _portable(error))
-        raise error
-    records = ledger.results()
-    _end(comm, ready, records, None)
-    return records
+        left = local.stop()
+    if error is not None and 0 in coordinator.busy():
+        _take_local(coordinator, left[0] if left else ("failed", f"{error}"))
+    return error
 
 
-def _assign(comm, ledger, local, ready, busy) -> None:
-    """Gives work to every idle rank (rank 0's thread included) while there is work."""
-    if 0 not in busy:
-        work = ledger.next_work(_core.thread_count())
-        if work is not None:
-            local.jobs.put(work)
-            busy[0] = work
-    for rank, lanes in ready.items():
-        if rank in busy:
-            continue
-        work = ledger.next_work(lanes)
-        if work is None:
-            return
-        comm.send(("assign", work[0], work[1]), dest=rank, tag=_TAG)
-        busy[rank] = work
+def _carry_out(comm, local, actions) -> bool:
+    """Sends the coordinator's assignments (rank 0's to its own thread): whether the study
+    ended."""
+    ended = False
+    for action in actions:
+        kind, rank, t, indices, spec = action
+        if kind == "assign" and rank == 0:
+            local.jobs.put((t, indices, spec))
+        elif kind == "assign":
+            comm.send(("assign", t, indices, spec), dest=rank, tag=_TAG)
+        elif kind == "end":
+            ended = True
+    return ended
 
 
-def _collect(comm, ledger, local, ready, busy) -> bool:
-    """Takes in one message (a finished assignment, or a rank ready), if any: whether one
-    was. A failed assignment raises, naming its rank."""
+def _take_local(coordinator, message) -> list:
+    if message[0] == "done":
+        return coordinator.on_done(0, message[1])
+    return coordinator.on_failed(0, message[1])
+
+
+def _collect(comm, coordinator, local) -> Optional[list]:
+    """Takes in one message (a finished assignment, or a rank ready), if any: the
+    coordinator's actions, or None if nothing arrived."""
     from mpi4py import MPI
 
-    if 0 in busy:
-        try:
-            rank, message = 0, local.results.get_nowait()
-        except queue.Empty:
-            rank, message = None, None
-    if 0 not in busy or rank is None:
-        status = MPI.Status()
-        if not comm.iprobe(source=MPI.ANY_SOURCE, tag=_TAG, status=status):
-            return False
-        rank = status.Get_source()
-        message = comm.recv(source=rank, tag=_TAG)
+    try:
+        return _take_local(coordinator, local.results.get_nowait())
+    except queue.Empty:
+        pass
+    status = MPI.Status()
+    if not comm.iprobe(source=MPI.ANY_SOURCE, tag=_TAG, status=status):
+        return None
+    rank = status.Get_source()
+    message = comm.recv(source=rank, tag=_TAG)
     if message[0] == "ready":
-        ready[rank] = max(1, int(message[1]))
-        return True
-    if rank not in busy:
-        raise RuntimeError(f"rank {rank} sent {message[0]!r} unasked")
-    t, indices = busy.pop(rank)
+        return coordinator.on_ready(rank, int(message[1]))
+    if message[0] == "done":
+        return coordinator.on_done(rank, message[1])
     if message[0] == "failed":
-        raise RuntimeError(f"rank {rank}: {message[1]}")
-    ledger.receive(t, indices, message[1])
-    return True
+        return coordinator.on_failed(rank, message[1])
+    return coordinator.halt(f"rank {rank} sent {message[0]!r} unasked")

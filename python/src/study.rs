@@ -13,10 +13,10 @@ use std::path::PathBuf;
 use asperity::lock::FolderLock;
 use asperity::stop::Stop;
 use asperity::study::{
-    Ledger, Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples,
-    CHECKPOINT_INTERVAL,
+    Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples, CHECKPOINT_INTERVAL,
 };
 use asperity::Error;
+use asperity_app::study::distributed::{Action, Coordinator, DistributedError};
 use asperity_app::study::progress::StudyProgress;
 use asperity_app::study::{self, rows, Kind, TaskFailure};
 use asperity_app::Names;
@@ -32,7 +32,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hurst_range, m)?)?;
     m.add_function(wrap_pyfunction!(comparison_columns, m)?)?;
     m.add_function(wrap_pyfunction!(thread_count, m)?)?;
-    m.add_class::<StudyLedger>()?;
+    m.add_class::<StudyCoordinator>()?;
     m.add_class::<SampleComputer>()?;
     Ok(())
 }
@@ -232,25 +232,42 @@ fn thread_count() -> usize {
 }
 
 /// Rank 0's side of a study spread over the ranks of an MPI job (`asperity/_mpi.py`): the
-/// folder checked, locked and opened as `run_study` does, and the library's
-/// [`Ledger`], which hands out samples, checkpoints those received and ends each task as
-/// the serial run does. The lock is held until [`StudyLedger::close`].
+/// front-end layer's coordinator ([`Coordinator`]: who computes what, the samples taken in
+/// and checkpointed by the library's ledger, a failure ending the study once nothing is in
+/// flight), which the CLI's MPI build drives too. Python carries its actions out as
+/// messages: `("assign", rank, task, indices, spec)` (`spec`: the study's spec as JSON for
+/// a rank that has not met it, else None), `("stop", rank)` and `("end",)`. The folder is
+/// opened by [`StudyCoordinator::begin`] and its lock held until
+/// [`StudyCoordinator::close`].
 #[pyclass(module = "asperity._asperity")]
-pub struct StudyLedger {
-    spec: StudySpec,
-    store: StudyDir,
-    ledger: Option<Ledger>,
+pub struct StudyCoordinator {
+    machine: Coordinator,
+    /// The study begun: its spec and folder.
+    study: Option<(StudySpec, StudyDir)>,
     lock: Option<FolderLock>,
 }
 
+type PyAction = (&'static str, usize, usize, Vec<usize>, Option<String>);
+
 #[pymethods]
-impl StudyLedger {
-    /// Opens the study as `run_study` (same arguments but the progress callback).
+impl StudyCoordinator {
+    /// A job of `size` ranks, rank 0 computing `lanes` samples at once.
     #[new]
+    fn new(size: usize, lanes: usize) -> Self {
+        StudyCoordinator {
+            machine: Coordinator::new(size, lanes),
+            study: None,
+            lock: None,
+        }
+    }
+
+    /// Opens the study as `run_study` does (same arguments but the progress callback) and
+    /// begins it: the first actions.
     #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
         max_fraction, levels, alpha_sweep, out, force, checkpoint_every))]
     #[allow(clippy::too_many_arguments)]
-    fn new(
+    fn begin(
+        &mut self,
         py: Python<'_>,
         method_name: &str,
         sizes: Vec<usize>,
@@ -265,7 +282,7 @@ impl StudyLedger {
         out: PathBuf,
         force: bool,
         checkpoint_every: Option<f64>,
-    ) -> PyResult<Self> {
+    ) -> PyResult<Vec<PyAction>> {
         let spec = make_spec(
             method_name,
             (sizes, hursts, samples),
@@ -278,79 +295,120 @@ impl StudyLedger {
         let spec = resumable(py, spec, &out, force)?;
         study::validate(&spec).map_err(request_error)?;
         let (lock, store) = open_folder(&spec, out, force, interval, Stop::new())?;
-        let ledger = Ledger::restore(&store).map_err(from_error)?;
-        Ok(StudyLedger {
-            spec,
-            store,
-            ledger: Some(ledger),
-            lock: Some(lock),
-        })
+        let actions = self
+            .machine
+            .begin(store.clone())
+            .map_err(distributed_error)?;
+        self.study = Some((spec, store));
+        self.lock = Some(lock);
+        Ok(self.actions(actions))
     }
 
-    /// The study's spec as JSON, for the other ranks' `SampleComputer`.
-    fn spec_json(&self) -> String {
-        serde_json::to_string(&self.spec).expect("specs serialise")
+    /// Rank `rank` is ready and computes `lanes` samples at once.
+    fn on_ready(&mut self, rank: usize, lanes: usize) -> Vec<PyAction> {
+        let actions = self.machine.on_ready(rank, lanes);
+        self.actions(actions)
     }
 
-    /// Up to `lanes` samples to compute next, `(task number, indices)`, or None.
-    fn next_work(&mut self, lanes: usize) -> PyResult<Option<(usize, Vec<usize>)>> {
-        Ok(self.ledger()?.next_work(lanes))
+    /// Rank `rank` computed its last assignment: the curves as JSON (from
+    /// `SampleComputer.compute`); garbled ones fail the assignment.
+    fn on_done(&mut self, rank: usize, curves: &str) -> Vec<PyAction> {
+        let actions = match serde_json::from_str::<Vec<SampleCurve>>(curves) {
+            Ok(curves) => self.machine.on_done(rank, curves),
+            Err(e) => (self.machine).on_failed(rank, &format!("garbled sample curves: {e}")),
+        };
+        self.actions(actions)
     }
 
-    /// Takes in the curves (JSON, from `SampleComputer.compute`) of samples `indices` of
-    /// task `t`.
-    fn receive(&mut self, t: usize, indices: Vec<usize>, curves: &str) -> PyResult<()> {
-        let curves: Vec<SampleCurve> = serde_json::from_str(curves)
-            .map_err(|e| invalid(format!("garbled sample curves: {e}")))?;
-        let store = self.store.clone();
-        let ledger = self.ledger()?;
-        let task = ledger.task(t);
-        ledger
-            .receive(&store, t, &indices, curves)
-            .map_err(|e| from_error(with_task(store.spec(), task, e)))
+    /// Rank `rank`'s last assignment failed with `reason`.
+    fn on_failed(&mut self, rank: usize, reason: &str) -> Vec<PyAction> {
+        let actions = self.machine.on_failed(rank, reason);
+        self.actions(actions)
     }
 
-    /// Checkpoints the samples received, when due; the number of files written.
-    fn save_due(&mut self) -> PyResult<usize> {
-        let store = self.store.clone();
-        self.ledger()?.save_due(&store).map_err(from_error)
+    /// This process failed on its own (`reason`): the study ends once nothing is in flight.
+    fn halt(&mut self, reason: &str) -> Vec<PyAction> {
+        let actions = self.machine.halt(reason);
+        self.actions(actions)
+    }
+
+    /// Checkpoints the samples received, when due.
+    fn save_due(&mut self) -> Vec<PyAction> {
+        let actions = self.machine.save_due();
+        self.actions(actions)
     }
 
     /// `(samples received, samples of the study)`.
-    fn progress(&mut self) -> PyResult<(u64, u64)> {
-        let ledger = self.ledger()?;
-        Ok((ledger.done(), ledger.total()))
+    fn progress(&self) -> (u64, u64) {
+        self.machine.progress()
     }
 
-    /// Whether every task is finished.
-    fn finished(&mut self) -> PyResult<bool> {
-        Ok(self.ledger()?.finished())
+    /// The ranks computing samples.
+    fn busy(&self) -> Vec<usize> {
+        self.machine.busy()
     }
 
-    /// The results, as `run_study` returns them; the study must be finished.
-    fn results(&mut self) -> PyResult<String> {
-        let ledger = self
-            .ledger
+    /// The results of the study that ended, as `run_study` returns them, or its failure.
+    fn finish(&mut self) -> PyResult<String> {
+        let results = self.machine.finish().map_err(distributed_error)?;
+        let (spec, store) = self
+            .study
             .take()
-            .ok_or_else(|| invalid("the study is closed"))?;
-        if !ledger.finished() {
-            return Err(invalid("the study is not finished"));
-        }
-        Ok(records(&self.spec, self.store.path(), &ledger.results()))
+            .ok_or_else(|| invalid("no study was begun"))?;
+        Ok(records(&spec, store.path(), &results))
+    }
+
+    /// Ends the job: the actions telling the ready ranks to stop (the others are told by
+    /// `on_ready`).
+    fn stop(&mut self) -> PyResult<Vec<PyAction>> {
+        let actions = self.machine.stop().map_err(distributed_error)?;
+        Ok(self.actions(actions))
+    }
+
+    /// Whether every other rank was told to stop.
+    fn stopped(&self) -> bool {
+        self.machine.stopped()
     }
 
     /// Releases the folder's lock.
     fn close(&mut self) {
-        self.ledger = None;
         self.lock = None;
     }
 }
 
-impl StudyLedger {
-    fn ledger(&mut self) -> PyResult<&mut Ledger> {
-        self.ledger
-            .as_mut()
-            .ok_or_else(|| invalid("the study is closed"))
+impl StudyCoordinator {
+    /// The actions as Python tuples (the struct docs).
+    fn actions(&self, actions: Vec<Action>) -> Vec<PyAction> {
+        let spec = || {
+            let (spec, _) = self.study.as_ref().expect("assignments within a study");
+            serde_json::to_string(spec).expect("specs serialise")
+        };
+        let spec_json = std::cell::OnceCell::new();
+        (actions.into_iter())
+            .map(|action| match action {
+                Action::Assign {
+                    rank,
+                    task,
+                    indices,
+                    spec: first,
+                } => {
+                    let json = first.then(|| spec_json.get_or_init(spec).clone());
+                    ("assign", rank, task, indices, json)
+                }
+                Action::Stop { rank } => ("stop", rank, 0, Vec::new(), None),
+                Action::End => ("end", 0, 0, Vec::new(), None),
+            })
+            .collect()
+    }
+}
+
+/// A distributed study's failure as Python raises it: the library's errors as everywhere
+/// (a task's named with it), a rank's failure or a protocol error as `RuntimeError`.
+fn distributed_error(error: DistributedError) -> PyErr {
+    match error {
+        DistributedError::Task(failure) => from_error(failure.into_error()),
+        DistributedError::Store(error) => from_error(error),
+        other => pyo3::exceptions::PyRuntimeError::new_err(other.to_string()),
     }
 }
 
@@ -366,7 +424,7 @@ pub struct SampleComputer {
 
 #[pymethods]
 impl SampleComputer {
-    /// For the study of `spec_json` (`StudyLedger.spec_json`).
+    /// For the study of `spec_json` (sent with a rank's first assignment, `StudyCoordinator`).
     #[new]
     fn new(spec_json: &str) -> PyResult<Self> {
         let spec: StudySpec = serde_json::from_str(spec_json)

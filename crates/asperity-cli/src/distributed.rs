@@ -8,6 +8,10 @@
 //!   reads and writes checkpoints and writes the outputs; every other rank only computes
 //!   samples and never opens the folder. A command that runs no study (e.g. `surface`)
 //!   runs on rank 0 while the others wait for the end.
+//! * **Who computes what is decided by the front-end layer's coordinator**
+//!   ([`asperity_app::study::distributed::Coordinator`], a state machine without MPI that
+//!   the Python package under `mpirun` drives too): this module turns each message into
+//!   one of its events and carries out the actions it returns.
 //! * **Samples are the unit of work, handed out dynamically.** A rank that is idle gets
 //!   the next samples not yet given out (in task order, then index order; as many as it
 //!   has threads, all of one task), computes them with
@@ -22,7 +26,7 @@
 //!   finished checkpoints are therefore byte-identical to a single-process run, for any K,
 //!   and either kind of run resumes the other's checkpoints. With K = 1 the serial code
 //!   runs unchanged.
-//! * **Checkpoints.** Rank 0 keeps the study in an [`asperity::study::Ledger`], which
+//! * **Checkpoints.** The coordinator keeps the study in an [`asperity::study::Ledger`], which
 //!   checkpoints every sample received soon after it arrives, including samples beyond
 //!   one still in flight (the checkpoint keeps them by index), so that a lost rank costs
 //!   only the samples then being computed (the ledger's docs say when it writes).
@@ -33,8 +37,9 @@
 //! What rank 0 had received is checkpointed (all but the samples in flight when the job
 //! ended), and running the same command again resumes from it.
 //! A sample that fails on a worker (a solver error) ends the study with an error naming
-//! the rank. An error on rank 0 while samples are in flight aborts the job
-//! (`MPI_Abort`) after printing it, so that no rank is left waiting.
+//! the rank, once the samples then in flight are in and checkpointed. An error of rank 0's
+//! own (a garbled message) while samples are in flight aborts the job (`MPI_Abort`) after
+//! printing it, so that no rank is left waiting.
 //!
 //! # Messages
 //! One tag; JSON bodies (floats round-trip exactly, as in checkpoints). Worker → rank 0:
@@ -50,7 +55,8 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
-use asperity::study::{Ledger, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples};
+use asperity::study::{SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples};
+use asperity_app::study::distributed::{Action, Coordinator};
 use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
 use mpi::topology::{Communicator, SimpleCommunicator};
 use serde::{Deserialize, Serialize};
@@ -138,7 +144,7 @@ pub fn main(cli: impl FnOnce() -> i32) -> i32 {
             }
         };
     }
-    *coordinator() = Some(Coordinator::new(world.size()));
+    *coordinator() = Some(Job::new(world.size()));
     let code = cli();
     let Some(mut state) = coordinator().take() else {
         return code;
@@ -207,8 +213,8 @@ fn compute(
 }
 
 /// The coordinator of rank 0, while the job runs with more than one rank.
-fn coordinator() -> std::sync::MutexGuard<'static, Option<Coordinator>> {
-    static STATE: Mutex<Option<Coordinator>> = Mutex::new(None);
+fn coordinator() -> std::sync::MutexGuard<'static, Option<Job>> {
+    static STATE: Mutex<Option<Job>> = Mutex::new(None);
     STATE.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -217,23 +223,11 @@ pub fn active() -> bool {
     coordinator().is_some()
 }
 
-/// What rank 0 knows of a worker rank.
-#[derive(Debug, Default)]
-struct Worker {
-    /// Samples computed at once; `None` until its `Ready` arrived.
-    lanes: Option<usize>,
-    /// The last study whose spec it was sent.
-    study: Option<u64>,
-    /// What it is computing: `(task number, indices)`.
-    busy: Option<(usize, Vec<usize>)>,
-}
-
 /// Rank 0's own worker: a thread computing samples while the main thread coordinates.
 struct Local {
     jobs: Sender<(Arc<StudySpec>, u64, Task, Vec<usize>)>,
     results: Receiver<Result<Vec<SampleCurve>>>,
     thread: JoinHandle<()>,
-    busy: Option<(usize, Vec<usize>)>,
 }
 
 impl Local {
@@ -267,53 +261,127 @@ impl Local {
             jobs,
             results,
             thread,
-            busy: None,
         })
     }
 }
 
-/// Rank 0's view of the job: its workers and the number of studies run so far.
-struct Coordinator {
-    workers: Vec<Worker>,
-    local: Option<Local>,
-    studies: u64,
-    /// Samples computed by each rank in the current study.
-    computed: Vec<u64>,
+/// The study being run: what an assignment needs.
+struct Current {
+    number: u64,
+    spec: Arc<StudySpec>,
+    tasks: Vec<Task>,
 }
 
-impl Coordinator {
-    fn new(size: i32) -> Coordinator {
-        Coordinator {
-            workers: (0..size).map(|_| Worker::default()).collect(),
+/// Rank 0's side of the job: the front-end layer's coordinator (which decides who computes
+/// what, takes the samples in and checkpoints them: [`asperity_app::study::distributed`])
+/// and the messages that carry its decisions out.
+struct Job {
+    machine: Coordinator,
+    local: Option<Local>,
+}
+
+impl Job {
+    fn new(size: i32) -> Job {
+        let lanes = rayon::current_num_threads().max(1);
+        Job {
+            machine: Coordinator::new(size as usize, lanes),
             local: None,
-            studies: 0,
-            computed: Vec::new(),
         }
     }
 
-    /// Ends the job: every worker is told to stop once it is idle and registered. Fails if
-    /// samples are still in flight (a study ended by an error), which the caller turns
-    /// into an abort.
+    /// Ends the job: every other rank is told to stop once it is registered. Fails if
+    /// samples are still in flight (a study ended by an error of this rank's own), which
+    /// the caller turns into an abort.
     fn stop(&mut self, world: &SimpleCommunicator) -> Result<()> {
-        let in_flight = self.workers.iter().any(|w| w.busy.is_some())
-            || self.local.as_ref().is_some_and(|l| l.busy.is_some());
-        if in_flight {
-            bail!("the study stopped with samples in flight: ending every rank");
-        }
+        let mut actions = self.machine.stop()?;
         if let Some(local) = self.local.take() {
             drop(local.jobs);
             let _ = local.thread.join();
         }
-        for rank in 1..self.workers.len() {
-            if self.workers[rank].lanes.is_none() {
-                match receive(world, Some(rank as i32))?.1 {
-                    Message::Ready { .. } => {}
-                    other => bail!("unexpected message from rank {rank}: {other:?}"),
-                }
+        loop {
+            self.carry_out(world, None, actions)?;
+            if self.machine.stopped() {
+                return Ok(());
             }
-            send(world, rank as i32, &Message::Stop);
+            actions = match receive(world, None)? {
+                (rank, Message::Ready { lanes }) => self.machine.on_ready(rank as usize, lanes),
+                (rank, other) => bail!("unexpected message from rank {rank}: {other:?}"),
+            };
         }
+    }
+
+    /// Carries out the coordinator's `actions`: whether the study ended.
+    fn carry_out(
+        &mut self,
+        world: &SimpleCommunicator,
+        study: Option<&Current>,
+        actions: Vec<Action>,
+    ) -> Result<bool> {
+        let mut ended = false;
+        for action in actions {
+            match action {
+                Action::Assign {
+                    rank,
+                    task,
+                    indices,
+                    spec,
+                } => {
+                    let study = study.ok_or_else(|| anyhow!("an assignment outside a study"))?;
+                    self.assign(world, study, rank, study.tasks[task], indices, spec)?;
+                }
+                Action::Stop { rank } => send(world, rank as i32, &Message::Stop),
+                Action::End => ended = true,
+            }
+        }
+        Ok(ended)
+    }
+
+    /// Sends rank `rank` (rank 0: its own thread) samples `indices` of `task`.
+    fn assign(
+        &mut self,
+        world: &SimpleCommunicator,
+        study: &Current,
+        rank: usize,
+        task: Task,
+        indices: Vec<usize>,
+        first: bool,
+    ) -> Result<()> {
+        if rank == 0 {
+            let local = self.local.as_ref().expect("started with the study");
+            return local
+                .jobs
+                .send((study.spec.clone(), study.number, task, indices))
+                .map_err(|_| anyhow!("rank 0's sample thread ended"));
+        }
+        let message = Message::Assign {
+            study: study.number,
+            spec: first.then(|| (*study.spec).clone()),
+            task,
+            indices,
+        };
+        send(world, rank as i32, &message);
         Ok(())
+    }
+
+    /// Takes in one message (a finished assignment, or a rank ready), if any, and returns
+    /// the coordinator's answer to it (`None`: nothing arrived).
+    fn collect(&mut self, world: &SimpleCommunicator) -> Result<Option<Vec<Action>>> {
+        if let Some(done) = self.local.as_ref().and_then(|l| l.results.try_recv().ok()) {
+            return Ok(Some(match done {
+                Ok(curves) => self.machine.on_done(0, curves),
+                Err(err) => self.machine.on_failed(0, &format!("{err:#}")),
+            }));
+        }
+        let Some((rank, message)) = try_receive(world, None)? else {
+            return Ok(None);
+        };
+        let rank_number = rank as usize;
+        Ok(Some(match message {
+            Message::Ready { lanes } => self.machine.on_ready(rank_number, lanes),
+            Message::Done { curves } => self.machine.on_done(rank_number, curves),
+            Message::Failed { reason } => self.machine.on_failed(rank_number, &reason),
+            other => bail!("unexpected message from rank {rank}: {other:?}"),
+        }))
     }
 }
 
@@ -326,26 +394,30 @@ pub type Progress<'a> = dyn Fn(u64, bool) + 'a;
 /// Unless `quiet`, says at the end how many samples each rank computed.
 pub fn run_study(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<Vec<TaskResult>> {
     let mut guard = coordinator();
-    let state = guard
+    let job = guard
         .as_mut()
         .ok_or_else(|| anyhow!("not the coordinator of an MPI job"))?;
     let world = SimpleCommunicator::world();
-    let mut study = Ledger::restore(store)?;
-    progress(study.done(), true);
-    state.studies += 1;
-    let number = state.studies;
-    let spec = Arc::new(store.spec().clone());
-    if state.local.is_none() {
-        state.local = Some(Local::start(rayon::current_num_threads().max(1))?);
+    if job.local.is_none() {
+        job.local = Some(Local::start(rayon::current_num_threads().max(1))?);
     }
-    state.computed = vec![0; state.workers.len()];
+    let actions = job.machine.begin(store.clone())?;
+    let study = Current {
+        number: job.machine.study_number(),
+        spec: Arc::new(store.spec().clone()),
+        tasks: store.spec().tasks(),
+    };
+    progress(job.machine.progress().0, true);
+    let mut ended = job.carry_out(&world, Some(&study), actions)?;
     let mut pause = Duration::from_micros(100);
-    while !study.finished() {
-        state.assign(&world, &mut study, number, &spec)?;
-        let collected = state.collect(&world, &mut study, store)?;
-        study.save_due(store)?;
-        if collected {
-            progress(study.done(), false);
+    while !ended {
+        let collected = job.collect(&world)?;
+        let arrived = collected.is_some();
+        let mut actions = collected.unwrap_or_default();
+        actions.extend(job.machine.save_due());
+        ended = job.carry_out(&world, Some(&study), actions)?;
+        if arrived {
+            progress(job.machine.progress().0, false);
             pause = Duration::from_micros(100);
         } else {
             std::thread::sleep(pause);
@@ -353,116 +425,12 @@ pub fn run_study(store: &StudyDir, progress: &Progress, quiet: bool) -> Result<V
         }
     }
     if !quiet {
-        let counts: Vec<String> = state.computed.iter().map(u64::to_string).collect();
+        let counts: Vec<String> = job.machine.computed().iter().map(u64::to_string).collect();
         eprintln!(
             "{} ranks computed {} samples (rank 0 first)",
             counts.len(),
             counts.join(" + ")
         );
     }
-    Ok(study.results())
-}
-
-impl Coordinator {
-    /// Gives work to every idle worker (rank 0's own thread included) while there is work.
-    fn assign(
-        &mut self,
-        world: &SimpleCommunicator,
-        study: &mut Ledger,
-        number: u64,
-        spec: &Arc<StudySpec>,
-    ) -> Result<()> {
-        if let Some(local) = self.local.as_mut().filter(|l| l.busy.is_none()) {
-            let lanes = rayon::current_num_threads().max(1);
-            if let Some((t, indices)) = study.next_work(lanes) {
-                let task = study.task(t);
-                local
-                    .jobs
-                    .send((spec.clone(), number, task, indices.clone()))
-                    .map_err(|_| anyhow!("rank 0's sample thread ended"))?;
-                local.busy = Some((t, indices));
-            }
-        }
-        for (rank, worker) in self.workers.iter_mut().enumerate().skip(1) {
-            let Some(lanes) = worker.lanes.filter(|_| worker.busy.is_none()) else {
-                continue;
-            };
-            let Some((t, indices)) = study.next_work(lanes) else {
-                break;
-            };
-            let first = worker.study != Some(number);
-            let message = Message::Assign {
-                study: number,
-                spec: first.then(|| (**spec).clone()),
-                task: study.task(t),
-                indices: indices.clone(),
-            };
-            send(world, rank as i32, &message);
-            worker.study = Some(number);
-            worker.busy = Some((t, indices));
-        }
-        Ok(())
-    }
-
-    /// Takes in one finished assignment, if any: whether one was.
-    fn collect(
-        &mut self,
-        world: &SimpleCommunicator,
-        study: &mut Ledger,
-        store: &StudyDir,
-    ) -> Result<bool> {
-        if let Some(local) = self.local.as_mut() {
-            if let Ok(done) = local.results.try_recv() {
-                let (t, indices) = local.busy.take().expect("an answer follows a job");
-                let curves = done.context("rank 0")?;
-                self.computed[0] += indices.len() as u64;
-                take_in(study, store, t, &indices, curves)?;
-                return Ok(true);
-            }
-        }
-        let Some((rank, message)) = try_receive(world, None)? else {
-            return Ok(false);
-        };
-        let worker = &mut self.workers[rank as usize];
-        match message {
-            Message::Ready { lanes } => worker.lanes = Some(lanes.max(1)),
-            Message::Done { curves } => {
-                let (t, indices) = worker
-                    .busy
-                    .take()
-                    .ok_or_else(|| anyhow!("rank {rank} sent samples it was not asked for"))?;
-                self.computed[rank as usize] += indices.len() as u64;
-                take_in(study, store, t, &indices, curves)?;
-            }
-            Message::Failed { reason } => {
-                worker.busy = None;
-                bail!("rank {rank}: {reason}");
-            }
-            other => bail!("unexpected message from rank {rank}: {other:?}"),
-        }
-        Ok(true)
-    }
-}
-
-/// [`Ledger::receive`], its errors named as the serial run names a task's.
-fn take_in(
-    study: &mut Ledger,
-    store: &StudyDir,
-    t: usize,
-    indices: &[usize],
-    curves: Vec<SampleCurve>,
-) -> Result<()> {
-    study
-        .receive(store, t, indices, curves)
-        .with_context(|| task_name(store, study.task(t)))
-}
-
-/// `bem N = 64 H = 0.5`, as errors of the serial run name a task.
-fn task_name(store: &StudyDir, task: Task) -> String {
-    format!(
-        "{} N = {} H = {}",
-        store.spec().method.name(),
-        task.n,
-        task.hurst
-    )
+    Ok(job.machine.finish()?)
 }

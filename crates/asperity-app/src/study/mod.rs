@@ -14,6 +14,7 @@
 //!
 //! The CLI writes the table as CSV with its plots; Python returns it as numpy columns.
 
+pub mod distributed;
 pub mod progress;
 pub mod rows;
 
