@@ -1846,14 +1846,12 @@ def _json_scalar(value: Any) -> Any:
 
 
 def _read_sidecar(path: str) -> Optional[Dict[str, Any]]:
-    try:
-        with open(path + ".json", encoding="utf-8") as f:
-            value = json.load(f)
-    except FileNotFoundError:
-        return None
-    except ValueError as e:
-        raise ValueError(f"{path}.json: not JSON ({e})") from None
-    return value if isinstance(value, dict) else None
+    """The sidecar of `path` (None: it has none), read by the rules of every input
+    (``asperity_app::argument::saved_sidecar``): `path` and its sidecar regular files (a
+    FIFO is refused, not waited on), the sidecar bounded and a JSON object, else
+    ``ValueError``."""
+    text = _core.saved_sidecar(path)
+    return None if text is None else json.loads(text)
 
 
 def _npz(path: str) -> Dict[str, np.ndarray]:

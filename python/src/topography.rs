@@ -25,7 +25,17 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(import_topography, m)?)?;
     m.add_function(wrap_pyfunction!(save_topography, m)?)?;
     m.add_function(wrap_pyfunction!(save_files, m)?)?;
+    m.add_function(wrap_pyfunction!(saved_sidecar, m)?)?;
     Ok(())
+}
+
+/// The sidecar of a file `asperity.load` loads back, as JSON text, or None: by the rules of
+/// every input ([`asperity_app::argument::saved_sidecar`]: the file and its sidecar regular
+/// files, the sidecar bounded and valid JSON; a FIFO is refused, not waited on).
+#[pyfunction]
+fn saved_sidecar(path: PathBuf) -> PyResult<Option<String>> {
+    let value = asperity_app::argument::saved_sidecar(&path).map_err(from_error)?;
+    Ok(value.map(|v| v.to_string()))
 }
 
 /// What `read_topography` hands to Python: the heights, the sizes, the provenance (JSON)

@@ -3,6 +3,9 @@ bit, sizes, metadata and provenance), in the field's formats (.npy + JSON sideca
 sidecar, X3P), and what Python writes is what the CLI writes and reads."""
 
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +13,7 @@ import pytest
 
 import asperity
 
+from conftest import cli_error, cli_path
 from test_topography import shared
 
 
@@ -259,3 +263,58 @@ def test_a_study_result_loads_back_identical(tmp_path):
     assert (back.rows, back.tasks, back.comparisons) == (r.rows, r.tasks, r.comparisons)
     assert back.metadata == r.metadata and back.metadata["spec"] is not None
     assert len(repr(back)) < 300, repr(back)
+
+
+# `asperity.load` in a fresh interpreter: its ValueError's words on stdout, exit 3 (a hang
+# is the timeout's failure, not this test's wait).
+_LOAD = """import sys, asperity
+try:
+    asperity.load(sys.argv[1])
+except ValueError as e:
+    print(e)
+    sys.exit(3)
+"""
+
+
+def _load_words(path) -> str:
+    done = subprocess.run([sys.executable, "-c", _LOAD, str(path)], capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 3, done.stderr
+    return done.stdout.strip()
+
+
+@pytest.mark.parametrize("fifo", ["sidecar", "file"])
+@pytest.mark.parametrize("name", ["s.npy", "sweep.npz"])
+def test_load_refuses_a_fifo_in_one_line_instead_of_waiting(tmp_path, fifo, name):
+    # The bug: load opened the sidecar (and numpy the file) as they came, so a FIFO in
+    # their place blocked it forever. Now the app layer's rules of every input apply
+    # (asperity_app::argument::saved_sidecar): the CLI's words for the same file.
+    path = tmp_path / name
+    if name.endswith(".npy"):
+        asperity.surface(16, hurst=0.8, seed=1).save(path)
+    else:
+        np.savez(path, force=np.zeros(2))
+        (tmp_path / (name + ".json")).write_text('{"kind": "sweep"}')
+    target = path if fifo == "file" else Path(str(path) + ".json")
+    target.unlink()
+    os.mkfifo(target)
+    words = _load_words(path)
+    assert words.startswith(str(target)), words
+    assert "is a FIFO, socket or device, not a regular file" in words, words
+    # The CLI reads a FIFO given as the surface itself with the measured reader, whose
+    # words differ ("not a regular file", topography::read_file): the sidecar only here.
+    if name.endswith(".npy") and fifo == "sidecar":
+        done = subprocess.run([str(cli_path()), "stats", str(path)], capture_output=True,
+                              text=True, timeout=60)
+        assert cli_error(done) == words
+
+
+def test_load_refuses_a_corrupt_sidecar_in_the_clis_words(cli, tmp_path):
+    path = tmp_path / "s.npy"
+    asperity.surface(16, hurst=0.8, seed=1).save(path)
+    Path(str(path) + ".json").write_text('{"kind": "surface", "spec": ')
+    words = _load_words(path)
+    assert "is a corrupt sidecar (not JSON" in words, words
+    assert cli_error(cli("stats", path, ok=False)) == words
+    Path(str(path) + ".json").write_text('["surface"]')
+    assert _load_words(path).endswith("is a corrupt sidecar (not a JSON object)")

@@ -113,6 +113,25 @@ pub fn is_npy(path: &Path) -> bool {
         && &head == b"\x93NUMPY"
 }
 
+/// The sidecar of a file a front end saved and loads back (Python's `asperity.load`: a
+/// surface's `.npy`, a sweep's `.npz`, …), by the rules of every input: the file itself
+/// must be a regular file (a FIFO is refused, not waited on), and its sidecar, where it
+/// has one, is read by [`asperity::input::read_sidecar`] (regular, bounded, valid JSON).
+/// `Ok(None)`: no sidecar.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("s.npz");
+/// std::fs::write(&path, b"PK").unwrap();
+/// std::fs::write(dir.path().join("s.npz.json"), b"{\"kind\": \"sweep\"").unwrap();
+/// let refusal = asperity_app::argument::saved_sidecar(&path).unwrap_err().to_string();
+/// assert!(refusal.contains("is a corrupt sidecar (not JSON"), "{refusal}");
+/// ```
+pub fn saved_sidecar(path: &Path) -> asperity::Result<Option<serde_json::Value>> {
+    asperity::input::open_regular(path)?;
+    asperity::input::read_sidecar(path)
+}
+
 fn library(e: asperity::Error) -> RequestError {
     RequestError::Invalid(Box::new(e))
 }
