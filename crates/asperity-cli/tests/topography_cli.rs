@@ -184,6 +184,63 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
         assert!((row[0] - k as f64 / 16.0).abs() < 1e-15, "{row:?}");
         assert!((row[1] - want).abs() <= 1e-9 * want.max(1.0), "{row:?}");
     }
+    // The scale-dependent slope √(2A(r))/r: the ramp's slope 1/Δx = 16 at every r > 0.
+    let args = [
+        "stats",
+        "ramp.npy",
+        "--size",
+        "1",
+        "--scale-dependent-slope",
+        "sds.csv",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let rows = numeric_csv(&dir.path().join("sds.csv"), "distance,slope");
+    assert_eq!(rows.len(), 15);
+    for (k, row) in rows.iter().enumerate() {
+        assert!((row[0] - (k + 1) as f64 / 16.0).abs() < 1e-15, "{row:?}");
+        assert!((row[1] - 16.0).abs() <= 1e-9 * 16.0, "{row:?}");
+    }
+}
+
+#[test]
+fn stats_writes_the_variable_bandwidth_analysis() {
+    // h = x² (x in pixels) on 8 rows × 16 columns, sizes 1 × 0.5: s = (2, 1), so 2M × M
+    // rectangles of m = 8/M columns. After its plane, x² on m equally spaced points leaves
+    // the discrete quadratic residual, rms √((m² − 1)(m² − 4)/180): √21 at m = 8, 1 at m = 4.
+    let dir = tempfile::tempdir().unwrap();
+    let h = ndarray::Array2::from_shape_fn((8, 16), |(_, c)| (c * c) as f64);
+    ndarray_npy::write_npy(dir.path().join("q.npy"), &h).unwrap();
+    let args = [
+        "stats",
+        "q.npy",
+        "--size",
+        "1",
+        "--variable-bandwidth",
+        "vb.csv",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let rows = numeric_csv(&dir.path().join("vb.csv"), "bandwidth,rms_height");
+    let want = [(0.5, 21f64.sqrt()), (0.25, 1.0)];
+    assert_eq!(rows.len(), want.len(), "{rows:?}");
+    for (row, (b, rms)) in rows.iter().zip(want) {
+        assert!((row[0] - b).abs() < 1e-15, "{row:?}");
+        assert!((row[1] - rms).abs() < 1e-9 * rms, "{row:?}");
+    }
+    // Too small for one section of 4 points a side: one line, exit 2, no output.
+    let h = ndarray::Array2::from_elem((3, 3), 1.0);
+    ndarray_npy::write_npy(dir.path().join("small.npy"), &h).unwrap();
+    let args = [
+        "stats",
+        "small.npy",
+        "--size",
+        "1",
+        "--variable-bandwidth",
+        "s.csv",
+    ];
+    let out = asperity(&args, dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("section"), "{}", stderr(&out));
+    assert!(!dir.path().join("s.csv").exists());
 }
 
 #[test]

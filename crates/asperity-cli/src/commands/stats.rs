@@ -73,6 +73,18 @@ pub struct StatsArgs {
     /// non-periodic scan on its grid), in the heights' unit (squared for acf).
     #[arg(long, value_name = "OUT.csv")]
     pub acf: Option<PathBuf>,
+    /// Write the variable-bandwidth analysis as CSV with columns bandwidth (the section
+    /// size ℓ) and rms_height: the rms height after a least-squares plane is removed in each
+    /// rectangle of a checkerboard of 1, 2, 4, … rectangles a side (a profile: a line in
+    /// each of 1, 2, 4, … sections), down to 4 grid points a section
+    /// (SurfaceTopography's variable_bandwidth_from_area / _from_profile).
+    #[arg(long, value_name = "OUT.csv")]
+    pub variable_bandwidth: Option<PathBuf>,
+    /// Write the scale-dependent rms slope along x as CSV with columns distance (r = kΔx,
+    /// k ≥ 1) and slope (√(2A(r))/r from the --acf function: the rms of (h(x + r) − h(x))/r;
+    /// SurfaceTopography's scale_dependent_slope_from_profile on the scan's grid).
+    #[arg(long, value_name = "OUT.csv")]
+    pub scale_dependent_slope: Option<PathBuf>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -80,7 +92,8 @@ pub struct StatsArgs {
     /// Print the statistics as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Overwrite existing outputs (--psd, --bearing-area, --acf, --plot).
+    /// Overwrite existing outputs (--psd, --bearing-area, --acf, --variable-bandwidth,
+    /// --scale-dependent-slope, --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -200,8 +213,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
     }
-    let outputs =
-        (args.psd.iter().chain(&args.bearing_area)).chain(args.acf.iter().chain(&args.plot));
+    let outputs = (args.psd.iter().chain(&args.bearing_area))
+        .chain(args.acf.iter().chain(&args.plot))
+        .chain(&args.variable_bandwidth)
+        .chain(&args.scale_dependent_slope);
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     let (source, record) = open_source(args, size)?;
@@ -209,15 +224,27 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         Some(_) => Some(bearing_curve(&source)?),
         None => None,
     };
-    let acf = match &args.acf {
-        Some(path) => Some((path, acf_along_x(&source)?)),
+    let acf = if args.acf.is_some() || args.scale_dependent_slope.is_some() {
+        Some(acf_along_x(&source)?)
+    } else {
+        None
+    };
+    let bandwidth = match &args.variable_bandwidth {
+        Some(path) => Some((path, variable_bandwidth(&source)?)),
         None => None,
     };
     let stats = compute(&request, source, &args.file.display().to_string())
         .map_err(crate::request::refused)?;
     stage_outputs(args, &mut staged, &stats, bearing.as_deref())?;
-    if let Some((path, rows)) = &acf {
+    if let (Some(path), Some(rows)) = (&args.acf, &acf) {
         stage_pairs(&mut staged, path, ["distance", "acf"], rows)?;
+    }
+    if let (Some(path), Some(rows)) = (&args.scale_dependent_slope, &acf) {
+        let slope = asperity::topography::stats::scale_dependent_slope(rows);
+        stage_pairs(&mut staged, path, ["distance", "slope"], &slope)?;
+    }
+    if let Some((path, rows)) = &bandwidth {
+        stage_pairs(&mut staged, path, ["bandwidth", "rms_height"], rows)?;
     }
     staged.commit()?;
     if args.json {
@@ -269,6 +296,34 @@ fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
     let dx = size_x / rows.ncols() as f64;
     let acf = asperity::topography::stats::height_difference_acf(rows.view())?;
     Ok(acf.into_iter().map(|(k, a)| (k as f64 * dx, a)).collect())
+}
+
+/// The variable-bandwidth analysis as `(bandwidth, rms height)`: a checkerboard of planes
+/// on a map, of lines on a profile.
+fn variable_bandwidth(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    use asperity::topography::bandwidth::{variable_bandwidth_area, variable_bandwidth_profile};
+    use ndarray::{Axis, Ix1, Ix2};
+    let out = match source {
+        StatsSource::Grid { heights, size, .. } => match heights.ndim() {
+            1 => {
+                let line = heights.view().into_dimensionality::<Ix1>()?;
+                variable_bandwidth_profile(line.insert_axis(Axis(0)), *size)?
+            }
+            _ => {
+                let map = heights.view().into_dimensionality::<Ix2>()?;
+                // Square pixels: L_y = L_x · rows / cols.
+                let size_y = *size * map.nrows() as f64 / map.ncols() as f64;
+                variable_bandwidth_area(map, [*size, size_y])?
+            }
+        },
+        StatsSource::Measured { heights, sizes } => match heights {
+            Heights::Areal(h) => variable_bandwidth_area(h.view(), [sizes[0], sizes[1]])?,
+            Heights::Profile(p) => {
+                variable_bandwidth_profile(p.view().insert_axis(Axis(0)), sizes[0])?
+            }
+        },
+    };
+    Ok(out.iter().map(|b| (b.bandwidth, b.rms_height)).collect())
 }
 
 /// Stages a two-column table.

@@ -24,8 +24,12 @@ use serde::{Deserialize, Serialize};
 use crate::{Error, Result};
 
 pub(crate) mod al3d;
+#[cfg(test)]
+mod audit;
+pub mod bandwidth;
 pub(crate) mod bcr;
 pub(crate) mod bytes;
+pub(crate) mod datx;
 pub(crate) mod di;
 pub(crate) mod frt;
 pub(crate) mod gwy;
@@ -219,7 +223,7 @@ const FORMATS: &[Format] = &[
     },
     Format {
         name: "hdf5",
-        extensions: &["h5", "hdf5", "hdf"],
+        extensions: &["h5", "hdf5", "hdf", "datx"],
         sniff: hdf5::sniff,
         read: hdf5::read,
     },
@@ -647,6 +651,10 @@ fn detect_and_read(path: &Path, bytes: &[u8]) -> Result<(Reading, Vec<String>)> 
 fn detect_and_read_raw(path: &Path, bytes: &[u8]) -> Result<(Reading, Vec<String>)> {
     if let Some(f) = FORMATS.iter().find(|f| (f.sniff)(bytes)) {
         return Ok(((f.read)(bytes)?, Vec::new()));
+    }
+    if let Some(text) = text::without_bom(bytes) {
+        // The same file without its byte-order mark, as UTF-8 (no mark any more).
+        return detect_and_read_raw(path, &text?);
     }
     if text::sniff(bytes) {
         return read_text(bytes);
@@ -1181,20 +1189,12 @@ mod shared_sets {
 #[cfg(test)]
 mod every_shared_file {
     //! Every real file of the three shared sets is recognised and read (each reader's own
-    //! test checks it against the reference; this one catches a file no reader claims).
-
-    /// Files no reader reads yet, with the reason.
-    #[cfg(not(feature = "hdf5"))]
-    const NOT_YET: &[(&str, &str)] = &[(
-        "multiple_data_sets.h5",
-        "HDF5 is read with the optional `hdf5` feature (the HDF5 library)",
-    )];
-    #[cfg(feature = "hdf5")]
-    const NOT_YET: &[(&str, &str)] = &[];
+    //! test checks it against the reference, and `audit` compares every file field by
+    //! field; this one catches a file no reader claims).
 
     #[test]
     fn every_file_of_the_shared_sets_is_read() {
-        let (mut read, mut skipped) = (0, 0);
+        let mut read = 0;
         let mut failed = Vec::new();
         for set in ["topographies", "topographies-2", "topographies-3"] {
             let Some(dir) = super::testkit::set_dir(set) else {
@@ -1209,13 +1209,6 @@ mod every_shared_file {
             for name in names {
                 let path = dir.join(&name);
                 let bytes = std::fs::read(&path).unwrap();
-                if NOT_YET.iter().any(|(n, _)| *n == name) {
-                    // Recognised, and refused with a line that names the missing feature.
-                    let err = super::detect_and_read(&path, &bytes).unwrap_err();
-                    assert!(err.to_string().contains("--features hdf5"), "{name}: {err}");
-                    skipped += 1;
-                    continue;
-                }
                 match super::detect_and_read(&path, &bytes) {
                     Ok(_) => read += 1,
                     Err(e) => failed.push(format!("{set}/{name}: {e}")),
@@ -1223,8 +1216,7 @@ mod every_shared_file {
             }
         }
         assert!(failed.is_empty(), "not read: {failed:#?}");
-        eprintln!("{read} shared files read, {skipped} not yet");
         // 16 + 21 + 8 files in the three sets.
-        assert_eq!((read, skipped), (45 - NOT_YET.len(), NOT_YET.len()));
+        assert_eq!(read, 45);
     }
 }

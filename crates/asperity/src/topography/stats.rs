@@ -355,6 +355,17 @@ pub fn material_ratio(heights: impl IntoIterator<Item = f64>, c: f64) -> f64 {
     above as f64 / n.max(1) as f64
 }
 
+/// The scale-dependent rms slope `s(r) = √(2A(r))/r` from the height-difference ACF
+/// `(r, A)` (as [`height_difference_acf`] gives it, distances in length): the rms of the
+/// two-point slope `(h(x + r) − h(x))/r` at each distance `r > 0` (SurfaceTopography's
+/// `scale_dependent_slope_from_profile`). `r = 0` is left out.
+pub fn scale_dependent_slope(acf: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    acf.iter()
+        .filter(|&&(r, _)| r > 0.0)
+        .map(|&(r, a)| (r, (2.0 * a).sqrt() / r))
+        .collect()
+}
+
 /// The height-difference autocorrelation function along x, `A(r_k) = ½⟨(h(x + r_k) −
 /// h(x))²⟩` at `r_k = kΔx` (SurfaceTopography's `autocorrelation_from_profile` of a
 /// non-periodic scan, on the grid): the mean over every pair of defined points at distance

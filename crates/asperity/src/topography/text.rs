@@ -28,6 +28,39 @@ pub(crate) fn sniff(bytes: &[u8]) -> bool {
             .all(|&b| b >= 0x20 || matches!(b, b'\t' | b'\n' | b'\r' | 0x0c))
 }
 
+/// A text file that starts with a byte-order mark — UTF-8 (`EF BB BF`), UTF-16
+/// little-endian (`FF FE`) or big-endian (`FE FF`), as spreadsheet programs write CSV —
+/// as UTF-8 without the mark, for the text readers; `None` where there is no mark. UTF-16
+/// of an odd length or with an unpaired surrogate is refused in one line.
+pub(crate) fn without_bom(bytes: &[u8]) -> Option<Result<Vec<u8>>> {
+    let little = match bytes {
+        [0xEF, 0xBB, 0xBF, rest @ ..] => return Some(Ok(rest.to_vec())),
+        [0xFF, 0xFE, ..] => true,
+        [0xFE, 0xFF, ..] => false,
+        _ => return None,
+    };
+    let body = &bytes[2..];
+    if body.len() % 2 != 0 {
+        return Some(Err(bad(
+            FORMAT,
+            "UTF-16 text of an odd number of bytes (truncated)",
+        )));
+    }
+    let units = body.chunks_exact(2).map(|p| {
+        let pair = [p[0], p[1]];
+        if little {
+            u16::from_le_bytes(pair)
+        } else {
+            u16::from_be_bytes(pair)
+        }
+    });
+    let text: std::result::Result<String, _> = char::decode_utf16(units).collect();
+    Some(
+        text.map(String::into_bytes)
+            .map_err(|e| bad(FORMAT, format!("UTF-16 text with {e}"))),
+    )
+}
+
 /// The text: UTF-8 where it is, else Latin-1 (one byte, one character).
 pub(crate) fn decode(bytes: &[u8]) -> std::borrow::Cow<'_, str> {
     match std::str::from_utf8(bytes) {
@@ -396,6 +429,73 @@ fn check_grid(block: &Block, rows: Option<&str>, cols: Option<&str>) -> Result<(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod bom_tests {
+    //! Text files with a byte-order mark (UTF-8, UTF-16 LE and BE) read like the same text
+    //! without one: the shared real text files re-encoded here (no other file is written).
+    use super::without_bom;
+    use crate::topography::{detect_and_read, testkit::set_dir};
+
+    fn utf16(text: &str, little: bool) -> Vec<u8> {
+        let mut out = if little {
+            vec![0xFF, 0xFE]
+        } else {
+            vec![0xFE, 0xFF]
+        };
+        for u in text.encode_utf16() {
+            out.extend(if little {
+                u.to_le_bytes()
+            } else {
+                u.to_be_bytes()
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn text_with_a_byte_order_mark_reads_like_without() {
+        let files = [
+            ("topographies", "dektak-1.csv"),
+            ("topographies", "gwyddion-export-english.txt"),
+            ("topographies-2", "gwyddion-export-german.txt"),
+            ("topographies-2", "hfm-1.hfm"),
+            ("topographies-3", "csv-1.csv"),
+        ];
+        for (set, name) in files {
+            let Some(dir) = set_dir(set) else { return };
+            let path = dir.join(name);
+            let bytes = std::fs::read(&path).unwrap();
+            // As the readers decode it (dektak-1.csv is Latin-1: its µ is one byte).
+            let text = super::decode(&bytes).into_owned();
+            let (plain, _) = detect_and_read(&path, &bytes).unwrap();
+            let mut utf8 = vec![0xEF, 0xBB, 0xBF];
+            utf8.extend_from_slice(&bytes);
+            for marked in [utf8, utf16(&text, true), utf16(&text, false)] {
+                let (read, _) =
+                    detect_and_read(&path, &marked).unwrap_or_else(|e| panic!("{name}: {e}"));
+                assert_eq!(read.format, plain.format, "{name}");
+                assert_eq!(read.channels, plain.channels, "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn corrupt_utf16_is_refused_in_one_line() {
+        let text = "x y\n1 2\n2 3\n3 5\n4 7\n";
+        let mut bytes = utf16(text, true);
+        for cut in 3..bytes.len() {
+            if let Some(Err(e)) = without_bom(&bytes[..cut]) {
+                assert!(!e.to_string().contains('\n'), "{e}");
+            }
+        }
+        // An unpaired high surrogate.
+        bytes.extend([0x00, 0xD8, 0x41, 0x00]);
+        let err = without_bom(&bytes).unwrap().unwrap_err().to_string();
+        assert!(err.contains("UTF-16"), "{err}");
+        assert!(without_bom(b"x y\n1 2\n").is_none());
+    }
 }
 
 #[cfg(test)]
