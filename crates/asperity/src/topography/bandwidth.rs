@@ -175,31 +175,36 @@ fn detrended_rms(h: ArrayView2<f64>, sections: [usize; 2], trend: Trend) -> Opti
 /// The least-squares coefficients of one section (Gaussian elimination with partial
 /// pivoting on its `terms × terms` normal equations), `None` where they are singular.
 fn solve(s: &Sums, terms: usize) -> Option<[f64; 3]> {
-    let mut a = [[0.0f64; 4]; 3];
-    for i in 0..terms {
-        for j in 0..terms {
-            a[i][j] = if i <= j { s.tt[i][j] } else { s.tt[j][i] };
-        }
-        a[i][terms] = s.th[i];
-    }
+    // The augmented matrix [T | h] of the normal equations, symmetric from the upper triangle.
+    let mut a: Vec<Vec<f64>> = (0..terms)
+        .map(|i| {
+            let mut row: Vec<f64> = (0..terms).map(|j| s.tt[i.min(j)][i.max(j)]).collect();
+            row.push(s.th[i]);
+            row
+        })
+        .collect();
     let scale = (0..terms).map(|i| a[i][i]).fold(0.0, f64::max);
     for col in 0..terms {
         let pivot = (col..terms).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))?;
-        if !(a[pivot][col].abs() > 1e-12 * scale) {
+        // A NaN or (near) zero pivot: the section's points do not fix the trend.
+        if a[pivot][col].abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         a.swap(col, pivot);
-        for row in col + 1..terms {
-            let f = a[row][col] / a[col][col];
-            for k in col..=terms {
-                a[row][k] -= f * a[col][k];
-            }
+        let (done, rest) = a.split_at_mut(col + 1);
+        let top = &done[col];
+        for row in rest.iter_mut() {
+            let f = row[col] / top[col];
+            row.iter_mut()
+                .zip(top)
+                .skip(col)
+                .for_each(|(r, t)| *r -= f * t);
         }
     }
     let mut x = [0.0; 3];
     for row in (0..terms).rev() {
-        let rest: f64 = (row + 1..terms).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (a[row][terms] - rest) / a[row][row];
+        let known: f64 = (row + 1..terms).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (a[row][terms] - known) / a[row][row];
     }
     Some(x)
 }

@@ -40,7 +40,7 @@ pub(crate) fn without_bom(bytes: &[u8]) -> Option<Result<Vec<u8>>> {
         _ => return None,
     };
     let body = &bytes[2..];
-    if body.len() % 2 != 0 {
+    if !body.len().is_multiple_of(2) {
         return Some(Err(bad(
             FORMAT,
             "UTF-16 text of an odd number of bytes (truncated)",
