@@ -339,4 +339,6 @@ def study_curve(
     out: PathLike, rolloff: Optional[float] = ..., seed: Optional[int] = ...,
     min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
     force: bool = ..., checkpoint_every: Optional[float] = ..., progress: ProgressArg = ...,
+    poisson: Optional[float] = ..., resistivity: Optional[Sequence[float]] = ...,
+    thermal_conductivity: Optional[Sequence[float]] = ...,
 ) -> StudyResult: ...

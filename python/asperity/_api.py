@@ -1660,13 +1660,18 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
 
 
 def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
-               levels, alpha_sweep, force, checkpoint_every, progress, description):
+               levels, alpha_sweep, force, checkpoint_every, progress, description,
+               derived=(None, None, None)):
     count = lambda v: None if v is None else int(v)
     args = (
         str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
         count(seed), count(min_contacts), _opt(max_fraction), count(levels),
         bool(alpha_sweep), os.fspath(out), bool(force), _opt(checkpoint_every),
     )
+    poisson, resistivity, thermal = derived
+    pair = lambda v: None if v is None else [float(x) for x in np.atleast_1d(v)]
+    derived = dict(poisson=_opt(poisson), resistivity=pair(resistivity),
+                   thermal_conductivity=pair(thermal))
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
     comm = _mpi.world()
     if comm is not None and comm.Get_rank() != 0:
@@ -1674,8 +1679,11 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
     bar = _Progress(progress, description)
     try:
         if comm is None:
-            text = _core.run_study(*args, bar.callback)
+            text = _core.run_study(*args, bar.callback, **derived)
         else:
+            if any(v is not None for v in derived.values()):
+                raise ValueError("poisson, resistivity and thermal_conductivity are not supported "
+                                 "under MPI yet: run the study without mpirun")
             text = _mpi.run_study(comm, lambda job: job.begin(*args), bar.callback)
     finally:
         bar.close()
@@ -1774,12 +1782,23 @@ def study_curve(
     force: bool = False,
     checkpoint_every: Optional[float] = None,
     progress: ProgressArg = None,
+    poisson: Optional[float] = None,
+    resistivity: Optional[Sequence[float]] = None,
+    thermal_conductivity: Optional[Sequence[float]] = None,
 ) -> StudyResult:
     """Ensemble-mean ``k(F)`` curves at one grid size ``n`` over ``hurst``, as
     ``asperity study curve`` (same folder, checkpoints and numbers; see
     :func:`study_alpha`). Returns the rows of ``curve.csv``: ``force``, ``stiffness``
     (mean), ``stiffness_low``/``stiffness_high`` (95 % interval of the mean),
     ``samples``, ``area_fraction``, per (method, n, hurst).
+
+    BEM only: ``poisson`` (ν) adds the tangential (no-slip) stiffness at every load,
+    ``tangential_ratio`` = (k_x + k_y)/(2k) with ``tangential_ratio_low``/``_high``;
+    ``resistivity=[ρ₁, ρ₂]`` adds ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and
+    ``thermal_conductivity=[κ₁, κ₂]`` ``thermal_conductance``, each with its interval
+    (Barber's analogy, E* = 1), as the CLI's ``--poisson``, ``--resistivity`` and
+    ``--thermal-conductivity``; ``figures["tangential"]`` then holds their plots
+    (docs/tangential.md).
 
     Example::
 
@@ -1791,7 +1810,7 @@ def study_curve(
     """
     records = _run_study(method, [n], hurst, samples, out, rolloff, seed, min_contacts,
                          max_fraction, levels, False, force, checkpoint_every, progress,
-                         f"{method} study")
+                         f"{method} study", (poisson, resistivity, thermal_conductivity))
     columns, rows = _table(records["curve"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
                        records["comparison_error"], _study_metadata("curve", out),

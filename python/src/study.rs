@@ -8,6 +8,7 @@
 //! returned), and Ctrl-C (or an exception of the progress callback) stops it after the
 //! samples in flight; the checkpoints already written stay.
 
+use asperity_app::figure::study::Derived as StudyDerived;
 use std::path::PathBuf;
 
 use asperity::lock::FolderLock;
@@ -70,7 +71,8 @@ fn method(name: &str) -> PyResult<Method> {
 /// (`alpha.csv`'s and `curve.csv`'s) as JSON text ([`records`]).
 #[pyfunction]
 #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-    max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress))]
+    max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress, poisson=None,
+    resistivity=None, thermal_conductivity=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_study(
     py: Python<'_>,
@@ -88,15 +90,22 @@ fn run_study(
     force: bool,
     checkpoint_every: Option<f64>,
     progress: Option<Py<PyAny>>,
+    poisson: Option<f64>,
+    resistivity: Option<Vec<f64>>,
+    thermal_conductivity: Option<Vec<f64>>,
 ) -> PyResult<String> {
-    let spec = make_spec(
-        method_name,
-        (sizes, hursts, samples),
-        rolloff,
-        seed,
-        (min_contacts, max_fraction, levels),
-        alpha_sweep,
-    )?;
+    let derived = derived(poisson, &resistivity, &thermal_conductivity)?;
+    let spec = StudySpec {
+        poisson,
+        ..make_spec(
+            method_name,
+            (sizes, hursts, samples),
+            rolloff,
+            seed,
+            (min_contacts, max_fraction, levels),
+            alpha_sweep,
+        )?
+    };
     let interval = checkpoint_interval(checkpoint_every)?;
     let spec = resumable(py, spec, &out, force)?;
     study::validate(&spec).map_err(request_error)?;
@@ -108,7 +117,24 @@ fn run_study(
         run_tasks(&store, &plan, progress.as_ref(), cancel)
     })?
     .map_err(|failure| from_error(failure.into_error()))?;
-    Ok(records(&spec, store.path(), &results))
+    Ok(records(&spec, store.path(), &results, derived))
+}
+
+/// The tangential and conductance columns and figures of a curve study
+/// ([`asperity_app::derived::Derived`]: the CLI's `--poisson`, `--resistivity`,
+/// `--thermal-conductivity`, refused in the same words).
+fn derived(
+    poisson: Option<f64>,
+    resistivity: &Option<Vec<f64>>,
+    thermal_conductivity: &Option<Vec<f64>>,
+) -> PyResult<StudyDerived> {
+    let derived =
+        asperity_app::derived::Derived::validate(poisson, resistivity, thermal_conductivity)
+            .map_err(crate::errors::refused)?;
+    Ok(StudyDerived {
+        poisson: derived.tangential,
+        transport: derived.transport,
+    })
 }
 
 /// A study's spec from `run_study`'s arguments (`alpha_sweep`: an α study's load sweep,
@@ -189,7 +215,12 @@ fn open_folder(
 /// [`study::comparison`]: α beside eq. (6)/(24), or a roll-off study's steepest slope
 /// beside "≈ 1" with the bootstrap interval over the sample curves in `dir`), or
 /// `comparison_error` where the study cannot be compared (the words).
-fn records(spec: &StudySpec, dir: &std::path::Path, results: &[TaskResult]) -> String {
+fn records(
+    spec: &StudySpec,
+    dir: &std::path::Path,
+    results: &[TaskResult],
+    derived: StudyDerived,
+) -> String {
     let (comparisons, error) = match study::comparison(spec, dir, results) {
         Ok(rows) => {
             let rows = rows.into_iter().map(|row| {
@@ -205,23 +236,27 @@ fn records(spec: &StudySpec, dir: &std::path::Path, results: &[TaskResult]) -> S
     json!({
         "tasks": results,
         "alpha": rows::alpha_table(results),
-        "curve": rows::curve_table(results),
+        "curve": rows::curve_table_with(results, &derived.transport),
         "comparisons": comparisons,
         "comparison_error": error,
-        "figures": figures(results),
+        "figures": figures(results, derived),
     })
     .to_string()
 }
 
 /// The study's figures as the CLI draws them ([`asperity_app::figure::study`]): `alpha`
 /// (α(H) with the theory curves, or α(N) for one H), `curve` (the ensemble k(F)) and
-/// `area` (the ensemble A/A₀(F)), each as `asperity-figure/1` JSON.
-fn figures(results: &[TaskResult]) -> serde_json::Value {
+/// `area` (the ensemble A/A₀(F)), each as `asperity-figure/1` JSON, and `tangential`
+/// (`k_t/k_n` and `C(F)`, [`asperity_app::figure::study::derived_charts`]) where the study
+/// has them.
+fn figures(results: &[TaskResult], derived: StudyDerived) -> serde_json::Value {
     use asperity_app::figure::{study as charts, to_json};
+    let extra = charts::derived_charts(results, derived);
     json!({
         "alpha": to_json(&[charts::alpha_chart(results, &charts::title(Kind::Alpha, None))]),
         "curve": to_json(&[charts::curve_chart(results, &charts::title(Kind::Curve, None))]),
         "area": to_json(&[charts::area_chart(results, "Contact fraction vs force (ensemble mean)")]),
+        "tangential": (!extra.is_empty()).then(|| to_json(&extra)),
     })
 }
 
@@ -355,7 +390,7 @@ impl StudyCoordinator {
             .study
             .take()
             .ok_or_else(|| invalid("no study was begun"))?;
-        Ok(records(&spec, store.path(), &results))
+        Ok(records(&spec, store.path(), &results, StudyDerived::default()))
     }
 
     /// Ends the job: the actions telling the ready ranks to stop (the others are told by

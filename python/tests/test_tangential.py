@@ -55,3 +55,34 @@ def test_contact_tangential_is_the_clis(cli, tmp_path):
         assert np.array_equal(ours[name], theirs[name]), name
     assert np.allclose(ours["tangential_ratio"], MINDLIN, rtol=1e-2)
     assert ours.metadata["contact"]["tangential"] is True
+
+
+def test_study_curve_tangential_and_conductance_are_the_clis(cli, tmp_path):
+    # The same study from both front ends: the same curve.csv columns, cell for cell
+    # (one definition: asperity_app::study::rows), the ratio at least Mindlin's (an exact
+    # bound, docs/tangential.md) and the conductance the stiffness times 2/(E*(ρ₁+ρ₂)).
+    args = dict(method="bem", n=32, hurst=[0.5], samples=2, rolloff=4, levels=4)
+    cli("study", "curve", "--method", "bem", "--n", 32, "--hurst", 0.5, "--samples", 2,
+        "--rolloff", 4, "--levels", 4, "--poisson", 0.3, "--resistivity", "1,3", "--quiet",
+        "--out", tmp_path / "cli")
+    theirs = np.genfromtxt(tmp_path / "cli" / "curve.csv", delimiter=",", names=True)
+    ours = asperity.study_curve(out=tmp_path / "py", poisson=0.3, resistivity=[1, 3], **args)
+    for name in ["stiffness", "tangential_ratio", "tangential_ratio_low",
+                 "tangential_ratio_high", "electrical_conductance",
+                 "electrical_conductance_high"]:
+        assert np.array_equal(ours[name], theirs[name]), name
+    assert np.all(ours.tangential_ratio >= MINDLIN * (1 - 1e-9))
+    assert np.allclose(ours.tangential_ratio, MINDLIN, rtol=1e-2)
+    assert np.array_equal(ours.electrical_conductance, ours.stiffness * 2 / 4)
+    charts = ours.figures["tangential"]["charts"]
+    assert len(charts) == 2 and "Mindlin" in charts[0]["series"][-1]["label"]
+    # Bad values are refused in the keywords' words, creating nothing.
+    for bad, words in [(dict(poisson=0.7), "poisson must be in [0, 0.5]"),
+                       (dict(resistivity=[1]), "give two values")]:
+        try:
+            asperity.study_curve(out=tmp_path / "bad", **args, **bad)
+        except ValueError as e:
+            assert words in str(e), str(e)
+        else:
+            raise AssertionError(f"{bad} accepted")
+        assert not (tmp_path / "bad").exists()

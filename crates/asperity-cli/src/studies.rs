@@ -15,7 +15,9 @@ use asperity_app::study::{self, rows, rows::Cell};
 use asperity_app::Names;
 
 use crate::output::{format_number, Table};
-use asperity_app::figure::study::{alpha_chart, curve_chart, title as titled};
+use asperity_app::figure::study::{
+    alpha_chart, curve_chart, derived_charts, title as titled, Derived,
+};
 
 use crate::plot::{Chart, ChartFiles};
 use crate::progress::Progress;
@@ -55,15 +57,25 @@ pub struct RunOptions {
     pub checkpoint_every: Duration,
     /// The `reproduce` setting a figure's study runs under, marked on its plot.
     pub setting: Option<&'static str>,
+    /// A curve study's Poisson's ratio and transport properties: its tangential-ratio
+    /// and conductance columns and figures ([`derived_charts`]).
+    pub derived: Derived,
 }
+
+/// The stem of a curve study's figures of `k_t/k_n` and `C(F)` ([`derived_charts`]).
+pub const DERIVED_STEM: &str = "tangential";
 
 /// The files a study of `kind` writes into `dir`.
 pub fn outputs(kind: Kind, dir: &Path) -> Vec<PathBuf> {
     let stem = kind.stem();
-    ["csv", "png", "svg"]
+    let mut files: Vec<PathBuf> = ["csv", "png", "svg"]
         .iter()
         .map(|ext| dir.join(format!("{stem}.{ext}")))
-        .collect()
+        .collect();
+    if kind == Kind::Curve {
+        files.extend(["png", "svg"].map(|ext| dir.join(format!("{DERIVED_STEM}.{ext}"))));
+    }
+    files
 }
 
 /// Validates (the spec, then whether its largest task fits in memory), checks outputs
@@ -87,6 +99,7 @@ pub fn execute(
         quiet,
         checkpoint_every,
         setting,
+        derived,
     } = options;
     study::validate(spec).map_err(crate::request::refused)?;
     study::check(spec, dir, force)?;
@@ -108,8 +121,12 @@ pub fn execute(
         Kind::Alpha => alpha_chart(&results, &title),
         Kind::Curve => curve_chart(&results, &title),
     };
-    let table = csv_table(&kind.table(&results));
-    write_together(dir, kind.stem(), &table, &chart, rewrite, true)?;
+    let table = csv_table(&kind.table(&results, &derived.transport));
+    let extra = match kind {
+        Kind::Curve => derived_charts(&results, derived),
+        Kind::Alpha => Vec::new(),
+    };
+    write_together(dir, kind.stem(), &table, (&chart, &extra), rewrite, true)?;
     Ok(results)
 }
 
@@ -165,13 +182,14 @@ fn run_tasks(
     Ok(study::run_tasks(store, &report, on_load)?)
 }
 
-/// Writes `<stem>.csv`, `.png` and `.svg` (and, with `record`, the record of what was
-/// written, [`crate::rerun::RECORD`]) into `dir`, all or none.
+/// Writes `<stem>.csv`, `.png` and `.svg`, the `extra` charts side by side as
+/// `tangential.png` and `.svg` ([`DERIVED_STEM`]) where there are any (and, with `record`,
+/// the record of what was written, [`crate::rerun::RECORD`]) into `dir`, all or none.
 pub fn write_together(
     dir: &Path,
     stem: &str,
     table: &Table,
-    chart: &Chart,
+    (chart, extra): (&Chart, &[Chart]),
     force: bool,
     record: bool,
 ) -> Result<()> {
@@ -180,14 +198,23 @@ pub fn write_together(
         dir.join(format!("{stem}.png")),
         dir.join(format!("{stem}.svg")),
     );
+    let derived = ["png", "svg"].map(|ext| dir.join(format!("{DERIVED_STEM}.{ext}")));
     let record_path = dir.join(crate::rerun::RECORD);
     let mut paths = vec![&csv, &png, &svg];
+    if !extra.is_empty() {
+        paths.extend(&derived);
+    }
     if record {
         paths.push(&record_path);
     }
     let mut staged = asperity::io::StagedOutputs::new(paths, force)?;
     table.stage(&mut staged, &csv)?;
     chart.stage(&mut staged, &png, &svg)?;
+    if !extra.is_empty() {
+        for path in &derived {
+            crate::plot::stage_charts(&mut staged, path, extra)?;
+        }
+    }
     if record {
         crate::rerun::stage_record(&mut staged, &record_path)?;
     }
@@ -225,7 +252,7 @@ pub fn write_alpha(
 ) -> Result<()> {
     let chart = alpha_chart(results, &titled(Kind::Alpha, setting));
     let table = csv_table(&rows::alpha_table(results));
-    write_together(dir, "alpha", &table, &chart, force, false)
+    write_together(dir, "alpha", &table, (&chart, &[]), force, false)
 }
 
 /// `<stem>.csv` with the ensemble-mean curves and a log–log plot of k(F), written together.
@@ -239,7 +266,7 @@ pub fn write_curves(
 ) -> Result<()> {
     let chart = curve_chart(results, &titled(Kind::Curve, setting));
     let table = csv_table(&rows::curve_table(results));
-    write_together(dir, stem, &table, &chart, force, false)
+    write_together(dir, stem, &table, (&chart, &[]), force, false)
 }
 
 #[cfg(test)]
@@ -263,6 +290,7 @@ mod tests {
             window: asperity::study::FitWindow::default(),
             levels: 48,
             sweep_end: None,
+            poisson: None,
         };
         let segments = StudyProgress::new(&spec, vec![0, 3]).segments();
         let mut eta = crate::progress::Eta::weighted(&segments);
@@ -294,6 +322,7 @@ mod tests {
             stiffness_high: 2.0,
             fraction: 0.1,
             samples: 3,
+            tangential_ratio: None,
         };
         TaskResult {
             method: Method::Mdr,

@@ -894,3 +894,109 @@ fn an_alpha_study_ends_its_bem_sweeps_past_the_windows_and_fits_as_the_whole_swe
     );
     assert!(!d.join("c").exists());
 }
+
+/// `study curve --poisson --resistivity`: the tangential ratio at every force level, with
+/// its interval, at least Mindlin's `2(1−ν)/(2−ν)` (an exact bound on any contact set,
+/// docs/tangential.md) and within 1 % of it; the electrical conductance and its interval
+/// are the stiffness's times `2/(E*(ρ₁+ρ₂))` (E* = 1); the normal columns are those of the
+/// study without them; the figures of k_t/k_n and C(F) are written beside `curve.png`.
+/// Bad values, or `--poisson` with MDR, are refused with one line, creating nothing.
+#[test]
+fn curve_study_adds_the_tangential_ratio_and_the_conductance() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = [
+        "study",
+        "curve",
+        "--method",
+        "bem",
+        "--n",
+        "32",
+        "--hurst",
+        "0.5",
+        "--rolloff",
+        "4",
+        "--samples",
+        "3",
+        "--levels",
+        "5",
+        "--quiet",
+        "--out",
+    ];
+    let with = |extra: &[&str]| asperity(&[&base[..], extra].concat(), d);
+    ok(&with(&["t", "--poisson", "0.3", "--resistivity", "1,3"]));
+    ok(&with(&["plain"]));
+    let read = |folder: &str| {
+        let csv = std::fs::read_to_string(d.join(folder).join("curve.csv")).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows: Vec<Vec<String>> = lines
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect();
+        (header, rows)
+    };
+    let (header, rows) = read("t");
+    let (plain_header, plain_rows) = read("plain");
+    assert_eq!(
+        header[plain_header.len()..],
+        [
+            "tangential_ratio",
+            "tangential_ratio_low",
+            "tangential_ratio_high",
+            "electrical_conductance",
+            "electrical_conductance_low",
+            "electrical_conductance_high"
+        ]
+    );
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mindlin = 2.0 * 0.7 / 1.7;
+    assert_eq!(rows.len(), 5);
+    for (row, plain) in rows.iter().zip(&plain_rows) {
+        assert_eq!(row[..plain.len()], plain[..]);
+        let at = |name: &str| row[col(name)].parse::<f64>().unwrap();
+        let ratio = at("tangential_ratio");
+        assert!(
+            ratio >= mindlin * (1.0 - 1e-9) && ratio < mindlin * 1.01,
+            "{ratio}"
+        );
+        assert!(at("tangential_ratio_low") <= ratio && ratio <= at("tangential_ratio_high"));
+        for (c, k) in [("", ""), ("_low", "_low"), ("_high", "_high")] {
+            let conductance = at(&format!("electrical_conductance{c}"));
+            let stiffness = at(&format!("stiffness{k}"));
+            assert!((conductance / (stiffness * 2.0 / 4.0) - 1.0).abs() < 1e-15);
+        }
+    }
+    assert!(d.join("t/tangential.png").is_file() && d.join("t/tangential.svg").is_file());
+    assert!(!d.join("plain/tangential.png").exists());
+    for (extra, needle) in [
+        (vec!["--poisson", "0.7"], "--poisson must be in [0, 0.5]"),
+        (vec!["--resistivity", "1"], "give two values"),
+        (
+            vec!["--thermal-conductivity", "1,-2"],
+            "positive and finite",
+        ),
+    ] {
+        let out = with(&[&["bad"], &extra[..]].concat());
+        refused(&out, needle);
+        assert!(!d.join("bad").exists());
+    }
+    let mdr = [
+        "study",
+        "curve",
+        "--method",
+        "mdr",
+        "--n",
+        "64",
+        "--hurst",
+        "0.5",
+        "--samples",
+        "2",
+        "--quiet",
+        "--poisson",
+        "0.3",
+        "--out",
+        "mdr",
+    ];
+    refused(&asperity(&mdr, d), "BEM only");
+    assert!(!d.join("mdr").exists());
+}

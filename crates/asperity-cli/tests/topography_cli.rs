@@ -622,6 +622,77 @@ fn contact_with_a_hardness_caps_the_pressure_in_si_units() {
     }
 }
 
+/// `--tangential` with `--hardness` is supported, on the elastic part of the contact
+/// (docs/tangential.md): points at the hardness take no added traction, normal or
+/// tangential, so `k`, `k_x` and `k_y` are the stiffnesses of the same set (the points below
+/// the hardness). On the paraboloid at half Hertz's peak pressure the plastic core leaves an
+/// elastic annulus, whose `k_t/k_n` is still at least Mindlin's (the bound holds on any
+/// set) and within 1 % of it; a hardness above the peak changes nothing (the hard wall's
+/// columns, to the solver's tolerance).
+#[test]
+fn contact_tangential_with_a_hardness_is_the_elastic_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, e_star) = (64usize, 20e-6, 1e-3, 1e9);
+    std::fs::write(d.join("sphere.txt"), paraboloid(n, side, radius)).unwrap();
+    let a: f64 = 4e-6;
+    let force = 4.0 * e_star * a.powi(3) / (3.0 * radius);
+    let peak = 2.0 * e_star * a / (std::f64::consts::PI * radius);
+    let p = format!("{}", force / (side * side));
+    let run = |name: &str, hardness: Option<f64>| {
+        let h = hardness.map(|h| format!("{h}"));
+        let mut args = vec![
+            "contact",
+            "sphere.txt",
+            "--modulus",
+            "1e9",
+            "--poisson",
+            "0.3",
+            "--tangential",
+            "--detrend",
+            "none",
+            "--pressures",
+            &p,
+            "--out",
+            name,
+        ];
+        if let Some(h) = &h {
+            args.extend(["--hardness", h.as_str()]);
+        }
+        ok(&asperity(&args, d));
+        let csv = std::fs::read_to_string(d.join(name)).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let row: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        move |name: &str| row[header.iter().position(|h| h == name).unwrap()]
+    };
+    let mindlin = 2.0 * 0.7 / 1.7;
+    let capped = run("capped.csv", Some(peak / 2.0));
+    assert!(capped("plastic_fraction") > 0.0);
+    let ratio = capped("tangential_ratio");
+    assert!(
+        ratio >= mindlin * (1.0 - 1e-9) && ratio < mindlin * 1.01,
+        "{ratio}"
+    );
+    let (hard, high) = (run("hard.csv", None), run("high.csv", Some(2.0 * peak)));
+    assert_eq!(high("plastic_fraction"), 0.0);
+    for column in [
+        "stiffness_n_per_m",
+        "stiffness_x_n_per_m",
+        "tangential_ratio",
+    ] {
+        let (a, b) = (hard(column), high(column));
+        assert!((a / b - 1.0).abs() < 1e-6, "{column}: {a} {b}");
+    }
+    // The annulus is not the disc: its stiffnesses differ from the hard wall's.
+    assert!((capped("stiffness_x_n_per_m") / hard("stiffness_x_n_per_m") - 1.0).abs() > 1e-3);
+}
+
 #[test]
 fn x3p_written_by_import_reads_back_bit_exact() {
     let dir = tempfile::tempdir().unwrap();

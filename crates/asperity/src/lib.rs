@@ -72,6 +72,7 @@
 //!     window: FitWindow::default(), // 8 contacts up to 1 % contact
 //!     levels: 48,
 //!     sweep_end: None,
+//!     poisson: None,
 //! };
 //! let task = Task { n, hurst: 1.0 };
 //! let samples = TaskSamples::new(&spec, task)?.compute(&(0..100).collect::<Vec<_>>())?;

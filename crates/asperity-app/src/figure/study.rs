@@ -289,3 +289,209 @@ fn slope_one(results: &[TaskResult]) -> Option<Series> {
         .color(Color::GREY),
     )
 }
+
+/// The colour of task `r` on the H scale of `results` (as [`curve_chart`]'s).
+fn hurst_color(results: &[TaskResult], r: &TaskResult) -> Color {
+    let (hmin, hmax) = results
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+            (a.min(r.task.hurst), b.max(r.task.hurst))
+        });
+    let t = if hmax > hmin {
+        (r.task.hurst - hmin) / (hmax - hmin)
+    } else {
+        0.5
+    };
+    Color::Ordered(t * 0.9)
+}
+
+/// What a study's tangential and conductance figures show besides its results: Poisson's
+/// ratio (for Mindlin's line) and the bodies' transport properties (for `C(F)`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Derived {
+    /// Poisson's ratio ν of the study's tangential stiffness.
+    pub poisson: Option<f64>,
+    /// The bodies' resistivities and conductivities.
+    pub transport: asperity::bem::conductance::Transport,
+}
+
+/// The figures of what the normal stiffness stands for, for a study that computed them:
+/// `k_t/k_n = (k_x + k_y)/(2k)` against force (log x), one series per task coloured by H,
+/// with the 95 % interval of the mean as a band and Mindlin's `2(1−ν)/(2−ν)` dashed (where
+/// the samples have the ratio), and the conductance `C(F)`, log–log, with the interval of
+/// the mean (electrical where resistivities are given, else thermal; none without either).
+pub fn derived_charts(results: &[TaskResult], derived: Derived) -> Vec<Chart> {
+    let mut charts = Vec::new();
+    if crate::study::rows::has_tangential(results) {
+        charts.push(tangential_chart(results, derived.poisson));
+    }
+    let modulus = |r: &TaskResult| asperity::study::Scales::of(r.method).modulus;
+    let transport = derived.transport;
+    let conductance = match (transport.resistivity, transport.thermal_conductivity) {
+        (Some(_), _) => Some(("electrical conductance C = 2k/(E*(ρ₁+ρ₂))", true)),
+        (None, Some(_)) => Some(("thermal conductance C = (2k/E*)κ₁κ₂/(κ₁+κ₂)", false)),
+        (None, None) => None,
+    };
+    if let Some((label, electrical)) = conductance {
+        let factor = |r: &TaskResult| {
+            let c = match electrical {
+                true => transport.electrical(1.0, modulus(r)),
+                false => transport.thermal(1.0, modulus(r)),
+            };
+            c.unwrap_or(f64::NAN)
+        };
+        let series = results.iter().map(|r| {
+            let c = factor(r);
+            let points = r.mean_curve.iter().map(|p| (p.force, c * p.stiffness));
+            let band = r
+                .mean_curve
+                .iter()
+                .map(|p| (c * p.stiffness_low, c * p.stiffness_high));
+            task_series(results, r, points.collect(), band.collect())
+        });
+        charts.push(Chart {
+            title: "Contact conductance vs force (ensemble mean, Barber's analogy)".into(),
+            x_label: force_label(results),
+            y_label: format!("{label}  (band: 95 % of the mean)"),
+            log_x: true,
+            log_y: true,
+            series: series.collect(),
+        });
+    }
+    charts
+}
+
+/// One task's line with its band where it has more than one sample.
+fn task_series(
+    results: &[TaskResult],
+    r: &TaskResult,
+    points: Vec<(f64, f64)>,
+    band: Vec<(f64, f64)>,
+) -> Series {
+    let label = format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst);
+    let line = Series::new(label, points, Style::Line).color(hurst_color(results, r));
+    match r.samples > 1 {
+        true => line.interval(band),
+        false => line,
+    }
+}
+
+fn force_label(results: &[TaskResult]) -> String {
+    let scale = match results.first().map(|r| r.method) {
+        Some(Method::Bem) => "L = 1, E* = 1, unit rms slope",
+        _ => "L = 1, E* = 1, unit rms height",
+    };
+    format!("normal force F ({scale})")
+}
+
+/// `k_t/k_n` against force (see [`derived_charts`]): with ν known, as its excess over
+/// Mindlin's ratio in per cent (Mindlin's line at 0; the ratio differs from it by parts in
+/// 1e-3, which a plain ratio axis cannot resolve); without, the ratio itself.
+fn tangential_chart(results: &[TaskResult], poisson: Option<f64>) -> Chart {
+    let mindlin = poisson.map(|nu| 2.0 * (1.0 - nu) / (2.0 - nu));
+    let shown = |ratio: f64| match mindlin {
+        Some(m) => 100.0 * (ratio / m - 1.0),
+        None => ratio,
+    };
+    let mut series: Vec<Series> = results
+        .iter()
+        .map(|r| {
+            let ratio = |p: &asperity::study::EnsemblePoint| p.tangential_ratio;
+            let points = r
+                .mean_curve
+                .iter()
+                .map(|p| (p.force, ratio(p).map_or(f64::NAN, |t| shown(t.mean))));
+            let band = r
+                .mean_curve
+                .iter()
+                .map(|p| ratio(p).map_or((f64::NAN, f64::NAN), |t| (shown(t.low), shown(t.high))));
+            task_series(results, r, points.collect(), band.collect())
+        })
+        .collect();
+    let forces = results
+        .iter()
+        .flat_map(|r| r.mean_curve.iter().map(|p| p.force));
+    let (lo, hi) = forces.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
+        (a.min(f), b.max(f))
+    });
+    let y_label = match (poisson, mindlin) {
+        (Some(nu), Some(m)) => {
+            if hi > lo {
+                let label = format!("Mindlin 2(1−ν)/(2−ν) = {m:.5} (ν = {nu}): a lower bound");
+                let line = vec![(lo, 0.0), (hi, 0.0)];
+                series.push(Series::new(label, line, Style::Dashed).color(Color::BLACK));
+            }
+            format!("k_t/k_n over Mindlin's ratio − 1 [%], ν = {nu}  (band: 95 % of the mean)")
+        }
+        _ => "k_t/k_n = (k_x + k_y)/(2k)  (band: 95 % of the mean)".into(),
+    };
+    Chart {
+        title: "Tangential over normal contact stiffness vs force (ensemble mean, full stick)"
+            .into(),
+        x_label: force_label(results),
+        y_label,
+        log_x: true,
+        log_y: false,
+        series,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asperity::bem::conductance::Transport;
+    use asperity::study::{EnsemblePoint, MeanInterval, Task};
+
+    fn result(ratio: Option<f64>) -> TaskResult {
+        let point = |force: f64| EnsemblePoint {
+            force,
+            stiffness: 2.0 * force,
+            stiffness_low: force,
+            stiffness_high: 3.0 * force,
+            fraction: 0.1,
+            samples: 4,
+            tangential_ratio: ratio.map(|mean| MeanInterval {
+                mean,
+                low: mean - 1e-4,
+                high: mean + 1e-4,
+            }),
+        };
+        TaskResult {
+            method: Method::Bem,
+            task: Task { n: 64, hurst: 0.5 },
+            samples: 4,
+            mean_curve: vec![point(1.0), point(10.0)],
+            alpha_ensemble: None,
+            alpha_samples: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn derived_charts_show_the_excess_over_mindlin_and_the_conductance() {
+        let mindlin = 2.0 * 0.7 / 1.7;
+        let transport = Transport::new(Some([1.0, 3.0]), None).unwrap();
+        let derived = Derived {
+            poisson: Some(0.3),
+            transport,
+        };
+        let charts = derived_charts(&[result(Some(mindlin * 1.001))], derived);
+        assert_eq!(charts.len(), 2);
+        // The ratio as its excess over Mindlin's, in per cent; Mindlin's line at 0.
+        let excess = &charts[0].series[0];
+        assert!(
+            (excess.points[0].1 - 0.1).abs() < 1e-9,
+            "{:?}",
+            excess.points
+        );
+        assert!(charts[0].series[1].points.iter().all(|p| p.1 == 0.0));
+        // C = 2k/(E*(ρ₁+ρ₂)) = k/2 here, its band the stiffness's.
+        let c = &charts[1].series[0];
+        assert_eq!(c.points, vec![(1.0, 1.0), (10.0, 10.0)]);
+        assert_eq!(c.interval.as_ref().unwrap()[1], (5.0, 15.0));
+        // Without ν the ratio itself; without the ratio or the properties, no chart.
+        let plain = derived_charts(&[result(Some(0.8))], Derived::default());
+        assert_eq!(plain.len(), 1);
+        assert_eq!(plain[0].series[0].points[0].1, 0.8);
+        assert!(derived_charts(&[result(None)], Derived::default()).is_empty());
+    }
+}

@@ -62,11 +62,16 @@ impl Kind {
         }
     }
 
-    /// Its result table.
-    pub fn table(self, results: &[TaskResult]) -> rows::Table {
+    /// Its result table; a curve study's with the conductance columns of `transport`
+    /// ([`rows::curve_table_with`]).
+    pub fn table(
+        self,
+        results: &[TaskResult],
+        transport: &asperity::bem::conductance::Transport,
+    ) -> rows::Table {
         match self {
             Kind::Alpha => rows::alpha_table(results),
-            Kind::Curve => rows::curve_table(results),
+            Kind::Curve => rows::curve_table_with(results, transport),
         }
     }
 }
@@ -278,6 +283,7 @@ mod tests {
             },
             levels: 12,
             sweep_end: None,
+            poisson: None,
         }
     }
 
@@ -310,7 +316,7 @@ mod tests {
         let progress = |task: usize, done: usize| again.lock().unwrap().push((task, done));
         assert_eq!(run_tasks(&store, &progress, None).unwrap(), results);
         assert_eq!(again.into_inner().unwrap(), vec![(0, 6), (1, 6)]);
-        let table = Kind::Alpha.table(&results);
+        let table = Kind::Alpha.table(&results, &Default::default());
         assert_eq!(table.rows.len(), 2);
     }
 
@@ -366,6 +372,7 @@ mod tests {
             },
             levels: 48,
             sweep_end: None,
+            poisson: None,
         };
         assert!(check_min_contacts(&spec(Method::Mdr, 32)).is_ok());
         assert!(check_min_contacts(&spec(Method::Bem, 1024)).is_ok());

@@ -1,8 +1,9 @@
 //! The result tables of a study, defined once: the rows of `alpha.csv` and `curve.csv`
 //! that the CLI writes and that Python returns as columns.
 
+use asperity::bem::conductance::Transport;
 use asperity::study::theory::alpha_theory;
-use asperity::study::TaskResult;
+use asperity::study::{Scales, TaskResult};
 use serde::Serialize;
 
 /// What a column holds (how a front end stores it: text, an integer, a float).
@@ -33,7 +34,7 @@ pub enum Cell {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Table {
     /// `(name, type)` of each column, in order.
-    pub columns: &'static [(&'static str, ColumnType)],
+    pub columns: Vec<(&'static str, ColumnType)>,
     /// The rows, each a cell per column.
     pub rows: Vec<Vec<Cell>>,
 }
@@ -110,19 +111,39 @@ pub fn alpha_table(results: &[TaskResult]) -> Table {
         })
         .collect();
     Table {
-        columns: ALPHA_COLUMNS,
+        columns: ALPHA_COLUMNS.to_vec(),
         rows,
     }
 }
 
+/// The columns `curve.csv` adds for a study with a Poisson's ratio
+/// ([`asperity::study::StudySpec::poisson`]): the ensemble-mean `(k_x + k_y)/(2k)` with the
+/// 95 % interval of the mean.
+pub const TANGENTIAL_COLUMNS: &[(&str, ColumnType)] = &[
+    ("tangential_ratio", Number),
+    ("tangential_ratio_low", Number),
+    ("tangential_ratio_high", Number),
+];
+
 /// `curve.csv`: per task and force level, the ensemble-mean stiffness with the 95 %
 /// interval of the mean, the samples that reach the level and the mean contact fraction.
 pub fn curve_table(results: &[TaskResult]) -> Table {
+    curve_table_with(results, &Transport::default())
+}
+
+/// [`curve_table`], and where the samples have them the tangential ratio's columns
+/// ([`TANGENTIAL_COLUMNS`]), and for the bodies of `transport` the conductances by
+/// Barber's analogy with their intervals (`electrical_conductance`, `…_low`, `…_high`,
+/// then the thermal ones; [`conductance_factors`]): the stiffness's columns times
+/// `2/(E*(ρ₁+ρ₂))` or `(2/E*)κ₁κ₂/(κ₁+κ₂)`, with the study's E* = 1.
+pub fn curve_table_with(results: &[TaskResult], transport: &Transport) -> Table {
+    let tangential = has_tangential(results);
     let rows = results
         .iter()
         .flat_map(|r| {
+            let conductances = conductance_factors(transport, Scales::of(r.method).modulus);
             r.mean_curve.iter().map(move |p| {
-                vec![
+                let mut row = vec![
                     Cell::Text(r.method.name()),
                     Cell::Count(r.task.n),
                     Cell::Number(Some(r.task.hurst)),
@@ -132,14 +153,59 @@ pub fn curve_table(results: &[TaskResult]) -> Table {
                     Cell::Number(Some(p.stiffness_high)),
                     Cell::Count(p.samples),
                     Cell::Number(Some(p.fraction)),
-                ]
+                ];
+                if tangential {
+                    let t = p.tangential_ratio;
+                    row.extend(
+                        [t.map(|t| t.mean), t.map(|t| t.low), t.map(|t| t.high)].map(Cell::Number),
+                    );
+                }
+                for (_, factor) in &conductances {
+                    let k = [p.stiffness, p.stiffness_low, p.stiffness_high];
+                    row.extend(k.map(|k| Cell::Number(Some(factor * k))));
+                }
+                row
             })
         })
         .collect();
-    Table {
-        columns: CURVE_COLUMNS,
-        rows,
+    let mut columns = CURVE_COLUMNS.to_vec();
+    if tangential {
+        columns.extend_from_slice(TANGENTIAL_COLUMNS);
     }
+    for (names, _) in conductance_factors(transport, 1.0) {
+        columns.extend(names.iter().map(|&name| (name, Number)));
+    }
+    Table { columns, rows }
+}
+
+/// Whether any task's curve has the tangential ratio.
+pub fn has_tangential(results: &[TaskResult]) -> bool {
+    let mut points = results.iter().flat_map(|r| &r.mean_curve);
+    points.any(|p| p.tangential_ratio.is_some())
+}
+
+/// The conductance columns of `transport` with the factor each applies to the stiffness
+/// on a half-space of effective modulus `modulus` (the study's, [`Scales`]): electrical,
+/// then thermal.
+pub fn conductance_factors(transport: &Transport, modulus: f64) -> Vec<([&'static str; 3], f64)> {
+    let mut out = Vec::new();
+    if let Some(c) = transport.electrical(1.0, modulus) {
+        let names = [
+            "electrical_conductance",
+            "electrical_conductance_low",
+            "electrical_conductance_high",
+        ];
+        out.push((names, c));
+    }
+    if let Some(c) = transport.thermal(1.0, modulus) {
+        let names = [
+            "thermal_conductance",
+            "thermal_conductance_low",
+            "thermal_conductance_high",
+        ];
+        out.push((names, c));
+    }
+    out
 }
 
 #[cfg(test)]
@@ -156,6 +222,7 @@ mod tests {
             stiffness_high: 3.5,
             fraction: 0.1,
             samples: 4,
+            tangential_ratio: None,
         };
         TaskResult {
             method: Method::Bem,
@@ -181,7 +248,7 @@ mod tests {
         for table in [alpha_table(&results), curve_table(&results)] {
             for row in &table.rows {
                 assert_eq!(row.len(), table.columns.len());
-                for (cell, (name, kind)) in row.iter().zip(table.columns) {
+                for (cell, (name, kind)) in row.iter().zip(table.columns.iter()) {
                     let matches = matches!(
                         (cell, kind),
                         (Cell::Text(_), Text) | (Cell::Count(_), Count) | (Cell::Number(_), Number)
@@ -201,6 +268,46 @@ mod tests {
         // Python reads the cells as JSON: a missing number is null.
         let json = serde_json::to_string(&alpha.rows[1][..5]).unwrap();
         assert_eq!(json, r#"["bem",64,0.5,null,null]"#);
+    }
+
+    #[test]
+    fn curve_rows_add_the_tangential_ratio_and_the_conductances() {
+        let mut with = result(None, vec![]);
+        for p in &mut with.mean_curve {
+            p.tangential_ratio = Some(asperity::study::MeanInterval {
+                mean: 0.824,
+                low: 0.823,
+                high: 0.825,
+            });
+        }
+        let transport = Transport::new(Some([1.0, 3.0]), Some([2.0, 2.0])).unwrap();
+        let table = curve_table_with(std::slice::from_ref(&with), &transport);
+        let names: Vec<&str> = table.columns.iter().map(|c| c.0).collect();
+        assert_eq!(
+            names[CURVE_COLUMNS.len()..],
+            [
+                "tangential_ratio",
+                "tangential_ratio_low",
+                "tangential_ratio_high",
+                "electrical_conductance",
+                "electrical_conductance_low",
+                "electrical_conductance_high",
+                "thermal_conductance",
+                "thermal_conductance_low",
+                "thermal_conductance_high"
+            ]
+        );
+        // E* = 1: electrical 2k/(1 + 3) = k/2, thermal 2k·(2·2/4) = 2k, for k and its ends.
+        let n = CURVE_COLUMNS.len();
+        let row = &table.rows[0];
+        assert_eq!(row[n], Cell::Number(Some(0.824)));
+        let expected = [1.5, 1.25, 1.75, 6.0, 5.0, 7.0];
+        for (cell, e) in row[n + 3..].iter().zip(expected) {
+            assert_eq!(*cell, Cell::Number(Some(e)));
+        }
+        // Without the ratio or the properties: the columns of before.
+        let plain = curve_table_with(&[result(None, vec![])], &Transport::default());
+        assert_eq!(plain.columns, CURVE_COLUMNS.to_vec());
     }
 
     #[test]

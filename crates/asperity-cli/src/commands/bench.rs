@@ -267,6 +267,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         window: asperity::study::FitWindow::default(),
         levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
+        poisson: None,
     }
     .with_alpha_sweep();
     let sweep_end = alpha.sweep_end.filter(|_| !args.full_sweep);

@@ -124,7 +124,8 @@ pub struct ContactArgs {
     /// stiffness_y_n_per_m (k_x, k_y of the frozen contact set with Cerruti's kernel for
     /// --poisson's ν, docs/tangential.md) and tangential_ratio = (k_x + k_y)/(2k). Needs
     /// --poisson (with --young, or beside --modulus for the kernel alone). About two more
-    /// stiffness solves per load.
+    /// stiffness solves per load. With --hardness, on the elastic set as k: points at the
+    /// hardness take no added traction, normal or tangential.
     #[arg(long)]
     pub tangential: bool,
     /// Overwrite existing outputs.
@@ -249,7 +250,8 @@ fn inputs_record(
         "tangential": plan.derived.tangential.map(|nu| json!({
             "poisson": nu,
             "method": "frozen contact set, Cerruti kernel (normal-tangential coupling \
-                neglected); tangential_ratio = (k_x + k_y)/(2k)",
+                neglected); tangential_ratio = (k_x + k_y)/(2k); with a hardness, on the \
+                elastic set (points at the hardness take no added traction)",
         })),
         "conductance": "Barber's analogy from the frozen-set stiffness: electrical \
             2k/(E*(ρ1+ρ2)), thermal (2k/E*)·κ1κ2/(κ1+κ2)",

@@ -13,6 +13,8 @@ use serde::de::{self, Visitor};
 use serde::Deserialize;
 
 use crate::studies::{execute, Kind, RunOptions};
+use asperity_app::derived::Derived;
+use asperity_app::figure::study as figure;
 use asperity_app::range::parse_range;
 
 /// `--method`.
@@ -149,11 +151,16 @@ DIR/curve.svg (log-log, band: the interval; dashed: slope 1).
                                 samples), unlike alpha_low/alpha_high of study alpha, which
                                 are the 2.5-97.5 % spread over samples
   area_fraction                 mean contact fraction at that force
+BEM with --poisson NU adds tangential_ratio, tangential_ratio_low, tangential_ratio_high
+(mean (k_x + k_y)/(2k) with its 95 % interval) and DIR/tangential.png, .svg (k_t/k_n over
+Mindlin's ratio, and C(F) with --resistivity or --thermal-conductivity, which add
+electrical_conductance or thermal_conductance with _low and _high; docs/tangential.md).
 
 ", scales_help!(), "
 
 Examples:
   asperity study curve --method bem --n 64 --hurst -1,0,1,3 --rolloff 6 --samples 8 --out curves
+  asperity study curve --method bem --n 128 --hurst 0,0.8 --rolloff 4 --samples 10 --poisson 0.3 --resistivity 1,1 --out tangential
   asperity study curve --method mdr --n 4096 --hurst -1:3:1 --samples 100 --out mdr-curves")
 )]
 pub struct CurveArgs {
@@ -163,6 +170,29 @@ pub struct CurveArgs {
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
+    /// BEM: Poisson's ratio ν in [0, 0.5] of the tangential (no-slip) stiffness computed at
+    /// every load (Cerruti's kernel on the frozen contact set): adds tangential_ratio
+    /// (k_x + k_y)/(2k) with its interval, and the figure DIR/tangential.png.
+    #[arg(long, value_name = "NU")]
+    pub poisson: Option<f64>,
+    /// The two bodies' electrical resistivities ρ₁,ρ₂: adds electrical_conductance
+    /// 2k/(E*(ρ₁+ρ₂)) with its interval (Barber's analogy; E* = 1) and its figure.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "RHO1,RHO2",
+        allow_hyphen_values = true
+    )]
+    pub resistivity: Option<Vec<f64>>,
+    /// The two bodies' thermal conductivities κ₁,κ₂: adds thermal_conductance
+    /// (2k/E*)κ₁κ₂/(κ₁+κ₂) with its interval.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "K1,K2",
+        allow_hyphen_values = true
+    )]
+    pub thermal_conductivity: Option<Vec<f64>>,
     #[command(flatten)]
     pub common: CommonArgs,
 }
@@ -474,6 +504,7 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
         },
         levels: file.levels.unwrap_or(defaults.levels),
         sweep_end: None,
+        poisson: None,
     };
     if file.kind == Kind::Curve && file.full_sweep.is_some() {
         anyhow::bail!(
@@ -533,6 +564,7 @@ fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudyS
         },
         levels: common.levels,
         sweep_end: None,
+        poisson: None,
     }
 }
 
@@ -544,6 +576,7 @@ impl RunOptions {
             quiet: run.quiet,
             checkpoint_every,
             setting: None,
+            derived: Default::default(),
         })
     }
 }
@@ -562,13 +595,20 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = spec_from(&c.common, c.n.clone(), parse_range(&c.hurst)?);
-            (
-                Kind::Curve,
-                spec,
-                &c.common.run.out,
-                RunOptions::from_args(&c.common.run)?,
-            )
+            let spec = StudySpec {
+                poisson: c.poisson,
+                ..spec_from(&c.common, c.n.clone(), parse_range(&c.hurst)?)
+            };
+            let derived = Derived::validate(c.poisson, &c.resistivity, &c.thermal_conductivity)
+                .map_err(|r| crate::request::refused(r.into()))?;
+            let options = RunOptions {
+                derived: figure::Derived {
+                    poisson: derived.tangential,
+                    transport: derived.transport,
+                },
+                ..RunOptions::from_args(&c.common.run)?
+            };
+            (Kind::Curve, spec, &c.common.run.out, options)
         }
         StudyCommand::Windows(w) => return windows(w),
         StudyCommand::Compare(c) => return crate::report::compare_study(&c.dir, c.force),

@@ -35,6 +35,10 @@ pub struct CurvePoint {
     pub force: f64,
     /// Contact stiffness dF/dd.
     pub stiffness: f64,
+    /// The tangential (no-slip) stiffness over the normal one, `(k_x + k_y)/(2k)`, where
+    /// the study asks for it ([`super::StudySpec::poisson`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_ratio: Option<f64>,
 }
 
 /// The force–stiffness curve of one realisation, sorted by increasing force.
@@ -135,6 +139,25 @@ impl SampleCurve {
         ))
     }
 
+    /// The tangential ratio at `force`, linear in `ln F` between the two loads around it
+    /// (it varies by parts in 1e-3 over the sweep); `None` outside the curve or where
+    /// either load has none.
+    pub fn tangential_ratio_at(&self, force: f64) -> Option<f64> {
+        let pts = &self.points;
+        let (first, last) = (pts.first()?, pts.last()?);
+        if !(force >= first.force && force <= last.force) {
+            return None;
+        }
+        let i = pts.partition_point(|p| p.force <= force);
+        let a = pts[i - 1];
+        if i == pts.len() || a.force == force {
+            return a.tangential_ratio;
+        }
+        let (b, (ra, rb)) = (pts[i], (a.tangential_ratio?, pts[i].tangential_ratio?));
+        let t = (force.ln() - a.force.ln()) / (b.force.ln() - a.force.ln());
+        Some(ra + t * (rb - ra))
+    }
+
     /// Forces at which the window starts and ends on this curve: the first point with at
     /// least the window's low contact fraction, and the last point not above its high one.
     pub fn window_forces(&self, window: &FitWindow) -> Option<(f64, f64)> {
@@ -174,6 +197,45 @@ pub struct EnsemblePoint {
     pub fraction: f64,
     /// Samples averaged.
     pub samples: usize,
+    /// The mean tangential ratio `(k_x + k_y)/(2k)` over samples with the 95 % interval of
+    /// the mean, where every sample has one ([`CurvePoint::tangential_ratio`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_ratio: Option<MeanInterval>,
+}
+
+/// A mean over samples with the 95 % confidence interval of the mean (Student t).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeanInterval {
+    /// The mean.
+    pub mean: f64,
+    /// Lower end of the interval.
+    pub low: f64,
+    /// Upper end of the interval.
+    pub high: f64,
+}
+
+impl MeanInterval {
+    /// The mean of `values` and the 95 % interval of the mean (zero width for one value);
+    /// `None` for none.
+    pub fn of(values: &[f64]) -> Option<MeanInterval> {
+        let m = values.len();
+        if m == 0 {
+            return None;
+        }
+        let n = m as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let half = if m > 1 {
+            let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            student_t_975(m - 1) * (var / n).sqrt()
+        } else {
+            0.0
+        };
+        Some(MeanInterval {
+            mean,
+            low: mean - half,
+            high: mean + half,
+        })
+    }
 }
 
 /// Mean curve over `samples` at `levels` log-spaced forces spanning the range that every
@@ -229,6 +291,10 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
             } else {
                 0.0
             };
+            let ratios: Option<Vec<f64>> = usable
+                .iter()
+                .map(|s| s.tangential_ratio_at(force))
+                .collect();
             EnsemblePoint {
                 force,
                 stiffness: mean,
@@ -236,6 +302,7 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
                 stiffness_high: mean + half_width,
                 fraction,
                 samples: values.len(),
+                tangential_ratio: ratios.and_then(|r| MeanInterval::of(&r)),
             }
         })
         .collect())
@@ -313,6 +380,7 @@ pub(crate) mod tests {
                     fraction: (force * 0.5).min(1.0),
                     force,
                     stiffness: c * force.powf(a),
+                    tangential_ratio: None,
                 }
             })
             .collect();
@@ -371,6 +439,7 @@ pub(crate) mod tests {
                 fraction: j as f64 / 40000.0,
                 force: (j * j) as f64,
                 stiffness: j as f64,
+                tangential_ratio: None,
             })
             .collect();
         let s = SampleCurve {

@@ -62,7 +62,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 pub use curve::{
-    ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, SampleCurve,
+    ensemble_alpha, ensemble_curve, quantile, CurvePoint, EnsemblePoint, FitWindow, MeanInterval,
+    SampleCurve,
 };
 #[allow(unused_imports)] // the crate-private items of the three, for the tests below
 use run::*;
@@ -105,6 +106,7 @@ mod tests {
             window: FitWindow::default(),
             levels: 16,
             sweep_end: None,
+            poisson: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let store = StudyDir::open(dir.path(), &spec, false).unwrap();
@@ -165,6 +167,7 @@ mod tests {
             window: FitWindow::default(),
             levels: 16,
             sweep_end: None,
+            poisson: None,
         };
         let (small, grown) = (spec(3), spec(5));
         let task = small.tasks()[0];
@@ -231,6 +234,7 @@ mod tests {
             },
             levels: 10,
             sweep_end: None,
+            poisson: None,
         }
     }
 
@@ -679,6 +683,7 @@ mod tests {
                         fraction: j as f64 / 64.0,
                         force,
                         stiffness: force.sqrt(),
+                        tangential_ratio: None,
                     }
                 })
                 .collect();

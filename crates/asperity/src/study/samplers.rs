@@ -26,6 +26,7 @@ use super::{
     run_task, CurvePoint, Method, ProgressFn, SampleCurve, Sampler, StudyDir, StudySpec, Task,
     TaskResult,
 };
+use crate::bem::tangential::TangentialStiffness;
 use crate::bem::{ContactSolver, Control, HalfSpace, Parallelism, SolverParams};
 use crate::elastic::Boundary;
 use crate::mdr::LinearCurve;
@@ -120,7 +121,9 @@ fn mdr_kept_contacts(n: usize) -> Vec<usize> {
 ///   the heights (8 B), the curve's two breakpoint buffers (16 B) and the sort's two key
 ///   buffers (16 B);
 /// * per thread, BEM: the surface generator (32 B per pixel), one generated surface
-///   (8 B) and the contact solver ([`ContactSolver::memory_bytes`], free boundaries);
+///   (8 B) and the contact solver ([`ContactSolver::memory_bytes`], free boundaries), with
+///   Cerruti's operators ([`TangentialStiffness::memory_bytes`]) in a study with a
+///   Poisson's ratio;
 /// * for the task, the curves of all its samples (kept until it ends): 24 B per point,
 ///   every kept contact count for MDR, [`BemSampler::LOADS`] loads for BEM.
 pub fn task_memory_bytes(spec: &StudySpec, task: Task, lanes: usize) -> Option<u64> {
@@ -131,11 +134,12 @@ pub fn task_memory_bytes(spec: &StudySpec, task: Task, lanes: usize) -> Option<u
             mdr_kept_contacts_len(n),
         ),
         Method::Bem => (
-            array_bytes(&[n, n], 32 + 8)?.checked_add(ContactSolver::memory_bytes(
-                n,
-                n,
-                Boundary::Free,
-            )?)?,
+            array_bytes(&[n, n], 32 + 8)?
+                .checked_add(ContactSolver::memory_bytes(n, n, Boundary::Free)?)?
+                .checked_add(match spec.poisson {
+                    Some(_) => TangentialStiffness::memory_bytes(n, n, Boundary::Free)?,
+                    None => 0,
+                })?,
             BemSampler::LOADS,
         ),
     };
@@ -259,6 +263,8 @@ pub struct BemSampler {
     surface: SurfaceSpec,
     mean_pressures: Vec<f64>,
     sweep_end: Option<f64>,
+    /// Poisson's ratio of the tangential stiffness at every load, if asked for.
+    poisson: Option<f64>,
     params: SolverParams,
     stop: crate::stop::Stop,
     on_load: Option<OnLoad>,
@@ -283,6 +289,7 @@ impl BemSampler {
             surface,
             mean_pressures,
             sweep_end: spec.sweep_end,
+            poisson: spec.poisson,
             params: bem_solver_params(),
             stop: crate::stop::Stop::new(),
             on_load: None,
@@ -317,6 +324,9 @@ pub fn sweep_ends_after(sweep_end: Option<f64>, fraction: f64) -> bool {
 pub struct BemWorker {
     generator: SurfaceGenerator,
     solver: Option<ContactSolver>,
+    /// Cerruti's operators of the grid, planned with the solver (studies with a Poisson's
+    /// ratio only).
+    tangential: Option<TangentialStiffness>,
 }
 
 impl Sampler for BemSampler {
@@ -326,6 +336,7 @@ impl Sampler for BemSampler {
         Ok(BemWorker {
             generator: SurfaceGenerator::new(&self.surface)?,
             solver: None,
+            tangential: None,
         })
     }
 
@@ -356,15 +367,27 @@ impl Sampler for BemSampler {
                 .with_stop(self.stop.clone()),
             ),
         };
+        if let (Some(poisson), None) = (self.poisson, &worker.tangential) {
+            worker.tangential = Some(TangentialStiffness::new(solver, poisson)?);
+        }
         let points_total = self.surface.rows() * self.surface.cols();
         let mut points = Vec::with_capacity(self.mean_pressures.len());
         for (i, &p) in self.mean_pressures.iter().enumerate() {
             let (summary, _) = solver.solve(Control::MeanPressure(p)).map_err(bem_error)?;
             let (stiffness, _) = solver.frozen_set_stiffness().map_err(bem_error)?;
+            // (k_x + k_y)/(2k), from the normal solution the stiffness left (warm start).
+            let tangential_ratio = match worker.tangential.as_mut() {
+                Some(t) => {
+                    let t = t.solve(solver).map_err(bem_error)?;
+                    Some((t.x + t.y) / (2.0 * stiffness))
+                }
+                None => None,
+            };
             points.push(CurvePoint {
                 fraction: summary.area_fraction,
                 force: summary.force,
                 stiffness,
+                tangential_ratio,
             });
             let past_end = sweep_ends_after(self.sweep_end, summary.area_fraction);
             // The loads not solved count as done, so that progress ends at every load.
@@ -446,6 +469,7 @@ impl Sampler for MdrSampler {
                 // there on j springs give k = E*Δx·j.
                 force: forces[j - 1],
                 stiffness: worker.curve.stiffness_with(j),
+                tangential_ratio: None,
             })
             .filter(|p| p.force > 0.0)
             .collect();
@@ -565,7 +589,7 @@ pub fn run_any_task_with_loads(
 mod tests {
     use super::*;
     use crate::study::theory::alpha_theory;
-    use crate::study::FitWindow;
+    use crate::study::{ensemble_curve, FitWindow};
 
     fn spec(method: Method, n: usize, hursts: Vec<f64>, samples: usize) -> StudySpec {
         StudySpec {
@@ -578,7 +602,60 @@ mod tests {
             window: FitWindow::default(),
             levels: 48,
             sweep_end: None,
+            poisson: None,
         }
+    }
+
+    #[test]
+    fn a_poisson_ratio_adds_the_tangential_ratio_at_every_load() {
+        // Every load of a BEM sample gets (k_x + k_y)/(2k): at least Mindlin's ratio (an
+        // exact bound on any contact set, docs/tangential.md) and within 1 % of it on a
+        // rough surface; the normal curve is that of the study without it, bit for bit;
+        // the ensemble carries the ratio's mean inside its interval.
+        let plain = StudySpec {
+            rolloff: Some(4.0),
+            ..spec(Method::Bem, 32, vec![0.5], 2)
+        };
+        let with = StudySpec {
+            poisson: Some(0.3),
+            ..plain.clone()
+        };
+        assert!(with.validate().is_ok());
+        let task = with.tasks()[0];
+        let sample = |spec: &StudySpec, seed| {
+            let sampler = BemSampler::new(spec, task).unwrap();
+            let mut worker = sampler.worker().unwrap();
+            sampler.sample(&mut worker, seed).unwrap()
+        };
+        let mindlin = 2.0 * 0.7 / 1.7;
+        let curves = [sample(&with, 7), sample(&with, 8)];
+        let without = sample(&plain, 7);
+        assert_eq!(curves[0].points.len(), without.points.len());
+        for (p, q) in curves[0].points.iter().zip(&without.points) {
+            assert_eq!((p.force, p.stiffness), (q.force, q.stiffness));
+            assert_eq!(q.tangential_ratio, None);
+            let ratio = p.tangential_ratio.unwrap();
+            assert!(
+                ratio >= mindlin * (1.0 - 1e-9) && ratio < mindlin * 1.01,
+                "{ratio}"
+            );
+        }
+        let mean = ensemble_curve(&curves, 6).unwrap();
+        for point in &mean {
+            let t = point.tangential_ratio.unwrap();
+            assert!(t.low <= t.mean && t.mean <= t.high && t.mean >= mindlin * (1.0 - 1e-9));
+        }
+        // ν outside [0, 0.5], or with MDR: refused.
+        let bad = StudySpec {
+            poisson: Some(0.6),
+            ..plain.clone()
+        };
+        assert!(bad.validate().unwrap_err().to_string().contains("[0, 0.5]"));
+        let mdr = StudySpec {
+            poisson: Some(0.3),
+            ..spec(Method::Mdr, 64, vec![0.5], 2)
+        };
+        assert!(mdr.validate().unwrap_err().to_string().contains("BEM only"));
     }
 
     fn alphas(spec: &StudySpec) -> Vec<(f64, f64)> {

@@ -282,6 +282,7 @@ mod tests {
                     fraction: 0.5 * 10f64.powf(lf),
                     force: 10f64.powf(lf),
                     stiffness: c * 10f64.powf(log_k(lf)),
+                    tangential_ratio: None,
                 }
             })
             .collect();

@@ -49,6 +49,12 @@ pub struct StudySpec {
     /// MDR samples ignore it (their whole curve costs one pass).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sweep_end: Option<f64>,
+    /// BEM: Poisson's ratio ν of the tangential (no-slip) frozen-set stiffnesses computed at
+    /// every load beside the normal one ([`crate::bem::tangential`]; each point's
+    /// [`CurvePoint::tangential_ratio`], the ensemble's [`EnsemblePoint::tangential_ratio`]);
+    /// `None`: none. MDR studies refuse it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson: Option<f64>,
 }
 
 /// A study of one MDR task, 64 samples of a line of N = 512 points at H = 0.5 without
@@ -76,6 +82,7 @@ impl Default for StudySpec {
             window: FitWindow::default(),
             levels: DEFAULT_LEVELS,
             sweep_end: None,
+            poisson: None,
         }
     }
 }
@@ -173,6 +180,13 @@ impl StudySpec {
                         crate::input::short_number(end)
                     ),
                 ));
+            }
+        }
+        if let Some(poisson) = self.poisson {
+            crate::mdr::check_poisson(poisson)?;
+            if self.method != Method::Bem {
+                let reason = "the tangential stiffness of a study is computed by BEM only";
+                return Err(Error::invalid("poisson", reason));
             }
         }
         self.ensure_size()?;

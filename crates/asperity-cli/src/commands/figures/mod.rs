@@ -87,6 +87,7 @@ fn study_spec(
         window: FitWindow::default(),
         levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
+        poisson: None,
     }
 }
 
@@ -149,6 +150,7 @@ fn figure_study(
         quiet: false,
         checkpoint_every: asperity::study::CHECKPOINT_INTERVAL,
         setting: Some(setting.name()),
+        derived: Default::default(),
     };
     execute(spec, &sub, options, kind)
 }

@@ -87,6 +87,10 @@ pub struct TaskIdentity {
     /// keep their checksums.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sweep_end: Option<f64>,
+    /// Poisson's ratio of the tangential stiffness at every load ([`StudySpec::poisson`]);
+    /// absent (none) in older checkpoints, which keep their checksums.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson: Option<f64>,
 }
 
 impl TaskIdentity {
@@ -109,6 +113,7 @@ impl TaskIdentity {
                 Method::Mdr => None,
             },
             sweep_end: spec.sweep_end,
+            poisson: spec.poisson,
         }
     }
 
@@ -267,8 +272,34 @@ mod tests {
             window: FitWindow::default(),
             levels: 10,
             sweep_end: None,
+            poisson: None,
         };
         TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 })
+    }
+
+    #[test]
+    fn a_poisson_ratio_is_part_of_the_identity_and_none_leaves_it_as_before() {
+        // Without one the identity has no `poisson` key: older checkpoints keep their
+        // checksums. With one, a study of another ν (or none) is another study.
+        let plain = identity();
+        let text = serde_json::to_string(&plain).unwrap();
+        assert!(!text.contains("poisson"), "{text}");
+        let spec = StudySpec {
+            method: Method::Bem,
+            sizes: vec![16],
+            hursts: vec![0.5],
+            samples: 2,
+            rolloff: Some(2.0),
+            seed: 11,
+            window: FitWindow::default(),
+            levels: 10,
+            sweep_end: None,
+            poisson: Some(0.3),
+        };
+        let with = TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 });
+        let differences = with.differences(&plain);
+        assert_eq!(differences.len(), 1, "{differences:?}");
+        assert!(differences[0].starts_with("poisson"), "{differences:?}");
     }
 
     /// Inputs tried by the property test below.

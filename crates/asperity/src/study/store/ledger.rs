@@ -215,6 +215,7 @@ mod tests {
             window: FitWindow::default(),
             levels: 12,
             sweep_end: None,
+            poisson: None,
         }
     }
 

@@ -189,6 +189,7 @@ impl StudyDir {
         }
         let whole = StudySpec {
             sweep_end: None,
+            poisson: None,
             ..spec.clone()
         };
         let resumes = matches!(
