@@ -816,8 +816,6 @@ class Solver:
         modulus = effective_modulus(modulus=modulus, young=young, poisson=poisson)
         if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations:
             raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
-        if max_iterations < 0:
-            raise ValueError(f"max_iterations must be at least 1, got {max_iterations}")
         self._core = _core.Solver(
             heights, size_x, size_y, float(modulus), str(boundary), float(tolerance),
             int(max_iterations), str(solver), _opt(hardness),
@@ -1076,8 +1074,8 @@ def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, flo
 def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) -> Tuple[str, List[float]]:
     def values(v):
         return None if v is None else [float(x) for x in np.atleast_1d(np.asarray(v, dtype=np.float64))]
-    if nloads is not None and (isinstance(nloads, bool) or int(nloads) != nloads or nloads < 0):
-        raise ValueError(f"nloads must be a count, got {nloads!r}")
+    if nloads is not None and (isinstance(nloads, bool) or int(nloads) != nloads):
+        raise ValueError(f"nloads must be an integer, got {nloads!r}")
     return _core.sweep_loads(
         values(forces), values(pressures), values(indentations),
         None if nloads is None else int(nloads), _opt(pmin), _opt(pmax), bool(fields),
@@ -1571,8 +1569,8 @@ def persson(
     heights, size_x, size_y = _surface_input(surface, size)
     values = None if pressures is None else [
         float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
-    if nloads is not None and (isinstance(nloads, bool) or int(nloads) != nloads or nloads < 0):
-        raise ValueError(f"nloads must be a count, got {nloads!r}")
+    if nloads is not None and (isinstance(nloads, bool) or int(nloads) != nloads):
+        raise ValueError(f"nloads must be an integer, got {nloads!r}")
     table = _core.persson_table(
         heights, size_x, size_y, float(modulus), float(gamma), float(kappa), values,
         None if nloads is None else int(nloads), _opt(pmin), _opt(pmax),

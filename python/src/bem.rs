@@ -12,11 +12,13 @@ use asperity::bem::{load_path, ContactSolver, Control, Interface, PathPoint, Sol
 use asperity::elastic::Boundary;
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
+use asperity_app::bem::params;
 use asperity_app::bem::{
     branches, check_capped_loads, check_fd_step, ensure_solver_fits, Loads, SolverRequest,
 };
 use asperity_app::derived::{Derived, Units};
 use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
+use asperity_app::refusal::count;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -40,11 +42,12 @@ fn sweep_loads(
     forces: Option<Vec<f64>>,
     pressures: Option<Vec<f64>>,
     indentations: Option<Vec<f64>>,
-    nloads: Option<usize>,
+    nloads: Option<i64>,
     pmin: Option<f64>,
     pmax: Option<f64>,
     fields: bool,
 ) -> PyResult<(&'static str, Vec<f64>)> {
+    let nloads = (nloads.map(|n| count(params::NLOADS, n)).transpose()).map_err(refused)?;
     let loads = Loads::from_options(forces, pressures, indentations, nloads, (pmin, pmax))
         .map_err(refused)?;
     let controls = loads.controls(fields).map_err(request_error)?;
@@ -153,7 +156,7 @@ impl Solver {
         modulus: f64,
         boundary: &str,
         tolerance: f64,
-        max_iterations: usize,
+        max_iterations: i64,
         solver: &str,
         hardness: Option<f64>,
     ) -> PyResult<Self> {
@@ -162,7 +165,7 @@ impl Solver {
             boundary: boundary.into(),
             solver: solver.into(),
             tolerance,
-            max_iterations,
+            max_iterations: count(params::MAX_ITER, max_iterations).map_err(refused)?,
             hardness,
         };
         let plan = request.validate().map_err(refused)?;

@@ -7,7 +7,8 @@
 //! so the numbers are the CLI's.
 
 use asperity::mdr::{CurvePoint, Spring, SpringLaw};
-use asperity_app::mdr::{Branch, Indenter, MdrRequest};
+use asperity_app::mdr::{params, Branch, Indenter, MdrRequest};
+use asperity_app::refusal::count;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
@@ -108,7 +109,10 @@ pub fn request<'py>(
         rms_height: item(keywords, "rms_height")?,
         asperity_radius: item(keywords, "asperity_radius")?,
         indentations: item(keywords, "indentations")?,
-        nloads: item(keywords, "nloads")?,
+        nloads: (item::<i64>(keywords, "nloads")?)
+            .map(|n| count(params::NLOADS, n))
+            .transpose()
+            .map_err(refused)?,
         dmin: item(keywords, "dmin")?,
         dmax: item(keywords, "dmax")?,
         breakpoints: item(keywords, "breakpoints")?.unwrap_or(defaults.breakpoints),

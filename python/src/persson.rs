@@ -4,13 +4,14 @@
 
 use asperity::persson::PerssonParams;
 use asperity::surface::Surface;
-use asperity_app::persson::{self, compute, PerssonRequest, COLUMNS};
+use asperity_app::persson::{self, compute, params, PerssonRequest, COLUMNS};
+use asperity_app::refusal::count;
 use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::arrays::owned_2d;
-use crate::errors::{from_error, request_error};
+use crate::errors::{from_error, refused, request_error};
 use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -34,10 +35,11 @@ fn persson_table<'py>(
     gamma: f64,
     kappa: f64,
     pressures: Option<Vec<f64>>,
-    nloads: Option<usize>,
+    nloads: Option<i64>,
     pmin: Option<f64>,
     pmax: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let nloads = (nloads.map(|n| count(params::NLOADS, n)).transpose()).map_err(refused)?;
     let pressures = persson::pressures(pressures, nloads, pmin, pmax).map_err(request_error)?;
     let request = PerssonRequest {
         params: PerssonParams {

@@ -138,6 +138,24 @@ impl From<Refusal> for RequestError {
     }
 }
 
+/// A count as a front end holds it, signed (a flag's text, a Python int), as a request's
+/// `usize`: a negative one is refused in the words of the requests' rule for 0, so that
+/// `--max-iter -1` and `max_iterations=-1` are refused alike (every count of a request is
+/// at least 1; 0 is refused by the request's own rule).
+///
+/// ```
+/// use asperity_app::refusal::{count, Names, Param};
+///
+/// const NLOADS: Param = Param::new("--nloads", "nloads");
+/// assert_eq!(count(NLOADS, 3).unwrap(), 3);
+/// let refusal = count(NLOADS, -2).unwrap_err();
+/// assert_eq!(refusal.words(Names::Keywords), "nloads must be at least 1, got -2");
+/// ```
+pub fn count(param: Param, value: i64) -> Result<usize, Refusal> {
+    usize::try_from(value)
+        .map_err(|_| Refusal::of(param).text(format!(" must be at least 1, got {value}")))
+}
+
 impl fmt::Display for Refusal {
     /// The CLI's words (flags); Python renders [`Refusal::words`] with [`Names::Keywords`].
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

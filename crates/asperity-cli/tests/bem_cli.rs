@@ -1070,10 +1070,13 @@ fn bad_numbers_name_their_flag() {
             "invalid --size 0: sizes must be positive and finite",
         ),
         (&["--size", "nan"][..], "--size"),
-        (&["--max-iter", "-1"][..], "--max-iter"),
+        (
+            &["--max-iter", "-1"][..],
+            "--max-iter must be at least 1, got -1",
+        ),
         (
             &["--nloads", "-1", "--pmin", "1", "--pmax", "2"][..],
-            "--nloads",
+            "--nloads must be at least 1, got -1",
         ),
     ] {
         let mut args = vec!["bem", "--surface", s];

@@ -16,10 +16,12 @@ use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::{
-    bookkeeping_bytes, ensure_solver_fits, BemPlan, BemRequest, Loads, SolverRequest, FD_STEP,
+    bookkeeping_bytes, ensure_solver_fits, params, BemPlan, BemRequest, Loads, SolverRequest,
+    FD_STEP,
 };
 use asperity_app::derived::{Derived, Units};
 use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
+use asperity_app::refusal::count;
 use serde_json::json;
 
 use super::measured::{open_argument, parse_size, MeasuredArgs};
@@ -103,7 +105,7 @@ pub struct BemArgs {
     pub indentations: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
-    pub nloads: Option<usize>,
+    pub nloads: Option<i64>,
     /// Smallest mean pressure for --nloads.
     #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
@@ -120,8 +122,8 @@ pub struct BemArgs {
     #[arg(long, default_value_t = SolverRequest::default().solver)]
     pub solver: String,
     /// Maximum solver iterations per load.
-    #[arg(long, default_value_t = SolverRequest::default().max_iterations, allow_hyphen_values = true)]
-    pub max_iter: usize,
+    #[arg(long, default_value_t = SolverRequest::default().max_iterations as i64, allow_hyphen_values = true)]
+    pub max_iter: i64,
     /// Cap the contact pressure at this hardness (in the units of the pressures and
     /// --modulus: E* units by default): elastic–perfectly-plastic contact
     /// (docs/hardness.md), with either solver; adds the column plastic_fraction. Each
@@ -483,7 +485,7 @@ pub(super) fn request(args: &BemArgs) -> Result<BemRequest> {
         args.forces.clone(),
         args.pressures.clone(),
         args.indentations.clone(),
-        args.nloads,
+        args.nloads.map(|n| count(params::NLOADS, n)).transpose()?,
         (args.pmin, args.pmax),
     )?;
     Ok(BemRequest {
@@ -492,7 +494,7 @@ pub(super) fn request(args: &BemArgs) -> Result<BemRequest> {
             boundary: args.boundary.clone(),
             solver: args.solver.clone(),
             tolerance: args.tol,
-            max_iterations: args.max_iter,
+            max_iterations: count(params::MAX_ITER, args.max_iter)?,
             hardness: args.hardness,
         },
         loads,

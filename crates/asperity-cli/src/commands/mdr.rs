@@ -12,7 +12,8 @@ use asperity::mdr::{CurvePoint, PullOffs, Spring, SpringLaw};
 use asperity::reference::Jkr;
 use asperity::topography::Heights;
 use asperity_app::argument::{Arrays, Dims};
-use asperity_app::mdr::{Branch, Indenter, MdrRequest, ADHESIVE_COLUMNS, COLUMNS};
+use asperity_app::mdr::{params, Branch, Indenter, MdrRequest, ADHESIVE_COLUMNS, COLUMNS};
+use asperity_app::refusal::count;
 
 use crate::request::refused;
 
@@ -99,8 +100,8 @@ pub struct MdrArgs {
     #[arg(long, value_delimiter = ',', num_args = 1.., allow_negative_numbers = true)]
     pub indentations: Option<Vec<f64>>,
     /// Number of log-spaced indentations from --dmin to --dmax (default 50).
-    #[arg(long)]
-    pub nloads: Option<usize>,
+    #[arg(long, allow_hyphen_values = true)]
+    pub nloads: Option<i64>,
     /// Smallest indentation for --nloads (default --dmax · 1e-6).
     #[arg(long, allow_hyphen_values = true)]
     pub dmin: Option<f64>,
@@ -162,8 +163,8 @@ pub struct MdrArgs {
 const ROW_BYTES: usize = 24 + 4 * 24 + 4 * 32 + 4 * 24;
 
 /// The request of the arguments (the line or radial samples themselves are read apart).
-fn request(args: &MdrArgs) -> MdrRequest {
-    MdrRequest {
+fn request(args: &MdrArgs) -> Result<MdrRequest> {
+    Ok(MdrRequest {
         line: args.line.is_some(),
         profile: args.profile.clone(),
         radial: args.radial.is_some(),
@@ -181,12 +182,12 @@ fn request(args: &MdrArgs) -> MdrRequest {
         rms_height: args.rms_height,
         asperity_radius: args.asperity_radius,
         indentations: args.indentations.clone(),
-        nloads: args.nloads,
+        nloads: args.nloads.map(|n| count(params::NLOADS, n)).transpose()?,
         dmin: args.dmin,
         dmax: args.dmax,
         breakpoints: args.breakpoints,
         work_of_adhesion: args.work_of_adhesion,
-    }
+    })
 }
 
 /// The line of `--line` through the front-end layer's one call: a measured profile (any
@@ -311,7 +312,7 @@ fn check_plot(args: &MdrArgs) -> Result<()> {
         return Ok(());
     }
     let count = match (&args.indentations, args.nloads) {
-        (Some(list), _) => list.len(),
+        (Some(list), _) => list.len() as i64,
         (None, Some(n)) if !args.breakpoints => n,
         _ => 2,
     };
@@ -372,7 +373,7 @@ fn adhesion_record(w: f64, pull_offs: Option<&PullOffs>) -> serde_json::Value {
 /// Runs `asperity mdr`: check, compute, then write every output together.
 pub fn run(args: &MdrArgs) -> Result<()> {
     // Every output is checked before any work, and all are written together at the end.
-    let request = request(args);
+    let request = request(args)?;
     request.check()?;
     if args.tangential_force.is_some() {
         return super::mdr_slip::run(args, &request);

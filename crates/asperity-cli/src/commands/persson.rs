@@ -11,7 +11,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use asperity::persson::PerssonParams;
 use asperity::surface::Surface;
-use asperity_app::persson::{compute, pressures, PerssonRequest, COLUMNS};
+use asperity_app::persson::{compute, params, pressures, PerssonRequest, COLUMNS};
+use asperity_app::refusal::count;
 
 use super::measured::{open_argument, parse_size, MeasuredArgs};
 use crate::output::Table;
@@ -51,8 +52,8 @@ pub struct PerssonArgs {
     )]
     pub pressures: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
-    #[arg(long, value_name = "K")]
-    pub nloads: Option<usize>,
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub nloads: Option<i64>,
     /// Smallest mean pressure for --nloads.
     #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
@@ -82,8 +83,13 @@ pub fn run(args: &PerssonArgs) -> Result<()> {
             gamma: args.gamma,
             kappa: args.kappa,
         },
-        pressures: pressures(args.pressures.clone(), args.nloads, args.pmin, args.pmax)
-            .map_err(refused)?,
+        pressures: pressures(
+            args.pressures.clone(),
+            args.nloads.map(|n| count(params::NLOADS, n)).transpose()?,
+            args.pmin,
+            args.pmax,
+        )
+        .map_err(refused)?,
     };
     request.validate().map_err(refused)?;
     let surface = read_surface(args)?;
