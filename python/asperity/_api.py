@@ -1788,7 +1788,8 @@ def study_curve(
     ``asperity study curve`` (same folder, checkpoints and numbers; see
     :func:`study_alpha`). Returns the rows of ``curve.csv``: ``force``, ``stiffness``
     (mean), ``stiffness_low``/``stiffness_high`` (95 % interval of the mean),
-    ``samples``, ``area_fraction``, per (method, n, hurst).
+    ``samples``, ``area_fraction`` (mean) with ``area_fraction_low``/``area_fraction_high``
+    (95 % interval of the mean), per (method, n, hurst).
 
     BEM only: ``poisson`` (ν) adds the tangential (no-slip) stiffness at every load,
     ``tangential_ratio`` = (k_x + k_y)/(2k) with ``tangential_ratio_low``/``_high``;

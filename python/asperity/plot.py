@@ -22,8 +22,8 @@ Every figure here but :func:`field` is defined once, in the library's front-end 
 for the CLI and the package: the same series, theory curves, intervals, images, scale
 bars, labels and titles as the CLI's PNG (``asperity_app::figure``; ``--plot FILE.json``
 writes that definition); the package draws it with matplotlib. (The ensemble-mean A/A₀(F)
-of a study, :func:`area` of a ``study_curve`` result, is defined there too, though the CLI
-tabulates it in ``curve.csv`` without drawing it.)
+of a study with its interval, :func:`area` of a ``study_curve`` result, is defined there
+too, though the CLI tabulates it in ``curve.csv`` without drawing it.)
 
 Example::
 
@@ -346,9 +346,9 @@ def area(result: Any, ax=None):
     """The contact area against force, log–log, by the library's figure definitions: a
     ``Solver.sweep``'s fraction A/A₀ as ``asperity bem --plot`` draws it, an
     :func:`~asperity.contact` sweep's true area in m² as ``asperity contact --plot`` draws
-    it, or a :func:`~asperity.study_curve` result's ensemble-mean A/A₀ per task (the
-    ``area_fraction`` column of ``curve.csv``; no band: the study records no interval of
-    the fraction)."""
+    it, or a :func:`~asperity.study_curve` result's ensemble-mean A/A₀ per task with the
+    95 % interval of the mean as a band (``area_fraction``, ``area_fraction_low`` and
+    ``area_fraction_high`` of ``curve.csv``)."""
     from . import StudyResult
 
     if isinstance(result, StudyResult):

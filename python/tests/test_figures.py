@@ -235,8 +235,8 @@ def test_a_contact_sweeps_panels_are_the_clis_bit_for_bit(cli, tmp_path):
 def test_a_study_curves_k_and_area_are_curve_csv_with_its_intervals(cli, tmp_path):
     # The Python study's k(F) and A/A₀(F) are built by the CLI's builder module from the
     # task results; the CLI resuming the same folder writes curve.csv from the same
-    # results: the drawn points, the bands (95 % interval of the mean) and the area are
-    # that table's columns.
+    # results: the drawn points and their bands (95 % intervals of the means) are that
+    # table's columns.
     study = asperity.study_curve(method="mdr", n=256, hurst=[0.25, 0.75], samples=3,
                                  out=tmp_path / "c")
     cli("study", "curve", "--method", "mdr", "--n", "256", "--hurst", "0.25,0.75",
@@ -254,11 +254,16 @@ def test_a_study_curves_k_and_area_are_curve_csv_with_its_intervals(cli, tmp_pat
                                         for r in mine]
         assert a_series["points"] == [[float(r["force"]), float(r["area_fraction"])]
                                       for r in mine]
+        assert a_series["interval"] == [[float(r["area_fraction_low"]),
+                                         float(r["area_fraction_high"])] for r in mine]
+        widths = [float(r["area_fraction_high"]) - float(r["area_fraction_low"]) for r in mine]
+        assert min(widths) >= 0 and sum(w > 0 for w in widths) > len(widths) // 2
     assert k_chart["series"][-1]["label"] == "slope 1 (k ∝ F)"
-    # Drawn: one band per curve under k(F); the area's lines are the fractions.
+    # Drawn: one band per curve under k(F) and under A/A₀(F); the lines are the means.
     ax = asperity.plot.stiffness(study)
     assert len(ax.collections) == 2
     ax = asperity.plot.area(study)
+    assert len(ax.collections) == 2
     assert ax.get_yscale() == "log" and ax.get_ylabel() == area_chart["y_label"]
     np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(),
                                   [p[1] for p in area_chart["series"][0]["points"]])

@@ -321,6 +321,8 @@ mod tests {
             stiffness_low: low,
             stiffness_high: 2.0,
             fraction: 0.1,
+            fraction_low: 0.1,
+            fraction_high: 0.1,
             samples: 3,
             tangential_ratio: None,
         };

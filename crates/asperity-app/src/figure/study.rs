@@ -227,8 +227,7 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
 }
 
 /// Log–log A/A₀(F): the ensemble-mean contact fraction of each task against the force,
-/// coloured by H as [`curve_chart`] (no band: the study records no interval of the
-/// fraction).
+/// coloured by H as [`curve_chart`], with the 95 % interval of the mean as a band.
 pub fn area_chart(results: &[TaskResult], title: &str) -> Chart {
     let (hmin, hmax) = results
         .iter()
@@ -244,12 +243,21 @@ pub fn area_chart(results: &[TaskResult], title: &str) -> Chart {
                 0.5
             };
             let points = r.mean_curve.iter().map(|p| (p.force, p.fraction));
-            Series::new(
+            let line = Series::new(
                 format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
                 points.collect(),
                 Style::Line,
             )
-            .color(Color::Ordered(t * 0.9))
+            .color(Color::Ordered(t * 0.9));
+            if r.samples > 1 {
+                let interval = r
+                    .mean_curve
+                    .iter()
+                    .map(|p| (p.fraction_low, p.fraction_high));
+                line.interval(interval.collect())
+            } else {
+                line
+            }
         })
         .collect();
     let scale = match results.first().map(|r| r.method) {
@@ -259,7 +267,7 @@ pub fn area_chart(results: &[TaskResult], title: &str) -> Chart {
     Chart {
         title: title.into(),
         x_label: format!("normal force F ({scale})"),
-        y_label: "contact fraction A/A₀ (ensemble mean)".into(),
+        y_label: "contact fraction A/A₀ (band: 95 % interval of the mean)".into(),
         log_x: true,
         log_y: true,
         series,
@@ -449,6 +457,8 @@ mod tests {
             stiffness_low: force,
             stiffness_high: 3.0 * force,
             fraction: 0.1,
+            fraction_low: 0.09,
+            fraction_high: 0.11,
             samples: 4,
             tangential_ratio: ratio.map(|mean| MeanInterval {
                 mean,

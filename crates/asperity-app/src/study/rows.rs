@@ -68,6 +68,8 @@ pub const CURVE_COLUMNS: &[(&str, ColumnType)] = &[
     ("stiffness_high", Number),
     ("samples", Count),
     ("area_fraction", Number),
+    ("area_fraction_low", Number),
+    ("area_fraction_high", Number),
 ];
 
 /// The columns of `comparison.csv` ([`asperity::study::compare::Row`], in its order): the
@@ -153,6 +155,8 @@ pub fn curve_table_with(results: &[TaskResult], transport: &Transport) -> Table 
                     Cell::Number(Some(p.stiffness_high)),
                     Cell::Count(p.samples),
                     Cell::Number(Some(p.fraction)),
+                    Cell::Number(Some(p.fraction_low)),
+                    Cell::Number(Some(p.fraction_high)),
                 ];
                 if tangential {
                     let t = p.tangential_ratio;
@@ -221,6 +225,8 @@ mod tests {
             stiffness_low: 2.5,
             stiffness_high: 3.5,
             fraction: 0.1,
+            fraction_low: 0.08,
+            fraction_high: 0.12,
             samples: 4,
             tangential_ratio: None,
         };

@@ -181,8 +181,8 @@ impl SampleCurve {
     }
 }
 
-/// One common force level of an ensemble: mean stiffness with its 95 % confidence
-/// interval (Student t over samples) and the mean contact fraction.
+/// One common force level of an ensemble: mean stiffness and mean contact fraction, each
+/// with its 95 % confidence interval (Student t over samples).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EnsemblePoint {
     /// Force level.
@@ -195,6 +195,10 @@ pub struct EnsemblePoint {
     pub stiffness_high: f64,
     /// Mean contact fraction.
     pub fraction: f64,
+    /// Lower end of the 95 % confidence interval of the mean contact fraction.
+    pub fraction_low: f64,
+    /// Upper end of the 95 % confidence interval of the mean contact fraction.
+    pub fraction_high: f64,
     /// Samples averaged.
     pub samples: usize,
     /// The mean tangential ratio `(k_x + k_y)/(2k)` over samples with the 95 % interval of
@@ -272,7 +276,6 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
             "the samples' force ranges do not overlap",
         ));
     }
-    let n = usable.len() as f64;
     Ok((0..levels)
         .map(|i| {
             let force = if i + 1 == levels {
@@ -283,14 +286,8 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
                     .clamp(lo, hi)
             };
             let values: Vec<(f64, f64)> = usable.iter().filter_map(|s| s.at_force(force)).collect();
-            let mean = values.iter().map(|v| v.0).sum::<f64>() / n;
-            let fraction = values.iter().map(|v| v.1).sum::<f64>() / n;
-            let half_width = if usable.len() > 1 {
-                let var = values.iter().map(|v| (v.0 - mean).powi(2)).sum::<f64>() / (n - 1.0);
-                student_t_975(usable.len() - 1) * (var / n).sqrt()
-            } else {
-                0.0
-            };
+            let (mean, k_half) = mean_interval(values.iter().map(|v| v.0), usable.len());
+            let (fraction, a_half) = mean_interval(values.iter().map(|v| v.1), usable.len());
             let ratios: Option<Vec<f64>> = usable
                 .iter()
                 .map(|s| s.tangential_ratio_at(force))
@@ -298,14 +295,28 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
             EnsemblePoint {
                 force,
                 stiffness: mean,
-                stiffness_low: mean - half_width,
-                stiffness_high: mean + half_width,
+                stiffness_low: mean - k_half,
+                stiffness_high: mean + k_half,
                 fraction,
+                fraction_low: fraction - a_half,
+                fraction_high: fraction + a_half,
                 samples: values.len(),
                 tangential_ratio: ratios.and_then(|r| MeanInterval::of(&r)),
             }
         })
         .collect())
+}
+
+/// The mean of `values` over `count` samples and the half-width of its 95 % confidence
+/// interval (Student t with `count − 1` degrees of freedom; zero for one sample).
+fn mean_interval(values: impl Iterator<Item = f64> + Clone, count: usize) -> (f64, f64) {
+    let n = count as f64;
+    let mean = values.clone().sum::<f64>() / n;
+    if count < 2 {
+        return (mean, 0.0);
+    }
+    let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, student_t_975(count - 1) * (var / n).sqrt())
 }
 
 /// α of the ensemble: the mean stiffness over samples at `levels` log-spaced forces
@@ -409,6 +420,47 @@ pub(crate) mod tests {
             assert!(mean
                 .iter()
                 .all(|p| p.stiffness_low <= p.stiffness && p.stiffness <= p.stiffness_high));
+            // The samples share their fractions: the fraction's interval has no width.
+            assert!(mean
+                .iter()
+                .all(|p| p.fraction_low == p.fraction && p.fraction_high == p.fraction));
+        }
+    }
+
+    #[test]
+    fn the_fraction_interval_is_students_t_of_the_sample_fractions() {
+        // Three samples with fractions 0.5F, 0.6F, 1.0F (below 1): mean 0.7F, sample
+        // standard deviation 0.2646F, t(0.975, 2) = 4.303 (the library's table, to 3
+        // decimals), so a half-width of F · 4.303 · 0.2646/√3.
+        let scaled = |c: f64| SampleCurve {
+            points: synthetic(0.5, 1.0, 1 << 14)
+                .points
+                .into_iter()
+                .map(|p| CurvePoint {
+                    fraction: (c * p.force).min(1.0),
+                    ..p
+                })
+                .collect(),
+            points_total: 1 << 14,
+            piecewise_constant: false,
+        };
+        let samples = [scaled(0.5), scaled(0.6), scaled(1.0)];
+        let mean = ensemble_curve(&samples, 20).unwrap();
+        let sd = ((0.04f64 + 0.01 + 0.09) / 2.0).sqrt();
+        for p in mean.iter().filter(|p| p.force < 0.5) {
+            let half = 4.303 * sd / 3f64.sqrt() * p.force;
+            assert!(
+                (p.fraction - 0.7 * p.force).abs() < 1e-12 * p.force,
+                "{p:?}"
+            );
+            assert!(
+                (p.fraction_high - p.fraction - half).abs() < 1e-9 * half,
+                "{p:?}"
+            );
+            assert!(
+                (p.fraction - p.fraction_low - half).abs() < 1e-9 * half,
+                "{p:?}"
+            );
         }
     }
 
