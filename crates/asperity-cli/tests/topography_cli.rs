@@ -244,6 +244,68 @@ fn stats_writes_the_variable_bandwidth_analysis() {
 }
 
 #[test]
+fn stats_writes_height_slope_and_curvature_distributions() {
+    let dir = tempfile::tempdir().unwrap();
+    // Heights 0, 1, ..., 99: ⌊√100⌋ = 10 bins of width 9.9, ten heights each.
+    let h = ndarray::Array2::from_shape_fn((10, 10), |(r, c)| (r * 10 + c) as f64);
+    ndarray_npy::write_npy(dir.path().join("ramp.npy"), &h).unwrap();
+    let args = [
+        "stats",
+        "ramp.npy",
+        "--size",
+        "1",
+        "--height-distribution",
+        "h.csv",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let rows = numeric_csv(&dir.path().join("h.csv"), "height,density");
+    assert_eq!(rows.len(), 10);
+    for (k, row) in rows.iter().enumerate() {
+        assert!((row[0] - (k as f64 + 0.5) * 9.9).abs() < 1e-9, "{row:?}");
+        assert!((row[1] - 10.0 / (100.0 * 9.9)).abs() < 1e-12, "{row:?}");
+    }
+    // h = c² on 11 columns, Δx = 1/11 (size 1): the slopes (2c + 1)/Δx, c = 0..9, twelve
+    // rows of each; ⌊√120⌋ = 10 bins of width 18/(10Δx) hold one slope value each: density
+    // 12/(120 · 1.8/Δx) = Δx/18. The second differences are exactly 2 (integers).
+    let dx = 1.0 / 11.0;
+    let q = ndarray::Array2::from_shape_fn((12, 11), |(_, c)| (c * c) as f64);
+    ndarray_npy::write_npy(dir.path().join("q.npy"), &q).unwrap();
+    let args = [
+        "stats",
+        "q.npy",
+        "--size",
+        "1",
+        "--slope-distribution",
+        "s.csv",
+    ];
+    ok(&asperity(&args, dir.path()));
+    let rows = numeric_csv(&dir.path().join("s.csv"), "slope,density");
+    assert_eq!(rows.len(), 10);
+    for (k, row) in rows.iter().enumerate() {
+        let centre = (1.0 + (k as f64 + 0.5) * 1.8) / dx;
+        assert!((row[0] - centre).abs() < 1e-12 * centre, "{row:?}");
+        assert!((row[1] - dx / 18.0).abs() < 1e-9 * dx, "{row:?}");
+    }
+    // Its curvatures are all 2: a distribution of no width is refused, nothing written.
+    let args = [
+        "stats",
+        "q.npy",
+        "--size",
+        "1",
+        "--curvature-distribution",
+        "c.csv",
+    ];
+    let out = asperity(&args, dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("curvature distribution"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.path().join("c.csv").exists());
+}
+
+#[test]
 fn bad_files_give_one_line_and_exit_2() {
     let Some(shared) = shared() else { return };
     let dir = tempfile::tempdir().unwrap();

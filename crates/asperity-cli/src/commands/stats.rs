@@ -85,6 +85,20 @@ pub struct StatsArgs {
     /// SurfaceTopography's scale_dependent_slope_from_profile on the scan's grid).
     #[arg(long, value_name = "OUT.csv")]
     pub scale_dependent_slope: Option<PathBuf>,
+    /// Write the height distribution as CSV with columns height (bin centre) and density
+    /// (count / (n · bin width): it integrates to 1), over ⌊√n⌋ equal bins (10 to 100) from
+    /// the lowest to the highest defined height.
+    #[arg(long, value_name = "OUT.csv")]
+    pub height_distribution: Option<PathBuf>,
+    /// Write the distribution of the slopes along x, (h[i+1] − h[i])/Δx within each row, as
+    /// CSV with columns slope and density (bins as --height-distribution).
+    #[arg(long, value_name = "OUT.csv")]
+    pub slope_distribution: Option<PathBuf>,
+    /// Write the distribution of the curvatures along x, (h[i+1] − 2h[i] + h[i−1])/Δx²
+    /// within each row, as CSV with columns curvature and density (bins as
+    /// --height-distribution).
+    #[arg(long, value_name = "OUT.csv")]
+    pub curvature_distribution: Option<PathBuf>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -93,7 +107,7 @@ pub struct StatsArgs {
     #[arg(long)]
     pub json: bool,
     /// Overwrite existing outputs (--psd, --bearing-area, --acf, --variable-bandwidth,
-    /// --scale-dependent-slope, --plot).
+    /// --scale-dependent-slope, the distributions, --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -216,7 +230,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     let outputs = (args.psd.iter().chain(&args.bearing_area))
         .chain(args.acf.iter().chain(&args.plot))
         .chain(&args.variable_bandwidth)
-        .chain(&args.scale_dependent_slope);
+        .chain(&args.scale_dependent_slope)
+        .chain(&args.height_distribution)
+        .chain(&args.slope_distribution)
+        .chain(&args.curvature_distribution);
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     let (source, record) = open_source(args, size)?;
@@ -229,6 +246,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     } else {
         None
     };
+    let distributions = distributions(args, &source)?;
     let bandwidth = match &args.variable_bandwidth {
         Some(path) => Some((path, variable_bandwidth(&source)?)),
         None => None,
@@ -242,6 +260,9 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let (Some(path), Some(rows)) = (&args.scale_dependent_slope, &acf) {
         let slope = asperity::topography::stats::scale_dependent_slope(rows);
         stage_pairs(&mut staged, path, ["distance", "slope"], &slope)?;
+    }
+    for (path, name, rows) in &distributions {
+        stage_pairs(&mut staged, path, [name, "density"], rows)?;
     }
     if let Some((path, rows)) = &bandwidth {
         stage_pairs(&mut staged, path, ["bandwidth", "rms_height"], rows)?;
@@ -270,8 +291,8 @@ fn bearing_curve(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
     )?)
 }
 
-/// The height-difference ACF along x as `(distance, A)`: a line is one row.
-fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+/// The heights as rows along x (a line is one row) and the spacing Δx.
+fn rows_along_x(source: &StatsSource) -> Result<(ndarray::Array2<f64>, f64)> {
     use ndarray::{Array2, Axis, Ix1, Ix2};
     let (rows, size_x): (Array2<f64>, f64) = match source {
         StatsSource::Grid { heights, size, .. } => match heights.ndim() {
@@ -294,6 +315,12 @@ fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
         },
     };
     let dx = size_x / rows.ncols() as f64;
+    Ok((rows, dx))
+}
+
+/// The height-difference ACF along x as `(distance, A)`: a line is one row.
+fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    let (rows, dx) = rows_along_x(source)?;
     let acf = asperity::topography::stats::height_difference_acf(rows.view())?;
     Ok(acf.into_iter().map(|(k, a)| (k as f64 * dx, a)).collect())
 }
@@ -324,6 +351,41 @@ fn variable_bandwidth(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
         },
     };
     Ok(out.iter().map(|b| (b.bandwidth, b.rms_height)).collect())
+}
+
+/// The bins of the distributions: ⌊√n⌋ for n values, at least 10 and at most 100.
+fn distribution_bins(n: usize) -> usize {
+    ((n as f64).sqrt() as usize).clamp(10, 100)
+}
+
+/// One requested distribution: its output, the name of its value column and its
+/// `(value, density)` rows.
+type Distribution = (PathBuf, &'static str, Vec<(f64, f64)>);
+
+/// The requested distributions (`--height-`, `--slope-`, `--curvature-distribution`).
+fn distributions(args: &StatsArgs, source: &StatsSource) -> Result<Vec<Distribution>> {
+    use asperity::topography::stats::{distribution, slopes_and_curvatures_along_x};
+    let wanted = [
+        (&args.height_distribution, "height"),
+        (&args.slope_distribution, "slope"),
+        (&args.curvature_distribution, "curvature"),
+    ];
+    if wanted.iter().all(|(path, _)| path.is_none()) {
+        return Ok(Vec::new());
+    }
+    let (rows, dx) = rows_along_x(source)?;
+    let (slopes, curvatures) = slopes_and_curvatures_along_x(rows.view(), dx);
+    let heights: Vec<f64> = rows.iter().copied().filter(|v| !v.is_nan()).collect();
+    let mut out = Vec::new();
+    for ((path, name), values) in wanted.into_iter().zip([heights, slopes, curvatures]) {
+        if let Some(path) = path {
+            let bins = distribution_bins(values.len());
+            let table =
+                distribution(values, bins).with_context(|| format!("the {name} distribution"))?;
+            out.push((path.clone(), name, table));
+        }
+    }
+    Ok(out)
 }
 
 /// Stages a two-column table.

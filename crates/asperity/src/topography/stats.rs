@@ -345,6 +345,63 @@ pub fn bearing_area_curve(
         .collect())
 }
 
+/// The probability density of `values` (NaN left out) as `(bin centre, density)` over
+/// `bins` equal bins from the smallest to the largest value (the last bin closed), the
+/// density `count / (n · width)` so that it integrates to 1 (numpy's
+/// `histogram(density=True)`). Refused where no value is defined, fewer than one bin is
+/// asked for, or every value is the same (a distribution of zero width has no density).
+pub fn distribution(values: impl IntoIterator<Item = f64>, bins: usize) -> Result<Vec<(f64, f64)>> {
+    let z: Vec<f64> = values.into_iter().filter(|v| !v.is_nan()).collect();
+    let (lo, hi) = z
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let width = (hi - lo) / bins as f64;
+    if z.is_empty() || bins == 0 || !(width.is_finite() && width > 0.0) {
+        return Err(Error::invalid(
+            "distribution",
+            format!(
+                "{} defined values from {lo:e} to {hi:e} in {bins} bins",
+                z.len()
+            ),
+        ));
+    }
+    let mut counts = vec![0usize; bins];
+    for v in &z {
+        let k = (((v - lo) / width) as usize).min(bins - 1);
+        counts[k] += 1;
+    }
+    let n = z.len() as f64;
+    Ok(counts
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| (lo + (k as f64 + 0.5) * width, c as f64 / (n * width)))
+        .collect())
+}
+
+/// The slopes along x, `(h[i+1] − h[i])/Δx` within each row (pairs with an undefined
+/// point left out), and the curvatures along x, `(h[i+1] − 2h[i] + h[i−1])/Δx²`: the values
+/// whose distributions contact.engineering shows beside the heights'.
+pub fn slopes_and_curvatures_along_x(rows: ArrayView2<f64>, dx: f64) -> (Vec<f64>, Vec<f64>) {
+    let mut slopes = Vec::new();
+    let mut curvatures = Vec::new();
+    for row in rows.rows() {
+        let r: Vec<f64> = row.iter().copied().collect();
+        slopes.extend(
+            r.windows(2)
+                .map(|w| (w[1] - w[0]) / dx)
+                .filter(|v| !v.is_nan()),
+        );
+        curvatures.extend(
+            r.windows(3)
+                .map(|w| (w[2] - 2.0 * w[1] + w[0]) / (dx * dx))
+                .filter(|v| !v.is_nan()),
+        );
+    }
+    (slopes, curvatures)
+}
+
 /// The material ratio `Smr(c)`: the fraction of the defined heights at or above `c`.
 pub fn material_ratio(heights: impl IntoIterator<Item = f64>, c: f64) -> f64 {
     let (mut above, mut n) = (0usize, 0usize);
@@ -434,6 +491,45 @@ fn fft_error(e: impl std::fmt::Display) -> Error {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_uniform_sample_has_a_flat_density_that_integrates_to_one() {
+        // 0, 1, ..., 99 and two undefined points in 10 bins of width 9.9: 10 values each.
+        let values = (0..100).map(f64::from).chain([f64::NAN, f64::NAN]);
+        let d = super::distribution(values, 10).unwrap();
+        assert_eq!(d.len(), 10);
+        for (k, &(centre, density)) in d.iter().enumerate() {
+            assert!((centre - (k as f64 + 0.5) * 9.9).abs() < 1e-12, "{centre}");
+            assert!((density - 10.0 / (100.0 * 9.9)).abs() < 1e-15, "{density}");
+        }
+        let total: f64 = d.iter().map(|&(_, p)| p * 9.9).sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // No width, no values, no bins: refused.
+        assert!(super::distribution([2.0, 2.0, f64::NAN], 5).is_err());
+        assert!(super::distribution([f64::NAN], 5).is_err());
+        assert!(super::distribution([1.0, 2.0], 0).is_err());
+    }
+
+    #[test]
+    fn slopes_and_curvatures_of_a_parabola() {
+        // h = x² at x = iΔx: slopes (2i + 1)Δx, curvature 2 everywhere; an undefined point
+        // removes the pairs and triples it is in.
+        let dx = 0.25;
+        let mut h = ndarray::Array2::from_shape_fn((2, 6), |(_, i)| (i as f64 * dx).powi(2));
+        h[(1, 5)] = f64::NAN;
+        let (slopes, curvatures) = super::slopes_and_curvatures_along_x(h.view(), dx);
+        let row: Vec<f64> = (0..5).map(|i| (2 * i + 1) as f64 * dx).collect();
+        let want: Vec<f64> = row.iter().chain(&row[..4]).copied().collect();
+        assert_eq!(slopes.len(), want.len());
+        for (g, w) in slopes.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-12, "{g} vs {w}");
+        }
+        assert_eq!(curvatures.len(), 4 + 3);
+        assert!(
+            curvatures.iter().all(|c| (c - 2.0).abs() < 1e-12),
+            "{curvatures:?}"
+        );
+    }
+
     use super::*;
     use ndarray::{Array1, Array2};
     use std::f64::consts::PI;
