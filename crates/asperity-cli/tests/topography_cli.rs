@@ -1034,3 +1034,137 @@ fn contact_of_the_shared_metropro_scan_converges_at_every_load() {
         "{rows:?}"
     );
 }
+
+/// The shared MetroPro scan's columns `names` of a run of `args` (ok), one row per load.
+fn columns_of(args: &[&str], dir: &Path, names: &[&str]) -> Vec<Vec<f64>> {
+    let out = asperity(args, dir);
+    ok(&out);
+    let csv = std::fs::read_to_string(dir.join(args[args.len() - 1])).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let at: Vec<usize> = names
+        .iter()
+        .map(|n| header.iter().position(|h| h == n).unwrap())
+        .collect();
+    csv.lines()
+        .skip(1)
+        .map(|l| {
+            let row: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+            at.iter().map(|&k| row[k]).collect()
+        })
+        .collect()
+}
+
+/// Issue 33, item 13: the shared MetroPro scan on a soft half-space (E* = 1e9 Pa) at
+/// 1e5–5e5 Pa, where its contact (19–66 % of the scan) reaches two opposite edges of the
+/// grid along straight lines. The BCCG with its edge rings never settled the contact set
+/// there (residual stuck near 1e-2 from iteration 11; given up after 1011 iterations); it
+/// now drops the rings after 60 iterations without progress and converges in 48–140.
+#[test]
+fn contact_of_the_shared_metropro_scan_on_a_soft_half_space_converges() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = shared.join("metropro-1.dat");
+    let args = [
+        "contact",
+        file.to_str().unwrap(),
+        "--modulus",
+        "1e9",
+        "--pressures",
+        "1e5,2e5,5e5",
+        "--quiet",
+        "--out",
+        "c.csv",
+    ];
+    let names = [
+        "mean_pressure_pa",
+        "force_n",
+        "area_fraction",
+        "mean_gap_m",
+        "iterations",
+        "residual",
+    ];
+    let rows = columns_of(&args, dir.path(), &names);
+    let nominal = 7.028812979115173e-4 * 5.27160973433638e-4;
+    for (row, p) in rows.iter().zip([1e5, 2e5, 5e5]) {
+        let [mean, force, fraction, gap, iterations, residual] = row[..] else {
+            unreachable!()
+        };
+        // The load is balanced by the solved pressures; converged, in a few hundred
+        // iterations at most.
+        assert!((mean - p).abs() < 1e-9 * p, "{row:?}");
+        assert!((force - p * nominal).abs() < 1e-9 * force, "{row:?}");
+        assert!(iterations < 400.0 && residual < 1e-8, "{row:?}");
+        assert!(fraction > 0.1 && fraction < 0.9 && gap > 0.0, "{row:?}");
+    }
+    // More load, more contact and a smaller mean gap.
+    assert!(
+        rows[0][2] < rows[1][2] && rows[1][2] < rows[2][2],
+        "{rows:?}"
+    );
+    assert!(
+        rows[0][3] > rows[1][3] && rows[1][3] > rows[2][3],
+        "{rows:?}"
+    );
+}
+
+/// The same loads by both solvers (`bem`, BCCG and Polonsky–Keer, which never used the
+/// rings): the same contact set and pressures to the tolerance, the pressures summing to
+/// the load, no negative pressure or gap, and no pressure where the gap is open.
+#[test]
+#[ignore = "slow tier: cargo test --release -- --ignored (.ci/run runs it)"]
+fn the_shared_metropro_scan_on_a_soft_half_space_solves_alike_with_both_solvers() {
+    let Some(shared) = shared() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = shared.join("metropro-1.dat");
+    let solve = |solver: &str| {
+        let fields = format!("fields-{solver}");
+        let out = format!("{solver}.csv");
+        let args = [
+            "bem",
+            "--surface",
+            file.to_str().unwrap(),
+            "--modulus",
+            "1e9",
+            "--pressures",
+            "1e5,5e5",
+            "--solver",
+            solver,
+            "--fields",
+            &fields,
+            "--quiet",
+            "--out",
+            &out,
+        ];
+        let rows = columns_of(&args, dir.path(), &["area_fraction", "iterations"]);
+        let field =
+            |name: &str, k: usize| npy(&dir.path().join(&fields).join(format!("{name}_{k}.npy")));
+        let fields: Vec<_> = (0..2)
+            .map(|k| (field("pressure", k), field("gap", k)))
+            .collect();
+        (rows, fields)
+    };
+    let (bccg, pk) = (solve("bccg"), solve("pk"));
+    let cell = 7.028812979115173e-4 / 640.0;
+    for (k, p) in [1e5, 5e5].into_iter().enumerate() {
+        let what = format!("{p} Pa: BCCG {:?}, PK {:?}", bccg.0[k], pk.0[k]);
+        assert!((bccg.0[k][0] - pk.0[k][0]).abs() < 1e-3, "{what}");
+        let ((pb, gb), (pp, _)) = (&bccg.1[k], &pk.1[k]);
+        let force: f64 = pb.iter().sum::<f64>() * cell * cell;
+        let load = p * 480.0 * 640.0 * cell * cell;
+        assert!(
+            (force - load).abs() < 1e-9 * load,
+            "{what}: {force} vs {load}"
+        );
+        assert!(pb.iter().chain(gb.iter()).all(|&v| v >= 0.0), "{what}");
+        assert!(
+            pb.iter().zip(gb).all(|(&p, &g)| p == 0.0 || g == 0.0),
+            "{what}"
+        );
+        let rms = |a: &ArrayD<f64>| (a.iter().map(|v| v * v).sum::<f64>() / a.len() as f64).sqrt();
+        let difference = rms(&(pb - pp)) / rms(pp);
+        assert!(
+            difference < 1e-4,
+            "{what}: pressures differ by {difference:.2e} (rms)"
+        );
+    }
+}

@@ -82,6 +82,7 @@ use super::plastic_field::{PlasticField, Restored};
 use super::preconditioner::Preconditioner;
 use super::ring_extension::{RingExtension, Ringed};
 use super::small_set::{small_set_start, SmallSet, SmallSetRun};
+use super::stagnation::Progress;
 use super::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 use crate::fft::Precision;
@@ -97,6 +98,14 @@ use crate::Result as CrateResult;
 /// time at 512² and 1024², about the same at 256², and up to 20 % more at 128² and 64²
 /// (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
 pub(super) const RING_MIN_POINTS: usize = 1 << 18;
+
+/// Iterations in which a solve with the rings must halve its best residual; one that does
+/// not goes on without them (issue 33, item 13: the shared MetroPro scan at E* = 1e9 Pa and
+/// 1e5–5e5 Pa, whose contact reaches two opposite edges of the grid along straight lines,
+/// never settled its free set with the rings; docs/bem.md, "When the rings stall"). A
+/// solve with the rings halves its residual every two or three iterations on average
+/// (the fingerprint's solves: 1 to 1e-8 in 30–60 iterations).
+pub(super) const RING_WINDOW: usize = 60;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
 pub(super) const REFRESH_INTERVAL: usize = 25;
@@ -174,6 +183,12 @@ pub(super) struct BccgScratch {
     /// The rings around the free set that extend the gradient before the preconditioner
     /// (grids of at least [`RING_MIN_POINTS`] points).
     pub(super) rings: Option<RingExtension>,
+    /// Whether the running solve still uses the rings: from its start where there are
+    /// rings, until its best residual has not halved in [`RING_WINDOW`] iterations
+    /// (`ring_progress`).
+    edge_rings: bool,
+    /// The residuals of the running solve while it uses the rings.
+    ring_progress: Progress,
     /// Whether a step expected to end in a refresh takes `sᵀK s` from the forward
     /// transform alone (always, but in the test that compares it with forming `K s`).
     energy_steps: bool,
@@ -244,6 +259,8 @@ impl BccgScratch {
             mean_gap: (operator.boundary() == Boundary::Periodic)
                 .then(|| MeanGapScratch::new(operator)),
             rings: (len >= RING_MIN_POINTS).then(|| RingExtension::on_grid_of(operator)),
+            edge_rings: false,
+            ring_progress: Progress::with_window(RING_WINDOW),
             energy_steps: true,
             single: operator.single_precision()?,
             single_steps: true,
@@ -643,6 +660,10 @@ impl Iteration for BccgScratch {
                 });
             }
             cx.check_progress(iteration, gradient.residual)?;
+            if self.rings_stalled(cx, iteration, gradient.residual) {
+                // Without the rings from here, from steepest descent (β = 0).
+                previous_zg = 0.0;
+            }
             iteration += 1;
             let direction = self.direction(cx, target, &gradient, previous_zg);
             previous_zg = direction.zg;
@@ -717,6 +738,8 @@ impl BccgScratch {
         self.pending_scale = 1.0;
         self.extra_energies = 0;
         self.stalled = false;
+        self.edge_rings = self.rings.is_some();
+        self.ring_progress.restart();
         if let Interface::Hardness { .. } = cx.interface {
             self.plastic.prepare(cx.state.pressure.len());
         }
@@ -798,6 +821,28 @@ impl BccgScratch {
         }
     }
 
+    /// Whether the preconditioner is extended over the rings: where there are rings, while
+    /// the solve has not dropped them ([`Self::rings_stalled`]), and not under a cap on a
+    /// periodic grid, where the rings cost more than they save (1024², H = 0.3 E*: 53
+    /// iterations without them against 57, 6.7 s against 10.3 s; on free grids they still
+    /// save iterations: 35 against 46 at 512²; hardness.md).
+    fn rings_apply(&self, cx: &Context) -> bool {
+        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
+        self.edge_rings && !(periodic && Rule::of(cx.interface).capped)
+    }
+
+    /// Records the residual of `iteration` while the solve uses the rings; true where it
+    /// has not halved in [`RING_WINDOW`] iterations: the solve then goes on without them
+    /// (`P_F M P_F`, the preconditioner of the smaller grids; its convergence does not
+    /// rest on the contact set's edges).
+    fn rings_stalled(&mut self, cx: &Context, iteration: usize, residual: f64) -> bool {
+        if !self.rings_apply(cx) || self.ring_progress.observe(iteration, residual).is_ok() {
+            return false;
+        }
+        self.edge_rings = false;
+        true
+    }
+
     /// Under displacement control with the mean gap deflated: the coarse curvature of the
     /// free set, for the coarse constant of the preconditioned gradient. False where the
     /// solve carries no mean-gap scratch (no deflation then).
@@ -815,14 +860,10 @@ impl BccgScratch {
     /// preconditioner), Π g formed row by row on its way into the transform (never stored
     /// whole).
     fn precondition_gradient(&mut self, cx: &mut Context, centre: f64) {
+        let ringed = self.rings_apply(cx);
         let scratch = &mut *self;
         let (free, gradient) = (&scratch.free[..], &mut scratch.gradient[..]);
         let (z, centred) = (&mut scratch.preconditioned[..], (free, centre));
-        // Not under a cap on a periodic grid, where the rings cost more than they save
-        // (1024², H = 0.3 E*: 53 iterations without them against 57, 6.7 s against 10.3 s;
-        // on free grids they still save iterations: 35 against 46 at 512²; hardness.md).
-        let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
-        let ringed = !(periodic && Rule::of(cx.interface).capped);
         match scratch.rings.as_mut().filter(|_| ringed) {
             Some(rings) => Ringed {
                 inner: &mut cx.preconditioner,
@@ -877,7 +918,7 @@ impl BccgScratch {
         let fletcher_reeves = zg / previous_zg;
         let beta = match previous_zg > 0.0 {
             false => 0.0,
-            true if deflated || scratch.rings.is_none() => polak_ribiere.max(0.0),
+            true if deflated || !scratch.edge_rings => polak_ribiere.max(0.0),
             true => polak_ribiere.min(fletcher_reeves).max(0.0),
         };
         // s = −(z − z̄) + β s_old on F: its sum and its product with Πg, from the sums.

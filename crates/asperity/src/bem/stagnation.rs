@@ -31,12 +31,7 @@ pub(super) struct Progress {
 
 impl Default for Progress {
     fn default() -> Self {
-        Progress {
-            best: f64::INFINITY,
-            mark: f64::INFINITY,
-            mark_at: 0,
-            window: WINDOW,
-        }
+        Progress::with_window(WINDOW)
     }
 }
 
@@ -66,6 +61,17 @@ impl Progress {
             });
         }
         Ok(())
+    }
+
+    /// A record that gives up after `window` iterations without a halving (the BCCG's
+    /// check on its edge rings, `bccg.rs`).
+    pub(super) const fn with_window(window: usize) -> Self {
+        Progress {
+            best: f64::INFINITY,
+            mark: f64::INFINITY,
+            mark_at: 0,
+            window,
+        }
     }
 
     /// Sets the window (tests: a long solve that must not be given up).
