@@ -96,6 +96,39 @@ fn log_line(name: &str, done: u64, total: u64, elapsed: f64, eta: f64) -> String
     format!("{name}: {done}/{total} ({elapsed:.0} s elapsed, ETA {eta:.0} s)")
 }
 
+/// The least time between two lines of progress inside one solve ([`Progress::solve_monitor`]).
+pub const SOLVE_EVERY: f64 = 2.0;
+
+/// `--progress SECONDS`: a finite number of seconds, zero or more.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "{text:?} is not a number of seconds (finite, 0 or more)"
+        )),
+    }
+}
+
+/// Whether to report progress inside each solve: asked for (`--progress`, with the hidden
+/// `--progress-every SECONDS` of the tests), or on a terminal unless `--quiet`. Returns the
+/// least seconds between two lines ([`SOLVE_EVERY`] unless given).
+pub fn solve_progress((asked, every): (bool, Option<f64>), quiet: bool) -> Option<f64> {
+    let shown = asked || every.is_some() || (!quiet && std::io::stderr().is_terminal());
+    shown.then_some(every.unwrap_or(SOLVE_EVERY))
+}
+
+/// The line of progress inside a solve.
+fn solve_line(
+    name: &str,
+    (load, loads): (u64, u64),
+    (iteration, residual): (usize, f64),
+    seconds: f64,
+) -> String {
+    format!(
+        "{name}: load {load}/{loads}: iteration {iteration}, residual {residual:.3e} ({seconds:.0} s into the solve)"
+    )
+}
+
 struct Shared {
     eta: Mutex<Eta>,
     start: Instant,
@@ -106,7 +139,7 @@ pub struct Progress {
     bar: Option<ProgressBar>,
     name: String,
     total: u64,
-    done: AtomicU64,
+    done: Arc<AtomicU64>,
     shared: Arc<Shared>,
     last_log: Mutex<Instant>,
 }
@@ -163,7 +196,7 @@ impl Progress {
                 name.to_string()
             },
             total,
-            done: 0.into(),
+            done: Arc::new(0.into()),
             shared,
             last_log: Mutex::new(now),
         }
@@ -220,6 +253,40 @@ impl Progress {
                 }
             }
         }
+    }
+
+    /// A monitor for the solver ([`asperity::bem::ContactSolver::set_monitor`]) that
+    /// prints `name: load K/N: iteration I, residual R (S s into the solve)` at most every
+    /// `every` seconds of a solve (above the bar on a terminal); `None` without `every`
+    /// ([`solve_progress`]). The load is the one after those this progress counts done.
+    pub fn solve_monitor(&self, name: &str, every: Option<f64>) -> Option<asperity::bem::Monitor> {
+        let every = Duration::from_secs_f64(every?.max(0.0));
+        let (name, loads, done, bar) = (
+            name.to_string(),
+            self.total,
+            Arc::clone(&self.done),
+            self.bar.clone(),
+        );
+        let (mut start, mut shown, mut previous) = (Instant::now(), Instant::now(), usize::MAX);
+        Some(Box::new(move |iteration: usize, residual: f64| {
+            let now = Instant::now();
+            if iteration < previous {
+                // A new solve.
+                (start, shown) = (now, now);
+            }
+            previous = iteration;
+            if now.duration_since(shown) < every {
+                return;
+            }
+            shown = now;
+            let load = (done.load(Ordering::Relaxed) + 1).min(loads.max(1));
+            let seconds = now.duration_since(start).as_secs_f64();
+            let line = solve_line(&name, (load, loads), (iteration, residual), seconds);
+            match &bar {
+                Some(bar) => bar.println(line),
+                None => eprintln!("{line}"),
+            }
+        }))
     }
 
     /// Ends the bar.

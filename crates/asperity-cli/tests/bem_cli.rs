@@ -1557,3 +1557,66 @@ fn persson_columns_beside_the_sweep() {
         "--persson goes with a load sweep",
     );
 }
+
+/// Issue 33, item 13: a single long solve printed nothing until it ended. `--progress`
+/// reports the iteration and the residual inside each solve (every 2 s; the hidden
+/// `--progress-every 0` of this test: every iteration, so that nothing here depends on the
+/// machine's speed); without it, off a terminal, the solve stays silent.
+#[test]
+fn progress_inside_a_solve_reports_iterations_and_residuals() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    for solver in ["bccg", "pk"] {
+        let run = |extra: &[&str]| {
+            let args = [
+                &["bem", "--surface", s.to_str().unwrap(), "--solver", solver][..],
+                &["--pressures", "0.01,0.02"][..],
+                extra,
+            ]
+            .concat();
+            let out = asperity(&args);
+            ok(&out);
+            let table = String::from_utf8(out.stdout.clone()).unwrap();
+            (table, stderr(&out))
+        };
+        let (quiet_table, silent) = run(&[]);
+        assert!(!silent.contains("iteration"), "{solver}: {silent}");
+        let (table, err) = run(&["--progress-every", "0"]);
+        assert_eq!(table, quiet_table, "{solver}: the same results");
+        let iterations: Vec<usize> = table
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(5).unwrap().parse().unwrap())
+            .collect();
+        for (load, &solved) in iterations.iter().enumerate() {
+            let prefix = format!("bem: load {}/2: iteration ", load + 1);
+            let lines: Vec<(usize, f64)> = err
+                .lines()
+                .filter_map(|l| l.strip_prefix(&prefix))
+                .map(|l| {
+                    let (iteration, rest) = l.split_once(", residual ").unwrap();
+                    let residual = rest.split_once(' ').unwrap().0;
+                    (iteration.parse().unwrap(), residual.parse().unwrap())
+                })
+                .collect();
+            assert!(
+                !lines.is_empty() && lines.len() <= solved + 1,
+                "{solver}: {err}"
+            );
+            assert!(lines.windows(2).all(|w| w[0].0 < w[1].0), "{solver}: {err}");
+            assert!(lines
+                .iter()
+                .all(|&(i, r)| i < solved && r.is_finite() && r >= 1e-8));
+        }
+        let out = asperity(&[
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01",
+            "--progress-every",
+            "-1",
+        ]);
+        refused(&out, "-1");
+    }
+}

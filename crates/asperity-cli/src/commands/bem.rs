@@ -227,6 +227,13 @@ pub struct BemArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Progress inside each solve on stderr: the iteration and the residual every 2 s
+    /// (shown anyway on a terminal, unless --quiet).
+    #[arg(long)]
+    pub progress: bool,
+    /// Seconds between two lines of --progress (tests: 0, every iteration).
+    #[arg(long, hide = true, value_name = "SECONDS", value_parser = crate::progress::parse_seconds)]
+    pub progress_every: Option<f64>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -684,6 +691,8 @@ fn solve(
         peak_rss: args.timing.then(Vec::new),
         mean_gaps: theory.map(|_| Vec::new()),
     };
+    let every = crate::progress::solve_progress((args.progress, args.progress_every), args.quiet);
+    solver.set_monitor(observer.progress.solve_monitor("bem", every));
     let solved = sweep(solver, loads, plan.bem.sweep, &mut observer).map_err(sweep_error)?;
     observer.progress.finish();
     let peak_rss = observer.peak_rss.take().unwrap_or_default();

@@ -134,6 +134,13 @@ pub struct ContactArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Progress inside each solve on stderr: the iteration and the residual every 2 s
+    /// (shown anyway on a terminal, unless --quiet).
+    #[arg(long)]
+    pub progress: bool,
+    /// Seconds between two lines of --progress (tests: 0, every iteration).
+    #[arg(long, hide = true, value_name = "SECONDS", value_parser = crate::progress::parse_seconds)]
+    pub progress_every: Option<f64>,
 }
 
 /// The request of the arguments.
@@ -290,6 +297,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     drop(surface);
     let loads = plan.loads.len();
     let progress = Progress::new("contact", loads as u64, args.quiet || loads < 2);
+    let every = crate::progress::solve_progress((args.progress, args.progress_every), args.quiet);
+    solver.set_monitor(progress.solve_monitor("contact", every));
     let solved = contact::run(
         &mut solver,
         &plan,

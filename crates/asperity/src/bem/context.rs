@@ -169,6 +169,11 @@ fn fill_profile(surface: &Surface, profile: &mut Vec<f64>) -> f64 {
     }
 }
 
+/// Called with the count and the residual of every iteration of a BCCG or Polonsky–Keer
+/// solve ([`super::ContactSolver::set_monitor`]): progress inside one long solve. `Send`
+/// and `Sync` as the solver is (the Python binding shares it between threads).
+pub type Monitor = Box<dyn FnMut(usize, f64) + Send + Sync>;
+
 /// What the iterations work on (module docs): owned by the solver, lent to one iteration at
 /// a time.
 pub(super) struct Context {
@@ -182,13 +187,15 @@ pub(super) struct Context {
     pub(super) stop: Stop,
     /// The residuals of the running BCCG or Polonsky–Keer solve (`stagnation.rs`).
     pub(super) progress: Progress,
+    /// Told of every iteration's residual, if set.
+    pub(super) monitor: Option<Monitor>,
     /// What "in contact" means ([`super::ContactSolver::set_interface`]; the hard wall by
     /// default).
     pub(super) interface: Interface,
 }
 
 impl Context {
-    /// The residual of `iteration` of a BCCG or Polonsky–Keer solve:
+    /// The residual of `iteration` of a BCCG or Polonsky–Keer solve, told to the monitor:
     /// [`SolveError::Stagnated`] where it has stopped decreasing (`stagnation.rs`).
     #[inline]
     pub(super) fn check_progress(
@@ -196,6 +203,9 @@ impl Context {
         iteration: usize,
         residual: f64,
     ) -> Result<(), SolveError> {
+        if let Some(monitor) = self.monitor.as_mut() {
+            monitor(iteration, residual);
+        }
         self.progress.observe(iteration, residual)
     }
 

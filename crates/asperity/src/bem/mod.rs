@@ -78,7 +78,7 @@ pub mod tangential;
 mod tests;
 mod threshold;
 
-pub use context::ContactProblem;
+pub use context::{ContactProblem, Monitor};
 pub use interface::Interface;
 pub use plasticity::{load_path, PathPoint};
 pub use solver::ContactSolver;

@@ -162,6 +162,7 @@ impl ContactSolver {
             preconditioner,
             stop: Stop::new(),
             progress: Progress::default(),
+            monitor: None,
             interface: Interface::HardWall,
         };
         Ok(ContactSolver {
@@ -172,6 +173,38 @@ impl ContactSolver {
             full_contact_scratch: None,
             permanent: None,
         })
+    }
+
+    /// Calls `monitor` with the iteration count and the residual (the module docs of
+    /// [`crate::bem`]) of every iteration of every BCCG or Polonsky–Keer solve from now on
+    /// (`None`, the default: nobody is told): progress inside a long solve. It runs on the
+    /// solving thread between iterations, so it should be quick (a look at the clock);
+    /// it changes no iterate.
+    ///
+    /// ```
+    /// use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+    /// use asperity::elastic::Boundary;
+    /// use asperity::surface::Surface;
+    /// use std::sync::{Arc, Mutex};
+    ///
+    /// let heights = ndarray::Array2::from_shape_fn((32, 32), |(i, j)| {
+    ///     ((i as f64) * 0.4).sin() * ((j as f64) * 0.3).cos()
+    /// });
+    /// let surface = Surface::new(heights, 1.0).unwrap();
+    /// let half_space = HalfSpace { modulus: 1.0, boundary: Boundary::Periodic };
+    /// let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
+    /// let seen = Arc::new(Mutex::new(Vec::new()));
+    /// let record = Arc::clone(&seen);
+    /// solver.set_monitor(Some(Box::new(move |iteration: usize, residual: f64| {
+    ///     record.lock().unwrap().push((iteration, residual));
+    /// })));
+    /// let (_, info) = solver.solve(Control::MeanPressure(0.05)).unwrap();
+    /// let seen = seen.lock().unwrap();
+    /// assert!(seen.len() <= info.iterations + 1);
+    /// assert!(seen.iter().all(|&(_, r)| r >= info.residual));
+    /// ```
+    pub fn set_monitor(&mut self, monitor: Option<super::Monitor>) {
+        self.cx.monitor = monitor;
     }
 
     /// The solver with `stop` as its stop flag (builder form of
