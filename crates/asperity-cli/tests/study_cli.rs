@@ -1000,3 +1000,36 @@ fn curve_study_adds_the_tangential_ratio_and_the_conductance() {
     refused(&asperity(&mdr, d), "BEM only");
     assert!(!d.join("mdr").exists());
 }
+
+/// Issue 33: `--out FILE/x` with FILE a regular file said "FILE/x/checkpoint: Not a
+/// directory (os error 20)"; now one line in asperity's words naming FILE, exit 2, and
+/// FILE untouched (both study commands, the folder itself a file too).
+#[test]
+fn an_output_folder_under_a_file_is_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("FILE"), "kept").unwrap();
+    for command in ["alpha", "curve"] {
+        for out in ["FILE/x", "FILE/x/y"] {
+            let mut args = ALPHA.to_vec();
+            args[1] = command;
+            args.push(out);
+            let err = refused(&asperity(&args, dir.path()), "FILE is a file, not a folder");
+            assert!(err.contains(&format!("{out}: cannot be a folder")), "{err}");
+            assert!(!err.contains("os error"), "{err}");
+        }
+        let mut args = ALPHA.to_vec();
+        args[1] = command;
+        args.push("FILE");
+        let err = refused(
+            &asperity(&args, dir.path()),
+            "FILE: exists and is not a folder",
+        );
+        assert!(!err.contains("os error"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("FILE")).unwrap(),
+        "kept"
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1, "{names:?}");
+}

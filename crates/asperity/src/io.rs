@@ -103,6 +103,30 @@ pub fn refuse_link(path: &Path) -> Result<()> {
     }
 }
 
+/// Refuses `dir` as a folder to write in where it, or a folder above it, exists and is not
+/// a folder: `FILE/x: cannot be a folder: FILE is a file, not a folder` (the system would
+/// say "Not a directory" of a path below it). A missing path is fine (it is made later).
+pub fn check_folder(dir: &Path) -> Result<()> {
+    for above in dir.ancestors().take_while(|a| !a.as_os_str().is_empty()) {
+        match std::fs::metadata(above) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(_) if above == dir => {
+                return Err(bad_output(dir, "exists and is not a folder"));
+            }
+            Ok(_) => {
+                let reason = format!(
+                    "cannot be a folder: {} is a file, not a folder",
+                    above.display()
+                );
+                return Err(bad_output(dir, reason));
+            }
+            // Missing (or not readable: said by whatever reads it next).
+            Err(_) => continue,
+        }
+    }
+    Ok(())
+}
+
 /// Adds `O_NOFOLLOW` (where it exists) to `options`: opening a symbolic link then fails
 /// (`ELOOP`) instead of opening the file it names.
 pub fn no_follow(options: &mut std::fs::OpenOptions) {

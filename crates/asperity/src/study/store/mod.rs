@@ -90,6 +90,7 @@ impl StudyDir {
     /// Locks the study folder `dir` (made if missing) against other processes for as long
     /// as the returned lock lives (see [`FolderLock`]); a folder in use is refused at once.
     pub fn lock(dir: &Path) -> Result<FolderLock> {
+        io::check_folder(dir)?;
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         FolderLock::acquire(dir)
     }
@@ -142,6 +143,7 @@ impl StudyDir {
     /// * [`Error::ForeignCheckpoint`] when it holds samples of another study, and
     ///   [`Error::Metadata`] when its `study.json` is corrupt and checkpoints hold samples.
     pub fn check(dir: &Path, spec: &StudySpec, discard: bool) -> Result<bool> {
+        io::check_folder(dir)?;
         let stored = Self::stored_spec(dir, spec)?;
         if matches!(stored, Stored::Same | Stored::Extended) {
             return Ok(false);
