@@ -150,10 +150,19 @@ impl From<Refusal> for RequestError {
 /// assert_eq!(count(NLOADS, 3).unwrap(), 3);
 /// let refusal = count(NLOADS, -2).unwrap_err();
 /// assert_eq!(refusal.words(Names::Keywords), "nloads must be at least 1, got -2");
+/// let refusal = count(NLOADS, i128::MAX).unwrap_err();
+/// assert!(refusal.words(Names::Flags).starts_with("--nloads is too large, got "));
 /// ```
-pub fn count(param: Param, value: i64) -> Result<usize, Refusal> {
-    usize::try_from(value)
-        .map_err(|_| Refusal::of(param).text(format!(" must be at least 1, got {value}")))
+pub fn count(param: Param, value: impl Into<i128>) -> Result<usize, Refusal> {
+    let value: i128 = value.into();
+    usize::try_from(value).map_err(|_| {
+        let rule = if value < 0 {
+            "must be at least 1"
+        } else {
+            "is too large"
+        };
+        Refusal::of(param).text(format!(" {rule}, got {value}"))
+    })
 }
 
 impl fmt::Display for Refusal {

@@ -105,7 +105,7 @@ pub struct BemArgs {
     pub indentations: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
-    pub nloads: Option<i64>,
+    pub nloads: Option<i128>,
     /// Smallest mean pressure for --nloads.
     #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
@@ -122,8 +122,8 @@ pub struct BemArgs {
     #[arg(long, default_value_t = SolverRequest::default().solver)]
     pub solver: String,
     /// Maximum solver iterations per load.
-    #[arg(long, default_value_t = SolverRequest::default().max_iterations as i64, allow_hyphen_values = true)]
-    pub max_iter: i64,
+    #[arg(long, default_value_t = SolverRequest::default().max_iterations as i128, allow_hyphen_values = true)]
+    pub max_iter: i128,
     /// Cap the contact pressure at this hardness (in the units of the pressures and
     /// --modulus: E* units by default): elastic–perfectly-plastic contact
     /// (docs/hardness.md), with either solver; adds the column plastic_fraction. Each

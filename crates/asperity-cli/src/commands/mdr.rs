@@ -101,7 +101,7 @@ pub struct MdrArgs {
     pub indentations: Option<Vec<f64>>,
     /// Number of log-spaced indentations from --dmin to --dmax (default 50).
     #[arg(long, allow_hyphen_values = true)]
-    pub nloads: Option<i64>,
+    pub nloads: Option<i128>,
     /// Smallest indentation for --nloads (default --dmax · 1e-6).
     #[arg(long, allow_hyphen_values = true)]
     pub dmin: Option<f64>,
@@ -312,7 +312,7 @@ fn check_plot(args: &MdrArgs) -> Result<()> {
         return Ok(());
     }
     let count = match (&args.indentations, args.nloads) {
-        (Some(list), _) => list.len() as i64,
+        (Some(list), _) => list.len() as i128,
         (None, Some(n)) if !args.breakpoints => n,
         _ => 2,
     };

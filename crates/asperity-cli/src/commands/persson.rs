@@ -53,7 +53,7 @@ pub struct PerssonArgs {
     pub pressures: Option<Vec<f64>>,
     /// Number of mean pressures, log-spaced from --pmin to --pmax.
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
-    pub nloads: Option<i64>,
+    pub nloads: Option<i128>,
     /// Smallest mean pressure for --nloads.
     #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pmin: Option<f64>,
