@@ -616,10 +616,17 @@ def test_python_defaults_are_the_clis(cli, command, flag, function, keyword):
     import inspect
     import re
 
-    lines = [l for l in cli(command, "--help").stdout.splitlines()
-             if re.match(rf"\s+(-\w, )?{flag} ", l)]
-    assert len(lines) == 1, lines
-    theirs = re.findall(r"\[default: ([^\]]+)\]", lines[0])[-1]
+    # clap prints a flag's help on its line, or on the lines below it when any help of
+    # the command is long: the flag's entry runs to the next flag or blank line.
+    help_lines = cli(command, "--help").stdout.splitlines()
+    starts = [i for i, l in enumerate(help_lines) if re.match(rf"\s+(-\w, )?{flag} ", l)]
+    assert len(starts) == 1, starts
+    entry = [help_lines[starts[0]]]
+    for line in help_lines[starts[0] + 1:]:
+        if not line.strip() or re.match(r"\s{0,8}-", line):
+            break
+        entry.append(line)
+    theirs = re.findall(r"\[default: ([^\]]+)\]", " ".join(entry))[-1]
     ours = inspect.signature(getattr(asperity, function)).parameters[keyword].default
     if isinstance(ours, str):
         assert ours == theirs
