@@ -26,9 +26,10 @@ pub enum Kernel {
     /// measured cost per iteration at each N times iteration counts measured at small
     /// probe sizes and extrapolated in N (docs/bem.md, "Estimating a BEM study").
     BemEstimate,
-    /// BEM solves: one cold solve of an N×N surface (H, roll-off 6, rms slope 1, seed 0) per
-    /// mean pressure of --pressures, by each solver (pk, bccg), free and periodic, with the
-    /// iterations, operator applications and the cost of an iteration in padded FFT pairs.
+    /// BEM solves: one cold solve of an N×N surface (H, roll-off 6, rms slope 1, seed of
+    /// --seed) per mean pressure of --pressures, by each solver (pk, bccg), free and periodic,
+    /// with the iterations, operator applications and the cost of an iteration in padded FFT
+    /// pairs.
     BemSolve,
 }
 
@@ -97,6 +98,10 @@ pub struct BenchArgs {
     /// Boundaries to time (bem-solve), comma separated: free, periodic.
     #[arg(long, value_delimiter = ',', default_value = "free,periodic")]
     pub boundaries: Vec<Boundary>,
+    /// Seed of the surface (bem-solve): the surface of `asperity surface --seed` with the same
+    /// N, H, roll-off 6 and rms slope 1.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
 }
 
 /// Minimum and median of some timings (seconds).
@@ -314,7 +319,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
 }
 
 /// `asperity bench bem-solve`: one line per boundary, mean pressure and solver,
-/// `kernel n threads boundary solver mean_pressure iterations operator_applications
+/// `kernel n seed threads boundary solver mean_pressure iterations operator_applications
 /// energy_transforms area_fraction indentation solve_min_s solve_median_s fft_pair_s iteration_fft_pairs
 /// padded_fft_pair_s iteration_padded_pairs`.
 /// Each repetition is a cold solve (the solver reset); `fft_pair_s` is the minimum time of
@@ -336,7 +341,7 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
     }
     let psd = Psd::new(args.hurst, LongWavelength::RollOff { q0: 6.0 }, None)?;
     let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
-    let surface = SurfaceGenerator::new(&spec)?.try_generate(0)?;
+    let surface = SurfaceGenerator::new(&spec)?.try_generate(args.seed)?;
     let pair_of = |boundary| -> Result<f64> {
         Ok(min_median(fft_pair_times(args.n, boundary, args.repeat.max(5))?).0)
     };
@@ -370,12 +375,13 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
                 let (summary, info) = last.expect("repeat is at least 1");
                 let (min, median) = min_median(times);
                 println!(
-                    "kernel=bem-solve n={} threads={} boundary={} solver={} mean_pressure={pressure} \
+                    "kernel=bem-solve n={} seed={} threads={} boundary={} solver={} mean_pressure={pressure} \
                      iterations={} operator_applications={} energy_transforms={} area_fraction={:.6} indentation={:.9e} \
                      solve_min_s={min:.4} solve_median_s={median:.4} fft_pair_s={fft_pair:.5} \
                      iteration_fft_pairs={:.2} padded_fft_pair_s={padded_pair:.5} \
                      iteration_padded_pairs={:.2}",
                     args.n,
+                    args.seed,
                     rayon::current_num_threads(),
                     boundary.name(),
                     solver.name(),
