@@ -109,7 +109,7 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
         Ok(start.elapsed().as_secs_f64() / iterations as f64)
     };
     // p̄ = 0.05 E* (about 10 % contact), higher on grids so small that its contact set is
-    // solved directly (`bem/small_set.rs`: no CG iteration to time).
+    // solved directly (`bem/iterations/bccg/small_set.rs`: no CG iteration to time).
     let mut load = 0.05;
     solver.set_params(loose)?;
     while load < 0.4 {

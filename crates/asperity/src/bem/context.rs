@@ -8,7 +8,7 @@
 //! its own loop and [`Context::finish`]) and works in its own scratch only.
 
 use super::interface::Interface;
-use super::preconditioner::FourierPreconditioner;
+use super::precondition::FourierPreconditioner;
 use super::stagnation::Progress;
 use super::threshold::FullContactThreshold;
 use super::{ContactSummary, HalfSpace, SolveError, SolverParams};

@@ -174,9 +174,9 @@ fn fill_weights(
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::{rough, rough_grid, sphere};
     use super::super::{Control, HalfSpace, SolverParams};
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::{rough, rough_grid, sphere};
 
     fn solver(surface: &crate::surface::Surface, boundary: Boundary) -> ContactSolver {
         let half_space = HalfSpace {

@@ -5,8 +5,8 @@
 
 use std::time::{Duration, Instant};
 
-use super::polonsky_keer::tests::rough;
 use super::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
+use crate::bem::iterations::polonsky_keer::tests::rough;
 use crate::elastic::Boundary;
 use crate::stop::Stop;
 use crate::surface::Surface;

@@ -52,7 +52,6 @@
 //! decreasing (`stagnation.rs`).
 
 pub mod adhesion;
-mod bccg;
 mod capped_load;
 pub mod conductance;
 mod context;
@@ -61,14 +60,10 @@ mod grid_pass;
 mod interface;
 #[cfg(test)]
 mod interruption;
-mod iteration;
-mod mean_gap;
+mod iterations;
 mod plastic_field;
 mod plasticity;
-mod polonsky_keer;
-mod preconditioner;
-mod ring_extension;
-mod small_set;
+mod precondition;
 mod solver;
 mod stagnation;
 mod stiffness;

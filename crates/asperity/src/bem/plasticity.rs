@@ -159,9 +159,9 @@ pub fn load_path(
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::rough_grid;
     use super::super::{HalfSpace, SolverKind, SolverParams};
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::rough_grid;
     use crate::elastic::Boundary;
     use crate::surface::Surface;
     use std::f64::consts::PI;
@@ -690,7 +690,8 @@ mod tests {
         // capped Polonsky–Keer cycled at /2 — residual 0.105 after 10 000 iterations — and
         // both solvers at /5 and /10). Odd, even and non-square grids, free and periodic.
         for (rows, cols) in [(64, 64), (63, 63), (50, 72)] {
-            let surface = super::super::polonsky_keer::tests::sphere(rows, cols, 20e-6, 1e-3);
+            let surface =
+                crate::bem::iterations::polonsky_keer::tests::sphere(rows, cols, 20e-6, 1e-3);
             for boundary in BOUNDARIES {
                 let half_space = HalfSpace {
                     modulus: 1e9,

@@ -13,9 +13,10 @@
 //!   - the settings ([`SolverParams`]), the Fourier preconditioner shared by the BCCG and
 //!     the CGs, the stop flag and the contact law ([`Interface`]);
 //! * one scratch struct per algorithm, in its own file and used by no other: the
-//!   iterations' `BccgScratch` (`bccg.rs`, with the coarse correction of `mean_gap.rs` and
-//!   the direct solve of small sets of `small_set.rs`) and `PkScratch`
-//!   (`polonsky_keer.rs`), each an [`Iteration`] (`iteration.rs`); `StiffnessWork`
+//!   iterations' `BccgScratch` (`iterations/bccg.rs`, with the coarse correction of
+//!   `bccg/mean_gap.rs` and the direct solve of small sets of `bccg/small_set.rs`) and
+//!   `PkScratch` (`iterations/polonsky_keer.rs`), each an [`Iteration`]
+//!   (`iterations/mod.rs`); `StiffnessWork`
 //!   (`stiffness/work.rs`: the frozen-set CG and the free-boundary threshold's CG) and
 //!   `FullContactScratch` (`threshold.rs`, used by `full_contact.rs`: the periodic threshold
 //!   and the lower bound). Scratch that not every solver needs is allocated on first use and
@@ -34,7 +35,7 @@
 //! (as both solve the hardness cap, `plasticity.rs`) is a new variant there.
 //!
 //! **Extending the core** (an adhesive contact, say, which needs its own iteration): a new
-//! file with the iteration's scratch struct implementing [`Iteration`] (`iteration.rs` says
+//! file with the iteration's scratch struct implementing [`Iteration`] (`iterations/mod.rs` says
 //! what it may read and write), which `ContactSolver::solve_with(control, &mut scratch)`
 //! runs as it stands (the caller owns its fields; the solver's validation, start, capped
 //! root search and solved state are those of every solve). To make it a choice of
@@ -46,12 +47,12 @@
 
 use ndarray::{Array2, ArrayView2};
 
-use super::bccg::BccgScratch;
 use super::context::{ContactProblem, Context, SolverState, Target};
 use super::interface::{restore_capped_load, Interface};
-use super::iteration::{Iteration, Limits};
-use super::polonsky_keer::PkScratch;
-use super::preconditioner::{FourierPreconditioner, Real};
+use super::iterations::BccgScratch;
+use super::iterations::PkScratch;
+use super::iterations::{Iteration, Limits};
+use super::precondition::{FourierPreconditioner, Real};
 use super::stagnation::Progress;
 use super::stiffness::work::StiffnessWork;
 use super::threshold::FullContactScratch;
@@ -119,7 +120,7 @@ impl ContactSolver {
             26
         };
         let fields = memory::array_bytes(&[count, rows, cols], 8)?;
-        let limit = super::small_set::limit(rows.checked_mul(cols)?);
+        let limit = super::iterations::small_set::limit(rows.checked_mul(cols)?);
         let factor = memory::array_bytes(&[limit + 3, limit], 8)?;
         ElasticOperator::memory_bytes(rows, cols, boundary)?
             .checked_add(ElasticOperator::single_precision_memory_bytes(
@@ -545,7 +546,7 @@ impl ContactSolver {
     pub(super) fn set_edge_rings(&mut self, on: bool) {
         let operator = &self.cx.problem.operator;
         self.bccg_scratch.rings =
-            on.then(|| super::ring_extension::RingExtension::on_grid_of(operator));
+            on.then(|| super::precondition::RingExtension::on_grid_of(operator));
         self.stiffness_work = Some(StiffnessWork::new(operator, on));
     }
 }
@@ -560,8 +561,8 @@ fn validate_params(params: &SolverParams) -> Result<(), SolveError> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::rough_grid;
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::rough_grid;
 
     #[test]
     fn thresholds_keep_the_solved_state_and_its_stiffness() {

@@ -83,9 +83,9 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::rough;
     use super::super::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::rough;
     use crate::elastic::Boundary;
 
     fn solver(kind: SolverKind, boundary: Boundary, tolerance: f64) -> ContactSolver {

@@ -374,7 +374,7 @@ pub fn sweep<O: SweepObserver>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bem::polonsky_keer::tests::rough;
+    use crate::bem::iterations::polonsky_keer::tests::rough;
     use crate::bem::{HalfSpace, SolverParams};
 
     fn solver() -> ContactSolver {

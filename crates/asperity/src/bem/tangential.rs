@@ -52,7 +52,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use super::preconditioner::FourierPreconditioner;
+use super::precondition::FourierPreconditioner;
 use super::solver::ContactSolver;
 use super::stiffness::cg::{
     conjugate_gradient_on_set_from, CgParams, CgWork, RightHandSide, Start,
@@ -125,7 +125,7 @@ impl TangentialStiffness {
             Self::preconditioner((rows, cols), spacings, modulus, (poisson, Direction::X))?,
             Self::preconditioner((rows, cols), spacings, modulus, (poisson, Direction::Y))?,
         ];
-        let rings = rows * cols >= super::bccg::RING_MIN_POINTS;
+        let rings = rows * cols >= super::iterations::RING_MIN_POINTS;
         let work = CgWork::for_operator(&operators[0], rings);
         Ok(TangentialStiffness {
             operators,
@@ -452,7 +452,7 @@ mod tests {
 
     #[test]
     fn the_warm_start_gives_the_cold_stiffnesses_in_fewer_iterations() {
-        let surface = crate::bem::polonsky_keer::tests::rough(64, 5);
+        let surface = crate::bem::iterations::polonsky_keer::tests::rough(64, 5);
         let half_space = HalfSpace::default();
         let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default()).unwrap();
         let mut warm = TangentialStiffness::new(&solver, 0.3).unwrap();
@@ -531,7 +531,7 @@ mod tests {
 
     #[test]
     fn each_directions_preconditioner_gives_the_isotropic_ones_stiffnesses() {
-        let surface = crate::bem::polonsky_keer::tests::rough(64, 5);
+        let surface = crate::bem::iterations::polonsky_keer::tests::rough(64, 5);
         let mut solver =
             ContactSolver::new(&surface, HalfSpace::default(), SolverParams::default()).unwrap();
         let mut exact = TangentialStiffness::new(&solver, 0.3).unwrap();

@@ -3,7 +3,7 @@
 
 use ndarray::Array2;
 
-use super::super::preconditioner::FourierPreconditioner;
+use super::super::precondition::FourierPreconditioner;
 use super::super::stiffness::cg::{conjugate_gradient_on_set, CgParams, CgWork, RightHandSide};
 use super::super::{Control, HalfSpace, SolveError};
 use super::{

@@ -10,7 +10,7 @@
 //!
 //! * The restriction `K_SS` of a symmetric positive definite operator is symmetric positive
 //!   definite, and so is the preconditioner restricted to the set, `P_S M P_S`: CG applies
-//!   unchanged. On grids of at least [`super::super::bccg::RING_MIN_POINTS`] points the
+//!   unchanged. On grids of at least [`super::super::iterations::RING_MIN_POINTS`] points the
 //!   residual is extended over two rings of the set before `M`,
 //!   `P_S (I + E)ᵀ M (I + E) P_S`, as in the BCCG (`ring_extension.rs`), when the work was
 //!   made with rings ([`CgWork::new`]).
@@ -41,10 +41,10 @@
 //! let tangential_stiffness = info.energy * dx * dy;
 //! ```
 //!
-//! [`FourierPreconditioner`]: super::super::preconditioner::FourierPreconditioner
+//! [`FourierPreconditioner`]: super::super::precondition::FourierPreconditioner
 
-use super::super::preconditioner::Preconditioner;
-use super::super::ring_extension::{RingExtension, Ringed};
+use super::super::precondition::Preconditioner;
+use super::super::precondition::{RingExtension, Ringed};
 use super::super::SolveError;
 use crate::elastic::HalfSpaceOperator;
 use crate::stop::Stop;
@@ -512,7 +512,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::super::super::preconditioner::FourierPreconditioner;
+    use super::super::super::precondition::FourierPreconditioner;
     use super::*;
     use crate::elastic::{Boundary, ElasticOperator};
 

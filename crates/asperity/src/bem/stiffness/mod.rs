@@ -42,10 +42,10 @@
 pub(crate) mod cg;
 pub(super) mod work;
 
-use super::bccg::RING_MIN_POINTS;
 use super::context::Target;
 use super::interface::Interface;
-use super::small_set;
+use super::iterations::small_set;
+use super::iterations::RING_MIN_POINTS;
 use super::solver::ContactSolver;
 use super::threshold::FullContactThreshold;
 use super::{Control, SolveError, SolveInfo};
@@ -349,9 +349,9 @@ fn predicted_below_cap(
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::{rough, rough_grid, sphere};
     use super::super::{HalfSpace, SolverParams};
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::{rough, rough_grid, sphere};
     use crate::elastic::Boundary;
     use crate::reference::{FlatPunch, Hertz};
     use crate::surface::Surface;

@@ -38,7 +38,7 @@
 
 use rayon::prelude::*;
 
-use super::preconditioner::{centre_on_set, Preconditioner};
+use super::fourier::{centre_on_set, Preconditioner};
 use crate::elastic::{Boundary, ElasticOperator};
 
 /// Weights of the first and the second ring (measured, see the module docs).
@@ -100,7 +100,7 @@ struct Listed {
 
 /// The rings' neighbour counts and lists for the current free set, the grid they live on,
 /// and scratch.
-pub(super) struct RingExtension {
+pub(in crate::bem) struct RingExtension {
     /// Per point of the first ring (bounded points next to the set): its number of
     /// neighbours on the set; zero elsewhere.
     first: Vec<u8>,
@@ -229,13 +229,13 @@ impl RowLists {
 
 impl RingExtension {
     /// The fields for the grid of `operator` (its size and boundaries).
-    pub(super) fn on_grid_of(operator: &ElasticOperator) -> Self {
+    pub(in crate::bem) fn on_grid_of(operator: &ElasticOperator) -> Self {
         let periodic = operator.boundary() == Boundary::Periodic;
         Self::new(operator.rows(), operator.cols(), periodic)
     }
 
     /// The fields for a `rows × cols` grid (periodic or free boundaries).
-    pub(super) fn new(rows: usize, cols: usize, periodic: bool) -> Self {
+    pub(in crate::bem) fn new(rows: usize, cols: usize, periodic: bool) -> Self {
         let len = rows * cols;
         assert!(
             u32::try_from(cols).is_ok(),
@@ -321,7 +321,7 @@ impl RingExtension {
     /// set: `z`, zero off the set, keeps its values there (uncentred) and gets the
     /// extension of the centred field on the two rings (two updates of listed points, two
     /// passes over the grid's bytes where the set changed).
-    pub(super) fn extend(&mut self, free: &[bool], z: &mut [f64], centre: f64) {
+    pub(in crate::bem) fn extend(&mut self, free: &[bool], z: &mut [f64], centre: f64) {
         self.count(free);
         let (grid, cols) = (self.grid, self.grid.1);
         let (first, second) = (&self.first, &self.second);
@@ -341,7 +341,7 @@ impl RingExtension {
     /// `z ← (I + E)ᵀ z` on the free set `free` of the last [`RingExtension::extend`]: there
     /// `z` plus what the rings took from each point. Off the set `z` is left unspecified
     /// (its callers read it on the set only, `P_F`). Two updates of listed points.
-    pub(super) fn gather(&mut self, free: &[bool], z: &mut [f64]) {
+    pub(in crate::bem) fn gather(&mut self, free: &[bool], z: &mut [f64]) {
         debug_assert!(self.counted_for[..] == *free, "gather follows extend");
         let (grid, cols) = (self.grid, self.grid.1);
         let (first, second) = (&self.first, &self.second);
@@ -364,13 +364,13 @@ impl RingExtension {
 /// preconditioner with the rings of its free set, the CG on a set with those of its set;
 /// any other preconditioner takes them alike. Nothing is allocated: the decorator borrows
 /// the preconditioner, the rings' fields and the set's mask for one application.
-pub(super) struct Ringed<'a, M: ?Sized> {
+pub(in crate::bem) struct Ringed<'a, M: ?Sized> {
     /// The preconditioner decorated.
-    pub(super) inner: &'a mut M,
+    pub(in crate::bem) inner: &'a mut M,
     /// The rings' counts, lists and scratch.
-    pub(super) rings: &'a mut RingExtension,
+    pub(in crate::bem) rings: &'a mut RingExtension,
     /// The set, as a mask of the grid.
-    pub(super) set: &'a [bool],
+    pub(in crate::bem) set: &'a [bool],
 }
 
 impl<M: Preconditioner + ?Sized> Preconditioner for Ringed<'_, M> {
@@ -668,7 +668,7 @@ mod tests {
         // The decorator of any preconditioner: (I + E)ᵀ M (I + E) on the set. With the
         // Fourier M (double precision) it is symmetric on the set (xᵀR y = yᵀR x) and at
         // least as large as M there would be on the set's fields' extension by zero …
-        use super::super::preconditioner::FourierPreconditioner;
+        use crate::bem::precondition::FourierPreconditioner;
         for (rows, cols, periodic) in [(31, 31, false), (24, 40, true), (50, 72, false)] {
             let len = rows * cols;
             let mut m = FourierPreconditioner::<f64>::new(rows, cols, 0.1, 0.1, 1.3).unwrap();

@@ -12,10 +12,10 @@
 //!    `g = u + f − d`. The free set is `F = {p > 0} ∪ {g < 0}`: every point but the bounded
 //!    ones (`p = 0`, `g ≥ 0`), which the iteration leaves alone.
 //! 2. Preconditioned gradient `z = Π P_F M P_F Π g`, with `M` the symbol `E*|q|/2`
-//!    ([`super::preconditioner`]) and, under load control, `Π` the mean-centring on `F`
+//!    ([`crate::bem::precondition`]) and, under load control, `Π` the mean-centring on `F`
 //!    (the projection onto `Σ_F = 0`, which keeps the load). On grids of at least
 //!    [`RING_MIN_POINTS`] points `Π P_F (I + E)ᵀ M (I + E) P_F Π g`, `E` the extension of
-//!    a field on `F` over two rings of bounded points ([`super::ring_extension`]): fewer
+//!    a field on `F` over two rings of bounded points ([`crate::bem::precondition::RingExtension`]): fewer
 //!    iterations, each dearer by two updates of the listed ring points (and their recount
 //!    where the set changed). `Π g` is never stored: the gradient field holds `g` on `F`,
 //!    and the centring is done by whatever reads it (the transform's row pass, the rings,
@@ -61,7 +61,7 @@
 //! the objective is bounded along the constant mode, in which `K` is zero (its slope there
 //! is `n (mean(f) − d) > 0`, the mean gap). The constant mode of the free set, held only by
 //! the open points, is preconditioned by its exact curvature `1_Oᵀ K 1_O` (a coarse-space
-//! correction, [`super::mean_gap`]), which keeps the iteration at tens of iterations up to
+//! correction, [`mean_gap`]), which keeps the iteration at tens of iterations up to
 //! full contact.
 //!
 //! The elementwise passes run in parallel over chunks of [`CHUNK`] points whose bounds do
@@ -71,19 +71,22 @@
 //! direction follow from those of the old one, so an iteration makes four passes besides
 //! the step's. They allocate nothing (the solver owns every buffer).
 
+mod mean_gap;
+pub(in crate::bem) mod small_set;
+
 use rayon::prelude::*;
 
-use super::context::{Context, Target};
-use super::grid_pass::{add_point_responses, CHUNK, CUT_LIMIT};
-use super::interface::{restore_capped_load, Interface, LOST_SET_LIMIT};
-use super::iteration::{Iteration, Limits};
-use super::mean_gap::MeanGapScratch;
-use super::plastic_field::{PlasticField, Restored};
-use super::preconditioner::Preconditioner;
-use super::ring_extension::{RingExtension, Ringed};
-use super::small_set::{small_set_start, SmallSet, SmallSetRun};
-use super::stagnation::Progress;
-use super::{ContactSummary, SolveError, SolveInfo};
+use mean_gap::MeanGapScratch;
+use small_set::{small_set_start, SmallSet, SmallSetRun};
+
+use super::{Iteration, Limits};
+use crate::bem::context::{Context, Target};
+use crate::bem::grid_pass::{add_point_responses, CHUNK, CUT_LIMIT};
+use crate::bem::interface::{restore_capped_load, Interface, LOST_SET_LIMIT};
+use crate::bem::plastic_field::{PlasticField, Restored};
+use crate::bem::precondition::{Preconditioner, RingExtension, Ringed};
+use crate::bem::stagnation::Progress;
+use crate::bem::{ContactSummary, SolveError, SolveInfo};
 use crate::elastic::{Boundary, ElasticOperator};
 use crate::fft::Precision;
 use crate::sum::sum4;
@@ -97,7 +100,7 @@ use crate::Result as CrateResult;
 /// earlier whole-grid sweeps (docs/bem_history.md), the solves of a study sample took 6–12 % less
 /// time at 512² and 1024², about the same at 256², and up to 20 % more at 128² and 64²
 /// (fig. 1's quick grids); cold solves at 1024² free, p̄ = 0.05, 57 → 44 iterations.
-pub(super) const RING_MIN_POINTS: usize = 1 << 18;
+pub(in crate::bem) const RING_MIN_POINTS: usize = 1 << 18;
 
 /// Iterations in which a solve with the rings must halve its best residual; one that does
 /// not goes on without them (issue 33, item 13: the shared MetroPro scan at E* = 1e9 Pa and
@@ -105,17 +108,17 @@ pub(super) const RING_MIN_POINTS: usize = 1 << 18;
 /// never settled its free set with the rings; docs/bem.md, "When the rings stall"). A
 /// solve with the rings halves its residual every two or three iterations on average
 /// (the fingerprint's solves: 1 to 1e-8 in 30–60 iterations).
-pub(super) const RING_WINDOW: usize = 60;
+pub(in crate::bem) const RING_WINDOW: usize = 60;
 
 /// Iterations after which `u = K p` is recomputed exactly even if no pressure was cut.
-pub(super) const REFRESH_INTERVAL: usize = 25;
+pub(in crate::bem) const REFRESH_INTERVAL: usize = 25;
 
 /// Residuals above which the `sᵀK s` of energy steps and the recomputations of `u` are made
 /// in single precision (module docs, step 7): their errors, about 5e-7 of the residual's
 /// scale (rms; 2e-6 at most, measured at 512²), are then at most 0.5 % of the residual.
 /// Measured at 512², free boundaries, p̄ = 0.05: 1e-3 to 1e-5 leave the 36 iterations as
 /// they are, 1e-6 takes 38.
-pub(super) const SINGLE_PRECISION_ABOVE: f64 = 1e-4;
+pub(in crate::bem) const SINGLE_PRECISION_ABOVE: f64 = 1e-4;
 
 /// Relative load error below which the rescaling of `p` and `u` is skipped: a step that
 /// cut nothing keeps `Σ p` up to rounding (the direction sums to zero on the free set).
@@ -123,7 +126,7 @@ const LOAD_ROUNDING: f64 = 1e-14;
 
 /// Partial sums of one chunk of a pass (the meaning of each slot is the pass's).
 #[derive(Clone, Copy, Default)]
-pub(super) struct Sums {
+pub(in crate::bem) struct Sums {
     x: [f64; 7],
     n: [usize; 2],
 }
@@ -143,29 +146,29 @@ impl Sums {
 /// The BCCG's own fields: the search direction and its response, the preconditioned
 /// gradient, the gradient, the free set and its rings, the operator's impulse response,
 /// the cut pressures and the partial sums of the parallel passes.
-pub(super) struct BccgScratch {
+pub(in crate::bem) struct BccgScratch {
     /// The search direction `s` (carried from one iteration to the next).
-    pub(super) direction: Vec<f64>,
+    pub(in crate::bem) direction: Vec<f64>,
     /// `w = K s`.
-    pub(super) response: Vec<f64>,
+    pub(in crate::bem) response: Vec<f64>,
     /// `z = Π P_F M P_F Π g`.
-    pub(super) preconditioned: Vec<f64>,
+    pub(in crate::bem) preconditioned: Vec<f64>,
     /// `g` on the free set (not centred: `Π g` is `g` minus [`Gradient::centre`] there),
     /// zero elsewhere; with the rings, their extension of `Π g` on them once extended.
-    pub(super) gradient: Vec<f64>,
+    pub(in crate::bem) gradient: Vec<f64>,
     /// The gradient field of the previous iteration (for the Polak–Ribière `β`; read on its
     /// free set only).
-    pub(super) previous_gradient: Vec<f64>,
+    pub(in crate::bem) previous_gradient: Vec<f64>,
     /// The free set `F` of the current iteration.
-    pub(super) free: Vec<bool>,
+    pub(in crate::bem) free: Vec<bool>,
     /// The free set of the previous iteration.
     previous_free: Vec<bool>,
     /// What the previous gradient field lacks of `Π g` on its free set (subtracted).
     previous_centre: f64,
     /// `K e_00`, the displacement under a unit pressure on pixel `(0, 0)`.
-    pub(super) impulse: Vec<f64>,
+    pub(in crate::bem) impulse: Vec<f64>,
     /// `(index, correction)` of the pressures cut in a step (capacity [`CUT_LIMIT`]).
-    pub(super) cuts: Vec<(usize, f64)>,
+    pub(in crate::bem) cuts: Vec<(usize, f64)>,
     /// The first [`CUT_LIMIT`] cuts of every chunk of the step pass, then (under a cap) its
     /// first [`CUT_LIMIT`] changes of the capped set.
     chunk_cuts: Vec<(usize, f64)>,
@@ -179,10 +182,10 @@ pub(super) struct BccgScratch {
     extra_energies: usize,
     /// The coarse correction of periodic displacement control (`mean_gap.rs`); periodic
     /// grids only.
-    pub(super) mean_gap: Option<MeanGapScratch>,
+    pub(in crate::bem) mean_gap: Option<MeanGapScratch>,
     /// The rings around the free set that extend the gradient before the preconditioner
     /// (grids of at least [`RING_MIN_POINTS`] points).
-    pub(super) rings: Option<RingExtension>,
+    pub(in crate::bem) rings: Option<RingExtension>,
     /// Whether the running solve still uses the rings: from its start where there are
     /// rings, until its best residual has not halved in [`RING_WINDOW`] iterations
     /// (`ring_progress`).
@@ -201,13 +204,13 @@ pub(super) struct BccgScratch {
     /// or the load restorations released the plastic set more than
     /// [`LOST_SET_LIMIT`] times: the load restoration is cycling (the solve is then
     /// finished by displacement control, `capped_load.rs`).
-    pub(super) stalled: bool,
+    pub(in crate::bem) stalled: bool,
     /// Under a cap: `K 1_C` of the capped set, for load restorations that keep `u`
     /// (`plastic_field.rs`).
     plastic: PlasticField,
     /// The dense fields of the direct solve of small contact sets (`small_set.rs`),
     /// allocated on first use.
-    pub(super) small_set: Option<SmallSet>,
+    pub(in crate::bem) small_set: Option<SmallSet>,
 }
 
 /// How the iteration treats the constant mode of the free set.
@@ -234,7 +237,7 @@ impl MeanMode {
 
 impl BccgScratch {
     /// The fields for the grid of `operator` (one operator application).
-    pub(super) fn new(operator: &mut ElasticOperator) -> CrateResult<Self> {
+    pub(in crate::bem) fn new(operator: &mut ElasticOperator) -> CrateResult<Self> {
         let len = operator.rows() * operator.cols();
         let mut unit = vec![0.0; len];
         unit[0] = 1.0;
@@ -1189,7 +1192,7 @@ impl BccgScratch {
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::rough_grid;
+    use crate::bem::iterations::polonsky_keer::tests::rough_grid;
 
     /// Issue 33 item 12: the default BCCG solves a problem whose heights and pressures are
     /// scaled by 1e17 (or 1e-17, or its modulus and pressures by 1e17) to the contact of
@@ -1220,8 +1223,8 @@ mod tests {
             assert!(d.abs() < 1e-6, "{heights:e} {modulus:e}: {d:e}");
         }
     }
-    use super::super::{ContactSolver, Control, HalfSpace, Parallelism, SolverKind, SolverParams};
     use super::*;
+    use crate::bem::{ContactSolver, Control, HalfSpace, Parallelism, SolverKind, SolverParams};
     use crate::elastic::Boundary;
     use crate::surface::Surface;
 

@@ -18,15 +18,22 @@
 //!   root search of a capped load (`capped_load.rs`), the stiffness and thresholds of the
 //!   solved state — applies to every iteration unchanged.
 //!
-//! The iterations today: the BCCG (`bccg.rs`, with its direct solve of small sets,
-//! `small_set.rs`, and the coarse correction of periodic displacement control,
-//! `mean_gap.rs`) and Polonsky–Keer's constrained conjugate gradients (`polonsky_keer.rs`).
+//! The iterations today, each in this folder: the BCCG (`bccg.rs`, with its direct solve of
+//! small sets, `bccg/small_set.rs`, and the coarse correction of periodic displacement
+//! control, `bccg/mean_gap.rs`) and Polonsky–Keer's constrained conjugate gradients
+//! (`polonsky_keer.rs`).
 //! A new one (an adhesive iteration, say) is a new file with `struct AdhesiveScratch` and
 //! `impl Iteration for AdhesiveScratch`, which `ContactSolver::solve_with(control, &mut
 //! scratch)` runs with no edit of the core (the caller owns its fields); to make it a
 //! choice of [`super::SolverParams`] as well, two lines name it: a [`super::SolverKind`]
 //! variant and its arm in `ContactSolver::iteration` (with its field in the solver,
 //! allocated on first use).
+
+pub(super) mod bccg;
+pub(super) mod polonsky_keer;
+
+pub(super) use bccg::{small_set, BccgScratch, RING_MIN_POINTS};
+pub(super) use polonsky_keer::PkScratch;
 
 use super::context::{Context, Target};
 use super::{ContactSummary, SolveError, SolveInfo};

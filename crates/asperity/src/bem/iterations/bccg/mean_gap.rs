@@ -33,7 +33,7 @@
 use crate::elastic::ElasticOperator;
 
 /// The fields of the coarse correction (periodic grids only).
-pub(super) struct MeanGapScratch {
+pub(in crate::bem) struct MeanGapScratch {
     /// `1_O`, the indicator of the points off the free set.
     open: Vec<f64>,
     /// The free set of the last curvature (its recomputation is skipped while `F` stays).
@@ -47,7 +47,7 @@ pub(super) struct MeanGapScratch {
 
 impl MeanGapScratch {
     /// Fields for the grid of `operator`.
-    pub(super) fn new(operator: &ElasticOperator) -> Self {
+    pub(in crate::bem) fn new(operator: &ElasticOperator) -> Self {
         let len = operator.rows() * operator.cols();
         let longest = (operator.cols() as f64 * operator.spacing())
             .max(operator.rows() as f64 * operator.spacing_y());
@@ -60,13 +60,13 @@ impl MeanGapScratch {
     }
 
     /// Forgets the cached curvature (a new solve or a new surface).
-    pub(super) fn reset(&mut self) {
+    pub(in crate::bem) fn reset(&mut self) {
         self.curvature = None;
     }
 
     /// `1_Oᵀ K 1_O` for the free set `free` and whether it cost a forward transform (only
     /// when the set differs from the previous call's).
-    pub(super) fn curvature(
+    pub(in crate::bem) fn curvature(
         &mut self,
         operator: &mut ElasticOperator,
         free: &[bool],
@@ -91,7 +91,7 @@ impl MeanGapScratch {
     /// `p ≥ 0` stops a step) the preconditioner's own `q = 0` value takes the curvature's
     /// place, `mean_F(g) E* q₁/2`, and the projection of the step cuts the pressures
     /// that reach zero.
-    pub(super) fn coarse_value(&self, gradient_sum: f64, free_points: usize) -> f64 {
+    pub(in crate::bem) fn coarse_value(&self, gradient_sum: f64, free_points: usize) -> f64 {
         match self.curvature {
             Some(c) if crate::is_positive_finite(c) => gradient_sum / c,
             _ => gradient_sum / free_points.max(1) as f64 * self.zero_mode,
@@ -101,9 +101,9 @@ impl MeanGapScratch {
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::{assert_no_convergence, rough_grid};
-    use super::super::solver::ContactSolver;
-    use super::super::{Control, HalfSpace, SolveError, SolverParams};
+    use crate::bem::iterations::polonsky_keer::tests::{assert_no_convergence, rough_grid};
+    use crate::bem::solver::ContactSolver;
+    use crate::bem::{Control, HalfSpace, SolveError, SolverParams};
     use crate::elastic::Boundary;
     use crate::reference::Westergaard;
     use crate::surface::Surface;

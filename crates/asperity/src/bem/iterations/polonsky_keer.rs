@@ -5,7 +5,7 @@
 //!
 //! One iteration (load control; displacement control skips the mean subtractions and the
 //! rescaling, with `d` fixed, on free and periodic boundaries alike: below full contact the
-//! periodic objective is bounded along the constant mode, see [`super::mean_gap`]):
+//! periodic objective is bounded along the constant mode, see [`super::bccg::mean_gap`]):
 //! 1. `u = K p`; on the contact set `I_c = {p > 0}` the indentation is the mean of `u + f`,
 //!    `g = u + f − d`, `G = Σ_{I_c} g²`.
 //! 2. Direction `t = g + δ (G/G_old) t` on `I_c`, zero elsewhere (`δ = 0` after the contact
@@ -19,26 +19,26 @@
 //! keeps results bit-identical for any thread count (the FFTs are parallel and
 //! independent of it too).
 
-use super::context::{Context, Target};
-use super::interface::{restore_capped_load, CappedRestoration, Interface, LOST_SET_LIMIT};
-use super::iteration::{Iteration, Limits};
-use super::{ContactSummary, SolveError, SolveInfo};
+use super::{Iteration, Limits};
+use crate::bem::context::{Context, Target};
+use crate::bem::interface::{restore_capped_load, CappedRestoration, Interface, LOST_SET_LIMIT};
+use crate::bem::{ContactSummary, SolveError, SolveInfo};
 
 /// The iteration's own fields: the conjugate direction `t` and its response `K t`. Owned
 /// by the solver, allocated on the first Polonsky–Keer solve; nothing is kept in them
 /// between solves.
-pub(super) struct PkScratch {
+pub(in crate::bem) struct PkScratch {
     direction: Vec<f64>,
     response: Vec<f64>,
     /// Under a cap and load control: the last solve stopped because its load
     /// restorations lost the plastic set more than [`LOST_SET_LIMIT`] times (cycling;
     /// `capped_load.rs` finishes it by displacement control).
-    pub(super) stalled: bool,
+    pub(in crate::bem) stalled: bool,
 }
 
 impl PkScratch {
     /// The fields for a grid of `len` points.
-    pub(super) fn new(len: usize) -> Self {
+    pub(in crate::bem) fn new(len: usize) -> Self {
         PkScratch {
             direction: vec![0.0; len],
             response: vec![0.0; len],
@@ -49,7 +49,7 @@ impl PkScratch {
 
 impl Iteration for PkScratch {
     /// The Polonsky–Keer iteration for `target` to the tolerance in at most the iterations
-    /// of `limits`, from the solver's start in `cx` (see [`super::ContactSolver::solve`]),
+    /// of `limits`, from the solver's start in `cx` (see [`crate::bem::ContactSolver::solve`]),
     /// in its own fields.
     fn solve(
         &mut self,
@@ -188,21 +188,21 @@ fn restore_load(cx: &mut Context, target: Target, total: f64) -> CappedRestorati
 }
 
 /// Sums of passes A and B over the grid.
-pub(super) struct GapPass {
+pub(in crate::bem) struct GapPass {
     /// Points in contact (`p > 0`).
-    pub(super) contact_points: usize,
+    pub(in crate::bem) contact_points: usize,
     /// Points the conjugate gradients move ([`moves`]; the contact points for the hard
     /// wall).
-    pub(super) moving_points: usize,
+    pub(in crate::bem) moving_points: usize,
     /// `G = Σ g²` on the points moved.
-    pub(super) gap_squared: f64,
+    pub(in crate::bem) gap_squared: f64,
     /// The squared violations off it (`Σ_{p=0} min(g, 0)²`, and `Σ_{p=H} max(g, 0)²`).
-    pub(super) penetration_squared: f64,
+    pub(in crate::bem) penetration_squared: f64,
 }
 
 impl GapPass {
     /// The residual of the module docs: `sqrt[(G + Σ_{p=0} min(g,0)²) / n_c] / h_rms`.
-    pub(super) fn residual(&self, height_scale: f64) -> f64 {
+    pub(in crate::bem) fn residual(&self, height_scale: f64) -> f64 {
         ((self.gap_squared + self.penetration_squared) / self.contact_points.max(1) as f64).sqrt()
             / height_scale
     }
@@ -212,7 +212,7 @@ impl GapPass {
 /// exit. Under load control `indentation` becomes the mean of `u + f` on the contact set
 /// (summed about its previous value, so that `G` does not cancel); `t` becomes the new
 /// conjugate direction (`previous_g = 0`: steepest descent).
-pub(super) fn gap_and_direction(
+pub(in crate::bem) fn gap_and_direction(
     interface: Interface,
     (p, f): (&[f64], &[f64]),
     gap: &mut [f64],
@@ -341,9 +341,9 @@ fn update_pressure(
 }
 
 #[cfg(test)]
-pub(super) mod tests {
-    use super::super::{ContactSolver, Control, HalfSpace, SolverParams};
+pub(in crate::bem) mod tests {
     use super::*;
+    use crate::bem::{ContactSolver, Control, HalfSpace, SolverParams};
     use crate::elastic::Boundary;
     use crate::reference::{Hertz, Westergaard};
     use crate::surface::Surface;

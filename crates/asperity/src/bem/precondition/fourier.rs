@@ -41,11 +41,11 @@ use crate::Result;
 /// of `K⁻¹` to begin with, and the iterations read `M g` only through the direction it
 /// suggests; their residuals, steps and convergence are all in double precision. Single
 /// precision takes a fifth off the preconditioner's time at 512² (docs/bem_history.md, "Single precision for the preconditioner").
-pub(super) type Real = f32;
+pub(in crate::bem) type Real = f32;
 
 /// `M ≈ K⁻¹` by its Fourier symbol `E*|q|/2` on the unpadded grid (see the module docs),
 /// computed in precision `T` (the solvers use [`Real`]).
-pub(super) struct FourierPreconditioner<T: Precision = Real> {
+pub(in crate::bem) struct FourierPreconditioner<T: Precision = Real> {
     fft: RealFft2<T>,
     /// Symbol in the transposed half-spectrum layout of [`RealFft2`] (`kx`-major), with the
     /// FFT's `1/(rows·cols)` folded in.
@@ -57,13 +57,19 @@ impl<T: Precision> FourierPreconditioner<T> {
     /// work buffer (complex, half grid) and the symbol (real, half grid), and the lanes'
     /// column buffers. Rounded up to whole `rows × cols` double fields: two (one in single
     /// precision, but the estimate does not count on it).
-    pub(super) fn memory_bytes(rows: usize, cols: usize) -> Option<u64> {
+    pub(in crate::bem) fn memory_bytes(rows: usize, cols: usize) -> Option<u64> {
         memory::array_bytes(&[2, rows, cols], 8)
     }
 
     /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of pixels
     /// `dx × dy` on a half-space of modulus `modulus`.
-    pub(super) fn new(rows: usize, cols: usize, dx: f64, dy: f64, modulus: f64) -> Result<Self> {
+    pub(in crate::bem) fn new(
+        rows: usize,
+        cols: usize,
+        dx: f64,
+        dy: f64,
+        modulus: f64,
+    ) -> Result<Self> {
         Self::with_symbol(rows, cols, (dx, dy), |_, _, q| 0.5 * modulus * q)
     }
 
@@ -71,7 +77,7 @@ impl<T: Precision> FourierPreconditioner<T> {
     /// operator's Fourier symbol, for a `rows × cols` grid of pixels `dx × dy`: `q` is
     /// `|(qx, qy)|`, or at `qx = qy = 0` the smallest non-zero wavenumber of the grid
     /// (module docs).
-    pub(super) fn with_symbol(
+    pub(in crate::bem) fn with_symbol(
         rows: usize,
         cols: usize,
         (dx, dy): (f64, f64),
@@ -98,13 +104,13 @@ impl<T: Precision> FourierPreconditioner<T> {
 
     /// `output ← M input` (`rows × cols` row-major fields): [`FourierPreconditioner::apply`]
     /// without first copying the input into the output.
-    pub(super) fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
+    pub(in crate::bem) fn apply_into(&mut self, input: &[f64], output: &mut [f64]) {
         self.apply_prepared(input, output, |_, _| {});
     }
 
     /// `output ← M x` for the field `x` that `prepare(i, row)` makes of row `i` of `input`
     /// (`cols` values) on its way into the transform; `input` is left alone.
-    pub(super) fn apply_prepared(
+    pub(in crate::bem) fn apply_prepared(
         &mut self,
         input: &[f64],
         output: &mut [f64],
@@ -117,7 +123,7 @@ impl<T: Precision> FourierPreconditioner<T> {
 
     /// `data ← M data` (a `rows × cols` row-major field, overwritten).
     /// One fused convolution: each column of the spectrum is multiplied while in cache.
-    pub(super) fn apply(&mut self, data: &mut [f64]) {
+    pub(in crate::bem) fn apply(&mut self, data: &mut [f64]) {
         let rows = self.fft.rows();
         let multiply = multiplier(&self.symbol, rows);
         self.fft.convolve_in_place(data, multiply);
@@ -129,7 +135,7 @@ impl<T: Precision> FourierPreconditioner<T> {
 /// load). Symmetric positive definite; allocates nothing; independent of the thread count.
 ///
 /// [`FourierPreconditioner`] is the one made from a symbol; the rings around a set
-/// (`ring_extension.rs`, [`super::ring_extension::Ringed`]) decorate any preconditioner,
+/// (`ring_extension.rs`, [`super::Ringed`]) decorate any preconditioner,
 /// and the BCCG and the CG on a set take either.
 pub(crate) trait Preconditioner {
     /// `output ← M input` (`rows × cols` row-major fields).
@@ -178,12 +184,12 @@ impl<T: Precision + Masked + SubAssign> Preconditioner for FourierPreconditioner
 /// would be mispredicted at every edge of the set). In double precision, or in the
 /// preconditioner's single.
 #[inline(always)]
-pub(super) fn centre_on_set<T: Masked>(centre: T, on_set: bool) -> T {
+pub(in crate::bem) fn centre_on_set<T: Masked>(centre: T, on_set: bool) -> T {
     centre.kept(on_set)
 }
 
 /// Floating-point values that can be kept or zeroed by a mask of their bits.
-pub(super) trait Masked: Copy {
+pub(in crate::bem) trait Masked: Copy {
     /// `self` if `keep`, else +0.
     fn kept(self, keep: bool) -> Self;
 }

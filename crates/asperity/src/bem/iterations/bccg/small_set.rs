@@ -34,9 +34,9 @@
 //! the set is still the solved state's (its residual checked against the stiffness
 //! tolerance).
 
-use super::context::{Context, Target};
-use super::interface::Interface;
-use super::SolveError;
+use crate::bem::context::{Context, Target};
+use crate::bem::interface::Interface;
+use crate::bem::SolveError;
 
 /// The contact rule of the direct solve (it serves the BCCG, which solves the hard wall).
 const WALL: Interface = Interface::HardWall;
@@ -60,7 +60,7 @@ const GAP_SLACK: f64 = 1e-2;
 /// factor's `|S|³/3` flops against a transform's `len log₂ len`), between 32 and 1024
 /// points. The constant is measured on study samples (docs/bem_history.md): 48 is about 4 % faster
 /// than 24 and as fast as 96 at 64² and 128²; 24 and 96 are alike at 1024².
-pub(super) fn limit(len: usize) -> usize {
+pub(in crate::bem) fn limit(len: usize) -> usize {
     let transform = len as f64 * (len.max(2) as f64).log2();
     ((48.0 * transform).cbrt() as usize).clamp(32, 1024)
 }
@@ -84,7 +84,7 @@ fn kernel(
 }
 
 /// The dense fields of the iteration, allocated on first use for [`limit`] points.
-pub(super) struct SmallSet {
+pub(in crate::bem) struct SmallSet {
     /// The set's grid indices in the order of the factor's rows.
     set: Vec<usize>,
     /// Whether each grid point is in the set.
@@ -108,11 +108,11 @@ pub(super) struct SmallSet {
 }
 
 /// What the direct iteration left for the BCCG.
-pub(super) struct SmallSetRun {
+pub(in crate::bem) struct SmallSetRun {
     /// Operator applications (one per iteration).
-    pub(super) applications: usize,
+    pub(in crate::bem) applications: usize,
     /// Whether the gap buffer holds `u = K p` for the pressure left.
-    pub(super) exact: bool,
+    pub(in crate::bem) exact: bool,
 }
 
 impl SmallSet {
@@ -291,7 +291,7 @@ fn highest_point(profile: &[f64]) -> usize {
 /// (module docs), in the fields of `slot` (allocated there on first use) with the operator's
 /// impulse response `impulse`; leaves a pressure for the BCCG to finish. At most
 /// `max_iterations` operator applications.
-pub(super) fn small_set_start(
+pub(in crate::bem) fn small_set_start(
     slot: &mut Option<SmallSet>,
     impulse: &[f64],
     cx: &mut Context,
@@ -434,7 +434,7 @@ fn small_set_iterate(
 /// (zero off the set), if the contact set of `pressure` is that solve's set and `x`
 /// solves the system to `tolerance` (relative residual, computed here from the
 /// kernel); returns the residual.
-pub(super) fn tangent(
+pub(in crate::bem) fn tangent(
     slot: Option<&SmallSet>,
     impulse: &[f64],
     pressure: &[f64],
@@ -469,9 +469,9 @@ pub(super) fn tangent(
 
 #[cfg(test)]
 mod tests {
-    use super::super::polonsky_keer::tests::rough_grid;
-    use super::super::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
     use super::*;
+    use crate::bem::iterations::polonsky_keer::tests::rough_grid;
+    use crate::bem::{ContactSolver, Control, HalfSpace, SolverKind, SolverParams};
     use crate::elastic::ElasticOperator;
 
     fn half_space(boundary: Boundary) -> HalfSpace {
