@@ -43,8 +43,10 @@ pub(crate) mod mi;
 pub(crate) mod mnt;
 pub(crate) mod netcdf;
 pub(crate) mod nid;
+pub(crate) mod nms;
 pub(crate) mod opd;
 pub(crate) mod opdx;
+pub(crate) mod park;
 pub mod patches;
 pub(crate) mod plu;
 pub(crate) mod sdf;
@@ -55,6 +57,7 @@ mod testkit;
 pub(crate) mod text;
 pub(crate) mod tiff;
 pub(crate) mod tmd;
+pub(crate) mod vk;
 pub(crate) mod wsxm;
 pub mod x3p;
 pub(crate) mod xlsx;
@@ -244,6 +247,24 @@ const FORMATS: &[Format] = &[
         extensions: &["jpk"],
         sniff: jpk::sniff,
         read: jpk::read,
+    },
+    Format {
+        name: "park",
+        extensions: &["tiff", "tif"],
+        sniff: park::sniff,
+        read: park::read,
+    },
+    Format {
+        name: "nms",
+        extensions: &["nms"],
+        sniff: nms::sniff,
+        read: nms::read,
+    },
+    Format {
+        name: "vk",
+        extensions: &["vk3", "vk4", "vk6", "vk7"],
+        sniff: vk::sniff,
+        read: vk::read,
     },
     // The instrument formats, before any text detection (DI and WSxM headers are text);
     // PLU last, its only signature being a date.
@@ -1216,7 +1237,7 @@ mod every_shared_file {
             }
         }
         assert!(failed.is_empty(), "not read: {failed:#?}");
-        // 16 + 21 + 8 files in the three sets.
-        assert_eq!(read, 45);
+        // 16 + 21 + 10 files in the three sets.
+        assert_eq!(read, 47);
     }
 }

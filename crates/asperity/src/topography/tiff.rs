@@ -48,11 +48,17 @@ impl Value {
     }
 }
 
-/// One page (IFD): its tags.
+/// One page (IFD): its tags, and where each tag's value lies in the file.
 #[derive(Debug, Clone)]
 pub(crate) struct Page {
     pub tags: HashMap<u16, Value>,
+    /// Each tag's value as `(offset, length in bytes)`, checked to lie inside the file.
+    pub blocks: HashMap<u16, (usize, usize)>,
 }
+
+/// Byte-typed values (BYTE, SBYTE, UNDEFINED) longer than this are not decoded into
+/// [`Value::Ints`] (they are data blocks, read through [`Page::blocks`]).
+const MAX_DECODED_BYTES: usize = 1 << 16;
 
 /// Whether `bytes` start with a TIFF signature.
 pub(crate) fn sniff(bytes: &[u8]) -> bool {
@@ -81,12 +87,14 @@ pub(crate) fn pages(format: &'static str, bytes: &[u8]) -> Result<(Endian, Vec<P
         c.seek(next)?;
         let n = c.u16(e)? as usize;
         let mut tags = HashMap::new();
+        let mut blocks = HashMap::new();
         for _ in 0..n {
-            let (tag, value) = entry(&mut c, e)?;
+            let (tag, value, block) = entry(&mut c, e)?;
             tags.insert(tag, value);
+            blocks.insert(tag, block);
         }
         next = c.u32(e)? as usize;
-        out.push(Page { tags });
+        out.push(Page { tags, blocks });
     }
     if out.is_empty() {
         return Err(bad(format, "no image directory"));
@@ -94,8 +102,8 @@ pub(crate) fn pages(format: &'static str, bytes: &[u8]) -> Result<(Endian, Vec<P
     Ok((e, out))
 }
 
-/// One 12-byte directory entry; the cursor ends after it.
-fn entry(c: &mut Cursor, e: Endian) -> Result<(u16, Value)> {
+/// One 12-byte directory entry and where its value lies; the cursor ends after it.
+fn entry(c: &mut Cursor, e: Endian) -> Result<(u16, Value, (usize, usize))> {
     let tag = c.u16(e)?;
     let kind = c.u16(e)?;
     let count = c.u32(e)? as usize;
@@ -111,7 +119,7 @@ fn entry(c: &mut Cursor, e: Endian) -> Result<(u16, Value)> {
     let after = c.pos();
     let len = count.saturating_mul(size);
     if size == 0 {
-        return Ok((tag, Value::Other));
+        return Ok((tag, Value::Other, (field, 0)));
     }
     let at = if len <= 4 {
         field
@@ -121,9 +129,16 @@ fn entry(c: &mut Cursor, e: Endian) -> Result<(u16, Value)> {
         o.u32(e)? as usize
     };
     c.seek(at)?;
-    let value = decode(c, e, kind, count)?;
+    let value = if size == 1 && count > MAX_DECODED_BYTES {
+        let start = c.pos();
+        c.skip(count)?;
+        c.seek(start)?;
+        Value::Other
+    } else {
+        decode(c, e, kind, count)?
+    };
     c.seek(after)?;
-    Ok((tag, value))
+    Ok((tag, value, (at, len)))
 }
 
 fn decode(c: &mut Cursor, e: Endian, kind: u16, count: usize) -> Result<Value> {

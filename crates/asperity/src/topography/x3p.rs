@@ -9,7 +9,13 @@
 //! `SizeY`, `SizeZ` = 1) and the data: a `PointDataLink` to the payload (little-endian,
 //! x fastest, then y — our row-major order with rows along y), or inline `DataList`
 //! `Datum` elements; an optional `ValidPointsLink` names a bit array (least significant
-//! bit first, 1 = valid). Float NaN and empty `Datum`s are undefined points. Sizes are
+//! bit first, 1 = valid). Float NaN and empty `Datum`s are undefined points. `CX` and
+//! `CY` may also be absolute (`A`, with their own `DataType`, `Increment`, `Offset`): each
+//! point's record then holds its coordinates before its height (binary: x, y, z values
+//! back to back; inline: `x;y;z`), and the coordinates must form a uniform grid (x by
+//! column, y by row, increasing, within a thousandth of a step), whose step is the
+//! spacing; other point sets are refused (openGPS's description of ISO 5436-2; Gwyddion
+//! and SurfaceTopography refuse absolute lateral axes). Sizes are
 //! `Increment × count` per axis (SurfaceTopography's convention; its arrays are our
 //! transpose). Facts from the openGPS description of ISO 5436-2 and SurfaceTopography's
 //! `X3PReader`; where they differ, the standard is followed: `I`/`L` are signed.
@@ -81,6 +87,8 @@ struct Layout {
     nx: usize,
     ny: usize,
     spacing: [f64; 2],
+    /// The coding of CX and CY where they are absolute (coordinates stored per point).
+    absolute: [Option<Coding>; 2],
     data_type: char,
     z_increment: f64,
     z_offset: f64,
@@ -88,6 +96,68 @@ struct Layout {
     payload_md5: Option<String>,
     valid_points: Option<String>,
     valid_md5: Option<String>,
+}
+
+/// How an axis' values are stored: `DataType` (`I`, `L`, `F`, `D`), and `value = Offset +
+/// Increment · raw` (defaults 0 and 1).
+#[derive(Debug, Clone, Copy)]
+struct Coding {
+    data_type: char,
+    increment: f64,
+    offset: f64,
+}
+
+impl Coding {
+    fn width(&self) -> usize {
+        match self.data_type {
+            'I' => 2,
+            'L' | 'F' => 4,
+            _ => 8,
+        }
+    }
+
+    fn raw(&self, b: &[u8]) -> f64 {
+        match self.data_type {
+            'I' => i16::from_le_bytes([b[0], b[1]]) as f64,
+            'L' => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            'F' => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            _ => f64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
+        }
+    }
+
+    fn value(&self, raw: f64) -> f64 {
+        self.offset + self.increment * raw
+    }
+}
+
+fn coding(record1: roxmltree::Node<'_, '_>, axis: &str) -> Result<Coding> {
+    let data_type = match required(record1, &["Axes", axis, "DataType"])? {
+        t @ ("I" | "L" | "F" | "D") => t.chars().next().expect("one letter"),
+        other => {
+            return Err(bad(
+                FORMAT,
+                format!("{axis} DataType {other} is not one of I, L, F, D"),
+            ))
+        }
+    };
+    let optional = |name: &str, default: f64| -> Result<f64> {
+        match text_at(record1, &["Axes", axis, name]) {
+            None | Some("") => Ok(default),
+            Some(_) => number(record1, &["Axes", axis, name]),
+        }
+    };
+    let c = Coding {
+        data_type,
+        increment: optional("Increment", 1.0)?,
+        offset: optional("Offset", 0.0)?,
+    };
+    if !(c.increment.is_finite() && c.increment != 0.0 && c.offset.is_finite()) {
+        return Err(bad(
+            FORMAT,
+            format!("{axis} Increment or Offset is not finite and non-zero"),
+        ));
+    }
+    Ok(c)
 }
 
 fn layout(root: roxmltree::Node<'_, '_>) -> Result<Layout> {
@@ -103,31 +173,20 @@ fn layout(root: roxmltree::Node<'_, '_>) -> Result<Layout> {
             ))
         }
     };
-    for axis in ["CX", "CY"] {
-        let kind = required(record1, &["Axes", axis, "AxisType"])?;
-        if kind != "I" {
-            return Err(bad(
-                FORMAT,
-                format!("{axis} AxisType {kind}: only incremental (I) axes are supported"),
-            ));
+    let mut absolute = [None, None];
+    for (k, axis) in ["CX", "CY"].into_iter().enumerate() {
+        match required(record1, &["Axes", axis, "AxisType"])? {
+            "I" => {}
+            "A" => absolute[k] = Some(coding(record1, axis)?),
+            kind => {
+                return Err(bad(
+                    FORMAT,
+                    format!("{axis} AxisType {kind}: neither incremental (I) nor absolute (A)"),
+                ))
+            }
         }
     }
-    let data_type = required(record1, &["Axes", "CZ", "DataType"])?;
-    let data_type = match data_type {
-        "I" | "L" | "F" | "D" => data_type.chars().next().expect("one letter"),
-        other => {
-            return Err(bad(
-                FORMAT,
-                format!("CZ DataType {other} is not one of I, L, F, D"),
-            ))
-        }
-    };
-    let optional = |name: &str, default: f64| -> Result<f64> {
-        match text_at(record1, &["Axes", "CZ", name]) {
-            None | Some("") => Ok(default),
-            Some(_) => number(record1, &["Axes", "CZ", name]),
-        }
-    };
+    let z = coding(record1, "CZ")?;
     if child(record3, "MatrixDimension").is_none() {
         return Err(bad(
             FORMAT,
@@ -141,21 +200,21 @@ fn layout(root: roxmltree::Node<'_, '_>) -> Result<Layout> {
             format!("SizeZ = {nz}: volumetric data is not supported"),
         ));
     }
+    // An absolute axis' spacing follows from its coordinates (see `absolute_spacing`).
+    let spacing = |k: usize, axis: &str| match absolute[k] {
+        Some(_) => Ok(1.0),
+        None if k == 1 && profile => Ok(1.0),
+        None => number(record1, &["Axes", axis, "Increment"]),
+    };
     Ok(Layout {
         profile,
         nx: number(record3, &["MatrixDimension", "SizeX"])?,
         ny: number(record3, &["MatrixDimension", "SizeY"])?,
-        spacing: [
-            number(record1, &["Axes", "CX", "Increment"])?,
-            if profile {
-                1.0
-            } else {
-                number(record1, &["Axes", "CY", "Increment"])?
-            },
-        ],
-        data_type,
-        z_increment: optional("Increment", 1.0)?,
-        z_offset: optional("Offset", 0.0)?,
+        spacing: [spacing(0, "CX")?, spacing(1, "CY")?],
+        absolute,
+        data_type: z.data_type,
+        z_increment: z.increment,
+        z_offset: z.offset,
         payload: text_at(record3, &["DataLink", "PointDataLink"]).map(str::to_string),
         payload_md5: text_at(record3, &["DataLink", "MD5ChecksumPointData"]).map(str::to_string),
         // The valid-points link sits in `DataLink` (openGPS samples) or in `Record3`.
@@ -199,22 +258,38 @@ impl Layout {
             .ok_or_else(|| bad(FORMAT, "the grid is larger than any memory"))
     }
 
-    fn width(&self) -> usize {
-        match self.data_type {
-            'I' => 2,
-            'L' | 'F' => 4,
-            _ => 8,
+    fn z_coding(&self) -> Coding {
+        Coding {
+            data_type: self.data_type,
+            increment: self.z_increment,
+            offset: self.z_offset,
         }
     }
 
-    fn decode(&self, raw: &[u8]) -> f64 {
-        let v = match self.data_type {
-            'I' => i16::from_le_bytes([raw[0], raw[1]]) as f64,
-            'L' => i32::from_le_bytes(raw.try_into().expect("4 bytes")) as f64,
-            'F' => f32::from_le_bytes(raw.try_into().expect("4 bytes")) as f64,
-            _ => f64::from_le_bytes(raw.try_into().expect("8 bytes")),
-        };
-        self.scale(v)
+    /// The bytes of one point's record: the absolute axes' values in order x, y, then z.
+    fn record_width(&self) -> usize {
+        self.absolute
+            .iter()
+            .flatten()
+            .map(Coding::width)
+            .sum::<usize>()
+            + self.z_coding().width()
+    }
+
+    /// Decodes one record (of [`Self::record_width`] bytes) into `out`.
+    fn push_record(&self, mut record: &[u8], out: &mut Records) {
+        for (k, c) in self.absolute.iter().enumerate() {
+            if let Some(c) = c {
+                let v = c.value(c.raw(record));
+                record = &record[c.width()..];
+                if k == 0 {
+                    out.x.push(v)
+                } else {
+                    out.y.push(v)
+                }
+            }
+        }
+        out.z.push(self.scale(self.z_coding().raw(record)));
     }
 
     fn scale(&self, v: f64) -> f64 {
@@ -388,20 +463,24 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     check_checksum_file(&mut archive, root, &xml)?;
     let layout = layout(root)?;
     let count = layout.validate()?;
-    let mut values = match &layout.payload {
+    let records = match &layout.payload {
         Some(name) => {
-            let width = layout.width();
+            let width = layout.record_width();
             let len = count
                 .checked_mul(width)
                 .ok_or_else(|| bad(FORMAT, "the grid is larger than any memory"))?;
             let data = entry(&mut archive, name, len)?;
             check_md5(name, &data, layout.payload_md5.as_deref())?;
-            data.chunks_exact(width)
-                .map(|c| layout.decode(c))
-                .collect::<Vec<f64>>()
+            let mut records = Records::default();
+            for record in data.chunks_exact(width) {
+                layout.push_record(record, &mut records);
+            }
+            records
         }
         None => inline_values(root, &layout, count)?,
     };
+    let spacing = absolute_spacing(&layout, &records)?;
+    let mut values = records.z;
     if let Some(name) = &layout.valid_points {
         let bits = entry(&mut archive, name, count.div_ceil(8))?;
         check_md5(name, &bits, layout.valid_md5.as_deref())?;
@@ -419,13 +498,13 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
                 .map_err(|e| bad(FORMAT, e.to_string()))?,
         )
     };
-    let size_y = (!layout.profile).then(|| layout.spacing[1] * layout.ny as f64);
+    let size_y = (!layout.profile).then(|| spacing[1] * layout.ny as f64);
     Ok(Reading {
         format: FORMAT,
         channels: vec![Channel {
             name: "heights".into(),
             heights,
-            size: [Some(layout.spacing[0] * layout.nx as f64), size_y],
+            size: [Some(spacing[0] * layout.nx as f64), size_y],
             unit: Some("m".into()),
             is_height: true,
         }],
@@ -433,36 +512,119 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
 }
 
 /// The values of an inline `DataList` (`Datum` elements; empty = undefined).
-fn inline_values(root: roxmltree::Node<'_, '_>, layout: &Layout, count: usize) -> Result<Vec<f64>> {
+fn inline_values(root: roxmltree::Node<'_, '_>, layout: &Layout, count: usize) -> Result<Records> {
     let list = child(root, "Record3")
         .and_then(|r| child(r, "DataList"))
         .ok_or_else(|| bad(FORMAT, "Record3 has neither a DataLink nor a DataList"))?;
-    let mut values = Vec::new();
+    let mut records = Records::default();
     for datum in list.children().filter(|c| c.tag_name().name() == "Datum") {
-        if values.len() == count {
+        if records.z.len() == count {
             return Err(bad(
                 FORMAT,
                 format!("DataList holds more than the {count} points of the grid"),
             ));
         }
+        // `x;y;z` with the absolute axes' values first (an empty field is undefined).
         let text = datum.text().map(str::trim).unwrap_or("");
-        let v = if text.is_empty() {
-            f64::NAN
-        } else {
-            layout.scale(
-                text.parse::<f64>()
-                    .map_err(|_| bad(FORMAT, format!("Datum {text:?} is not a number")))?,
-            )
+        let mut fields = text.split(';').map(str::trim);
+        let parse = |f: Option<&str>| -> Result<f64> {
+            match f {
+                None | Some("") => Ok(f64::NAN),
+                Some(t) => t
+                    .parse::<f64>()
+                    .map_err(|_| bad(FORMAT, format!("Datum {text:?} is not a number"))),
+            }
         };
-        values.push(v);
+        for (k, c) in layout.absolute.iter().enumerate() {
+            if let Some(c) = c {
+                let v = c.value(parse(fields.next())?);
+                if k == 0 {
+                    records.x.push(v)
+                } else {
+                    records.y.push(v)
+                }
+            }
+        }
+        let z = parse(fields.next())?;
+        records.z.push(if z.is_nan() { z } else { layout.scale(z) });
+        if fields.next().is_some() {
+            return Err(bad(
+                FORMAT,
+                format!("Datum {text:?} holds more values than axes"),
+            ));
+        }
     }
-    if values.len() != count {
+    if records.z.len() != count {
         return Err(bad(
             FORMAT,
-            format!("DataList holds {} points, the grid {count}", values.len()),
+            format!(
+                "DataList holds {} points, the grid {count}",
+                records.z.len()
+            ),
         ));
     }
-    Ok(values)
+    Ok(records)
+}
+
+/// The coordinates of the absolute axes and the heights, point by point.
+#[derive(Default)]
+struct Records {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+}
+
+/// The largest distance of a stored coordinate from the uniform grid, in steps: coordinates
+/// are written as f32 or rounded decimals, and a thousandth of a step is far below what
+/// matters for the grid and well above f32 rounding on grids below a million points a side.
+const GRID_TOLERANCE: f64 = 1e-3;
+
+/// The spacing along x and y: the increments of incremental axes; for an absolute axis,
+/// the step of the uniform grid its coordinates must form (x depending on the column only,
+/// y on the row only, increasing; undefined coordinates skipped), or an error.
+fn absolute_spacing(layout: &Layout, r: &Records) -> Result<[f64; 2]> {
+    let mut spacing = layout.spacing;
+    let (nx, ny) = (layout.nx, layout.ny);
+    for (k, coords) in [&r.x, &r.y].into_iter().enumerate() {
+        if layout.absolute[k].is_none() || (k == 1 && layout.profile) {
+            continue;
+        }
+        let axis = ["x", "y"][k];
+        let index = |i: usize| if k == 0 { i % nx } else { i / nx };
+        let n = if k == 0 { nx } else { ny };
+        // The step from a least-squares-free estimate: first and last defined indices.
+        let defined: Vec<(usize, f64)> = coords
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .map(|(i, &v)| (index(i), v))
+            .collect();
+        let first = defined.iter().min_by_key(|p| p.0);
+        let last = defined.iter().max_by_key(|p| p.0);
+        let (Some(&(i0, v0)), Some(&(i1, v1))) = (first, last) else {
+            return Err(bad(FORMAT, format!("no defined {axis} coordinate")));
+        };
+        let step = (v1 - v0) / (i1 as f64 - i0 as f64);
+        if n < 2 || i1 == i0 || !(step.is_finite() && step > 0.0) {
+            return Err(bad(
+                FORMAT,
+                format!("the {axis} coordinates do not increase along the grid"),
+            ));
+        }
+        let origin = v0 - step * i0 as f64;
+        let worst = defined
+            .iter()
+            .map(|&(i, v)| ((v - origin) / step - i as f64).abs())
+            .fold(0.0, f64::max);
+        if worst > GRID_TOLERANCE {
+            return Err(bad(
+                FORMAT,
+                format!("the absolute {axis} coordinates are {worst:.3} steps off a uniform grid: not supported"),
+            ));
+        }
+        spacing[k] = step;
+    }
+    Ok(spacing)
 }
 
 /// Hex MD5 in capitals, as X3P records it.
@@ -640,6 +802,81 @@ mod tests {
         assert_close(h[(0, 1)], 1e-6 - 2e-9, 1e-15, "offset + increment · raw");
         assert!(h[(1, 0)].is_nan());
         assert_eq!(r.channels[0].size, [Some(2e-6), Some(4e-6)]);
+    }
+
+    /// An X3P archive in the standard's layout whose CX (f64) and CY (f32) axes are absolute:
+    /// each point's record is x, y, z; the coordinates are `xs[col]`, `ys[row]`.
+    fn absolute_axes_file(xs: &[f64], ys: &[f32], z: &[f64], inline: bool) -> Vec<u8> {
+        let (nx, ny) = (xs.len(), ys.len());
+        let mut data = Vec::new();
+        let mut list = String::new();
+        for (i, &h) in z.iter().enumerate() {
+            data.extend_from_slice(&xs[i % nx].to_le_bytes());
+            data.extend_from_slice(&ys[i / nx].to_le_bytes());
+            data.extend_from_slice(&h.to_le_bytes());
+            list += &format!("<Datum>{};{};{h}</Datum>", xs[i % nx], ys[i / nx]);
+        }
+        let link = if inline {
+            format!("<DataList>{list}</DataList>")
+        } else {
+            "<DataLink><PointDataLink>bindata/data.bin</PointDataLink></DataLink>".to_string()
+        };
+        let xml = format!(
+            r#"<?xml version="1.0"?><p:ISO5436_2 xmlns:p="x"><Record1><Revision>ISO5436 - 2000</Revision><FeatureType>SUR</FeatureType>
+            <Axes><CX><AxisType>A</AxisType><DataType>D</DataType></CX>
+            <CY><AxisType>A</AxisType><DataType>F</DataType><Increment>1e-6</Increment></CY>
+            <CZ><AxisType>A</AxisType><DataType>D</DataType></CZ></Axes></Record1>
+            <Record3><MatrixDimension><SizeX>{nx}</SizeX><SizeY>{ny}</SizeY><SizeZ>1</SizeZ></MatrixDimension>{link}</Record3></p:ISO5436_2>"#
+        );
+        let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+        let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
+        zip.start_file("main.xml", options).unwrap();
+        zip.write_all(xml.as_bytes()).unwrap();
+        if !inline {
+            zip.start_file("bindata/data.bin", options).unwrap();
+            zip.write_all(&data).unwrap();
+        }
+        zip.finish().unwrap().into_inner()
+    }
+
+    #[test]
+    fn absolute_lateral_axes_on_a_uniform_grid_are_read() {
+        // x = 5 µm + 2 µm · col (stored in metres), y = (3 + 0.5 · row) µm (stored in µm
+        // as f32 with Increment 1e-6).
+        let xs = [5e-6, 7e-6, 9e-6];
+        let ys = [3.0f32, 3.5];
+        let z = [1e-9, 2e-9, f64::NAN, 4e-9, 5e-9, 6e-9];
+        for inline in [false, true] {
+            let bytes = absolute_axes_file(&xs, &ys, &z, inline);
+            let r = read(&bytes).unwrap();
+            let c = &r.channels[0];
+            let Heights::Areal(h) = &c.heights else {
+                panic!()
+            };
+            assert_eq!(h.dim(), (2, 3));
+            for (g, w) in h.iter().zip(z) {
+                assert!(g.is_nan() && w.is_nan() || g == &w, "{g} vs {w}");
+            }
+            let [sx, sy] = c.size;
+            assert_close(sx.unwrap(), 6e-6, 1e-12, "x: 3 steps of 2 µm");
+            assert_close(sy.unwrap(), 1e-6, 1e-6, "y: 2 steps of 0.5 µm (f32)");
+        }
+    }
+
+    #[test]
+    fn absolute_axes_off_a_uniform_grid_or_truncated_are_refused() {
+        let z = [0.0; 6];
+        let bytes = absolute_axes_file(&[0.0, 1e-6, 3e-6], &[0.0, 1.0], &z, false);
+        let err = read(&bytes).unwrap_err().to_string();
+        assert!(err.contains("off a uniform grid"), "{err}");
+        let bytes = absolute_axes_file(&[2e-6, 1e-6, 0.0], &[0.0, 1.0], &z, true);
+        let err = read(&bytes).unwrap_err().to_string();
+        assert!(err.contains("do not increase"), "{err}");
+        let good = absolute_axes_file(&[0.0, 1e-6, 2e-6], &[0.0, 1.0], &z, false);
+        for cut in (0..good.len()).step_by(7) {
+            assert!(read(&good[..cut]).is_err(), "cut at {cut}");
+        }
+        fuzz(&good, read);
     }
 
     /// The archive `bytes` with each entry passed through `edit(name, data)`; with
