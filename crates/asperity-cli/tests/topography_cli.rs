@@ -43,8 +43,6 @@ fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
-/// Refused: status 2, one line on stderr containing `needle`, no files left in `dir`
-/// besides `keep`.
 /// The rows of a CSV of numbers whose header is `header`.
 fn numeric_csv(path: &Path, header: &str) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -55,6 +53,26 @@ fn numeric_csv(path: &Path, header: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// Writes `heights` to `<flag>.npy` in `dir`, runs `asperity stats <flag>.npy --size 1
+/// --<flag> <flag>.csv`, checks it succeeded and returns the rows of the CSV, whose header
+/// must be `header`.
+fn stats_csv(
+    dir: &Path,
+    heights: &ndarray::Array2<f64>,
+    flag: &str,
+    header: &str,
+) -> Vec<Vec<f64>> {
+    let input = format!("{flag}.npy");
+    let output = format!("{flag}.csv");
+    ndarray_npy::write_npy(dir.join(&input), heights).unwrap();
+    let option = format!("--{flag}");
+    let args = ["stats", &input, "--size", "1", &option, &output];
+    ok(&asperity(&args, dir));
+    numeric_csv(&dir.join(output), header)
+}
+
+/// Refused: status 2, one line on stderr containing `needle`, no files left in `dir`
+/// besides `keep`.
 fn assert_refused(out: &Output, dir: &Path, keep: &[&str], needle: &str) {
     let err = refused(out, needle);
     let left: Vec<String> = names(dir)
@@ -153,17 +171,7 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
     // above c(p) = 127 (1 − p) exactly, the order statistics being equally spaced.
     let dir = tempfile::tempdir().unwrap();
     let h = ndarray::Array2::from_shape_fn((8, 16), |(r, c)| (r * 16 + c) as f64);
-    ndarray_npy::write_npy(dir.path().join("ramp.npy"), &h).unwrap();
-    let args = [
-        "stats",
-        "ramp.npy",
-        "--size",
-        "1",
-        "--bearing-area",
-        "b.csv",
-    ];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("b.csv"), "material_ratio,height");
+    let rows = stats_csv(dir.path(), &h, "bearing-area", "material_ratio,height");
     assert_eq!(rows.len(), 101);
     for (k, row) in rows.iter().enumerate() {
         let p = k as f64 / 100.0;
@@ -171,13 +179,19 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
         assert!((row[1] - 127.0 * (1.0 - p)).abs() < 1e-9, "{row:?}");
     }
     // An existing output is kept unless --force.
+    let args = [
+        "stats",
+        "bearing-area.npy",
+        "--size",
+        "1",
+        "--bearing-area",
+        "bearing-area.csv",
+    ];
     let out = asperity(&args, dir.path());
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     // The height-difference ACF along x: heights rise by 1 per pixel along a row, so
     // A(k Δx) = k²/2, with Δx = 1/16.
-    let args = ["stats", "ramp.npy", "--size", "1", "--acf", "acf.csv"];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("acf.csv"), "distance,acf");
+    let rows = stats_csv(dir.path(), &h, "acf", "distance,acf");
     assert_eq!(rows.len(), 16);
     for (k, row) in rows.iter().enumerate() {
         let want = 0.5 * (k * k) as f64;
@@ -185,21 +199,61 @@ fn stats_writes_the_bearing_area_curve_and_the_acf() {
         assert!((row[1] - want).abs() <= 1e-9 * want.max(1.0), "{row:?}");
     }
     // The scale-dependent slope √(2A(r))/r: the ramp's slope 1/Δx = 16 at every r > 0.
-    let args = [
-        "stats",
-        "ramp.npy",
-        "--size",
-        "1",
-        "--scale-dependent-slope",
-        "sds.csv",
-    ];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("sds.csv"), "distance,slope");
+    let rows = stats_csv(dir.path(), &h, "scale-dependent-slope", "distance,slope");
     assert_eq!(rows.len(), 15);
     for (k, row) in rows.iter().enumerate() {
         assert!((row[0] - (k + 1) as f64 / 16.0).abs() < 1e-15, "{row:?}");
         assert!((row[1] - 16.0).abs() <= 1e-9 * 16.0, "{row:?}");
     }
+}
+
+#[test]
+fn stats_writes_the_scale_dependent_curvature() {
+    // h = c² (c in pixels, Δx = 1/16 at size 1): every second difference at scale s is 2s²,
+    // the curvature 2/Δx² = 512 at every distance 2sΔx (s = 1, 2, ..., 6, log-spaced 10 a
+    // decade up to ⌊15/2⌋ = 7).
+    let dir = tempfile::tempdir().unwrap();
+    let h = ndarray::Array2::from_shape_fn((8, 16), |(_, c)| (c * c) as f64);
+    let rows = stats_csv(
+        dir.path(),
+        &h,
+        "scale-dependent-curvature",
+        "distance,curvature",
+    );
+    let factors: Vec<f64> = rows.iter().map(|r| r[0] * 8.0).collect();
+    assert_eq!(factors, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    for row in &rows {
+        assert!((row[1] - 512.0).abs() <= 1e-12 * 512.0, "{row:?}");
+    }
+}
+
+#[test]
+fn stats_writes_the_radially_averaged_acf_of_a_map() {
+    // h = 3c on 8 × 8 pixels of side 1 (size 8): the bin of |r| ≈ 1 holds the lags (1, 0)
+    // (56 pairs differing by 3), (0, 1) (56 pairs, equal) and (±1, 1) (49 pairs each, |r|
+    // = √2, differing by 3): A = ½ · 9 · 154/210, at the mean distance (112 + 98√2)/210.
+    let dir = tempfile::tempdir().unwrap();
+    let h = ndarray::Array2::from_shape_fn((8, 8), |(_, c)| 3.0 * c as f64);
+    ndarray_npy::write_npy(dir.path().join("plane.npy"), &h).unwrap();
+    let args = ["stats", "plane.npy", "--size", "8", "--acf-2d", "a.csv"];
+    ok(&asperity(&args, dir.path()));
+    let rows = numeric_csv(&dir.path().join("a.csv"), "distance,acf");
+    assert_eq!(rows[0], [0.0, 0.0]);
+    let r = (112.0 + 98.0 * 2f64.sqrt()) / 210.0;
+    assert!((rows[1][0] - r).abs() < 1e-12, "{:?}", rows[1]);
+    assert!(
+        (rows[1][1] - 4.5 * 154.0 / 210.0).abs() < 1e-9,
+        "{:?}",
+        rows[1]
+    );
+    // A profile has no 2-D ACF: one line, exit 2, nothing written.
+    let line = ndarray::Array1::from_shape_fn(8, |c| c as f64);
+    ndarray_npy::write_npy(dir.path().join("line.npy"), &line).unwrap();
+    let args = ["stats", "line.npy", "--size", "8", "--acf-2d", "b.csv"];
+    let out = asperity(&args, dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("needs a map"), "{}", stderr(&out));
+    assert!(!dir.path().join("b.csv").exists());
 }
 
 #[test]
@@ -209,17 +263,7 @@ fn stats_writes_the_variable_bandwidth_analysis() {
     // the discrete quadratic residual, rms √((m² − 1)(m² − 4)/180): √21 at m = 8, 1 at m = 4.
     let dir = tempfile::tempdir().unwrap();
     let h = ndarray::Array2::from_shape_fn((8, 16), |(_, c)| (c * c) as f64);
-    ndarray_npy::write_npy(dir.path().join("q.npy"), &h).unwrap();
-    let args = [
-        "stats",
-        "q.npy",
-        "--size",
-        "1",
-        "--variable-bandwidth",
-        "vb.csv",
-    ];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("vb.csv"), "bandwidth,rms_height");
+    let rows = stats_csv(dir.path(), &h, "variable-bandwidth", "bandwidth,rms_height");
     let want = [(0.5, 21f64.sqrt()), (0.25, 1.0)];
     assert_eq!(rows.len(), want.len(), "{rows:?}");
     for (row, (b, rms)) in rows.iter().zip(want) {
@@ -248,17 +292,7 @@ fn stats_writes_height_slope_and_curvature_distributions() {
     let dir = tempfile::tempdir().unwrap();
     // Heights 0, 1, ..., 99: ⌊√100⌋ = 10 bins of width 9.9, ten heights each.
     let h = ndarray::Array2::from_shape_fn((10, 10), |(r, c)| (r * 10 + c) as f64);
-    ndarray_npy::write_npy(dir.path().join("ramp.npy"), &h).unwrap();
-    let args = [
-        "stats",
-        "ramp.npy",
-        "--size",
-        "1",
-        "--height-distribution",
-        "h.csv",
-    ];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("h.csv"), "height,density");
+    let rows = stats_csv(dir.path(), &h, "height-distribution", "height,density");
     assert_eq!(rows.len(), 10);
     for (k, row) in rows.iter().enumerate() {
         assert!((row[0] - (k as f64 + 0.5) * 9.9).abs() < 1e-9, "{row:?}");
@@ -269,17 +303,7 @@ fn stats_writes_height_slope_and_curvature_distributions() {
     // 12/(120 · 1.8/Δx) = Δx/18. The second differences are exactly 2 (integers).
     let dx = 1.0 / 11.0;
     let q = ndarray::Array2::from_shape_fn((12, 11), |(_, c)| (c * c) as f64);
-    ndarray_npy::write_npy(dir.path().join("q.npy"), &q).unwrap();
-    let args = [
-        "stats",
-        "q.npy",
-        "--size",
-        "1",
-        "--slope-distribution",
-        "s.csv",
-    ];
-    ok(&asperity(&args, dir.path()));
-    let rows = numeric_csv(&dir.path().join("s.csv"), "slope,density");
+    let rows = stats_csv(dir.path(), &q, "slope-distribution", "slope,density");
     assert_eq!(rows.len(), 10);
     for (k, row) in rows.iter().enumerate() {
         let centre = (1.0 + (k as f64 + 0.5) * 1.8) / dx;
@@ -289,7 +313,7 @@ fn stats_writes_height_slope_and_curvature_distributions() {
     // Its curvatures are all 2: a distribution of no width is refused, nothing written.
     let args = [
         "stats",
-        "q.npy",
+        "slope-distribution.npy",
         "--size",
         "1",
         "--curvature-distribution",

@@ -73,6 +73,12 @@ pub struct StatsArgs {
     /// non-periodic scan on its grid), in the heights' unit (squared for acf).
     #[arg(long, value_name = "OUT.csv")]
     pub acf: Option<PathBuf>,
+    /// Write the radially averaged 2-D height-difference ACF of a map as CSV with columns
+    /// distance (the mean |r| of the bin's pairs, bins of width min(Δx, Δy)) and acf
+    /// (½⟨(h(x + r) − h(x))²⟩ over every pair of defined points, any direction, whose
+    /// distance falls in the bin); refused for a profile.
+    #[arg(long, value_name = "OUT.csv")]
+    pub acf_2d: Option<PathBuf>,
     /// Write the variable-bandwidth analysis as CSV with columns bandwidth (the section
     /// size ℓ) and rms_height: the rms height after a least-squares plane is removed in each
     /// rectangle of a checkerboard of 1, 2, 4, … rectangles a side (a profile: a line in
@@ -85,6 +91,12 @@ pub struct StatsArgs {
     /// SurfaceTopography's scale_dependent_slope_from_profile on the scan's grid).
     #[arg(long, value_name = "OUT.csv")]
     pub scale_dependent_slope: Option<PathBuf>,
+    /// Write the scale-dependent rms curvature along x as CSV with columns distance (the
+    /// stencil's length r = 2sΔx, scale factors s log-spaced, 10 a decade) and curvature
+    /// (the rms of (h[i+s] − 2h[i] + h[i−s])/(sΔx)² over the rows; SurfaceTopography's
+    /// scale_dependent_statistical_property(n=2) of a profile at that distance).
+    #[arg(long, value_name = "OUT.csv")]
+    pub scale_dependent_curvature: Option<PathBuf>,
     /// Write the height distribution as CSV with columns height (bin centre) and density
     /// (count / (n · bin width): it integrates to 1), over ⌊√n⌋ equal bins (10 to 100) from
     /// the lowest to the highest defined height.
@@ -107,7 +119,8 @@ pub struct StatsArgs {
     #[arg(long)]
     pub json: bool,
     /// Overwrite existing outputs (--psd, --bearing-area, --acf, --variable-bandwidth,
-    /// --scale-dependent-slope, the distributions, --plot).
+    /// --acf-2d, --scale-dependent-slope, --scale-dependent-curvature, the distributions,
+    /// --plot).
     #[arg(long)]
     pub force: bool,
 }
@@ -231,6 +244,8 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         .chain(args.acf.iter().chain(&args.plot))
         .chain(&args.variable_bandwidth)
         .chain(&args.scale_dependent_slope)
+        .chain(&args.scale_dependent_curvature)
+        .chain(&args.acf_2d)
         .chain(&args.height_distribution)
         .chain(&args.slope_distribution)
         .chain(&args.curvature_distribution);
@@ -246,6 +261,14 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     } else {
         None
     };
+    let curvature = match &args.scale_dependent_curvature {
+        Some(path) => Some((path, curvature_along_x(&source)?)),
+        None => None,
+    };
+    let radial = match &args.acf_2d {
+        Some(path) => Some((path, radial_acf(&source)?)),
+        None => None,
+    };
     let distributions = distributions(args, &source)?;
     let bandwidth = match &args.variable_bandwidth {
         Some(path) => Some((path, variable_bandwidth(&source)?)),
@@ -260,6 +283,12 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let (Some(path), Some(rows)) = (&args.scale_dependent_slope, &acf) {
         let slope = asperity::topography::stats::scale_dependent_slope(rows);
         stage_pairs(&mut staged, path, ["distance", "slope"], &slope)?;
+    }
+    if let Some((path, rows)) = &radial {
+        stage_pairs(&mut staged, path, ["distance", "acf"], rows)?;
+    }
+    if let Some((path, rows)) = &curvature {
+        stage_pairs(&mut staged, path, ["distance", "curvature"], rows)?;
     }
     for (path, name, rows) in &distributions {
         stage_pairs(&mut staged, path, [name, "density"], rows)?;
@@ -323,6 +352,45 @@ fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
     let (rows, dx) = rows_along_x(source)?;
     let acf = asperity::topography::stats::height_difference_acf(rows.view())?;
     Ok(acf.into_iter().map(|(k, a)| (k as f64 * dx, a)).collect())
+}
+
+/// The radially averaged 2-D height-difference ACF of a map as `(distance, A)`.
+fn radial_acf(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    use ndarray::Ix2;
+    let (map, dx, dy) = match source {
+        StatsSource::Grid { heights, size, .. } if heights.ndim() == 2 => {
+            let map = heights.view().into_dimensionality::<Ix2>()?;
+            let dx = *size / map.ncols() as f64;
+            (map.to_owned(), dx, dx)
+        }
+        StatsSource::Measured {
+            heights: Heights::Areal(h),
+            sizes,
+        } => (
+            h.clone(),
+            sizes[0] / h.ncols() as f64,
+            sizes[1] / h.nrows() as f64,
+        ),
+        _ => {
+            return Err(anyhow::anyhow!(
+                "--acf-2d needs a map; for a profile use --acf"
+            ))
+        }
+    };
+    Ok(asperity::topography::stats::radial_height_difference_acf(
+        map.view(),
+        dx,
+        dy,
+    )?)
+}
+
+/// The scale-dependent rms curvature along x as `(distance, curvature)`: a line is one row.
+fn curvature_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
+    let (rows, dx) = rows_along_x(source)?;
+    Ok(asperity::topography::stats::scale_dependent_curvature(
+        rows.view(),
+        dx,
+    )?)
 }
 
 /// The variable-bandwidth analysis as `(bandwidth, rms height)`: a checkerboard of planes

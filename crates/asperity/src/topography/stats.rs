@@ -423,6 +423,53 @@ pub fn scale_dependent_slope(acf: &[(f64, f64)]) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Scale factors per decade of [`scale_dependent_curvature`] (SurfaceTopography's default
+/// log collocation).
+pub const CURVATURE_FACTORS_PER_DECADE: f64 = 10.0;
+
+/// The scale-dependent rms curvature along x: at each integer scale factor `s` (log-spaced,
+/// [`CURVATURE_FACTORS_PER_DECADE`] a decade, every distinct integer from 1 to
+/// `⌊(n − 1)/2⌋`), the rms of the three-point second difference
+/// `(h[i+s] − 2h[i] + h[i−s])/(sΔx)²` over every triple of defined points within a row,
+/// pooled over the rows, reported at the stencil's length `r = 2sΔx`
+/// (SurfaceTopography's `scale_dependent_statistical_property(n=2, scale_factor=s)` of a
+/// profile, whose `distance` is that length). Returns `(r, rms curvature)` for each factor
+/// with at least one defined triple, in the heights' unit per length squared; `O(N)` a
+/// factor. Refused where no row has three points.
+pub fn scale_dependent_curvature(rows: ArrayView2<f64>, dx: f64) -> Result<Vec<(f64, f64)>> {
+    let n = rows.ncols();
+    if n < 3 || !(dx.is_finite() && dx > 0.0) {
+        return Err(Error::invalid(
+            "scale-dependent curvature",
+            format!("{n} points per row at a spacing of {dx:e}"),
+        ));
+    }
+    let largest = (n - 1) / 2;
+    let mut factors: Vec<usize> = (0..)
+        .map(|k| (10f64.powf(k as f64 / CURVATURE_FACTORS_PER_DECADE)).round() as usize)
+        .take_while(|&s| s <= largest)
+        .collect();
+    factors.dedup();
+    let mut out = Vec::with_capacity(factors.len());
+    for s in factors {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for row in rows.rows() {
+            for i in s..n - s {
+                let c = row[i + s] - 2.0 * row[i] + row[i - s];
+                if !c.is_nan() {
+                    sum += c * c;
+                    count += 1;
+                }
+            }
+        }
+        if count > 0 {
+            let step = s as f64 * dx;
+            out.push((2.0 * step, (sum / count as f64).sqrt() / (step * step)));
+        }
+    }
+    Ok(out)
+}
+
 /// The height-difference autocorrelation function along x, `A(r_k) = ½⟨(h(x + r_k) −
 /// h(x))²⟩` at `r_k = kΔx` (SurfaceTopography's `autocorrelation_from_profile` of a
 /// non-periodic scan, on the grid): the mean over every pair of defined points at distance
@@ -483,6 +530,117 @@ pub fn height_difference_acf(rows: ArrayView2<f64>) -> Result<Vec<(usize, f64)>>
             })
         })
         .collect())
+}
+
+/// The radially averaged two-dimensional height-difference ACF of a map,
+/// `A(r) = ½⟨(h(x + r) − h(x))²⟩` over every pair of defined points whose separation `r`
+/// (any direction; `Δx`, `Δy` may differ) has a length in the bin: bins of width
+/// `Δ = min(Δx, Δy)` centred on `0, Δ, 2Δ, …` (`|r|/Δ` rounded). Returns
+/// `(mean |r| of the bin's pairs, A)` for every bin holding a pair, in the heights' unit
+/// squared. The pair sums over every lag vector come from three 2-D cross-correlations by
+/// zero-padded FFTs (as [`height_difference_acf`] along x); they need about
+/// `48 · (2n_x)(2n_y)` bytes, checked against the memory first.
+/// SurfaceTopography's `autocorrelation_from_area` of a non-periodic map differs by
+/// definition: it averages the map over lag vectors with non-negative components only,
+/// unweighted by their pair counts, in log-spaced bins.
+pub fn radial_height_difference_acf(
+    h: ArrayView2<f64>,
+    dx: f64,
+    dy: f64,
+) -> Result<Vec<(f64, f64)>> {
+    use rustfft::num_complex::Complex64;
+    let (ny, nx) = h.dim();
+    let defined = h.iter().filter(|v| !v.is_nan()).count();
+    if nx < 2 || ny < 2 || defined == 0 || !(dx > 0.0 && dy > 0.0) {
+        return Err(Error::invalid(
+            "radial autocorrelation",
+            format!("a {ny} × {nx} map with {defined} defined heights (a map is needed)"),
+        ));
+    }
+    let (py, px) = (
+        (2 * ny - 1).next_power_of_two(),
+        (2 * nx - 1).next_power_of_two(),
+    );
+    crate::memory::ensure_fits(
+        "the radially averaged ACF",
+        (py as u64)
+            .checked_mul(px as u64)
+            .map(|n| n.saturating_mul(48)),
+    )?;
+    let mean = h.iter().filter(|v| !v.is_nan()).sum::<f64>() / defined as f64;
+    let field = |which: usize| {
+        let mut f = vec![Complex64::new(0.0, 0.0); py * px];
+        for ((r, c), &v) in h.indexed_iter() {
+            if !v.is_nan() {
+                let g = v - mean;
+                f[r * px + c].re = [1.0, g, g * g][which];
+            }
+        }
+        f
+    };
+    let (mut m, mut g, mut s) = (field(0), field(1), field(2));
+    let mut planner = rustfft::FftPlanner::<f64>::new();
+    for f in [&mut m, &mut g, &mut s] {
+        fft_2d(&mut planner, f, py, px, rustfft::FftDirection::Forward);
+    }
+    for ((mi, gi), si) in m.iter_mut().zip(&mut g).zip(&mut s) {
+        *si = si.conj() * *mi + mi.conj() * *si;
+        *gi = gi.conj() * *gi;
+        *mi = mi.conj() * *mi;
+    }
+    for f in [&mut m, &mut g, &mut s] {
+        fft_2d(&mut planner, f, py, px, rustfft::FftDirection::Inverse);
+    }
+    let scale = 1.0 / (py * px) as f64;
+    let step = dx.min(dy);
+    let mut bins: Vec<[f64; 3]> = Vec::new(); // Σ pairs, Σ pairs · A, Σ pairs · |r|
+                                              // Half of the lag vectors (ky > 0, or ky = 0 and kx ≥ 0): A(−r) = A(r).
+    for ky in 0..ny {
+        let lo = if ky == 0 { 0 } else { 1 - nx as isize };
+        for kx in lo..nx as isize {
+            let at = ky * px + kx.rem_euclid(px as isize) as usize;
+            let pairs = (m[at].re * scale).round();
+            if pairs < 1.0 {
+                continue;
+            }
+            let sum = (0.5 * s[at].re - g[at].re) * scale; // Σ ½(h_i − h_j)²
+            let r = ((kx as f64 * dx).powi(2) + (ky as f64 * dy).powi(2)).sqrt();
+            let b = (r / step).round() as usize;
+            if bins.len() <= b {
+                bins.resize(b + 1, [0.0; 3]);
+            }
+            bins[b][0] += pairs;
+            bins[b][1] += sum.max(0.0);
+            bins[b][2] += pairs * r;
+        }
+    }
+    Ok(bins
+        .iter()
+        .filter(|b| b[0] > 0.0)
+        .map(|b| (b[2] / b[0], b[1] / b[0]))
+        .collect())
+}
+
+/// An in-place 2-D FFT of a row-major `rows × cols` array (unnormalised).
+fn fft_2d(
+    planner: &mut rustfft::FftPlanner<f64>,
+    data: &mut [rustfft::num_complex::Complex64],
+    rows: usize,
+    cols: usize,
+    direction: rustfft::FftDirection,
+) {
+    planner.plan_fft(cols, direction).process(data);
+    let column = planner.plan_fft(rows, direction);
+    let mut buffer = vec![rustfft::num_complex::Complex64::new(0.0, 0.0); rows];
+    for c in 0..cols {
+        for (r, b) in buffer.iter_mut().enumerate() {
+            *b = data[r * cols + c];
+        }
+        column.process(&mut buffer);
+        for (r, b) in buffer.iter().enumerate() {
+            data[r * cols + c] = *b;
+        }
+    }
 }
 
 fn fft_error(e: impl std::fmt::Display) -> Error {
@@ -815,6 +973,94 @@ mod tests {
             );
         }
         assert!(height_difference_acf(Array2::from_elem((2, 1), 1.0).view()).is_err());
+    }
+
+    #[test]
+    fn scale_dependent_curvature_of_polynomials_in_closed_form() {
+        // h = x² (x = iΔx): every second difference is 2(sΔx)², the curvature 2 at every
+        // scale. h = x³: (h[i+s] − 2h[i] + h[i−s])/(sΔx)² = 6x exactly, so the rms over
+        // i = s..n−s−1 is 6Δx √(Σ i²/count).
+        let (n, dx) = (40, 0.25);
+        let x = |i: usize| i as f64 * dx;
+        let sq = ndarray::Array2::from_shape_fn((3, n), |(_, i)| x(i) * x(i));
+        let rows = super::scale_dependent_curvature(sq.view(), dx).unwrap();
+        let factors: Vec<f64> = rows.iter().map(|r| r.0 / (2.0 * dx)).collect();
+        assert_eq!(
+            factors,
+            [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 13.0, 16.0]
+        );
+        for &(_, c) in &rows {
+            close(c, 2.0, 1e-12, "curvature of x²");
+        }
+        let mut cube = ndarray::Array2::from_shape_fn((2, n), |(_, i)| x(i).powi(3));
+        cube[(1, 7)] = f64::NAN; // its three triples left out
+        let rows = super::scale_dependent_curvature(cube.view(), dx).unwrap();
+        for &(r, c) in &rows {
+            let s = (r / (2.0 * dx)).round() as usize;
+            let (mut sum, mut count) = (0.0, 0.0);
+            for row in 0..2 {
+                for i in s..n - s {
+                    if row == 1 && [i - s, i, i + s].contains(&7) {
+                        continue;
+                    }
+                    sum += (6.0 * x(i)).powi(2);
+                    count += 1.0;
+                }
+            }
+            close(c, (sum / count).sqrt(), 1e-9, "curvature of x³");
+        }
+        assert!(super::scale_dependent_curvature(cube.slice(ndarray::s![.., ..2]), dx).is_err());
+    }
+
+    #[test]
+    fn radial_acf_against_its_definition_and_a_plane() {
+        // Every pair of defined points, binned by round(|r|/min(Δx, Δy)): the definition.
+        let (ny, nx, dx, dy) = (5, 7, 0.5, 0.75);
+        let mut h = ndarray::Array2::from_shape_fn((ny, nx), |(r, c)| {
+            ((r * 7 + c * 3) as f64).sin() + 0.1 * (r * c) as f64
+        });
+        h[(2, 3)] = f64::NAN;
+        let got = super::radial_height_difference_acf(h.view(), dx, dy).unwrap();
+        let mut bins: Vec<[f64; 3]> = Vec::new();
+        for (i, &a) in h.indexed_iter() {
+            for (j, &b) in h.indexed_iter() {
+                let (ky, kx) = (j.0 as f64 - i.0 as f64, j.1 as f64 - i.1 as f64);
+                let half = ky > 0.0 || (ky == 0.0 && kx >= 0.0);
+                if !half || a.is_nan() || b.is_nan() {
+                    continue;
+                }
+                let r = ((kx * dx).powi(2) + (ky * dy).powi(2)).sqrt();
+                let k = (r / dx).round() as usize;
+                if bins.len() <= k {
+                    bins.resize(k + 1, [0.0; 3]);
+                }
+                bins[k][0] += 1.0;
+                bins[k][1] += 0.5 * (a - b).powi(2);
+                bins[k][2] += r;
+            }
+        }
+        let want: Vec<(f64, f64)> = bins
+            .iter()
+            .filter(|b| b[0] > 0.0)
+            .map(|b| (b[2] / b[0], b[1] / b[0]))
+            .collect();
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            close(g.0, w.0, 1e-12, "mean distance");
+            assert!((g.1 - w.1).abs() <= 1e-12 * w.1.max(1.0), "{g:?} vs {w:?}");
+        }
+        // A plane h = a·x: every pair at lag (kx, ky) differs by a·kx·Δx, so the bin of
+        // the lags along y alone (kx = 0, |r| = kyΔy) holds zero where no other lag falls.
+        let plane = ndarray::Array2::from_shape_fn((4, 4), |(_, c)| 3.0 * c as f64);
+        let got = super::radial_height_difference_acf(plane.view(), 1.0, 10.0).unwrap();
+        // Bins at 0, 1, 2, 3 (lags along x: A = ½(3k)²) and 10, 20, 30 (along y, plus
+        // the diagonal lags, whose |r| rounds to the same bins).
+        close(got[1].1, 4.5, 1e-12, "A(Δx) = ½ · 3²");
+        close(got[3].1, 40.5, 1e-12, "A(3Δx) = ½ · 9²");
+        assert!(
+            super::radial_height_difference_acf(plane.slice(ndarray::s![..1, ..]), 1.0, 1.0)
+                .is_err()
+        );
     }
 
     #[test]
