@@ -42,12 +42,15 @@ def _float64(values: Any, what: str) -> np.ndarray:
     return array.astype(np.float64)
 
 
-def _positive(value: Optional[float], name: str) -> Optional[float]:
-    if value is not None:
-        value = float(value)
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be positive and finite, got {value}")
-    return value
+def _sizes(size: Union[None, float, Sequence[float]]) -> Tuple[Optional[float], Optional[float]]:
+    """``size=`` of a surface or line argument: None, ``x`` or ``(x, y)``, by the rule of the
+    CLI's ``--size`` (the front-end layer's ``argument::sizes``: one or two, positive and
+    finite)."""
+    if size is None:
+        return None, None
+    values = [float(v) for v in size] if isinstance(size, (tuple, list)) else [float(size)]
+    x, y = _core.sizes(values)
+    return x, y
 
 
 class _Saved:
@@ -84,11 +87,21 @@ ProgressArg = Union[None, bool, str, Callable[[int, int], Any]]
 class _Progress:
     """What a ``progress=`` argument asks for: nothing (None/False), a tqdm bar (True or
     ``"tqdm"``; a plain line on stderr when tqdm is not installed) or a callable
-    ``progress(done, total)``."""
+    ``progress(done, total)``.
+
+    A study hands its ETA over (:meth:`weigh`, the front-end layer's arithmetic that the
+    CLI's bar uses: samples read back from checkpoints do not count towards the rate, each
+    sample weighs its cost); the bar and the plain line then show it instead of a rate
+    that counts restored samples as done at once."""
 
     def __init__(self, progress: ProgressArg, description: str):
+        import time
+
         self.bar = None
         self.callback: Optional[Callable[[int, int], Any]] = None
+        self.description = description
+        self.eta = None
+        self.start = time.monotonic()
         if progress is None or progress is False:
             return
         if callable(progress):
@@ -98,17 +111,37 @@ class _Progress:
             try:
                 from tqdm.auto import tqdm
             except ImportError:
-                self.callback = _plain_progress(description)
+                self.callback = _plain_progress(self)
                 return
             self.bar = tqdm(desc=description, total=None)
             self.callback = self._update
             return
         raise ValueError(f"progress: expected None, True, 'tqdm' or a callable, got {progress!r}")
 
+    def weigh(self, eta: Any) -> None:
+        """Takes a study's ETA (``_core.StudyEta``); the clock of this run starts here."""
+        import time
+
+        self.eta, self.start = eta, time.monotonic()
+        if self.bar is not None:
+            self.bar.bar_format = "{l_bar}{bar}| {n_fmt}/{total_fmt} [{elapsed}{postfix}]"
+
+    def remaining(self, done: int) -> Optional[float]:
+        """Seconds left by the study's ETA, or None (no ETA handed over, or none yet)."""
+        import time
+
+        if self.eta is None:
+            return None
+        return self.eta.remaining(done, time.monotonic() - self.start)
+
     def _update(self, done: int, total: int) -> None:
         if self.bar.total != total:
             self.bar.total = total
         self.bar.n = done
+        if self.eta is not None:
+            left = self.remaining(done)
+            self.bar.set_postfix_str("ETA ?" if left is None else f"ETA {left:.0f} s",
+                                     refresh=False)
         self.bar.refresh()
 
     def close(self) -> None:
@@ -116,9 +149,9 @@ class _Progress:
             self.bar.close()
 
 
-def _plain_progress(description: str) -> Callable[[int, int], None]:
+def _plain_progress(state: _Progress) -> Callable[[int, int], None]:
     """Progress on stderr without tqdm: one line rewritten in place on a terminal, else a
-    line at most every 5 s and at the end."""
+    line at most every 5 s and at the end; a study's with the CLI's words and ETA."""
     import time
 
     tty = sys.stderr.isatty()
@@ -129,7 +162,9 @@ def _plain_progress(description: str) -> Callable[[int, int], None]:
         if done < total and (now - last[0] < (0.1 if tty else 5.0)):
             return
         last[0] = now
-        text = f"{description}: {done}/{total}"
+        text = f"{state.description}: {done}/{total}"
+        if state.eta is not None:
+            text = state.eta.line(state.description, done, now - state.start) or text
         if tty:
             print("\r" + text, end="\n" if done >= total else "", file=sys.stderr, flush=True)
         else:
@@ -343,7 +378,7 @@ def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
     if isinstance(values, (Surface, Line)):
         if isinstance(size, (tuple, list)):
             raise ValueError("size: a generated surface has square pixels; give one size")
-        size_x = values.size if size is None else float(size)
+        size_x = values.size if size is None else _sizes(size)[0]
         return values.heights, size_x, None, False, json.dumps(values.metadata)
     if isinstance(values, Topography):
         if size is not None:
@@ -366,11 +401,12 @@ def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
             f"values: expected an asperity Surface, Line or Topography, a SurfaceTopography "
             f"topography or an array of heights, got {type(values).__name__}")
     heights = _float64(values, "heights")
-    if isinstance(size, (tuple, list)):
-        if len(size) != 2 or heights.ndim != 2:
+    size_x, size_y = _sizes(size)
+    if size_y is not None:
+        if heights.ndim != 2:
             raise ValueError(f"size: give L, or (x, y) for a 2D map, got {size!r}")
-        return heights, _positive(size[0], "size"), _positive(size[1], "size"), True, None
-    return heights, _DEFAULTS["size"] if size is None else float(size), None, False, None
+        return heights, size_x, size_y, True, None
+    return heights, _DEFAULTS["size"] if size_x is None else size_x, None, False, None
 
 
 def _statistics(values: Any, size, fit_from, fit_to, window: str = _DEFAULTS["window"],
@@ -538,7 +574,7 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
         >>> t.provenance["cleaning"]
         ['levelled: least-squares mean plane subtracted']
     """
-    size_x, size_y = _measured_size(size)
+    size_x, size_y = _sizes(size)
     heights, sizes, provenance, warned = _core.read_topography(
         os.fspath(path), None if channel is None else str(channel), size_x, size_y,
         detrend, fill)
@@ -570,7 +606,7 @@ def import_topography(path: Union[str, "os.PathLike[str]"], out: Union[str, "os.
         >>> bool((asperity.load("s.npy").heights == t.heights).all())
         True
     """
-    size_x, size_y = _measured_size(size)
+    size_x, size_y = _sizes(size)
     heights, sizes, provenance, warned = _core.import_topography(
         os.fspath(path), os.fspath(out), None if channel is None else str(channel), size_x,
         size_y, detrend, fill, bool(force))
@@ -579,16 +615,6 @@ def import_topography(path: Union[str, "os.PathLike[str]"], out: Union[str, "os.
     return Topography(heights=heights, size=float(sizes[0]),
                       size_y=float(sizes[1]) if len(sizes) > 1 else None,
                       provenance=json.loads(provenance))
-
-
-def _measured_size(size: Union[None, float, Tuple[float, float]]
-                   ) -> Tuple[Optional[float], Optional[float]]:
-    """``size=`` of a measured file: ``x`` or ``(x, y)`` in metres, or None."""
-    if isinstance(size, (tuple, list)):
-        if len(size) != 2:
-            raise ValueError(f"size: give x or (x, y), got {size!r}")
-        return _positive(size[0], "size"), _positive(size[1], "size")
-    return _positive(size, "size"), None
 
 
 def psd(
@@ -744,11 +770,8 @@ _BOUNDARIES = ("free", "periodic")
 
 
 def _one_load(pressure, force, indentation, what: str) -> Tuple[str, float]:
-    given = [(k, v) for k, v in (("pressure", pressure), ("force", force), ("indentation", indentation)) if v is not None]
-    if len(given) != 1:
-        raise ValueError(f"{what}: give exactly one of pressure=, force= or indentation=")
-    quantity, value = given[0]
-    return quantity, float(value)
+    """The load of one solve, by the front-end layer's rule (``bem::one_load``)."""
+    return _core.one_load(what, _opt(pressure), _opt(force), _opt(indentation))
 
 
 class Solver:
@@ -954,12 +977,8 @@ class Solver:
         displacement); a mean pressure or force at or above H times the nominal area is
         refused before the first solve.
         """
-        if not persson and (gamma is not None or kappa is not None):
-            raise ValueError("gamma and kappa go with persson=True")
-        theory = None
-        if persson:
-            theory = (float(_DEFAULTS["gamma"] if gamma is None else gamma),
-                      float(PERSSON_KAPPA if kappa is None else kappa))
+        # The theory's rule and defaults: the front-end layer's (SweepPersson::from_options).
+        theory = _core.sweep_persson(bool(persson), _opt(gamma), _opt(kappa))
         quantity, values = _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields)
         fd = float(fd_step) if fd_stiffness else None
         bar = _Progress(progress, "bem")
@@ -1045,8 +1064,11 @@ class Solver:
 
 def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, float, Optional[float]]:
     """Heights (rows × cols), size along x and (for SurfaceTopography objects) along y."""
+    size_x, size_y = _sizes(size)
     if isinstance(surface, Surface):
-        return surface.heights, surface.size if size is None else float(size), None
+        if size_y is not None:
+            raise ValueError("size: a generated surface has square pixels; give one size")
+        return surface.heights, surface.size if size_x is None else size_x, None
     if isinstance(surface, Topography):
         if surface.heights.ndim != 2:
             raise ValueError("surface: a measured profile is no surface (use mdr for lines)")
@@ -1068,7 +1090,7 @@ def _surface_input(surface: Any, size: Optional[float]) -> Tuple[np.ndarray, flo
     heights = _float64(surface, "surface")
     if heights.ndim != 2:
         raise ValueError(f"surface: expected a 2D array of heights (rows, cols), got shape {heights.shape}")
-    return heights, _DEFAULTS["size"] if size is None else float(size), None
+    return heights, _DEFAULTS["size"] if size_x is None else size_x, size_y
 
 
 def _sweep_loads(pressures, forces, indentations, nloads, pmin, pmax, fields) -> Tuple[str, List[float]]:
@@ -1220,9 +1242,8 @@ def patches(contact_set: Any, *, pixel_area: float = 1.0) -> Patches:
     if array.dtype != np.bool_ or array.ndim != 2:
         raise ValueError(f"contact_set: expected a 2D boolean array, got {array.dtype} "
                          f"of shape {array.shape}")
-    labels, points = _core.label_patches(np.ascontiguousarray(array))
-    area = _positive(pixel_area, "pixel_area")
-    return Patches(labels, points, points * area)
+    labels, points, areas = _core.label_patches(np.ascontiguousarray(array), float(pixel_area))
+    return Patches(labels, points, areas)
 
 
 def _floats(values: Any) -> Optional[List[float]]:
@@ -1677,7 +1698,7 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
     bar = _Progress(progress, description)
     try:
         if comm is None:
-            text = _core.run_study(*args, bar.callback, **derived)
+            text = _core.run_study(*args, bar.callback, eta=bar.weigh, **derived)
         else:
             if any(v is not None for v in derived.values()):
                 raise ValueError("poisson, resistivity and thermal_conductivity are not supported "

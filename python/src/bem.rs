@@ -30,7 +30,40 @@ use crate::interrupt::{run_detached, run_detached_with, Cancel};
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Solver>()?;
     m.add_function(wrap_pyfunction!(sweep_loads, m)?)?;
+    m.add_function(wrap_pyfunction!(one_load, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_persson, m)?)?;
     Ok(())
+}
+
+/// Persson's theory beside a sweep as `(gamma, kappa)`, or None: the front-end layer's
+/// rule and defaults ([`SweepPersson::from_options`], `asperity bem --persson`'s).
+#[pyfunction]
+#[pyo3(signature = (persson, gamma, kappa))]
+fn sweep_persson(
+    persson: bool,
+    gamma: Option<f64>,
+    kappa: Option<f64>,
+) -> PyResult<Option<(f64, f64)>> {
+    let theory = SweepPersson::from_options(persson, gamma, kappa).map_err(refused)?;
+    Ok(theory.map(|t| (t.gamma, t.kappa)))
+}
+
+/// The load of one solve as `(quantity, value)`: exactly one of the three, by the
+/// front-end layer's rule ([`asperity_app::bem::one_load`]); `what` names the method.
+#[pyfunction]
+#[pyo3(signature = (what, pressure, force, indentation))]
+fn one_load(
+    what: &str,
+    pressure: Option<f64>,
+    force: Option<f64>,
+    indentation: Option<f64>,
+) -> PyResult<(&'static str, f64)> {
+    let load = asperity_app::bem::one_load(what, pressure, force, indentation).map_err(refused)?;
+    Ok(match load {
+        Control::MeanPressure(p) => ("pressure", p),
+        Control::Force(f) => ("force", f),
+        Control::Indentation(d) => ("indentation", d),
+    })
 }
 
 /// The loads of a sweep as `(quantity, values)`: exactly one of the three lists or
@@ -170,13 +203,8 @@ impl Solver {
         };
         let plan = request.validate().map_err(refused)?;
         let half_space = plan.half_space;
-        for (name, size) in [("size", Some(size_x)), ("size_y", size_y)] {
-            if let Some(size) = size.filter(|s| !(s.is_finite() && *s > 0.0)) {
-                return Err(invalid(format!(
-                    "{name} must be positive and finite, got {size}"
-                )));
-            }
-        }
+        let given: Vec<f64> = std::iter::once(size_x).chain(size_y).collect();
+        asperity_app::argument::sizes(&given).map_err(refused)?;
         let (rows, cols) = heights.as_array().dim();
         ensure_solver_fits(
             rows,

@@ -9,6 +9,7 @@ use asperity::surface::Surface;
 use asperity::topography::patches;
 use asperity_app::bem::ensure_solver_fits;
 use asperity_app::contact::{self as app, ContactRequest, Value};
+use asperity_app::refusal::{positive, Param};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -40,16 +41,27 @@ fn effective_modulus(
 }
 
 /// The 4-connected contact patches of a contact set (`asperity::topography::patches`, the
-/// rule of `asperity contact`'s `patches` column): a label per point (0: no contact) and
-/// each patch's number of points.
+/// rule of `asperity contact`'s `patches` column): a label per point (0: no contact), each
+/// patch's number of points and its area at `pixel_area` a point (positive and finite, by
+/// the front-end layer's rule; a keyword of Python's alone: the CLI's column takes the
+/// grid's pixel).
 #[pyfunction]
+#[allow(clippy::type_complexity)]
 fn label_patches<'py>(
     py: Python<'py>,
     set: PyReadonlyArray2<'py, bool>,
-) -> (Bound<'py, PyArray2<u32>>, Bound<'py, PyArray1<u64>>) {
+    pixel_area: f64,
+) -> PyResult<(
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
+    const PIXEL_AREA: Param = Param::new("pixel_area", "pixel_area");
+    let area = positive(PIXEL_AREA, pixel_area).map_err(refused)?;
     let (labels, sizes) = patches::label_patches(set.as_array());
+    let areas = PyArray1::from_iter(py, sizes.iter().map(|&n| n as u64 as f64 * area));
     let sizes = PyArray1::from_iter(py, sizes.into_iter().map(|n| n as u64));
-    (labels.into_pyarray(py), sizes)
+    Ok((labels.into_pyarray(py), sizes, areas))
 }
 
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of

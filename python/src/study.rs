@@ -18,7 +18,7 @@ use asperity::study::{
 };
 use asperity::Error;
 use asperity_app::study::distributed::{Action, Coordinator, DistributedError};
-use asperity_app::study::progress::StudyProgress;
+use asperity_app::study::progress::{log_line, Eta, StudyProgress};
 use asperity_app::study::{self, rows, Kind, TaskFailure};
 use asperity_app::Names;
 use pyo3::prelude::*;
@@ -35,7 +35,39 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(thread_count, m)?)?;
     m.add_class::<StudyCoordinator>()?;
     m.add_class::<SampleComputer>()?;
+    m.add_class::<StudyEta>()?;
     Ok(())
+}
+
+/// The ETA of a study's progress in samples (the front-end layer's [`Eta`], the CLI's
+/// arithmetic: samples read back from checkpoints do not count towards the rate, each
+/// sample weighs its cost), handed to `run_study`'s `eta` callable before the first sample.
+#[pyclass(module = "asperity._asperity", name = "StudyEta")]
+pub struct StudyEta {
+    eta: Eta,
+}
+
+#[pymethods]
+impl StudyEta {
+    /// The samples of the study.
+    #[getter]
+    fn total(&self) -> u64 {
+        self.eta.total()
+    }
+
+    /// Seconds left once `done` samples are held after `elapsed` seconds of this run;
+    /// None until a sample was computed in this run.
+    fn remaining(&self, done: u64, elapsed: f64) -> Option<f64> {
+        self.eta.remaining(done, elapsed)
+    }
+
+    /// The CLI's line of progress (`name: done/total (E s elapsed, ETA R s)`), or None
+    /// while the ETA is unknown.
+    fn line(&self, name: &str, done: u64, elapsed: f64) -> Option<String> {
+        let total = self.eta.total();
+        (self.eta.remaining(done, elapsed))
+            .map(|left| log_line(name, done.min(total), total, elapsed, left))
+    }
 }
 
 /// `hurst` values from the CLI's syntax: values and ranges `A:B:STEP`, comma-separated.
@@ -72,7 +104,7 @@ fn method(name: &str) -> PyResult<Method> {
 #[pyfunction]
 #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
     max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress, poisson=None,
-    resistivity=None, thermal_conductivity=None))]
+    resistivity=None, thermal_conductivity=None, eta=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_study(
     py: Python<'_>,
@@ -93,6 +125,7 @@ fn run_study(
     poisson: Option<f64>,
     resistivity: Option<Vec<f64>>,
     thermal_conductivity: Option<Vec<f64>>,
+    eta: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let derived = derived(poisson, &resistivity, &thermal_conductivity)?;
     let spec = StudySpec {
@@ -113,6 +146,15 @@ fn run_study(
     let stop = Stop::new();
     let (_lock, store) = open_folder(&spec, out, force, interval, stop.clone())?;
     let plan = StudyProgress::of(&store).map_err(from_error)?;
+    if let Some(eta) = &eta {
+        let handed = Py::new(
+            py,
+            StudyEta {
+                eta: plan.sample_eta(),
+            },
+        )?;
+        eta.call1(py, (handed,))?;
+    }
     let results = run_detached_with(py, &stop, |cancel| {
         run_tasks(&store, &plan, progress.as_ref(), cancel)
     })?
@@ -390,7 +432,12 @@ impl StudyCoordinator {
             .study
             .take()
             .ok_or_else(|| invalid("no study was begun"))?;
-        Ok(records(&spec, store.path(), &results, StudyDerived::default()))
+        Ok(records(
+            &spec,
+            store.path(),
+            &results,
+            StudyDerived::default(),
+        ))
     }
 
     /// Ends the job: the actions telling the ready ranks to stop (the others are told by

@@ -26,7 +26,16 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(save_topography, m)?)?;
     m.add_function(wrap_pyfunction!(save_files, m)?)?;
     m.add_function(wrap_pyfunction!(saved_sidecar, m)?)?;
+    m.add_function(wrap_pyfunction!(sizes, m)?)?;
     Ok(())
+}
+
+/// `size=` of a surface or line argument as `(x, y)` (`y` None: square pixels), by the rule
+/// of the CLI's `--size` ([`asperity_app::argument::sizes`]).
+#[pyfunction]
+fn sizes(values: Vec<f64>) -> PyResult<(Option<f64>, Option<f64>)> {
+    let [x, y] = asperity_app::argument::sizes(&values).map_err(crate::errors::refused)?;
+    Ok((x, y))
 }
 
 /// The sidecar of a file `asperity.load` loads back, as JSON text, or None: by the rules of

@@ -249,7 +249,7 @@ def test_bem_persson_columns_equal_the_cli(cli, tmp_path, boundary):
     plain = asperity.Solver(s.heights, size=2, modulus=2, boundary=boundary).sweep(
         pressures=[0.005, 0.02, 0.08])
     assert "mean_gap" not in plain.columns
-    with pytest.raises(ValueError, match="gamma and kappa go with persson=True"):
+    with pytest.raises(ValueError, match="gamma goes with persson"):
         solver.sweep(pressures=[0.01], gamma=0.4)
     with pytest.raises(ValueError, match=r"γ must lie in \(0, 1\]"):
         solver.sweep(pressures=[0.01], persson=True, gamma=1.5)

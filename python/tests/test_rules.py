@@ -66,6 +66,7 @@ KEYWORDS = {
     "--cycle-points": "cycle_points",
     "--gamma": "gamma",
     "--kappa": "kappa",
+    "--persson": "persson",
 }
 
 
@@ -147,6 +148,19 @@ BEM = [
     (["--pressures", "0.01", "--hardness", "0.3", "--solver", "pk", "--poisson", "0.7"],
      dict(hardness=0.3, solver="pk"), dict(pressures=[0.01], poisson=0.7),
      "poisson must be in [0, 0.5]"),
+    # The side lengths of the surface argument (asperity_app::argument::sizes: one or two,
+    # positive and finite; before, Python's own words and the CLI's "invalid --size").
+    (["--pressures", "0.01", "--size", "-1"], dict(size=-1), None,
+     "size must be positive and finite, got -1"),
+    (["--pressures", "0.01", "--size", "1,0"], dict(size=(1, 0)), None, "got 0"),
+    (["--pressures", "0.01", "--size", "nan"], dict(size=NAN), None, "got NaN"),
+    (["--pressures", "0.01", "--size", "1,2,3"], dict(size=(1, 2, 3)), None,
+     "size takes one value (x) or two (x and y), got 3"),
+    # Persson's theory beside the sweep (asperity_app::persson::SweepPersson::from_options).
+    (["--pressures", "0.01", "--gamma", "0.4"], {}, dict(pressures=[0.01], gamma=0.4),
+     "gamma goes with persson"),
+    (["--pressures", "0.01", "--kappa", "2"], {}, dict(pressures=[0.01], kappa=2),
+     "kappa goes with persson"),
 ]
 
 # asperity contact: (flags, keywords, expected words in keywords).
@@ -307,6 +321,8 @@ STATS = [
     (["--fit-to", "1.5"], dict(fit_to=1.5),
      "invalid fit_to 1.5: the PSD fit range would be empty, its lower end is 2 (the default "
      "lower end); give a larger fit_to or a smaller fit_from"),
+    (["--size", "-2"], dict(size=-2), "size must be positive and finite, got -2"),
+    (["--size", "inf"], dict(size=INF), "size must be positive and finite, got inf"),
 ]
 
 # A measured file's cleaning (every command that reads one; Python's read_topography):
@@ -316,6 +332,9 @@ MEASURED = [
      'detrend must be one of none, mean, plane, poly2, poly3, lines, line-means, got "tilt"'),
     (["--fill", "zero"], dict(fill="zero"),
      'fill must be harmonic (Laplace inpainting) or refuse, got "zero"'),
+    (["--size", "0"], dict(size=0), "size must be positive and finite, got 0"),
+    (["--size", "1e-6,-1e-6"], dict(size=(1e-6, -1e-6)), "got -0.000001"),
+    (["--size", "1,2,3"], dict(size=(1, 2, 3)), "size takes one value (x) or two (x and y)"),
 ]
 
 # asperity persson: (flags, keywords, expected words in keywords). Its loads follow bem's
@@ -519,7 +538,7 @@ def test_stats_refuses_alike(cli, heights, flags, kwargs, words):
 @pytest.mark.parametrize("flags,kwargs,words", MEASURED)
 def test_measured_options_are_refused_alike(cli, heights, tmp_path, command, flags, kwargs, words):
     _, path = heights
-    extra = {"import": ["--out", tmp_path / "t.npy"], "contact": ["--modulus", "1e9"]}
+    extra = {"import": ["--out", tmp_path / "t.npy"], "contact": ["--modulus", "1e9", "--pressures", "1e5"]}
     theirs = in_keywords(cli_error(cli(command, path, *flags, *extra.get(command, []), ok=False)))
     ours = python_words(lambda: asperity.read_topography(path, **kwargs))
     assert ours == theirs
@@ -632,3 +651,39 @@ def test_python_defaults_are_the_clis(cli, command, flag, function, keyword):
         assert ours == theirs
     else:
         assert ours == type(ours)(float(theirs)), (ours, theirs)
+
+
+def test_a_fifo_given_as_the_input_is_refused_alike(cli, tmp_path):
+    """A FIFO as the surface argument is refused at once (not waited on), in the one wording
+    of every input (asperity::input::open_regular, which topography::read_file now uses)."""
+    import os
+
+    fifo = tmp_path / "f.txt"
+    os.mkfifo(fifo)
+    for command, extra in [("contact", ["--modulus", "1e9", "--pressures", "1e5"]),
+                           ("stats", []), ("bem", ["--pressures", "0.01"])]:
+        args = ["--surface", fifo] if command == "bem" else [fifo]
+        theirs = cli_error(cli(command, *args, *extra, ok=False))
+        ours = python_words(lambda: asperity.read_topography(fifo))
+        assert ours == theirs, command
+        assert ours == f"{fifo}: is a FIFO, socket or device, not a regular file; give a file"
+
+
+def test_one_load_of_a_solve_is_the_front_end_layers_rule(heights):
+    """Solver.solve and fd_stiffness take exactly one load (asperity_app::bem::one_load;
+    Python's alone: the CLI solves sweeps, whose rule is the BEM table's "give one of")."""
+    solver = asperity.Solver(heights[0])
+    for call, what in [(solver.solve, "solve"), (solver.fd_stiffness, "fd_stiffness")]:
+        for loads in [{}, dict(pressure=0.01, force=0.01), dict(force=0.1, indentation=0.1)]:
+            words = python_words(lambda: call(**loads))
+            assert words == f"{what}: give exactly one of pressure=, force= or indentation="
+    assert solver.solve(force=0.01, fields=False).force == pytest.approx(0.01, rel=1e-12)
+
+
+def test_patches_refuse_a_pixel_area_by_the_shared_rule():
+    contact_set = np.array([[1, 1, 0], [0, 0, 1]], dtype=bool)
+    for bad, shown in [(0, "0"), (-1, "-1"), (NAN, "NaN"), (INF, "inf")]:
+        words = python_words(lambda: asperity.patches(contact_set, pixel_area=bad))
+        assert words == f"pixel_area must be positive and finite, got {shown}"
+    p = asperity.patches(contact_set, pixel_area=0.25)
+    assert p.areas.tolist() == [0.5, 0.25] and p.points.tolist() == [2, 1]

@@ -281,3 +281,29 @@ def test_study_arguments_are_checked_like_the_cli(cli, tmp_path):
     asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=4, out=tmp_path / "e")
     with pytest.raises(ValueError, match="holds the checkpoint of another study"):
         asperity.study_alpha(method="mdr", n=64, hurst=0.5, samples=4, seed=9, out=tmp_path / "e")
+
+
+def test_a_studys_progress_weighs_samples_as_the_clis(tmp_path, monkeypatch, capsys):
+    """Python's progress of a study takes the front-end layer's ETA (the CLI's arithmetic,
+    asperity_app::study::progress::Eta): each sample weighs its cost (MDR: N log2 N), and
+    samples read back from checkpoints do not count towards the rate."""
+    from asperity import _api
+
+    handed = []
+    weigh = _api._Progress.weigh
+    monkeypatch.setattr(_api._Progress, "weigh",
+                        lambda self, eta: (handed.append(eta), weigh(self, eta))[1])
+    study = dict(method="mdr", n=[256, 512], hurst=[0.5], samples=2, seed=3)
+    asperity.study_alpha(**study, out=tmp_path / "s", progress=True)
+    eta = handed[0]
+    assert eta.total == 4 and eta.remaining(0, 1.0) is None
+    # Both samples of N = 256 in 1 s; each of N = 512 costs (512·9)/(256·8) = 2.25 times
+    # as much: 2.25 s left (counting samples alike would say 1 s).
+    assert eta.remaining(2, 1.0) == pytest.approx(2.25, rel=1e-12)
+    assert eta.line("mdr study", 2, 1.0) == "mdr study: 2/4 (1 s elapsed, ETA 2 s)"
+    # Without tqdm, the plain line is the CLI's log line, ETA included.
+    if "tqdm" not in sys.modules:
+        assert "mdr study: 4/4 (" in capsys.readouterr().err
+    # Resumed with every sample held: all of them restored, none done in this run.
+    asperity.study_alpha(**study, out=tmp_path / "s", progress=True)
+    assert handed[1].remaining(2, 1.0) is None and handed[1].remaining(4, 1.0) == 0.0

@@ -37,7 +37,8 @@ use std::path::Path;
 use asperity::topography::{Fill, Heights, Provenance, Topography};
 
 use crate::measured::{MeasuredRequest, Warning};
-use crate::refusal::{Refusal, RequestError};
+use crate::refusal::{positive, Refusal, RequestError};
+use crate::surface::params::SIZE;
 
 /// The dimensions a command reads a plain array as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -130,6 +131,34 @@ pub fn is_npy(path: &Path) -> bool {
 pub fn saved_sidecar(path: &Path) -> asperity::Result<Option<serde_json::Value>> {
     asperity::input::open_regular(path)?;
     asperity::input::read_sidecar(path)
+}
+
+/// The side lengths a request gives a surface or line argument (`--size X[,Y]`, Python's
+/// `size=x` or `size=(x, y)`): one (x; y from square pixels) or two, each positive and
+/// finite, by one rule in one wording for both front ends (the CLI parses the text first).
+///
+/// ```
+/// use asperity_app::argument::sizes;
+/// use asperity_app::Names;
+///
+/// assert_eq!(sizes(&[2e-6]).unwrap(), [Some(2e-6), None]);
+/// assert_eq!(sizes(&[2e-6, 1e-6]).unwrap(), [Some(2e-6), Some(1e-6)]);
+/// let refused = |v: &[f64]| sizes(v).unwrap_err().words(Names::Flags);
+/// assert_eq!(refused(&[1.0, -1.0]), "--size must be positive and finite, got -1");
+/// assert_eq!(refused(&[1.0, 2.0, 3.0]), "--size takes one value (x) or two (x and y), got 3");
+/// ```
+pub fn sizes(values: &[f64]) -> Result<[Option<f64>; 2], Refusal> {
+    if values.is_empty() || values.len() > 2 {
+        return Err(Refusal::of(SIZE).text(format!(
+            " takes one value (x) or two (x and y), got {}",
+            values.len()
+        )));
+    }
+    let mut out = [None, None];
+    for (slot, &value) in out.iter_mut().zip(values) {
+        *slot = Some(positive(SIZE, value)?);
+    }
+    Ok(out)
 }
 
 fn library(e: asperity::Error) -> RequestError {

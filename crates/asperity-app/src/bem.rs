@@ -67,6 +67,34 @@ pub fn bookkeeping_bytes(loads: usize, fields: bool) -> Option<u64> {
     array_bytes(&[loads], per_load)
 }
 
+/// The load of one solve (Python's `Solver.solve` and `Solver.fd_stiffness`; the CLI solves
+/// sweeps, whose loads are [`Loads::from_options`]): exactly one of a mean `pressure`, a
+/// `force` or an `indentation`; `context` (the method) begins the refusal.
+///
+/// ```
+/// use asperity::bem::Control;
+/// use asperity_app::bem::one_load;
+///
+/// assert_eq!(one_load("solve", None, Some(0.5), None).unwrap(), Control::Force(0.5));
+/// let refusal = one_load("solve", Some(0.1), Some(0.5), None).unwrap_err();
+/// assert_eq!(refusal.to_string(), "solve: give exactly one of pressure=, force= or indentation=");
+/// ```
+pub fn one_load(
+    context: &str,
+    pressure: Option<f64>,
+    force: Option<f64>,
+    indentation: Option<f64>,
+) -> Result<Control, Refusal> {
+    match (pressure, force, indentation) {
+        (Some(p), None, None) => Ok(Control::MeanPressure(p)),
+        (None, Some(f), None) => Ok(Control::Force(f)),
+        (None, None, Some(d)) => Ok(Control::Indentation(d)),
+        _ => Err(Refusal::saying(format!(
+            "{context}: give exactly one of pressure=, force= or indentation="
+        ))),
+    }
+}
+
 /// Checks a tolerance: in `(0, MAX_TOLERANCE]`.
 pub fn check_tolerance(tolerance: f64) -> Result<(), Refusal> {
     if tolerance > 0.0 && tolerance <= MAX_TOLERANCE {
@@ -80,10 +108,7 @@ pub fn check_tolerance(tolerance: f64) -> Result<(), Refusal> {
 
 /// Checks a modulus (E*): positive and finite.
 pub fn check_modulus(param: Param, modulus: f64) -> Result<(), Refusal> {
-    if modulus.is_finite() && modulus > 0.0 {
-        return Ok(());
-    }
-    Err(Refusal::of(param).text(format!(" must be positive and finite, got {modulus}")))
+    crate::refusal::positive(param, modulus).map(|_| ())
 }
 
 /// Parses the boundary conditions: `free` or `periodic`.

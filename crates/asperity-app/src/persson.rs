@@ -155,7 +155,51 @@ impl Default for SweepPersson {
     }
 }
 
+/// `asperity bem --persson` with `--gamma` and `--kappa` (Python's `Solver.sweep(persson=,
+/// gamma=, kappa=)`).
+pub mod sweep_params {
+    use crate::refusal::Param;
+
+    /// Persson's theory beside the sweep.
+    pub const PERSSON: Param = Param::new("--persson", "persson");
+    /// γ.
+    pub const GAMMA: Param = Param::new("--gamma", "gamma");
+    /// κ.
+    pub const KAPPA: Param = Param::new("--kappa", "kappa");
+}
+
 impl SweepPersson {
+    /// The theory a sweep asks for: with `persson`, `gamma` and `kappa` as given, else the
+    /// defaults; without it none, and a γ or κ given is refused (`--gamma goes with
+    /// --persson`, `gamma goes with persson` in Python), the one rule of both front ends.
+    ///
+    /// ```
+    /// use asperity_app::persson::SweepPersson;
+    ///
+    /// assert_eq!(SweepPersson::from_options(false, None, None).unwrap(), None);
+    /// let theory = SweepPersson::from_options(true, Some(0.4), None).unwrap().unwrap();
+    /// assert_eq!((theory.gamma, theory.kappa), (0.4, SweepPersson::default().kappa));
+    /// let refusal = SweepPersson::from_options(false, None, Some(1.0)).unwrap_err();
+    /// assert_eq!(refusal.to_string(), "--kappa goes with --persson");
+    /// ```
+    pub fn from_options(
+        persson: bool,
+        gamma: Option<f64>,
+        kappa: Option<f64>,
+    ) -> Result<Option<SweepPersson>, Refusal> {
+        use sweep_params::{GAMMA, KAPPA, PERSSON};
+        for (param, given) in [(GAMMA, gamma), (KAPPA, kappa)] {
+            if given.is_some() && !persson {
+                return Err(Refusal::of(param).text(" goes with ").param(PERSSON));
+            }
+        }
+        let defaults = SweepPersson::default();
+        Ok(persson.then(|| SweepPersson {
+            gamma: gamma.unwrap_or(defaults.gamma),
+            kappa: kappa.unwrap_or(defaults.kappa),
+        }))
+    }
+
     /// The theory's parameters on a half-space of effective modulus `modulus`, or why not
     /// (the library's rules for γ and κ), before any solve.
     pub fn params(self, modulus: f64) -> Result<PerssonParams, RequestError> {

@@ -165,6 +165,25 @@ pub fn count(param: Param, value: impl Into<i128>) -> Result<usize, Refusal> {
     })
 }
 
+/// A value that must be positive and finite (a modulus, a side length, an area), refused
+/// otherwise in one wording: `--size must be positive and finite, got -1` (CLI),
+/// `size must be positive and finite, got -1` (Python).
+///
+/// ```
+/// use asperity_app::refusal::{positive, Names, Param};
+///
+/// const SIZE: Param = Param::new("--size", "size");
+/// assert_eq!(positive(SIZE, 2.0).unwrap(), 2.0);
+/// let refusal = positive(SIZE, f64::NAN).unwrap_err();
+/// assert_eq!(refusal.words(Names::Keywords), "size must be positive and finite, got NaN");
+/// ```
+pub fn positive(param: Param, value: f64) -> Result<f64, Refusal> {
+    if value.is_finite() && value > 0.0 {
+        return Ok(value);
+    }
+    Err(Refusal::of(param).text(format!(" must be positive and finite, got {value}")))
+}
+
 impl fmt::Display for Refusal {
     /// The CLI's words (flags); Python renders [`Refusal::words`] with [`Names::Keywords`].
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -2,7 +2,8 @@
 //! (indicatif hides its bar when stderr is not a terminal).
 //!
 //! # The ETA
-//! The estimate is `elapsed / work done in this run × work left` ([`Eta`]), where
+//! The estimate is `elapsed / work done in this run × work left` (the front-end layer's
+//! [`Eta`], which Python's progress bars use too), where
 //!
 //! * only steps done in this run count as done work: steps read back from a checkpoint
 //!   ([`Progress::restore`]) move the bar but not the rate, so a resumed study does not
@@ -20,81 +21,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use asperity_app::study::progress::{log_line, Eta};
 use indicatif::{HumanDuration, ProgressBar, ProgressState, ProgressStyle};
-
-/// The ETA arithmetic of a run of weighted steps, apart from the clock (module docs).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Eta {
-    /// Consecutive runs of steps: `(steps, cost of each)`.
-    segments: Vec<(u64, f64)>,
-    /// Cost of the steps read back instead of done in this run.
-    restored: f64,
-}
-
-impl Eta {
-    /// `total` steps of equal cost.
-    pub fn uniform(total: u64) -> Self {
-        Self::weighted(&[(total, 1.0)])
-    }
-
-    /// Runs of `(steps, cost of each step)`, in the order they are done.
-    pub fn weighted(segments: &[(u64, f64)]) -> Self {
-        Eta {
-            segments: segments
-                .iter()
-                .map(|&(steps, cost)| (steps, if cost > 0.0 { cost } else { 0.0 }))
-                .collect(),
-            restored: 0.0,
-        }
-    }
-
-    /// Number of steps.
-    pub fn total(&self) -> u64 {
-        self.segments.iter().map(|s| s.0).sum()
-    }
-
-    /// Cost of the first `steps` steps.
-    pub fn cost_to(&self, steps: u64) -> f64 {
-        let mut left = steps;
-        let mut cost = 0.0;
-        for &(count, each) in &self.segments {
-            let take = left.min(count);
-            cost += take as f64 * each;
-            left -= take;
-            if left == 0 {
-                break;
-            }
-        }
-        cost
-    }
-
-    /// Steps `from..to` were read back, not done in this run.
-    pub fn restore(&mut self, from: u64, to: u64) {
-        if to > from {
-            self.restored += self.cost_to(to) - self.cost_to(from);
-        }
-    }
-
-    /// Seconds left when `done` steps are done after `elapsed` seconds of this run; `None`
-    /// until some work was done in this run.
-    pub fn remaining(&self, done: u64, elapsed: f64) -> Option<f64> {
-        let total = self.total();
-        if done >= total {
-            return Some(0.0);
-        }
-        let worked = self.cost_to(done) - self.restored;
-        // Below a millionth of the cost done, rounding of the restored sum: nothing done.
-        if worked <= 1e-9 * self.cost_to(total) || elapsed <= 0.0 {
-            return None;
-        }
-        Some(elapsed / worked * (self.cost_to(total) - self.cost_to(done)))
-    }
-}
-
-/// The log line printed when stderr is not a terminal.
-fn log_line(name: &str, done: u64, total: u64, elapsed: f64, eta: f64) -> String {
-    format!("{name}: {done}/{total} ({elapsed:.0} s elapsed, ETA {eta:.0} s)")
-}
 
 /// The least time between two lines of progress inside one solve ([`Progress::solve_monitor`]).
 pub const SOLVE_EVERY: f64 = 2.0;
@@ -294,58 +222,5 @@ impl Progress {
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn restored_steps_do_not_count_towards_the_rate() {
-        // The audit's case: 180 of 270 samples read back, then 30 done in 5 s. 60 are left
-        // at 6 per second: 10 s (the old estimate, 5 s / 210 × 60, said 1 s).
-        let mut eta = Eta::uniform(270);
-        assert_eq!(eta.remaining(0, 1.0), None, "nothing done yet");
-        eta.restore(0, 180);
-        assert_eq!(eta.remaining(180, 0.5), None, "only restored so far");
-        let left = eta.remaining(210, 5.0).unwrap();
-        assert!((left - 10.0).abs() < 1e-9, "{left}");
-        assert_eq!(eta.remaining(270, 9.0), Some(0.0));
-    }
-
-    #[test]
-    fn restored_steps_in_a_later_task_are_not_counted_either() {
-        // Task 1 (10 steps) done in this run in 2 s, task 2 (10 steps) half restored.
-        let mut eta = Eta::weighted(&[(10, 1.0), (10, 1.0)]);
-        eta.restore(10, 15);
-        let left = eta.remaining(15, 2.0).unwrap();
-        assert!((left - 1.0).abs() < 1e-9, "5 steps at 5 per second: {left}");
-    }
-
-    #[test]
-    fn steps_are_weighted_by_cost() {
-        // 10 cheap steps (cost 1) done in 2 s, 10 expensive ones (cost 4) left: 40 units at
-        // 5 per second. Counting steps alike would say 2 s.
-        let eta = Eta::weighted(&[(10, 1.0), (10, 4.0)]);
-        assert_eq!(eta.total(), 20);
-        assert_eq!(eta.cost_to(12), 18.0);
-        let left = eta.remaining(10, 2.0).unwrap();
-        assert!((left - 8.0).abs() < 1e-9, "{left}");
-        // BEM N = 64 then 128, as `reproduce fig1 --quick`: the second grid's samples cost
-        // 4.67 times as much.
-        use asperity::study::{sample_cost, Method};
-        let (a, b) = (sample_cost(Method::Bem, 64), sample_cost(Method::Bem, 128));
-        let eta = Eta::weighted(&[(20, a), (20, b)]);
-        let left = eta.remaining(20, 6.0).unwrap();
-        assert!((left - 6.0 * b / a).abs() < 1e-9, "{left}");
-    }
-
-    #[test]
-    fn the_log_line_keeps_its_format() {
-        assert_eq!(
-            log_line("mdr study", 210, 270, 5.2, 10.4),
-            "mdr study: 210/270 (5 s elapsed, ETA 10 s)"
-        );
     }
 }

@@ -293,7 +293,7 @@ mod tests {
             poisson: None,
         };
         let segments = StudyProgress::new(&spec, vec![0, 3]).segments();
-        let mut eta = crate::progress::Eta::weighted(&segments);
+        let mut eta = asperity_app::study::progress::Eta::weighted(&segments);
         let loads = BemSampler::LOADS as u64;
         assert_eq!(eta.total(), 8 * loads);
         eta.restore(0, 3 * loads);

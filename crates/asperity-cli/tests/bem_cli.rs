@@ -1063,11 +1063,11 @@ fn bad_numbers_name_their_flag() {
         ),
         (
             &["--size", "-1"][..],
-            "invalid --size -1: sizes must be positive and finite",
+            "--size must be positive and finite, got -1",
         ),
         (
             &["--size", "0"][..],
-            "invalid --size 0: sizes must be positive and finite",
+            "--size must be positive and finite, got 0",
         ),
         (&["--size", "nan"][..], "--size"),
         (

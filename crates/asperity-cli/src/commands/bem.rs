@@ -540,15 +540,8 @@ fn plan(args: &BemArgs) -> Result<Plan> {
         modulus: bem.half_space.modulus,
         persson: args.persson,
     };
-    for (flag, given) in [("--gamma", args.gamma), ("--kappa", args.kappa)] {
-        if given.is_some() && !args.persson {
-            bail!("{flag} goes with --persson");
-        }
-    }
-    let persson = args.persson.then(|| SweepPersson {
-        gamma: args.gamma.unwrap_or(SweepPersson::default().gamma),
-        kappa: args.kappa.unwrap_or(SweepPersson::default().kappa),
-    });
+    let persson = SweepPersson::from_options(args.persson, args.gamma, args.kappa)
+        .map_err(|r| refused(r.into()))?;
     if let Some(options) = persson {
         options.params(bem.half_space.modulus).map_err(refused)?;
     }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use asperity::topography::Topography;
 use asperity_app::argument::{open, Arrays, Input};
 use asperity_app::measured::{parse_detrend, parse_fill, MeasuredRequest};
@@ -47,24 +47,17 @@ impl MeasuredArgs {
     }
 }
 
-/// Parses `--size X[,Y]` (metres for a measured file).
+/// Parses `--size X[,Y]` (metres for a measured file): the numbers here, their rule
+/// (one or two, positive and finite) in the front-end layer's words
+/// ([`asperity_app::argument::sizes`], Python's `size=` too).
 pub fn parse_size(text: &str) -> Result<[Option<f64>; 2]> {
-    let parts: Vec<&str> = text.split(',').collect();
-    if parts.len() > 2 {
-        bail!("invalid --size {text}: give X or X,Y");
-    }
-    let mut out = [None, None];
-    for (slot, part) in out.iter_mut().zip(&parts) {
-        let v: f64 = part
-            .trim()
-            .parse()
-            .with_context(|| format!("invalid --size {text}: {part:?} is not a number"))?;
-        if !(v.is_finite() && v > 0.0) {
-            bail!("invalid --size {text}: sizes must be positive and finite");
-        }
-        *slot = Some(v);
-    }
-    Ok(out)
+    let values = (text.split(','))
+        .map(|part| {
+            (part.trim().parse::<f64>())
+                .with_context(|| format!("invalid --size {text}: {part:?} is not a number"))
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    asperity_app::argument::sizes(&values).map_err(|r| anyhow::anyhow!(r.words(Names::Flags)))
 }
 
 /// Opens a surface or line argument by the front-end layer's one call

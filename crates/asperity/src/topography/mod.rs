@@ -626,16 +626,14 @@ fn infinities_undefined(reading: &mut Reading) {
 /// neither gives one. `.npy` files are read by [`crate::io::read_npy`]; their sizes come
 /// from `options.size`, else from an asperity sidecar. No cleaning is done (see [`clean`]).
 pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
-    if !meta.is_file() {
-        return Err(bad_file(path, "not a regular file"));
-    }
-    if meta.len() > options.max_bytes {
+    use std::io::Read;
+    // Every input is opened by one rule, in one wording (a FIFO is refused, not waited on).
+    let (file, length) = crate::input::open_regular(path)?;
+    if length > options.max_bytes {
         return Err(bad_file(
             path,
             format!(
-                "{} bytes is more than the {} bytes allowed for a topography file",
-                meta.len(),
+                "{length} bytes is more than the {} bytes allowed for a topography file",
                 options.max_bytes
             ),
         ));
@@ -644,18 +642,21 @@ pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
     // binary formats; text holds ~3 values per 2 bytes at worst (e.g. `1 2 3`).
     crate::memory::ensure_fits(
         &format!("reading {}", path.display()),
-        meta.len().checked_mul(16),
+        length.checked_mul(16),
     )?;
+    let mut file = file.take(options.max_bytes + 1);
     let mut head = [0u8; 8];
-    let head_len = {
-        use std::io::Read;
-        let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-        f.read(&mut head).map_err(|e| Error::io(path, e))?
-    };
+    let head_len = file.read(&mut head).map_err(|e| Error::io(path, e))?;
     if head[..head_len].starts_with(NPY_MAGIC) {
         return read_npy_topography(path, options);
     }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let mut bytes = Vec::with_capacity(length as usize);
+    bytes.extend_from_slice(&head[..head_len]);
+    file.read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > options.max_bytes {
+        return Err(bad_file(path, "grew beyond its size limit while read"));
+    }
     let (reading, notes) =
         detect_and_read(path, &bytes).map_err(|e| bad_file(path, e.to_string()))?;
     topography_from(path, reading, notes, options)
@@ -1073,7 +1074,24 @@ mod tests {
     fn only_regular_files_within_the_cap() {
         let dir = tempfile::tempdir().unwrap();
         let err = read_file(dir.path(), &ReadOptions::default()).unwrap_err();
-        assert!(err.to_string().contains("not a regular file"), "{err}");
+        assert!(
+            err.to_string().contains("is a folder, not a regular file"),
+            "{err}"
+        );
+        #[cfg(unix)]
+        {
+            // A FIFO is refused at once, not waited on, in the words of every input.
+            let fifo = dir.path().join("f.txt");
+            let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+            assert!(made.unwrap().success());
+            let err = read_file(&fifo, &ReadOptions::default()).unwrap_err();
+            let once = crate::input::open_regular(&fifo).unwrap_err();
+            assert_eq!(err.to_string(), once.to_string());
+            assert!(
+                err.to_string().contains("is a FIFO, socket or device"),
+                "{err}"
+            );
+        }
         let path = dir.path().join("big.txt");
         std::fs::write(&path, "1 2 3 4\n5 6 7 8\n").unwrap();
         let options = ReadOptions {
