@@ -5,8 +5,9 @@
 #   python/ci.sh            # from anywhere; PYTHON=python3.12 python/ci.sh to pick one
 #
 # 1. a virtual environment python/.venv (git-ignored; reused when present);
-# 2. the build and test dependencies from PyPI: maturin, numpy, pytest, matplotlib and the
-#    peers ContactMechanics + SurfaceTopography (the cross-check tests need them);
+# 2. the build and test dependencies from PyPI: maturin, numpy, pytest, matplotlib, scipy
+#    (its netcdf_file reads the NetCDF files test_netcdf.py writes) and the peers
+#    ContactMechanics + SurfaceTopography (the cross-check tests need them);
 # 3. the `asperity` binary the tests compare against (ASPERITY_BIN, else cargo build
 #    --release), then `pip install ./python` (maturin builds the abi3 extension in the
 #    root's target/);
@@ -25,7 +26,7 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 "$venv/bin/python" -m pip install --quiet "maturin>=1.16,<2" numpy pytest matplotlib \
-    ContactMechanics SurfaceTopography
+    scipy ContactMechanics SurfaceTopography
 
 # The CLI the tests compare with: ASPERITY_BIN where given (.ci/run passes the binary its
 # Rust tests built), else a release build here.

@@ -698,12 +698,19 @@ class ContactResult:
 
     def save(self, path: Union[str, os.PathLike], *, force: bool = False) -> None:
         """Writes ``path`` (``.npz``: the fields present, float64) and ``path.json`` (the
-        scalars and :attr:`metadata`), both or neither; :func:`load` gives it back."""
+        scalars and :attr:`metadata`), both or neither; or, for a name ending in ``.nc``,
+        one NetCDF file (the fields on ``y``, ``x`` with CF attributes, the rest in its
+        ``asperity_record`` attribute). :func:`load` gives it back."""
         arrays = {name: getattr(self, name) for name in _CONTACT_FIELDS
                   if getattr(self, name) is not None}
         scalars = {name: getattr(self, name) for name in _CONTACT_SCALARS}
-        _save_bundle(path, "contact result", arrays, {"scalars": scalars,
-                                                      "metadata": self.metadata}, force)
+        record = {"scalars": scalars, "metadata": self.metadata}
+        _result_path(path)
+        if _is_netcdf(path):
+            _save_netcdf(path, "contact result", {n: ("map", a) for n, a in arrays.items()},
+                         record, force)
+            return
+        _save_bundle(path, "contact result", arrays, record, force)
 
     def __repr__(self) -> str:
         shape = "" if self.pressure is None else ", fields " + "x".join(map(str, self.pressure.shape))
@@ -745,7 +752,10 @@ class Sweep:
         """Writes ``path`` (``.npz``: one array per column; the fields of a sweep with
         ``fields=True`` as ``pressure``/``gap`` stacks of loads × rows × cols) and
         ``path.json`` (column names, :attr:`metadata`), both or neither (an existing file
-        is refused unless ``force``). :func:`load` gives back the same sweep."""
+        is refused unless ``force``); or, for a name ending in ``.nc``, one NetCDF file:
+        the columns along ``load``, the fields on (``load``,) ``y``, ``x``, CF attributes,
+        the rest in its ``asperity_record`` attribute (``asperity bem --fields FILE.nc``
+        writes the same variables). :func:`load` gives back the same sweep."""
         arrays, stacked, scalars = {}, [], {}
         for name, value in self.columns.items():
             if isinstance(value, list):
@@ -757,9 +767,15 @@ class Sweep:
                 scalars[name] = value
             else:
                 raise ValueError(f"column {name}: cannot save a {type(value).__name__}")
-        _save_bundle(path, "sweep", arrays, {"columns": list(self.columns),
-                                             "stacked": stacked, "scalars": scalars,
-                                             "metadata": self.metadata}, force)
+        record = {"columns": list(self.columns), "stacked": stacked, "scalars": scalars,
+                  "metadata": self.metadata}
+        _result_path(path)
+        if _is_netcdf(path):
+            placed = {name: (_placement(name, a, name in stacked), a)
+                      for name, a in arrays.items()}
+            _save_netcdf(path, "sweep", placed, record, force)
+            return
+        _save_bundle(path, "sweep", arrays, record, force)
 
     def __repr__(self) -> str:
         names = ", ".join(self.columns)
@@ -844,12 +860,15 @@ class Solver:
             int(max_iterations), str(solver), _opt(hardness),
         )
         self._surface = _surface_identity(surface, heights)
+        self._size_y = size_y
 
     def _metadata(self, **load: Any) -> Dict[str, Any]:
         """The identity of a result of this solver: its settings, the surface, the load."""
         settings = {"shape": list(self.shape), "size": self.size, "modulus": self.modulus,
                     "boundary": self.boundary, "tolerance": self.tolerance,
                     "max_iterations": self.max_iterations, "solver": self.solver}
+        if self._size_y is not None:
+            settings["size_y"] = self._size_y
         if self.hardness is not None:
             settings["hardness"] = self.hardness
         return {"generator": f"asperity {__version__}", "solver": settings,
@@ -1296,12 +1315,23 @@ class MdrCurve(_Saved):
     pull_off: Optional[Dict[str, Dict[str, float]]] = None
 
 
-def _mdr_request(line: Any, radial: Any, size: Optional[float],
-                 indentations: Optional[Sequence[float]], **options: Any
+#: The keywords of the front-end layer's ``MdrRequest`` that :func:`mdr` and
+#: :func:`mdr_slip` share (the indenter, the springs, the loads), besides ``line``,
+#: ``radial``, ``size`` and ``indentations``.
+_MDR_KEYWORDS = ("profile", "radial_step", "radius", "slope", "coefficient", "exponent", "n",
+                 "dx", "modulus", "spring", "hurst", "rms_height", "asperity_radius", "nloads",
+                 "dmin", "dmax", "breakpoints", "work_of_adhesion")
+
+
+def _mdr_request(keywords: Dict[str, Any]
                  ) -> Tuple[Dict[str, Any], Optional[np.ndarray], Optional[np.ndarray]]:
-    """The request of :func:`mdr` and :func:`mdr_slip` (the keywords of the front-end
-    layer's ``MdrRequest``) with the line's heights and the radial samples. Keywords left
-    ``None`` are left out and take the request's defaults (the CLI's)."""
+    """The one request builder of :func:`mdr` and :func:`mdr_slip`: from their keywords
+    (``locals()``), the request (the keywords of ``MdrRequest`` in :data:`_MDR_KEYWORDS`)
+    with the line's heights and the radial samples. Keywords left ``None`` are left out
+    and take the request's defaults (the CLI's)."""
+    line, radial, size = keywords["line"], keywords["radial"], keywords["size"]
+    indentations = keywords["indentations"]
+    options = {name: keywords[name] for name in _MDR_KEYWORDS if name in keywords}
     line_heights = None
     if line is not None:
         if isinstance(line, Line):
@@ -1380,13 +1410,8 @@ def mdr(
         >>> round(jkr.pull_off["force_controlled"]["force"] / (-1.5 * np.pi * 1e-3), 3)
         1.0
     """
-    request, line_heights, radial_values = _mdr_request(
-        line, radial, size, indentations, profile=profile, radial_step=radial_step,
-        radius=radius, slope=slope, coefficient=coefficient, exponent=exponent, n=n, dx=dx,
-        modulus=modulus, spring=spring, hurst=hurst, rms_height=rms_height,
-        asperity_radius=asperity_radius, nloads=nloads, dmin=dmin, dmax=dmax,
-        breakpoints=bool(breakpoints), work_of_adhesion=work_of_adhesion,
-    )
+    breakpoints = bool(breakpoints)
+    request, line_heights, radial_values = _mdr_request(locals())
     out = _core.mdr_curve(request, line_heights, radial_values)
     return MdrCurve(**out)
 
@@ -1448,12 +1473,7 @@ def mdr_slip(
         >>> round(float(c.stick_radius[49]), 3)  # top of the loading branch: 0.5^(1/3)
         0.794
     """
-    request, line_heights, radial_values = _mdr_request(
-        line, radial, size, indentations, profile=profile, radial_step=radial_step,
-        radius=radius, slope=slope, coefficient=coefficient, exponent=exponent, n=n, dx=dx,
-        modulus=modulus, spring=spring, hurst=hurst, rms_height=rms_height,
-        asperity_radius=asperity_radius, work_of_adhesion=work_of_adhesion,
-    )
+    request, line_heights, radial_values = _mdr_request(locals())
     out = _core.mdr_slip(
         request, line_heights, radial_values, float(tangential_force), _opt(friction),
         _opt(poisson), cycle_points,
@@ -1850,6 +1870,49 @@ def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
 
 
 # --------------------------------------------------------------------------------------
+# The paper's figures
+# --------------------------------------------------------------------------------------
+
+
+def reproduce(figure: str, out: Union[str, "os.PathLike[str]"], *, setting: str = "paper",
+              force: bool = False) -> str:
+    """Regenerates a figure of the paper, ``asperity reproduce FIGURE --setting SETTING
+    --out OUT``: ``figure`` ``"fig1"``, ``"fig2"``, ``"fig5"``, ``"fig6"``,
+    ``"fig15.1"``, ``"fig15.2"`` or ``"all"``; ``setting`` ``"quick"`` (minutes),
+    ``"medium"`` (hours) or ``"paper"`` (about 10 hours for all). Writes one sub-folder
+    per figure (its CSV, PNG, SVG and ``report.md`` with the paper's value beside ours;
+    resumable, never overwritten without ``force``) and returns ``out``.
+
+    It runs the command line compiled into this package (the installed ``asperity``
+    command) in a child process of its own, so a long run keeps the command's own
+    checkpoints, progress lines and Ctrl-C handling (an interrupted figure resumes when
+    called again), and the files are the CLI's byte for byte. Its studies are also
+    Python calls (:func:`study_alpha`, :func:`study_curve`, :meth:`StudyResult.comparison`).
+    A bad request raises ``ValueError`` with the CLI's one line; a failed run
+    ``RuntimeError`` with its last line.
+
+    Example::
+
+        >>> import os
+        >>> folder = asperity.reproduce("fig15.1", "paper-figures")
+        >>> os.path.exists(os.path.join(folder, "fig15.1", "fig15_1.csv"))
+        True
+    """
+    import subprocess
+
+    out = os.fspath(out)
+    args = [sys.executable, "-m", "asperity._cli", "reproduce", str(figure), "--setting",
+            str(setting), "--out", out, *(["--force"] if force else [])]
+    result = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if result.returncode != 0:
+        lines = [l for l in result.stderr.splitlines() if l.strip()]
+        errors = [l[len("error: "):] for l in lines if l.startswith("error: ")]
+        message = (errors or lines or [f"exit status {result.returncode}"])[-1]
+        raise (ValueError if result.returncode == 2 else RuntimeError)(message)
+    return out
+
+
+# --------------------------------------------------------------------------------------
 # Saving and loading
 # --------------------------------------------------------------------------------------
 
@@ -1876,6 +1939,126 @@ def _save_bundle(path: Union[str, os.PathLike], kind: str, arrays: Dict[str, np.
         raise ValueError(f"{path}: the record holds a non-finite number ({e})") from None
     _core.save_files([(path, buffer.getvalue()), (path + ".json", (text + "\n").encode())],
                      bool(force))
+
+
+def _is_netcdf(path: Union[str, os.PathLike]) -> bool:
+    return os.fspath(path).lower().endswith(".nc")
+
+
+def _result_path(path: Union[str, os.PathLike]) -> None:
+    """Refuses a result's file name that names neither format it can be saved in."""
+    name = os.fspath(path)
+    if not (_is_netcdf(name) or name.lower().endswith(".npz")):
+        raise ValueError(f"path {name}: the file name must end in .npz (numpy archive and "
+                         "JSON sidecar) or .nc (NetCDF)")
+
+
+#: 1-D columns that lie along a dimension of their own, not along the loads.
+_NC_ALONG = {"patch_areas_m2": "patch"}
+
+
+def _placement(name: str, array: np.ndarray, stacked: bool) -> str:
+    """Where a sweep's array lies in a NetCDF file (see ``asperity_app::fields``)."""
+    if stacked:
+        return "load_map"
+    if array.ndim == 2:
+        return "map"
+    if array.ndim == 1:
+        return f"along:{_NC_ALONG[name]}" if name in _NC_ALONG else "load"
+    raise ValueError(f"column {name}: a {array.ndim}-D array cannot be saved as NetCDF")
+
+
+def _nc_sides(metadata: Dict[str, Any], shape: Tuple[int, int]) -> Tuple[float, float]:
+    """The sides (x, y) of the surface a result lies on, from its metadata: a solver's
+    settings, a contact request's sizes, or the record of ``asperity bem``."""
+    settings = metadata.get("solver") if isinstance(metadata.get("solver"), dict) else metadata
+    size = settings.get("size")
+    size_y = settings.get("size_y")
+    if "sizes" in metadata:
+        size, size_y = metadata["sizes"]
+    if size is None:
+        raise ValueError("the metadata give no side length: cannot write the map's "
+                         "coordinates (save as .npz instead)")
+    rows, cols = shape
+    return float(size), float(size_y) if size_y is not None else float(size) * rows / cols
+
+
+def _nc_units(metadata: Dict[str, Any]) -> Tuple[bool, bool]:
+    """Which units are known (metres, pascals): SI for ``contact``; metres for a
+    measured surface (read in metres; the modulus's unit is the user's), as the CLI."""
+    if "contact" in metadata:
+        return True, True
+    surface = metadata.get("surface")
+    measured = isinstance(surface, dict) and "provenance" in surface
+    return measured or metadata.get("size_source") == "file", False
+
+
+def _save_netcdf(path: Union[str, os.PathLike], kind: str,
+                 arrays: Dict[str, Tuple[str, np.ndarray]], record: Dict[str, Any],
+                 force: bool) -> None:
+    """Writes a result as one NetCDF file (the library's ``asperity::fields``, as
+    ``asperity bem --fields FILE.nc``): each array where ``arrays`` places it, float64,
+    int32 or bool, its dtype kept in the record so that :func:`load` restores it."""
+    path = os.fspath(path)
+    variables, dtypes, texts, shape = [], {}, {}, None
+    for name, (place, value) in arrays.items():
+        a = np.asarray(value)
+        dtypes[name] = a.dtype.str
+        if a.dtype.kind == "U":  # names (a load path's branches): in the record
+            texts[name] = a.tolist()
+            continue
+        if a.dtype.kind in "iu":
+            fits = a.size == 0 or (a.min() >= -2**31 and a.max() < 2**31)
+            a = a.astype(np.int32 if fits else np.float64)
+            if not fits and np.abs(a).max() > 2**53:
+                raise ValueError(f"{name}: integers beyond 2**53 cannot be saved as NetCDF")
+        elif a.dtype.kind == "f":
+            a = a.astype(np.float64)
+        elif a.dtype.kind != "b":
+            raise ValueError(f"{name}: a {a.dtype} array cannot be saved as NetCDF")
+        if place in ("map", "load_map"):
+            shape = a.shape[-2:]
+        variables.append((name, place, np.ascontiguousarray(a)))
+    metadata = record.get("metadata", {})
+    grid = None if shape is None else (tuple(shape), _nc_sides(metadata, tuple(shape)))
+    sidecar = {"kind": kind, "generator": f"asperity {__version__}", **record,
+               "dtypes": dtypes, "texts": texts}
+    try:
+        text = json.dumps(sidecar, allow_nan=False, default=_json_scalar)
+    except ValueError as e:
+        raise ValueError(f"{path}: the record holds a non-finite number ({e})") from None
+    _core.write_fields(path, grid, _nc_units(metadata), f"asperity {kind}", text, variables,
+                       bool(force))
+
+
+def _load_netcdf(path: str) -> Any:
+    """A result saved as NetCDF (by :meth:`Sweep.save`, :meth:`ContactResult.save` or
+    ``asperity bem --fields FILE.nc``), or None for another NetCDF file (a topography)."""
+    try:
+        attributes, _, variables = _core.read_fields(path)
+    except ValueError:
+        return None  # not laid out as a field file: read_topography's to read or refuse
+    text = dict(attributes).get("asperity_record")
+    if text is None:
+        return None
+    record = json.loads(text)
+    dtypes = record.get("dtypes", {})
+    arrays = {name: (a.astype(np.dtype(dtypes[name])) if name in dtypes else a)
+              for name, _, _, _, _, a in variables}
+    for name, values in record.get("texts", {}).items():
+        arrays[name] = np.array(values, dtype=np.dtype(dtypes[name]))
+    kind = record.get("kind")
+    if kind == "contact result":
+        return ContactResult(**record["scalars"], **arrays, metadata=record["metadata"])
+    if kind == "sweep":
+        scalars = record.get("scalars", {})
+        columns = {name: (scalars[name] if name in scalars else
+                          list(arrays[name]) if name in record["stacked"] else arrays[name])
+                   for name in record["columns"]}
+        return Sweep(columns, record["metadata"])
+    # `asperity bem --fields FILE.nc`: the record is OUT.csv.json's.
+    columns = {name: (list(a) if a.ndim == 3 else a) for name, a in arrays.items()}
+    return Sweep(columns, record)
 
 
 def _json_scalar(value: Any) -> Any:
@@ -1928,6 +2111,10 @@ def load(path: Union[str, "os.PathLike[str]"]) -> Any:
         (True, True)
     """
     path = os.fspath(path)
+    if _is_netcdf(path):
+        loaded = _load_netcdf(path)
+        if loaded is not None:
+            return loaded
     record = _read_sidecar(path)
     kind = None if record is None else record.get("kind")
     if kind in ("surface", "line"):

@@ -30,11 +30,7 @@ fn surface_figure(
     metres: bool,
     name: &str,
 ) -> String {
-    let figure = MapFigure {
-        name,
-        size: (size_x, size_y),
-        metres,
-    };
+    let figure = map_figure(name, (size_x, size_y), metres);
     figure::to_json(&[surface_chart(heights.as_array(), figure)]).to_string()
 }
 
@@ -47,12 +43,14 @@ fn contact_map_figure(
     metres: bool,
     name: &str,
 ) -> String {
-    let figure = MapFigure {
-        name,
-        size: (size_x, size_y),
-        metres,
-    };
+    let figure = map_figure(name, (size_x, size_y), metres);
     figure::to_json(&[contact_map_chart(set.as_array(), figure)]).to_string()
+}
+
+/// The map figure of both maps above: its name, sides along x and y, lengths in metres
+/// or the surface's unit.
+fn map_figure(name: &str, size: (f64, f64), metres: bool) -> MapFigure<'_> {
+    MapFigure { name, size, metres }
 }
 
 /// The PSD's figure as `asperity stats --plot FILE.json` writes it: bins (q, psd), the

@@ -12,6 +12,7 @@ mod arrays;
 mod bem;
 mod contact;
 mod errors;
+mod fields;
 mod figure;
 mod interrupt;
 mod mdr;
@@ -48,6 +49,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     bem::register(m)?;
     adhesion::register(m)?;
     contact::register(m)?;
+    fields::register(m)?;
     figure::register(m)?;
     mdr::register(m)?;
     persson::register(m)?;

@@ -78,3 +78,22 @@ def test_an_interrupt_removes_unfinished_outputs_and_exits_130(tmp_path):
     assert proc.returncode == 130, err
     assert err.strip().splitlines()[-1].startswith("interrupted: unfinished outputs removed")
     assert not (tmp_path / "d" / "alpha.csv").exists()
+
+
+def test_reproduce_is_a_python_call_that_writes_the_clis_files(tmp_path):
+    import pytest
+
+    import asperity
+
+    folder = asperity.reproduce("fig15.1", tmp_path / "py")
+    assert folder == str(tmp_path / "py")
+    subprocess.run([str(cli_path()), "reproduce", "fig15.1", "--out", str(tmp_path / "cli")],
+                   check=True, capture_output=True)
+    name = "fig15_1.csv"
+    ours = (tmp_path / "py" / "fig15.1" / name).read_bytes()
+    assert ours == (tmp_path / "cli" / "fig15.1" / name).read_bytes()
+    with pytest.raises(ValueError, match="fig99") as e:
+        asperity.reproduce("fig99", tmp_path / "bad")
+    assert "\n" not in str(e.value)
+    with pytest.raises(ValueError, match="not made by .*--force"):
+        asperity.reproduce("fig15.1", tmp_path / "py", setting="quick")

@@ -31,6 +31,7 @@ pub mod argument;
 pub mod bem;
 pub mod contact;
 pub mod derived;
+pub mod fields;
 pub mod figure;
 pub mod import;
 pub mod mdr;

@@ -1620,3 +1620,150 @@ fn progress_inside_a_solve_reports_iterations_and_residuals() {
         refused(&out, "-1");
     }
 }
+
+/// The bits of a field file's float64 variable.
+fn nc_real(file: &asperity::fields::FieldFile, name: &str) -> Vec<f64> {
+    let v = file.variables.iter().find(|v| v.name == name).unwrap();
+    match &v.values {
+        asperity::fields::Values::Real(x) => x.clone(),
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+#[test]
+fn fields_to_a_netcdf_file_hold_the_npy_fields_bit_for_bit() {
+    use asperity::fields::FieldFile;
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let (nc, folder, csv) = (
+        dir.path().join("fields.nc"),
+        dir.path().join("fields"),
+        dir.path().join("out.csv"),
+    );
+    for (fields, out) in [(&nc, Some(&csv)), (&folder, None)] {
+        let mut args = vec![
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01,0.03",
+        ];
+        args.extend(["--fields", fields.to_str().unwrap(), "--quiet"]);
+        if let Some(out) = out {
+            args.extend(["--out", out.to_str().unwrap()]);
+        }
+        ok(&asperity(&args));
+    }
+    let file = FieldFile::read(&nc).unwrap();
+    let grid = file.grid.as_ref().unwrap();
+    assert_eq!(
+        (grid.rows, grid.cols, grid.size, grid.size_y),
+        (64, 64, 1.0, 1.0)
+    );
+    assert_eq!(grid.units, None); // a generated surface: the heights' unit is the user's
+    assert_eq!(file.dims, vec![("load".to_string(), 2)]);
+    let (pressure, gap) = (nc_real(&file, "pressure"), nc_real(&file, "gap"));
+    for k in 0..2 {
+        let p: Array2<f64> = read_npy(folder.join(format!("pressure_{k}.npy"))).unwrap();
+        let g: Array2<f64> = read_npy(folder.join(format!("gap_{k}.npy"))).unwrap();
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&pressure[k * 4096..(k + 1) * 4096]),
+            bits(p.as_slice().unwrap())
+        );
+        assert_eq!(
+            bits(&gap[k * 4096..(k + 1) * 4096]),
+            bits(g.as_slice().unwrap())
+        );
+    }
+    // The per-load columns are the table's; the record is OUT.csv.json's.
+    let (header, rows) = read_csv(&csv);
+    for name in ["force", "mean_pressure", "indentation", "area_fraction"] {
+        let table: Vec<f64> = rows.iter().map(|r| r[column(&header, name)]).collect();
+        assert_eq!(nc_real(&file, name), table, "{name}");
+    }
+    let record: serde_json::Value = serde_json::from_str(
+        &file
+            .attributes
+            .iter()
+            .find(|a| a.0 == "asperity_record")
+            .unwrap()
+            .1,
+    )
+    .unwrap();
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out.csv.json")).unwrap())
+            .unwrap();
+    assert_eq!(record, sidecar);
+    let p = file
+        .variables
+        .iter()
+        .find(|v| v.name == "pressure")
+        .unwrap();
+    assert_eq!(p.dims, ["load", "y", "x"]);
+    assert_eq!(p.units, None);
+    assert_eq!(p.comment.as_deref(), Some("in the units of the modulus E*"));
+}
+
+#[test]
+fn a_netcdf_fields_file_is_refused_where_it_cannot_be_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let run = |fields: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01",
+        ];
+        args.extend(["--fields", fields.to_str().unwrap(), "--quiet"]);
+        args.extend(extra);
+        asperity(&args)
+    };
+    // A folder named *.nc; a .nc in a missing folder; an existing file without --force.
+    let folder = dir.path().join("taken.nc");
+    std::fs::create_dir(&folder).unwrap();
+    refused(&run(&folder, &[]), "is a folder");
+    let missing = dir.path().join("no/such/f.nc");
+    refused(&run(&missing, &[]), "no/such");
+    assert!(!dir.path().join("no").exists());
+    let existing = dir.path().join("f.nc");
+    std::fs::write(&existing, b"mine").unwrap();
+    refused(&run(&existing, &[]), "already exists");
+    assert_eq!(std::fs::read(&existing).unwrap(), b"mine");
+    ok(&run(&existing, &["--force"]));
+    assert!(asperity::fields::FieldFile::read(&existing).is_ok());
+}
+
+#[test]
+fn a_load_path_writes_its_permanent_displacement_to_a_netcdf_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let (nc, folder) = (dir.path().join("path.nc"), dir.path().join("path"));
+    for fields in [&nc, &folder] {
+        ok(&asperity(&[
+            "bem",
+            "--surface",
+            s.to_str().unwrap(),
+            "--pressures",
+            "0.01,0.04,0.01",
+            "--hardness",
+            "0.3",
+            "--load-path",
+            "--boundary",
+            "periodic",
+            "--quiet",
+            "--fields",
+            fields.to_str().unwrap(),
+        ]));
+    }
+    let file = asperity::fields::FieldFile::read(&nc).unwrap();
+    let permanent: Array2<f64> = read_npy(folder.join("permanent.npy")).unwrap();
+    assert_eq!(
+        nc_real(&file, "permanent_displacement"),
+        permanent.as_slice().unwrap()
+    );
+    assert!(permanent.iter().any(|&w| w > 0.0));
+    assert_eq!(nc_real(&file, "permanent_max").len(), 3);
+}

@@ -89,6 +89,7 @@ pub mod bem;
 pub mod elastic;
 mod error;
 pub mod fft;
+pub mod fields;
 pub mod fit;
 pub mod huge_pages;
 pub mod input;

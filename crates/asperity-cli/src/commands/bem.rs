@@ -24,6 +24,9 @@ use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUM
 use asperity_app::refusal::count;
 use serde_json::json;
 
+use super::fields_nc::{
+    check_target, fields_folder, netcdf_target, stage_sweep, Grid as NcGrid, Stacks,
+};
 use super::measured::{open_argument, parse_size, MeasuredArgs};
 use crate::output::{format_number, print_stdout, Table};
 use asperity_app::argument::{Arrays, Dims, SizeSource};
@@ -167,8 +170,11 @@ pub struct BemArgs {
     pub plot: Option<PathBuf>,
     /// Write pressure_K.npy and gap_K.npy for every load K (0-based) into DIR. Refused if
     /// DIR holds pressure_*.npy or gap_*.npy files this run would not replace (an earlier
-    /// run's; use another folder).
-    #[arg(long, value_name = "DIR")]
+    /// run's; use another folder). A name ending in .nc writes one NetCDF file instead:
+    /// pressure(load, y, x), gap(load, y, x), the per-load force, mean_pressure,
+    /// indentation and area_fraction, x and y coordinates, CF attributes (units where
+    /// known: metres for a measured surface) and the run's record (docs/python.md).
+    #[arg(long, value_name = "DIR|FILE.nc")]
     pub fields: Option<PathBuf>,
     /// Add the column stiffness_fd: the finite-difference dF/dd by central differences of
     /// two extra solves at the load × (1 ± 1e-3), after the frozen-set stiffness and the
@@ -304,6 +310,7 @@ fn ensure_no_stale_fields(dir: &Path, count: usize) -> Result<()> {
 struct CliObserver<'a> {
     staged: &'a mut StagedOutputs,
     fields: Option<&'a [(PathBuf, PathBuf)]>,
+    netcdf: Option<&'a mut Stacks>,
     progress: Progress,
     peak_rss: Option<Vec<f64>>,
     mean_gaps: Option<Vec<f64>>,
@@ -316,6 +323,9 @@ impl SweepObserver for CliObserver<'_> {
         if let Some((p_path, g_path)) = self.fields.map(|f| &f[load]) {
             self.staged.write_npy_2d(p_path, &solver.pressure())?;
             self.staged.write_npy_2d(g_path, &solver.gap())?;
+        }
+        if let Some(stacks) = &mut self.netcdf {
+            stacks.push(solver);
         }
         if let Some(gaps) = &mut self.mean_gaps {
             gaps.push(bem_mean_gap(solver));
@@ -558,6 +568,8 @@ fn plan(args: &BemArgs) -> Result<Plan> {
 pub(super) struct Outputs {
     pub(super) staged: StagedOutputs,
     fields: Option<Vec<(PathBuf, PathBuf)>>,
+    /// `--fields FILE.nc`: the fields of every load, written at the end.
+    netcdf: Option<Stacks>,
 }
 
 /// Step 1b: the outputs, checked before any work. Each folder exists (`--fields DIR` and its
@@ -566,28 +578,41 @@ pub(super) struct Outputs {
 /// no field files of another run. They are written to temporary files as each load is solved
 /// and renamed into place together at the end.
 pub(super) fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
-    if let Some(dir) = &args.fields {
+    let netcdf = netcdf_target(args.fields.as_ref());
+    let folder = fields_folder(args.fields.as_ref());
+    if let Some(path) = netcdf {
+        check_target(path)?;
+    }
+    if let Some(dir) = folder {
         ensure_no_stale_fields(dir, loads)?;
     }
-    let fields = args.fields.as_ref().map(|dir| field_paths(dir, loads));
+    let fields = folder.map(|dir| field_paths(dir, loads));
     let record_path = args.out.as_deref().map(sidecar_path);
     let output_paths = args
         .out
         .iter()
         .chain(&record_path)
         .chain(&args.plot)
-        .chain(fields.iter().flatten().flat_map(|(p, g)| [p, g]));
-    let staged = StagedOutputs::in_new_folders(&args.fields, output_paths, args.force)?;
+        .map(PathBuf::as_path)
+        .chain(netcdf)
+        .chain(fields.iter().flatten().flat_map(|(p, g)| [p.as_path(), g]));
+    let staged = StagedOutputs::in_new_folders(folder, output_paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
-    Ok(Outputs { staged, fields })
+    let netcdf = netcdf.map(Stacks::new);
+    Ok(Outputs {
+        staged,
+        fields,
+        netcdf,
+    })
 }
 
 /// Step 1c: the surface, with where its side length came from. A `.npy`'s memory is checked
 /// from its header before its data is read (the solver plus the heights, alive while the
 /// solver is built, plus the per-load bookkeeping); a measured file is read, bounded, by
 /// the topography reader and checked after.
-fn read_surface(args: &BemArgs, plan: &Plan, fields: bool) -> Result<(Surface, SizeSource)> {
+fn read_surface(args: &BemArgs, plan: &Plan, outputs: &Outputs) -> Result<(Surface, SizeSource)> {
     let loads = plan.bem.loads.len();
+    let fields = (outputs.fields.is_some(), outputs.netcdf.is_some());
     read_surface_with(
         args,
         (plan.size, plan.bem.half_space.boundary),
@@ -605,22 +630,27 @@ pub(super) fn read_surface_for(
         Some(text) => parse_size(text)?,
         None => [None, None],
     };
-    let (surface, source) = read_surface_with(args, (size, boundary), (0, false))?;
+    let (surface, source) = read_surface_with(args, (size, boundary), (0, (false, false)))?;
     Ok((surface, source.name()))
 }
 
 /// [`read_surface`] for `size` (`--size`) and `boundary`, with the bookkeeping of `loads`
-/// loads (and their fields) in the memory check.
+/// loads (and their fields: written as solved, or kept for one `.nc` file) in the memory
+/// check.
 fn read_surface_with(
     args: &BemArgs,
     (size, boundary): ([Option<f64>; 2], asperity::elastic::Boundary),
-    (loads, fields): (usize, bool),
+    (loads, (fields, kept)): (usize, (bool, bool)),
 ) -> Result<(Surface, SizeSource)> {
     let fits = |shape: &[usize]| match *shape {
         [rows, cols] => {
+            // A .nc file: pressure and gap of every load, a filled copy and the bytes.
+            let kept = if kept { [loads, rows, cols, 6] } else { [0; 4] };
             let extra = array_bytes(&[rows, cols], 8)
-                .zip(bookkeeping_bytes(loads, fields))
-                .and_then(|(heights, loads)| heights.checked_add(loads));
+                .zip(bookkeeping_bytes(loads, fields || kept[0] > 0))
+                .and_then(|(heights, loads)| heights.checked_add(loads))
+                .zip(array_bytes(&kept, 8))
+                .and_then(|(extra, kept)| extra.checked_add(kept));
             ensure_solver_fits(rows, cols, boundary, extra)
         }
         _ => Ok(()),
@@ -680,6 +710,7 @@ fn solve(
     let mut observer = CliObserver {
         staged: &mut outputs.staged,
         fields: outputs.fields.as_deref(),
+        netcdf: outputs.netcdf.as_mut(),
         progress: Progress::new("bem", loads.len() as u64, args.quiet || loads.len() < 2),
         peak_rss: args.timing.then(Vec::new),
         mean_gaps: theory.map(|_| Vec::new()),
@@ -777,8 +808,17 @@ fn write(
     (plan, theory): (&Plan, Option<&SweepTheory>),
     surface: &SurfaceInfo,
     rows: &[Row],
-    mut staged: StagedOutputs,
+    outputs: Outputs,
 ) -> Result<()> {
+    let Outputs {
+        mut staged, netcdf, ..
+    } = outputs;
+    if let Some(stacks) = netcdf {
+        let path = stacks.path.clone();
+        let record = record(args, plan, surface, theory);
+        stage_netcdf(&mut staged, stacks, surface, rows, &record)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     let mut table = Table::new(&plan.columns.header());
     for row in rows {
         table.push(&plan.columns.cells(row));
@@ -826,6 +866,32 @@ fn write(
     Ok(())
 }
 
+/// Stages `--fields FILE.nc`: every load's fields with the table's first columns and the
+/// run's record.
+fn stage_netcdf(
+    staged: &mut StagedOutputs,
+    stacks: Stacks,
+    surface: &SurfaceInfo,
+    rows: &[Row],
+    record: &serde_json::Value,
+) -> Result<()> {
+    let column = |f: fn(&asperity::bem::ContactSummary) -> f64| -> Vec<f64> {
+        rows.iter().map(|r| f(&r.sweep.summary)).collect()
+    };
+    let columns = [
+        ("force", column(|s| s.force)),
+        ("mean_pressure", column(|s| s.mean_pressure)),
+        ("indentation", column(|s| s.indentation)),
+        ("area_fraction", column(|s| s.area_fraction)),
+    ];
+    let grid = NcGrid {
+        dim: surface.grid,
+        sizes: (surface.size, surface.size_y),
+        metres: matches!(surface.source, SizeSource::File),
+    };
+    stage_sweep(staged, stacks, &grid, &columns, record)
+}
+
 /// Runs `asperity bem`: plan (every check before the first solve), solve, write.
 pub fn run(args: &BemArgs) -> Result<()> {
     if args.persson && (args.work_of_adhesion.is_some() || args.load_path) {
@@ -849,7 +915,7 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     let plan = plan(args)?;
     let mut outputs = stage_outputs(args, plan.bem.loads.len())?;
-    let (surface, source) = read_surface(args, &plan, outputs.fields.is_some())?;
+    let (surface, source) = read_surface(args, &plan, &outputs)?;
     let info = SurfaceInfo {
         grid: surface.dim(),
         size: surface.size(),
@@ -867,5 +933,5 @@ pub fn run(args: &BemArgs) -> Result<()> {
         .transpose()
         .map_err(refused)?;
     let rows = solve(args, &plan, (&mut solver, theory.as_ref()), &mut outputs)?;
-    write(args, (&plan, theory.as_ref()), &info, &rows, outputs.staged)
+    write(args, (&plan, theory.as_ref()), &info, &rows, outputs)
 }

@@ -15,8 +15,10 @@ use asperity_app::figure::path::{PathColumns, PathFigure};
 use serde_json::json;
 
 use super::bem::{read_surface_for, request, BemArgs};
+use super::fields_nc::{check_target, fields_folder, netcdf_target, stage_path, Grid as NcGrid};
 use crate::output::{format_number, Table};
 use crate::plot::{stage_charts, Chart, ImageFormat};
+use asperity_app::argument::SizeSource;
 
 /// The options of `asperity bem` that a load path refuses, with the flag named.
 fn refuse_other_options(args: &BemArgs) -> Result<()> {
@@ -85,7 +87,8 @@ fn stage(args: &BemArgs, permanent: Option<&Path>) -> Result<StagedOutputs> {
         .chain(record_path.as_deref())
         .chain(args.plot.as_deref())
         .chain(permanent);
-    let staged = StagedOutputs::in_new_folders(&args.fields, paths, args.force)?;
+    let folder = fields_folder(args.fields.as_ref());
+    let staged = StagedOutputs::in_new_folders(folder, paths, args.force)?;
     staged.ensure_not_input(&args.surface)?;
     Ok(staged)
 }
@@ -112,8 +115,13 @@ pub fn run(args: &BemArgs) -> Result<()> {
     refuse_other_options(args)?;
     let request = request(args)?;
     let plan = request.validate()?;
-    let permanent_path = args.fields.as_ref().map(|dir| dir.join("permanent.npy"));
-    let mut staged = stage(args, permanent_path.as_deref())?;
+    let netcdf = netcdf_target(args.fields.as_ref());
+    if let Some(path) = netcdf {
+        check_target(path)?;
+    }
+    let folder = fields_folder(args.fields.as_ref());
+    let permanent_path = folder.map(|dir| dir.join("permanent.npy"));
+    let mut staged = stage(args, permanent_path.as_deref().or(netcdf))?;
     let (surface, size_source) = read_surface_for(args, plan.half_space.boundary)?;
     let mut solver = plan.solver(&surface)?;
     plan.check_forces(solver.nominal_area())?;
@@ -134,6 +142,16 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     if let Some(path) = &permanent_path {
         staged.write_npy_2d(path, &solver.permanent_displacement())?;
+    }
+    if let Some(path) = netcdf {
+        let record = record(args, (&request, &plan), (&surface, size_source));
+        let grid = NcGrid {
+            dim: surface.dim(),
+            sizes: (surface.size(), surface.size_y()),
+            metres: size_source == SizeSource::File.name(),
+        };
+        stage_netcdf(&mut staged, (path, &grid), (&points, &solver), &record)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(out) = &args.out {
         table
@@ -157,6 +175,26 @@ pub fn run(args: &BemArgs) -> Result<()> {
         None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
+}
+
+/// Stages `--fields FILE.nc`: the steps' columns and the permanent displacement, with the
+/// path's record.
+fn stage_netcdf(
+    staged: &mut StagedOutputs,
+    (path, grid): (&Path, &NcGrid),
+    (points, solver): (&[PathPoint], &asperity::bem::ContactSolver),
+    record: &serde_json::Value,
+) -> Result<()> {
+    let column = |f: fn(&PathPoint) -> f64| -> Vec<f64> { points.iter().map(f).collect() };
+    let columns = [
+        ("force", column(|p| p.summary.force)),
+        ("mean_pressure", column(|p| p.summary.mean_pressure)),
+        ("indentation", column(|p| p.summary.indentation)),
+        ("area_fraction", column(|p| p.summary.area_fraction)),
+        ("plastic_fraction", column(|p| p.summary.plastic_fraction)),
+        ("permanent_max", column(|p| p.permanent_max)),
+    ];
+    stage_path(staged, path, grid, (&columns, solver), record)
 }
 
 /// The inputs of a path, for OUT.csv.json.

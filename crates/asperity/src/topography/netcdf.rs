@@ -32,28 +32,30 @@ pub(crate) fn sniff(bytes: &[u8]) -> bool {
 }
 
 /// An attribute's value: text or numbers.
-enum Attr {
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Attr {
     Text(String),
     Numbers(Vec<f64>),
 }
 
-struct Variable {
-    name: String,
-    dims: Vec<usize>,
-    attrs: Vec<(String, Attr)>,
-    kind: u32,
+/// A variable of the header: its dimensions (ids), attributes, type and data offset.
+pub(crate) struct Variable {
+    pub(crate) name: String,
+    pub(crate) dims: Vec<usize>,
+    pub(crate) attrs: Vec<(String, Attr)>,
+    pub(crate) kind: u32,
     begin: usize,
 }
 
 impl Variable {
-    fn text(&self, key: &str) -> Option<&str> {
+    pub(crate) fn text(&self, key: &str) -> Option<&str> {
         self.attrs.iter().find_map(|(k, v)| match v {
             Attr::Text(t) if k == key => Some(t.as_str()),
             _ => None,
         })
     }
 
-    fn number(&self, key: &str) -> Option<f64> {
+    pub(crate) fn number(&self, key: &str) -> Option<f64> {
         self.attrs.iter().find_map(|(k, v)| match v {
             Attr::Numbers(n) if k == key => n.first().copied(),
             _ => None,
@@ -145,8 +147,18 @@ fn attributes(c: &mut Cursor<'_>, len: usize) -> Result<Vec<(String, Attr)>> {
 /// The dimensions of a file: name and length.
 type Dimensions = Vec<(String, usize)>;
 
-/// The dimensions (name, length) and variables of the header.
-fn header(bytes: &[u8]) -> Result<(Dimensions, Vec<Variable>)> {
+/// A parsed header: the dimensions (name, length), the global attributes and the variables.
+pub(crate) struct Header {
+    pub(crate) dims: Dimensions,
+    pub(crate) attrs: Vec<(String, Attr)>,
+    pub(crate) vars: Vec<Variable>,
+}
+
+/// The header of a NetCDF classic file (checked against the bytes, see the module docs).
+pub(crate) fn header(bytes: &[u8]) -> Result<Header> {
+    if !sniff(bytes) {
+        return Err(bad(FORMAT, "no CDF signature"));
+    }
     let len = bytes.len();
     let mut c = Cursor::new(FORMAT, bytes);
     let offset64 = c.take(4)?[3] == 2;
@@ -156,7 +168,7 @@ fn header(bytes: &[u8]) -> Result<(Dimensions, Vec<Variable>)> {
         let n = name(&mut c, len)?;
         dims.push((n, c.u32(BE)? as usize));
     }
-    attributes(&mut c, len)?; // global attributes
+    let attrs = attributes(&mut c, len)?;
     let mut vars = Vec::new();
     for _ in 0..list(&mut c, len, 0x0B)? {
         let var_name = name(&mut c, len)?;
@@ -180,29 +192,39 @@ fn header(bytes: &[u8]) -> Result<(Dimensions, Vec<Variable>)> {
             begin: usize::try_from(begin).map_err(|_| bad(FORMAT, "offset too large"))?,
         });
     }
-    Ok((dims, vars))
+    Ok(Header { dims, attrs, vars })
+}
+
+/// The shape of a variable (its dimensions' lengths); a record variable is refused.
+pub(crate) fn shape(dims: &Dimensions, v: &Variable) -> Result<Vec<usize>> {
+    let shape = v
+        .dims
+        .iter()
+        .map(|&d| dims.get(d).map(|d| d.1))
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| bad(FORMAT, format!("variable {}: undefined dimension", v.name)))?;
+    if shape.contains(&0) {
+        return Err(bad(
+            FORMAT,
+            format!("variable {}: record variables are not supported", v.name),
+        ));
+    }
+    Ok(shape)
+}
+
+/// A variable's values as float64 (exact for every type but char), row-major.
+pub(crate) fn values(bytes: &[u8], v: &Variable, shape: &[usize]) -> Result<Vec<f64>> {
+    let data = block(bytes, v, shape)?;
+    let w = width(v.kind).expect("checked by block");
+    Ok(data.chunks_exact(w).map(|b| decode(v.kind, b)).collect())
 }
 
 /// Reads a NetCDF classic file (see the module docs).
 pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
-    if !sniff(bytes) {
-        return Err(bad(FORMAT, "no CDF signature"));
-    }
-    let (dims, vars) = header(bytes)?;
+    let Header { dims, vars, .. } = header(bytes)?;
     let mut channels = Vec::new();
     for v in &vars {
-        let shape = v
-            .dims
-            .iter()
-            .map(|&d| dims.get(d).map(|d| d.1))
-            .collect::<Option<Vec<_>>>()
-            .ok_or_else(|| bad(FORMAT, format!("variable {}: undefined dimension", v.name)))?;
-        if shape.contains(&0) {
-            return Err(bad(
-                FORMAT,
-                format!("variable {}: record variables are not supported", v.name),
-            ));
-        }
+        let shape = shape(&dims, v)?;
         // Every variable's data must lie in the file, channel or not.
         let data = block(bytes, v, &shape)?;
         let is_coordinate = v.dims.len() == 1 && dims[v.dims[0]].0 == v.name;
