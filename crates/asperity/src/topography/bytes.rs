@@ -167,6 +167,8 @@ pub(crate) enum Sample {
     U16,
     /// Signed 32-bit integer.
     I32,
+    /// Unsigned 32-bit integer.
+    U32,
     /// 32-bit IEEE float.
     F32,
     /// 64-bit IEEE float.
@@ -179,7 +181,7 @@ impl Sample {
         match self {
             Sample::U8 => 1,
             Sample::I16 | Sample::U16 => 2,
-            Sample::I32 | Sample::F32 => 4,
+            Sample::I32 | Sample::U32 | Sample::F32 => 4,
             Sample::F64 => 8,
         }
     }
@@ -210,6 +212,14 @@ impl Sample {
                     i32::from_le_bytes(a)
                 } else {
                     i32::from_be_bytes(a)
+                })
+            }
+            Sample::U32 => {
+                let a = [b[0], b[1], b[2], b[3]];
+                f64::from(if le {
+                    u32::from_le_bytes(a)
+                } else {
+                    u32::from_be_bytes(a)
                 })
             }
             Sample::F32 => {

@@ -38,6 +38,7 @@ pub(crate) mod ibw;
 pub mod inpaint;
 pub(crate) mod jpk;
 pub mod level;
+pub(crate) mod lext;
 pub(crate) mod metropro;
 pub(crate) mod mi;
 pub(crate) mod mnt;
@@ -62,6 +63,7 @@ pub(crate) mod wsxm;
 pub mod x3p;
 pub(crate) mod xlsx;
 pub(crate) mod xyz;
+pub(crate) mod zon;
 
 /// The heights of one channel: a map or a line profile.
 #[derive(Debug, Clone, PartialEq)]
@@ -253,6 +255,18 @@ const FORMATS: &[Format] = &[
         extensions: &["tiff", "tif"],
         sniff: park::sniff,
         read: park::read,
+    },
+    Format {
+        name: "lext",
+        extensions: &["lext"],
+        sniff: lext::sniff,
+        read: lext::read,
+    },
+    Format {
+        name: "zon",
+        extensions: &["zon"],
+        sniff: zon::sniff,
+        read: zon::read,
     },
     Format {
         name: "nms",

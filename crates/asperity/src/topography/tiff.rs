@@ -84,22 +84,46 @@ pub(crate) fn pages(format: &'static str, bytes: &[u8]) -> Result<(Endian, Vec<P
                 "the chain of image directories loops or is too long",
             ));
         }
-        c.seek(next)?;
-        let n = c.u16(e)? as usize;
-        let mut tags = HashMap::new();
-        let mut blocks = HashMap::new();
-        for _ in 0..n {
-            let (tag, value, block) = entry(&mut c, e)?;
-            tags.insert(tag, value);
-            blocks.insert(tag, block);
-        }
-        next = c.u32(e)? as usize;
-        out.push(Page { tags, blocks });
+        let (page, following) = directory(format, bytes, e, next)?;
+        next = following;
+        out.push(page);
     }
     if out.is_empty() {
         return Err(bad(format, "no image directory"));
     }
     Ok((e, out))
+}
+
+/// The image file directory at `offset` (e.g. an EXIF directory a tag points to), and the
+/// offset of the next one (0: none).
+fn directory(
+    format: &'static str,
+    bytes: &[u8],
+    e: Endian,
+    offset: usize,
+) -> Result<(Page, usize)> {
+    let mut c = Cursor::new(format, bytes);
+    c.seek(offset)?;
+    let n = c.u16(e)? as usize;
+    let mut tags = HashMap::new();
+    let mut blocks = HashMap::new();
+    for _ in 0..n {
+        let (tag, value, block) = entry(&mut c, e)?;
+        tags.insert(tag, value);
+        blocks.insert(tag, block);
+    }
+    let next = c.u32(e)? as usize;
+    Ok((Page { tags, blocks }, next))
+}
+
+/// The image file directory at `offset` alone (a sub-directory such as EXIF's).
+pub(crate) fn page_at(
+    format: &'static str,
+    bytes: &[u8],
+    e: Endian,
+    offset: usize,
+) -> Result<Page> {
+    directory(format, bytes, e, offset).map(|(page, _)| page)
 }
 
 /// One 12-byte directory entry and where its value lies; the cursor ends after it.
@@ -241,6 +265,7 @@ pub(crate) fn raster(
     let sample = match (kind, bits) {
         (1, 8) => Sample::U8,
         (1, 16) => Sample::U16,
+        (1, 32) => Sample::U32,
         (2, 16) => Sample::I16,
         (2, 32) => Sample::I32,
         (3, 32) => Sample::F32,

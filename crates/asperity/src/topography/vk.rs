@@ -118,7 +118,7 @@ fn image(bytes: &[u8], offset: u32) -> Result<Option<(ndarray::Array2<f64>, u32)
     let sample = match depth {
         8 => Sample::U8,
         16 => Sample::U16,
-        32 => Sample::I32, // decoded as unsigned below
+        32 => Sample::U32,
         d => return Err(bad(FORMAT, format!("an image of {d} bits per sample"))),
     };
     if compression != 0 {
@@ -131,12 +131,7 @@ fn image(bytes: &[u8], offset: u32) -> Result<Option<(ndarray::Array2<f64>, u32)
             format!("an image of {w} × {h} × {depth} bits declares {byte_size} bytes"),
         ));
     }
-    let mut values = samples(FORMAT, bytes, c.pos(), n, sample, le)?;
-    if depth == 32 {
-        values
-            .iter_mut()
-            .for_each(|v| *v = f64::from(*v as i32 as u32));
-    }
+    let values = samples(FORMAT, bytes, c.pos(), n, sample, le)?;
     Ok(Some((
         areal(FORMAT, h as usize, w as usize, values)?,
         depth,
