@@ -1,5 +1,5 @@
 //! Adhesive contact of a rigid indenter on an elastic half-space: the closed forms of JKR,
-//! DMT, Maugis–Dugdale and Kendall's flat punch.
+//! DMT, Maugis–Dugdale, Kendall's flat punch and Johnson's adhesive wavy surface.
 //!
 //! Conventions, shared by every type here: `w` is the work of adhesion `Δγ` (energy per
 //! unit area, `> 0`), `E*` the effective modulus, `R` the sphere's radius (a paraboloid
@@ -26,6 +26,7 @@
 //! * Kendall, J. Phys. D 4, 1186 (1971) (flat punch).
 //! * Maugis, J. Colloid Interface Sci. 150, 243 (1992); the dimensionless form of Johnson
 //!   & Greenwood, J. Colloid Interface Sci. 192, 326 (1997).
+//! * Johnson, Int. J. Solids Struct. 32, 423 (1995) (the adhesive sinusoid).
 //! * Popov & Heß, *Method of Dimensionality Reduction in Contact Mechanics and Friction*
 //!   (Springer 2015), ch. 6 (adhesion, Heß's rule).
 
@@ -227,6 +228,170 @@ impl Kendall {
     }
 }
 
+/// Johnson's adhesive wavy surface (Int. J. Solids Struct. 32, 423 (1995)): a rigid
+/// sinusoid `f(x) = Δ(1 − cos 2πx/λ)` (one-dimensional waviness, crests at `x = 0, λ, …`)
+/// on a periodic half-space with adhesion of vanishing range (JKR's limit), in strips of
+/// contact `|x| < a` per period.
+///
+/// The state at contact half-width `a` (`ψ = πa/λ`) is Westergaard's non-adhesive one at
+/// that width ([`crate::reference::Westergaard`], no stress singularity) plus a periodic
+/// array of flat punches of width `2a`, `p = p̄ₚ cos(πx/λ)/√(sin²ψ − sin²(πx/λ))`, whose
+/// edge carries the stress intensity `K = p̄ₚ √(λ/tan ψ)`. Griffith's balance at the edge,
+/// `K²/2E* = w`, fixes the punches' tension `p̄ₚ = −√(2E*w tan ψ/λ)`, so
+///
+/// `p̄ = p*[sin²ψ − α √(tan ψ)]`, `p* = πE*Δ/λ`, `α = √(2wλ/(π²E*Δ²))`,
+///
+/// and the approach (the convention of periodic half-spaces, displacements of zero mean,
+/// as in [`crate::reference::Westergaard::indentation`]) adds the punches' rigid
+/// displacement `(2λp̄ₚ/πE*) ln(1/sin ψ)` (their compliance, by Barber's theorem the
+/// inverse of Westergaard's `dp̄/dd` at the same width) to Westergaard's
+/// `d = Δr(1 − ln r)`, `r = sin²ψ`.
+///
+/// Along `ψ` the mean pressure falls from zero to a least value (the force-controlled
+/// pull-off), rises to a greatest one and falls without bound as `ψ → π/2` (the gaps
+/// close: the surfaces snap into full contact beyond the greatest value). The stable
+/// branch exists while `α < 4 sin^{3/2}ψ cos^{5/2}ψ` somewhere, i.e. below
+/// [`JohnsonSinusoid::ALPHA_STABLE`] `= 4(3/8)^{3/4}(5/8)^{5/4} ≈ 1.065`; its greatest
+/// pressure is negative — the surfaces pull themselves into full contact under no load —
+/// from [`JohnsonSinusoid::ALPHA_SNAP`] `= max sin^{3/2}ψ cos^{1/2}ψ = (3/4)^{3/4}/√2 ≈ 0.570`
+/// (Johnson's 0.57).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JohnsonSinusoid {
+    /// Wavelength λ.
+    pub wavelength: f64,
+    /// Amplitude Δ (half the peak-to-valley height).
+    pub amplitude: f64,
+    /// Effective modulus E*.
+    pub modulus: f64,
+    /// Work of adhesion w = Δγ.
+    pub work_of_adhesion: f64,
+}
+
+impl JohnsonSinusoid {
+    /// Johnson's parameter above which no partial contact is stable.
+    pub const ALPHA_STABLE: f64 = 1.065_205_656_063_280_8;
+    /// Johnson's parameter above which the surfaces snap into full contact under no load.
+    pub const ALPHA_SNAP: f64 = 0.569_876_764_238_694_4;
+
+    /// The wavy contact, refused unless every parameter is positive and finite.
+    pub fn new(wavelength: f64, amplitude: f64, modulus: f64, w: f64) -> Result<Self> {
+        Ok(JohnsonSinusoid {
+            wavelength: checked("wavelength", wavelength)?,
+            amplitude: checked("amplitude", amplitude)?,
+            modulus: checked("modulus", modulus)?,
+            work_of_adhesion: checked("work of adhesion", w)?,
+        })
+    }
+
+    /// Westergaard's mean pressure of full contact, `p* = πE*Δ/λ`.
+    pub fn full_contact_pressure(&self) -> f64 {
+        PI * self.modulus * self.amplitude / self.wavelength
+    }
+
+    /// Johnson's parameter `α = √(2wλ/(π²E*Δ²))`.
+    pub fn alpha(&self) -> f64 {
+        (2.0 * self.work_of_adhesion * self.wavelength
+            / (PI * PI * self.modulus * self.amplitude * self.amplitude))
+            .sqrt()
+    }
+
+    fn angle(&self, half_width: f64) -> f64 {
+        PI * half_width.clamp(0.0, 0.5 * self.wavelength) / self.wavelength
+    }
+
+    /// The mean tension of the punch array that holds the edges at Griffith's balance,
+    /// `p̄ₚ = −√(2E*w tan ψ/λ)`.
+    fn punch_pressure(&self, psi: f64) -> f64 {
+        -(2.0 * self.modulus * self.work_of_adhesion * psi.tan() / self.wavelength).sqrt()
+    }
+
+    /// The mean pressure `p̄ = p*[sin²ψ − α√(tan ψ)]` at contact half-width `a` (`0 ≤ a < λ/2`).
+    pub fn mean_pressure(&self, half_width: f64) -> f64 {
+        let psi = self.angle(half_width);
+        self.full_contact_pressure() * psi.sin().powi(2) + self.punch_pressure(psi)
+    }
+
+    /// The approach at contact half-width `a` (`0 < a < λ/2`): Westergaard's plus the
+    /// punches' `(2λp̄ₚ/πE*) ln(1/sin ψ)` (type docs).
+    pub fn approach(&self, half_width: f64) -> f64 {
+        let psi = self.angle(half_width);
+        let r = psi.sin().powi(2);
+        let westergaard = self.amplitude * r * (1.0 - r.ln());
+        let punch = -2.0 * self.wavelength * self.punch_pressure(psi) / (PI * self.modulus)
+            * psi.sin().ln();
+        westergaard + punch
+    }
+
+    /// The half-widths where `p̄` is least and greatest on the stable branch (the roots of
+    /// `dp̄/dψ = 0`, i.e. `4 sin^{3/2}ψ cos^{5/2}ψ = α`, either side of its peak at
+    /// `tan²ψ = 3/5`); `None` when `α ≥ ALPHA_STABLE` (no partial contact is stable).
+    pub fn stable_branch(&self) -> Option<(f64, f64)> {
+        let alpha = self.alpha();
+        let g = |psi: f64| 4.0 * psi.sin().powf(1.5) * psi.cos().powf(2.5);
+        let peak = (0.6f64).sqrt().atan();
+        if alpha >= g(peak) {
+            return None;
+        }
+        let root = |mut rising: f64, mut falling: f64| {
+            // g − α changes sign between the two ends; bisect to rounding.
+            for _ in 0..200 {
+                let mid = 0.5 * (rising + falling);
+                if g(mid) < alpha {
+                    rising = mid;
+                } else {
+                    falling = mid;
+                }
+            }
+            0.5 * (rising + falling)
+        };
+        let least = root(0.0, peak);
+        let greatest = root(0.5 * PI, peak);
+        let to_width = |psi: f64| psi * self.wavelength / PI;
+        Some((to_width(least), to_width(greatest)))
+    }
+
+    /// The pull-off under `control` as `(half-width, mean pressure)`: the least mean
+    /// pressure of the stable branch (force control) or the pressure where the approach is
+    /// least (displacement control, over `ψ` up to the stable branch's greatest pressure,
+    /// by a logarithmic scan and golden-section refinement); `None` when no partial contact
+    /// is stable.
+    pub fn pull_off(&self, control: PullOff) -> Option<(f64, f64)> {
+        let (least, greatest) = self.stable_branch()?;
+        let a = match control {
+            PullOff::ForceControlled => least,
+            PullOff::DisplacementControlled => {
+                let objective = |ln_a: f64| self.approach(ln_a.exp());
+                let (low, high) = ((1e-9 * self.wavelength).ln(), greatest.ln());
+                golden_minimum(objective, low, high).exp()
+            }
+        };
+        Some((a, self.mean_pressure(a)))
+    }
+}
+
+/// The least value's abscissa of `f` over `[low, high]`: a scan of 400 points, then 100
+/// golden-section steps around the best.
+fn golden_minimum(f: impl Fn(f64) -> f64, low: f64, high: f64) -> f64 {
+    let count = 400;
+    let step = (high - low) / count as f64;
+    let best = (0..=count)
+        .map(|i| low + i as f64 * step)
+        .min_by(|x, y| f(*x).total_cmp(&f(*y)))
+        .unwrap_or(low);
+    let (mut left, mut right) = ((best - step).max(low), (best + step).min(high));
+    let golden = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..100 {
+        let x1 = right - golden * (right - left);
+        let x2 = left + golden * (right - left);
+        if f(x1) < f(x2) {
+            right = x2;
+        } else {
+            left = x1;
+        }
+    }
+    0.5 * (left + right)
+}
+
 /// One point of the Maugis–Dugdale curve, dimensionless (Johnson & Greenwood 1997):
 /// `Ā = a (K/πwR²)^{1/3}`, `P̄ = F/(πwR)`, `Δ̄ = δ (K²/π²w²R)^{1/3}` with `K = 4E*/3`,
 /// and `m = c/a` (`c`: the outer radius of the cohesive zone).
@@ -338,24 +503,7 @@ impl MaugisDugdale {
                 PullOff::DisplacementControlled => point.approach,
             }
         };
-        let (low, high, count) = ((1e-6f64).ln(), 10f64.ln(), 400);
-        let step = (high - low) / count as f64;
-        let best = (0..=count)
-            .map(|i| low + i as f64 * step)
-            .min_by(|x, y| objective(*x).total_cmp(&objective(*y)))
-            .unwrap_or(low);
-        let (mut left, mut right) = ((best - step).max(low), (best + step).min(high));
-        let golden = (5f64.sqrt() - 1.0) / 2.0;
-        for _ in 0..100 {
-            let x1 = right - golden * (right - left);
-            let x2 = left + golden * (right - left);
-            if objective(x1) < objective(x2) {
-                right = x2;
-            } else {
-                left = x1;
-            }
-        }
-        self.at_radius((0.5 * (left + right)).exp())
+        self.at_radius(golden_minimum(objective, (1e-6f64).ln(), 10f64.ln()).exp())
     }
 }
 
@@ -506,5 +654,134 @@ mod tests {
         assert!(Jkr::new(1.0, 1.0, 0.0).is_err());
         assert!(Jkr::new(1.0, 1.0, f64::NAN).is_err());
         assert!(MaugisDugdale::new(f64::INFINITY).is_err());
+    }
+    #[test]
+    fn johnson_sinusoid_without_adhesion_is_westergaard() {
+        let faint = JohnsonSinusoid::new(2.0, 0.1, 3.0, 1e-18).unwrap();
+        let westergaard = crate::reference::Westergaard {
+            wavelength: 2.0,
+            amplitude: 0.1,
+            modulus: 3.0,
+        };
+        for a in [0.1, 0.4, 0.7, 0.95] {
+            let p = faint.mean_pressure(a);
+            assert!(
+                (westergaard.contact_half_width(p) / a - 1.0).abs() < 1e-7,
+                "a = {a}"
+            );
+            let d = westergaard.indentation(p);
+            assert!((faint.approach(a) / d - 1.0).abs() < 1e-7, "a = {a}");
+        }
+    }
+
+    #[test]
+    fn johnson_sinusoid_at_long_wavelength_is_the_jkr_cylinder() {
+        // A crest of curvature 4π²Δ/λ² = 1/R: an isolated cylinder, whose JKR force per
+        // length is P = πE*a²/4R − √(2πE*wa) (Barquins 1988); the error is O(ψ²) ≈ 3e-6.
+        let (radius, modulus, w, wavelength) = (1.0, 2.0, 1e-3, 100.0);
+        let amplitude = wavelength * wavelength / (4.0 * PI * PI * radius);
+        let wavy = JohnsonSinusoid::new(wavelength, amplitude, modulus, w).unwrap();
+        for a in [0.02, 0.05, 0.1] {
+            let cylinder =
+                PI * modulus * a * a / (4.0 * radius) - (2.0 * PI * modulus * w * a).sqrt();
+            let force = wavy.mean_pressure(a) * wavelength;
+            assert!(
+                (force / cylinder - 1.0).abs() < 1e-4,
+                "a = {a}: {force} vs {cylinder}"
+            );
+        }
+    }
+
+    #[test]
+    fn johnson_edges_release_the_work_of_adhesion() {
+        // Griffith from the compliance, independently of the stress intensity: the punches'
+        // compliance per period is 1/(λk), k = dp̄/dd of Westergaard at the same width
+        // (Barber), and two edges advance per period, so G = ¼ p̄ₚ²λ |d(1/k)/da| must be w.
+        let (wavelength, amplitude, modulus, w) = (2.0, 0.1, 3.0, 0.01);
+        let wavy = JohnsonSinusoid::new(wavelength, amplitude, modulus, w).unwrap();
+        let westergaard = crate::reference::Westergaard {
+            wavelength,
+            amplitude,
+            modulus,
+        };
+        let p_star = westergaard.full_contact_pressure();
+        let pressure_at = |a: f64| p_star * (PI * a / wavelength).sin().powi(2);
+        let compliance = |a: f64| {
+            let (p, h) = (pressure_at(a), 1e-6 * pressure_at(a));
+            (westergaard.indentation(p + h) - westergaard.indentation(p - h)) / (2.0 * h)
+        };
+        for a in [0.1, 0.3, 0.6, 0.8] {
+            let punch = wavy.mean_pressure(a) - pressure_at(a);
+            let h = 1e-4;
+            let slope = (compliance(a + h) - compliance(a - h)) / (2.0 * h);
+            let release = 0.25 * punch * punch * wavelength * slope.abs();
+            assert!((release / w - 1.0).abs() < 1e-5, "a = {a}: G = {release}");
+            let rigid = wavy.approach(a) - westergaard.indentation(pressure_at(a));
+            assert!(
+                (rigid / (punch * compliance(a)) - 1.0).abs() < 1e-6,
+                "a = {a}"
+            );
+        }
+    }
+
+    #[test]
+    fn johnson_pull_offs_are_the_least_pressure_and_approach() {
+        let wavy = JohnsonSinusoid::new(2.0, 0.1, 3.0, 0.01).unwrap();
+        let alpha = wavy.alpha();
+        assert!(
+            alpha > 0.0 && alpha < JohnsonSinusoid::ALPHA_SNAP,
+            "{alpha}"
+        );
+        let (_, greatest) = wavy.stable_branch().unwrap();
+        let n = 400_000;
+        let widths = (1..n).map(|i| greatest * i as f64 / n as f64);
+        let least = |f: &dyn Fn(f64) -> f64| {
+            widths
+                .clone()
+                .min_by(|x, y| f(*x).total_cmp(&f(*y)))
+                .unwrap()
+        };
+        let a_f = least(&|a| wavy.mean_pressure(a));
+        let (a, p) = wavy.pull_off(PullOff::ForceControlled).unwrap();
+        assert!((a / a_f - 1.0).abs() < 1e-4, "{a} vs {a_f}");
+        assert!((p / wavy.mean_pressure(a_f) - 1.0).abs() < 1e-8);
+        let a_d = least(&|a| wavy.approach(a));
+        let (a, p_d) = wavy.pull_off(PullOff::DisplacementControlled).unwrap();
+        assert!((a / a_d - 1.0).abs() < 1e-4, "{a} vs {a_d}");
+        assert!(p_d < 0.0 && p_d > p, "{p_d} vs {p}");
+    }
+
+    #[test]
+    fn johnson_thresholds_are_where_the_branch_ends_and_snaps() {
+        let g = |psi: f64| 4.0 * psi.sin().powf(1.5) * psi.cos().powf(2.5);
+        let peak = (0.6f64).sqrt().atan();
+        assert!((g(peak) - JohnsonSinusoid::ALPHA_STABLE).abs() < 1e-14);
+        let snap = (PI / 3.0).sin().powf(1.5) * (PI / 3.0).cos().sqrt();
+        assert!((snap - JohnsonSinusoid::ALPHA_SNAP).abs() < 1e-14);
+        // α set through w (λ = 2, Δ = 0.1, E* = 3): w = α²π²E*Δ²/2λ.
+        let with_alpha =
+            |alpha: f64| JohnsonSinusoid::new(2.0, 0.1, 3.0, alpha * alpha * PI * PI * 0.03 / 4.0);
+        let greatest = |alpha: f64| {
+            let wavy = with_alpha(alpha).unwrap();
+            assert!((wavy.alpha() / alpha - 1.0).abs() < 1e-12);
+            wavy.mean_pressure(wavy.stable_branch().unwrap().1)
+        };
+        assert!(greatest(0.99 * JohnsonSinusoid::ALPHA_SNAP) > 0.0);
+        assert!(greatest(1.01 * JohnsonSinusoid::ALPHA_SNAP) < 0.0);
+        let stable = JohnsonSinusoid::ALPHA_STABLE;
+        assert!(with_alpha(0.999 * stable)
+            .unwrap()
+            .stable_branch()
+            .is_some());
+        assert!(with_alpha(1.001 * stable)
+            .unwrap()
+            .stable_branch()
+            .is_none());
+        assert!(with_alpha(1.001 * stable)
+            .unwrap()
+            .pull_off(PullOff::ForceControlled)
+            .is_none());
+        assert!(JohnsonSinusoid::new(2.0, 0.0, 3.0, 0.01).is_err());
+        assert!(JohnsonSinusoid::new(2.0, 0.1, 3.0, f64::NAN).is_err());
     }
 }
