@@ -290,6 +290,7 @@ def bem_adhesion(
     surface: Any, *, work_of_adhesion: float, indentations: Sequence[float],
     size: Optional[float] = ..., modulus: float = ..., boundary: str = ...,
     retract_step: Optional[float] = ..., adhesion_range: Optional[float] = ...,
+    adhesion_model: Optional[str] = ...,
 ) -> BemAdhesion: ...
 
 PERSSON_KAPPA: float

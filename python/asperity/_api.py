@@ -1523,10 +1523,13 @@ def bem_adhesion(
     boundary: str = _DEFAULTS["boundary"],
     retract_step: Optional[float] = None,
     adhesion_range: Optional[float] = None,
+    adhesion_model: Optional[str] = None,
 ) -> BemAdhesion:
-    """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, or a Maugis–Dugdale
-    cohesive zone of range ``adhesion_range`` (stress ``work_of_adhesion / adhesion_range``),
-    as ``asperity bem --work-of-adhesion [--adhesion-range]`` (the same code and numbers):
+    """Adhesive contact on the BEM by Pohrt & Popov's pixel criterion, or a cohesive law of
+    range ``adhesion_range``: a Maugis–Dugdale zone (``adhesion_model="maugis-dugdale"``, the
+    default; stress ``work_of_adhesion / adhesion_range``) or the exponential potential
+    (``adhesion_model="exponential"``; tension ``(w/ρ)·exp(−g/ρ)``), as ``asperity bem
+    --work-of-adhesion [--adhesion-range] [--adhesion-model]`` (the same code and numbers):
     the ``indentations`` are a path (negative allowed), then the indenter is retracted in
     steps of ``retract_step`` (default: the deepest indentation, plus any range, / 200)
     until nothing is attached. Square pixels. See docs/adhesion.md.
@@ -1544,7 +1547,8 @@ def bem_adhesion(
     path = [float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
     out = _core.bem_adhesion(heights, size_x, size_y, float(modulus), str(boundary),
                              float(work_of_adhesion), path, _opt(retract_step),
-                             _opt(adhesion_range))
+                             _opt(adhesion_range),
+                             None if adhesion_model is None else str(adhesion_model))
     return BemAdhesion(**out)
 
 

@@ -97,6 +97,7 @@ def bem_adhesion(
     array: F64, size_x: float, size_y: Optional[float], modulus: float, boundary: str,
     work_of_adhesion: float, indentations: List[float], retract_step: Optional[float],
     adhesion_range: Optional[float] = ...,
+    adhesion_model: Optional[str] = ...,
 ) -> Dict[str, Any]: ...
 def persson_table(
     array: F64, size_x: float, size_y: Optional[float], modulus: float, gamma: float,

@@ -20,7 +20,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// The columns of `asperity bem --work-of-adhesion` for heights `array` of sizes `size_x`
 /// and `size_y` (`None`: square pixels), with both pull-offs and `σ_c`.
 #[pyfunction]
-#[pyo3(signature = (array, size_x, size_y, modulus, boundary, work_of_adhesion, indentations, retract_step, adhesion_range=None))]
+#[pyo3(signature = (array, size_x, size_y, modulus, boundary, work_of_adhesion, indentations, retract_step, adhesion_range=None, adhesion_model=None))]
 #[allow(clippy::too_many_arguments)]
 fn bem_adhesion<'py>(
     py: Python<'py>,
@@ -33,12 +33,14 @@ fn bem_adhesion<'py>(
     indentations: Vec<f64>,
     retract_step: Option<f64>,
     adhesion_range: Option<f64>,
+    adhesion_model: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = AdhesionRequest {
         modulus,
         boundary,
         work_of_adhesion,
         adhesion_range,
+        adhesion_model,
         indentations,
         retract_step,
     };

@@ -311,3 +311,37 @@ def test_bem_cohesive_zone_equals_the_cli(cli, tmp_path):
     with pytest.raises(ValueError, match="spans no pixel"):
         asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
                               adhesion_range=1e-9)
+
+
+def test_bem_exponential_potential_equals_the_cli(cli, tmp_path):
+    # The exponential potential (--adhesion-model exponential / adhesion_model): same numbers.
+    x = (np.arange(40) - 20) * 5e-3
+    h = -(x[:, None]**2 + x[None, :]**2) / 2
+    np.save(tmp_path / "sphere.npy", h)
+    path = [0.002, 0.004, 0.008, 0.004]
+    rho = 2e-4 ** (2 / 3)
+    cli("bem", "--surface", tmp_path / "sphere.npy", "--size", 0.2, "--work-of-adhesion", 2e-4,
+        "--adhesion-range", rho, "--adhesion-model", "exponential",
+        "--indentations", ",".join(map(str, path)), "--retract-step", 2e-4,
+        "--out", tmp_path / "exp.csv")
+    with open(tmp_path / "exp.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ours = asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                                 retract_step=2e-4, adhesion_range=rho,
+                                 adhesion_model="exponential")
+    assert ours.branch == [r["branch"] for r in rows]
+    for name in ["indentation", "force", "tensile_fraction"]:
+        assert getattr(ours, name).tolist() == [float(r[name]) for r in rows], name
+    for name in ["rounds", "cg_iterations"]:
+        assert getattr(ours, name).tolist() == [int(r[name]) for r in rows], name
+    record = json.load(open(tmp_path / "exp.csv.json"))
+    assert record["adhesion"]["model"] == "exponential potential"
+    assert record["adhesion"]["pull_off"]["force_controlled"]["force"] == \
+        ours.pull_off["force_controlled"]["force"]
+    assert ours.pull_off["force_controlled"]["force"] < 0
+    with pytest.raises(ValueError, match="adhesion_model needs adhesion_range"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                              adhesion_model="exponential")
+    with pytest.raises(ValueError, match="invalid adhesion_model"):
+        asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
+                              adhesion_range=rho, adhesion_model="lennard-jones")

@@ -1,6 +1,6 @@
 //! Adhesive BEM contact for `asperity bem --work-of-adhesion` and Python's `bem_adhesion`:
-//! Pohrt & Popov's pixel criterion, or a Maugis–Dugdale cohesive zone where a range is
-//! given ([`asperity::bem::adhesion::PixelAdhesion`]), along a path of indentations, then
+//! Pohrt & Popov's pixel criterion, or where a range is given a Maugis–Dugdale cohesive
+//! zone or an exponential potential ([`asperity::bem::adhesion::PixelAdhesion`]), along a path of indentations, then
 //! retracted to pull-off. One request type, validated once, and
 //! one run, for both front ends.
 
@@ -18,6 +18,8 @@ use crate::refusal::{Param, Refusal};
 pub const WORK_OF_ADHESION: Param = Param::new("--work-of-adhesion", "work_of_adhesion");
 /// The range h₀ of a Maugis–Dugdale cohesive zone.
 pub const ADHESION_RANGE: Param = Param::new("--adhesion-range", "adhesion_range");
+/// The cohesive law of a range: `maugis-dugdale` (the default) or `exponential`.
+pub const ADHESION_MODEL: Param = Param::new("--adhesion-model", "adhesion_model");
 /// The step of the retraction to pull-off.
 pub const RETRACT_STEP: Param = Param::new("--retract-step", "retract_step");
 
@@ -25,9 +27,10 @@ pub const RETRACT_STEP: Param = Param::new("--retract-step", "retract_step");
 /// cohesive zone of range `h₀`) when no step is given: the step is that distance over this.
 pub const DEFAULT_RETRACT_STEPS: f64 = 200.0;
 
-/// A Maugis–Dugdale range below this many times one pixel's own opening
-/// ([`PixelAdhesion::cohesive_resolution`]) draws a warning: at 4.4 the sphere's pull-off
-/// is off by 3.2 %, at 8.8 by 1.4–4.9 % (docs/adhesion.md); below 1 the run is refused.
+/// A cohesive range below this many times one pixel's own opening
+/// ([`PixelAdhesion::cohesive_resolution`]) draws a warning: at 4.4 the Maugis–Dugdale
+/// sphere's pull-off is off by 3.2 %, at 8.8 by 1.4–4.9 % (docs/adhesion.md); below 1 the
+/// run is refused.
 pub const COARSE_ZONE_RESOLUTION: f64 = 10.0;
 
 /// A contact radius at pull-off below this many pixels draws a warning: the criterion's
@@ -43,10 +46,15 @@ pub struct AdhesionRequest {
     pub boundary: String,
     /// Δγ, positive and finite.
     pub work_of_adhesion: f64,
-    /// The range h₀ of a Maugis–Dugdale cohesive zone (stress Δγ/h₀), positive and finite;
-    /// `None`: the pixel criterion (adhesion of vanishing range).
+    /// The range of a cohesive law, positive and finite: `h₀` of a Maugis–Dugdale zone
+    /// (stress Δγ/h₀) or `ρ` of an exponential potential (greatest tension Δγ/ρ); `None`:
+    /// the pixel criterion (adhesion of vanishing range).
     #[serde(default)]
     pub adhesion_range: Option<f64>,
+    /// The cohesive law of the range: `maugis-dugdale` (`None`: this) or `exponential`;
+    /// needs a range.
+    #[serde(default)]
+    pub adhesion_model: Option<String>,
     /// The indentations in the order visited (negative allowed: pulled back beyond first
     /// touch); the retraction to pull-off follows the last.
     pub indentations: Vec<f64>,
@@ -131,9 +139,9 @@ impl AdhesionRun {
             return (resolution < COARSE_ZONE_RESOLUTION).then(|| {
                 format!(
                     "the cohesive zone is coarse: its range is {resolution:.1} times the \
-                     opening one pixel's Dugdale stress causes (below {COARSE_ZONE_RESOLUTION} \
-                     a sphere's pull-off is off by a few %, docs/adhesion.md); a finer grid \
-                     or a longer range is more accurate"
+                     opening one pixel's greatest adhesive tension causes (below \
+                     {COARSE_ZONE_RESOLUTION} a sphere's pull-off is off by a few %, \
+                     docs/adhesion.md); a finer grid or a longer range is more accurate"
                 )
             });
         }
@@ -168,11 +176,11 @@ impl AdhesionRequest {
                 return Err(Refusal::saying("invalid ")
                     .param(ADHESION_RANGE)
                     .text(format!(
-                        ": the range h₀ of the Maugis–Dugdale stress must be positive and \
-                         finite, got {h}"
+                        ": the range of the adhesive law must be positive and finite, got {h}"
                     )));
             }
         }
+        let law = self.law()?;
         check_modulus(MODULUS, self.modulus)?;
         let boundary = parse_boundary(&self.boundary)?;
         let path = &self.indentations;
@@ -210,13 +218,38 @@ impl AdhesionRequest {
                 boundary,
             },
             work_of_adhesion: w,
-            law: match self.adhesion_range {
-                None => AdhesionLaw::PixelCriterion,
-                Some(range) => AdhesionLaw::MaugisDugdale { range },
-            },
+            law,
             indentations: path.clone(),
             retract_step: step,
         })
+    }
+}
+
+impl AdhesionRequest {
+    /// The law of the range and model (the range already checked).
+    fn law(&self) -> Result<AdhesionLaw, Refusal> {
+        Ok(
+            match (self.adhesion_range, self.adhesion_model.as_deref()) {
+                (None, None) => AdhesionLaw::PixelCriterion,
+                (None, Some(_)) => {
+                    return Err(Refusal::of(ADHESION_MODEL)
+                        .text(" needs ")
+                        .param(ADHESION_RANGE)
+                        .text(": the pixel criterion has no range"))
+                }
+                (Some(range), None | Some("maugis-dugdale")) => {
+                    AdhesionLaw::MaugisDugdale { range }
+                }
+                (Some(range), Some("exponential")) => AdhesionLaw::Exponential { range },
+                (Some(_), Some(other)) => {
+                    return Err(Refusal::saying("invalid ")
+                        .param(ADHESION_MODEL)
+                        .text(format!(
+                            ": {other:?} is not a cohesive law; use maugis-dugdale or exponential"
+                        )))
+                }
+            },
+        )
     }
 }
 
@@ -232,15 +265,16 @@ impl AdhesionPlan {
         let mut contact =
             PixelAdhesion::with_law(surface, self.half_space, self.work_of_adhesion, self.law)?;
         let zone_resolution = contact.cohesive_resolution();
-        if let (Some(r), AdhesionLaw::MaugisDugdale { range }) = (zone_resolution, self.law) {
+        if let (Some(r), Some(range)) = (zone_resolution, self.law.range()) {
             if r < 1.0 {
                 let finest = contact.spacing() * r;
                 return Err(asperity::Error::invalid(
                     "adhesion range",
                     format!(
-                        "the cohesive zone spans no pixel: one pixel's Dugdale stress opens \
-                         it by {:.3e}, more than the range {range}; use pixels below \
-                         {finest:.3e} or a longer range",
+                        "the cohesive zone spans no pixel: one pixel's greatest adhesive \
+                         tension ({}) opens it by {:.3e}, more than the range {range}; use \
+                         pixels below {finest:.3e} or a longer range",
+                        self.law.name(),
                         range / r
                     ),
                 )
@@ -289,6 +323,7 @@ mod tests {
             boundary: "free".into(),
             work_of_adhesion: 2e-4,
             adhesion_range: None,
+            adhesion_model: None,
             indentations: vec![0.004, 0.008],
             retract_step: None,
         }
@@ -416,5 +451,72 @@ mod tests {
         .unwrap();
         let error = coarse.run(&surface, &mut |_| {}).unwrap_err().to_string();
         assert!(error.contains("spans no pixel"), "{error}");
+    }
+    #[test]
+    fn an_exponential_potential_is_chosen_checked_and_runs() {
+        let words = |r: AdhesionRequest| r.validate().unwrap_err().words(Names::Flags);
+        let exponential = || Some("exponential".to_string());
+        let text = words(AdhesionRequest {
+            adhesion_model: exponential(),
+            ..request()
+        });
+        assert!(
+            text.starts_with("--adhesion-model needs --adhesion-range"),
+            "{text}"
+        );
+        let python = AdhesionRequest {
+            adhesion_model: exponential(),
+            ..request()
+        }
+        .validate()
+        .unwrap_err()
+        .words(Names::Keywords);
+        assert!(
+            python.starts_with("adhesion_model needs adhesion_range"),
+            "{python}"
+        );
+        let text = words(AdhesionRequest {
+            adhesion_range: Some(1e-3),
+            adhesion_model: Some("lennard-jones".into()),
+            ..request()
+        });
+        assert!(text.starts_with("invalid --adhesion-model"), "{text}");
+        // A sphere (R = 1, 40² pixels of 1e-2, w = 2e-4: a_c ≈ 8.9 pixels) at Tabor's μ = 1
+        // (ρ = w^{2/3}, resolution ≈ 6): a tensile pull-off between JKR's −1.5πwR and
+        // DMT's −2πwR (the grid cuts the potential's far tail, gaps beyond about 3ρ, so a
+        // little less than the full force; loose on purpose: the library's tests hold the
+        // limits).
+        let (n, dx, w) = (40, 1e-2, 2e-4f64);
+        let heights = Array2::from_shape_fn((n, n), |(i, j)| {
+            let (y, x) = ((i as f64 - 20.0) * dx, (j as f64 - 20.0) * dx);
+            -(x * x + y * y) / 2.0
+        });
+        let surface = Surface::new(heights, n as f64 * dx).unwrap();
+        let range = w.powf(2.0 / 3.0);
+        let plan = AdhesionRequest {
+            adhesion_range: Some(range),
+            adhesion_model: exponential(),
+            indentations: vec![0.005, 0.012],
+            ..request()
+        }
+        .validate()
+        .unwrap();
+        assert_eq!(plan.law, AdhesionLaw::Exponential { range });
+        let run = plan.run(&surface, &mut |_| {}).unwrap();
+        let force = run.pull_off.unwrap().force_controlled.force / (std::f64::consts::PI * w);
+        assert!(force < -1.3 && force > -2.0, "{force}");
+        assert!(run.zone_resolution.unwrap() > 3.0);
+        let coarse = AdhesionRequest {
+            adhesion_range: Some(1e-9),
+            adhesion_model: exponential(),
+            ..request()
+        }
+        .validate()
+        .unwrap();
+        let error = coarse.run(&surface, &mut |_| {}).unwrap_err().to_string();
+        assert!(
+            error.contains("spans no pixel") && error.contains("exponential"),
+            "{error}"
+        );
     }
 }

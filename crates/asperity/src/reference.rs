@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 
 pub mod adhesion;
 
-pub use adhesion::{Dmt, JohnsonSinusoid, Jkr, Kendall, MaugisDugdale, PullOff};
+pub use adhesion::{Dmt, Jkr, JohnsonSinusoid, Kendall, MaugisDugdale, PullOff};
 
 /// Hertz: a rigid sphere of radius `radius` (paraboloid `r²/2R`) on a half-space.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -155,6 +155,11 @@ pub struct BemArgs {
     /// (docs/adhesion.md). Refused where one pixel's own stress closes more than h₀.
     #[arg(long, value_name = "H0", allow_hyphen_values = true)]
     pub adhesion_range: Option<f64>,
+    /// The cohesive law of --adhesion-range: maugis-dugdale (the default: stress Δγ/h₀
+    /// within h₀) or exponential (tension (Δγ/ρ)·exp(−g/ρ) at gap g, ρ the range; Rey,
+    /// Anciaux & Molinari 2017, the contact-mechanics challenge's law).
+    #[arg(long, value_name = "MODEL")]
+    pub adhesion_model: Option<String>,
     /// The retraction's step in indentation (with --work-of-adhesion; default the deepest
     /// indentation, plus any --adhesion-range, / 200).
     #[arg(long, value_name = "STEP", allow_hyphen_values = true)]
@@ -909,6 +914,9 @@ pub fn run(args: &BemArgs) -> Result<()> {
     }
     if args.adhesion_range.is_some() {
         bail!("--adhesion-range goes with --work-of-adhesion");
+    }
+    if args.adhesion_model.is_some() {
+        bail!("--adhesion-model goes with --work-of-adhesion");
     }
     if args.load_path {
         return super::bem_path::run(args);

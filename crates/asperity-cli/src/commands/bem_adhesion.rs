@@ -1,9 +1,11 @@
 //! `asperity bem --work-of-adhesion`: adhesive contact by Pohrt & Popov's pixel criterion
-//! (or a Maugis–Dugdale cohesive zone with `--adhesion-range`) along the path of `--indentations`, then retracted to pull-off (the front-end layer's
+//! (or with `--adhesion-range` a Maugis–Dugdale cohesive zone or, `--adhesion-model
+//! exponential`, an exponential potential) along the path of `--indentations`, then retracted to pull-off (the front-end layer's
 //! [`AdhesionRequest`], the one Python's `bem_adhesion` runs). Outputs as `asperity bem`'s:
 //! checked before any work, written together at the end.
 
 use anyhow::{bail, Context, Result};
+use asperity::bem::adhesion::AdhesionLaw;
 use asperity::io::sidecar_path;
 use asperity_app::adhesion::{AdhesionRequest, AdhesionRun};
 use serde_json::json;
@@ -63,6 +65,7 @@ fn request(args: &BemArgs, w: f64) -> AdhesionRequest {
         boundary: args.boundary.clone(),
         work_of_adhesion: w,
         adhesion_range: args.adhesion_range,
+        adhesion_model: args.adhesion_model.clone(),
         indentations: args.indentations.clone().unwrap_or_default(),
         retract_step: args.retract_step,
     }
@@ -97,7 +100,7 @@ pub fn run(args: &BemArgs, w: f64) -> Result<()> {
             .stage(&mut outputs.staged, out)
             .with_context(|| format!("writing {}", out.display()))?;
         let record_path = sidecar_path(out);
-        let record = record(args, &request, (&surface, size_source), &run);
+        let record = record(args, (&request, plan.law), (&surface, size_source), &run);
         outputs
             .staged
             .write_json(&record_path, &record)
@@ -110,7 +113,7 @@ pub fn run(args: &BemArgs, w: f64) -> Result<()> {
 /// The inputs and the pull-offs of a run, for OUT.csv.json.
 fn record(
     args: &BemArgs,
-    request: &AdhesionRequest,
+    (request, law): (&AdhesionRequest, AdhesionLaw),
     (surface, size_source): (&asperity::surface::Surface, &'static str),
     run: &AdhesionRun,
 ) -> serde_json::Value {
@@ -128,9 +131,10 @@ fn record(
         "modulus": request.modulus,
         "boundary": request.boundary,
         "adhesion": {
-            "model": match request.adhesion_range {
-                None => "Pohrt–Popov pixel criterion",
-                Some(_) => "Maugis–Dugdale cohesive zone",
+            "model": match law {
+                AdhesionLaw::PixelCriterion => "Pohrt–Popov pixel criterion",
+                AdhesionLaw::MaugisDugdale { .. } => "Maugis–Dugdale cohesive zone",
+                AdhesionLaw::Exponential { .. } => "exponential potential",
             },
             "work_of_adhesion": request.work_of_adhesion,
             "range": request.adhesion_range,

@@ -1,6 +1,6 @@
 //! Adhesive contact on the boundary elements: Pohrt & Popov's mesh-dependent detachment
-//! criterion (Facta Univ. Mech. Eng. 13, 3, 2015) or a Maugis–Dugdale cohesive zone
-//! ([`AdhesionLaw`]), with loading, unloading, hysteresis and both pull-offs
+//! criterion (Facta Univ. Mech. Eng. 13, 3, 2015), a Maugis–Dugdale cohesive zone or an
+//! exponential potential ([`AdhesionLaw`]), with loading, unloading, hysteresis and both pull-offs
 //! ([`PixelAdhesion`]).
 //!
 //! **The model.** A pixel of the half-space is either *attached* to the rigid indenter or
@@ -52,6 +52,20 @@
 //! opening one pixel's tension causes. Measured on Maugis's sphere (force-controlled
 //! pull-off, `a_c/Δx` = 10, 20, 40): λ = 0.5 +2.4 %, +0.8 %, +0.2 %; λ = 1 +4.9 %, +1.8 %,
 //! +0.6 %; λ = 2 +5.5 %, +3.2 %, +1.4 % (about order 1.5 in `Δx`).
+//!
+//! **The exponential potential** ([`AdhesionLaw::Exponential`], range `ρ`, greatest tension
+//! `σ_m = w/ρ`): a free pixel at gap `g` carries `σ_m e^{−g/ρ}` (a known load in the
+//! solve), an attached one lets go beyond `σ_m`. The tensions are a fixed point: each round
+//! solves the attached set under the free pixels' tensions, then sets every free pixel's
+//! tension from its new gap, until no pixel attaches or lets go and no tension moves by more
+//! than [`TENSION_TOLERANCE`]`·σ_m`. The fixed point's map has the Jacobian `D·K` (`D` the
+//! potential's stiffness `σ_m e^{−g/ρ}/ρ` on the free pixels, `K` the elastic compliance),
+//! whose spectral radius is below 1 exactly where the state is stable under displacement
+//! control (the energy's Hessian `K⁻¹ − D` is positive definite): the iteration converges
+//! on every stable branch, slowly near its end, and leaves it where the branch ends (the
+//! jumps into and out of contact). One pixel alone is stable only while its own stiffness
+//! against the potential wins, `σ_m κ/ρ < 1` with `κ ≈ 1.12Δx/E*` its self-compliance:
+//! the pixel must resolve the range, [`PixelAdhesion::cohesive_resolution`] above 1.
 //!
 //! **Retraction** ([`PixelAdhesion::retract`]): the indentation falls in steps until no
 //! pixel is attached; the force-controlled pull-off is the least force met (beyond it no
@@ -113,7 +127,46 @@ pub enum AdhesionLaw {
         /// The range `h₀` of the Dugdale stress.
         range: f64,
     },
+    /// The exponential potential of range `ρ` (`range`), as in Rey, Anciaux & Molinari
+    /// (Comput. Mech. 60, 69, 2017) and the contact-mechanics challenge (Müser et al.,
+    /// Tribol. Lett. 65, 118, 2017): a free pixel at gap `g` carries the tension
+    /// `(w/ρ)e^{−g/ρ}`, an attached one (gap zero) lets go when its tension exceeds `w/ρ`.
+    /// Its pixels' tensions are settled by a fixed point (type docs of [`PixelAdhesion`]'s
+    /// module); the pixel must resolve the range ([`PixelAdhesion::cohesive_resolution`]).
+    Exponential {
+        /// The range `ρ` of the potential.
+        range: f64,
+    },
 }
+
+impl AdhesionLaw {
+    /// The range of a cohesive law (`None` for the pixel criterion).
+    pub fn range(&self) -> Option<f64> {
+        match *self {
+            AdhesionLaw::PixelCriterion => None,
+            AdhesionLaw::MaugisDugdale { range } | AdhesionLaw::Exponential { range } => {
+                Some(range)
+            }
+        }
+    }
+
+    /// The model's name in records: `pixel criterion`, `maugis-dugdale`, `exponential`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            AdhesionLaw::PixelCriterion => "pixel criterion",
+            AdhesionLaw::MaugisDugdale { .. } => "maugis-dugdale",
+            AdhesionLaw::Exponential { .. } => "exponential",
+        }
+    }
+}
+
+/// Relative change of a pixel's tension (over `w/ρ`) below which the exponential law's
+/// fixed point counts as settled.
+pub const TENSION_TOLERANCE: f64 = 1e-9;
+
+/// Tensions of the exponential law below `e^{−CUTOFF}·w/ρ` (gaps beyond `CUTOFF·ρ`) are
+/// left out: `e^{−36} ≈ 2·10⁻¹⁶`, under the rounding of the tension at contact.
+pub const EXPONENTIAL_CUTOFF: f64 = 36.0;
 
 /// How the adhesive iteration stops (documented defaults).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -176,8 +229,8 @@ pub struct AdhesiveSummary {
     pub area_fraction: f64,
     /// Pixels in tension (`p < 0`): attached ones, and free ones in a cohesive zone.
     pub tensile_points: usize,
-    /// Free pixels that carry the cohesive tension (Maugis–Dugdale; 0 under the pixel
-    /// criterion).
+    /// Free pixels that carry a cohesive tension (Maugis–Dugdale, exponential; 0 under the
+    /// pixel criterion).
     pub cohesive_points: usize,
 }
 

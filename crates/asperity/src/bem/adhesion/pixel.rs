@@ -7,7 +7,8 @@ use super::super::precondition::FourierPreconditioner;
 use super::super::stiffness::cg::{conjugate_gradient_on_set, CgParams, CgWork, RightHandSide};
 use super::super::{Control, HalfSpace, SolveError};
 use super::{
-    AdhesionInfo, AdhesionLaw, AdhesionParams, AdhesivePullOff, AdhesiveSummary, RETRACT_BISECTIONS,
+    AdhesionInfo, AdhesionLaw, AdhesionParams, AdhesivePullOff, AdhesiveSummary,
+    EXPONENTIAL_CUTOFF, RETRACT_BISECTIONS, TENSION_TOLERANCE,
 };
 use crate::elastic::{Boundary, ElasticOperator, HalfSpaceOperator};
 use crate::reference::adhesion::{pixel_critical_stress, pixel_mean_compliance};
@@ -60,7 +61,7 @@ impl PixelAdhesion {
         law: AdhesionLaw,
     ) -> Result<Self, SolveError> {
         crate::positive_finite("work of adhesion", w, "")?;
-        if let AdhesionLaw::MaugisDugdale { range } = law {
+        if let Some(range) = law.range() {
             crate::positive_finite("range", range, "")?;
         }
         crate::positive_finite("modulus", half_space.modulus, "")?;
@@ -114,7 +115,9 @@ impl PixelAdhesion {
             law,
             critical_stress: match law {
                 AdhesionLaw::PixelCriterion => pixel_critical_stress(half_space.modulus, w, dx),
-                AdhesionLaw::MaugisDugdale { range } => w / range,
+                AdhesionLaw::MaugisDugdale { range } | AdhesionLaw::Exponential { range } => {
+                    w / range
+                }
             },
             modulus: half_space.modulus,
             indentation: 0.0,
@@ -146,20 +149,19 @@ impl PixelAdhesion {
         self.law
     }
 
-    /// How well the pixel resolves a Maugis–Dugdale cohesive zone: the range `h₀` over the
-    /// opening that the Dugdale stress on one pixel causes there, `c̄σ₀Δx/E*`
-    /// ([`pixel_mean_compliance`]), i.e. `E*h₀²/(c̄wΔx)`. Below 1 a pixel's own tension
-    /// closes more than the whole range, and a pixel-by-pixel zone means nothing (the zone
-    /// spans no pixel); `None` for the pixel criterion.
+    /// How well the pixel resolves a cohesive law's range: the range (`h₀`, `ρ`) over the
+    /// opening that the law's greatest tension on one pixel causes there, `c̄σΔx/E*`
+    /// ([`pixel_mean_compliance`]; `σ = w/h₀` or `w/ρ`), i.e. `E*h₀²/(c̄wΔx)`. Below 1 a
+    /// pixel's own tension closes more than the whole range: a pixel-by-pixel zone means
+    /// nothing (Maugis–Dugdale), a lone pixel snaps against the potential (exponential;
+    /// the issue's `Δx ≤ (8/3π)ρ²E*/w` is resolution 1.12 by this measure); `None` for the
+    /// pixel criterion.
     pub fn cohesive_resolution(&self) -> Option<f64> {
-        match self.law {
-            AdhesionLaw::PixelCriterion => None,
-            AdhesionLaw::MaugisDugdale { range } => Some(
-                range
-                    / (pixel_mean_compliance() * self.critical_stress * self.spacing()
-                        / self.modulus),
-            ),
-        }
+        let range = self.law.range()?;
+        Some(
+            range
+                / (pixel_mean_compliance() * self.critical_stress * self.spacing() / self.modulus),
+        )
     }
 
     /// The work of adhesion `w`.
@@ -225,7 +227,7 @@ impl PixelAdhesion {
     }
 
     /// Detaches every pixel and unloads the surface at indentation `d` (under the
-    /// Maugis–Dugdale law the next move settles the cohesive zone).
+    /// cohesive laws the next move settles the tensions of the free pixels).
     pub fn separate(&mut self, d: f64) {
         self.attached.fill(false);
         self.pressure.fill(0.0);
@@ -327,8 +329,10 @@ impl PixelAdhesion {
     /// the indenter penetrates (not those released at this indentation); returns the counts
     /// `(attached, released)`.
     fn update_sets(&mut self) -> (usize, usize) {
-        if let AdhesionLaw::MaugisDugdale { range } = self.law {
-            return self.update_cohesive(range);
+        match self.law {
+            AdhesionLaw::MaugisDugdale { range } => return self.update_cohesive(range),
+            AdhesionLaw::Exponential { range } => return self.update_exponential(range),
+            AdhesionLaw::PixelCriterion => {}
         }
         let (d, sigma) = (self.indentation, self.critical_stress);
         let (mut attached, mut released) = (0, 0);
@@ -399,6 +403,44 @@ impl PixelAdhesion {
                 self.released_here[i] = true;
                 released += 1;
             }
+        }
+        (attached, released)
+    }
+
+    /// The exponential law's update: an attached pixel in tension beyond `σ_m = w/ρ` lets
+    /// go (and carries `−σ_m`), a free one the indenter penetrates attaches (unless it let
+    /// go at this indentation), and every other free one takes the tension
+    /// `−σ_m e^{−g/ρ}` of its gap (zero beyond [`EXPONENTIAL_CUTOFF`]`·ρ`); returns
+    /// `(attached, released)` with the free pixels whose tension moved by more than
+    /// [`TENSION_TOLERANCE`]`·σ_m` counted as released (module docs of [`super`]).
+    fn update_exponential(&mut self, range: f64) -> (usize, usize) {
+        let (d, sigma) = (self.indentation, self.critical_stress);
+        let (mut attached, mut released) = (0, 0);
+        for i in 0..self.pressure.len() {
+            if self.attached[i] {
+                if self.pressure[i] < -sigma {
+                    self.attached[i] = false;
+                    self.released_here[i] = true;
+                    self.pressure[i] = -sigma;
+                    released += 1;
+                }
+                continue;
+            }
+            let gap = self.displacement[i] + self.profile[i] - d;
+            if gap < 0.0 && !self.released_here[i] {
+                self.attached[i] = true;
+                attached += 1;
+                continue;
+            }
+            let opening = gap.max(0.0) / range;
+            let tension = match opening < EXPONENTIAL_CUTOFF {
+                true => -sigma * (-opening).exp(),
+                false => 0.0,
+            };
+            if (tension - self.pressure[i]).abs() > TENSION_TOLERANCE * sigma {
+                released += 1;
+            }
+            self.pressure[i] = tension;
         }
         (attached, released)
     }

@@ -325,3 +325,200 @@ fn vanishing_dugdale_stress_is_the_hard_wall() {
         assert!(refused.is_err(), "{range}");
     }
 }
+
+/// Johnson's adhesive sinusoid (`reference::JohnsonSinusoid`, λ = 1, Δ = 0.01, E* = 1,
+/// α = 0.5) on a periodic grid, its crests along y (`diagonal` false: `n` pixels per
+/// wavelength, 2 rows, a front along the grid) or along the diagonal (`diagonal` true:
+/// `n × n` pixels, wave vector `(1, 1)·2π/L`, λ = L/√2, a staircase front), under `law`.
+/// Loaded to a contact of half-width 0.2λ in 20 steps and retracted; returns the relative
+/// errors of the force- and displacement-controlled pull-offs (mean pressure), the largest
+/// distance of a peeling state's mean pressure from Johnson's at its half-width (contact
+/// fraction · λ/2) over `|p̄_c|`, and the pull-off half-width in pixels (along x).
+fn johnson_retraction(n: usize, diagonal: bool, law: AdhesionLaw) -> (f64, f64, f64, f64) {
+    use crate::reference::JohnsonSinusoid;
+    let (amplitude, modulus, size) = (0.01, 1.0, 1.0);
+    let (rows, wavelength) = match diagonal {
+        false => (2, size),
+        true => (n, size / 2f64.sqrt()),
+    };
+    let w = johnson_work_of_adhesion(wavelength);
+    let wavy = JohnsonSinusoid::new(wavelength, amplitude, modulus, w).unwrap();
+    let dx = size / n as f64;
+    let heights = Array2::from_shape_fn((rows, n), |(i, j)| {
+        let phase = (j as f64 - (n / 2) as f64) + if diagonal { i as f64 } else { 0.0 };
+        amplitude * (2.0 * PI * phase / n as f64).cos()
+    });
+    let surface = Surface::new(heights, size).unwrap();
+    let half_space = HalfSpace {
+        modulus,
+        boundary: crate::elastic::Boundary::Periodic,
+    };
+    let mut contact = PixelAdhesion::with_law(&surface, half_space, w, law).unwrap();
+    let d0 = wavy.approach(0.2 * wavelength).max(0.0) + 0.2 * amplitude;
+    for k in 1..=20 {
+        contact.move_to(d0 * k as f64 / 20.0).unwrap();
+    }
+    let (_, p_c) = wavy.pull_off(PullOff::ForceControlled).unwrap();
+    let (_, p_d) = wavy.pull_off(PullOff::DisplacementControlled).unwrap();
+    let start = contact.summary().attached_points;
+    let half_width = |s: &AdhesiveSummary| s.area_fraction * wavelength / 2.0;
+    let mut worst = 0.0f64;
+    let pull = contact
+        .retract((d0 + law.range().unwrap_or(0.0)) / 2000.0, |s| {
+            if s.attached_points < start {
+                let p = wavy.mean_pressure(half_width(s));
+                worst = worst.max((s.mean_pressure - p).abs() / p_c.abs());
+            }
+        })
+        .unwrap()
+        .expect("in contact");
+    (
+        pull.force_controlled.mean_pressure / p_c - 1.0,
+        pull.displacement_controlled.mean_pressure / p_d - 1.0,
+        worst,
+        half_width(&pull.force_controlled) / dx,
+    )
+}
+
+/// The work of adhesion of Johnson's parameter α = 0.5 (Δ = 0.01, E* = 1).
+fn johnson_work_of_adhesion(wavelength: f64) -> f64 {
+    0.25 * PI * PI * 1e-4 / (2.0 * wavelength)
+}
+
+/// The periodic grid reproduces Johnson's sinusoid with a cohesive law of short range
+/// (slow tier, minutes): the exponential potential on a front along the grid (2 × 1024
+/// pixels, ρ = 6.75·10⁻⁴ for the resolution E*ρ²/(c̄wΔx) = 4) lets go within 2 % of
+/// Johnson's force-controlled pull-off (measured +0.52 % through `asperity bem`, 87 pixels
+/// of half-width; the rest is a finite range's distance from JKR's limit, as the sphere's
+/// μ = 3 is 3.1 % from JKR). It also checks `JohnsonSinusoid` by an independent method.
+#[test]
+#[ignore]
+fn johnson_sinusoid_by_a_short_exponential_range() {
+    let w = johnson_work_of_adhesion(1.0);
+    let c_bar = crate::reference::adhesion::pixel_mean_compliance();
+    let n = 1024;
+    let range = (4.0 * c_bar * w / n as f64).sqrt();
+    let errors = johnson_retraction(n, false, AdhesionLaw::Exponential { range });
+    println!("n = {n}, ρ = {range:e}: {errors:?}");
+    assert!(errors.0.abs() < 0.02, "{errors:?}");
+}
+
+/// The pixel criterion on the periodic grid holds Johnson's fronts too strongly, by an
+/// amount that depends on the front's orientation and does not vanish with the pixel
+/// (a characterization, docs/adhesion.md): the force-controlled pull-off is +54.4 %,
+/// +53.0 %, +52.3 %, +51.9 % off at 14, 28, 57, 114 pixels of pull-off half-width on a
+/// front along the grid, and +24.2 %, +21.8 %, +20.5 % on a diagonal (staircase) front at
+/// 5, 9, 17 pixels. Checked (256 along, 64² diagonal, seconds): both
+/// above +15 %, the aligned one above +40 %.
+#[test]
+fn pixel_criterion_on_johnson_s_sinusoid_depends_on_the_front() {
+    let aligned = johnson_retraction(256, false, AdhesionLaw::PixelCriterion);
+    let diagonal = johnson_retraction(64, true, AdhesionLaw::PixelCriterion);
+    println!("aligned {aligned:?}\ndiagonal {diagonal:?}");
+    assert!(
+        aligned.0 > 0.4 && diagonal.0 > 0.15,
+        "{aligned:?} {diagonal:?}"
+    );
+    assert!(aligned.0 > diagonal.0 + 0.15, "{aligned:?} {diagonal:?}");
+}
+
+/// A sphere (`R = 1`, `E* = 1`, `w = 10⁻³`) under the exponential potential at Tabor's
+/// parameter `μ = (Rw²/E*²ρ³)^{1/3}` on pixels of `a_c/Δx = pixels` (`a_c` JKR's
+/// force-controlled pull-off radius), the grid wide enough for the potential's reach
+/// (gaps to 15ρ); loaded to `1.25a_c` and retracted. Returns the force-controlled
+/// pull-off over `πwR`, the resolution, and the rounds of the whole run.
+fn exponential_sphere(mu: f64, pixels: f64) -> (f64, f64, usize) {
+    let (radius, w) = (1.0f64, 1e-3f64);
+    let range = (radius * w * w / mu.powi(3)).cbrt();
+    let a_c = (9.0 * PI * w * radius * radius / 8.0).cbrt();
+    let dx = a_c / pixels;
+    let reach = (1.4 * a_c).max((2.0 * radius * 15.0 * range).sqrt());
+    let n = (2.0 * reach / dx).ceil() as usize + 4;
+    let law = AdhesionLaw::Exponential { range };
+    let mut contact =
+        PixelAdhesion::with_law(&sphere(n, dx, radius), HalfSpace::default(), w, law).unwrap();
+    let d0 = (1.25 * a_c).powi(2) / radius;
+    let mut rounds = 0;
+    for k in 1..=10 {
+        rounds += contact.move_to(d0 * k as f64 / 10.0).unwrap().1.rounds;
+    }
+    let resolution = contact.cohesive_resolution().unwrap();
+    let pull = contact
+        .retract((d0 + range) / 500.0, |_| {})
+        .unwrap()
+        .expect("in contact");
+    (
+        pull.force_controlled.force / (PI * w * radius),
+        resolution,
+        rounds,
+    )
+}
+
+/// The exponential potential's sphere at small Tabor parameter is DMT's: at μ = 0.1 the
+/// force-controlled pull-off is within 2.5 % of `−2πwR` (measured −1.9596πwR at
+/// `a_c/Δx = 10`, resolution 694; the rest is the elastic correction of a finite μ, of
+/// the order of Maugis–Dugdale's at λ ≈ 1.16μ, −1.940), and the fixed point
+/// settles every state of the run.
+#[test]
+fn exponential_sphere_is_dmt_at_small_tabor_parameter() {
+    let (force, resolution, _) = exponential_sphere(0.1, 10.0);
+    assert!(resolution > 100.0, "{resolution}");
+    assert!(force < -1.95 && force > -2.0, "{force}");
+}
+
+/// Across Tabor's parameter the exponential sphere's pull-off moves from DMT's `−2πwR`
+/// toward JKR's `−1.5πwR` (slow tier, minutes): measured −1.960, −1.856, −1.664 at
+/// μ = 0.1, 0.3, 1 (`a_c/Δx = 10`) and −1.546 at μ = 3 (`a_c/Δx = 26`, resolution 2.0).
+/// The tolerance at μ = 3 (within 6 % of JKR) is the distance of a finite μ from the
+/// limit (Maugis–Dugdale at λ = 1.16μ = 3.48 is −1.513), not the solver's.
+#[test]
+#[ignore]
+fn exponential_sphere_moves_from_dmt_to_jkr() {
+    let mut last = -2.0;
+    for (mu, pixels) in [(0.1, 10.0), (0.3, 10.0), (1.0, 10.0), (3.0, 26.0)] {
+        let (force, resolution, _) = exponential_sphere(mu, pixels);
+        println!("μ = {mu}: {force} (resolution {resolution})");
+        assert!(force > last && force < -1.5, "μ = {mu}: {force}");
+        last = force;
+    }
+    assert!(last < -1.5 && last > -1.59, "{last}");
+}
+
+/// A pixel that does not resolve the range is flagged: the resolution falls as `ρ²/Δx`.
+#[test]
+fn exponential_resolution_is_range_squared_over_pixel() {
+    let law = AdhesionLaw::Exponential { range: 1e-3 };
+    let coarse = PixelAdhesion::with_law(&sphere(16, 1e-2, 1.0), HalfSpace::default(), 1e-3, law);
+    let fine = PixelAdhesion::with_law(&sphere(16, 5e-3, 1.0), HalfSpace::default(), 1e-3, law);
+    let (coarse, fine) = (coarse.unwrap(), fine.unwrap());
+    let expected = 1e-6 / (crate::reference::adhesion::pixel_mean_compliance() * 1e-3 * 1e-2);
+    assert!((coarse.cohesive_resolution().unwrap() / expected - 1.0).abs() < 1e-12);
+    assert!(
+        (fine.cohesive_resolution().unwrap() / coarse.cohesive_resolution().unwrap() - 2.0).abs()
+            < 1e-12
+    );
+    assert_eq!(coarse.critical_stress(), 1.0);
+    for range in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let law = AdhesionLaw::Exponential { range };
+        assert!(
+            PixelAdhesion::with_law(&sphere(16, 1e-2, 1.0), HalfSpace::default(), 1e-3, law)
+                .is_err()
+        );
+    }
+}
+
+/// As `w → 0` the exponential law is the hard wall: the non-adhesive solver's forces.
+#[test]
+fn vanishing_exponential_adhesion_is_the_hard_wall() {
+    let surface = sphere(32, 1e-2, 1.0);
+    let law = AdhesionLaw::Exponential { range: 1e-3 };
+    let mut contact = PixelAdhesion::with_law(&surface, HalfSpace::default(), 1e-14, law).unwrap();
+    let mut solver =
+        crate::bem::ContactSolver::new(&surface, HalfSpace::default(), Default::default()).unwrap();
+    for d in [0.002, 0.004, 0.008] {
+        let (state, _) = contact.move_to(d).unwrap();
+        let (plain, _) = solver.solve(crate::bem::Control::Indentation(d)).unwrap();
+        let error = (state.force / plain.force - 1.0).abs();
+        assert!(error < 1e-6, "d = {d}: {error:e}");
+    }
+}
