@@ -155,8 +155,9 @@ pub fn curve_table_with(results: &[TaskResult], transport: &Transport) -> Table 
                     Cell::Number(Some(p.stiffness_high)),
                     Cell::Count(p.samples),
                     Cell::Number(Some(p.fraction)),
-                    Cell::Number(Some(p.fraction_low)),
-                    Cell::Number(Some(p.fraction_high)),
+                    // Unknown (NaN) in a checkpoint older than the interval: no number.
+                    Cell::Number(Some(p.fraction_low).filter(|v| v.is_finite())),
+                    Cell::Number(Some(p.fraction_high).filter(|v| v.is_finite())),
                 ];
                 if tangential {
                     let t = p.tangential_ratio;

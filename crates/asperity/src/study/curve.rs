@@ -116,9 +116,10 @@ impl FitWindow {
 }
 
 impl SampleCurve {
-    /// Stiffness and contact fraction at `force` (step or log–log interpolation, see the
-    /// module docs); `None` outside the curve.
-    pub fn at_force(&self, force: f64) -> Option<(f64, f64)> {
+    /// The loads around `force`: the last load `a` at or below it, and, unless `force` is
+    /// `a`'s own or above the last load, the next load `b` with `t`, the position of
+    /// `force` between the two in `ln F` (0 at `a`, 1 at `b`); `None` outside the curve.
+    fn bracket(&self, force: f64) -> Option<(CurvePoint, Option<(CurvePoint, f64)>)> {
         let pts = &self.points;
         let (first, last) = (pts.first()?, pts.last()?);
         if !(force >= first.force && force <= last.force) {
@@ -127,11 +128,21 @@ impl SampleCurve {
         // Index of the first point with a force above `force` (≥ 1 here).
         let i = pts.partition_point(|p| p.force <= force);
         let a = pts[i - 1];
-        if self.piecewise_constant || i == pts.len() || a.force == force {
-            return Some((a.stiffness, a.fraction));
+        if i == pts.len() || a.force == force {
+            return Some((a, None));
         }
         let b = pts[i];
         let t = (force.ln() - a.force.ln()) / (b.force.ln() - a.force.ln());
+        Some((a, Some((b, t))))
+    }
+
+    /// Stiffness and contact fraction at `force` (step or log–log interpolation, see the
+    /// module docs); `None` outside the curve.
+    pub fn at_force(&self, force: f64) -> Option<(f64, f64)> {
+        let (a, next) = self.bracket(force)?;
+        let Some((b, t)) = next.filter(|_| !self.piecewise_constant) else {
+            return Some((a.stiffness, a.fraction));
+        };
         let lerp = |x: f64, y: f64| (x.ln() + t * (y.ln() - x.ln())).exp();
         Some((
             lerp(a.stiffness, b.stiffness),
@@ -143,18 +154,11 @@ impl SampleCurve {
     /// (it varies by parts in 1e-3 over the sweep); `None` outside the curve or where
     /// either load has none.
     pub fn tangential_ratio_at(&self, force: f64) -> Option<f64> {
-        let pts = &self.points;
-        let (first, last) = (pts.first()?, pts.last()?);
-        if !(force >= first.force && force <= last.force) {
-            return None;
-        }
-        let i = pts.partition_point(|p| p.force <= force);
-        let a = pts[i - 1];
-        if i == pts.len() || a.force == force {
+        let (a, next) = self.bracket(force)?;
+        let Some((b, t)) = next else {
             return a.tangential_ratio;
-        }
-        let (b, (ra, rb)) = (pts[i], (a.tangential_ratio?, pts[i].tangential_ratio?));
-        let t = (force.ln() - a.force.ln()) / (b.force.ln() - a.force.ln());
+        };
+        let (ra, rb) = (a.tangential_ratio?, b.tangential_ratio?);
         Some(ra + t * (rb - ra))
     }
 
@@ -195,9 +199,15 @@ pub struct EnsemblePoint {
     pub stiffness_high: f64,
     /// Mean contact fraction.
     pub fraction: f64,
-    /// Lower end of the 95 % confidence interval of the mean contact fraction.
+    /// Lower end of the 95 % confidence interval of the mean contact fraction. Unknown
+    /// (NaN, and then not written) in a finished task's checkpoint written before the
+    /// interval was kept (533a278), unless its sample curves give it back on reading
+    /// ([`super::StudyDir`]); a table shows it as an empty cell.
+    #[serde(default = "unknown", skip_serializing_if = "is_unknown")]
     pub fraction_low: f64,
-    /// Upper end of the 95 % confidence interval of the mean contact fraction.
+    /// Upper end of the 95 % confidence interval of the mean contact fraction (unknown
+    /// as [`EnsemblePoint::fraction_low`]).
+    #[serde(default = "unknown", skip_serializing_if = "is_unknown")]
     pub fraction_high: f64,
     /// Samples averaged.
     pub samples: usize,
@@ -205,6 +215,24 @@ pub struct EnsemblePoint {
     /// the mean, where every sample has one ([`CurvePoint::tangential_ratio`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tangential_ratio: Option<MeanInterval>,
+}
+
+/// An interval end that an older checkpoint did not keep.
+fn unknown() -> f64 {
+    f64::NAN
+}
+
+/// Whether an interval end is [`unknown`]: left out of the JSON, so that an older
+/// checkpoint serialises to its own bytes again (its checksum).
+fn is_unknown(value: &f64) -> bool {
+    value.is_nan()
+}
+
+impl EnsemblePoint {
+    /// Whether the contact fraction's interval is unknown (an older checkpoint).
+    pub fn lacks_fraction_interval(&self) -> bool {
+        is_unknown(&self.fraction_low) || is_unknown(&self.fraction_high)
+    }
 }
 
 /// A mean over samples with the 95 % confidence interval of the mean (Student t).
@@ -285,38 +313,28 @@ pub fn ensemble_curve_of(samples: &[&SampleCurve], levels: usize) -> Result<Vec<
                     .exp()
                     .clamp(lo, hi)
             };
+            // Every usable sample covers [lo, hi], so each gives a value (and there is one).
             let values: Vec<(f64, f64)> = usable.iter().filter_map(|s| s.at_force(force)).collect();
-            let (mean, k_half) = mean_interval(values.iter().map(|v| v.0), usable.len());
-            let (fraction, a_half) = mean_interval(values.iter().map(|v| v.1), usable.len());
+            let of = |v: Vec<f64>| MeanInterval::of(&v).expect("a sample at every level");
+            let stiffness = of(values.iter().map(|v| v.0).collect());
+            let fraction = of(values.iter().map(|v| v.1).collect());
             let ratios: Option<Vec<f64>> = usable
                 .iter()
                 .map(|s| s.tangential_ratio_at(force))
                 .collect();
             EnsemblePoint {
                 force,
-                stiffness: mean,
-                stiffness_low: mean - k_half,
-                stiffness_high: mean + k_half,
-                fraction,
-                fraction_low: fraction - a_half,
-                fraction_high: fraction + a_half,
+                stiffness: stiffness.mean,
+                stiffness_low: stiffness.low,
+                stiffness_high: stiffness.high,
+                fraction: fraction.mean,
+                fraction_low: fraction.low,
+                fraction_high: fraction.high,
                 samples: values.len(),
                 tangential_ratio: ratios.and_then(|r| MeanInterval::of(&r)),
             }
         })
         .collect())
-}
-
-/// The mean of `values` over `count` samples and the half-width of its 95 % confidence
-/// interval (Student t with `count − 1` degrees of freedom; zero for one sample).
-fn mean_interval(values: impl Iterator<Item = f64> + Clone, count: usize) -> (f64, f64) {
-    let n = count as f64;
-    let mean = values.clone().sum::<f64>() / n;
-    if count < 2 {
-        return (mean, 0.0);
-    }
-    let var = values.map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, student_t_975(count - 1) * (var / n).sqrt())
 }
 
 /// α of the ensemble: the mean stiffness over samples at `levels` log-spaced forces

@@ -355,7 +355,7 @@ impl StudyDir {
             reason: format!("{what}; delete it to recompute its task"),
         };
         match identity::unseal::<Checkpoint>(text.as_bytes(), &wanted) {
-            Ok(checkpoint) => Ok(Some(checkpoint)),
+            Ok(checkpoint) => Ok(Some(self.with_fraction_intervals(checkpoint))),
             Err(Unsealed::Corrupt(why)) => Err(refuse(format!("corrupt checkpoint ({why})"))),
             Err(Unsealed::Checksum) => Err(refuse(
                 "the checkpoint does not match its checksum (edited or damaged)".into(),
@@ -369,6 +369,37 @@ impl StudyDir {
                 ),
             }),
         }
+    }
+
+    /// A finished task's checkpoint written before the mean curve kept the contact
+    /// fraction's interval (533a278, issue 36): the interval recomputed from the sample
+    /// curves it keeps (BEM), by the operations that compute it for a new task, where they
+    /// give the same force levels; else left unknown (MDR keeps no curves: an empty cell).
+    /// The file is left as it is.
+    fn with_fraction_intervals(&self, checkpoint: Checkpoint) -> Checkpoint {
+        let Checkpoint::Done {
+            mut result,
+            samples,
+        } = checkpoint
+        else {
+            return checkpoint;
+        };
+        let lacking = result
+            .mean_curve
+            .iter()
+            .any(|p| p.lacks_fraction_interval());
+        if lacking && !samples.is_empty() {
+            let fresh = super::curve::ensemble_curve(&samples, self.spec.levels).ok();
+            let old = &mut result.mean_curve;
+            if let Some(fresh) = fresh.filter(|f| f.len() == old.len()) {
+                if old.iter().zip(&fresh).all(|(a, b)| a.force == b.force) {
+                    for (a, b) in old.iter_mut().zip(&fresh) {
+                        (a.fraction_low, a.fraction_high) = (b.fraction_low, b.fraction_high);
+                    }
+                }
+            }
+        }
+        Checkpoint::Done { result, samples }
     }
 
     pub(super) fn save(&self, task: Task, checkpoint: &Checkpoint) -> Result<()> {
@@ -614,5 +645,70 @@ impl StudyDir {
     /// The study this folder was opened for.
     pub fn spec(&self) -> &StudySpec {
         &self.spec
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::{run_any_task, FitWindow, Method};
+
+    /// A finished task's checkpoint as written before the mean curve kept the contact
+    /// fraction's interval (533a278): the same result without `fraction_low`/`_high`.
+    fn as_written_before_the_interval(store: &StudyDir, task: Task, keep_samples: bool) {
+        let Some(Checkpoint::Done {
+            mut result,
+            samples,
+        }) = store.load(task).unwrap()
+        else {
+            panic!("a finished task")
+        };
+        for p in &mut result.mean_curve {
+            (p.fraction_low, p.fraction_high) = (f64::NAN, f64::NAN);
+        }
+        let samples = if keep_samples { samples } else { Vec::new() };
+        store
+            .save(task, &Checkpoint::Done { result, samples })
+            .unwrap();
+        let text = std::fs::read_to_string(store.checkpoint_path(task)).unwrap();
+        assert!(!text.contains("fraction_low") && text.contains("\"fraction\""));
+    }
+
+    /// Every study folder written before 533a278 was refused as "corrupt checkpoint
+    /// (missing field `fraction_low`)" (found resuming docs/results/tangential/study):
+    /// such a checkpoint is read again, with the interval from its kept sample curves, the
+    /// same as a new run's bit for bit; without kept curves, unknown (NaN).
+    #[test]
+    fn checkpoints_older_than_the_fraction_interval_are_read_with_it() {
+        let spec = StudySpec {
+            method: Method::Bem,
+            sizes: vec![16],
+            hursts: vec![0.5],
+            samples: 3,
+            rolloff: None,
+            seed: 3,
+            window: FitWindow::default(),
+            levels: 16,
+            sweep_end: None,
+            poisson: None,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        let task = spec.tasks()[0];
+        let result = run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
+        assert!(result.mean_curve.iter().all(|p| p.fraction_low.is_finite()));
+        as_written_before_the_interval(&store, task, true);
+        let Some(Checkpoint::Done { result: read, .. }) = store.load(task).unwrap() else {
+            panic!("a finished task")
+        };
+        assert_eq!(read, result);
+        as_written_before_the_interval(&store, task, false);
+        let Some(Checkpoint::Done { result: read, .. }) = store.load(task).unwrap() else {
+            panic!("a finished task")
+        };
+        assert!(read.mean_curve.iter().all(|p| p.lacks_fraction_interval()));
+        let stiffness =
+            |r: &TaskResult| r.mean_curve.iter().map(|p| p.stiffness).collect::<Vec<_>>();
+        assert_eq!(stiffness(&read), stiffness(&result));
     }
 }
