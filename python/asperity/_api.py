@@ -1724,10 +1724,7 @@ def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, 
         if comm is None:
             text = _core.run_study(*args, bar.callback, eta=bar.weigh, **derived)
         else:
-            if any(v is not None for v in derived.values()):
-                raise ValueError("poisson, resistivity and thermal_conductivity are not supported "
-                                 "under MPI yet: run the study without mpirun")
-            text = _mpi.run_study(comm, lambda job: job.begin(*args), bar.callback)
+            text = _mpi.run_study(comm, lambda job: job.begin(*args, **derived), bar.callback)
     finally:
         bar.close()
     return json.loads(text)

@@ -132,7 +132,8 @@ class StudyCoordinator:
         self, method_name: str, sizes: List[int], hursts: List[float], samples: int,
         rolloff: Optional[float], seed: Optional[int], min_contacts: Optional[int],
         max_fraction: Optional[float], levels: Optional[int], alpha_sweep: bool, out: str,
-        force: bool, checkpoint_every: Optional[float],
+        force: bool, checkpoint_every: Optional[float], poisson: Optional[float] = ...,
+        resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
     ) -> List[Action]: ...
     def on_ready(self, rank: int, lanes: int) -> List[Action]: ...
     def on_done(self, rank: int, curves: str) -> List[Action]: ...

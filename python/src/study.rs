@@ -321,6 +321,8 @@ pub struct StudyCoordinator {
     machine: Coordinator,
     /// The study begun: its spec and folder.
     study: Option<(StudySpec, StudyDir)>,
+    /// Its tangential and conductance columns ([`derived`]).
+    derived: StudyDerived,
     lock: Option<FolderLock>,
 }
 
@@ -334,6 +336,7 @@ impl StudyCoordinator {
         StudyCoordinator {
             machine: Coordinator::new(size, lanes),
             study: None,
+            derived: StudyDerived::default(),
             lock: None,
         }
     }
@@ -341,7 +344,8 @@ impl StudyCoordinator {
     /// Opens the study as `run_study` does (same arguments but the progress callback) and
     /// begins it: the first actions.
     #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-        max_fraction, levels, alpha_sweep, out, force, checkpoint_every))]
+        max_fraction, levels, alpha_sweep, out, force, checkpoint_every, poisson=None,
+        resistivity=None, thermal_conductivity=None))]
     #[allow(clippy::too_many_arguments)]
     fn begin(
         &mut self,
@@ -359,15 +363,22 @@ impl StudyCoordinator {
         out: PathBuf,
         force: bool,
         checkpoint_every: Option<f64>,
+        poisson: Option<f64>,
+        resistivity: Option<Vec<f64>>,
+        thermal_conductivity: Option<Vec<f64>>,
     ) -> PyResult<Vec<PyAction>> {
-        let spec = make_spec(
-            method_name,
-            (sizes, hursts, samples),
-            rolloff,
-            seed,
-            (min_contacts, max_fraction, levels),
-            alpha_sweep,
-        )?;
+        let derived = derived(poisson, &resistivity, &thermal_conductivity)?;
+        let spec = StudySpec {
+            poisson,
+            ..make_spec(
+                method_name,
+                (sizes, hursts, samples),
+                rolloff,
+                seed,
+                (min_contacts, max_fraction, levels),
+                alpha_sweep,
+            )?
+        };
         let interval = checkpoint_interval(checkpoint_every)?;
         let spec = resumable(py, spec, &out, force)?;
         study::validate(&spec).map_err(request_error)?;
@@ -377,6 +388,7 @@ impl StudyCoordinator {
             .begin(store.clone())
             .map_err(distributed_error)?;
         self.study = Some((spec, store));
+        self.derived = derived;
         self.lock = Some(lock);
         Ok(self.actions(actions))
     }
@@ -432,12 +444,7 @@ impl StudyCoordinator {
             .study
             .take()
             .ok_or_else(|| invalid("no study was begun"))?;
-        Ok(records(
-            &spec,
-            store.path(),
-            &results,
-            StudyDerived::default(),
-        ))
+        Ok(records(&spec, store.path(), &results, self.derived))
     }
 
     /// Ends the job: the actions telling the ready ranks to stop (the others are told by

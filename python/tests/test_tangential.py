@@ -3,6 +3,8 @@
 front-end layer, crates/asperity-app/src/derived.rs), with Mindlin's ratio and Barber's
 analogy as oracles (docs/tangential.md)."""
 
+import os
+
 import numpy as np
 
 import asperity
@@ -77,12 +79,52 @@ def test_study_curve_tangential_and_conductance_are_the_clis(cli, tmp_path):
     charts = ours.figures["tangential"]["charts"]
     assert len(charts) == 2 and "Mindlin" in charts[0]["series"][-1]["label"]
     # Bad values are refused in the keywords' words, creating nothing.
+    mdr = "poisson applies to BEM studies only (method=\"bem\"): an MDR line has no tangential"
     for bad, words in [(dict(poisson=0.7), "poisson must be in [0, 0.5]"),
-                       (dict(resistivity=[1]), "give two values")]:
+                       (dict(resistivity=[1]), "give two values"),
+                       (dict(method="mdr", poisson=0.3), mdr)]:
         try:
-            asperity.study_curve(out=tmp_path / "bad", **args, **bad)
+            asperity.study_curve(out=tmp_path / "bad", **{**args, **bad})
         except ValueError as e:
             assert words in str(e), str(e)
         else:
             raise AssertionError(f"{bad} accepted")
         assert not (tmp_path / "bad").exists()
+
+
+def test_the_distributed_coordinator_carries_poisson_and_the_resistivities(tmp_path):
+    # The coordinator and sample computer that a study under mpirun drives (_mpi.py),
+    # driven here by hand on one rank: Poisson's ratio reaches the ranks in the spec they
+    # are sent, and the records are the serial run's, tangential and conductance columns
+    # included, with the same checkpoints byte for byte (tests/mpi/run.sh runs the same
+    # under mpirun).
+    import filecmp
+    import json
+
+    from asperity import _asperity as core
+
+    def args(out):
+        return ("bem", [32], [0.5], 2, 4.0, None, None, None, 4, False, str(tmp_path / out),
+                False, None)
+
+    derived = dict(poisson=0.3, resistivity=[1.0, 3.0])
+    coordinator = core.StudyCoordinator(1, 1)
+    actions, computer, sent = coordinator.begin(*args("mpi"), **derived), None, []
+    while not any(action[0] == "end" for action in actions):
+        (kind, rank, t, indices, spec), = actions
+        assert (kind, rank) == ("assign", 0)
+        if spec is not None:
+            sent.append(json.loads(spec))
+            computer = core.SampleComputer(spec)
+        actions = coordinator.on_done(0, computer.compute(t, indices)) + coordinator.save_due()
+    distributed = json.loads(coordinator.finish())
+    coordinator.close()
+    assert sent and all(spec["poisson"] == 0.3 for spec in sent)
+    serial = json.loads(core.run_study(*args("serial"), None, **derived))
+    assert distributed["curve"] == serial["curve"]
+    assert distributed["figures"] == serial["figures"]
+    names = [name for name, _ in distributed["curve"]["columns"]]
+    assert "tangential_ratio" in names and "electrical_conductance" in names
+    for name in ["study.json"] + [f"checkpoint/{f}" for f in
+                                  sorted(os.listdir(tmp_path / "serial" / "checkpoint"))]:
+        assert filecmp.cmp(tmp_path / "mpi" / name, tmp_path / "serial" / name, shallow=False)

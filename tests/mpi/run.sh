@@ -97,15 +97,19 @@ EOF
 bem_loud=(study alpha --method bem --n 32,48 --hurst 0.5,0.8 --samples 7 --seed 3)
 bem=("${bem_loud[@]}" --quiet)
 curve=(study curve --method bem --n 32 --hurst 0.2,1.0 --samples 5 --rolloff 4 --quiet)
+tangential=("${curve[@]}" --poisson 0.3 --resistivity 1,1)
 file=(study file "$work/study.toml" --quiet)
 "$serial" "${bem[@]}" --out "$work/bem-serial"
 "$serial" "${curve[@]}" --out "$work/curve-serial"
+"$serial" "${tangential[@]}" --out "$work/tangential-serial"
 "$serial" "${file[@]}" --out "$work/file-serial"
 for k in 1 2 3; do
     "${mpirun_cmd[@]}" -n $k "$mpi" "${bem[@]}" --out "$work/bem-$k"
     same_files "$work/bem-serial" "$work/bem-$k" "study alpha on $k ranks"
     "${mpirun_cmd[@]}" -n $k "$mpi" "${curve[@]}" --out "$work/curve-$k"
     same_files "$work/curve-serial" "$work/curve-$k" "study curve on $k ranks"
+    "${mpirun_cmd[@]}" -n $k "$mpi" "${tangential[@]}" --out "$work/tangential-$k"
+    same_files "$work/tangential-serial" "$work/tangential-$k" "study curve --poisson on $k ranks"
     "${mpirun_cmd[@]}" -n $k "$mpi" "${file[@]}" --out "$work/file-$k"
     same_files "$work/file-serial" "$work/file-$k" "study file on $k ranks"
 done
@@ -245,7 +249,18 @@ if [ "$python_tests" = 1 ]; then
                 fail "Python on $k ranks: rank $rank returned another result than the serial run"
         done
     done
-    echo "ok: Python under mpirun: identical checkpoints and results on 1, 2, 3 ranks"
+    # Issue 37: Poisson's ratio and the resistivities reach the ranks (they were refused).
+    "${study_py[@]}" tangential "$work/py-tangential-serial" "$work/py-tangential-serial.json"
+    same_checkpoints "$work/tangential-serial" "$work/py-tangential-serial" "Python --poisson against the CLI"
+    for k in 2 3; do
+        "${mpirun_cmd[@]}" -n $k "${study_py[@]}" tangential "$work/py-tangential-$k" "$work/py-tangential-$k.json"
+        same_checkpoints "$work/tangential-serial" "$work/py-tangential-$k" "Python --poisson on $k ranks"
+        for ((rank = 0; rank < k; rank++)); do
+            cmp -s "$work/py-tangential-serial.json.0" "$work/py-tangential-$k.json.$rank" ||
+                fail "Python --poisson on $k ranks: rank $rank returned another result than the serial run"
+        done
+    done
+    echo "ok: Python under mpirun: identical checkpoints and results on 1, 2, 3 ranks (also with poisson)"
     export RAYON_NUM_THREADS=1
     "${mpirun_cmd[@]}" -n 3 "${study_py[@]}" long "$work/py-long" >/dev/null 2>"$work/py-killed.txt" &
     job=$!

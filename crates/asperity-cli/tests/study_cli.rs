@@ -997,7 +997,12 @@ fn curve_study_adds_the_tangential_ratio_and_the_conductance() {
         "--out",
         "mdr",
     ];
-    refused(&asperity(&mdr, d), "BEM only");
+    // In the CLI's words (issue 37: it said the library's "invalid poisson: ...").
+    refused(
+        &asperity(&mdr, d),
+        "error: --poisson applies to BEM studies only (--method bem): an MDR line has no \
+         tangential kernel",
+    );
     assert!(!d.join("mdr").exists());
 }
 

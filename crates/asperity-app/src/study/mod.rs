@@ -116,11 +116,12 @@ pub fn resumable(spec: StudySpec, dir: &Path, discard: bool) -> (StudySpec, Opti
     (run, Some(note))
 }
 
-/// Refuses a study that cannot run: the library's rules on the spec
-/// ([`StudySpec::validate`]), a fit window no load reaches ([`check_min_contacts`]), and
+/// Refuses a study that cannot run: Poisson's ratio of an MDR study
+/// ([`check_tangential`]), the library's rules on the spec ([`StudySpec::validate`]), a fit window no load reaches ([`check_min_contacts`]), and
 /// results that would not fit in memory ([`StudySpec::ensure_fits`]).
 pub fn validate(spec: &StudySpec) -> Result<(), RequestError> {
     let library = |e| RequestError::Invalid(Box::new(e));
+    check_tangential(spec)?;
     spec.validate().map_err(library)?;
     check_min_contacts(spec)?;
     spec.ensure_fits().map_err(library)
@@ -237,6 +238,39 @@ pub fn comparison(
         Some((row, verdict))
     };
     Ok(results.iter().map(row).collect())
+}
+
+/// The BEM method, as each front end asks for it.
+pub const METHOD_BEM: Param = Param::new("--method bem", "method=\"bem\"");
+
+/// Refuses Poisson's ratio in an MDR study, in the front end's words: the tangential
+/// stiffness is computed on BEM's frozen contact set (Cerruti's kernel); an MDR line has
+/// no tangential kernel (the library's own rule, [`StudySpec::validate`], says the same in
+/// its words).
+///
+/// ```
+/// use asperity::study::{Method, StudySpec};
+/// use asperity_app::{study::check_tangential, Names};
+///
+/// let spec = StudySpec { method: Method::Mdr, poisson: Some(0.3), ..StudySpec::default() };
+/// let refusal = check_tangential(&spec).unwrap_err();
+/// assert_eq!(
+///     refusal.words(Names::Flags),
+///     "--poisson applies to BEM studies only (--method bem): an MDR line has no \
+///      tangential kernel"
+/// );
+/// assert!(refusal.words(Names::Keywords).starts_with(
+///     "poisson applies to BEM studies only (method=\"bem\")"));
+/// assert!(check_tangential(&StudySpec { method: Method::Bem, ..spec }).is_ok());
+/// ```
+pub fn check_tangential(spec: &StudySpec) -> Result<(), Refusal> {
+    if spec.poisson.is_none() || spec.method == Method::Bem {
+        return Ok(());
+    }
+    Err(Refusal::of(crate::derived::params::POISSON)
+        .text(" applies to BEM studies only (")
+        .param(METHOD_BEM)
+        .text("): an MDR line has no tangential kernel"))
 }
 
 /// The smallest number of contacts of the α fit window.
