@@ -198,7 +198,7 @@ pub struct CurveArgs {
 }
 
 /// The keys of a study file: `(key, type, default, meaning)`, for `--help` and the README.
-pub const FILE_KEYS: [(&str, &str, &str, &str); 11] = [
+pub const FILE_KEYS: [(&str, &str, &str, &str); 14] = [
     (
         "kind",
         "\"alpha\" or \"curve\"",
@@ -254,6 +254,24 @@ pub const FILE_KEYS: [(&str, &str, &str, &str); 11] = [
         "true or false",
         "false",
         "alpha, BEM: solve every load, not only those up to 4x the windows' end",
+    ),
+    (
+        "poisson",
+        "number in [0, 0.5]",
+        "none",
+        "curve, BEM: Poisson's ratio of the tangential stiffness at every load (tangential_ratio)",
+    ),
+    (
+        "resistivity",
+        "list of two numbers > 0",
+        "none",
+        "curve: the bodies' resistivities: electrical_conductance 2k/(E*(rho1+rho2))",
+    ),
+    (
+        "thermal_conductivity",
+        "list of two numbers > 0",
+        "none",
+        "curve: the bodies' thermal conductivities: thermal_conductance",
     ),
 ];
 
@@ -482,13 +500,19 @@ struct StudyFile {
     max_fraction: Option<f64>,
     levels: Option<usize>,
     full_sweep: Option<bool>,
+    poisson: Option<f64>,
+    resistivity: Option<Vec<f64>>,
+    thermal_conductivity: Option<Vec<f64>>,
 }
 
-/// Reads a study file's text: the kind and the spec (not yet validated). Errors name the
-/// file, the line and column, and the key concerned, in one line.
-fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
+/// Reads a study file's text: the kind, the spec (not yet validated) and a curve study's
+/// tangential and conductance columns (`poisson`, `resistivity`, `thermal_conductivity`,
+/// refused as `study curve` refuses its flags, in the keys' words). Errors name the file,
+/// the line and column, and the key concerned, in one line.
+fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec, figure::Derived)> {
     let file: StudyFile =
         toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", toml_error(path, text, &e)))?;
+    let derived = file_derived(path, &file)?;
     // The keys left out take the library's defaults (`StudySpec::default`).
     let defaults = StudySpec::default();
     let spec = StudySpec {
@@ -504,7 +528,7 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
         },
         levels: file.levels.unwrap_or(defaults.levels),
         sweep_end: None,
-        poisson: None,
+        poisson: file.poisson,
     };
     if file.kind == Kind::Curve && file.full_sweep.is_some() {
         anyhow::bail!(
@@ -512,10 +536,41 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec)> {
             path.display()
         );
     }
+    asperity_app::study::check_tangential(&spec).map_err(|r| {
+        let words = r.words(asperity_app::Names::Keywords);
+        anyhow::anyhow!("{}: {words}", path.display())
+    })?;
     Ok((
         file.kind,
         file.kind.spec(spec, file.full_sweep.unwrap_or(false)),
+        derived,
     ))
+}
+
+/// The tangential and conductance columns of a study file, refused as `study curve`
+/// refuses them ([`Derived::validate`]) but in the file's words (its keys are Python's
+/// keywords).
+fn file_derived(path: &Path, file: &StudyFile) -> Result<figure::Derived> {
+    use asperity_app::Names;
+    let given = [
+        file.resistivity.is_some(),
+        file.thermal_conductivity.is_some(),
+    ];
+    if file.kind == Kind::Alpha && (file.poisson.is_some() || given.contains(&true)) {
+        anyhow::bail!(
+            "{}: poisson, resistivity and thermal_conductivity apply to curve studies only",
+            path.display()
+        );
+    }
+    let refused = |r: asperity_app::Refusal| {
+        anyhow::anyhow!("{}: {}", path.display(), r.words(Names::Keywords))
+    };
+    let derived = Derived::validate(file.poisson, &file.resistivity, &file.thermal_conductivity)
+        .map_err(refused)?;
+    Ok(figure::Derived {
+        poisson: derived.tangential,
+        transport: derived.transport,
+    })
 }
 
 /// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on
@@ -614,8 +669,12 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         StudyCommand::Compare(c) => return crate::report::compare_study(&c.dir, c.force),
         StudyCommand::File(f) => {
             let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
-            let (kind, spec) = parse_study_file(&f.file, &text)?;
-            (kind, spec, &f.run.out, RunOptions::from_args(&f.run)?)
+            let (kind, spec, derived) = parse_study_file(&f.file, &text)?;
+            let options = RunOptions {
+                derived,
+                ..RunOptions::from_args(&f.run)?
+            };
+            (kind, spec, &f.run.out, options)
         }
     };
     let spec = crate::studies::resumable(spec, out, options.force, options.quiet);
@@ -663,18 +722,66 @@ mod tests {
     fn study_files_take_single_values_and_lists() {
         let parse = |text: &str| parse_study_file(Path::new("s.toml"), text);
         let base = "kind = \"curve\"\nmethod = \"mdr\"\nsamples = 3\n";
-        let (kind, spec) = parse(&format!("{base}n = 512\nhurst = 0.5\n")).unwrap();
+        let (kind, spec, _) = parse(&format!("{base}n = 512\nhurst = 0.5\n")).unwrap();
         assert_eq!(kind, Kind::Curve);
         assert_eq!((spec.sizes, spec.hursts), (vec![512], vec![0.5]));
-        let (_, spec) = parse(&format!("{base}n = [512, 1024]\nhurst = 1\n")).unwrap();
+        let (_, spec, _) = parse(&format!("{base}n = [512, 1024]\nhurst = 1\n")).unwrap();
         assert_eq!((spec.sizes, spec.hursts), (vec![512, 1024], vec![1.0]));
-        let (_, spec) = parse(&format!("{base}n = 64\nhurst = \"-1:0:0.5\"\n")).unwrap();
+        let (_, spec, _) = parse(&format!("{base}n = 64\nhurst = \"-1:0:0.5\"\n")).unwrap();
         assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0]);
-        let (_, spec) = parse(&format!("{base}n = 64\nhurst = [\"-1:0:0.5\", 2, 2.5]\n")).unwrap();
+        let (_, spec, _) =
+            parse(&format!("{base}n = 64\nhurst = [\"-1:0:0.5\", 2, 2.5]\n")).unwrap();
         assert_eq!(spec.hursts, vec![-1.0, -0.5, 0.0, 2.0, 2.5]);
         assert_eq!(spec.seed, 1);
         assert_eq!(spec.levels, 48);
         assert_eq!(spec.window, FitWindow::default());
+    }
+
+    #[test]
+    fn study_files_take_the_tangential_and_conductance_keys() {
+        let parse = |text: &str| parse_study_file(Path::new("s.toml"), text);
+        let base = "kind = \"curve\"\nmethod = \"bem\"\nn = 32\nhurst = 0.5\nsamples = 2\n";
+        let (kind, spec, derived) = parse(&format!(
+            "{base}poisson = 0.3\nresistivity = [1, 3]\nthermal_conductivity = [2.0, 2.0]\n"
+        ))
+        .unwrap();
+        assert_eq!(
+            (kind, spec.poisson, derived.poisson),
+            (Kind::Curve, Some(0.3), Some(0.3))
+        );
+        spec.validate().unwrap();
+        // Barber's analogy with these bodies: 2k/(E*(1+3)) and (2k/E*)·2·2/(2+2).
+        assert_eq!(derived.transport.electrical(1.0, 1.0), Some(0.5));
+        assert_eq!(derived.transport.thermal(1.0, 1.0), Some(2.0));
+        let (_, plain, none) = parse(base).unwrap();
+        assert_eq!((plain.poisson, none.poisson), (None, None));
+        assert_eq!(none.transport.electrical(1.0, 1.0), None);
+        // Refused in the keys' words, naming the file.
+        let refused = |extra: &str| parse(&format!("{base}{extra}")).unwrap_err().to_string();
+        assert_eq!(
+            refused("poisson = 0.7\n"),
+            "s.toml: poisson must be in [0, 0.5] (Poisson's ratio), got 0.7"
+        );
+        assert!(refused("resistivity = [1]\n").starts_with("s.toml: invalid resistivity: give two"));
+        let err = refused("thermal_conductivity = [1, -2]\n");
+        assert!(
+            err.contains("thermal_conductivity") && err.contains("positive"),
+            "{err}"
+        );
+        let mdr = base.replace("bem", "mdr");
+        let err = parse(&format!("{mdr}poisson = 0.3\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("s.toml: poisson applies to BEM studies only"),
+            "{err}"
+        );
+        let alpha = base.replace("curve", "alpha");
+        let err = parse(&format!("{alpha}resistivity = [1, 1]\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("apply to curve studies only"), "{err}");
+        assert!(refused("poisson = \"0.3\"\n").contains("(key `poisson`)"));
     }
 
     #[test]
@@ -734,7 +841,7 @@ mod tests {
             }
             let text = String::from_utf8_lossy(&bytes);
             match parse_study_file(Path::new("s.toml"), &text) {
-                Ok((_, spec)) => {
+                Ok((_, spec, _)) => {
                     if let Err(e) = spec.validate() {
                         proptest::prop_assert!(!e.to_string().contains('\n'));
                     }
@@ -746,7 +853,8 @@ mod tests {
 
     #[test]
     fn the_example_file_parses_and_help_and_readme_list_every_key() {
-        let (kind, spec) = parse_study_file(Path::new("docs/sweep.toml"), SWEEP_EXAMPLE).unwrap();
+        let (kind, spec, _) =
+            parse_study_file(Path::new("docs/sweep.toml"), SWEEP_EXAMPLE).unwrap();
         assert_eq!(kind, Kind::Alpha);
         spec.validate().unwrap();
         let help = file_help();
