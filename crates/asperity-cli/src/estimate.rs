@@ -1,12 +1,15 @@
 //! The up-front run time of a BEM study on this machine, before it starts (issue 7's
 //! estimate; docs/bem.md, "Estimating a BEM study"): per-iteration costs measured at each
 //! N on one thread, the iteration counts of a whole sample measured at two small probe
-//! sizes for every H and carried to N by the power law through them. Used by
-//! `asperity study`, `asperity reproduce` and `asperity bench bem-estimate`.
+//! sizes for every H and carried to N by the power law through them. A study with a
+//! Poisson's ratio adds the tangential CGs of every load (`k_x` and `k_y`, counted at the
+//! probes and timed per iteration at N as the normal ones are). Used by `asperity study`,
+//! `asperity reproduce` and `asperity bench bem-estimate`.
 
 use std::time::Instant;
 
 use anyhow::Result;
+use asperity::bem::tangential::TangentialStiffness;
 use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverParams};
 use asperity::elastic::Boundary;
 use asperity::memory;
@@ -45,20 +48,22 @@ struct SampleCounts {
     direct: f64,
     /// Frozen-set CG iterations.
     cg: f64,
+    /// Operator applications of the tangential CGs (`k_x` and `k_y`, their warm starts
+    /// included; none without a Poisson's ratio).
+    tangential: f64,
 }
 
-fn sample_iterations(
-    n: usize,
-    hurst: f64,
-    rolloff: Option<f64>,
-    sweep_end: Option<f64>,
-) -> Result<SampleCounts> {
-    let surface = study_surface(n, hurst, rolloff)?;
+fn sample_iterations(n: usize, hurst: f64, study: &BemStudy) -> Result<SampleCounts> {
+    let surface = study_surface(n, hurst, study.rolloff)?;
     let mut solver = ContactSolver::new(&surface, FREE, SolverParams::default())?;
+    let mut tangential = (study.poisson)
+        .map(|nu| TangentialStiffness::new(&solver, nu))
+        .transpose()?;
     let mut counts = SampleCounts {
         solve: 0.0,
         direct: 0.0,
         cg: 0.0,
+        tangential: 0.0,
     };
     for p in study_pressures(n) {
         let (summary, info) = solver.solve(Control::MeanPressure(p))?;
@@ -69,7 +74,12 @@ fn sample_iterations(
             counts.solve += info.iterations as f64;
         }
         counts.cg += stiffness.iterations as f64;
-        if asperity::study::samplers::sweep_ends_after(sweep_end, summary.area_fraction) {
+        if let Some(t) = tangential.as_mut() {
+            let t = t.solve(&solver)?;
+            counts.tangential +=
+                (t.info_x.operator_applications + t.info_y.operator_applications) as f64;
+        }
+        if asperity::study::samplers::sweep_ends_after(study.sweep_end, summary.area_fraction) {
             break;
         }
     }
@@ -147,6 +157,42 @@ fn iteration_costs(n: usize) -> Result<(f64, f64)> {
     Ok((solve, cg))
 }
 
+/// Seconds per iteration of a tangential CG (Cerruti's operator, Poisson's ratio
+/// `poisson`) on an `n × n` grid, as [`iteration_costs`] times the normal CG's: on the
+/// contact set at p̄ = 0.05 E*, warm from the normal frozen-set solution as in a study,
+/// cut off after a few iterations of `k_x`; the minimum of three.
+fn tangential_iteration_cost(n: usize, poisson: f64) -> Result<f64> {
+    const CUT: usize = 12;
+    let surface = study_surface(n, 0.8, None)?;
+    let loose = SolverParams {
+        tolerance: 1e-4,
+        ..SolverParams::default()
+    };
+    let mut solver = ContactSolver::new(&surface, FREE, loose)?;
+    let mut tangential = TangentialStiffness::new(&solver, poisson)?;
+    solver.solve(Control::MeanPressure(0.05))?;
+    solver.frozen_set_stiffness()?;
+    solver.set_params(SolverParams {
+        stiffness_max_iterations: CUT,
+        ..loose
+    })?;
+    let mut cost = f64::INFINITY;
+    for _ in 0..3 {
+        let start = Instant::now();
+        let iterations = match tangential.solve(&solver) {
+            Ok(t) => t.info_x.operator_applications + t.info_y.operator_applications,
+            Err(SolveError::NoConvergence { iterations, .. }) => iterations,
+            Err(e) => return Err(e.into()),
+        };
+        anyhow::ensure!(
+            iterations > 0,
+            "the tangential cost probe at N = {n} took no iteration"
+        );
+        cost = cost.min(start.elapsed().as_secs_f64() / iterations as f64);
+    }
+    Ok(cost)
+}
+
 /// The probe sizes for a study on grids up to `sizes`' largest: 32² and 64² (a second or
 /// two per H) up to 256², 128² and 256² up to 512², 256² and 512² above (a few seconds per
 /// H). The direct solve of small sets and the rings (512² and up) make the counts grow
@@ -209,6 +255,9 @@ pub struct BemStudy<'a> {
     /// Samples of `(N, H)` already checkpointed (not computed again), if any: see
     /// [`held_samples`].
     pub stored: &'a [HeldSamples],
+    /// Poisson's ratio of a study that computes the tangential stiffness at every load
+    /// ([`asperity::study::StudySpec::poisson`]), if any.
+    pub poisson: Option<f64>,
 }
 
 /// Samples of one task of a study already in its checkpoints.
@@ -236,6 +285,7 @@ pub fn estimate_study(
         rolloff: spec.rolloff,
         sweep_end: spec.sweep_end,
         stored: &stored,
+        poisson: spec.poisson,
     };
     let estimate = estimate_bem_seconds(&study, probes_for(&spec.sizes, spec.sweep_end))?;
     Ok((estimate, stored.iter().map(|s| s.samples).sum()))
@@ -278,8 +328,12 @@ pub struct SizeEstimate {
     pub solve_iterations: f64,
     pub direct_applications: f64,
     pub cg_iterations: f64,
+    /// Operator applications of the tangential CGs of one sample (0 without ν).
+    pub tangential_applications: f64,
     pub solve_iteration_s: f64,
     pub cg_iteration_s: f64,
+    /// Seconds per tangential CG iteration (0 without ν).
+    pub tangential_iteration_s: f64,
     pub seconds: f64,
 }
 
@@ -303,15 +357,20 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut counts = Vec::with_capacity(study.hursts.len());
     for &hurst in study.hursts {
-        let small = sample_iterations(probes.0, hurst, study.rolloff, study.sweep_end)?;
-        let large = sample_iterations(probes.1, hurst, study.rolloff, study.sweep_end)?;
+        let small = sample_iterations(probes.0, hurst, study)?;
+        let large = sample_iterations(probes.1, hurst, study)?;
         counts.push((small, large));
     }
     let mut per_size = Vec::with_capacity(study.sizes.len());
     for &n in study.sizes {
         let (c_solve, c_cg) = one_thread.install(|| iteration_costs(n))?;
+        let c_tangential = match study.poisson {
+            Some(nu) => one_thread.install(|| tangential_iteration_cost(n, nu))?,
+            None => 0.0,
+        };
         // Counts of one sample, summed over H; and seconds of the samples left per lane.
-        let (mut solve, mut direct, mut cg, mut seconds) = (0.0, 0.0, 0.0, 0.0);
+        let (mut solve, mut direct, mut cg, mut tangential, mut seconds) =
+            (0.0, 0.0, 0.0, 0.0, 0.0);
         for (&hurst, (small, large)) in study.hursts.iter().zip(&counts) {
             let carried = |count: fn(&SampleCounts) -> f64| {
                 extrapolate((count(small), count(large)), probes, n)
@@ -321,17 +380,25 @@ pub fn estimate_bem_seconds(study: &BemStudy, probes: (usize, usize)) -> Result<
                 carried(|c| c.direct),
                 carried(|c| c.cg),
             );
+            let tangential_h = match study.poisson {
+                Some(_) => carried(|c| c.tangential),
+                None => 0.0,
+            };
             let per_lane = study.samples_left(n, hurst).div_ceil(lanes) as f64;
             (solve, direct, cg) = (solve + solve_h, direct + direct_h, cg + cg_h);
-            seconds += per_lane * (solve_h * c_solve + (direct_h + cg_h) * c_cg);
+            tangential += tangential_h;
+            seconds += per_lane
+                * (solve_h * c_solve + (direct_h + cg_h) * c_cg + tangential_h * c_tangential);
         }
         per_size.push(SizeEstimate {
             n,
             solve_iterations: solve,
             direct_applications: direct,
             cg_iterations: cg,
+            tangential_applications: tangential,
             solve_iteration_s: c_solve,
             cg_iteration_s: c_cg,
+            tangential_iteration_s: c_tangential,
             seconds,
         });
     }
@@ -362,6 +429,47 @@ mod tests {
         // No iteration at the smaller probe (its sample solved directly): from one.
         assert!((extrapolate((0.0, 8.0), probes, 256) - 64.0).abs() < 1e-9);
         assert_eq!(extrapolate((0.0, 0.0), probes, 256), 0.0);
+    }
+
+    /// Issue 37: a study with a Poisson's ratio also solves `k_x` and `k_y` at every load;
+    /// its estimate said 6 min for a run of about 15 before it counted them.
+    #[test]
+    fn the_estimate_grows_by_the_tangential_cgs_when_poisson_is_set() {
+        let study = |poisson| BemStudy {
+            sizes: &[64],
+            samples: 2,
+            hursts: &[0.8],
+            rolloff: Some(4.0),
+            sweep_end: None,
+            stored: &[],
+            poisson,
+        };
+        let plain = estimate_bem_seconds(&study(None), (32, 64)).unwrap();
+        let with = estimate_bem_seconds(&study(Some(0.3)), (32, 64)).unwrap();
+        let (p, t) = (&plain.per_size[0], &with.per_size[0]);
+        assert_eq!(
+            (p.tangential_applications, p.tangential_iteration_s),
+            (0.0, 0.0)
+        );
+        // The normal counts are the same; each direction takes about the normal CG's
+        // iterations, and the CGs of small sets that the normal stiffness solves directly.
+        assert_eq!(
+            (p.solve_iterations, p.direct_applications, p.cg_iterations),
+            (t.solve_iterations, t.direct_applications, t.cg_iterations)
+        );
+        assert!(
+            t.tangential_applications > t.cg_iterations,
+            "{}",
+            t.tangential_applications
+        );
+        assert!(t.tangential_iteration_s > 0.0);
+        let per_lane = 2usize.div_ceil(with.lanes) as f64;
+        let normal = per_lane
+            * (t.solve_iterations * t.solve_iteration_s
+                + (t.direct_applications + t.cg_iterations) * t.cg_iteration_s);
+        let tangential = per_lane * t.tangential_applications * t.tangential_iteration_s;
+        assert!((t.seconds - normal - tangential).abs() <= 1e-12 * t.seconds);
+        assert!(t.seconds > normal && tangential > 0.0);
     }
 
     #[test]

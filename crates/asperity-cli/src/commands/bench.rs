@@ -290,6 +290,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         rolloff: args.rolloff,
         sweep_end,
         stored: &[],
+        poisson: None,
     };
     let estimate = estimate_bem_seconds(&study, probes)?;
     let lanes = estimate.lanes;
