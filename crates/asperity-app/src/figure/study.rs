@@ -179,18 +179,8 @@ fn alpha_n_chart(results: &[TaskResult], title: &str) -> Chart {
 /// as a band in the same colour (ends that a log axis cannot show are left out, see
 /// [`Series::interval`]), and a slope-1 reference line (k ∝ F).
 pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
-    let (hmin, hmax) = results
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
-            (a.min(r.task.hurst), b.max(r.task.hurst))
-        });
     let mut series = Vec::new();
     for r in results {
-        let t = if hmax > hmin {
-            (r.task.hurst - hmin) / (hmax - hmin)
-        } else {
-            0.5
-        };
         let points = r
             .mean_curve
             .iter()
@@ -201,7 +191,7 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
             points,
             Style::Line,
         )
-        .color(Color::Ordered(t * 0.9));
+        .color(task_color(results, r));
         if r.samples > 1 {
             let interval = r
                 .mean_curve
@@ -229,26 +219,16 @@ pub fn curve_chart(results: &[TaskResult], title: &str) -> Chart {
 /// Log–log A/A₀(F): the ensemble-mean contact fraction of each task against the force,
 /// coloured by H as [`curve_chart`], with the 95 % interval of the mean as a band.
 pub fn area_chart(results: &[TaskResult], title: &str) -> Chart {
-    let (hmin, hmax) = results
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
-            (a.min(r.task.hurst), b.max(r.task.hurst))
-        });
     let series = results
         .iter()
         .map(|r| {
-            let t = if hmax > hmin {
-                (r.task.hurst - hmin) / (hmax - hmin)
-            } else {
-                0.5
-            };
             let points = r.mean_curve.iter().map(|p| (p.force, p.fraction));
             let line = Series::new(
                 format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst),
                 points.collect(),
                 Style::Line,
             )
-            .color(Color::Ordered(t * 0.9));
+            .color(task_color(results, r));
             if r.samples > 1 {
                 let interval = r
                     .mean_curve
@@ -298,17 +278,23 @@ fn slope_one(results: &[TaskResult]) -> Option<Series> {
     )
 }
 
-/// The colour of task `r` on the H scale of `results` (as [`curve_chart`]'s).
-fn hurst_color(results: &[TaskResult], r: &TaskResult) -> Color {
-    let (hmin, hmax) = results
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
-            (a.min(r.task.hurst), b.max(r.task.hurst))
-        });
-    let t = if hmax > hmin {
-        (r.task.hurst - hmin) / (hmax - hmin)
-    } else {
-        0.5
+/// The colour of task `r` of `results`, one per series: where every task has its own H,
+/// its place on the H scale of `results`; where tasks of several N share an H, its place
+/// among the tasks in order of H, then N (so that no two series share a colour, and the
+/// N of one H stay neighbours).
+fn task_color(results: &[TaskResult], r: &TaskResult) -> Color {
+    let mut tasks: Vec<(f64, usize)> = results.iter().map(|r| (r.task.hurst, r.task.n)).collect();
+    tasks.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    tasks.dedup();
+    let one_per_h = tasks.windows(2).all(|w| w[0].0 != w[1].0);
+    let (hmin, hmax) = (tasks.first(), tasks.last());
+    let t = match (hmin, hmax) {
+        (Some(&(lo, _)), Some(&(hi, _))) if one_per_h && hi > lo => (r.task.hurst - lo) / (hi - lo),
+        _ if tasks.len() > 1 => {
+            let place = tasks.iter().position(|&t| t == (r.task.hurst, r.task.n));
+            place.unwrap_or(0) as f64 / (tasks.len() - 1) as f64
+        }
+        _ => 0.5,
     };
     Color::Ordered(t * 0.9)
 }
@@ -377,7 +363,7 @@ fn task_series(
     band: Vec<(f64, f64)>,
 ) -> Series {
     let label = format!("{} N = {} H = {}", r.method.name(), r.task.n, r.task.hurst);
-    let line = Series::new(label, points, Style::Line).color(hurst_color(results, r));
+    let line = Series::new(label, points, Style::Line).color(task_color(results, r));
     match r.samples > 1 {
         true => line.interval(band),
         false => line,
@@ -474,6 +460,65 @@ mod tests {
             alpha_ensemble: None,
             alpha_samples: Vec::new(),
         }
+    }
+
+    #[test]
+    fn every_series_has_its_own_colour_when_sizes_share_an_h() {
+        // The 256²/512² tangential study drew N = 256 and 512 of one H in one colour.
+        let task = |n: usize, hurst: f64| TaskResult {
+            task: Task { n, hurst },
+            ..result(Some(0.824))
+        };
+        let results = [
+            task(256, 0.0),
+            task(256, 0.8),
+            task(512, 0.0),
+            task(512, 0.8),
+        ];
+        let transport = Transport::new(Some([1.0, 1.0]), None).unwrap();
+        let derived = Derived {
+            poisson: Some(0.3),
+            transport,
+        };
+        let mut charts = derived_charts(&results, derived);
+        charts.push(curve_chart(&results, "k(F)"));
+        charts.push(area_chart(&results, "A(F)"));
+        for chart in &charts {
+            let mut colours: Vec<String> = chart.series[..4]
+                .iter()
+                .map(|s| format!("{:?}", s.color))
+                .collect();
+            colours.sort();
+            colours.dedup();
+            assert_eq!(colours.len(), 4, "{}: {colours:?}", chart.title);
+        }
+        // In order of H, then N: the two N of H = 0 first, at the ends of the scale 0, 0.9.
+        let placed = |r: &TaskResult| match task_color(&results, r) {
+            Color::Ordered(t) => t,
+            other => panic!("{other:?}"),
+        };
+        let near = |t: Vec<f64>, expected: [f64; 4]| {
+            t.iter().zip(expected).all(|(a, b)| (a - b).abs() < 1e-12)
+        };
+        let t: Vec<f64> = results.iter().map(placed).collect();
+        assert!(near(t.clone(), [0.0, 0.6, 0.3, 0.9]), "{t:?}");
+        // One task per H keeps the H scale (the figures of single-N studies unchanged).
+        let single = [
+            task(256, 0.0),
+            task(256, 0.5),
+            task(256, 2.0),
+            task(256, 4.0),
+        ];
+        let t: Vec<f64> = single
+            .iter()
+            .map(|r| {
+                let Color::Ordered(t) = task_color(&single, r) else {
+                    panic!()
+                };
+                t
+            })
+            .collect();
+        assert!(near(t.clone(), [0.0, 0.1125, 0.45, 0.9]), "{t:?}");
     }
 
     #[test]
