@@ -86,6 +86,10 @@ pub struct BenchArgs {
     /// those a study on `--sizes` uses (32,64 up to 256; 128,256 up to 512; 256,512 above).
     #[arg(long)]
     pub probes: Option<String>,
+    /// Poisson's ratio of a study that also computes the tangential stiffness at every load
+    /// (`study curve --poisson`; bem-estimate): adds its CGs to the estimate.
+    #[arg(long, value_name = "NU")]
+    pub poisson: Option<f64>,
     /// Mean pressures in units of E* (bem-solve), comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
     pub pressures: Vec<f64>,
@@ -244,7 +248,8 @@ fn parse_sizes(text: &str, flag: &str) -> Result<Vec<usize>> {
 }
 
 /// Prints per N one line `n samples hursts lanes solve_iterations direct_applications
-/// cg_iterations solve_iteration_s cg_iteration_s seconds`, then `total_seconds`,
+/// cg_iterations tangential_applications solve_iteration_s cg_iteration_s
+/// tangential_iteration_s seconds` (the tangential ones 0 without `--poisson`), then `total_seconds`,
 /// `total_hours`, `lanes` and, for an α study's sweep, `sweep_end`.
 ///
 /// Per (N, H) one sample costs `I_solve·c_solve(N) + (A_direct + I_cg)·c_cg(N)` (`A_direct`
@@ -290,23 +295,26 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         rolloff: args.rolloff,
         sweep_end,
         stored: &[],
-        poisson: None,
+        poisson: args.poisson,
     };
     let estimate = estimate_bem_seconds(&study, probes)?;
     let lanes = estimate.lanes;
     for row in &estimate.per_size {
         println!(
             "n={} samples={} hursts={} lanes={lanes} solve_iterations={:.0} \
-             direct_applications={:.0} cg_iterations={:.0} solve_iteration_s={:.3e} \
-             cg_iteration_s={:.3e} seconds={:.3}",
+             direct_applications={:.0} cg_iterations={:.0} tangential_applications={:.0} \
+             solve_iteration_s={:.3e} cg_iteration_s={:.3e} tangential_iteration_s={:.3e} \
+             seconds={:.3}",
             row.n,
             args.samples,
             hursts.len(),
             row.solve_iterations,
             row.direct_applications,
             row.cg_iterations,
+            row.tangential_applications,
             row.solve_iteration_s,
             row.cg_iteration_s,
+            row.tangential_iteration_s,
             row.seconds,
         );
     }
