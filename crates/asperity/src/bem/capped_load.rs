@@ -28,6 +28,7 @@
 //! `1 ± LOAD_HANDOVER`, holding the sets), so the load is exact as in any load-controlled
 //! solve and convergence is judged by the same residual.
 
+use crate::elastic::ContactOperator;
 use super::context::Target;
 use super::interface::{bearing_start, Interface};
 use super::solver::{ContactSolver, Runner};
@@ -81,13 +82,13 @@ impl Spent {
     }
 }
 
-impl ContactSolver {
+impl<K: ContactOperator> ContactSolver<K> {
     /// Load control at the mean pressure `mean_pressure` under a cap, by the iteration of `runner`: its load
     /// iteration, and where that cycles the root search of the module docs. The
     /// iterations and applications reported are those of all the parts.
     pub(super) fn capped_load(
         &mut self,
-        runner: &mut Runner<'_>,
+        runner: &mut Runner<'_, K>,
         mean_pressure: f64,
         tolerance: f64,
         max_iterations: usize,
@@ -129,7 +130,7 @@ impl ContactSolver {
     /// the regula falsi of the module docs; adds what it spent to `spent`.
     fn indentation_for_load(
         &mut self,
-        runner: &mut Runner<'_>,
+        runner: &mut Runner<'_, K>,
         mean_pressure: f64,
         tolerance: f64,
         max_iterations: usize,

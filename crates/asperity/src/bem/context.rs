@@ -12,7 +12,7 @@ use super::precondition::FourierPreconditioner;
 use super::stagnation::Progress;
 use super::threshold::FullContactThreshold;
 use super::{ContactSummary, HalfSpace, SolveError, SolverParams};
-use crate::elastic::ElasticOperator;
+use crate::elastic::{ContactOperator, ElasticOperator};
 use crate::stop::Stop;
 use crate::surface::Surface;
 use crate::Error;
@@ -28,10 +28,11 @@ pub(super) enum Target {
 /// What is solved: the indenter profile of one surface on a half-space, on a grid. Read by
 /// every iteration; changed only by [`super::ContactSolver::set_surface`] (a new profile on
 /// the same grid). The operator applies `K` in place of the half-space (its FFT buffers are
-/// its own).
-pub struct ContactProblem {
+/// its own). `K` is the body's operator: the homogeneous half-space's by default, any
+/// [`ContactOperator`] through [`super::ContactSolver::with_operator`].
+pub struct ContactProblem<K: ContactOperator = ElasticOperator> {
     /// The half-space (modulus, boundary) on the grid and spacings of the surface.
-    pub(super) operator: ElasticOperator,
+    pub(super) operator: K,
     pub(super) rows: usize,
     pub(super) cols: usize,
     /// Indenter profile `f = max(h) − h ≥ 0`, row-major.
@@ -52,23 +53,33 @@ impl ContactProblem {
             half_space.modulus,
             half_space.boundary,
         )?;
-        let mut profile = Vec::with_capacity(rows * cols);
-        let height_scale = fill_profile(surface, &mut profile);
-        Ok(ContactProblem {
+        ContactProblem::with_operator(surface, operator)
+    }
+}
+
+impl<K: ContactOperator> ContactProblem<K> {
+    /// The problem of `surface` on the body of `operator`, which must have the surface's
+    /// grid and spacings.
+    pub(super) fn with_operator(surface: &Surface, operator: K) -> Result<Self, SolveError> {
+        let (rows, cols) = (operator.rows(), operator.cols());
+        let mut problem = ContactProblem {
             operator,
             rows,
             cols,
-            profile,
-            height_scale,
-        })
+            profile: Vec::with_capacity(rows * cols),
+            height_scale: 1.0,
+        };
+        problem.set_surface(surface)?;
+        Ok(problem)
     }
 
     /// Swaps in the profile of `surface`, which must have the grid and spacings of the
     /// problem (the operator is kept).
     pub(super) fn set_surface(&mut self, surface: &Surface) -> Result<(), SolveError> {
+        let (dx, dy) = self.operator.spacings();
         if surface.dim() != (self.rows, self.cols)
-            || surface.spacing() != self.operator.spacing()
-            || surface.spacing_y() != self.operator.spacing_y()
+            || surface.spacing() != dx
+            || surface.spacing_y() != dy
         {
             return Err(Error::invalid(
                 "surface",
@@ -76,8 +87,8 @@ impl ContactProblem {
                     "the solver was planned for {}x{} points at spacings {} x {}, got {:?} at {} x {}",
                     self.rows,
                     self.cols,
-                    self.operator.spacing(),
-                    self.operator.spacing_y(),
+                    dx,
+                    dy,
                     surface.dim(),
                     surface.spacing(),
                     surface.spacing_y()
@@ -94,9 +105,15 @@ impl ContactProblem {
         (self.rows, self.cols)
     }
 
+    /// The body's operator (the half-space's, or the one given to
+    /// [`super::ContactSolver::with_operator`]).
+    pub fn operator(&self) -> &K {
+        &self.operator
+    }
+
     /// Pixel spacings `(Δx, Δy)`.
     pub fn spacings(&self) -> (f64, f64) {
-        (self.operator.spacing(), self.operator.spacing_y())
+        self.operator.spacings()
     }
 
     /// The half-space: effective modulus and boundary.
@@ -110,7 +127,8 @@ impl ContactProblem {
     /// Nominal (projected) area `rows · cols · Δx · Δy`.
     pub fn nominal_area(&self) -> f64 {
         // Multiplied in this order so that square pixels give today's value bit for bit.
-        (self.rows * self.cols) as f64 * self.operator.spacing() * self.operator.spacing_y()
+        let (dx, dy) = self.operator.spacings();
+        (self.rows * self.cols) as f64 * dx * dy
     }
 
     /// The indenter profile `f = max(h) − h`, `rows × cols`.
@@ -176,8 +194,8 @@ pub type Monitor = Box<dyn FnMut(usize, f64) + Send + Sync>;
 
 /// What the iterations work on (module docs): owned by the solver, lent to one iteration at
 /// a time.
-pub(super) struct Context {
-    pub(super) problem: ContactProblem,
+pub(super) struct Context<K: ContactOperator = ElasticOperator> {
+    pub(super) problem: ContactProblem<K>,
     pub(super) params: SolverParams,
     pub(super) state: SolverState,
     /// `M ≈ K⁻¹` in Fourier space, for the BCCG and the frozen-set CG (read-only but for
@@ -194,7 +212,7 @@ pub(super) struct Context {
     pub(super) interface: Interface,
 }
 
-impl Context {
+impl<K: ContactOperator> Context<K> {
     /// The residual of `iteration` of a BCCG or Polonsky–Keer solve, told to the monitor:
     /// [`SolveError::Stagnated`] where it has stopped decreasing (`stagnation.rs`).
     #[inline]

@@ -23,6 +23,7 @@
 //! ([`super::stiffness`]). None of them touches the solved state or another iteration's
 //! fields.
 
+use crate::elastic::ContactOperator;
 use super::solver::ContactSolver;
 use super::threshold::{FullContactScratch, FullContactThreshold};
 use super::SolveError;
@@ -35,7 +36,7 @@ enum Weights {
     Laplacian,
 }
 
-impl ContactSolver {
+impl<K: ContactOperator> ContactSolver<K> {
     /// Where a periodic surface comes into full contact. Mean pressure: with `K p = d − f`
     /// everywhere, `p = p̄ − K⁺f`, non-negative iff `p̄ ≥ max(K⁺f)` (Westergaard's
     /// `p* = π E* Δ / λ` for a sinusoid). Indentation: `K p` has zero mean, so

@@ -25,13 +25,14 @@
 //! The peers: ContactMechanics (`PlasticSystem`, `hardness=` on its Polonsky–Keer) and
 //! tamaas (`KatoSaturated`) solve the same problem.
 
+use crate::elastic::ContactOperator;
 use ndarray::Array2;
 
 use super::interface::Interface;
 use super::solver::ContactSolver;
 use super::{ContactSummary, Control, SolveError};
 
-impl ContactSolver {
+impl<K: ContactOperator> ContactSolver<K> {
     /// Solves with `interface` from now on (validated; the hard wall by default). The
     /// next solve starts cold; a kept plastic displacement stays.
     pub fn set_interface(&mut self, interface: Interface) -> Result<(), SolveError> {

@@ -60,7 +60,7 @@ use super::{
     ContactState, ContactSummary, Control, HalfSpace, SolveError, SolveInfo, SolverKind,
     SolverParams,
 };
-use crate::elastic::{Boundary, ElasticOperator};
+use crate::elastic::{Boundary, ContactOperator, ElasticOperator};
 use crate::pool::on_worker;
 use crate::stop::Stop;
 use crate::surface::Surface;
@@ -68,23 +68,25 @@ use crate::{memory, Error};
 
 /// Which iteration a solve runs: that of a [`SolverKind`] (its fields the solver's), or one
 /// the caller plugs in ([`ContactSolver::solve_with`]).
-pub(super) enum Runner<'a> {
+pub(super) enum Runner<'a, K: ContactOperator> {
     Kind(SolverKind),
     // (No iteration of the library is plugged yet: the seam's test plugs two.)
     #[cfg_attr(not(test), allow(dead_code))]
-    Plugged(&'a mut dyn Iteration),
+    Plugged(&'a mut dyn Iteration<K>),
 }
 
 /// A contact solver for one surface: the problem, the state of the last solve, and the
 /// scratch of each algorithm, each its own (module docs); successive solves allocate
-/// nothing and start from the previous pressure.
-pub struct ContactSolver {
+/// nothing and start from the previous pressure. `K` is the elastic body's operator: the
+/// homogeneous half-space's ([`ContactSolver::new`]) or any [`ContactOperator`]
+/// ([`ContactSolver::with_operator`]).
+pub struct ContactSolver<K: ContactOperator = ElasticOperator> {
     /// The problem, settings, state, preconditioner, stop flag and contact law that every
     /// iteration works on (`context.rs`).
-    pub(super) cx: Context,
+    pub(super) cx: Context<K>,
     /// The BCCG's own fields (`bccg.rs`, with the coarse correction of `mean_gap.rs` and
     /// the direct solve of small sets of `small_set.rs`).
-    pub(super) bccg_scratch: BccgScratch,
+    pub(super) bccg_scratch: BccgScratch<K>,
     /// The Polonsky–Keer iteration's own fields (`polonsky_keer.rs`), allocated on its
     /// first solve.
     pub(super) pk_scratch: Option<PkScratch>,
@@ -147,14 +149,63 @@ impl ContactSolver {
             ),
             Self::memory_bytes(rows, cols, half_space.boundary),
         )?;
-        let mut problem = ContactProblem::new(surface, half_space)?;
-        let preconditioner = FourierPreconditioner::new(
-            rows,
-            cols,
-            surface.spacing(),
-            surface.spacing_y(),
-            half_space.modulus,
+        let problem = ContactProblem::new(surface, half_space)?;
+        Self::assemble(problem, params)
+    }
+}
+
+impl<K: ContactOperator> ContactSolver<K> {
+    /// Plans a solver for `surface` on the body of `operator` (any [`ContactOperator`]: a
+    /// kernel other than the homogeneous half-space's plugs in here; it must have the
+    /// surface's grid and spacings); validates `params`, refuses grids whose fields would
+    /// not fit in memory (estimated as [`ContactSolver::memory_bytes`], with the
+    /// homogeneous half-space's operator). The solver is compiled for `K`: no dynamic
+    /// dispatch inside a solve. [`ContactSolver::new`] is this with the operator of the
+    /// half-space, to the bit.
+    ///
+    /// ```
+    /// use asperity::bem::{ContactSolver, Control, HalfSpace, SolverParams};
+    /// use asperity::elastic::{Boundary, ElasticOperator};
+    /// use asperity::surface::Surface;
+    ///
+    /// let heights = ndarray::Array2::from_shape_fn((32, 32), |(i, j)| {
+    ///     ((i as f64) * 0.4).sin() * ((j as f64) * 0.3).cos()
+    /// });
+    /// let surface = Surface::new(heights, 1.0).unwrap();
+    /// let operator = ElasticOperator::new(32, 32, 1.0, 2.0, Boundary::Periodic).unwrap();
+    /// let params = SolverParams::default();
+    /// let mut plugged = ContactSolver::with_operator(&surface, operator, params).unwrap();
+    /// let half_space = HalfSpace { modulus: 2.0, boundary: Boundary::Periodic };
+    /// let mut built_in = ContactSolver::new(&surface, half_space, params).unwrap();
+    /// let control = Control::MeanPressure(0.05);
+    /// assert_eq!(plugged.solve(control).unwrap(), built_in.solve(control).unwrap());
+    /// assert_eq!(plugged.pressure(), built_in.pressure());
+    /// ```
+    pub fn with_operator(
+        surface: &Surface,
+        operator: K,
+        params: SolverParams,
+    ) -> Result<Self, SolveError> {
+        validate_params(&params)?;
+        let (rows, cols, boundary) = (operator.rows(), operator.cols(), operator.boundary());
+        memory::ensure_fits(
+            &format!(
+                "a BEM solver for a {rows}x{cols} grid ({} boundaries)",
+                boundary.name()
+            ),
+            ContactSolver::memory_bytes(rows, cols, boundary),
         )?;
+        let problem = ContactProblem::with_operator(surface, operator)?;
+        Self::assemble(problem, params)
+    }
+
+    /// The solver of `problem`: the preconditioner for its operator's grid and modulus, the
+    /// BCCG's fields, the hard wall, no state.
+    fn assemble(mut problem: ContactProblem<K>, params: SolverParams) -> Result<Self, SolveError> {
+        let (rows, cols) = problem.dim();
+        let (dx, dy) = problem.operator.spacings();
+        let modulus = problem.operator.modulus();
+        let preconditioner = FourierPreconditioner::new(rows, cols, dx, dy, modulus)?;
         let bccg_scratch = BccgScratch::new(&mut problem.operator)?;
         let cx = Context {
             problem,
@@ -265,7 +316,7 @@ impl ContactSolver {
     }
 
     /// What is solved: the surface's profile on the half-space, on the grid.
-    pub fn problem(&self) -> &ContactProblem {
+    pub fn problem(&self) -> &ContactProblem<K> {
         &self.cx.problem
     }
 
@@ -295,7 +346,7 @@ impl ContactSolver {
     pub(super) fn solve_with(
         &mut self,
         control: Control,
-        iteration: &mut dyn Iteration,
+        iteration: &mut dyn Iteration<K>,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         self.solve_by(control, Runner::Plugged(iteration))
     }
@@ -304,7 +355,7 @@ impl ContactSolver {
     fn solve_by(
         &mut self,
         control: Control,
-        mut runner: Runner<'_>,
+        mut runner: Runner<'_, K>,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
         let target = match control {
             Control::MeanPressure(p) => Target::MeanPressure(check_load("mean pressure", p)?),
@@ -443,8 +494,8 @@ impl ContactSolver {
     /// one place that maps a [`SolverKind`] to its [`Iteration`].
     pub(super) fn iteration<'s>(
         &'s mut self,
-        runner: &'s mut Runner<'_>,
-    ) -> (&'s mut dyn Iteration, &'s mut Context) {
+        runner: &'s mut Runner<'_, K>,
+    ) -> (&'s mut dyn Iteration<K>, &'s mut Context<K>) {
         match runner {
             Runner::Kind(SolverKind::Bccg) => (&mut self.bccg_scratch, &mut self.cx),
             Runner::Kind(SolverKind::PolonskyKeer) => {
@@ -458,7 +509,7 @@ impl ContactSolver {
 
     /// Whether the last solve of the iteration of `runner` stalled
     /// ([`Iteration::stalled`]).
-    pub(super) fn stalled(&mut self, runner: &mut Runner<'_>) -> bool {
+    pub(super) fn stalled(&mut self, runner: &mut Runner<'_, K>) -> bool {
         self.iteration(runner).0.stalled()
     }
 
@@ -467,7 +518,7 @@ impl ContactSolver {
     /// or cold).
     pub(super) fn iterate(
         &mut self,
-        runner: &mut Runner<'_>,
+        runner: &mut Runner<'_, K>,
         target: Target,
         tolerance: f64,
         max_iterations: usize,
@@ -540,7 +591,7 @@ impl ContactSolver {
 }
 
 #[cfg(test)]
-impl ContactSolver {
+impl<K: ContactOperator> ContactSolver<K> {
     /// Switches the rings of the BCCG and of the frozen-set CG on or off whatever the grid's
     /// size (to test the solver both ways on small grids).
     pub(super) fn set_edge_rings(&mut self, on: bool) {
@@ -668,7 +719,7 @@ mod tests {
         solves: usize,
     }
 
-    impl Iteration for Counted {
+    impl Iteration<ElasticOperator> for Counted {
         fn solve(
             &mut self,
             cx: &mut Context,
@@ -687,7 +738,7 @@ mod tests {
     /// An iteration that gives up at once.
     struct GivesUp;
 
-    impl Iteration for GivesUp {
+    impl Iteration<ElasticOperator> for GivesUp {
         fn solve(
             &mut self,
             _cx: &mut Context,

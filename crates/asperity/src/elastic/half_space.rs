@@ -18,6 +18,7 @@
 
 use super::operator::{Boundary, ElasticOperator};
 use crate::fft::Precision;
+use crate::Result;
 
 /// A linear elastic response on a grid of pixels (module docs).
 pub trait HalfSpaceOperator {
@@ -80,5 +81,52 @@ impl<T: Precision> HalfSpaceOperator for ElasticOperator<T> {
 
     fn energy(&mut self, load: &[f64]) -> f64 {
         ElasticOperator::energy(self, load)
+    }
+}
+
+/// What the contact solver ([`crate::bem::ContactSolver`]: its iterations, BCCG and
+/// Polonsky–Keer, and its services) needs of an elastic body beyond [`HalfSpaceOperator`].
+/// The solver is generic over it and monomorphised: a body of another kernel (a layered or
+/// anisotropic half-space) plugs in by implementing both traits and
+/// [`crate::bem::ContactSolver::with_operator`], with no dynamic dispatch in the iterations.
+///
+/// The contract, beyond [`HalfSpaceOperator`]'s: `K` is translation invariant (the
+/// displacement at `i` of a unit load at `j` depends on `i − j` alone, periodically
+/// wrapped on periodic grids), so that its impulse response (`K e₀`, which the BCCG takes
+/// once through [`HalfSpaceOperator::apply`]) describes it — the BCCG's corrections of cut
+/// pressures and its direct solve of small sets read `K` from there.
+pub trait ContactOperator: HalfSpaceOperator + Send {
+    /// The operator the BCCG applies where single precision cannot change its iterates
+    /// (`bem/iterations/bccg.rs`); the operator itself where there is no cheaper one.
+    type Single: HalfSpaceOperator + Send;
+
+    /// The single-precision copy (errors: memory).
+    fn single_precision(&self) -> Result<Self::Single>;
+
+    /// The effective modulus `E*` of the Fourier preconditioner's symbol `E*|q|/2` (an
+    /// approximate inverse of `K`) and of the curvature of the periodic constant mode;
+    /// for a kernel other than the homogeneous half-space's, the modulus whose symbol is
+    /// closest to its own.
+    fn modulus(&self) -> f64;
+
+    /// Periodic boundaries: `load ← K⁺ displacement`, the zero-mean load whose
+    /// displacement is `displacement` up to a constant (the periodic full-contact
+    /// threshold, `bem/full_contact.rs`); an error on free boundaries.
+    fn apply_pseudo_inverse(&mut self, displacement: &[f64], load: &mut [f64]) -> Result<()>;
+}
+
+impl ContactOperator for ElasticOperator {
+    type Single = ElasticOperator<f32>;
+
+    fn single_precision(&self) -> Result<ElasticOperator<f32>> {
+        ElasticOperator::single_precision(self)
+    }
+
+    fn modulus(&self) -> f64 {
+        ElasticOperator::modulus(self)
+    }
+
+    fn apply_pseudo_inverse(&mut self, displacement: &[f64], load: &mut [f64]) -> Result<()> {
+        ElasticOperator::apply_pseudo_inverse(self, displacement, load)
     }
 }

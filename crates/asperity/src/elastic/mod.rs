@@ -26,6 +26,6 @@ pub mod love;
 pub mod operator;
 
 pub use cerruti::{cerruti_pixel_displacement, cerruti_spectrum, Direction};
-pub use half_space::HalfSpaceOperator;
+pub use half_space::{ContactOperator, HalfSpaceOperator};
 pub use love::{love_pixel_displacement, rectangle_self_influence, self_influence};
 pub use operator::{Boundary, ElasticOperator, Kernel};

@@ -87,8 +87,7 @@ use crate::bem::plastic_field::{PlasticField, Restored};
 use crate::bem::precondition::{Preconditioner, RingExtension, Ringed};
 use crate::bem::stagnation::Progress;
 use crate::bem::{ContactSummary, SolveError, SolveInfo};
-use crate::elastic::{Boundary, ElasticOperator};
-use crate::fft::Precision;
+use crate::elastic::{Boundary, ContactOperator, ElasticOperator, HalfSpaceOperator};
 use crate::sum::sum4;
 use crate::Result as CrateResult;
 
@@ -146,7 +145,7 @@ impl Sums {
 /// The BCCG's own fields: the search direction and its response, the preconditioned
 /// gradient, the gradient, the free set and its rings, the operator's impulse response,
 /// the cut pressures and the partial sums of the parallel passes.
-pub(in crate::bem) struct BccgScratch {
+pub(in crate::bem) struct BccgScratch<K: ContactOperator = ElasticOperator> {
     /// The search direction `s` (carried from one iteration to the next).
     pub(in crate::bem) direction: Vec<f64>,
     /// `w = K s`.
@@ -196,7 +195,7 @@ pub(in crate::bem) struct BccgScratch {
     /// transform alone (always, but in the test that compares it with forming `K s`).
     energy_steps: bool,
     /// The operator in single precision (module docs, step 7).
-    single: ElasticOperator<f32>,
+    single: K::Single,
     /// Whether the iteration uses `single` (always, but in the test that compares the
     /// solves with and without it).
     single_steps: bool,
@@ -235,9 +234,9 @@ impl MeanMode {
     }
 }
 
-impl BccgScratch {
+impl<K: ContactOperator> BccgScratch<K> {
     /// The fields for the grid of `operator` (one operator application).
-    pub(in crate::bem) fn new(operator: &mut ElasticOperator) -> CrateResult<Self> {
+    pub(in crate::bem) fn new(operator: &mut K) -> CrateResult<Self> {
         let len = operator.rows() * operator.cols();
         let mut unit = vec![0.0; len];
         unit[0] = 1.0;
@@ -510,8 +509,8 @@ fn direction_pass(
 }
 
 /// [`ContactSolver::curvature`] with `operator`, of either precision.
-fn curvature_with<T: Precision>(
-    operator: &mut ElasticOperator<T>,
+fn curvature_with(
+    operator: &mut impl HalfSpaceOperator,
     (direction, response, partials): (&[f64], &mut [f64], &mut [Sums]),
     energy_only: bool,
 ) -> f64 {
@@ -607,12 +606,12 @@ fn step_pass<const DISPLACEMENT: bool, const CAPPED: bool>(
     Sums::total(partials)
 }
 
-impl Iteration for BccgScratch {
+impl<K: ContactOperator> Iteration<K> for BccgScratch<K> {
     /// The BCCG iteration for `target` to the tolerance in at most the iterations of
     /// `limits`, from the solver's start in `cx` (see the module docs).
     fn solve(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         limits: Limits,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
@@ -695,14 +694,14 @@ impl Iteration for BccgScratch {
     }
 }
 
-impl BccgScratch {
+impl<K: ContactOperator> BccgScratch<K> {
     /// Under a cap: the direct solve of a small set (`small_set.rs`) knows the hard wall
     /// only; where its pressure passes the cap, it is projected onto `[0, h]`, the load
     /// restored, and the BCCG goes on from there (`u` then recomputed). Where it does not,
     /// it is the capped solution as well.
     fn cap_small_set(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         small: SmallSetRun,
     ) -> SmallSetRun {
@@ -730,7 +729,7 @@ impl BccgScratch {
     /// (the last solve's under load control) and what the direct solve did.
     fn bccg_start(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         max_iterations: usize,
     ) -> Result<(f64, SmallSetRun), SolveError> {
@@ -769,7 +768,7 @@ impl BccgScratch {
     /// Passes over the grid: `d` (load control, the mean of `u + f` on the contact set),
     /// the residual, the free set and its mean gradient; writes `Π g` on the free set (zero
     /// elsewhere) into the preconditioner's field and the gradient field.
-    fn gradient_pass(&mut self, cx: &mut Context, target: Target, previous: f64) -> Gradient {
+    fn gradient_pass(&mut self, cx: &mut Context<K>, target: Target, previous: f64) -> Gradient {
         let scratch = &mut *self;
         let Rule { capped, h } = Rule::of(cx.interface);
         let indentation = match target {
@@ -829,7 +828,7 @@ impl BccgScratch {
     /// periodic grid, where the rings cost more than they save (1024², H = 0.3 E*: 53
     /// iterations without them against 57, 6.7 s against 10.3 s; on free grids they still
     /// save iterations: 35 against 46 at 512²; hardness.md).
-    fn rings_apply(&self, cx: &Context) -> bool {
+    fn rings_apply(&self, cx: &Context<K>) -> bool {
         let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
         self.edge_rings && !(periodic && Rule::of(cx.interface).capped)
     }
@@ -838,7 +837,7 @@ impl BccgScratch {
     /// has not halved in [`RING_WINDOW`] iterations: the solve then goes on without them
     /// (`P_F M P_F`, the preconditioner of the smaller grids; its convergence does not
     /// rest on the contact set's edges).
-    fn rings_stalled(&mut self, cx: &Context, iteration: usize, residual: f64) -> bool {
+    fn rings_stalled(&mut self, cx: &Context<K>, iteration: usize, residual: f64) -> bool {
         if !self.rings_apply(cx) || self.ring_progress.observe(iteration, residual).is_ok() {
             return false;
         }
@@ -849,7 +848,7 @@ impl BccgScratch {
     /// Under displacement control with the mean gap deflated: the coarse curvature of the
     /// free set, for the coarse constant of the preconditioned gradient. False where the
     /// solve carries no mean-gap scratch (no deflation then).
-    fn deflate_mean(&mut self, cx: &mut Context) -> bool {
+    fn deflate_mean(&mut self, cx: &mut Context<K>) -> bool {
         let Some(mean_gap) = self.mean_gap.as_mut() else {
             return false;
         };
@@ -862,7 +861,7 @@ impl BccgScratch {
     /// P_F (I + E)ᵀ M (I + E) Π g (`ring_extension.rs`, [`Ringed`] decorating the Fourier
     /// preconditioner), Π g formed row by row on its way into the transform (never stored
     /// whole).
-    fn precondition_gradient(&mut self, cx: &mut Context, centre: f64) {
+    fn precondition_gradient(&mut self, cx: &mut Context<K>, centre: f64) {
         let ringed = self.rings_apply(cx);
         let scratch = &mut *self;
         let (free, gradient) = (&scratch.free[..], &mut scratch.gradient[..]);
@@ -883,7 +882,7 @@ impl BccgScratch {
     /// new direction follow from those of the old one (one pass of sums, one of writes).
     fn direction(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         gradient: &Gradient,
         previous_zg: f64,
@@ -963,7 +962,7 @@ impl BccgScratch {
     /// points then stay far inside f32's range (`3.4e38` down to `1.2e-38`). Outside, the
     /// energies are computed in double precision (as PK's always are): the result is the
     /// same, only slower, whatever the units.
-    fn f32_safe(cx: &Context, target: Target) -> bool {
+    fn f32_safe(cx: &Context<K>, target: Target) -> bool {
         let inside = |x: f64| x == 0.0 || (x.abs() > 2f64.powi(-40) && x.abs() < 2f64.powi(40));
         let load = match target {
             Target::MeanPressure(p) => p,
@@ -976,7 +975,7 @@ impl BccgScratch {
     /// recomputed afterwards needs no more: with `energy_only`, from the forward transform
     /// of `s` alone (Parseval, about half an application); else with `w = K s` in the
     /// response field, for the step's `u`.
-    fn curvature(&mut self, cx: &mut Context, energy_only: bool, single: bool) -> f64 {
+    fn curvature(&mut self, cx: &mut Context<K>, energy_only: bool, single: bool) -> f64 {
         let scratch = &mut *self;
         let fields = (
             &scratch.direction[..],
@@ -994,7 +993,7 @@ impl BccgScratch {
     /// `p` and `u` (in the next pass). `(sg, curvature)` is `(sᵀΠg, sᵀK s)`.
     fn step(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         gradient: &Gradient,
         (sg, curvature): (f64, f64),
@@ -1070,7 +1069,7 @@ impl BccgScratch {
     /// is now stale (it was with `stale`) and the operator applications it took.
     fn restore_step_load(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         mean_pressure: f64,
         (total, peak): (f64, f64),
         mut stale: bool,
@@ -1109,7 +1108,7 @@ impl BccgScratch {
 
     /// `K 1_C` follows the `changes` the step pass made to the capped set (listed in the
     /// second half of each chunk's slots).
-    fn follow_capped_set(&mut self, cx: &mut Context, changes: usize) {
+    fn follow_capped_set(&mut self, cx: &mut Context<K>, changes: usize) {
         let periodic = cx.problem.operator.boundary() == Boundary::Periodic;
         let grid = (cx.problem.rows, cx.problem.cols, periodic);
         let scratch = &mut *self;
@@ -1132,7 +1131,7 @@ impl BccgScratch {
     /// the steps' `K s` are).
     fn restore_capped(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         (mean_pressure, h, total): (f64, f64, f64),
         exact_u: bool,
     ) -> (Restored, bool) {
@@ -1167,7 +1166,7 @@ impl BccgScratch {
 
     /// `u = K p` (in the gap buffer; with `single`, in single precision), after the pending
     /// load restoration of `p` (that of `u` is moot).
-    fn refresh_displacement(&mut self, cx: &mut Context, single: bool) {
+    fn refresh_displacement(&mut self, cx: &mut Context<K>, single: bool) {
         let scale = std::mem::replace(&mut self.pending_scale, 1.0);
         if scale != 1.0 {
             cx.state
@@ -1183,7 +1182,7 @@ impl BccgScratch {
     }
 
     /// Turns the displacement in the gap buffer into the gap `u + f − d`.
-    fn write_gap(&mut self, cx: &mut Context, indentation: f64) {
+    fn write_gap(&mut self, cx: &mut Context<K>, indentation: f64) {
         for (g, &f) in cx.state.gap.iter_mut().zip(&cx.problem.profile) {
             *g += f - indentation;
         }

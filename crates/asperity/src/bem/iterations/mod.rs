@@ -37,6 +37,7 @@ pub(super) use polonsky_keer::PkScratch;
 
 use super::context::{Context, Target};
 use super::{ContactSummary, SolveError, SolveInfo};
+use crate::elastic::ContactOperator;
 
 /// When an iteration stops: at a residual (the module docs of [`crate::bem`]) below
 /// `tolerance`, or with [`SolveError::NoConvergence`] after `max_iterations`.
@@ -48,15 +49,16 @@ pub(super) struct Limits {
     pub(super) max_iterations: usize,
 }
 
-/// An algorithm that solves the contact problem of a [`Context`] (module docs). `Send`: a
-/// solve runs on a worker of the thread pool.
-pub(super) trait Iteration: Send {
+/// An algorithm that solves the contact problem of a [`Context`] (module docs) on the body
+/// of `K` (monomorphised: no dynamic dispatch inside a solve). `Send`: a solve runs on a
+/// worker of the thread pool.
+pub(super) trait Iteration<K: ContactOperator>: Send {
     /// Solves for `target` within `limits` from the initial pressure in `cx.state`; on
     /// success `cx.state` holds the solved pressure and gap and the summary comes from
     /// [`Context::finish`]. Allocates nothing once its fields exist.
     fn solve(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         limits: Limits,
     ) -> Result<(ContactSummary, SolveInfo), SolveError>;

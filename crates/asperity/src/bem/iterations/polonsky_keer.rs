@@ -23,6 +23,7 @@ use super::{Iteration, Limits};
 use crate::bem::context::{Context, Target};
 use crate::bem::interface::{restore_capped_load, CappedRestoration, Interface, LOST_SET_LIMIT};
 use crate::bem::{ContactSummary, SolveError, SolveInfo};
+use crate::elastic::ContactOperator;
 
 /// The iteration's own fields: the conjugate direction `t` and its response `K t`. Owned
 /// by the solver, allocated on the first Polonsky–Keer solve; nothing is kept in them
@@ -47,13 +48,13 @@ impl PkScratch {
     }
 }
 
-impl Iteration for PkScratch {
+impl<K: ContactOperator> Iteration<K> for PkScratch {
     /// The Polonsky–Keer iteration for `target` to the tolerance in at most the iterations
     /// of `limits`, from the solver's start in `cx` (see [`crate::bem::ContactSolver::solve`]),
     /// in its own fields.
     fn solve(
         &mut self,
-        cx: &mut Context,
+        cx: &mut Context<K>,
         target: Target,
         limits: Limits,
     ) -> Result<(ContactSummary, SolveInfo), SolveError> {
@@ -136,8 +137,8 @@ impl Iteration for PkScratch {
 /// update (penetrating points enter with p = −τ g; before any step exists, the empty
 /// set, a Jacobi step with the self-influence). Returns the pressures' sum and whether
 /// points entered.
-fn pk_step(
-    cx: &mut Context,
+fn pk_step<K: ContactOperator>(
+    cx: &mut Context<K>,
     pk: &mut PkScratch,
     load_control: bool,
     moving_points: usize,
@@ -168,7 +169,7 @@ fn pk_step(
 /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
 /// sum `total` (or reset to uniform if nothing is left: `Restarted`); under a cap by
 /// [`restore_capped_load`].
-fn restore_load(cx: &mut Context, target: Target, total: f64) -> CappedRestoration {
+fn restore_load<K: ContactOperator>(cx: &mut Context<K>, target: Target, total: f64) -> CappedRestoration {
     let Target::MeanPressure(mean_pressure) = target else {
         return CappedRestoration::Held;
     };

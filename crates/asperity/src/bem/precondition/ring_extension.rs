@@ -39,7 +39,7 @@
 use rayon::prelude::*;
 
 use super::fourier::{centre_on_set, Preconditioner};
-use crate::elastic::{Boundary, ElasticOperator};
+use crate::elastic::{Boundary, HalfSpaceOperator};
 
 /// Weights of the first and the second ring (measured, see the module docs).
 const GAMMA: [f64; 2] = [0.7, 0.5];
@@ -229,7 +229,7 @@ impl RowLists {
 
 impl RingExtension {
     /// The fields for the grid of `operator` (its size and boundaries).
-    pub(in crate::bem) fn on_grid_of(operator: &ElasticOperator) -> Self {
+    pub(in crate::bem) fn on_grid_of(operator: &impl HalfSpaceOperator) -> Self {
         let periodic = operator.boundary() == Boundary::Periodic;
         Self::new(operator.rows(), operator.cols(), periodic)
     }

@@ -42,6 +42,7 @@
 pub(crate) mod cg;
 pub(super) mod work;
 
+use crate::elastic::ContactOperator;
 use super::context::Target;
 use super::interface::Interface;
 use super::iterations::small_set;
@@ -77,7 +78,7 @@ fn solve_info(info: &CgInfo) -> SolveInfo {
     }
 }
 
-impl ContactSolver {
+impl<K: ContactOperator> ContactSolver<K> {
     fn stiffness_work(&mut self) -> StiffnessWork {
         let operator = &self.cx.problem.operator;
         let rings = operator.rows() * operator.cols() >= RING_MIN_POINTS;
@@ -158,10 +159,7 @@ impl ContactSolver {
                 .map_err(SolveError::from)
             }
         };
-        let (dx, dy) = (
-            self.cx.problem.operator.spacing(),
-            self.cx.problem.operator.spacing_y(),
-        );
+        let (dx, dy) = self.cx.problem.operator.spacings();
         work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
         result.map(|(info, ones_x)| (ones_x * dx * dy, info))

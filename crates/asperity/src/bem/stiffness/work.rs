@@ -2,7 +2,7 @@
 //! solver; the computations that use them are in `stiffness/mod.rs`.
 
 use super::cg::CgWork;
-use crate::elastic::ElasticOperator;
+use crate::elastic::HalfSpaceOperator;
 
 /// The fields of the stiffness and full-contact CGs, owned by the solver and allocated on
 /// first use: never the solved state's.
@@ -19,7 +19,7 @@ pub(in crate::bem) struct StiffnessWork {
 impl StiffnessWork {
     /// The fields for the grid of `operator`, with the rings around the set (as in the
     /// BCCG, `ring_extension.rs`) if `rings`.
-    pub(in crate::bem) fn new(operator: &ElasticOperator, rings: bool) -> Self {
+    pub(in crate::bem) fn new(operator: &impl HalfSpaceOperator, rings: bool) -> Self {
         let len = operator.rows() * operator.cols();
         StiffnessWork {
             cg: CgWork::for_operator(operator, rings),

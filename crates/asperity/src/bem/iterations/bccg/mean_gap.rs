@@ -27,10 +27,10 @@
 //! act on complementary subspaces, so `z` is a valid preconditioned gradient, and the rest
 //! of the iteration (Polak–Ribière direction, exact line minimum, projection) is unchanged.
 //! The curvature costs one forward transform whenever `F` changes (the quadratic form
-//! [`ElasticOperator::energy`], a sum of non-negative terms; computed from `1_O`, not `1_F`,
+//! [`crate::elastic::ElasticOperator::energy`], a sum of non-negative terms; computed from `1_O`, not `1_F`,
 //! so that it keeps its relative accuracy when `O` is small).
 
-use crate::elastic::ElasticOperator;
+use crate::elastic::{ContactOperator, HalfSpaceOperator};
 
 /// The fields of the coarse correction (periodic grids only).
 pub(in crate::bem) struct MeanGapScratch {
@@ -47,10 +47,10 @@ pub(in crate::bem) struct MeanGapScratch {
 
 impl MeanGapScratch {
     /// Fields for the grid of `operator`.
-    pub(in crate::bem) fn new(operator: &ElasticOperator) -> Self {
+    pub(in crate::bem) fn new(operator: &impl ContactOperator) -> Self {
         let len = operator.rows() * operator.cols();
-        let longest = (operator.cols() as f64 * operator.spacing())
-            .max(operator.rows() as f64 * operator.spacing_y());
+        let (dx, dy) = operator.spacings();
+        let longest = (operator.cols() as f64 * dx).max(operator.rows() as f64 * dy);
         MeanGapScratch {
             open: vec![0.0; len],
             free: vec![false; len],
@@ -68,7 +68,7 @@ impl MeanGapScratch {
     /// when the set differs from the previous call's).
     pub(in crate::bem) fn curvature(
         &mut self,
-        operator: &mut ElasticOperator,
+        operator: &mut impl HalfSpaceOperator,
         free: &[bool],
     ) -> (f64, bool) {
         if let Some(c) = self.curvature.filter(|_| self.free[..] == free[..]) {

@@ -40,7 +40,7 @@ use crate::bem::SolveError;
 
 /// The contact rule of the direct solve (it serves the BCCG, which solves the hard wall).
 const WALL: Interface = Interface::HardWall;
-use crate::elastic::Boundary;
+use crate::elastic::{Boundary, ContactOperator};
 
 /// Factorisations per solve after which the iteration gives up (the active set cycles).
 const MAX_SOLVES: usize = 24;
@@ -291,10 +291,10 @@ fn highest_point(profile: &[f64]) -> usize {
 /// (module docs), in the fields of `slot` (allocated there on first use) with the operator's
 /// impulse response `impulse`; leaves a pressure for the BCCG to finish. At most
 /// `max_iterations` operator applications.
-pub(in crate::bem) fn small_set_start(
+pub(in crate::bem) fn small_set_start<K: ContactOperator>(
     slot: &mut Option<SmallSet>,
     impulse: &[f64],
-    cx: &mut Context,
+    cx: &mut Context<K>,
     (target, max_iterations): (Target, usize),
 ) -> Result<SmallSetRun, SolveError> {
     let (rows, cols) = (cx.problem.rows, cx.problem.cols);
@@ -362,9 +362,9 @@ pub(in crate::bem) fn small_set_start(
 /// points where that bound is below the entering slack (less a margin for the rounding
 /// of the transforms) would all enter: more than [`GIVE_UP_ENTERING`] limits of them
 /// and the check, an operator application, would give up.
-fn highest_point_gives_up(
+fn highest_point_gives_up<K: ContactOperator>(
     impulse: &[f64],
-    cx: &Context,
+    cx: &Context<K>,
     (mean_pressure, limit): (f64, usize),
 ) -> bool {
     let load = mean_pressure * impulse.len() as f64;
@@ -380,10 +380,10 @@ fn highest_point_gives_up(
 }
 
 /// The iteration of the module docs from the set in `small_set`.
-fn small_set_iterate(
+fn small_set_iterate<K: ContactOperator>(
     slot: &mut Option<SmallSet>,
     impulse: &[f64],
-    cx: &mut Context,
+    cx: &mut Context<K>,
     (target, max_iterations): (Target, usize),
 ) -> Result<SmallSetRun, SolveError> {
     let mut run = SmallSetRun {
