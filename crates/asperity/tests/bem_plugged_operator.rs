@@ -110,7 +110,11 @@ fn a_plugged_operator_gives_the_built_in_results_bit_for_bit() {
                     assert_eq!(k, built_in.frozen_set_stiffness().unwrap(), "{case}");
                 }
                 let d = Control::Indentation(built_in.summary().unwrap().indentation);
-                assert_eq!(plugged.solve(d).unwrap(), built_in.solve(d).unwrap(), "{case}");
+                assert_eq!(
+                    plugged.solve(d).unwrap(),
+                    built_in.solve(d).unwrap(),
+                    "{case}"
+                );
                 assert_eq!(plugged.state(), built_in.state(), "{case}");
                 assert!(plugged.problem().operator().applications > 0, "{case}");
             }

@@ -28,11 +28,11 @@
 //! `1 ± LOAD_HANDOVER`, holding the sets), so the load is exact as in any load-controlled
 //! solve and convergence is judged by the same residual.
 
-use crate::elastic::ContactOperator;
 use super::context::Target;
 use super::interface::{bearing_start, Interface};
 use super::solver::{ContactSolver, Runner};
 use super::{ContactSummary, SolveError, SolveInfo};
+use crate::elastic::ContactOperator;
 
 /// The relative load error of a displacement-controlled solve at which the root search
 /// hands over to the load iteration: well above the load's noise from the solves'

@@ -23,11 +23,11 @@
 //! ([`super::stiffness`]). None of them touches the solved state or another iteration's
 //! fields.
 
-use crate::elastic::ContactOperator;
 use super::solver::ContactSolver;
 use super::threshold::{FullContactScratch, FullContactThreshold};
 use super::SolveError;
 use crate::elastic::Boundary;
+use crate::elastic::ContactOperator;
 
 /// The weightings of the lower bound (module docs).
 #[derive(Debug, Clone, Copy)]

@@ -169,7 +169,11 @@ fn pk_step<K: ContactOperator>(
 /// Pass E: under load control, `p` rescaled to the prescribed mean pressure from its
 /// sum `total` (or reset to uniform if nothing is left: `Restarted`); under a cap by
 /// [`restore_capped_load`].
-fn restore_load<K: ContactOperator>(cx: &mut Context<K>, target: Target, total: f64) -> CappedRestoration {
+fn restore_load<K: ContactOperator>(
+    cx: &mut Context<K>,
+    target: Target,
+    total: f64,
+) -> CappedRestoration {
     let Target::MeanPressure(mean_pressure) = target else {
         return CappedRestoration::Held;
     };

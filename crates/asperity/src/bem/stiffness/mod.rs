@@ -42,7 +42,6 @@
 pub(crate) mod cg;
 pub(super) mod work;
 
-use crate::elastic::ContactOperator;
 use super::context::Target;
 use super::interface::Interface;
 use super::iterations::small_set;
@@ -50,6 +49,7 @@ use super::iterations::RING_MIN_POINTS;
 use super::solver::ContactSolver;
 use super::threshold::FullContactThreshold;
 use super::{Control, SolveError, SolveInfo};
+use crate::elastic::ContactOperator;
 use crate::Error;
 use cg::{conjugate_gradient_on_set, CgInfo, CgParams, RightHandSide};
 use work::StiffnessWork;
