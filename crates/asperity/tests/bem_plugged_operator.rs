@@ -84,7 +84,7 @@ fn a_plugged_operator_gives_the_built_in_results_bit_for_bit() {
                     boundary,
                 };
                 let operator = Counting {
-                    inner: ElasticOperator::new(64, 64, 1.0, 1.3, boundary).unwrap(),
+                    inner: ElasticOperator::new(64, 64, surface.spacing(), 1.3, boundary).unwrap(),
                     applications: 0,
                 };
                 let mut plugged = ContactSolver::with_operator(&surface, operator, params)
