@@ -172,7 +172,8 @@ impl<K: ContactOperator> ContactSolver<K> {
     ///     ((i as f64) * 0.4).sin() * ((j as f64) * 0.3).cos()
     /// });
     /// let surface = Surface::new(heights, 1.0).unwrap();
-    /// let operator = ElasticOperator::new(32, 32, 1.0, 2.0, Boundary::Periodic).unwrap();
+    /// let dx = surface.spacing(); // (the side 1.0 over 32 points)
+    /// let operator = ElasticOperator::new(32, 32, dx, 2.0, Boundary::Periodic).unwrap();
     /// let params = SolverParams::default();
     /// let mut plugged = ContactSolver::with_operator(&surface, operator, params).unwrap();
     /// let half_space = HalfSpace { modulus: 2.0, boundary: Boundary::Periodic };
