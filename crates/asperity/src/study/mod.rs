@@ -91,11 +91,14 @@ use crate::{io, Error, Result};
 use identity::{TaskIdentity, Unsealed};
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A study of one task (N = `n`, H = 0.5, 3 samples) in a new folder, opened.
-    fn three_sample_study(method: Method, n: usize) -> (StudySpec, tempfile::TempDir, StudyDir) {
+    pub(crate) fn three_sample_study(
+        method: Method,
+        n: usize,
+    ) -> (StudySpec, tempfile::TempDir, StudyDir) {
         let spec = StudySpec {
             method,
             sizes: vec![n],

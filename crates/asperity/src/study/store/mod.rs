@@ -651,7 +651,7 @@ impl StudyDir {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::{run_any_task, FitWindow, Method};
+    use crate::study::{run_any_task, Method};
 
     /// A finished task's checkpoint as written before the mean curve kept the contact
     /// fraction's interval (533a278): the same result without `fraction_low`/`_high`.
@@ -680,20 +680,7 @@ mod tests {
     /// same as a new run's bit for bit; without kept curves, unknown (NaN).
     #[test]
     fn checkpoints_older_than_the_fraction_interval_are_read_with_it() {
-        let spec = StudySpec {
-            method: Method::Bem,
-            sizes: vec![16],
-            hursts: vec![0.5],
-            samples: 3,
-            rolloff: None,
-            seed: 3,
-            window: FitWindow::default(),
-            levels: 16,
-            sweep_end: None,
-            poisson: None,
-        };
-        let dir = tempfile::tempdir().unwrap();
-        let store = StudyDir::open(dir.path(), &spec, false).unwrap();
+        let (spec, _dir, store) = crate::study::tests::three_sample_study(Method::Bem, 16);
         let task = spec.tasks()[0];
         let result = run_any_task(&spec, task, &store, &|_, _| {}).unwrap();
         assert!(result.mean_curve.iter().all(|p| p.fraction_low.is_finite()));
