@@ -1702,19 +1702,23 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
     return [float(h) for h in np.atleast_1d(np.asarray(hurst, dtype=np.float64))]
 
 
-def _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts, max_fraction,
-               levels, alpha_sweep, force, checkpoint_every, progress, description,
-               derived=(None, None, None)):
+def _run_study(kind, method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
+               max_fraction, levels, full_sweep, force, checkpoint_every, progress,
+               description, derived=(None, None, None)):
+    # The study's keywords, read by the front-end layer (asperity_app::study::request):
+    # integers as given (a negative count is refused there, in the CLI's words).
     count = lambda v: None if v is None else int(v)
-    args = (
-        str(method), [int(n) for n in sizes], _hursts(hurst), int(samples), _opt(rolloff),
-        count(seed), count(min_contacts), _opt(max_fraction), count(levels),
-        bool(alpha_sweep), os.fspath(out), bool(force), _opt(checkpoint_every),
+    request = dict(
+        kind=kind, method=str(method), sizes=[int(n) for n in sizes], hursts=_hursts(hurst),
+        samples=int(samples), rolloff=_opt(rolloff),
+        seed=None if seed is None else _seed(seed), min_contacts=count(min_contacts),
+        max_fraction=_opt(max_fraction), levels=count(levels), full_sweep=bool(full_sweep),
+        poisson=_opt(derived[0]),
     )
-    poisson, resistivity, thermal = derived
+    args = (request, os.fspath(out), bool(force), _opt(checkpoint_every))
+    _, resistivity, thermal = derived
     pair = lambda v: None if v is None else [float(x) for x in np.atleast_1d(v)]
-    derived = dict(poisson=_opt(poisson), resistivity=pair(resistivity),
-                   thermal_conductivity=pair(thermal))
+    derived = dict(resistivity=pair(resistivity), thermal_conductivity=pair(thermal))
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
     comm = _mpi.world()
     if comm is not None and comm.Get_rank() != 0:
@@ -1798,9 +1802,9 @@ def study_alpha(
         True
     """
     sizes = [n] if np.ndim(n) == 0 else list(n)
-    records = _run_study(method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
-                         max_fraction, levels, not full_sweep, force, checkpoint_every, progress,
-                         f"{method} study")
+    records = _run_study("alpha", method, sizes, hurst, samples, out, rolloff, seed,
+                         min_contacts, max_fraction, levels, full_sweep, force,
+                         checkpoint_every, progress, f"{method} study")
     columns, rows = _table(records["alpha"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
                        records["comparison_error"], _study_metadata("alpha", out),
@@ -1849,9 +1853,10 @@ def study_curve(
         >>> bool((np.diff(c.stiffness) >= 0).all())     # k rises with F
         True
     """
-    records = _run_study(method, [n], hurst, samples, out, rolloff, seed, min_contacts,
-                         max_fraction, levels, False, force, checkpoint_every, progress,
-                         f"{method} study", (poisson, resistivity, thermal_conductivity))
+    records = _run_study("curve", method, [n], hurst, samples, out, rolloff, seed,
+                         min_contacts, max_fraction, levels, False, force, checkpoint_every,
+                         progress, f"{method} study", (poisson, resistivity,
+                                                       thermal_conductivity))
     columns, rows = _table(records["curve"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
                        records["comparison_error"], _study_metadata("curve", out),

@@ -104,12 +104,12 @@ def persson_table(
     kappa: float, pressures: Optional[List[float]], nloads: Optional[int],
     pmin: Optional[float], pmax: Optional[float],
 ) -> Dict[str, Any]: ...
+# A study's keywords: kind ("alpha"|"curve"), method, sizes, hursts, samples, rolloff,
+# seed (its digits), min_contacts, max_fraction, levels, full_sweep, poisson.
+StudyKeywords = Dict[str, Any]
 def run_study(
-    method_name: str, sizes: List[int], hursts: List[float], samples: int,
-    rolloff: Optional[float], seed: Optional[int], min_contacts: Optional[int],
-    max_fraction: Optional[float], levels: Optional[int], alpha_sweep: bool, out: str,
-    force: bool, checkpoint_every: Optional[float], progress: Progress,
-    poisson: Optional[float] = ..., resistivity: Optional[List[float]] = ...,
+    request: StudyKeywords, out: str, force: bool, checkpoint_every: Optional[float],
+    progress: Progress, resistivity: Optional[List[float]] = ...,
     thermal_conductivity: Optional[List[float]] = ...,
     eta: Optional[Callable[["StudyEta"], Any]] = ...,
 ) -> str: ...
@@ -129,11 +129,9 @@ Action = Tuple[str, int, int, List[int], Optional[str]]
 class StudyCoordinator:
     def __init__(self, size: int, lanes: int) -> None: ...
     def begin(
-        self, method_name: str, sizes: List[int], hursts: List[float], samples: int,
-        rolloff: Optional[float], seed: Optional[int], min_contacts: Optional[int],
-        max_fraction: Optional[float], levels: Optional[int], alpha_sweep: bool, out: str,
-        force: bool, checkpoint_every: Optional[float], poisson: Optional[float] = ...,
-        resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
+        self, request: StudyKeywords, out: str, force: bool,
+        checkpoint_every: Optional[float], resistivity: Optional[List[float]] = ...,
+        thermal_conductivity: Optional[List[float]] = ...,
     ) -> List[Action]: ...
     def on_ready(self, rank: int, lanes: int) -> List[Action]: ...
     def on_done(self, rank: int, curves: str) -> List[Action]: ...

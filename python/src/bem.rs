@@ -75,7 +75,7 @@ fn sweep_loads(
     forces: Option<Vec<f64>>,
     pressures: Option<Vec<f64>>,
     indentations: Option<Vec<f64>>,
-    nloads: Option<i64>,
+    nloads: Option<i128>,
     pmin: Option<f64>,
     pmax: Option<f64>,
     fields: bool,
@@ -189,7 +189,7 @@ impl Solver {
         modulus: f64,
         boundary: &str,
         tolerance: f64,
-        max_iterations: i64,
+        max_iterations: i128,
         solver: &str,
         hardness: Option<f64>,
     ) -> PyResult<Self> {

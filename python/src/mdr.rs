@@ -100,7 +100,10 @@ pub fn request<'py>(
         slope: item(keywords, "slope")?,
         coefficient: item(keywords, "coefficient")?,
         exponent: item(keywords, "exponent")?,
-        n: item(keywords, "n")?,
+        n: (item::<i128>(keywords, "n")?)
+            .map(|n| count(params::N, n))
+            .transpose()
+            .map_err(refused)?,
         dx: item(keywords, "dx")?,
         size: item(keywords, "size")?,
         modulus: item(keywords, "modulus")?.unwrap_or(defaults.modulus),
@@ -109,7 +112,7 @@ pub fn request<'py>(
         rms_height: item(keywords, "rms_height")?,
         asperity_radius: item(keywords, "asperity_radius")?,
         indentations: item(keywords, "indentations")?,
-        nloads: (item::<i64>(keywords, "nloads")?)
+        nloads: (item::<i128>(keywords, "nloads")?)
             .map(|n| count(params::NLOADS, n))
             .transpose()
             .map_err(refused)?,

@@ -35,7 +35,7 @@ fn persson_table<'py>(
     gamma: f64,
     kappa: f64,
     pressures: Option<Vec<f64>>,
-    nloads: Option<i64>,
+    nloads: Option<i128>,
     pmin: Option<f64>,
     pmax: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {

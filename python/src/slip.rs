@@ -27,7 +27,7 @@ fn mdr_slip<'py>(
     tangential_force: f64,
     friction: Option<f64>,
     poisson: Option<f64>,
-    cycle_points: Option<usize>,
+    cycle_points: Option<i128>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mdr = crate::mdr::request(request, &line, &radial)?;
     let slip = SlipRequest {

@@ -14,11 +14,12 @@ use std::path::PathBuf;
 use asperity::lock::FolderLock;
 use asperity::stop::Stop;
 use asperity::study::{
-    Method, SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples, CHECKPOINT_INTERVAL,
+    SampleCurve, StudyDir, StudySpec, Task, TaskResult, TaskSamples, CHECKPOINT_INTERVAL,
 };
 use asperity::Error;
 use asperity_app::study::distributed::{Action, Coordinator, DistributedError};
 use asperity_app::study::progress::{log_line, Eta, StudyProgress};
+use asperity_app::study::request::StudyRequest;
 use asperity_app::study::{self, rows, Kind, TaskFailure};
 use asperity_app::Names;
 use pyo3::prelude::*;
@@ -89,56 +90,68 @@ fn comparison_columns() -> Vec<(&'static str, String)> {
         .collect()
 }
 
-fn method(name: &str) -> PyResult<Method> {
-    match name {
-        "mdr" => Ok(Method::Mdr),
-        "bem" => Ok(Method::Bem),
-        other => Err(invalid(format!(
-            "invalid method {other:?}: expected mdr or bem"
-        ))),
+/// The keywords of a study (`study_alpha`, `study_curve`) as `_run_study` hands them over,
+/// a dict with these keys: the [`StudyRequest`] both front ends make.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct StudyKeywords {
+    /// `alpha` or `curve`.
+    kind: String,
+    method: String,
+    sizes: Vec<i128>,
+    hursts: Vec<f64>,
+    samples: i128,
+    rolloff: Option<f64>,
+    seed: Option<String>,
+    min_contacts: Option<i128>,
+    max_fraction: Option<f64>,
+    levels: Option<i128>,
+    full_sweep: bool,
+    poisson: Option<f64>,
+}
+
+impl From<StudyKeywords> for StudyRequest {
+    fn from(k: StudyKeywords) -> Self {
+        StudyRequest {
+            kind: match k.kind.as_str() {
+                "curve" => Kind::Curve,
+                _ => Kind::Alpha,
+            },
+            method: k.method,
+            sizes: k.sizes,
+            hursts: k.hursts,
+            samples: k.samples,
+            rolloff: k.rolloff,
+            seed: k.seed,
+            min_contacts: k.min_contacts,
+            max_fraction: k.max_fraction,
+            levels: k.levels,
+            full_sweep: k.full_sweep,
+            poisson: k.poisson,
+        }
     }
 }
 
 /// Runs (or resumes) a study in `out`; returns the task results and the result tables
 /// (`alpha.csv`'s and `curve.csv`'s) as JSON text ([`records`]).
 #[pyfunction]
-#[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-    max_fraction, levels, alpha_sweep, out, force, checkpoint_every, progress, poisson=None,
-    resistivity=None, thermal_conductivity=None, eta=None))]
+#[pyo3(signature = (request, out, force, checkpoint_every, progress, resistivity=None,
+    thermal_conductivity=None, eta=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_study(
     py: Python<'_>,
-    method_name: &str,
-    sizes: Vec<usize>,
-    hursts: Vec<f64>,
-    samples: usize,
-    rolloff: Option<f64>,
-    seed: Option<u64>,
-    min_contacts: Option<usize>,
-    max_fraction: Option<f64>,
-    levels: Option<usize>,
-    alpha_sweep: bool,
+    request: StudyKeywords,
     out: PathBuf,
     force: bool,
     checkpoint_every: Option<f64>,
     progress: Option<Py<PyAny>>,
-    poisson: Option<f64>,
     resistivity: Option<Vec<f64>>,
     thermal_conductivity: Option<Vec<f64>>,
     eta: Option<Py<PyAny>>,
 ) -> PyResult<String> {
-    let derived = derived(poisson, &resistivity, &thermal_conductivity)?;
-    let spec = StudySpec {
-        poisson,
-        ..make_spec(
-            method_name,
-            (sizes, hursts, samples),
-            rolloff,
-            seed,
-            (min_contacts, max_fraction, levels),
-            alpha_sweep,
-        )?
-    };
+    let request = StudyRequest::from(request);
+    let derived = derived(request.poisson, &resistivity, &thermal_conductivity)?;
+    let spec = request.spec().map_err(refused)?;
     let interval = checkpoint_interval(checkpoint_every)?;
     let spec = resumable(py, spec, &out, force)?;
     study::validate(&spec).map_err(request_error)?;
@@ -177,36 +190,6 @@ fn derived(
         poisson: derived.tangential,
         transport: derived.transport,
     })
-}
-
-/// A study's spec from `run_study`'s arguments (`alpha_sweep`: an α study's load sweep,
-/// [`Kind::spec`]), not yet validated: `(sizes, hursts, samples)` as given, and the seed,
-/// the α window and the levels as given or, where `None`, [`StudySpec::default`]'s — the
-/// defaults of `asperity study`, which live there only.
-fn make_spec(
-    method_name: &str,
-    (sizes, hursts, samples): (Vec<usize>, Vec<f64>, usize),
-    rolloff: Option<f64>,
-    seed: Option<u64>,
-    (min_contacts, max_fraction, levels): (Option<usize>, Option<f64>, Option<usize>),
-    alpha_sweep: bool,
-) -> PyResult<StudySpec> {
-    let defaults = StudySpec::default();
-    let mut window = defaults.window;
-    window.min_contacts = min_contacts.unwrap_or(window.min_contacts);
-    window.max_fraction = max_fraction.unwrap_or(window.max_fraction);
-    let spec = StudySpec {
-        method: method(method_name)?,
-        sizes,
-        hursts,
-        samples,
-        rolloff,
-        seed: seed.unwrap_or(defaults.seed),
-        window,
-        levels: levels.unwrap_or(defaults.levels),
-        ..defaults
-    };
-    Ok(Kind::Alpha.spec(spec, !alpha_sweep))
 }
 
 /// The checkpoint interval: `checkpoint_every` seconds by the front-end layer's rule, or
@@ -343,42 +326,22 @@ impl StudyCoordinator {
 
     /// Opens the study as `run_study` does (same arguments but the progress callback) and
     /// begins it: the first actions.
-    #[pyo3(signature = (method_name, sizes, hursts, samples, rolloff, seed, min_contacts,
-        max_fraction, levels, alpha_sweep, out, force, checkpoint_every, poisson=None,
-        resistivity=None, thermal_conductivity=None))]
+    #[pyo3(signature = (request, out, force, checkpoint_every, resistivity=None,
+        thermal_conductivity=None))]
     #[allow(clippy::too_many_arguments)]
     fn begin(
         &mut self,
         py: Python<'_>,
-        method_name: &str,
-        sizes: Vec<usize>,
-        hursts: Vec<f64>,
-        samples: usize,
-        rolloff: Option<f64>,
-        seed: Option<u64>,
-        min_contacts: Option<usize>,
-        max_fraction: Option<f64>,
-        levels: Option<usize>,
-        alpha_sweep: bool,
+        request: StudyKeywords,
         out: PathBuf,
         force: bool,
         checkpoint_every: Option<f64>,
-        poisson: Option<f64>,
         resistivity: Option<Vec<f64>>,
         thermal_conductivity: Option<Vec<f64>>,
     ) -> PyResult<Vec<PyAction>> {
-        let derived = derived(poisson, &resistivity, &thermal_conductivity)?;
-        let spec = StudySpec {
-            poisson,
-            ..make_spec(
-                method_name,
-                (sizes, hursts, samples),
-                rolloff,
-                seed,
-                (min_contacts, max_fraction, levels),
-                alpha_sweep,
-            )?
-        };
+        let request = StudyRequest::from(request);
+        let derived = derived(request.poisson, &resistivity, &thermal_conductivity)?;
+        let spec = request.spec().map_err(refused)?;
         let interval = checkpoint_interval(checkpoint_every)?;
         let spec = resumable(py, spec, &out, force)?;
         study::validate(&spec).map_err(request_error)?;

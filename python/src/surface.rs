@@ -11,7 +11,7 @@ use asperity::topography;
 use asperity_app::stats::{
     compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
 };
-use asperity_app::surface::{ensure_usable, sidecar, SurfaceRequest};
+use asperity_app::surface::{ensure_usable, grid, sidecar, SurfaceRequest};
 use asperity_app::Names;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -60,8 +60,8 @@ fn request(
 #[allow(clippy::too_many_arguments)]
 fn generate_surface<'py>(
     py: Python<'py>,
-    n: usize,
-    m: Option<usize>,
+    n: i128,
+    m: Option<i128>,
     hurst: f64,
     rolloff: Option<f64>,
     cutoff: Option<f64>,
@@ -71,6 +71,7 @@ fn generate_surface<'py>(
     size: f64,
     seed: String,
 ) -> PyResult<(Bound<'py, numpy::PyArray2<f64>>, String)> {
+    let (n, m) = grid(n, m).map_err(refused)?;
     let cutoffs = (rolloff, cutoff, short_cutoff);
     let (spec, seed) = request(n, m, hurst, cutoffs, (rms_height, rms_slope), size, seed)
         .surface()
@@ -94,7 +95,7 @@ fn generate_surface<'py>(
 #[allow(clippy::too_many_arguments)]
 fn generate_line<'py>(
     py: Python<'py>,
-    n: usize,
+    n: i128,
     hurst: f64,
     rolloff: Option<f64>,
     cutoff: Option<f64>,
@@ -103,6 +104,7 @@ fn generate_line<'py>(
     size: f64,
     seed: String,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, String)> {
+    let (n, _) = grid(n, None).map_err(refused)?;
     let cutoffs = (rolloff, cutoff, None);
     let (spec, seed) = request(n, None, hurst, cutoffs, (rms_height, rms_slope), size, seed)
         .line()

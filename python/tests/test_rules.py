@@ -67,6 +67,10 @@ KEYWORDS = {
     "--gamma": "gamma",
     "--kappa": "kappa",
     "--persson": "persson",
+    "--samples": "samples",
+    "--m": "m",
+    "--levels": "levels",
+    "--method": "method",
 }
 
 
@@ -243,6 +247,9 @@ SURFACE = [
      "give at most one of rolloff and cutoff (a roll-off keeps the power below q0 flat"),
     ("line", ["--rms-height", "1", "--rms-slope", "1"], dict(rms_height=1, rms_slope=1),
      "give at most one of rms_height and rms_slope"),
+    # A negative count (asperity_app::surface::grid; before, clap's "invalid digit" and
+    # Python's OverflowError).
+    ("surface", ["--m", "-3"], dict(m=-3), "m must be at least 1, got -3"),
     ("surface", ["--rms-height", "1e-320"], dict(rms_height=1e-320),
      "the generated heights are not representable (rms height 1e-320): rms_height or "
      "rms_slope with size 1 is beyond the range of float64"),
@@ -285,6 +292,8 @@ MDR = [
      "breakpoints gives the exact curve: drop indentations and nloads"),
     (["--line", "LINE", "--nloads", "-1"], dict(line="LINE", nloads=-1),
      "nloads must be at least 1, got -1"),
+    (["--profile", "hertz", "--radius", "1", "--n", "-11", "--dx", "0.1"],
+     dict(profile="hertz", radius=1, n=-11, dx=0.1), "n must be at least 1, got -11"),
     (["--line", "LINE", "--indentations", "1", "--nloads", "3"],
      dict(line="LINE", indentations=[1], nloads=3), "give at most one of indentations and nloads"),
     (["--line", "LINE", "--indentations", "-1"], dict(line="LINE", indentations=[-1]),
@@ -365,7 +374,25 @@ PERSSON = [
      "invalid modulus: E* must be positive and finite, got NaN"),
 ]
 
-ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED + PERSSON
+# asperity study alpha|curve (Python: study_alpha, study_curve): (kind, keywords changed
+# from a valid MDR study of one N and one H, expected words in keywords); the flags are the
+# keywords' (`min_contacts` → `--min-contacts`, a list comma-separated). The study's request
+# is the front-end layer's (asperity_app::study::request): the method by name and every
+# count read there, a negative one refused as nloads is.
+STUDY = [
+    ("alpha", dict(n=-32), "n must be at least 1, got -32"),
+    ("alpha", dict(n=[64, -32]), "n must be at least 1, got -32"),
+    ("curve", dict(n=-32), "n must be at least 1, got -32"),
+    ("alpha", dict(samples=-1), "samples must be at least 1, got -1"),
+    ("curve", dict(samples=-4), "samples must be at least 1, got -4"),
+    ("alpha", dict(levels=-3), "levels must be at least 1, got -3"),
+    ("alpha", dict(min_contacts=-1), "min_contacts must be at least 1, got -1"),
+    ("curve", dict(seed=-1), "seed must be a whole number from 0 to 18446744073709551615, got -1"),
+    ("alpha", dict(method="fem"), 'method must be mdr or bem, got "fem"'),
+    ("curve", dict(method="MDR"), 'method must be mdr or bem, got "MDR"'),
+]
+
+ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED + PERSSON + STUDY
 # asperity mdr --tangential-force (Python: mdr_slip): (flags, keywords, expected words in
 # keywords), on a sphere at d = 1 (μF = 2/3 with μ = 0.5).
 SPHERE = (["--profile", "hertz", "--radius", "1", "--n", "401", "--dx", "0.01", "--indentations", "1"],
@@ -391,6 +418,9 @@ SLIP = [
     (["--tangential-force", "0.1", "--friction", "0.5", "--cycle-points", "1"],
      dict(tangential_force=0.1, friction=0.5, cycle_points=1),
      "invalid cycle_points: a branch needs at least 2 points, got 1"),
+    (["--tangential-force", "0.1", "--friction", "0.5", "--cycle-points", "-3"],
+     dict(tangential_force=0.1, friction=0.5, cycle_points=-3),
+     "invalid cycle_points: a branch needs at least 2 points, got -3"),
 ]
 
 
@@ -543,6 +573,28 @@ def test_measured_options_are_refused_alike(cli, heights, tmp_path, command, fla
     ours = python_words(lambda: asperity.read_topography(path, **kwargs))
     assert ours == theirs
     assert words in ours
+
+
+@pytest.mark.parametrize("kind,changes,words", STUDY)
+def test_studies_refuse_alike(cli, tmp_path, kind, changes, words):
+    keywords = dict(dict(method="mdr", n=32, hurst=0.5, samples=2), **changes)
+    flags = []
+    for name, value in keywords.items():
+        text = ",".join(map(str, value)) if isinstance(value, list) else str(value)
+        flags += ["--" + name.replace("_", "-"), text]
+    theirs = in_keywords(cli_error(cli("study", kind, *flags, "--out", tmp_path / "cli", ok=False)))
+    ours = python_words(lambda: getattr(asperity, f"study_{kind}")(**keywords, out=tmp_path / "py"))
+    assert ours == theirs
+    assert words in ours
+    assert not (tmp_path / "cli").exists() and not (tmp_path / "py").exists()
+
+
+@pytest.mark.parametrize("command,n", [("surface", -16), ("line", -8)])
+def test_a_negative_grid_size_is_refused_alike(cli, tmp_path, command, n):
+    theirs = cli(command, "--n", n, "--hurst", 0.5, "--out", tmp_path / "x.npy", ok=False)
+    ours = python_words(lambda: getattr(asperity, command)(n, hurst=0.5))
+    assert ours == in_keywords(cli_error(theirs)) == f"n must be at least 1, got {n}"
+    assert not (tmp_path / "x.npy").exists()
 
 
 @pytest.mark.parametrize("method,n,min_contacts", [("mdr", 32, 33), ("bem", 8, 65)])

@@ -266,7 +266,7 @@ def test_study_arguments_are_checked_like_the_cli(cli, tmp_path):
     with pytest.raises(ValueError) as err:
         asperity.study_alpha(method="mdr", n=512, hurst=4, samples=2, out=tmp_path / "b")
     assert str(err.value) in message
-    with pytest.raises(ValueError, match="expected mdr or bem"):
+    with pytest.raises(ValueError, match="method must be mdr or bem, got \"fem\""):
         asperity.study_alpha(method="fem", n=512, hurst=0.5, samples=2, out=tmp_path / "c")
     with pytest.raises(ValueError, match="given twice"):
         asperity.study_alpha(method="mdr", n=[512, 512], hurst=0.5, samples=2, out=tmp_path / "d")

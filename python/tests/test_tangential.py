@@ -104,10 +104,12 @@ def test_the_distributed_coordinator_carries_poisson_and_the_resistivities(tmp_p
     from asperity import _asperity as core
 
     def args(out):
-        return ("bem", [32], [0.5], 2, 4.0, None, None, None, 4, False, str(tmp_path / out),
-                False, None)
+        request = dict(kind="curve", method="bem", sizes=[32], hursts=[0.5], samples=2,
+                       rolloff=4.0, seed=None, min_contacts=None, max_fraction=None, levels=4,
+                       full_sweep=False, poisson=0.3)
+        return (request, str(tmp_path / out), False, None)
 
-    derived = dict(poisson=0.3, resistivity=[1.0, 3.0])
+    derived = dict(resistivity=[1.0, 3.0])
     coordinator = core.StudyCoordinator(1, 1)
     actions, computer, sent = coordinator.begin(*args("mpi"), **derived), None, []
     while not any(action[0] == "end" for action in actions):

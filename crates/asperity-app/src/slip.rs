@@ -48,8 +48,9 @@ pub struct SlipRequest {
     pub friction: Option<f64>,
     /// Q*, positive and at most μF at the indentation.
     pub tangential_force: f64,
-    /// Points per branch (default [`DEFAULT_CYCLE_POINTS`]).
-    pub cycle_points: Option<usize>,
+    /// Points per branch (default [`DEFAULT_CYCLE_POINTS`]), signed as a front end holds
+    /// it: below 2 (negative ones too) refused by one rule, in one wording.
+    pub cycle_points: Option<i128>,
 }
 
 /// The cycle and what characterises it.
@@ -103,6 +104,9 @@ impl SlipRequest {
                 format!(": a branch needs at least 2 points, got {points}"),
             ));
         }
+        if let Some(points) = self.cycle_points {
+            crate::refusal::count(CYCLE_POINTS, points)?;
+        }
         if mdr.work_of_adhesion.is_some() {
             let refusal = Refusal::of(TANGENTIAL_FORCE)
                 .text(" is for non-adhesive contact: drop ")
@@ -142,7 +146,10 @@ impl SlipRequest {
         let ratio = mindlin_ratio(self.poisson).map_err(invalid)?;
         let friction = self.friction.unwrap_or_default();
         let slip = PartialSlip::new(&foundation, d, ratio, friction).map_err(invalid)?;
-        let points = self.cycle_points.unwrap_or(DEFAULT_CYCLE_POINTS);
+        let points = match self.cycle_points {
+            Some(points) => crate::refusal::count(CYCLE_POINTS, points)?,
+            None => DEFAULT_CYCLE_POINTS,
+        };
         let cycle = slip.cycle(self.tangential_force, points).map_err(invalid)?;
         let top = slip.displacement(self.tangential_force).map_err(invalid)?;
         let stick_radius = (!indenter.is_line).then(|| {

@@ -9,7 +9,7 @@ use asperity::surface::{LineSpec, Normalisation, SurfaceSpec};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
-use crate::refusal::{Param, Refusal, RequestError};
+use crate::refusal::{count, Param, Refusal, RequestError};
 
 /// The parameters of `asperity surface` and `asperity line`, as each front end names them.
 pub mod params {
@@ -49,6 +49,23 @@ pub fn parse_seed(text: &str) -> Result<u64, Refusal> {
             asperity::input::clip(text)
         ))
     })
+}
+
+/// The grid's counts as a front end holds them, signed (a flag's text, a Python int):
+/// `n` and a surface's `m` ([`count`]: a negative one refused as `--n must be at least 1,
+/// got -16` by both front ends; 0 and 1 by the library's rule on the grid).
+///
+/// ```
+/// use asperity_app::surface::grid;
+/// use asperity_app::Names;
+///
+/// assert_eq!(grid(64, Some(32)).unwrap(), (64, Some(32)));
+/// let refusal = grid(64, Some(-3)).unwrap_err();
+/// assert_eq!(refusal.words(Names::Flags), "--m must be at least 1, got -3");
+/// assert_eq!(grid(-16, None).unwrap_err().words(Names::Keywords), "n must be at least 1, got -16");
+/// ```
+pub fn grid(n: i128, m: Option<i128>) -> Result<(usize, Option<usize>), Refusal> {
+    Ok((count(N, n)?, m.map(|m| count(M, m)).transpose()?))
 }
 
 /// A surface or line request, as given.

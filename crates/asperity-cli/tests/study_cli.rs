@@ -305,6 +305,62 @@ fn bad_studies_are_refused_and_lose_nothing() {
     ));
 }
 
+/// A negative count, a bad seed or an unknown method: refused by the front-end layer's rules
+/// (asperity_app::study::request) in one line that names the flag, before any folder is
+/// made (clap said "invalid digit found in string" before; Python words them alike,
+/// python/tests/test_rules.py).
+#[test]
+fn negative_counts_and_unknown_methods_are_refused_by_the_study_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases: [(&[&str], &str); 7] = [
+        (&["--n", "64,-32"], "--n must be at least 1, got -32"),
+        (&["--samples", "-1"], "--samples must be at least 1, got -1"),
+        (&["--levels", "-3"], "--levels must be at least 1, got -3"),
+        (
+            &["--min-contacts", "-1"],
+            "--min-contacts must be at least 1, got -1",
+        ),
+        (
+            &["--seed", "-1"],
+            "--seed must be a whole number from 0 to 18446744073709551615, got -1",
+        ),
+        (
+            &["--method", "fem"],
+            "--method must be mdr or bem, got \"fem\"",
+        ),
+        (
+            &["--samples", "99999999999999999999"],
+            "--samples is too large, got ",
+        ),
+    ];
+    for (change, words) in cases {
+        let mut args = vec![
+            "study",
+            "alpha",
+            "--method",
+            "mdr",
+            "--n",
+            "32",
+            "--samples",
+        ];
+        args.extend(["2", "--hurst", "0.5", "--out", "x"]);
+        for pair in change.chunks(2) {
+            let at = args.iter().position(|a| *a == pair[0]).map(|i| i + 1);
+            match at {
+                Some(i) => args[i] = pair[1],
+                None => args.extend(pair),
+            }
+        }
+        let message = refused(&asperity(&args, d), words);
+        assert!(
+            message.lines().count() == 1 && message.contains(words),
+            "{message}"
+        );
+        assert!(!d.join("x").exists(), "{change:?}: nothing written");
+    }
+}
+
 #[test]
 fn toml_study_file_runs() {
     let dir = tempfile::tempdir().unwrap();

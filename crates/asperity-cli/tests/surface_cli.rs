@@ -787,3 +787,56 @@ fn surface_plot_is_the_height_map_with_its_scale_bar() {
     );
     assert_refused(&out, d, before, "--plot u.jpg");
 }
+
+/// A negative grid size of `surface`, `line` and `mdr --profile`, and a negative number of
+/// points of a tangential cycle: refused in the front-end layer's words (the same as
+/// Python's, python/tests/test_rules.py; clap said "invalid digit found in string" before),
+/// nothing written.
+#[test]
+fn negative_counts_are_refused_in_the_front_end_layers_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let hertz = ["mdr", "--profile", "hertz", "--radius", "1", "--dx", "0.01"];
+    let slip = [
+        "--n",
+        "401",
+        "--indentations",
+        "1",
+        "--tangential-force",
+        "0.1",
+    ];
+    let cases: [(Vec<&str>, &str); 5] = [
+        (
+            vec!["surface", "--n", "-16", "--hurst", "0.5", "--out", "x.npy"],
+            "--n must be at least 1, got -16",
+        ),
+        (
+            vec![
+                "surface", "--n", "16", "--m", "-3", "--hurst", "0.5", "--out", "x.npy",
+            ],
+            "--m must be at least 1, got -3",
+        ),
+        (
+            vec!["line", "--n", "-8", "--hurst", "0.5", "--out", "x.npy"],
+            "--n must be at least 1, got -8",
+        ),
+        (
+            [&hertz[..], &["--n", "-11", "--out", "x.csv"]].concat(),
+            "--n must be at least 1, got -11",
+        ),
+        (
+            [
+                &hertz[..],
+                &slip,
+                &["--friction", "0.5", "--cycle-points", "-3"],
+            ]
+            .concat(),
+            "invalid --cycle-points: a branch needs at least 2 points, got -3",
+        ),
+    ];
+    for (args, words) in cases {
+        let out = asperity(&args, d);
+        assert_eq!(stderr(&out).trim(), format!("error: {words}"), "{args:?}");
+        assert_refused(&out, d, 0, words);
+    }
+}

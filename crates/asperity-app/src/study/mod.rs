@@ -1,7 +1,8 @@
 //! Studies (`asperity study alpha|curve`, Python's `study_alpha`/`study_curve`): the
 //! protocol both front ends run, once.
 //!
-//! A front end turns its arguments into a [`StudySpec`] and then, in this order:
+//! A front end turns its arguments into a [`request::StudyRequest`], the request into a
+//! [`StudySpec`] ([`request::StudyRequest::spec`]) and then, in this order:
 //! 1. [`Kind::spec`]: the load sweep of the study's kind (an α study's BEM samples stop
 //!    loading past the fit windows unless a full sweep is asked for);
 //! 2. [`checkpoint_interval`]: the checkpoint interval's rule;
@@ -16,6 +17,7 @@
 
 pub mod distributed;
 pub mod progress;
+pub mod request;
 pub mod rows;
 
 use std::path::Path;

@@ -70,8 +70,8 @@ pub struct MdrArgs {
     #[arg(long)]
     pub exponent: Option<f64>,
     /// Number of springs for --profile / --radial (symmetric about the axis; odd puts one on it).
-    #[arg(long)]
-    pub n: Option<usize>,
+    #[arg(long, allow_hyphen_values = true)]
+    pub n: Option<i128>,
     /// Spring spacing Δx for --profile / --radial (a line's is size / n).
     #[arg(long, allow_hyphen_values = true)]
     pub dx: Option<f64>,
@@ -150,8 +150,8 @@ pub struct MdrArgs {
     #[arg(long, allow_hyphen_values = true, default_value_t = asperity_app::slip::DEFAULT_POISSON)]
     pub poisson: f64,
     /// Points per branch of the --tangential-force cycle (default 50).
-    #[arg(long)]
-    pub cycle_points: Option<usize>,
+    #[arg(long, allow_hyphen_values = true)]
+    pub cycle_points: Option<i128>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -173,7 +173,7 @@ fn request(args: &MdrArgs) -> Result<MdrRequest> {
         slope: args.slope,
         coefficient: args.coefficient,
         exponent: args.exponent,
-        n: args.n,
+        n: args.n.map(|n| count(params::N, n)).transpose()?,
         dx: args.dx,
         size: args.size,
         modulus: args.modulus,

@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use asperity::study::{FitWindow, Method, StudySpec, CHECKPOINT_INTERVAL};
+use asperity::study::{Method, StudySpec, CHECKPOINT_INTERVAL};
 use serde::de::{self, Visitor};
 use serde::Deserialize;
 
@@ -16,9 +16,13 @@ use crate::studies::{execute, Kind, RunOptions};
 use asperity_app::derived::Derived;
 use asperity_app::figure::study as figure;
 use asperity_app::range::parse_range;
+use asperity_app::study::request::StudyRequest;
 
-/// `--method`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Deserialize)]
+use crate::request::refused;
+
+/// `method` of a study file (the flag `--method` is read by the front-end layer's rule,
+/// [`asperity_app::study::request::method`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MethodArg {
     /// 1D method of dimensionality reduction on rough lines.
@@ -39,27 +43,28 @@ impl From<MethodArg> for Method {
 /// Options shared by every study.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CommonArgs {
-    /// Solver.
-    #[arg(long, value_enum)]
-    pub method: MethodArg,
+    /// Solver: mdr (1D method of dimensionality reduction on rough lines) or bem (3D
+    /// boundary elements on rough surfaces, free boundaries).
+    #[arg(long, value_name = "mdr|bem")]
+    pub method: String,
     /// Realisations per (N, H).
     #[arg(long)]
-    pub samples: usize,
+    pub samples: i128,
     /// Long-wavelength roll-off q0·L/2π (paper Fig. 2 uses 6).
     #[arg(long, value_name = "Q")]
     pub rolloff: Option<f64>,
     /// Study seed (every sample's seed derives from it, N, H and the sample index).
-    #[arg(long, default_value_t = StudySpec::default().seed)]
-    pub seed: u64,
+    #[arg(long, default_value_t = StudySpec::default().seed.to_string())]
+    pub seed: String,
     /// α fit window: fewest points in contact.
-    #[arg(long, default_value_t = StudySpec::default().window.min_contacts)]
-    pub min_contacts: usize,
+    #[arg(long, default_value_t = StudySpec::default().window.min_contacts as i128)]
+    pub min_contacts: i128,
     /// α fit window: largest contact fraction.
     #[arg(long, default_value_t = StudySpec::default().window.max_fraction)]
     pub max_fraction: f64,
     /// Common force levels of the ensemble-mean curves.
-    #[arg(long, default_value_t = StudySpec::default().levels)]
-    pub levels: usize,
+    #[arg(long, default_value_t = StudySpec::default().levels as i128)]
+    pub levels: i128,
     #[command(flatten)]
     pub run: RunArgs,
 }
@@ -125,7 +130,7 @@ Examples:
 pub struct AlphaArgs {
     /// Grid sizes N (comma-separated).
     #[arg(long, value_delimiter = ',', required = true)]
-    pub n: Vec<usize>,
+    pub n: Vec<i128>,
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
@@ -166,7 +171,7 @@ Examples:
 pub struct CurveArgs {
     /// Grid sizes N (comma-separated), one curve per (N, H).
     #[arg(long, value_delimiter = ',', required = true)]
-    pub n: Vec<usize>,
+    pub n: Vec<i128>,
     /// Hurst exponents: values and inclusive ranges A:B:STEP, comma-separated.
     #[arg(long, allow_hyphen_values = true)]
     pub hurst: String,
@@ -514,20 +519,18 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec, figure:
         toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", toml_error(path, text, &e)))?;
     let derived = file_derived(path, &file)?;
     // The keys left out take the library's defaults (`StudySpec::default`).
-    let defaults = StudySpec::default();
-    let spec = StudySpec {
-        method: file.method.into(),
-        sizes: file.n.0,
+    let request = StudyRequest {
+        kind: file.kind,
+        method: Method::from(file.method).name().into(),
+        sizes: file.n.0.iter().map(|&n| n as i128).collect(),
         hursts: file.hurst.0,
-        samples: file.samples,
+        samples: file.samples as i128,
         rolloff: file.rolloff,
-        seed: file.seed.unwrap_or(defaults.seed),
-        window: FitWindow {
-            min_contacts: file.min_contacts.unwrap_or(defaults.window.min_contacts),
-            max_fraction: file.max_fraction.unwrap_or(defaults.window.max_fraction),
-        },
-        levels: file.levels.unwrap_or(defaults.levels),
-        sweep_end: None,
+        seed: file.seed.map(|seed| seed.to_string()),
+        min_contacts: file.min_contacts.map(|c| c as i128),
+        max_fraction: file.max_fraction,
+        levels: file.levels.map(|l| l as i128),
+        full_sweep: file.full_sweep.unwrap_or(false),
         poisson: file.poisson,
     };
     if file.kind == Kind::Curve && file.full_sweep.is_some() {
@@ -536,15 +539,13 @@ fn parse_study_file(path: &Path, text: &str) -> Result<(Kind, StudySpec, figure:
             path.display()
         );
     }
-    asperity_app::study::check_tangential(&spec).map_err(|r| {
+    let in_keys = |r: asperity_app::Refusal| {
         let words = r.words(asperity_app::Names::Keywords);
         anyhow::anyhow!("{}: {words}", path.display())
-    })?;
-    Ok((
-        file.kind,
-        file.kind.spec(spec, file.full_sweep.unwrap_or(false)),
-        derived,
-    ))
+    };
+    let spec = request.spec().map_err(in_keys)?;
+    asperity_app::study::check_tangential(&spec).map_err(in_keys)?;
+    Ok((file.kind, spec, derived))
 }
 
 /// The tangential and conductance columns of a study file, refused as `study curve`
@@ -605,22 +606,23 @@ fn toml_error(path: &Path, text: &str, error: &toml::de::Error) -> String {
     }
 }
 
-fn spec_from(common: &CommonArgs, sizes: Vec<usize>, hursts: Vec<f64>) -> StudySpec {
-    StudySpec {
-        method: common.method.into(),
-        sizes,
-        hursts,
+/// The request of the options shared by every study, with the sizes and H values of the
+/// kind's own flags.
+fn request(kind: Kind, common: &CommonArgs, sizes: &[i128], hurst: &str) -> Result<StudyRequest> {
+    Ok(StudyRequest {
+        kind,
+        method: common.method.clone(),
+        sizes: sizes.to_vec(),
+        hursts: parse_range(hurst)?,
         samples: common.samples,
         rolloff: common.rolloff,
-        seed: common.seed,
-        window: FitWindow {
-            min_contacts: common.min_contacts,
-            max_fraction: common.max_fraction,
-        },
-        levels: common.levels,
-        sweep_end: None,
+        seed: Some(common.seed.clone()),
+        min_contacts: Some(common.min_contacts),
+        max_fraction: Some(common.max_fraction),
+        levels: Some(common.levels),
+        full_sweep: false,
         poisson: None,
-    }
+    })
 }
 
 impl RunOptions {
@@ -640,8 +642,11 @@ impl RunOptions {
 pub fn run(args: &StudyArgs) -> Result<()> {
     let (kind, spec, out, options) = match &args.command {
         StudyCommand::Alpha(a) => {
-            let spec = spec_from(&a.common, a.n.clone(), parse_range(&a.hurst)?);
-            let spec = Kind::Alpha.spec(spec, a.full_sweep);
+            let request = StudyRequest {
+                full_sweep: a.full_sweep,
+                ..request(Kind::Alpha, &a.common, &a.n, &a.hurst)?
+            };
+            let spec = request.spec().map_err(|r| refused(r.into()))?;
             (
                 Kind::Alpha,
                 spec,
@@ -650,12 +655,13 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             )
         }
         StudyCommand::Curve(c) => {
-            let spec = StudySpec {
+            let request = StudyRequest {
                 poisson: c.poisson,
-                ..spec_from(&c.common, c.n.clone(), parse_range(&c.hurst)?)
+                ..request(Kind::Curve, &c.common, &c.n, &c.hurst)?
             };
+            let spec = request.spec().map_err(|r| refused(r.into()))?;
             let derived = Derived::validate(c.poisson, &c.resistivity, &c.thermal_conductivity)
-                .map_err(|r| crate::request::refused(r.into()))?;
+                .map_err(|r| refused(r.into()))?;
             let options = RunOptions {
                 derived: figure::Derived {
                     poisson: derived.tangential,
@@ -717,6 +723,7 @@ fn announce_bem(spec: &StudySpec, out: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use asperity::study::FitWindow;
 
     #[test]
     fn study_files_take_single_values_and_lists() {

@@ -7,7 +7,7 @@ use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::surface::stats::{line_summary, surface_summary};
 use asperity::surface::{LineGenerator, SurfaceGenerator};
 use asperity_app::figure::map::{surface_chart, MapFigure};
-use asperity_app::surface::{ensure_usable, sidecar as generated_sidecar, SurfaceRequest};
+use asperity_app::surface::{ensure_usable, grid, sidecar as generated_sidecar, SurfaceRequest};
 
 use crate::request::refused;
 
@@ -68,10 +68,10 @@ fn array_path(text: &str) -> Result<PathBuf, String> {
 pub struct SurfaceArgs {
     /// Grid points along x (columns).
     #[arg(long)]
-    pub n: usize,
+    pub n: i128,
     /// Grid points along y (rows); defaults to N (square).
     #[arg(long)]
-    pub m: Option<usize>,
+    pub m: Option<i128>,
     #[command(flatten)]
     pub spectrum: SpectrumArgs,
     /// Short-wavelength cut-off q1·L/2π: no power above q1.
@@ -102,7 +102,7 @@ pub struct SurfaceArgs {
 pub struct LineArgs {
     /// Number of points.
     #[arg(long)]
-    pub n: usize,
+    pub n: i128,
     #[command(flatten)]
     pub spectrum: SpectrumArgs,
     /// Scale to this rms height (default 1 when neither this nor --rms-slope is given).
@@ -139,7 +139,8 @@ fn request(
 pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let s = &args.spectrum;
     let norm = (args.rms_height, args.rms_slope);
-    let (spec, seed) = request(args.n, args.m, s, args.short_cutoff, norm)
+    let (n, m) = grid(args.n, args.m)?;
+    let (spec, seed) = request(n, m, s, args.short_cutoff, norm)
         .surface()
         .map_err(refused)?;
     let rows = spec.rows();
@@ -166,7 +167,7 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     let summary = surface_summary(&surface);
     ensure_usable(&summary, s.size)?;
     staged.write_npy_2d(&s.out, surface.heights())?;
-    let record = generated_sidecar("surface", &[rows, args.n], seed, &spec, &summary);
+    let record = generated_sidecar("surface", &[rows, n], seed, &spec, &summary);
     staged.write_json(&sidecar, &record)?;
     if let Some(png) = &args.png {
         crate::plot::greyscale_png(&mut staged, png, surface.heights().view())?;
@@ -178,7 +179,7 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
             .map_or_else(String::new, |n| n.to_string_lossy().into());
         let figure = MapFigure {
             name: &name,
-            size: (s.size, s.size * rows as f64 / args.n as f64),
+            size: (s.size, s.size * rows as f64 / n as f64),
             metres: false,
         };
         let chart = surface_chart(surface.heights().view(), figure);
@@ -186,9 +187,8 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
     }
     staged.commit()?;
     eprintln!(
-        "wrote {} ({rows}x{} in {elapsed:.3} s): rms height {:.6e}, rms slope {:.6e}",
+        "wrote {} ({rows}x{n} in {elapsed:.3} s): rms height {:.6e}, rms slope {:.6e}",
         s.out.display(),
-        args.n,
         summary.rms_height,
         summary.rms_slope
     );
@@ -199,22 +199,20 @@ pub fn run_surface(args: &SurfaceArgs) -> Result<()> {
 pub fn run_line(args: &LineArgs) -> Result<()> {
     let s = &args.spectrum;
     let norm = (args.rms_height, args.rms_slope);
-    let (spec, seed) = request(args.n, None, s, None, norm)
-        .line()
-        .map_err(refused)?;
+    let (n, _) = grid(args.n, None)?;
+    let (spec, seed) = request(n, None, s, None, norm).line().map_err(refused)?;
     let sidecar = sidecar_path(&s.out);
     let mut staged = StagedOutputs::new([&s.out, &sidecar], s.force)?;
     let line = LineGenerator::new(&spec)?.try_generate(seed)?;
     let summary = line_summary(&line);
     ensure_usable(&summary, s.size)?;
     staged.write_npy_1d(&s.out, line.heights())?;
-    let record = generated_sidecar("line", &[args.n], seed, &spec, &summary);
+    let record = generated_sidecar("line", &[n], seed, &spec, &summary);
     staged.write_json(&sidecar, &record)?;
     staged.commit()?;
     eprintln!(
-        "wrote {} ({} points): rms height {:.6e}, rms slope {:.6e}",
+        "wrote {} ({n} points): rms height {:.6e}, rms slope {:.6e}",
         s.out.display(),
-        args.n,
         summary.rms_height,
         summary.rms_slope
     );
