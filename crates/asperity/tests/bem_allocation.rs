@@ -10,7 +10,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use asperity::bem::tangential::TangentialStiffness;
-use asperity::bem::{ContactSolver, Control, HalfSpace, SolveError, SolverKind, SolverParams};
+use asperity::bem::{
+    ContactSolver, Control, HalfSpace, Interface, SolveError, SolverKind, SolverParams,
+};
 use asperity::elastic::Boundary;
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
@@ -159,11 +161,78 @@ fn solves_and_stiffness_allocate_nothing_per_iteration() {
                 info.iterations
             );
             assert_eq!(allocations, 0, "{kind:?} {boundary:?}: {bytes} bytes");
+            capped_solves_allocate_nothing(&surface, kind, boundary);
         }
         for boundary in [Boundary::Free, Boundary::Periodic] {
             tangential_stiffness_allocates_nothing(&surface, boundary);
         }
     });
+}
+
+/// Under a hardness cap (`Interface::Hardness`, issue 31) a solve works in the same
+/// buffers as the hard wall's: the capped load restoration (`u <- s u + (1 - s) H K 1_C`,
+/// `plastic_field.rs`), its point responses and the frozen elastic set's CG allocate
+/// nothing, a loose and a tight solve alike, under load and displacement control.
+fn capped_solves_allocate_nothing(
+    surface: &asperity::surface::Surface,
+    kind: SolverKind,
+    boundary: Boundary,
+) {
+    let half_space = HalfSpace {
+        modulus: 1.0,
+        boundary,
+    };
+    let base = SolverParams {
+        solver: kind,
+        ..SolverParams::default()
+    };
+    let pressure = 0.03;
+    let mut solver = ContactSolver::new(surface, half_space, base)
+        .unwrap()
+        .with_interface(Interface::hardness(0.1).unwrap())
+        .unwrap();
+    // Warm up: the stiffness buffers and the capped set's field on first use.
+    let (summary, _) = solver.solve(Control::MeanPressure(pressure)).unwrap();
+    assert!(summary.plastic_points > 0, "the cap is reached");
+    solver.frozen_set_stiffness().unwrap();
+    let mut run = |tolerance: f64| {
+        solver
+            .set_params(SolverParams { tolerance, ..base })
+            .unwrap();
+        solver.reset();
+        let ((iterations, plastic), allocations, bytes) = count(|| {
+            let (summary, info) = solver.solve(Control::MeanPressure(pressure)).unwrap();
+            solver.frozen_set_stiffness().unwrap();
+            (info.iterations, summary.plastic_points)
+        });
+        assert!(plastic > 0, "the cap is reached");
+        (iterations, allocations, bytes)
+    };
+    let (few, allocations_few, bytes_few) = run(1e-4);
+    let (many, allocations_many, bytes_many) = run(1e-10);
+    eprintln!(
+        "capped {kind:?} {boundary:?}: {few} and {many} iterations: {allocations_few} and \
+         {allocations_many} allocations, {bytes_few} and {bytes_many} bytes"
+    );
+    assert!(many >= 2 * few, "{few} vs {many} iterations");
+    assert_eq!(
+        allocations_few, 0,
+        "{kind:?} {boundary:?}: {bytes_few} bytes"
+    );
+    assert_eq!(
+        allocations_many, 0,
+        "{kind:?} {boundary:?}: {bytes_many} bytes"
+    );
+    let (summary, _) = solver.solve(Control::MeanPressure(pressure)).unwrap();
+    let indentation = Control::Indentation(0.98 * summary.indentation);
+    let (result, allocations, bytes) = count(|| solver.solve(indentation));
+    let (summary, info) = result.unwrap();
+    eprintln!(
+        "capped {kind:?} {boundary:?}: displacement control, {} iterations, {} plastic \
+         points: {allocations} allocations, {bytes} bytes",
+        info.iterations, summary.plastic_points
+    );
+    assert_eq!(allocations, 0, "{kind:?} {boundary:?}: {bytes} bytes");
 }
 
 /// The tangential frozen-set CGs (`k_x`, `k_y`: Cerruti's operators on the contact set)
