@@ -59,11 +59,7 @@ fn one_load(
     indentation: Option<f64>,
 ) -> PyResult<(&'static str, f64)> {
     let load = asperity_app::bem::one_load(what, pressure, force, indentation).map_err(refused)?;
-    Ok(match load {
-        Control::MeanPressure(p) => ("pressure", p),
-        Control::Force(f) => ("force", f),
-        Control::Indentation(d) => ("indentation", d),
-    })
+    Ok(asperity_app::bem::quantity_of(load))
 }
 
 /// The loads of a sweep as `(quantity, values)`: exactly one of the three lists or
@@ -84,24 +80,16 @@ fn sweep_loads(
     let loads = Loads::from_options(forces, pressures, indentations, nloads, (pmin, pmax))
         .map_err(refused)?;
     let controls = loads.controls(fields).map_err(request_error)?;
-    let quantity = match loads {
-        Loads::Forces(_) => "force",
-        Loads::Indentations(_) => "indentation",
-        Loads::Pressures(_) | Loads::LogPressures { .. } => "pressure",
-    };
-    Ok((quantity, controls.iter().map(|c| c.value()).collect()))
+    Ok((
+        loads.quantity(),
+        controls.iter().map(|c| c.value()).collect(),
+    ))
 }
 
-/// A load as the library's control: `quantity` is `pressure`, `force` or `indentation`.
+/// A load as the library's control: `quantity` is `pressure`, `force` or `indentation`
+/// (the front-end layer's names, [`asperity_app::bem::load_of`]).
 fn control(quantity: &str, value: f64) -> PyResult<Control> {
-    match quantity {
-        "pressure" => Ok(Control::MeanPressure(value)),
-        "force" => Ok(Control::Force(value)),
-        "indentation" => Ok(Control::Indentation(value)),
-        other => Err(invalid(format!(
-            "unknown load quantity {other:?} (pressure, force or indentation)"
-        ))),
-    }
+    asperity_app::bem::load_of(quantity, value).map_err(refused)
 }
 
 /// `error` with `context: ` in front (a `SolveError` keeps its type and attributes).
@@ -213,11 +201,8 @@ impl Solver {
             array_bytes(&[rows, cols], 8),
         )
         .map_err(from_error)?;
-        if rows < 2 || cols < 2 {
-            return Err(invalid(format!(
-                "invalid grid: a surface needs at least 2x2 points, got ({rows}, {cols})"
-            )));
-        }
+        // A grid below 2×2 is refused by the library's rule (`Surface::new`), as the CLI's
+        // surfaces are.
         let owned = owned_2d(&heights);
         let surface = match size_y {
             Some(size_y) => Surface::with_sizes(owned, size_x, size_y),

@@ -122,7 +122,7 @@ BEM = [
     (["--pressures", "0.01", "--modulus", "0"], dict(modulus=0), None,
      "modulus must be positive and finite, got 0"),
     (["--pressures", "0.01", "--modulus", "-1"], dict(modulus=-1), None, "got -1"),
-    (["--pressures", "0.01", "--modulus", "inf"], dict(modulus=INF), None, "got inf"),
+    (["--pressures", "0.01", "--modulus", "inf"], dict(modulus=INF), None, "got infinity"),
     (["--pressures", "0.01", "--modulus", "nan"], dict(modulus=NAN), None, "got NaN"),
     (["--pressures", "0.01", "--poisson", "0.7"], {}, dict(pressures=[0.01], poisson=0.7),
      "poisson must be in [0, 0.5] (Poisson's ratio), got 0.7"),
@@ -139,7 +139,7 @@ BEM = [
      "hardness must be positive and finite, got 0"),
     (["--pressures", "0.01", "--hardness=-1"], dict(hardness=-1), None, "got -1"),
     (["--pressures", "0.01", "--hardness", "nan"], dict(hardness=NAN), None, "got NaN"),
-    (["--pressures", "0.01", "--hardness", "inf"], dict(hardness=INF), None, "got inf"),
+    (["--pressures", "0.01", "--hardness", "inf"], dict(hardness=INF), None, "got infinity"),
     (["--pressures", "0.01,0.3", "--hardness", "0.3"], dict(hardness=0.3),
      dict(pressures=[0.01, 0.3]),
      "a mean pressure of 0.3 is at or above the hardness 0.3: more than a fully plastic "
@@ -225,7 +225,7 @@ CONTACT = [
     (["--modulus", "1e9", "--pressures", "1e5", "--thermal-conductivity", "inf,1"],
      dict(modulus=1e9, pressures=[1e5], thermal_conductivity=[INF, 1]),
      "invalid thermal_conductivity: each body's thermal conductivity must be positive and "
-     "finite, got inf"),
+     "finite, got infinity"),
     (["--modulus", "1e9", "--pressures", "1e5", "--thermal-conductivity", "1,-5"],
      dict(modulus=1e9, pressures=[1e5], thermal_conductivity=[1, -5]), "got -5"),
     (["--modulus", "1e9", "--pressures", "1e5", "--tangential"],
@@ -306,7 +306,7 @@ MDR = [
     (HERTZ[0] + ["--work-of-adhesion", "0"], dict(HERTZ[1], work_of_adhesion=0),
      "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got 0"),
     (HERTZ[0] + ["--work-of-adhesion", "inf"], dict(HERTZ[1], work_of_adhesion=float("inf")),
-     "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got inf"),
+     "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got infinity"),
     (HERTZ[0] + ["--work-of-adhesion", "-1e-3"], dict(HERTZ[1], work_of_adhesion=-1e-3),
      "invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got -0.001"),
     (HERTZ[0] + ["--work-of-adhesion", "1e-3", "--spring", "hertz"],
@@ -331,7 +331,7 @@ STATS = [
      "invalid fit_to 1.5: the PSD fit range would be empty, its lower end is 2 (the default "
      "lower end); give a larger fit_to or a smaller fit_from"),
     (["--size", "-2"], dict(size=-2), "size must be positive and finite, got -2"),
-    (["--size", "inf"], dict(size=INF), "size must be positive and finite, got inf"),
+    (["--size", "inf"], dict(size=INF), "size must be positive and finite, got infinity"),
 ]
 
 # A measured file's cleaning (every command that reads one; Python's read_topography):
@@ -342,7 +342,9 @@ MEASURED = [
     (["--fill", "zero"], dict(fill="zero"),
      'fill must be harmonic (Laplace inpainting) or refuse, got "zero"'),
     (["--size", "0"], dict(size=0), "size must be positive and finite, got 0"),
-    (["--size", "1e-6,-1e-6"], dict(size=(1e-6, -1e-6)), "got -0.000001"),
+    # Numbers as every refusal writes them (asperity_app::refusal::number): -1e-6, not
+    # -0.000001.
+    (["--size", "1e-6,-1e-6"], dict(size=(1e-6, -1e-6)), "got -1e-6"),
     (["--size", "1,2,3"], dict(size=(1, 2, 3)), "size takes one value (x) or two (x and y)"),
 ]
 
@@ -734,7 +736,7 @@ def test_one_load_of_a_solve_is_the_front_end_layers_rule(heights):
 
 def test_patches_refuse_a_pixel_area_by_the_shared_rule():
     contact_set = np.array([[1, 1, 0], [0, 0, 1]], dtype=bool)
-    for bad, shown in [(0, "0"), (-1, "-1"), (NAN, "NaN"), (INF, "inf")]:
+    for bad, shown in [(0, "0"), (-1, "-1"), (NAN, "NaN"), (INF, "infinity"), (-1e-6, "-1e-6")]:
         words = python_words(lambda: asperity.patches(contact_set, pixel_area=bad))
         assert words == f"pixel_area must be positive and finite, got {shown}"
     p = asperity.patches(contact_set, pixel_area=0.25)

@@ -168,7 +168,8 @@ impl AdhesionRequest {
             return Err(Refusal::saying("invalid ")
                 .param(WORK_OF_ADHESION)
                 .text(format!(
-                    ": the work of adhesion Δγ must be positive and finite, got {w}"
+                    ": the work of adhesion Δγ must be positive and finite, got {}",
+                    crate::refusal::number(w)
                 )));
         }
         if let Some(h) = self.adhesion_range {
@@ -176,7 +177,8 @@ impl AdhesionRequest {
                 return Err(Refusal::saying("invalid ")
                     .param(ADHESION_RANGE)
                     .text(format!(
-                        ": the range of the adhesive law must be positive and finite, got {h}"
+                        ": the range of the adhesive law must be positive and finite, got {}",
+                        crate::refusal::number(h)
                     )));
             }
         }
@@ -208,9 +210,10 @@ impl AdhesionRequest {
             .retract_step
             .unwrap_or((deepest + reach) / DEFAULT_RETRACT_STEPS);
         if !(step.is_finite() && step > 0.0) {
-            return Err(
-                Refusal::of(RETRACT_STEP).text(format!(" must be positive and finite, got {step}"))
-            );
+            return Err(Refusal::of(RETRACT_STEP).text(format!(
+                " must be positive and finite, got {}",
+                crate::refusal::number(step)
+            )));
         }
         Ok(AdhesionPlan {
             half_space: HalfSpace {

@@ -10,7 +10,7 @@ use asperity::memory::{array_bytes, ensure_fits};
 use serde::{Deserialize, Serialize};
 
 use crate::derived::Derived;
-use crate::refusal::{Param, Refusal, RequestError};
+use crate::refusal::{number, Param, Refusal, RequestError};
 
 /// The parameters of `asperity bem` and Python's `Solver`, as each front end names them.
 pub mod params {
@@ -65,6 +65,51 @@ const BYTES_PER_FIELD_LOAD: usize = 2048;
 pub fn bookkeeping_bytes(loads: usize, fields: bool) -> Option<u64> {
     let per_load = BYTES_PER_LOAD + if fields { BYTES_PER_FIELD_LOAD } else { 0 };
     array_bytes(&[loads], per_load)
+}
+
+/// A load's control of its value.
+type LoadOf = fn(f64) -> Control;
+
+/// The names of the loads' quantities as Python carries a load between its calls
+/// (`Solver.solve`, `sweep`, `load_path`: the keywords of [`one_load`] without `=`),
+/// with their controls: `pressure`, `force`, `indentation`.
+const QUANTITIES: [(&str, LoadOf); 3] = [
+    ("pressure", Control::MeanPressure),
+    ("force", Control::Force),
+    ("indentation", Control::Indentation),
+];
+
+/// The load of `value` in the quantity named `quantity` (`pressure`, `force` or
+/// `indentation`: [`Loads::quantity`]'s names), refused in one wording otherwise.
+///
+/// ```
+/// use asperity::bem::Control;
+/// use asperity_app::bem::load_of;
+///
+/// assert_eq!(load_of("force", 0.5).unwrap(), Control::Force(0.5));
+/// assert_eq!(
+///     load_of("stress", 0.5).unwrap_err().to_string(),
+///     "unknown load quantity \"stress\" (pressure, force or indentation)"
+/// );
+/// ```
+pub fn load_of(quantity: &str, value: f64) -> Result<Control, Refusal> {
+    match QUANTITIES.iter().find(|(name, _)| *name == quantity) {
+        Some((_, control)) => Ok(control(value)),
+        None => Err(Refusal::saying(format!(
+            "unknown load quantity {:?} (pressure, force or indentation)",
+            asperity::input::clip(quantity)
+        ))),
+    }
+}
+
+/// The name of the quantity of `control` ([`load_of`]'s names) and its value.
+pub fn quantity_of(control: Control) -> (&'static str, f64) {
+    let name = match control {
+        Control::MeanPressure(_) => QUANTITIES[0].0,
+        Control::Force(_) => QUANTITIES[1].0,
+        Control::Indentation(_) => QUANTITIES[2].0,
+    };
+    (name, control.value())
 }
 
 /// The load of one solve (Python's `Solver.solve` and `Solver.fd_stiffness`; the CLI solves
@@ -226,8 +271,9 @@ pub fn hardness_interface(hardness: Option<f64>) -> Result<Interface, Refusal> {
     let Some(h) = hardness else {
         return Ok(Interface::HardWall);
     };
-    Interface::hardness(h)
-        .map_err(|_| Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {h}")))
+    Interface::hardness(h).map_err(|_| {
+        Refusal::of(HARDNESS).text(format!(" must be positive and finite, got {}", number(h)))
+    })
 }
 
 /// Refuses the loads that `interface` cannot carry: a mean pressure at or above the
@@ -307,6 +353,17 @@ pub enum Loads {
 }
 
 impl Loads {
+    /// The name of their quantity ([`load_of`]'s names): `force`, `indentation` or
+    /// `pressure` (a list of mean pressures or a log-spaced one).
+    pub fn quantity(&self) -> &'static str {
+        let control = match self {
+            Loads::Forces(_) => Control::Force(0.0),
+            Loads::Indentations(_) => Control::Indentation(0.0),
+            Loads::Pressures(_) | Loads::LogPressures { .. } => Control::MeanPressure(0.0),
+        };
+        quantity_of(control).0
+    }
+
     /// The one load specification among a front end's options, or why not: exactly one of
     /// the three lists or `nloads` (with `pmin` and `pmax`, which go with it only).
     pub fn from_options(
@@ -457,7 +514,7 @@ pub fn check_fd_step(step: f64) -> Result<(), Refusal> {
     if step > 0.0 && step < 1.0 {
         return Ok(());
     }
-    Err(Refusal::of(STEP).text(format!(" must lie in (0, 1), got {step}")))
+    Err(Refusal::of(STEP).text(format!(" must lie in (0, 1), got {}", number(step))))
 }
 
 /// The columns of a load path's table (`asperity bem --load-path`, Python's
@@ -766,7 +823,10 @@ mod tests {
             let words = refused(&capped(bad, Loads::Pressures(vec![0.01])));
             assert_eq!(
                 words,
-                format!("--hardness must be positive and finite, got {bad}")
+                format!(
+                    "--hardness must be positive and finite, got {}",
+                    number(bad)
+                )
             );
         }
         // Indentations are not limited; no hardness is the hard wall.

@@ -57,7 +57,8 @@ pub fn check_poisson(poisson: f64) -> Result<(), Refusal> {
         return Ok(());
     }
     Err(Refusal::of(POISSON).text(format!(
-        " must be in [0, 0.5] (Poisson's ratio), got {poisson}"
+        " must be in [0, 0.5] (Poisson's ratio), got {}",
+        crate::refusal::number(poisson)
     )))
 }
 
@@ -79,7 +80,8 @@ pub fn body_pair(
     }
     if let Some(bad) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
         return Err(invalid().text(format!(
-            ": each body's {what} must be positive and finite, got {bad}"
+            ": each body's {what} must be positive and finite, got {}",
+            crate::refusal::number(*bad)
         )));
     }
     Ok(Some([values[0], values[1]]))
@@ -208,7 +210,10 @@ mod tests {
             let (flags, keywords) = refused(Some(bad), None, None);
             assert_eq!(
                 flags,
-                format!("--poisson must be in [0, 0.5] (Poisson's ratio), got {bad}")
+                format!(
+                    "--poisson must be in [0, 0.5] (Poisson's ratio), got {}",
+                    crate::refusal::number(bad)
+                )
             );
             assert!(keywords.starts_with("poisson must be"), "{keywords}");
         }

@@ -104,7 +104,8 @@ impl Indenter {
     pub fn line(heights: Vec<f64>, size: f64, name: &str) -> Result<Indenter, Refusal> {
         if !(size.is_finite() && size > 0.0) {
             return Err(Refusal::saying("invalid ").param(SIZE).text(format!(
-                ": the line length must be positive and finite, got {size}"
+                ": the line length must be positive and finite, got {}",
+                crate::refusal::number(size)
             )));
         }
         if heights.is_empty() {
@@ -275,7 +276,8 @@ impl MdrRequest {
             return Err(Refusal::saying("invalid ")
                 .param(WORK_OF_ADHESION)
                 .text(format!(
-                    ": the work of adhesion Δγ must be positive and finite, got {w}"
+                    ": the work of adhesion Δγ must be positive and finite, got {}",
+                    crate::refusal::number(w)
                 )));
         }
         if self.spring != "linear" || self.breakpoints {
@@ -295,7 +297,8 @@ impl MdrRequest {
         let dx = need(self.dx, DX, || Refusal::of(what))?;
         if !(dx.is_finite() && dx > 0.0) {
             let refusal = Refusal::saying("invalid ").param(DX).text(format!(
-                ": the spring spacing Δx must be positive and finite, got {dx}"
+                ": the spring spacing Δx must be positive and finite, got {}",
+                crate::refusal::number(dx)
             ));
             return Err(refusal.into());
         }
@@ -453,7 +456,10 @@ impl MdrRequest {
                 };
                 let refusal = Refusal::saying("invalid ")
                     .param(INDENTATIONS)
-                    .text(format!(": each must be {rule}, got {bad}"));
+                    .text(format!(
+                        ": each must be {rule}, got {}",
+                        crate::refusal::number(*bad)
+                    ));
                 return Err(refusal.into());
             }
             return Ok(list.clone());
@@ -718,7 +724,11 @@ mod tests {
             let words = request.check().unwrap_err().words(Names::Keywords);
             assert_eq!(
                 words,
-                format!("invalid work_of_adhesion: the work of adhesion Δγ must be positive and finite, got {w}")
+                format!(
+                    "invalid work_of_adhesion: the work of adhesion Δγ must be positive and \
+                     finite, got {}",
+                    crate::refusal::number(w)
+                )
             );
         }
         let hertz_springs = MdrRequest {

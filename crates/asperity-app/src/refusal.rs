@@ -138,6 +138,24 @@ impl From<Refusal> for RequestError {
     }
 }
 
+/// A number as every refusal writes it (`got 1e-6`, `got 0.25`, `got infinity`): the
+/// library's [`asperity::input::short_number`], so that a rule of the front-end layer and
+/// one of the library word the same value alike, and the CLI (which shortens numbers of
+/// more than 20 characters) and Python alike.
+///
+/// ```
+/// use asperity_app::refusal::number;
+///
+/// assert_eq!(number(-1e-6), "-1e-6");
+/// assert_eq!(number(0.7), "0.7");
+/// assert_eq!(number(100000.0), "100000");
+/// assert_eq!(number(f64::INFINITY), "infinity");
+/// assert_eq!(number(f64::NAN), "NaN");
+/// ```
+pub fn number(value: f64) -> String {
+    asperity::input::short_number(value)
+}
+
 /// A count as a front end holds it, signed (a flag's text, a Python int), as a request's
 /// `usize`: a negative one is refused in the words of the requests' rule for 0, so that
 /// `--max-iter -1` and `max_iterations=-1` are refused alike (every count of a request is
@@ -161,13 +179,18 @@ pub fn count(param: Param, value: impl Into<i128>) -> Result<usize, Refusal> {
         } else {
             "is too large"
         };
-        Refusal::of(param).text(format!(" {rule}, got {value}"))
+        // Past 20 digits, shortened as the CLI shortens every long number of its errors.
+        let shown = match value.to_string() {
+            digits if digits.len() > 20 => number(value as f64),
+            digits => digits,
+        };
+        Refusal::of(param).text(format!(" {rule}, got {shown}"))
     })
 }
 
 /// A value that must be positive and finite (a modulus, a side length, an area), refused
 /// otherwise in one wording: `--size must be positive and finite, got -1` (CLI),
-/// `size must be positive and finite, got -1` (Python).
+/// `size must be positive and finite, got -1` (Python), the number as [`number`] writes it.
 ///
 /// ```
 /// use asperity_app::refusal::{positive, Names, Param};
@@ -176,12 +199,17 @@ pub fn count(param: Param, value: impl Into<i128>) -> Result<usize, Refusal> {
 /// assert_eq!(positive(SIZE, 2.0).unwrap(), 2.0);
 /// let refusal = positive(SIZE, f64::NAN).unwrap_err();
 /// assert_eq!(refusal.words(Names::Keywords), "size must be positive and finite, got NaN");
+/// let refusal = positive(SIZE, -1e-6).unwrap_err();
+/// assert_eq!(refusal.words(Names::Flags), "--size must be positive and finite, got -1e-6");
 /// ```
 pub fn positive(param: Param, value: f64) -> Result<f64, Refusal> {
     if value.is_finite() && value > 0.0 {
         return Ok(value);
     }
-    Err(Refusal::of(param).text(format!(" must be positive and finite, got {value}")))
+    Err(Refusal::of(param).text(format!(
+        " must be positive and finite, got {}",
+        number(value)
+    )))
 }
 
 impl fmt::Display for Refusal {

@@ -95,7 +95,10 @@ impl SlipRequest {
         if !(q.is_finite() && q > 0.0) {
             return Err(param_refusal(
                 TANGENTIAL_FORCE,
-                format!(": the tangential force Q* must be positive and finite, got {q}"),
+                format!(
+                    ": the tangential force Q* must be positive and finite, got {}",
+                    crate::refusal::number(q)
+                ),
             ));
         }
         if let Some(points) = self.cycle_points.filter(|p| *p < 2) {

@@ -131,7 +131,8 @@ fn fit_bound(param: Param, value: Option<f64>) -> Result<(), Refusal> {
     match value {
         Some(v) if !(v.is_finite() && v > 0.0) => {
             Err(Refusal::saying("invalid ").param(param).text(format!(
-                ": must be a positive number of wavelengths per side, got {v}"
+                ": must be a positive number of wavelengths per side, got {}",
+                crate::refusal::number(v)
             )))
         }
         _ => Ok(()),
