@@ -858,6 +858,27 @@ mod tests {
         }
     }
 
+    /// The defaults that `--help` of `study file` and the README list are the library's
+    /// (`StudySpec::default`, where every front end takes them from), not a copy that
+    /// could drift.
+    #[test]
+    fn the_file_keys_defaults_are_the_librarys() {
+        let spec = StudySpec::default();
+        let default = |key: &str| FILE_KEYS.iter().find(|k| k.0 == key).unwrap().2;
+        assert_eq!(default("seed"), spec.seed.to_string());
+        assert_eq!(
+            default("min_contacts"),
+            spec.window.min_contacts.to_string()
+        );
+        assert_eq!(
+            default("max_fraction"),
+            spec.window.max_fraction.to_string()
+        );
+        assert_eq!(default("levels"), spec.levels.to_string());
+        let alpha = StudyRequest::default();
+        assert_eq!(default("full_sweep"), alpha.full_sweep.to_string());
+    }
+
     #[test]
     fn the_example_file_parses_and_help_and_readme_list_every_key() {
         let (kind, spec, _) =
