@@ -1192,3 +1192,49 @@ fn the_shared_metropro_scan_on_a_soft_half_space_solves_alike_with_both_solvers(
         );
     }
 }
+
+/// Sets the uncompressed size of every member of the zip archive in `file`, in its local
+/// and central headers.
+fn declare_zip_sizes(file: &mut [u8], size: u32) {
+    for i in 0..file.len().saturating_sub(30) {
+        if file[i..].starts_with(b"PK\x03\x04") {
+            file[i + 22..i + 26].copy_from_slice(&size.to_le_bytes());
+        } else if file[i..].starts_with(b"PK\x01\x02") {
+            file[i + 24..i + 28].copy_from_slice(&size.to_le_bytes());
+        }
+    }
+}
+
+#[test]
+fn zip_bombs_give_one_line_and_exit_2() {
+    use std::io::Write;
+    // Each zip-based format with the member its reader opens first declaring 4 GiB − 2 from
+    // a few dozen deflated bytes, and declaring 100 bytes while inflating to 16 MiB.
+    let mut zon = b"KPK0".to_vec();
+    zon.extend_from_slice(&2u32.to_le_bytes());
+    zon.extend_from_slice(b"BM");
+    let formats: [(&str, Vec<u8>, &str); 5] = [
+        ("bomb.zon", zon, "686613b8-27b5-4a29-8ffc-438c2780873e"),
+        ("bomb.vk6", b"VK6\0\0\0\0\0\0\0\0\0".to_vec(), "Vk4File"),
+        ("bomb.vk7", b"VK7\0\0\0\0\0\0\0\0\0".to_vec(), "Vk4File"),
+        ("bomb.x3p", Vec::new(), "main.xml"),
+        ("bomb.xlsx", Vec::new(), "xl/workbook.xml"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (file, prefix, member) in formats {
+        for (content, size) in [(vec![7u8; 4096], u32::MAX - 1), (vec![0u8; 16 << 20], 100)] {
+            let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+            let deflated = zip::write::SimpleFileOptions::default()
+                .compression_method(zip::CompressionMethod::Deflated);
+            zip.start_file(member, deflated).unwrap();
+            zip.write_all(&content).unwrap();
+            let mut bytes = prefix.clone();
+            bytes.extend_from_slice(&zip.finish().unwrap().into_inner());
+            declare_zip_sizes(&mut bytes, size);
+            std::fs::write(d.join(file), &bytes).unwrap();
+            let out = asperity(&["import", file, "--out", "s.npy"], d);
+            assert_refused(&out, d, &[file], member);
+        }
+    }
+}

@@ -12,8 +12,8 @@
 //! the map is read as it is (SurfaceTopography's `[x, y]` transposed). The texture (colour)
 //! planes and the icon are not read.
 
-use super::bytes::{areal, bad, grid_points, sample_block, Cursor, Sample};
-use super::{Channel, Heights, Reading};
+use super::bytes::{areal, bad, grid_points, height_reading, sample_block, Cursor, Sample};
+use super::Reading;
 use crate::Result;
 use std::collections::HashMap;
 
@@ -81,16 +81,13 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
         }
     }
     let map = depth_image(bytes, offset, nx as usize, ny as usize, invalid)?;
-    Ok(Reading {
-        format: FORMAT,
-        channels: vec![Channel {
-            name: "Default".into(),
-            heights: Heights::Areal(map),
-            size: [Some(nx as f64 * dx), Some(ny as f64 * dy)],
-            unit: Some("m".into()),
-            is_height: true,
-        }],
-    })
+    Ok(height_reading(
+        FORMAT,
+        "Default",
+        map,
+        [nx as f64 * dx, ny as f64 * dy],
+        "m",
+    ))
 }
 
 /// One 52-byte tag: key and value, the `\r\n` checked.
@@ -129,6 +126,7 @@ fn depth_image(
 #[cfg(test)]
 mod tests {
     use super::super::testkit::{assert_matches, assert_robust, reference, transposed};
+    use super::super::Heights;
     use super::*;
     use std::time::Duration;
 

@@ -310,6 +310,39 @@ pub(crate) fn areal(
     })
 }
 
+/// An areal channel of `map` (rows along y) with sizes `[x, y]` in metres (`None`: not in
+/// the file, asked for) and the file's unit (`None`: the file gives none).
+pub(crate) fn areal_channel(
+    name: impl Into<String>,
+    map: Array2<f64>,
+    size: [Option<f64>; 2],
+    unit: Option<&str>,
+    is_height: bool,
+) -> super::Channel {
+    super::Channel {
+        name: name.into(),
+        heights: super::Heights::Areal(map),
+        size,
+        unit: unit.map(str::to_string),
+        is_height,
+    }
+}
+
+/// A reading of one areal height channel, `name`, of `map` in `unit` with sizes `[x, y]`
+/// in metres: what single-image formats (LEXT, ZON, AL3D, …) give.
+pub(crate) fn height_reading(
+    format: &'static str,
+    name: &str,
+    map: Array2<f64>,
+    size: [f64; 2],
+    unit: &str,
+) -> super::Reading {
+    super::Reading {
+        format,
+        channels: vec![areal_channel(name, map, size.map(Some), Some(unit), true)],
+    }
+}
+
 /// A length unit as the formats write it: its canonical spelling and its value in metres.
 /// Accepts the SI prefixes from pico to kilo, the micro sign in its Unicode, ISO-8859-1
 /// (`µ`), MS-DOS (`æ`) and ASCII (`u`, Nanoscope's `~`) spellings, and the ångström.

@@ -14,9 +14,9 @@
 
 use std::collections::HashMap;
 
-use super::bytes::{bad, Endian};
+use super::bytes::{bad, height_reading, Endian};
 use super::tiff::{self, Page, Value};
-use super::{Channel, Heights, Reading};
+use super::Reading;
 use crate::Result;
 
 const FORMAT: &str = "lext";
@@ -113,21 +113,19 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     }
     let (rows, cols, values) = tiff::raster(FORMAT, bytes, e, page)?;
     let map = super::bytes::areal(FORMAT, rows, cols, values.iter().map(|v| v * dz).collect())?;
-    Ok(Reading {
-        format: FORMAT,
-        channels: vec![Channel {
-            name: "Height".into(),
-            heights: Heights::Areal(map),
-            size: [Some(cols as f64 * dx), Some(rows as f64 * dy)],
-            unit: Some("pm".into()),
-            is_height: true,
-        }],
-    })
+    Ok(height_reading(
+        FORMAT,
+        "Height",
+        map,
+        [cols as f64 * dx, rows as f64 * dy],
+        "pm",
+    ))
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::testkit::{assert_close, assert_robust};
+    use super::super::Heights;
     use super::*;
     use std::time::Duration;
 

@@ -63,6 +63,7 @@ pub(crate) mod wsxm;
 pub mod x3p;
 pub(crate) mod xlsx;
 pub(crate) mod xyz;
+pub(crate) mod zipped;
 pub(crate) mod zon;
 
 /// The heights of one channel: a map or a line profile.

@@ -196,6 +196,86 @@ pub(crate) fn assert_robust(
     eprintln!("{tries} corrupted headers read without a panic");
 }
 
+/// The offsets of the size fields of every zip header in `bytes`: the compressed and
+/// uncompressed sizes of each local file header (`PK\x03\x04`, at +18 and +22) and each
+/// central directory header (`PK\x01\x02`, at +20 and +24), as `(offset, uncompressed)`.
+fn zip_size_fields(bytes: &[u8]) -> Vec<(usize, bool)> {
+    let mut fields = Vec::new();
+    for i in 0..bytes.len().saturating_sub(46) {
+        if bytes[i..].starts_with(b"PK\x03\x04") {
+            fields.extend([(i + 18, false), (i + 22, true)]);
+        } else if bytes[i..].starts_with(b"PK\x01\x02") {
+            fields.extend([(i + 20, false), (i + 24, true)]);
+        }
+    }
+    fields
+}
+
+/// The zip-bomb loop of a zip-based format: every member made to declare 4 GiB (in its
+/// local and central headers) is refused in one line; then, for about `budget`, one to
+/// three size fields at a time are set to sizes a hostile file would hold (0, 1, a little
+/// more or less than the true size, 2³¹, 4 GiB − 1, the zip64 marker, random), which
+/// must never panic nor read more points than the file has bytes. Prints how many
+/// archives were tried and how many were refused.
+pub(crate) fn assert_zip_sizes_robust(bytes: &[u8], read: ReadFn, budget: Duration) {
+    let fields = zip_size_fields(bytes);
+    assert!(!fields.is_empty(), "no zip headers found");
+    let le = |b: &[u8], at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+    let locals: Vec<usize> = (0..fields.len()).filter(|&k| fields[k].1).collect();
+    for &k in &locals {
+        // This member's local and central uncompressed sizes (the central entry names the
+        // same member when it holds the same size).
+        let mut bomb = bytes.to_vec();
+        let size = le(bytes, fields[k].0);
+        for &(at, uncompressed) in &fields {
+            if uncompressed && le(bytes, at) == size {
+                bomb[at..at + 4].copy_from_slice(&(u32::MAX - 1).to_le_bytes());
+            }
+        }
+        let err = read(&bomb)
+            .expect_err("a member declaring 4 GiB was read")
+            .to_string();
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+    let (start, mut tries, mut refused) = (Instant::now(), 0usize, 0usize);
+    let mut work = bytes.to_vec();
+    while start.elapsed() < budget && tries < 20_000 {
+        tries += 1;
+        let picked: Vec<usize> = (0..1 + rng.below(3))
+            .map(|_| rng.below(fields.len()))
+            .collect();
+        for &k in &picked {
+            let at = fields[k].0;
+            let true_size = le(bytes, at);
+            let value = match rng.below(8) {
+                0 => 0,
+                1 => 1,
+                2 => true_size.wrapping_add(1 + rng.below(64) as u32),
+                3 => true_size.saturating_sub(1 + rng.below(64) as u32),
+                4 => 1 << 31,
+                5 => u32::MAX - 1,
+                6 => u32::MAX,
+                _ => rng.next() as u32,
+            };
+            work[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        }
+        match read(&work) {
+            Ok(reading) => assert_bounded(&reading, bytes.len()),
+            Err(e) => {
+                refused += 1;
+                assert_eq!(e.to_string().lines().count(), 1, "{e}");
+            }
+        }
+        for &k in &picked {
+            let at = fields[k].0;
+            work[at..at + 4].copy_from_slice(&bytes[at..at + 4]);
+        }
+    }
+    assert!(tries > 0);
+    eprintln!("{tries} archives with altered zip sizes read without a panic ({refused} refused)");
+}
+
 /// The reference's `[x, y]` heights as our `(row, col) = (y, x)` map: the transpose.
 pub(crate) fn transposed(r: &Reference) -> Array2<f64> {
     r.heights_xy.t().as_standard_layout().into_owned()

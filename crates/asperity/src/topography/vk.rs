@@ -18,8 +18,8 @@
 
 use std::io::Cursor as IoCursor;
 
-use super::bytes::{areal, bad, grid_points, samples, Cursor, Endian, Sample};
-use super::{Channel, Heights, Reading};
+use super::bytes::{areal, areal_channel, bad, grid_points, samples, Cursor, Endian, Sample};
+use super::{Channel, Reading};
 use crate::Result;
 use zip::ZipArchive;
 
@@ -95,13 +95,8 @@ fn channel(name: String, map: ndarray::Array2<f64>, step: [u32; 2], unit: Option
     let (rows, cols) = map.dim();
     // (n − 1) · step, as both peers; a zero step gives no size (asked for).
     let side = |n: usize, s: u32| (s > 0 && n > 1).then(|| (n - 1) as f64 * f64::from(s) * PM);
-    Channel {
-        name,
-        size: [side(cols, step[0]), side(rows, step[1])],
-        heights: Heights::Areal(map),
-        unit: unit.map(str::to_string),
-        is_height: unit.is_some(),
-    }
+    let size = [side(cols, step[0]), side(rows, step[1])];
+    areal_channel(name, map, size, unit, unit.is_some())
 }
 
 /// The image at `offset` (0: none) as counts, with its bit depth.
@@ -148,7 +143,7 @@ fn read_container(bytes: &[u8]) -> Result<Reading> {
         .ok_or_else(|| bad(FORMAT, "a VK6/VK7 file without its zip archive"))?;
     let mut archive = ZipArchive::new(IoCursor::new(&bytes[start..]))
         .map_err(|e| bad(FORMAT, format!("the VK6/VK7 archive: {e}")))?;
-    let inner = super::xlsx::member(&mut archive, FORMAT, "Vk4File", MAX_MEMBER)?;
+    let inner = super::zipped::member(&mut archive, FORMAT, "Vk4File", MAX_MEMBER)?;
     if !inner.starts_with(b"VK4_") {
         return Err(bad(FORMAT, "the archive's Vk4File is not a VK4 file"));
     }
@@ -157,7 +152,8 @@ fn read_container(bytes: &[u8]) -> Result<Reading> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testkit::{assert_close, assert_robust};
+    use super::super::testkit::{assert_close, assert_robust, assert_zip_sizes_robust};
+    use super::super::Heights;
     use super::*;
     use std::io::Write;
     use std::time::Duration;
@@ -269,5 +265,9 @@ mod tests {
             Some(3),
             Duration::from_millis(300),
         );
+        for magic in [&b"VK6"[..], b"VK7"] {
+            let c = write_container(magic, &f);
+            assert_zip_sizes_robust(&c, read, Duration::from_millis(200));
+        }
     }
 }

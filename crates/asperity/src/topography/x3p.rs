@@ -387,22 +387,12 @@ fn check_md5(what: &str, data: &[u8], recorded: Option<&str>) -> Result<()> {
     }
 }
 
-/// `main.xml`, read whole (so its CRC-32 is checked) up to [`MAX_XML`] bytes.
+/// `main.xml`, read whole (so its CRC-32 is checked) up to [`MAX_XML`] bytes, through
+/// [`zipped::member`](super::zipped::member) (its declared size checked before anything is
+/// allocated, and against what it inflates to).
 fn main_xml_text(archive: &mut ZipArchive<Cursor<&[u8]>>) -> Result<String> {
-    let file = archive
-        .by_name("main.xml")
-        .map_err(|_| bad(FORMAT, "the archive has no main.xml"))?;
-    let mut xml = String::new();
-    file.take(MAX_XML + 1)
-        .read_to_string(&mut xml)
-        .map_err(|e| entry_error("main.xml", e))?;
-    if xml.len() as u64 > MAX_XML {
-        return Err(bad(
-            FORMAT,
-            format!("main.xml is larger than {MAX_XML} bytes"),
-        ));
-    }
-    Ok(xml)
+    let xml = super::zipped::member(archive, FORMAT, "main.xml", MAX_XML)?;
+    String::from_utf8(xml).map_err(|_| bad(FORMAT, "main.xml is not UTF-8"))
 }
 
 /// The checksum file that `Record4/ChecksumFile` names: `HEX *NAME` lines, each checked
@@ -1081,7 +1071,7 @@ mod tests {
         // 17 MiB of spaces deflate to about 17 kB.
         let mut xml = main_xml(2, 2, 1e-6, 1e-6, "").into_bytes();
         xml.resize((MAX_XML + (1 << 20)) as usize, b' ');
-        one_line(&archive(&[("main.xml", &xml)]), "main.xml is larger than");
+        one_line(&archive(&[("main.xml", &xml)]), "main.xml declares");
         // 20000 x 20000 doubles declared; 4 kB of zeros stored.
         let xml = main_xml(20_000, 20_000, 1e-6, 1e-6, "");
         let zeros = vec![0u8; 4096];
@@ -1097,5 +1087,11 @@ mod tests {
         declare_size(&mut more, "bindata/data.bin", 32);
         let err = read(&more).unwrap_err().to_string();
         assert_eq!(err.lines().count(), 1, "{err}");
+        // Every member declaring 4 GiB, and sizes altered at random (issue 34).
+        super::super::testkit::assert_zip_sizes_robust(
+            &map_bytes(),
+            read,
+            std::time::Duration::from_millis(300),
+        );
     }
 }

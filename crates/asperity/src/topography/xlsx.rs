@@ -10,17 +10,18 @@
 //! `Certificate` whose cell E48 holds the cut-off (`0.08mm`, whose unit is the
 //! positions'). Layout facts from SurfaceTopography's reader and the shared mock file.
 //!
-//! Every member is read through [`member`], which refuses a declared size past a cap or
-//! past what its compressed bytes can inflate to, and stops reading one byte past the
-//! declared size: a zip bomb costs neither memory nor time.
+//! Every member is read through [`member`](super::zipped::member), which refuses a
+//! declared size past a cap or past what its compressed bytes can inflate to, and stops
+//! reading one byte past the declared size: a zip bomb costs neither memory nor time.
 
 use std::collections::HashMap;
-use std::io::{Cursor, Read};
+use std::io::Cursor;
 
 use ndarray::Array1;
 use zip::ZipArchive;
 
 use super::bytes::{bad, length_unit};
+use super::zipped::member;
 use super::{Channel, Heights, Reading};
 use crate::Result;
 
@@ -28,8 +29,6 @@ const FORMAT: &str = "xlsx";
 const ZIP_MAGIC: &[u8] = b"PK\x03\x04";
 /// The largest XML part read, in bytes.
 const MAX_PART: u64 = 256 << 20;
-/// The largest ratio of inflated to deflated size (deflate's limit is about 1032).
-const MAX_RATIO: u64 = 1100;
 
 /// A zip archive with an `xl/workbook.xml`.
 pub(crate) fn sniff(bytes: &[u8]) -> bool {
@@ -37,39 +36,6 @@ pub(crate) fn sniff(bytes: &[u8]) -> bool {
         && ZipArchive::new(Cursor::new(bytes))
             .map(|mut z| z.by_name("xl/workbook.xml").is_ok())
             .unwrap_or(false)
-}
-
-/// Reads a zip member of at most `cap` bytes: its declared size is checked against the cap
-/// and against its compressed size before anything is allocated, and at most one byte past
-/// the declared size is inflated (a member that inflates to more is refused).
-pub(crate) fn member(
-    archive: &mut ZipArchive<Cursor<&[u8]>>,
-    format: &'static str,
-    name: &str,
-    cap: u64,
-) -> Result<Vec<u8>> {
-    let file = archive
-        .by_name(name)
-        .map_err(|_| bad(format, format!("the archive has no {name}")))?;
-    let declared = file.size();
-    let packed = file.compressed_size();
-    if declared > cap || declared > packed.saturating_mul(MAX_RATIO).max(1 << 16) {
-        return Err(bad(
-            format,
-            format!("{name} declares {declared} bytes from {packed} compressed: refused"),
-        ));
-    }
-    let mut data = Vec::with_capacity(declared as usize);
-    file.take(declared + 1)
-        .read_to_end(&mut data)
-        .map_err(|e| bad(format, format!("{name}: {e}")))?;
-    if data.len() as u64 != declared {
-        return Err(bad(
-            format,
-            format!("{name} inflates to more or fewer than its {declared} bytes"),
-        ));
-    }
-    Ok(data)
 }
 
 fn part(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<String> {
@@ -276,7 +242,9 @@ fn profile(x: &[f64], z: &[f64], to_z: f64, unit: (&'static str, f64)) -> Result
 
 #[cfg(test)]
 mod tests {
-    use super::super::testkit::{assert_close, assert_robust, check_shared, set_dir};
+    use super::super::testkit::{
+        assert_close, assert_robust, assert_zip_sizes_robust, check_shared, set_dir,
+    };
     use super::*;
     use std::io::Write;
     use std::time::Duration;
@@ -391,6 +359,9 @@ mod tests {
             3_200_000
         );
         assert!(member(&mut archive, FORMAT, "zeros", 1 << 20).is_err());
+        // Every member declaring 4 GiB, and sizes altered at random.
+        let book = workbook(&data_sheet(), CERTIFICATE);
+        assert_zip_sizes_robust(&book, read, Duration::from_millis(300));
     }
 
     #[test]

@@ -1,0 +1,128 @@
+//! Zip bombs in the zip-based topography formats (Keyence ZON, VK6, VK7; X3P; Mitutoyo
+//! `.xlsx`), read through the public [`asperity::topography::read_file`]: a member that
+//! declares 4 GiB from a few hundred compressed bytes, and one that declares 1000 bytes but
+//! inflates to 64 MiB, are refused in one line, and no single allocation made while reading
+//! them comes near either size.
+//!
+//! A global allocator that records the largest allocation made on the reading thread
+//! applies to this test binary only (an integration test); this binary holds one test so
+//! that no other test allocates while it measures.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::io::Write;
+
+use asperity::topography::{read_file, ReadOptions};
+
+struct Largest;
+
+thread_local! {
+    // The largest single allocation on this thread since the last reset. Const-initialised
+    // without a destructor: touching it inside the allocator allocates nothing.
+    static LARGEST: Cell<usize> = const { Cell::new(0) };
+}
+
+fn note(bytes: usize) {
+    LARGEST.with(|m| m.set(m.get().max(bytes)));
+}
+
+// SAFETY: forwards every call to the system allocator unchanged; only records sizes.
+unsafe impl GlobalAlloc for Largest {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        note(layout.size());
+        // SAFETY: the caller's contract for `alloc` is passed on.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        note(layout.size());
+        // SAFETY: as for `alloc`.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `System` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        note(new_size);
+        // SAFETY: as for `dealloc`; `new_size` is the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Largest = Largest;
+
+/// `prefix` then a zip archive whose one member `name` holds `data`, deflated.
+fn container(prefix: &[u8], name: &str, data: &[u8]) -> Vec<u8> {
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    zip.start_file(name, options).unwrap();
+    zip.write_all(data).unwrap();
+    let mut file = prefix.to_vec();
+    file.extend_from_slice(&zip.finish().unwrap().into_inner());
+    file
+}
+
+/// Sets the uncompressed size of every member, in its local and central headers.
+fn declare_size(zip: &mut [u8], size: u32) {
+    for i in 0..zip.len().saturating_sub(30) {
+        if zip[i..].starts_with(b"PK\x03\x04") {
+            zip[i + 22..i + 26].copy_from_slice(&size.to_le_bytes());
+        } else if zip[i..].starts_with(b"PK\x01\x02") {
+            zip[i + 24..i + 28].copy_from_slice(&size.to_le_bytes());
+        }
+    }
+}
+
+#[test]
+fn zip_bombs_are_refused_in_one_line_without_allocating_them() {
+    // (file name, bytes before the archive, the member the reader opens first)
+    let mut zon_prefix = b"KPK0".to_vec();
+    zon_prefix.extend_from_slice(&2u32.to_le_bytes());
+    zon_prefix.extend_from_slice(b"BM");
+    let formats: [(&str, Vec<u8>, &str); 5] = [
+        (
+            "bomb.zon",
+            zon_prefix,
+            "686613b8-27b5-4a29-8ffc-438c2780873e",
+        ),
+        ("bomb.vk6", b"VK6\0\0\0\0\0\0\0\0\0".to_vec(), "Vk4File"),
+        ("bomb.vk7", b"VK7\0\0\0\0\0\0\0\0\0".to_vec(), "Vk4File"),
+        ("bomb.x3p", Vec::new(), "main.xml"),
+        ("bomb.xlsx", Vec::new(), "xl/workbook.xml"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let zeros = vec![0u8; 64 << 20];
+    for (file, prefix, member) in formats {
+        let path = dir.path().join(file);
+        // Declares 4 GiB − 2 from a few hundred bytes; then declares 1000 bytes and
+        // inflates to 64 MiB (about 64 KiB deflated).
+        let mut declared = container(&prefix, member, &[7u8; 4096]);
+        declare_size(&mut declared, u32::MAX - 1);
+        let mut lying = container(&prefix, member, &zeros);
+        declare_size(&mut lying, 1000);
+        for (what, bytes) in [("declared", declared), ("lying", lying)] {
+            std::fs::write(&path, &bytes).unwrap();
+            LARGEST.with(|m| m.set(0));
+            let err = read_file(&path, &ReadOptions::default())
+                .expect_err(file)
+                .to_string();
+            let largest = LARGEST.with(Cell::get);
+            assert_eq!(err.lines().count(), 1, "{file} ({what}): {err}");
+            // The file itself is read whole: allow it, and 1 MiB of working buffers.
+            assert!(
+                largest <= bytes.len() + (1 << 20),
+                "{file} ({what}): an allocation of {largest} bytes for a file of {}",
+                bytes.len()
+            );
+            eprintln!(
+                "{file} ({what}, {} bytes): {err}; largest allocation {largest} bytes",
+                bytes.len()
+            );
+        }
+    }
+}
