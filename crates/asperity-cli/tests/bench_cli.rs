@@ -1,5 +1,5 @@
 //! `asperity bench fft-pair` (the unit of the BEM benchmark's per-iteration cost) and
-//! `asperity bench bem-estimate`. Drives the real binary: `key=value` fields with finite
+//! `asperity bench bem-estimate` and `bench tangential`. Drives the real binary: `key=value` fields with finite
 //! values that add up; bad input is one line on stderr and exit status 2.
 
 use std::collections::HashMap;
@@ -147,5 +147,71 @@ fn bem_estimate_refuses_bad_input_with_one_line() {
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn tangential_times_each_direction_against_the_normal_cg() {
+    let out = asperity(&[
+        "bench",
+        "tangential",
+        "--n",
+        "48",
+        "--repeat",
+        "2",
+        "--pressures",
+        "0.02",
+    ]);
+    ok(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    // The normal CG, then x, y, both in f64 and mixed, then the agreement.
+    assert_eq!(lines.len(), 8, "{stdout}");
+    let field = |line: &str, key: &str| -> String {
+        line.split_whitespace()
+            .find_map(|item| item.strip_prefix(&format!("{key}=")[..]).map(String::from))
+            .unwrap_or_else(|| panic!("{key} in {line}"))
+    };
+    let solves: Vec<(String, String)> = lines[..7]
+        .iter()
+        .map(|l| (field(l, "solve"), field(l, "precision")))
+        .collect();
+    let expected = [
+        ("normal", "f64"),
+        ("x", "f64"),
+        ("y", "f64"),
+        ("both", "f64"),
+        ("x", "mixed"),
+        ("y", "mixed"),
+        ("both", "mixed"),
+    ];
+    for ((solve, precision), (s, p)) in solves.iter().zip(expected) {
+        assert_eq!((solve.as_str(), precision.as_str()), (s, p));
+    }
+    for line in &lines[1..7] {
+        // Mindlin's 2(1−ν)/(2−ν) = 0.8235 at ν = 0.3, within the sample's anisotropy.
+        let ratio: f64 = field(line, "stiffness_ratio").parse().unwrap();
+        assert!((ratio - 0.8235).abs() < 0.02, "{line}");
+        let median: f64 = field(line, "cpu_median_s").parse().unwrap();
+        assert!(median.is_finite() && median >= 0.0, "{line}");
+    }
+    let agree: f64 = field(lines[7], "mixed_vs_f64_max_relative")
+        .parse()
+        .unwrap();
+    assert!(agree < 1e-11, "{}", lines[7]);
+}
+
+#[test]
+fn tangential_refuses_bad_input_with_one_line() {
+    for args in [
+        &["bench", "tangential", "--n", "16", "--poisson", "0.6"][..],
+        &["bench", "tangential", "--n", "16", "--pressures", "-1"][..],
+        &["bench", "tangential", "--n", "16", "--repeat", "0"][..],
+    ] {
+        let out = asperity(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}");
     }
 }

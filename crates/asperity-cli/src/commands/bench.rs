@@ -31,6 +31,13 @@ pub enum Kernel {
     /// with the iterations, operator applications and the cost of an iteration in padded FFT
     /// pairs.
     BemSolve,
+    /// The tangential frozen-set stiffness against the normal one: on the solved states of
+    /// an N×N surface (H, roll-off --rolloff or 4, rms slope 1, seed of --seed, free
+    /// boundaries) at each mean pressure of --pressures, the normal frozen-set CG, then `k_x`
+    /// alone, `k_y` alone and both, all in double precision (`f64`) and with the
+    /// single-precision iterations (`mixed`, the default), interleaved in rotating order,
+    /// --repeat rounds, in CPU seconds of the process.
+    Tangential,
 }
 
 /// Arguments of `asperity bench`.
@@ -43,11 +50,14 @@ pub enum Kernel {
                   bem-estimate: prints, per N and in total, the estimated run time of a BEM study\n\
                   (free boundaries, 24 loads per sample, frozen-set stiffness at each).\n\
                   bem-solve: per boundary, pressure and solver, iterations, operator applications and\n\
-                  the solve time, also in padded FFT pairs per iteration.\n\n\
+                  the solve time, also in padded FFT pairs per iteration.\n\
+                  tangential: per mean pressure and solve (normal; x, y, both in f64 and mixed), the\n\
+                  operator applications and the CPU seconds (median, min, max over --repeat rounds).\n\n\
                   Examples:\n  asperity bench surface --n 4096 --repeat 5\n  \
                   asperity bench fft-pair --n 512 --boundary free --repeat 20\n  \
                   asperity bench bem-estimate --sizes 256,512,1024 --samples 60 --hursts=-1:3:0.25\n  \
-                  asperity bench bem-solve --n 512 --pressures 0.01,0.05 --repeat 3"
+                  asperity bench bem-solve --n 512 --pressures 0.01,0.05 --repeat 3\n  \
+                  asperity bench tangential --n 512 --pressures 0.005,0.02,0.08 --repeat 5"
 )]
 pub struct BenchArgs {
     /// The kernel to time.
@@ -75,7 +85,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = "-1:3:0.25", allow_hyphen_values = true)]
     pub hursts: String,
     /// Roll-off q0·L/2π of the study's surfaces (bem-estimate); none by default, as in a
-    /// study without `rolloff`.
+    /// study without `rolloff`. The surface's (tangential): 4 by default.
     #[arg(long)]
     pub rolloff: Option<f64>,
     /// Estimate a study that solves every load (`study curve`, `study alpha --full-sweep`)
@@ -87,10 +97,11 @@ pub struct BenchArgs {
     #[arg(long)]
     pub probes: Option<String>,
     /// Poisson's ratio of a study that also computes the tangential stiffness at every load
-    /// (`study curve --poisson`; bem-estimate): adds its CGs to the estimate.
+    /// (`study curve --poisson`; bem-estimate): adds its CGs to the estimate; the kernel's ν
+    /// (tangential; 0.3 if not given).
     #[arg(long, value_name = "NU")]
     pub poisson: Option<f64>,
-    /// Mean pressures in units of E* (bem-solve), comma separated.
+    /// Mean pressures in units of E* (bem-solve, tangential), comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.01,0.05")]
     pub pressures: Vec<f64>,
     /// Solver tolerance (bem-solve).
@@ -102,7 +113,7 @@ pub struct BenchArgs {
     /// Boundaries to time (bem-solve), comma separated: free, periodic.
     #[arg(long, value_delimiter = ',', default_value = "free,periodic")]
     pub boundaries: Vec<Boundary>,
-    /// Seed of the surface (bem-solve): the surface of `asperity surface --seed` with the same
+    /// Seed of the surface (bem-solve, tangential): the surface of `asperity surface --seed` with the same
     /// N, H, roll-off 6 and rms slope 1.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -123,6 +134,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         Kernel::FftPair => time_fft_pair(args),
         Kernel::BemEstimate => estimate_bem_study(args),
         Kernel::BemSolve => bem_solve(args),
+        Kernel::Tangential => tangential(args),
     }
 }
 
@@ -406,4 +418,153 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// CPU seconds of this process, all threads (`CLOCK_PROCESS_CPUTIME_ID`): on a shared
+/// machine the steadier measure of a computation's cost than the wall clock.
+#[cfg(unix)]
+fn cpu_seconds() -> f64 {
+    let mut now = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `now` is a valid timespec for the call to write.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut now) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_PROCESS_CPUTIME_ID) failed");
+    now.tv_sec as f64 + now.tv_nsec as f64 * 1e-9
+}
+
+/// The wall clock where there is no process CPU clock.
+#[cfg(not(unix))]
+fn cpu_seconds() -> f64 {
+    use std::sync::OnceLock;
+    static ORIGIN: OnceLock<Instant> = OnceLock::new();
+    ORIGIN.get_or_init(Instant::now).elapsed().as_secs_f64()
+}
+
+/// The solves `bench tangential` times after the normal one, in rotating order: which
+/// directions, in single precision (`mixed`) or not.
+const TANGENTIAL_SOLVES: [(&str, bool); 6] = [
+    ("x", false),
+    ("y", false),
+    ("both", false),
+    ("x", true),
+    ("y", true),
+    ("both", true),
+];
+
+/// `asperity bench tangential`: one line per mean pressure and solve, `kernel n seed
+/// threads mean_pressure area_fraction solve precision applications stiffness_ratio
+/// cpu_median_s cpu_min_s cpu_max_s median_over_normal`, and after each pressure the
+/// largest relative difference between the `f64` and the `mixed` stiffnesses. Each round
+/// times the normal frozen-set CG first (its solution is the tangential CGs' start), then
+/// the six tangential solves, the first of them one further in every round;
+/// `stiffness_ratio` is `k/k_n` (`both`: `(k_x + k_y)/(2 k_n)`), `applications` the
+/// operator applications (`both`: `x+y`).
+fn tangential(args: &BenchArgs) -> Result<()> {
+    use asperity::bem::tangential::TangentialStiffness;
+    use asperity::elastic::Direction;
+    let poisson = args.poisson.unwrap_or(0.3);
+    for &p in &args.pressures {
+        anyhow::ensure!(
+            p.is_finite() && p > 0.0,
+            "--pressures must be positive, got {p}"
+        );
+    }
+    let rolloff = LongWavelength::RollOff {
+        q0: args.rolloff.unwrap_or(4.0),
+    };
+    let psd = Psd::new(args.hurst, rolloff, None)?;
+    let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
+    let surface = SurfaceGenerator::new(&spec)?.try_generate(args.seed)?;
+    let half_space = HalfSpace {
+        modulus: 1.0,
+        boundary: Boundary::Free,
+    };
+    let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default())?;
+    let mut double = TangentialStiffness::new(&solver, poisson)?.with_single_precision(false);
+    let mut mixed = TangentialStiffness::new(&solver, poisson)?;
+    for &pressure in &args.pressures {
+        let (summary, _) = solver.solve(Control::MeanPressure(pressure))?;
+        let mut normal = (Vec::new(), 0, 0.0);
+        let mut solves = [(); 6].map(|_| (Vec::new(), String::new(), 0.0));
+        for round in 0..args.repeat {
+            let cpu = cpu_seconds();
+            let (k_n, info) = solver.frozen_set_stiffness()?;
+            normal.0.push(cpu_seconds() - cpu);
+            (normal.1, normal.2) = (info.operator_applications, k_n);
+            for v in 0..TANGENTIAL_SOLVES.len() {
+                let which = (round + v) % TANGENTIAL_SOLVES.len();
+                let (what, single) = TANGENTIAL_SOLVES[which];
+                let operators = if single { &mut mixed } else { &mut double };
+                let cpu = cpu_seconds();
+                let (k, applications) = match what {
+                    "x" | "y" => {
+                        let d = if what == "x" {
+                            Direction::X
+                        } else {
+                            Direction::Y
+                        };
+                        let (k, info) = operators.solve_along(&solver, d)?;
+                        (k, info.operator_applications.to_string())
+                    }
+                    _ => {
+                        let t = operators.solve(&solver)?;
+                        let a = t.info_x.operator_applications;
+                        (
+                            0.5 * (t.x + t.y),
+                            format!("{a}+{}", t.info_y.operator_applications),
+                        )
+                    }
+                };
+                solves[which].0.push(cpu_seconds() - cpu);
+                (solves[which].1, solves[which].2) = (applications, k);
+            }
+        }
+        let (k_n, normal_median) = (normal.2, median_spread(&mut normal.0).0);
+        let line = |solve: &str,
+                    precision: &str,
+                    applications: &str,
+                    k: f64,
+                    times: &mut Vec<f64>| {
+            let (median, min, max) = median_spread(times);
+            println!(
+                "kernel=tangential n={} seed={} threads={} mean_pressure={pressure} \
+                 area_fraction={:.4} solve={solve} precision={precision} applications={applications} \
+                 stiffness_ratio={:.6} cpu_median_s={median:.4} cpu_min_s={min:.4} cpu_max_s={max:.4} \
+                 median_over_normal={:.3}",
+                args.n,
+                args.seed,
+                rayon::current_num_threads(),
+                summary.area_fraction,
+                k / k_n,
+                median / normal_median,
+            );
+        };
+        line("normal", "f64", &normal.1.to_string(), k_n, &mut normal.0);
+        for (i, (times, applications, k)) in solves.iter_mut().enumerate() {
+            let (what, single) = TANGENTIAL_SOLVES[i];
+            line(
+                what,
+                if single { "mixed" } else { "f64" },
+                applications,
+                *k,
+                times,
+            );
+        }
+        let agree = (0..3)
+            .map(|i| (solves[i + 3].2 / solves[i].2 - 1.0).abs())
+            .fold(0.0f64, f64::max);
+        println!(
+            "kernel=tangential n={} mean_pressure={pressure} mixed_vs_f64_max_relative={agree:.2e}",
+            args.n
+        );
+    }
+    Ok(())
+}
+
+/// Median, minimum and maximum of some timings (seconds).
+fn median_spread(times: &mut [f64]) -> (f64, f64, f64) {
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], times[0], times[times.len() - 1])
 }

@@ -162,6 +162,15 @@ pub(crate) enum Start<'a> {
     /// `r₀ = b − K x₀`; the energy is then `bᵀx₀ + x₀ᵀr₀` plus the CG's sum for the
     /// correction (`bᵀx = bᵀx₀ + x₀ᵀr₀ + r₀ᵀK⁻¹r₀` with `K` symmetric).
     From(&'a [f64]),
+    /// `x₀` = the work's unknown as the previous solve on the same set and right-hand side
+    /// left it (one computed with a cheaper, less precise operator: the tangential CGs'
+    /// single-precision pass): one application for `r₀ = b − K x₀` and the energy base
+    /// `bᵀx₀ + x₀ᵀr₀` as for [`Start::From`], exact to second order in `r₀`. The remainder
+    /// `r₀ᵀK⁻¹r₀` is then of the order of the cheaper operator's rounding squared, and the
+    /// energy estimate looks back one step instead of [`ENERGY_DELAY`]: the CG stops once
+    /// its last step moved `bᵀx` by at most [`CgParams::energy_error`] of it (what is left
+    /// falls geometrically, at the CG's rate, from there).
+    Refine,
 }
 
 /// The fields of a CG on a set, allocated once for a grid.
@@ -242,15 +251,19 @@ struct EnergyEstimate {
     /// The last [`ENERGY_DELAY`] terms (cyclic).
     recent: [f64; ENERGY_DELAY],
     steps: usize,
+    /// The steps the estimate sums: [`ENERGY_DELAY`], or 1 after a [`Start::Refine`].
+    delay: usize,
 }
 
 impl EnergyEstimate {
-    /// From `bᵀx₀ + x₀ᵀr₀` (zero from `x₀ = 0`).
-    fn new(base: f64) -> Self {
+    /// From `bᵀx₀ + x₀ᵀr₀` (zero from `x₀ = 0`), over the last `delay` (1 to
+    /// [`ENERGY_DELAY`]) steps.
+    fn new(base: f64, delay: usize) -> Self {
         EnergyEstimate {
             total: base,
             recent: [0.0; ENERGY_DELAY],
             steps: 0,
+            delay: delay.clamp(1, ENERGY_DELAY),
         }
     }
 
@@ -262,21 +275,31 @@ impl EnergyEstimate {
         self.steps += 1;
     }
 
-    /// Whether the last [`ENERGY_DELAY`] steps moved `bᵀx` by at most `relative` of it.
+    /// Whether the last `delay` steps moved `bᵀx` by at most `relative` of it.
     fn converged(&self, relative: f64) -> bool {
-        self.steps >= ENERGY_DELAY && self.recent.iter().sum::<f64>() <= relative * self.total.abs()
+        if self.steps < self.delay {
+            return false;
+        }
+        // All of them in index order (the sum of before `delay`), or the last `delay`.
+        let moved = match self.delay {
+            ENERGY_DELAY => self.recent.iter().sum::<f64>(),
+            d => (0..d)
+                .map(|j| self.recent[(self.steps - 1 - j) % ENERGY_DELAY])
+                .sum(),
+        };
+        moved <= relative * self.total.abs()
     }
 }
 
-/// `x = x₀`, `r = b − K x₀` on the set (zero off it), from `x₀` given ([`Start::From`]);
-/// returns `‖b‖²`, `‖r₀‖²` and the energy base `bᵀx₀ + x₀ᵀr₀`.
+/// `x = x₀`, `r = b − K x₀` on the set (zero off it), from `x₀` given ([`Start::From`]) or,
+/// with `None`, the work's own `x` ([`Start::Refine`]); returns `‖b‖²`, `‖r₀‖²` and the
+/// energy base `bᵀx₀ + x₀ᵀr₀`.
 fn start_from<A: HalfSpaceOperator + ?Sized>(
     operator: &mut A,
     work: &mut CgWork,
     rhs: RightHandSide<'_>,
-    x0: &[f64],
+    x0: Option<&[f64]>,
 ) -> (f64, f64, f64) {
-    let bb = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
     let CgWork {
         x,
         residual,
@@ -284,9 +307,15 @@ fn start_from<A: HalfSpaceOperator + ?Sized>(
         set,
         ..
     } = work;
-    for &i in set.iter() {
-        x[i] = x0[i];
-    }
+    // x off the set is zero: after `start_on_set`, or as the previous solve left it.
+    let bb = match x0 {
+        Some(x0) => {
+            let bb = start_on_set((x, residual), set, rhs);
+            set.iter().for_each(|&i| x[i] = x0[i]);
+            bb
+        }
+        None => rhs_on_set(residual, set, rhs),
+    };
     operator.apply(x, response);
     for &i in set.iter() {
         residual[i] -= response[i];
@@ -307,6 +336,11 @@ fn start_on_set(
     rhs: RightHandSide<'_>,
 ) -> f64 {
     x.fill(0.0);
+    rhs_on_set(residual, set, rhs)
+}
+
+/// `r = b` on the set (zero off it); returns `‖b‖²`.
+fn rhs_on_set(residual: &mut [f64], set: &[usize], rhs: RightHandSide<'_>) -> f64 {
     residual.fill(0.0);
     let mut rr = 0.0;
     for &i in set {
@@ -463,7 +497,8 @@ where
             let bb = start_on_set((&mut work.x, &mut work.residual), &work.set, rhs);
             (bb, bb, 0.0)
         }
-        Start::From(x0) => start_from(operator, work, rhs, x0),
+        Start::From(x0) => start_from(operator, work, rhs, Some(x0)),
+        Start::Refine => start_from(operator, work, rhs, None),
     };
     let b_norm = bb.sqrt();
     let mut rz = precondition_on_set(
@@ -478,7 +513,11 @@ where
         work.direction[i] = work.preconditioned[i];
     }
     let mut iterations = 0;
-    let mut energy = EnergyEstimate::new(base);
+    let delay = match start {
+        Start::Refine => 1,
+        Start::Zero | Start::From(_) => ENERGY_DELAY,
+    };
+    let mut energy = EnergyEstimate::new(base, delay);
     loop {
         let relative = if b_norm > 0.0 {
             rr.sqrt() / b_norm
