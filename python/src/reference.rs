@@ -31,7 +31,8 @@ fn positive<const N: usize>(model: &str, names: [&str; N], params: &[f64]) -> Py
     for (name, value) in names.iter().zip(params) {
         if !(value.is_finite() && *value > 0.0) {
             return Err(invalid(format!(
-                "{model}: {name} must be positive and finite, got {value}"
+                "{model}: {name} must be positive and finite, got {}",
+                asperity_app::refusal::number(*value)
             )));
         }
     }
@@ -272,7 +273,8 @@ fn reference<'py>(
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Some(bad) = scalars.iter().find(|v| !v.is_finite()) {
         return Err(invalid(format!(
-            "{method}: arguments must be finite, got {bad}"
+            "{method}: arguments must be finite, got {}",
+            asperity_app::refusal::number(*bad)
         )));
     }
     let f = indenter(model, &params, method, &scalars)?;
