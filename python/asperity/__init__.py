@@ -6,8 +6,10 @@ command line, so the same seed gives the same numbers bit for bit):
 * :func:`surface`, :func:`line` -- self-affine rough surfaces and lines (Fourier
   synthesis, ``C2D(q) ∝ q^(-2H-2)``, roll-off / cut-off / short cut-off, rms height or
   slope), returned as numpy arrays with their metadata;
-* :func:`stats`, :func:`psd` -- rms height, slope, curvature and the (radially averaged)
-  power spectrum with an optional power-law fit;
+* :func:`stats`, :func:`psd`, :func:`analysis` -- rms height, slope, curvature and the
+  (radially averaged) power spectrum with an optional power-law fit; the bearing-area
+  curve, the ACF (1D and 2D), scale-dependent slope and curvature, variable-bandwidth rms
+  height and the height, slope and curvature distributions;
 * :class:`Solver` -- the boundary-element contact solver (bound-constrained conjugate
   gradients or Polonsky & Keer, on FFTs; free or periodic boundaries), reusable across
   loads, with frozen-set and finite-difference stiffness and load sweeps;
@@ -15,7 +17,8 @@ command line, so the same seed gives the same numbers bit for bit):
   indenters on linear, Hertz (15.2) or fractal (15.7) spring foundations;
 * :func:`study_alpha`, :func:`study_curve` -- checkpointed ensemble studies of the exponent
   α of ``k ∝ F^α`` and of mean ``k(F)`` curves, in the CLI's folders (a study started here
-  resumes from ``asperity study`` and the other way round).
+  resumes from ``asperity study`` and the other way round); :func:`study_windows` refits a
+  BEM study's α with other windows.
 
 Conventions (as the library's): lengths in the unit of the heights, E* = 1 by default,
 side L = 1 by default; arrays row-major ``(row, col) = (y, x)`` with square pixels
@@ -41,6 +44,9 @@ Example::
 
 from . import reference
 from ._api import (  # noqa: F401 (re-exported)
+    ANALYSES,
+    analysis,
+    Analysis,
     AsperityWarning,
     bem_adhesion,
     BemAdhesion,
@@ -68,6 +74,7 @@ from ._api import (  # noqa: F401 (re-exported)
     stats,
     study_alpha,
     study_curve,
+    study_windows,
     StudyResult,
     Surface,
     surface,
@@ -81,6 +88,8 @@ from ._asperity import BeyondFullContactError, ConvergenceError, __version__
 # The public names, and only these: the implementation and its helpers (numpy as ``np``,
 # ``os``, ``json``, ...) live in the private module ``asperity._api``.
 __all__ = [
+    "ANALYSES",
+    "Analysis",
     "AsperityWarning",
     "BeyondFullContactError",
     "ContactResult",
@@ -98,6 +107,7 @@ __all__ = [
     "Topography",
     "UnitWarning",
     "UnlevelledWarning",
+    "analysis",
     "contact",
     "bem_adhesion",
     "effective_modulus",
@@ -117,6 +127,7 @@ __all__ = [
     "stats",
     "study_alpha",
     "study_curve",
+    "study_windows",
     "surface",
     "__version__",
 ]

@@ -67,6 +67,24 @@ def stats(
 ) -> Dict[str, Any]: ...
 
 @dataclass
+class Analysis:
+    name: str
+    columns: List[str]
+    x: F64
+    y: F64
+    @property
+    def table(self) -> Dict[str, F64]: ...
+    def __getitem__(self, column: str) -> F64: ...
+    def __len__(self) -> int: ...
+    def save(self, path: PathLike, *, force: bool = ...) -> None: ...
+
+ANALYSES: Tuple[str, ...]
+
+def analysis(
+    values: Any, name: str, *, size: Union[None, float, Tuple[float, float]] = ...,
+) -> Analysis: ...
+
+@dataclass
 class Psd:
     q: F64
     psd: F64
@@ -345,3 +363,4 @@ def study_curve(
     poisson: Optional[float] = ..., resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
 ) -> StudyResult: ...
+def study_windows(out: PathLike) -> Dict[str, npt.NDArray[Any]]: ...

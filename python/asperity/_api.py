@@ -455,6 +455,79 @@ def stats(values: Any, *, size: Union[None, float, Tuple[float, float]] = None,
 
 
 @dataclass
+class Analysis(_Saved):
+    """One analysis of ``asperity stats`` (:func:`analysis`): ``name`` (the CLI's option
+    without its dashes and with underscores: ``acf_2d`` for ``--acf-2d``), ``columns`` (the
+    names of the two columns of the CSV the CLI writes) and their values ``x`` and ``y``
+    (float64, bit for bit the CLI's). ``a["distance"]`` is a column by name, ``a.table`` both
+    as a dict (``pandas.DataFrame(a.table)`` copies nothing)."""
+
+    name: str
+    columns: List[str]
+    x: np.ndarray
+    y: np.ndarray
+
+    @property
+    def table(self) -> Dict[str, np.ndarray]:
+        return dict(zip(self.columns, (self.x, self.y)))
+
+    def __getitem__(self, column: str) -> np.ndarray:
+        table = self.table
+        if column not in table:
+            raise KeyError(f"{column!r}: the columns of {self.name} are {self.columns}")
+        return table[column]
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def __repr__(self) -> str:
+        return f"Analysis({self.name}, {len(self.x)} rows: {', '.join(self.columns)})"
+
+
+ANALYSES: Tuple[str, ...] = tuple(_core.analysis_names())
+"""The names :func:`analysis` takes, in the order of ``asperity stats --help``."""
+
+
+def analysis(values: Any, name: str, *,
+             size: Union[None, float, Tuple[float, float]] = None) -> Analysis:
+    """One analysis of ``asperity stats`` by the same code and numbers (the front-end
+    layer's ``stats::analysis``), from the heights as they are (level and fill a measured
+    file when reading it: :func:`read_topography`'s ``detrend`` and ``fill``). ``name`` is
+    the option without its dashes (see :data:`ANALYSES`):
+
+    * ``bearing_area`` -- the bearing-area (Abbott-Firestone) curve: ``material_ratio``
+      (0 to 1 in 101 steps) and ``height`` above which that fraction of the defined heights
+      lies (ISO 25178-2's Smr(c), inverted);
+    * ``acf`` -- the height-difference ACF along x: ``distance`` r = kΔx and ``acf``
+      ½⟨(h(x + r) − h(x))²⟩ over the pairs of defined points in a row, pooled over the rows;
+    * ``acf_2d`` -- its radial average over every direction on a map (``distance``, the
+      mean distance of a bin's pairs, and ``acf``); refused for a profile;
+    * ``variable_bandwidth`` -- ``bandwidth`` ℓ and ``rms_height`` after a plane (a line on a
+      profile) is removed in each of 1, 2, 4, ... sections a side;
+    * ``scale_dependent_slope`` -- ``distance`` and ``slope`` √(2A(r))/r from the ACF;
+    * ``scale_dependent_curvature`` -- ``distance`` 2sΔx and ``curvature``, the rms of
+      (h[i+s] − 2h[i] + h[i−s])/(sΔx)²;
+    * ``height_distribution``, ``slope_distribution``, ``curvature_distribution`` -- the
+      value (bin centre) and its ``density`` (integrating to 1) over ⌊√n⌋ bins (10 to 100).
+
+    ``values`` and ``size`` as for :func:`stats` (a :class:`Topography` brings its sizes;
+    an array takes ``size`` = L along x, or ``(x, y)``). Units: the heights' (metres for a
+    measured file). See docs/topography.md for each definition and its check against
+    SurfaceTopography.
+
+    Example::
+
+        >>> ramp = asperity.analysis(np.arange(64.0), "scale_dependent_slope", size=4.0)
+        >>> ramp.columns, round(float(ramp["slope"][0]), 6)
+        (['distance', 'slope'], 16.0)
+    """
+    heights, size_x, size_y, measured, metadata = _stats_source(values, size)
+    ((first, x), (second, y)), = _core.analyses(heights, size_x, size_y, measured, metadata,
+                                                [str(name)])
+    return Analysis(str(name), [first, second], x, y)
+
+
+@dataclass
 class Psd(_Saved):
     """A power spectrum: wavenumbers ``q`` (rad/length), values ``psd`` (C2D for a surface,
     radially averaged; C1D for a line), ``modes`` per bin and ``wavenumber`` = q·L/2π; the
@@ -1880,6 +1953,27 @@ def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
+def study_windows(out: Union[str, "os.PathLike[str]"]) -> Dict[str, np.ndarray]:
+    """α of the BEM study in the folder ``out`` (finished or running) refitted with other
+    windows, as ``asperity study windows`` (the same rows, bit for bit): every start of 4,
+    8 and 16 points in contact with every end of 0.5, 1 and 2 % contact, from the sample
+    curves its checkpoints keep; reads only. Returns the CSV's columns by name: ``n``,
+    ``hurst``, ``min_contacts``, ``max_fraction``, ``alpha`` (the ensemble-mean fit),
+    ``low``, ``high`` (2.5 and 97.5 % of 400 bootstrap resamples of the samples) and
+    ``samples``; counts as int64, the rest float64 (``pandas.DataFrame`` takes the dict).
+    A study whose tasks keep no sample curves (MDR) is refused: ``ValueError``.
+
+    Example::
+
+        >>> _ = asperity.study_curve(method="bem", n=64, hurst=0.5, samples=3, seed=5,
+        ...                          out="bem_study", progress=None)
+        >>> w = asperity.study_windows("bem_study")
+        >>> list(w), int(w["samples"][0])
+        (['n', 'hurst', 'min_contacts', 'max_fraction', 'alpha', 'low', 'high', 'samples'], 3)
+    """
+    return dict(_core.study_windows(os.fspath(out)))
+
+
 def reproduce(figure: str, out: Union[str, "os.PathLike[str]"], *, setting: str = "paper",
               force: bool = False) -> str:
     """Regenerates a figure of the paper, ``asperity reproduce FIGURE --setting SETTING
@@ -2088,12 +2182,14 @@ def _npz(path: str) -> Dict[str, np.ndarray]:
 
 
 Psd._kind = "psd"
+Analysis._kind = "analysis"
 Patches._kind = "patches"
 MdrCurve._kind = "mdr curve"
 SlipCycle._kind = "slip cycle"
 BemAdhesion._kind = "bem adhesion"
 PerssonTable._kind = "persson table"
-_SAVED = {cls._kind: cls for cls in (Psd, Patches, MdrCurve, SlipCycle, BemAdhesion, PerssonTable)}
+_SAVED = {cls._kind: cls for cls in (Psd, Analysis, Patches, MdrCurve, SlipCycle, BemAdhesion,
+                                      PerssonTable)}
 
 
 def load(path: Union[str, "os.PathLike[str]"]) -> Any:

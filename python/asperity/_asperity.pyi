@@ -35,6 +35,11 @@ def statistics(
     metadata: Optional[str], fit_from: Optional[float], fit_to: Optional[float],
     window: str, convention: str,
 ) -> Dict[str, Any]: ...
+def analyses(
+    array: npt.NDArray[np.float64], size_x: float, size_y: Optional[float], measured: bool,
+    metadata: Optional[str], names: List[str],
+) -> List[List[Tuple[str, npt.NDArray[np.float64]]]]: ...
+def analysis_names() -> List[str]: ...
 def sweep_loads(
     forces: Optional[List[float]], pressures: Optional[List[float]],
     indentations: Optional[List[float]], nloads: Optional[int], pmin: Optional[float],
@@ -104,6 +109,7 @@ def persson_table(
     kappa: float, pressures: Optional[List[float]], nloads: Optional[int],
     pmin: Optional[float], pmax: Optional[float],
 ) -> Dict[str, Any]: ...
+def study_windows(dir: str) -> Dict[str, npt.NDArray[Any]]: ...
 # A study's keywords: kind ("alpha"|"curve"), method, sizes, hursts, samples, rolloff,
 # seed (its digits), min_contacts, max_fraction, levels, full_sweep, poisson.
 StudyKeywords = Dict[str, Any]

@@ -20,6 +20,7 @@ mod persson;
 mod reference;
 mod slip;
 mod study;
+mod study_windows;
 mod surface;
 mod topography;
 
@@ -56,6 +57,7 @@ fn _asperity(m: &Bound<'_, PyModule>) -> PyResult<()> {
     reference::register(m)?;
     slip::register(m)?;
     study::register(m)?;
+    study_windows::register(m)?;
     topography::register(m)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(defaults, m)?)?;

@@ -8,6 +8,7 @@ use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::surface::stats::{line_summary, surface_summary};
 use asperity::surface::{LineGenerator, SurfaceGenerator};
 use asperity::topography;
+use asperity_app::stats::analysis::{analyse, Analysis};
 use asperity_app::stats::{
     compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
 };
@@ -26,6 +27,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(generate_line, m)?)?;
     m.add_function(wrap_pyfunction!(save_heights, m)?)?;
     m.add_function(wrap_pyfunction!(statistics, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis_names, m)?)?;
     Ok(())
 }
 
@@ -171,7 +174,25 @@ fn statistics<'py>(
         convention: PsdConvention::parse(convention).map_err(refused)?,
     };
     request.validate().map_err(refused)?;
-    let source = match (heights(&array, "heights")?, measured) {
+    let source = stats_source(&array, size_x, size_y, measured, metadata)?;
+    // On the calling thread's pool like every computation here (its sums are parallel):
+    // rayon's global pool has no threads in a process forked after it started.
+    let stats =
+        run_detached(py, move |_| compute(&request, source, "heights"))?.map_err(request_error)?;
+    statistics_dict(py, &stats)
+}
+
+/// What the statistics and the analyses are computed from, by the rules of
+/// [`statistics`]: heights on square pixels with a generated surface's spectrum hints, or a
+/// measured topography with a size per axis.
+fn stats_source(
+    array: &PyReadonlyArrayDyn<'_, f64>,
+    size_x: f64,
+    size_y: Option<f64>,
+    measured: bool,
+    metadata: Option<String>,
+) -> PyResult<StatsSource> {
+    Ok(match (heights(array, "heights")?, measured) {
         (Heights::Line(h), true) => StatsSource::Measured {
             heights: topography::Heights::Profile(h),
             sizes: vec![size_x],
@@ -196,12 +217,45 @@ fn statistics<'py>(
                     .map_or_else(SpectrumHints::default, |v| SpectrumHints::from_sidecar(&v)),
             }
         }
-    };
-    // On the calling thread's pool like every computation here (its sums are parallel):
-    // rayon's global pool has no threads in a process forked after it started.
-    let stats =
-        run_detached(py, move |_| compute(&request, source, "heights"))?.map_err(request_error)?;
-    statistics_dict(py, &stats)
+    })
+}
+
+/// The tables of `asperity stats`'s analyses (`--acf`, `--bearing-area`, ...), by the
+/// front-end layer's one call ([`analyse`]) on the source [`statistics`] takes: `names` are
+/// Python's names of the analyses (`acf`, `acf_2d`, ...); returns, for each, its two
+/// columns as `(name, array)`.
+#[pyfunction]
+#[pyo3(signature = (array, size_x, size_y, measured, metadata, names))]
+fn analyses<'py>(
+    py: Python<'py>,
+    array: PyReadonlyArrayDyn<'_, f64>,
+    size_x: f64,
+    size_y: Option<f64>,
+    measured: bool,
+    metadata: Option<String>,
+    names: Vec<String>,
+) -> PyResult<Vec<[Column<'py>; 2]>> {
+    let wanted = (names.iter().map(|n| Analysis::parse(n)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(refused)?;
+    let source = stats_source(&array, size_x, size_y, measured, metadata)?;
+    let tables = run_detached(py, |_| analyse(&source, &wanted))?.map_err(request_error)?;
+    Ok((wanted.iter().zip(tables))
+        .map(|(analysis, rows)| {
+            let [first, second] = analysis.columns();
+            let (a, b): (Vec<f64>, Vec<f64>) = rows.into_iter().unzip();
+            [(first, a.into_pyarray(py)), (second, b.into_pyarray(py))]
+        })
+        .collect())
+}
+
+/// One column of an analysis: its name and values.
+type Column<'py> = (&'static str, Bound<'py, PyArray1<f64>>);
+
+/// The names of the analyses, in the order of `asperity stats --help`.
+#[pyfunction]
+fn analysis_names() -> Vec<&'static str> {
+    Analysis::ALL.iter().map(|a| a.param().keyword).collect()
 }
 
 fn statistics_dict<'py>(py: Python<'py>, stats: &Statistics) -> PyResult<Bound<'py, PyDict>> {

@@ -17,6 +17,8 @@ use serde::Serialize;
 
 use crate::refusal::{Param, Refusal, RequestError};
 
+pub mod analysis;
+
 /// The parameters of `asperity stats`.
 pub mod params {
     use crate::refusal::Param;

@@ -17,10 +17,9 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use asperity::study::compare;
 pub use asperity::study::compare::{rows, steepest_slope, Results, Row, CLOSE};
-use asperity::study::sensitivity::{
-    sensitivity_windows, study_sensitivity, study_slopes, TaskSensitivity,
-};
+use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity, study_slopes};
 use asperity_app::study::rows::COMPARISON_COLUMNS;
+use asperity_app::study::windows::WindowRow;
 
 use crate::output::{format_number, Table};
 
@@ -244,33 +243,22 @@ fn sensitivity(dir: &Path, study_dir: &Path, force: bool) -> Result<String> {
             );
         }
     }
-    let table = window_table(&found);
+    let table = window_table(&asperity_app::study::windows::rows(&found));
     table.write(&dir.join("window_sensitivity.csv"), force)?;
     Ok(md)
 }
 
-/// The window sensitivity as a table: one row per (task, window).
-pub fn window_table(found: &[TaskSensitivity]) -> Table {
-    let mut table = Table::new(&[
-        "n",
-        "hurst",
-        "min_contacts",
-        "max_fraction",
-        "alpha",
-        "low",
-        "high",
-        "samples",
-    ]);
-    for t in found {
-        let n = t.task.n.to_string();
-        for w in &t.windows {
-            // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
-            let mut row = vec![n.clone(), format_number(t.task.hurst)];
-            row.push(w.window.min_contacts.to_string());
-            row.extend([w.window.max_fraction, w.alpha, w.low, w.high].map(format_number));
-            row.push(w.samples.to_string());
-            table.push(&row);
-        }
+/// The window sensitivity as a table: one row per (task, window), the columns of
+/// [`asperity_app::study::windows`].
+pub fn window_table(rows: &[WindowRow]) -> Table {
+    let mut table = Table::new(&asperity_app::study::windows::COLUMNS);
+    for r in rows {
+        // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
+        let mut row = vec![r.n.to_string(), format_number(r.hurst)];
+        row.push(r.min_contacts.to_string());
+        row.extend([r.max_fraction, r.alpha, r.low, r.high].map(format_number));
+        row.push(r.samples.to_string());
+        table.push(&row);
     }
     table
 }

@@ -19,6 +19,7 @@ pub mod distributed;
 pub mod progress;
 pub mod request;
 pub mod rows;
+pub mod windows;
 
 use std::path::Path;
 use std::time::Duration;

@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use asperity::io::StagedOutputs;
 use asperity::memory::{array_bytes, ensure_fits};
 use asperity::topography::Heights;
+use asperity_app::stats::analysis::{analyse, Analysis};
 use asperity_app::stats::{
     compute, parse_window, PsdConvention, SpectrumHints, Statistics, StatsRequest, StatsSource,
 };
@@ -240,61 +241,18 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
     }
-    let outputs = (args.psd.iter().chain(&args.bearing_area))
-        .chain(args.acf.iter().chain(&args.plot))
-        .chain(&args.variable_bandwidth)
-        .chain(&args.scale_dependent_slope)
-        .chain(&args.scale_dependent_curvature)
-        .chain(&args.acf_2d)
-        .chain(&args.height_distribution)
-        .chain(&args.slope_distribution)
-        .chain(&args.curvature_distribution);
+    let requested = analyses(args);
+    let outputs = (args.psd.iter().chain(&args.plot)).chain(requested.iter().map(|(p, _)| *p));
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     let (source, record) = open_source(args, size)?;
-    let bearing = match &args.bearing_area {
-        Some(_) => Some(bearing_curve(&source)?),
-        None => None,
-    };
-    let acf = if args.acf.is_some() || args.scale_dependent_slope.is_some() {
-        Some(acf_along_x(&source)?)
-    } else {
-        None
-    };
-    let curvature = match &args.scale_dependent_curvature {
-        Some(path) => Some((path, curvature_along_x(&source)?)),
-        None => None,
-    };
-    let radial = match &args.acf_2d {
-        Some(path) => Some((path, radial_acf(&source)?)),
-        None => None,
-    };
-    let distributions = distributions(args, &source)?;
-    let bandwidth = match &args.variable_bandwidth {
-        Some(path) => Some((path, variable_bandwidth(&source)?)),
-        None => None,
-    };
+    let wanted: Vec<Analysis> = requested.iter().map(|(_, a)| *a).collect();
+    let tables = analyse(&source, &wanted).map_err(crate::request::refused)?;
     let stats = compute(&request, source, &args.file.display().to_string())
         .map_err(crate::request::refused)?;
-    stage_outputs(args, &mut staged, &stats, bearing.as_deref())?;
-    if let (Some(path), Some(rows)) = (&args.acf, &acf) {
-        stage_pairs(&mut staged, path, ["distance", "acf"], rows)?;
-    }
-    if let (Some(path), Some(rows)) = (&args.scale_dependent_slope, &acf) {
-        let slope = asperity::topography::stats::scale_dependent_slope(rows);
-        stage_pairs(&mut staged, path, ["distance", "slope"], &slope)?;
-    }
-    if let Some((path, rows)) = &radial {
-        stage_pairs(&mut staged, path, ["distance", "acf"], rows)?;
-    }
-    if let Some((path, rows)) = &curvature {
-        stage_pairs(&mut staged, path, ["distance", "curvature"], rows)?;
-    }
-    for (path, name, rows) in &distributions {
-        stage_pairs(&mut staged, path, [name, "density"], rows)?;
-    }
-    if let Some((path, rows)) = &bandwidth {
-        stage_pairs(&mut staged, path, ["bandwidth", "rms_height"], rows)?;
+    stage_outputs(args, &mut staged, &stats)?;
+    for ((path, analysis), rows) in requested.iter().zip(&tables) {
+        stage_pairs(&mut staged, path, analysis.columns(), rows)?;
     }
     staged.commit()?;
     if args.json {
@@ -305,155 +263,28 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
 }
 
-/// Rows of the `--bearing-area` table: material ratios 0, 0.01, ..., 1.
-const BEARING_POINTS: usize = 101;
-
-/// The bearing-area curve `(material ratio, height)` of the heights to be analysed.
-fn bearing_curve(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
-    let values: Box<dyn Iterator<Item = f64> + '_> = match source {
-        StatsSource::Grid { heights, .. } => Box::new(heights.iter().copied()),
-        StatsSource::Measured { heights, .. } => heights.values(),
-    };
-    Ok(asperity::topography::stats::bearing_area_curve(
-        values,
-        BEARING_POINTS,
-    )?)
-}
-
-/// The heights as rows along x (a line is one row) and the spacing Δx.
-fn rows_along_x(source: &StatsSource) -> Result<(ndarray::Array2<f64>, f64)> {
-    use ndarray::{Array2, Axis, Ix1, Ix2};
-    let (rows, size_x): (Array2<f64>, f64) = match source {
-        StatsSource::Grid { heights, size, .. } => match heights.ndim() {
-            1 => (
-                heights
-                    .view()
-                    .into_dimensionality::<Ix1>()?
-                    .insert_axis(Axis(0))
-                    .to_owned(),
-                *size,
-            ),
-            _ => (
-                heights.view().into_dimensionality::<Ix2>()?.to_owned(),
-                *size,
-            ),
-        },
-        StatsSource::Measured { heights, sizes } => match heights {
-            Heights::Areal(h) => (h.clone(), sizes[0]),
-            Heights::Profile(p) => (p.clone().insert_axis(Axis(0)), sizes[0]),
-        },
-    };
-    let dx = size_x / rows.ncols() as f64;
-    Ok((rows, dx))
-}
-
-/// The height-difference ACF along x as `(distance, A)`: a line is one row.
-fn acf_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
-    let (rows, dx) = rows_along_x(source)?;
-    let acf = asperity::topography::stats::height_difference_acf(rows.view())?;
-    Ok(acf.into_iter().map(|(k, a)| (k as f64 * dx, a)).collect())
-}
-
-/// The radially averaged 2-D height-difference ACF of a map as `(distance, A)`.
-fn radial_acf(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
-    use ndarray::Ix2;
-    let (map, dx, dy) = match source {
-        StatsSource::Grid { heights, size, .. } if heights.ndim() == 2 => {
-            let map = heights.view().into_dimensionality::<Ix2>()?;
-            let dx = *size / map.ncols() as f64;
-            (map.to_owned(), dx, dx)
-        }
-        StatsSource::Measured {
-            heights: Heights::Areal(h),
-            sizes,
-        } => (
-            h.clone(),
-            sizes[0] / h.ncols() as f64,
-            sizes[1] / h.nrows() as f64,
+/// The analyses asked for, each with its output, in the order of the options.
+fn analyses(args: &StatsArgs) -> Vec<(&PathBuf, Analysis)> {
+    let paths = [
+        (&args.bearing_area, Analysis::BearingArea),
+        (&args.acf, Analysis::Acf),
+        (&args.acf_2d, Analysis::Acf2d),
+        (&args.variable_bandwidth, Analysis::VariableBandwidth),
+        (&args.scale_dependent_slope, Analysis::ScaleDependentSlope),
+        (
+            &args.scale_dependent_curvature,
+            Analysis::ScaleDependentCurvature,
         ),
-        _ => {
-            return Err(anyhow::anyhow!(
-                "--acf-2d needs a map; for a profile use --acf"
-            ))
-        }
-    };
-    Ok(asperity::topography::stats::radial_height_difference_acf(
-        map.view(),
-        dx,
-        dy,
-    )?)
-}
-
-/// The scale-dependent rms curvature along x as `(distance, curvature)`: a line is one row.
-fn curvature_along_x(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
-    let (rows, dx) = rows_along_x(source)?;
-    Ok(asperity::topography::stats::scale_dependent_curvature(
-        rows.view(),
-        dx,
-    )?)
-}
-
-/// The variable-bandwidth analysis as `(bandwidth, rms height)`: a checkerboard of planes
-/// on a map, of lines on a profile.
-fn variable_bandwidth(source: &StatsSource) -> Result<Vec<(f64, f64)>> {
-    use asperity::topography::bandwidth::{variable_bandwidth_area, variable_bandwidth_profile};
-    use ndarray::{Axis, Ix1, Ix2};
-    let out = match source {
-        StatsSource::Grid { heights, size, .. } => match heights.ndim() {
-            1 => {
-                let line = heights.view().into_dimensionality::<Ix1>()?;
-                variable_bandwidth_profile(line.insert_axis(Axis(0)), *size)?
-            }
-            _ => {
-                let map = heights.view().into_dimensionality::<Ix2>()?;
-                // Square pixels: L_y = L_x · rows / cols.
-                let size_y = *size * map.nrows() as f64 / map.ncols() as f64;
-                variable_bandwidth_area(map, [*size, size_y])?
-            }
-        },
-        StatsSource::Measured { heights, sizes } => match heights {
-            Heights::Areal(h) => variable_bandwidth_area(h.view(), [sizes[0], sizes[1]])?,
-            Heights::Profile(p) => {
-                variable_bandwidth_profile(p.view().insert_axis(Axis(0)), sizes[0])?
-            }
-        },
-    };
-    Ok(out.iter().map(|b| (b.bandwidth, b.rms_height)).collect())
-}
-
-/// The bins of the distributions: ⌊√n⌋ for n values, at least 10 and at most 100.
-fn distribution_bins(n: usize) -> usize {
-    ((n as f64).sqrt() as usize).clamp(10, 100)
-}
-
-/// One requested distribution: its output, the name of its value column and its
-/// `(value, density)` rows.
-type Distribution = (PathBuf, &'static str, Vec<(f64, f64)>);
-
-/// The requested distributions (`--height-`, `--slope-`, `--curvature-distribution`).
-fn distributions(args: &StatsArgs, source: &StatsSource) -> Result<Vec<Distribution>> {
-    use asperity::topography::stats::{distribution, slopes_and_curvatures_along_x};
-    let wanted = [
-        (&args.height_distribution, "height"),
-        (&args.slope_distribution, "slope"),
-        (&args.curvature_distribution, "curvature"),
+        (&args.height_distribution, Analysis::HeightDistribution),
+        (&args.slope_distribution, Analysis::SlopeDistribution),
+        (
+            &args.curvature_distribution,
+            Analysis::CurvatureDistribution,
+        ),
     ];
-    if wanted.iter().all(|(path, _)| path.is_none()) {
-        return Ok(Vec::new());
-    }
-    let (rows, dx) = rows_along_x(source)?;
-    let (slopes, curvatures) = slopes_and_curvatures_along_x(rows.view(), dx);
-    let heights: Vec<f64> = rows.iter().copied().filter(|v| !v.is_nan()).collect();
-    let mut out = Vec::new();
-    for ((path, name), values) in wanted.into_iter().zip([heights, slopes, curvatures]) {
-        if let Some(path) = path {
-            let bins = distribution_bins(values.len());
-            let table =
-                distribution(values, bins).with_context(|| format!("the {name} distribution"))?;
-            out.push((path.clone(), name, table));
-        }
-    }
-    Ok(out)
+    (paths.into_iter())
+        .filter_map(|(path, analysis)| path.as_ref().map(|p| (p, analysis)))
+        .collect()
 }
 
 /// Stages a two-column table.
@@ -472,17 +303,8 @@ fn stage_pairs(
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Stages the --psd and --bearing-area tables and the --plot chart (committed together by
-/// the caller).
-fn stage_outputs(
-    args: &StatsArgs,
-    staged: &mut StagedOutputs,
-    stats: &Statistics,
-    bearing: Option<&[(f64, f64)]>,
-) -> Result<()> {
-    if let (Some(path), Some(curve)) = (&args.bearing_area, bearing) {
-        stage_pairs(staged, path, ["material_ratio", "height"], curve)?;
-    }
+/// Stages the --psd table and the --plot chart (committed together by the caller).
+fn stage_outputs(args: &StatsArgs, staged: &mut StagedOutputs, stats: &Statistics) -> Result<()> {
     let (bins, size) = (&stats.bins, stats.size);
     if let Some(path) = &args.psd {
         let mut table = Table::new(&["q", "psd", "q_l_2pi"]);

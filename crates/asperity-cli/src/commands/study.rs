@@ -371,16 +371,9 @@ pub struct WindowsArgs {
 
 /// `asperity study windows`: the window sensitivity as CSV on stdout.
 fn windows(args: &WindowsArgs) -> Result<()> {
-    use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity};
-    let found = study_sensitivity(&args.dir, &sensitivity_windows())?;
-    if found.is_empty() {
-        anyhow::bail!(
-            "{}: no task of this study has stored sample curves (MDR tasks and BEM tasks \
-             finished before asperity kept them have none)",
-            args.dir.display()
-        );
-    }
-    let table = crate::report::window_table(&found);
+    let rows = asperity_app::study::windows::window_sensitivity(&args.dir)
+        .map_err(crate::request::refused)?;
+    let table = crate::report::window_table(&rows);
     use std::io::Write as _;
     std::io::stdout().write_all(&table.to_csv()?)?;
     Ok(())
