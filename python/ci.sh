@@ -6,7 +6,8 @@
 #
 # 1. a virtual environment python/.venv (git-ignored; reused when present);
 # 2. the build and test dependencies from PyPI: maturin, numpy, pytest, matplotlib, scipy
-#    (its netcdf_file reads the NetCDF files test_netcdf.py writes) and the peers
+#    and xarray (scipy's netcdf_file and xarray read the NetCDF files test_netcdf.py
+#    writes; xarray with pandas installs in about 8 s here) and the peers
 #    ContactMechanics + SurfaceTopography (the cross-check tests need them);
 # 3. the `asperity` binary the tests compare against (ASPERITY_BIN, else cargo build
 #    --release), then `pip install ./python` (maturin builds the abi3 extension in the
@@ -26,7 +27,7 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 "$venv/bin/python" -m pip install --quiet "maturin>=1.16,<2" numpy pytest matplotlib \
-    scipy ContactMechanics SurfaceTopography
+    scipy xarray ContactMechanics SurfaceTopography
 
 # The CLI the tests compare with: ASPERITY_BIN where given (.ci/run passes the binary its
 # Rust tests built), else a release build here.
