@@ -16,6 +16,7 @@
 //! The CLI writes the table as CSV with its plots; Python returns it as numpy columns.
 
 pub mod distributed;
+pub mod file;
 pub mod progress;
 pub mod request;
 pub mod rows;
