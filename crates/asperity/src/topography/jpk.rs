@@ -10,6 +10,14 @@
 //! GridReflect is set, and rows are returned top down. Layout learnt from
 //! SurfaceTopography's reader and Gwyddion's `jpkscan.c`; checked on the shared
 //! `afmreader-sample_0.jpk`.
+//!
+//! **QI maps** (Quantitative Imaging): a `.jpk-qi-image` is such a TIFF (Gwyddion's
+//! `jpkscan.c` and AFMReader read it as a `.jpk` image), detected by content like one; a
+//! `.jpk-qi-data` file is a zip archive holding that image as `data-image.jpk-qi-image`
+//! beside the force curves (`index/<n>/segments/...`, not read), read here through
+//! [`zipped::member`](super::zipped::member). SurfaceTopography 1.27.1 reads neither; no
+//! real QI file was at hand: the tests put the real `afmreader-sample_0.jpk` and a written
+//! scan into that layout.
 
 use std::collections::HashMap;
 
@@ -19,6 +27,10 @@ use super::{Channel, Heights, Reading};
 use crate::Result;
 
 const FORMAT: &str = "jpk";
+/// The QI image inside a `.jpk-qi-data` archive.
+const QI_IMAGE: &str = "data-image.jpk-qi-image";
+/// The largest QI image read from an archive.
+const MAX_QI_IMAGE: u64 = 4 << 30;
 const FIRST_SLOT: u16 = 0x8090;
 const SLOT_STRIDE: u16 = 0x30;
 
@@ -138,11 +150,78 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     })
 }
 
+/// A zip archive holding a QI image (`.jpk-qi-data`).
+pub(crate) fn sniff_qi_data(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"PK\x03\x04")
+        && zip::ZipArchive::new(std::io::Cursor::new(bytes))
+            .map(|z| super::zipped::has(&z, QI_IMAGE))
+            .unwrap_or(false)
+}
+
+/// Reads the QI image of a `.jpk-qi-data` archive as a JPK image scan.
+pub(crate) fn read_qi_data(bytes: &[u8]) -> Result<Reading> {
+    if !bytes.starts_with(b"PK\x03\x04") {
+        return Err(bad(FORMAT, "a QI data file that is not a zip archive"));
+    }
+    let mut archive = zip::ZipArchive::new(std::io::Cursor::new(bytes))
+        .map_err(|e| bad(FORMAT, format!("not a readable QI data archive ({e})")))?;
+    let image = super::zipped::member(&mut archive, FORMAT, QI_IMAGE, MAX_QI_IMAGE)?;
+    if !sniff(&image) {
+        return Err(bad(
+            FORMAT,
+            format!("{QI_IMAGE} is not a JPK image (TIFF with the grid tags)"),
+        ));
+    }
+    read(&image)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::testkit::{assert_robust, check_shared, set_dir};
+    use super::super::testkit::{assert_robust, assert_zip_sizes_robust, check_shared, set_dir};
     use super::*;
+    use std::io::Write;
     use std::time::Duration;
+
+    /// A `.jpk-qi-data` archive in the layout: a force-curve member and the QI image.
+    fn qi_data(image: &[u8]) -> Vec<u8> {
+        let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        let deflated = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated);
+        zip.start_file("header.properties", deflated).unwrap();
+        zip.write_all(b"type=quantitative-imaging-map\n").unwrap();
+        zip.start_file("index/0/segments/0/channels/vDeflection.dat", deflated)
+            .unwrap();
+        zip.write_all(&[0, 0, 0, 1]).unwrap();
+        zip.start_file(QI_IMAGE, deflated).unwrap();
+        zip.write_all(image).unwrap();
+        zip.finish().unwrap().into_inner()
+    }
+
+    #[test]
+    fn a_qi_image_and_qi_data_read_as_the_image_scan() {
+        let Some(dir) = set_dir("topographies-3") else {
+            return;
+        };
+        let bytes = std::fs::read(dir.join("afmreader-sample_0.jpk")).unwrap();
+        let direct = read(&bytes).unwrap();
+        // A .jpk-qi-image is detected by content, its extension also names this reader.
+        let path = std::path::Path::new("scan.jpk-qi-image");
+        let (image, _) = super::super::detect_and_read(path, &bytes).unwrap();
+        assert_eq!(image, direct);
+        let data = qi_data(&bytes);
+        assert!(sniff_qi_data(&data) && !sniff(&data));
+        let path = std::path::Path::new("scan.jpk-qi-data");
+        let (wrapped, _) = super::super::detect_and_read(path, &data).unwrap();
+        assert_eq!(wrapped, direct);
+        // An archive without the image, or whose image is no JPK scan: one line.
+        let err = read_qi_data(&qi_data(b"II*\0 not a scan"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("not a JPK image") && err.lines().count() == 1,
+            "{err}"
+        );
+    }
 
     #[test]
     fn reads_the_real_scan_to_the_reference() {
@@ -242,6 +321,19 @@ mod tests {
         ];
         let file = tiff_file(vec![(thumbnail, vec![7]), (height, raw)]);
         assert!(sniff(&file));
+        // The same scan as a QI data archive: the same reading, and the archive's zip
+        // sizes fuzzed.
+        let data = qi_data(&file);
+        assert_eq!(read_qi_data(&data).unwrap(), read(&file).unwrap());
+        assert_robust(
+            &data,
+            sniff_qi_data,
+            read_qi_data,
+            data.len() - 1,
+            Some(4),
+            Duration::from_millis(300),
+        );
+        assert_zip_sizes_robust(&data, read_qi_data, Duration::from_millis(300));
         let r = read(&file).unwrap();
         let c = &r.channels[0];
         assert_eq!(c.name, "Height (measured, retrace)");

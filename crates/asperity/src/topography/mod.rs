@@ -247,9 +247,15 @@ const FORMATS: &[Format] = &[
     },
     Format {
         name: "jpk",
-        extensions: &["jpk"],
+        extensions: &["jpk", "jpk-qi-image"],
         sniff: jpk::sniff,
         read: jpk::read,
+    },
+    Format {
+        name: "jpk-qi-data",
+        extensions: &["jpk-qi-data"],
+        sniff: jpk::sniff_qi_data,
+        read: jpk::read_qi_data,
     },
     Format {
         name: "park",
