@@ -42,11 +42,6 @@ const DIFFERENCES: &[(&str, &[&str], &str)] = &[
         "the file's zunit µm (the peer reports the lateral unit nm); heights in metres agree",
     ),
     (
-        "nms-1.nms",
-        &["size"],
-        "the steps have no unit: the peer reads mm (a 160 m side), we ask for --size",
-    ),
-    (
         "multiple_data_sets.h5",
         &["size"],
         "no size in the file: the peer was given one unit per pixel, we ask for --size",

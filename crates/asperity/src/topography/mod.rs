@@ -1276,7 +1276,7 @@ mod every_shared_file {
             }
         }
         assert!(failed.is_empty(), "not read: {failed:#?}");
-        // 16 + 21 + 10 files in the three sets.
-        assert_eq!(read, 47);
+        // 16 + 21 + 8 files in the three sets.
+        assert_eq!(read, 45);
     }
 }
