@@ -1953,6 +1953,27 @@ def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
 # --------------------------------------------------------------------------------------
 
 
+def study_file(path: Union[str, "os.PathLike[str]"], out: Union[str, "os.PathLike[str]"], *,
+               force: bool = False, checkpoint_every: Optional[float] = None,
+               progress: ProgressArg = None) -> StudyResult:
+    """Runs (or resumes) the study a TOML study file describes, as ``asperity study file
+    PATH --out OUT``: the file is read by the CLI's reader (the same keys, defaults and
+    refusals, in the same words; see ``asperity study file --help`` and docs/sweep.toml),
+    then the study runs as :func:`study_alpha` or :func:`study_curve` (its ``kind``) would
+    run it, in the same folder with the same checkpoints and numbers."""
+    k = _core.read_study_file(os.fspath(path))
+    kind = k["kind"]
+    records = _run_study(kind, k["method"], k["sizes"], k["hursts"], k["samples"], out,
+                         k["rolloff"], k["seed"], k["min_contacts"], k["max_fraction"],
+                         k["levels"], k["full_sweep"], force, checkpoint_every, progress,
+                         f"{k['method']} study", (k["poisson"], k["resistivity"],
+                                                  k["thermal_conductivity"]))
+    columns, rows = _table(records[kind])
+    return StudyResult(columns, rows, records["tasks"], records["comparisons"],
+                       records["comparison_error"], _study_metadata(kind, out),
+                       records["figures"])
+
+
 def study_windows(out: Union[str, "os.PathLike[str]"]) -> Dict[str, np.ndarray]:
     """α of the BEM study in the folder ``out`` (finished or running) refitted with other
     windows, as ``asperity study windows`` (the same rows, bit for bit): every start of 4,

@@ -13,6 +13,7 @@ use crate::interrupt::run_detached;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_windows, m)?)?;
+    m.add_function(wrap_pyfunction!(read_study_file, m)?)?;
     Ok(())
 }
 
@@ -53,5 +54,37 @@ fn study_windows(py: Python<'_>, dir: PathBuf) -> PyResult<Bound<'_, PyDict>> {
     for (name, column) in columns {
         dict.set_item(name, column)?;
     }
+    Ok(dict)
+}
+
+/// A study file read by the front-end layer's reader (`asperity_app::study::file::read`, the
+/// one `asperity study file` uses): its keywords for `run_study` (kind, method, sizes,
+/// hursts, samples, rolloff, seed, min_contacts, max_fraction, levels, full_sweep, poisson,
+/// resistivity, thermal_conductivity); its refusals are the CLI's words.
+#[pyfunction]
+pub fn read_study_file(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
+    let text = asperity::input::read_text(&path, asperity::input::TEXT_MAX_BYTES)
+        .map_err(crate::errors::from_error)?;
+    let read = asperity_app::study::file::read(&path, &text).map_err(crate::errors::refused)?;
+    let r = read.request;
+    let dict = PyDict::new(py);
+    let kind = match r.kind {
+        asperity_app::study::Kind::Curve => "curve",
+        _ => "alpha",
+    };
+    dict.set_item("kind", kind)?;
+    dict.set_item("method", r.method)?;
+    dict.set_item("sizes", r.sizes)?;
+    dict.set_item("hursts", r.hursts)?;
+    dict.set_item("samples", r.samples)?;
+    dict.set_item("rolloff", r.rolloff)?;
+    dict.set_item("seed", r.seed)?;
+    dict.set_item("min_contacts", r.min_contacts)?;
+    dict.set_item("max_fraction", r.max_fraction)?;
+    dict.set_item("levels", r.levels)?;
+    dict.set_item("full_sweep", r.full_sweep)?;
+    dict.set_item("poisson", r.poisson)?;
+    dict.set_item("resistivity", read.resistivity)?;
+    dict.set_item("thermal_conductivity", read.thermal_conductivity)?;
     Ok(dict)
 }
