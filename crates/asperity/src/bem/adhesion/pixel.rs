@@ -368,34 +368,17 @@ impl PixelAdhesion {
     fn update_cohesive(&mut self, range: f64) -> (usize, usize) {
         let (d, sigma) = (self.indentation, self.critical_stress);
         let half_own = 0.5 * sigma * self.operator.self_influence();
-        let (mut attached, mut released) = (0, 0);
-        let mut entering = false;
-        for i in 0..self.pressure.len() {
-            if self.attached[i] {
-                if self.pressure[i] < -sigma {
-                    self.attached[i] = false;
-                    self.released_here[i] = true;
-                    self.pressure[i] = -sigma;
-                    released += 1;
-                }
-                continue;
+        let (attached, let_go, entered) = self.sweep_laws(|pressure, released_here, gap| {
+            let enters = !released_here && *pressure == 0.0 && gap - half_own <= range;
+            if enters {
+                *pressure = -sigma;
             }
-            let gap = self.displacement[i] + self.profile[i] - d;
-            if self.released_here[i] {
-                continue;
-            }
-            if gap < 0.0 {
-                self.attached[i] = true;
-                attached += 1;
-            } else if self.pressure[i] == 0.0 && gap - half_own <= range {
-                self.pressure[i] = -sigma;
-                entering = true;
-                released += 1;
-            }
+            enters
+        });
+        if entered > 0 {
+            return (attached, let_go + entered);
         }
-        if entering {
-            return (attached, released);
-        }
+        let mut released = let_go;
         for i in 0..self.pressure.len() {
             let gap = self.displacement[i] + self.profile[i] - d;
             if !self.attached[i] && self.pressure[i] < 0.0 && gap + half_own > range {
@@ -414,15 +397,38 @@ impl PixelAdhesion {
     /// `(attached, released)` with the free pixels whose tension moved by more than
     /// [`TENSION_TOLERANCE`]`·σ_m` counted as released (module docs of [`super`]).
     fn update_exponential(&mut self, range: f64) -> (usize, usize) {
+        let sigma = self.critical_stress;
+        let (attached, let_go, moved) = self.sweep_laws(|pressure, _, gap| {
+            let opening = gap.max(0.0) / range;
+            let tension = match opening < EXPONENTIAL_CUTOFF {
+                true => -sigma * (-opening).exp(),
+                false => 0.0,
+            };
+            let moves = (tension - *pressure).abs() > TENSION_TOLERANCE * sigma;
+            *pressure = tension;
+            moves
+        });
+        (attached, let_go + moved)
+    }
+
+    /// The sweep the cohesive laws share: an attached pixel in tension beyond `σ` lets go
+    /// (and carries `−σ`), a free one the indenter penetrates attaches unless it let go at
+    /// this indentation, and every other free pixel is handed to the law,
+    /// `law(pressure, released_here, gap)`, which sets its tension and says whether it
+    /// changed; returns the counts `(attached, let go, changed by the law)`.
+    fn sweep_laws(
+        &mut self,
+        mut law: impl FnMut(&mut f64, bool, f64) -> bool,
+    ) -> (usize, usize, usize) {
         let (d, sigma) = (self.indentation, self.critical_stress);
-        let (mut attached, mut released) = (0, 0);
+        let (mut attached, mut let_go, mut changed) = (0, 0, 0);
         for i in 0..self.pressure.len() {
             if self.attached[i] {
                 if self.pressure[i] < -sigma {
                     self.attached[i] = false;
                     self.released_here[i] = true;
                     self.pressure[i] = -sigma;
-                    released += 1;
+                    let_go += 1;
                 }
                 continue;
             }
@@ -430,19 +436,11 @@ impl PixelAdhesion {
             if gap < 0.0 && !self.released_here[i] {
                 self.attached[i] = true;
                 attached += 1;
-                continue;
+            } else if law(&mut self.pressure[i], self.released_here[i], gap) {
+                changed += 1;
             }
-            let opening = gap.max(0.0) / range;
-            let tension = match opening < EXPONENTIAL_CUTOFF {
-                true => -sigma * (-opening).exp(),
-                false => 0.0,
-            };
-            if (tension - self.pressure[i]).abs() > TENSION_TOLERANCE * sigma {
-                released += 1;
-            }
-            self.pressure[i] = tension;
         }
-        (attached, released)
+        (attached, let_go, changed)
     }
 
     /// Retracts from the current state in steps of `step` (> 0) until no pixel is attached,
