@@ -5,7 +5,9 @@
 use std::convert::Infallible;
 
 use asperity::bem::sweep::{sweep, SweepError, SweepObserver, SweepParams, SweepRow};
-use asperity::bem::{ContactSolver, Control, HalfSpace, Interface, SolverParams};
+use asperity::bem::{
+    ContactSolver, Control, HalfSpace, Interface, PathPoint, SolveError, SolverParams,
+};
 use asperity::topography::patches::count_patches;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
@@ -457,6 +459,35 @@ pub fn run(
         rows: observer.rows,
         map: observer.map,
     })
+}
+
+/// The columns of `asperity contact --load-path` (SI units), in the order of
+/// [`crate::bem::PATH_COLUMNS`] (`asperity bem --load-path`'s), each with its unit.
+pub const PATH_COLUMNS: [&str; 9] = [
+    "branch",
+    "force_n",
+    "mean_pressure_pa",
+    "indentation_m",
+    "area_fraction",
+    "plastic_fraction",
+    "stiffness_n_per_m",
+    "iterations",
+    "permanent_max_m",
+];
+
+/// Walks the plan's pressures, in the given order, as one load path with the plan's
+/// contact law: the library's [`asperity::bem::load_path`] (the one `asperity bem
+/// --load-path` and Python's `Solver.load_path` run), each step warm from the last and
+/// its plastic displacement kept. SI units throughout (the solver's E* in Pa, its surface
+/// in metres): forces in N, displacements in m, stiffness in N/m.
+pub fn load_path(
+    solver: &mut ContactSolver,
+    plan: &ContactPlan,
+) -> Result<Vec<PathPoint>, SolveError> {
+    if solver.interface() != plan.interface {
+        solver.set_interface(plan.interface)?;
+    }
+    asperity::bem::load_path(solver, &plan.loads)
 }
 
 #[cfg(test)]

@@ -708,6 +708,115 @@ fn contact_with_a_hardness_caps_the_pressure_in_si_units() {
     }
 }
 
+/// The rows (split cells) of a CSV, its header first.
+fn csv_cells(path: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+/// `contact --load-path` in SI units is `bem --load-path` on the same measured paraboloid:
+/// with `bem --modulus E*` (E* = E/(1 − ν²), the same f64 `contact` makes of `--young`
+/// and `--poisson`) and the same pressures and hardness in Pa, every cell is the same
+/// (bit for bit: both print round-trip numbers and run the library's one load path). The
+/// loop shows the hysteresis: unloading to the first pressure needs a deeper approach
+/// than loading did (the plastic displacement, kept, flattened the top), so at the same
+/// approach the unloading force is lower; the permanent displacement stays.
+#[test]
+fn contact_load_path_is_bems_in_si_units_with_the_hysteresis() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (n, side, radius, young, nu) = (64usize, 20e-6, 1e-3, 0.91e9, 0.3);
+    std::fs::write(d.join("sphere.txt"), paraboloid(n, side, radius)).unwrap();
+    let e_star: f64 = young / (1.0 - nu * nu);
+    let a: f64 = 4e-6;
+    let high = 4.0 * e_star * a.powi(3) / (3.0 * radius) / (side * side);
+    let hardness = e_star * a / (std::f64::consts::PI * radius);
+    let path = [high / 4.0, high, high / 4.0, high];
+    let list: Vec<String> = path.iter().map(|p| format!("{p}")).collect();
+    let list = list.join(",");
+    let (young, nu) = (format!("{young}"), format!("{nu}"));
+    ok(&asperity(
+        &[
+            "contact",
+            "sphere.txt",
+            "--young",
+            &young,
+            "--poisson",
+            &nu,
+            "--detrend",
+            "none",
+            "--pressures",
+            &list,
+            "--hardness",
+            &format!("{hardness}"),
+            "--load-path",
+            "--out",
+            "c.csv",
+        ],
+        d,
+    ));
+    let bem = |out: &str| -> Vec<Vec<String>> {
+        ok(&asperity(
+            &[
+                "bem",
+                "--surface",
+                "sphere.txt",
+                "--detrend",
+                "none",
+                "--modulus",
+                &format!("{e_star}"),
+                "--pressures",
+                &list,
+                "--hardness",
+                &format!("{hardness}"),
+                "--load-path",
+                "--quiet",
+                "--out",
+                out,
+            ],
+            d,
+        ));
+        csv_cells(&d.join(out))
+    };
+    let contact = csv_cells(&d.join("c.csv"));
+    assert_eq!(
+        contact[0],
+        [
+            "branch",
+            "force_n",
+            "mean_pressure_pa",
+            "indentation_m",
+            "area_fraction",
+            "plastic_fraction",
+            "stiffness_n_per_m",
+            "iterations",
+            "permanent_max_m"
+        ]
+    );
+    assert_eq!(contact[1..], bem("b.csv")[1..]);
+    let number = |cell: &str| -> f64 { cell.parse().unwrap() };
+    let rows: Vec<Vec<f64>> = contact[1..]
+        .iter()
+        .map(|r| r[1..].iter().map(|c| number(c)).collect())
+        .collect();
+    let branch: Vec<&str> = contact[1..].iter().map(|r| r[0].as_str()).collect();
+    assert_eq!(branch, ["loading", "loading", "unloading", "reloading"]);
+    // Columns (after branch): 0 force, 2 indentation, 4 plastic_fraction, 7 permanent_max.
+    assert!(rows[1][4] > 0.0, "no plastic point at the top load");
+    assert!(
+        rows[2][2] > rows[0][2],
+        "unloading approach {} vs {}",
+        rows[2][2],
+        rows[0][2]
+    );
+    assert!(
+        rows[2][7] > 0.0 && rows[2][7] == rows[1][7],
+        "the permanent displacement stays"
+    );
+}
+
 /// `--tangential` with `--hardness` is supported, on the elastic part of the contact
 /// (docs/tangential.md): points at the hardness take no added traction, normal or
 /// tangential, so `k`, `k_x` and `k_y` are the stiffnesses of the same set (the points below

@@ -93,8 +93,9 @@ fn stage(args: &BemArgs, permanent: Option<&Path>) -> Result<StagedOutputs> {
     Ok(staged)
 }
 
-/// One step's CSV cells, in the order of [`PATH_COLUMNS`].
-fn cells(branch: Branch, point: &PathPoint) -> Vec<String> {
+/// One step's CSV cells, in the order of [`PATH_COLUMNS`] (and of `asperity contact
+/// --load-path`'s, whose units are SI).
+pub(super) fn cells(branch: Branch, point: &PathPoint) -> Vec<String> {
     let s = &point.summary;
     vec![
         branch.name().to_string(),

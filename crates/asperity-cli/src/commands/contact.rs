@@ -128,6 +128,15 @@ pub struct ContactArgs {
     /// hardness take no added traction, normal or tangential.
     #[arg(long)]
     pub tangential: bool,
+    /// Walk the pressures in the given order as one load path (loading, unloading,
+    /// reloading: e.g. --pressures 1e7,4e7,1e7,4e7 --hardness 2e8), each step warm from the
+    /// last and its plastic displacement kept (the library's load_path, as `asperity bem
+    /// --load-path` and Python's Solver.load_path), so the table shows the hysteresis.
+    /// Columns branch, force_n, mean_pressure_pa, indentation_m, area_fraction,
+    /// plastic_fraction, stiffness_n_per_m, iterations, permanent_max_m; --plot draws the
+    /// loop: F and A/A0 against d, k against F, the steps marked by branch.
+    #[arg(long)]
+    pub load_path: bool,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -165,7 +174,7 @@ fn request(args: &ContactArgs) -> Result<ContactRequest> {
 
 /// Step 1: the request (the front-end layer's rules) and the image outputs, checked before
 /// any file is read.
-fn check_args(args: &ContactArgs) -> Result<ContactPlan> {
+pub(super) fn check_args(args: &ContactArgs) -> Result<ContactPlan> {
     let plan = request(args)?.validate()?;
     if let Some(plot) = &args.plot {
         ImageFormat::from_path(plot, "--plot")?;
@@ -216,7 +225,7 @@ fn one_or_both(values: &[f64]) -> serde_json::Value {
 }
 
 /// The surface's file name, for titles.
-fn file_name(args: &ContactArgs) -> String {
+pub(super) fn file_name(args: &ContactArgs) -> String {
     args.file
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into())
@@ -238,7 +247,7 @@ fn charts(args: &ContactArgs, rows: &[ContactRow], e_star: f64) -> [Chart; 3] {
 }
 
 /// What `OUT.csv.json` records of the inputs.
-fn inputs_record(
+pub(super) fn inputs_record(
     args: &ContactArgs,
     plan: &ContactPlan,
     surface: serde_json::Value,
@@ -269,6 +278,9 @@ fn inputs_record(
 /// Runs `asperity contact`: check, read, solve (the library's load sweep), then write
 /// every output together.
 pub fn run(args: &ContactArgs) -> Result<()> {
+    if args.load_path {
+        return super::contact_path::run(args);
+    }
     let plan = check_args(args)?;
     let boundary = plan.half_space.boundary;
     let e_star = plan.half_space.modulus;
