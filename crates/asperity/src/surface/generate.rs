@@ -105,8 +105,10 @@ impl SurfaceSpec {
         normalisation: Normalisation,
     ) -> Result<Self> {
         if rows < 2 || cols < 2 {
+            // Name the count that is wrong: `m` (rows) when only it is, else `n` (columns).
+            let param = if cols >= 2 { "m" } else { "n" };
             return Err(Error::invalid(
-                "n",
+                param,
                 format!("grid must be at least 2x2, got {rows}x{cols}"),
             ));
         }
@@ -461,6 +463,30 @@ mod tests {
             serde_json::from_str::<SurfaceSpec>(&text.replace("\"size\":1.0", "\"size\":-1.0"))
                 .unwrap_err();
         assert!(err.to_string().contains("size"), "{err}");
+    }
+
+    /// A grid below 2x2 names the count that is wrong: `m` (the rows) when only it is,
+    /// else `n` (the columns; both when both are).
+    #[test]
+    fn a_grid_too_small_names_the_count_that_is() {
+        let refused = |rows, cols| {
+            let psd = Psd::power_law(0.5).unwrap();
+            SurfaceSpec::new(rows, cols, 1.0, psd, Normalisation::RmsHeight(1.0))
+                .unwrap_err()
+                .to_string()
+        };
+        assert_eq!(
+            refused(0, 16),
+            "invalid m: grid must be at least 2x2, got 0x16"
+        );
+        assert_eq!(
+            refused(16, 1),
+            "invalid n: grid must be at least 2x2, got 16x1"
+        );
+        assert_eq!(
+            refused(1, 1),
+            "invalid n: grid must be at least 2x2, got 1x1"
+        );
     }
 
     /// Slope of the ensemble-averaged radial PSD, fitted over κ ∈ [4, κ_max].
