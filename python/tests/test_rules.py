@@ -250,6 +250,9 @@ SURFACE = [
     # A negative count (asperity_app::surface::grid; before, clap's "invalid digit" and
     # Python's OverflowError).
     ("surface", ["--m", "-3"], dict(m=-3), "m must be at least 1, got -3"),
+    # A grid below 2x2 names the count that is wrong (the library's rule; before, n for both).
+    ("surface", ["--m", "0"], dict(m=0), "invalid m: grid must be at least 2x2, got 0x16"),
+    ("surface", ["--m", "1"], dict(m=1), "invalid m: grid must be at least 2x2, got 1x16"),
     ("surface", ["--rms-height", "1e-320"], dict(rms_height=1e-320),
      "the generated heights are not representable (rms height 1e-320): rms_height or "
      "rms_slope with size 1 is beyond the range of float64"),
@@ -409,11 +412,12 @@ SLIP = [
     (["--tangential-force", "0.1", "--friction", "0"], dict(tangential_force=0.1, friction=0),
      "invalid friction: the friction coefficient μ must be positive and finite, got 0"),
     (["--tangential-force", "0.1", "--friction", "inf"], dict(tangential_force=0.1, friction=INF),
-     "got inf"),
+     "invalid friction: the friction coefficient μ must be positive and finite, got infinity"),
     (["--tangential-force", "-1", "--friction", "0.5"], dict(tangential_force=-1, friction=0.5),
      "invalid tangential_force: the tangential force Q* must be positive and finite, got -1"),
     (["--tangential-force", "0.7", "--friction", "0.5"], dict(tangential_force=0.7, friction=0.5),
-     "invalid tangential_force: the tangential force Q must be finite with |Q| <= μF = 6.66"),
+     "invalid tangential_force: the tangential force Q must be finite with |Q| <= μF = 0.6667 "
+     "(beyond it the contact slides as a whole), got 0.7"),
     (["--tangential-force", "0.1", "--friction", "0.5", "--work-of-adhesion", "1e-3"],
      dict(tangential_force=0.1, friction=0.5, work_of_adhesion=1e-3),
      "tangential_force is for non-adhesive contact: drop work_of_adhesion"),

@@ -215,7 +215,10 @@ pub(crate) fn positive_finite(name: &'static str, value: f64, what: &str) -> Res
     };
     Err(Error::invalid(
         name,
-        format!("{what}must be positive and finite, got {value}"),
+        format!(
+            "{what}must be positive and finite, got {}",
+            crate::input::short_number(value)
+        ),
     ))
 }
 

@@ -164,7 +164,8 @@ impl FieldFile {
             if !crate::is_positive_finite(g.size) || !crate::is_positive_finite(g.size_y) {
                 return Err(invalid(format!(
                     "the sides must be positive and finite, got {} × {}",
-                    g.size, g.size_y
+                    crate::input::short_number(g.size),
+                    crate::input::short_number(g.size_y)
                 )));
             }
         }

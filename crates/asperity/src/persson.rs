@@ -114,19 +114,28 @@ impl PerssonParams {
         if !crate::is_positive_finite(self.modulus) {
             return Err(Error::invalid(
                 "modulus",
-                format!("E* must be positive and finite, got {}", self.modulus),
+                format!(
+                    "E* must be positive and finite, got {}",
+                    crate::input::short_number(self.modulus)
+                ),
             ));
         }
         if !(self.gamma > 0.0 && self.gamma <= 1.0) {
             return Err(Error::invalid(
                 "gamma",
-                format!("Persson's γ must lie in (0, 1], got {}", self.gamma),
+                format!(
+                    "Persson's γ must lie in (0, 1], got {}",
+                    crate::input::short_number(self.gamma)
+                ),
             ));
         }
         if !crate::is_positive_finite(self.kappa) {
             return Err(Error::invalid(
                 "kappa",
-                format!("κ must be positive and finite, got {}", self.kappa),
+                format!(
+                    "κ must be positive and finite, got {}",
+                    crate::input::short_number(self.kappa)
+                ),
             ));
         }
         Ok(())
@@ -174,7 +183,10 @@ impl Persson {
         if !crate::is_positive_finite(area) {
             return Err(Error::invalid(
                 "area",
-                format!("the nominal area must be positive and finite, got {area}"),
+                format!(
+                    "the nominal area must be positive and finite, got {}",
+                    crate::input::short_number(area)
+                ),
             ));
         }
         let mode_area = (2.0 * PI).powi(2) / area;
@@ -288,7 +300,10 @@ impl Persson {
         if !crate::is_positive_finite(pressure) {
             return Err(Error::invalid(
                 "pressure",
-                format!("Persson's theory needs a positive, finite mean pressure, got {pressure}"),
+                format!(
+                    "Persson's theory needs a positive, finite mean pressure, got {}",
+                    crate::input::short_number(pressure)
+                ),
             ));
         }
         let stiffness = self.stiffness(pressure);

@@ -44,7 +44,10 @@ fn check_pair(name: &'static str, what: &str, pair: Option<[f64; 2]>) -> Result<
         if !crate::is_positive_finite(value) {
             return Err(Error::invalid(
                 name,
-                format!("each body's {what} must be positive and finite, got {value}"),
+                format!(
+                    "each body's {what} must be positive and finite, got {}",
+                    crate::input::short_number(value)
+                ),
             ));
         }
     }

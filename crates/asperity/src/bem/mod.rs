@@ -245,7 +245,10 @@ impl SolverParams {
             } else {
                 Err(crate::Error::invalid(
                     name,
-                    format!("must be positive and finite, got {v}"),
+                    format!(
+                        "must be positive and finite, got {}",
+                        crate::input::short_number(v)
+                    ),
                 ))
             }
         };
@@ -256,7 +259,7 @@ impl SolverParams {
                 "stiffness error",
                 format!(
                     "must be zero or positive and finite, got {}",
-                    self.stiffness_error
+                    crate::input::short_number(self.stiffness_error)
                 ),
             ));
         }

@@ -367,7 +367,10 @@ impl<K: ContactOperator> ContactSolver<K> {
                 if !(d.is_finite() && d >= 0.0) {
                     return Err(Error::invalid(
                         "indentation",
-                        format!("must be finite and >= 0, got {d}"),
+                        format!(
+                            "must be finite and >= 0, got {}",
+                            crate::input::short_number(d)
+                        ),
                     )
                     .into());
                 }

@@ -56,7 +56,10 @@ impl SweepParams {
         match self.fd_step {
             Some(step) if !(step > 0.0 && step < 1.0) => Err(Error::invalid(
                 "relative step",
-                format!("must lie in (0, 1), got {step}"),
+                format!(
+                    "must lie in (0, 1), got {}",
+                    crate::input::short_number(step)
+                ),
             )),
             _ => Ok(()),
         }

@@ -304,7 +304,7 @@ impl AdhesiveLine {
         if !d.is_finite() {
             return Err(Error::invalid(
                 "indentation",
-                format!("must be finite, got {d}"),
+                format!("must be finite, got {}", crate::input::short_number(d)),
             ));
         }
         if d >= self.indentation {

@@ -157,7 +157,11 @@ pub fn log_spaced(low: f64, high: f64, count: usize) -> Result<Vec<f64>> {
     if !(low.is_finite() && high.is_finite() && low > 0.0 && high > low) {
         return Err(Error::invalid(
             "range",
-            format!("need 0 < low < high, both finite, got {low} and {high}"),
+            format!(
+                "need 0 < low < high, both finite, got {} and {}",
+                crate::input::short_number(low),
+                crate::input::short_number(high)
+            ),
         ));
     }
     if count < 2 {

@@ -109,7 +109,10 @@ impl Axisymmetric {
             if !crate::is_positive_finite(value) {
                 return Err(Error::invalid(
                     name,
-                    format!("must be positive and finite, got {value}"),
+                    format!(
+                        "must be positive and finite, got {}",
+                        crate::input::short_number(value)
+                    ),
                 ));
             }
         }
@@ -161,7 +164,10 @@ fn check_grid(n: usize, spacing: f64) -> Result<()> {
     if !crate::is_positive_finite(spacing) {
         return Err(Error::invalid(
             "dx",
-            format!("the spring spacing Δx must be positive and finite, got {spacing}"),
+            format!(
+                "the spring spacing Δx must be positive and finite, got {}",
+                crate::input::short_number(spacing)
+            ),
         ));
     }
     // The sampled profile is one f64 per spring; refuse it before allocating.
@@ -202,7 +208,10 @@ impl RadialProfile {
         if !crate::is_positive_finite(step) {
             return Err(Error::invalid(
                 "radial_step",
-                format!("the radial sample step must be positive and finite, got {step}"),
+                format!(
+                    "the radial sample step must be positive and finite, got {}",
+                    crate::input::short_number(step)
+                ),
             ));
         }
         let m = values.len();

@@ -108,7 +108,10 @@ impl LinearCurve {
             if !crate::is_positive_finite(value) {
                 return Err(Error::invalid(
                     name,
-                    format!("{what} must be positive and finite, got {value}"),
+                    format!(
+                        "{what} must be positive and finite, got {}",
+                        crate::input::short_number(value)
+                    ),
                 ));
             }
         }

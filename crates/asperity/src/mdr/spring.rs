@@ -120,7 +120,8 @@ impl Spring {
                         "hurst",
                         format!(
                             "the fractal spring law (15.7) needs 0 < H < 2 (it holds h^(-1/H); \
-                             for H >= 2 roughness acts as one Hertzian asperity), got {hurst}"
+                             for H >= 2 roughness acts as one Hertzian asperity), got {}",
+                            crate::input::short_number(hurst)
                         ),
                     ));
                 }

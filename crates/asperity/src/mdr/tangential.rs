@@ -70,7 +70,10 @@ pub fn check_poisson(poisson: f64) -> Result<()> {
     if !is_poisson_ratio(poisson) {
         return Err(Error::invalid(
             "poisson",
-            format!("Poisson's ratio ν must be in [0, 0.5], got {poisson}"),
+            format!(
+                "Poisson's ratio ν must be in [0, 0.5], got {}",
+                crate::input::short_number(poisson)
+            ),
         ));
     }
     Ok(())
@@ -81,7 +84,10 @@ pub fn check_friction(friction: f64) -> Result<()> {
     if !crate::is_positive_finite(friction) {
         return Err(Error::invalid(
             "friction",
-            format!("the friction coefficient μ must be positive and finite, got {friction}"),
+            format!(
+                "the friction coefficient μ must be positive and finite, got {}",
+                crate::input::short_number(friction)
+            ),
         ));
     }
     Ok(())
@@ -155,7 +161,10 @@ impl PartialSlip {
         if !(crate::is_positive_finite(ratio) && ratio <= 1.0) {
             return Err(Error::invalid(
                 "ratio",
-                format!("the stiffness ratio G*/E* must be in (0, 1], got {ratio}"),
+                format!(
+                    "the stiffness ratio G*/E* must be in (0, 1], got {}",
+                    crate::input::short_number(ratio)
+                ),
             ));
         }
         crate::positive_finite("indentation", indentation, "the indentation d")?;
@@ -275,8 +284,10 @@ impl PartialSlip {
             return Err(Error::invalid(
                 "tangential_force",
                 format!(
-                    "the tangential force Q must be finite with |Q| <= μF = {limit:.6e} \
-                     (beyond it the contact slides as a whole), got {force}"
+                    "the tangential force Q must be finite with |Q| <= μF = {} \
+                     (beyond it the contact slides as a whole), got {}",
+                    crate::input::short_number(limit),
+                    crate::input::short_number(force)
                 ),
             ));
         }
@@ -334,7 +345,10 @@ impl PartialSlip {
         if amplitude.is_nan() || amplitude <= 0.0 {
             return Err(Error::invalid(
                 "tangential_force",
-                format!("the cycle's amplitude Q* must be positive, got {amplitude}"),
+                format!(
+                    "the cycle's amplitude Q* must be positive, got {}",
+                    crate::input::short_number(amplitude)
+                ),
             ));
         }
         let top = self.displacement(amplitude)?;

@@ -124,7 +124,10 @@ fn ensure_usable(values: impl Iterator<Item = f64>, spacings: &[f64], min: usize
     if let Some(s) = spacings.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
         return Err(Error::invalid(
             "spacing",
-            format!("must be positive and finite, got {s}"),
+            format!(
+                "must be positive and finite, got {}",
+                crate::input::short_number(*s)
+            ),
         ));
     }
     Ok(())

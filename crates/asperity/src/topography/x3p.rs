@@ -671,7 +671,10 @@ pub fn to_bytes(heights: ArrayView2<f64>, size: [f64; 2]) -> Result<Vec<u8>> {
     if let Some(s) = size.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
         return Err(Error::invalid(
             "size",
-            format!("must be positive and finite, got {s}"),
+            format!(
+                "must be positive and finite, got {}",
+                crate::input::short_number(*s)
+            ),
         ));
     }
     let mut data = Vec::new();

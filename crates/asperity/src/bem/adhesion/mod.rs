@@ -199,7 +199,10 @@ impl AdhesionParams {
         if self.tolerance >= 1.0 {
             return Err(crate::Error::invalid(
                 "tolerance",
-                format!("must be below 1, got {}", self.tolerance),
+                format!(
+                    "must be below 1, got {}",
+                    crate::input::short_number(self.tolerance)
+                ),
             ));
         }
         for (name, v) in [

@@ -70,8 +70,8 @@ impl PixelAdhesion {
                 "surface",
                 format!(
                     "the pixel criterion needs square pixels, got {} x {}",
-                    surface.spacing(),
-                    surface.spacing_y()
+                    crate::input::short_number(surface.spacing()),
+                    crate::input::short_number(surface.spacing_y())
                 ),
             )
             .into());
@@ -239,7 +239,11 @@ impl PixelAdhesion {
     /// settle (module docs of [`super`]); the settled scalars and how they were reached.
     pub fn move_to(&mut self, d: f64) -> Result<(AdhesiveSummary, AdhesionInfo), SolveError> {
         if !d.is_finite() {
-            return Err(Error::invalid("indentation", format!("must be finite, got {d}")).into());
+            return Err(Error::invalid(
+                "indentation",
+                format!("must be finite, got {}", crate::input::short_number(d)),
+            )
+            .into());
         }
         self.indentation = d;
         self.released_here.fill(false);

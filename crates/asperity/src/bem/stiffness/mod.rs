@@ -233,7 +233,10 @@ impl<K: ContactOperator> ContactSolver<K> {
         if !(relative_step > 0.0 && relative_step < 1.0) {
             return Err(Error::invalid(
                 "relative step",
-                format!("must lie in (0, 1), got {relative_step}"),
+                format!(
+                    "must lie in (0, 1), got {}",
+                    crate::input::short_number(relative_step)
+                ),
             )
             .into());
         }
