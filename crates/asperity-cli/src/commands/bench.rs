@@ -463,7 +463,6 @@ const TANGENTIAL_SOLVES: [(&str, bool); 6] = [
 /// operator applications (`both`: `x+y`).
 fn tangential(args: &BenchArgs) -> Result<()> {
     use asperity::bem::tangential::TangentialStiffness;
-    use asperity::elastic::Direction;
     let poisson = args.poisson.unwrap_or(0.3);
     for &p in &args.pressures {
         anyhow::ensure!(
@@ -471,17 +470,7 @@ fn tangential(args: &BenchArgs) -> Result<()> {
             "--pressures must be positive, got {p}"
         );
     }
-    let rolloff = LongWavelength::RollOff {
-        q0: args.rolloff.unwrap_or(4.0),
-    };
-    let psd = Psd::new(args.hurst, rolloff, None)?;
-    let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
-    let surface = SurfaceGenerator::new(&spec)?.try_generate(args.seed)?;
-    let half_space = HalfSpace {
-        modulus: 1.0,
-        boundary: Boundary::Free,
-    };
-    let mut solver = ContactSolver::new(&surface, half_space, SolverParams::default())?;
+    let mut solver = tangential_surface_solver(args)?;
     let mut double = TangentialStiffness::new(&solver, poisson)?.with_single_precision(false);
     let mut mixed = TangentialStiffness::new(&solver, poisson)?;
     for &pressure in &args.pressures {
@@ -498,25 +487,7 @@ fn tangential(args: &BenchArgs) -> Result<()> {
                 let (what, single) = TANGENTIAL_SOLVES[which];
                 let operators = if single { &mut mixed } else { &mut double };
                 let cpu = cpu_seconds();
-                let (k, applications) = match what {
-                    "x" | "y" => {
-                        let d = if what == "x" {
-                            Direction::X
-                        } else {
-                            Direction::Y
-                        };
-                        let (k, info) = operators.solve_along(&solver, d)?;
-                        (k, info.operator_applications.to_string())
-                    }
-                    _ => {
-                        let t = operators.solve(&solver)?;
-                        let a = t.info_x.operator_applications;
-                        (
-                            0.5 * (t.x + t.y),
-                            format!("{a}+{}", t.info_y.operator_applications),
-                        )
-                    }
-                };
+                let (k, applications) = tangential_solve(operators, &solver, what)?;
                 solves[which].0.push(cpu_seconds() - cpu);
                 (solves[which].1, solves[which].2) = (applications, k);
             }
@@ -561,6 +532,55 @@ fn tangential(args: &BenchArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `bench tangential`'s surface (H, roll-off 4 unless given, unit rms slope, the seed) on a
+/// free half-space with E* = 1, in a contact solver with the default parameters.
+fn tangential_surface_solver(args: &BenchArgs) -> Result<ContactSolver> {
+    let rolloff = LongWavelength::RollOff {
+        q0: args.rolloff.unwrap_or(4.0),
+    };
+    let psd = Psd::new(args.hurst, rolloff, None)?;
+    let spec = SurfaceSpec::new(args.n, args.n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
+    let surface = SurfaceGenerator::new(&spec)?.try_generate(args.seed)?;
+    let half_space = HalfSpace {
+        modulus: 1.0,
+        boundary: Boundary::Free,
+    };
+    Ok(ContactSolver::new(
+        &surface,
+        half_space,
+        SolverParams::default(),
+    )?)
+}
+
+/// One of `bench tangential`'s solves (`x`, `y` or `both`): the stiffness (`both`: the mean
+/// of `k_x` and `k_y`) and the operator applications (`both`: `x+y`).
+fn tangential_solve(
+    operators: &mut asperity::bem::tangential::TangentialStiffness,
+    solver: &ContactSolver,
+    what: &str,
+) -> Result<(f64, String)> {
+    use asperity::elastic::Direction;
+    Ok(match what {
+        "x" | "y" => {
+            let d = if what == "x" {
+                Direction::X
+            } else {
+                Direction::Y
+            };
+            let (k, info) = operators.solve_along(solver, d)?;
+            (k, info.operator_applications.to_string())
+        }
+        _ => {
+            let t = operators.solve(solver)?;
+            let a = t.info_x.operator_applications;
+            (
+                0.5 * (t.x + t.y),
+                format!("{a}+{}", t.info_y.operator_applications),
+            )
+        }
+    })
 }
 
 /// Median, minimum and maximum of some timings (seconds).
