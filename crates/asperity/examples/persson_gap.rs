@@ -6,9 +6,10 @@
 //! frozen-set stiffness, and writes them beside Persson's predictions from the same
 //! surface's PSD.
 //!
-//! `cargo run --release -p asperity --example persson_gap -- OUT.csv [N,N,… [SEEDS]]`
-//! (default grids 256,512, 8 seeds). Surfaces: H = 0.3 and 0.8, roll-off q_r L/2π = 4,
-//! cut-off q_s L/2π = 64 (λ_s = L/64: 4 pixels on 256², 8 on 512², 16 on 1024²), unit rms
+//! `cargo run --release -p asperity --example persson_gap -- OUT.csv [N,N,… [SEEDS
+//! [ROLLOFF CUTOFF]]]` (default grids 256,512, 8 seeds). Surfaces: H = 0.3 and 0.8, roll-off
+//! q_r L/2π = 4, cut-off q_s L/2π = 64 unless given (λ_s = L/64: 4 pixels on 256², 8 on
+//! 512², 16 on 1024²; e.g. `1024 4 16 256` keeps λ_r/λ_s = 16 at L/λ_r = 16), unit rms
 //! slope (forward differences), L = 1, E* = 1; loads p/E* = 10⁻⁴ … 10⁻¹ (19 points).
 //! Columns: n, hurst, seed, pressure, area_bem, gap_bem, stiffness_bem (K = k/A₀, A₀ = 1),
 //! iterations, area_persson (κ = √(8/π)), gap_persson and stiffness_persson (γ = 0.45),
@@ -28,10 +29,19 @@ use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
 type Res<T> = Result<T, Box<dyn Error>>;
 
 const HURSTS: [f64; 2] = [0.3, 0.8];
-const ROLLOFF: f64 = 4.0;
-const CUTOFF: f64 = 64.0;
+/// The default roll-off `q_r L/2π` and cut-off `q_s L/2π`.
+const SPECTRUM: Spectrum = Spectrum {
+    rolloff: 4.0,
+    cutoff: 64.0,
+};
 const LOADS: usize = 19;
 
+/// The spectrum's roll-off `q_r L/2π` and short-wavelength cut-off `q_s L/2π`.
+#[derive(Clone, Copy)]
+struct Spectrum {
+    rolloff: f64,
+    cutoff: f64,
+}
 /// Takes each load's mean gap.
 struct Gaps(Vec<f64>);
 
@@ -54,6 +64,13 @@ fn main() -> Res<()> {
         None => vec![256, 512],
     };
     let seeds: u64 = args.get(3).map_or(Ok(8), |s| s.parse())?;
+    let spectrum = match (args.get(4), args.get(5)) {
+        (Some(rolloff), Some(cutoff)) => Spectrum {
+            rolloff: rolloff.parse()?,
+            cutoff: cutoff.parse()?,
+        },
+        _ => SPECTRUM,
+    };
     let loads: Vec<f64> = (0..LOADS)
         .map(|i| 10f64.powf(-4.0 + 3.0 * i as f64 / (LOADS - 1) as f64))
         .collect();
@@ -64,7 +81,7 @@ fn main() -> Res<()> {
         for hurst in HURSTS {
             for seed in 1..=seeds {
                 eprintln!("N = {n}, H = {hurst}, seed {seed}");
-                one_surface(&mut csv, n, hurst, seed, &loads)?;
+                one_surface(&mut csv, (n, hurst, seed), spectrum, &loads)?;
             }
         }
     }
@@ -74,8 +91,16 @@ fn main() -> Res<()> {
     Ok(())
 }
 
-fn one_surface(csv: &mut String, n: usize, hurst: f64, seed: u64, loads: &[f64]) -> Res<()> {
-    let psd = Psd::new(hurst, LongWavelength::RollOff { q0: ROLLOFF }, Some(CUTOFF))?;
+fn one_surface(
+    csv: &mut String,
+    (n, hurst, seed): (usize, f64, u64),
+    spectrum: Spectrum,
+    loads: &[f64],
+) -> Res<()> {
+    let long = LongWavelength::RollOff {
+        q0: spectrum.rolloff,
+    };
+    let psd = Psd::new(hurst, long, Some(spectrum.cutoff))?;
     let spec = SurfaceSpec::new(n, n, 1.0, psd, Normalisation::RmsSlope(1.0))?;
     let surface = SurfaceGenerator::new(&spec)?.try_generate(seed)?;
     let theory = Persson::from_surface(&surface, PerssonParams::default())?;

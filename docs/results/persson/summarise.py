@@ -92,4 +92,5 @@ def plot(data):
     fig.savefig(HERE / "persson.png", dpi=110)
 
 
-main()
+if __name__ == "__main__":
+    main()
