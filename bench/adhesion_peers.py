@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""Compare asperity's exponential-potential adhesion (`asperity bem --work-of-adhesion W
---adhesion-range RHO --adhesion-model exponential --boundary periodic`) with tamaas'
-`ExponentialAdhesionFunctional` (a `PolonskyKeerRey` solver on the gap, mean gap imposed)
-on asperity's own periodic rough surfaces, in one run (docs/adhesion.md, issue 38).
+"""Compare asperity's cohesive-law adhesion (`asperity bem --work-of-adhesion W
+--adhesion-range RHO --adhesion-model exponential|maugis-dugdale --boundary periodic`) with
+tamaas' `ExponentialAdhesionFunctional` or `MaugisAdhesionFunctional` (a `PolonskyKeerRey`
+solver on the gap, mean gap imposed) on asperity's own periodic rough surfaces, in one run
+(docs/adhesion.md, issue 38). --model picks the law (the same w and range in both codes:
+exponential sigma_m = w/rho, Maugis-Dugdale sigma_0 = w/h0).
 
 Both codes walk the same loading-unloading path in displacement control: asperity's
 `--indentations` then its retraction rows (step --retract-step), tamaas at the same mean
@@ -14,10 +16,12 @@ tamaas' pixels with zero gap); then the pull-off (asperity's bisected displaceme
 pull-off against tamaas' force at the same d and the least force of a fine tamaas sweep
 around it), and the CPU time of each code for the whole path (getrusage of the asperity
 child; process_time of tamaas, both with one thread). The record states the load average.
+Each size's record is written to --out as soon as that size is done (the file is rewritten
+with all sizes so far), so a long run loses nothing when it is stopped.
 
 Run with the peers' venv (tamaas):
   /work/venv-peers/bin/python bench/adhesion_peers.py --asperity target/release/asperity \
-      [--sizes 64,128,256] [--w 1e-6] [--rho 5e-4] [--out results.json]
+      [--sizes 64,128,256] [--model exponential] [--w 1e-6] [--rho 5e-4] [--out results.json]
 """
 import argparse
 import csv
@@ -42,10 +46,10 @@ def child_cpu():
     return r.ru_utime + r.ru_stime
 
 
-def run_asperity(args, surface, out):
+def run_asperity(args, surface, out, indentations=None):
     cmd = [args.asperity, "bem", "--surface", surface, "--boundary", "periodic",
            "--work-of-adhesion", str(args.w), "--adhesion-range", str(args.rho),
-           "--adhesion-model", "exponential", "--indentations", args.indentations,
+           "--adhesion-model", args.model, "--indentations", indentations or args.indentations,
            "--retract-step", str(args.retract_step), "--tol", str(args.tol), "--out", out]
     before = child_cpu()
     subprocess.run(cmd, check=True, capture_output=True, text=True)
@@ -63,7 +67,9 @@ def tamaas_solver(h, args):
     model.E, model.nu = 1.0, 0.0
     solver = tm.PolonskyKeerRey(model, h, args.tol, tm.PolonskyKeerRey.gap,
                                 tm.PolonskyKeerRey.gap)
-    adhesion = tm.ExponentialAdhesionFunctional(h)
+    functional = {"exponential": tm.ExponentialAdhesionFunctional,
+                  "maugis-dugdale": tm.MaugisAdhesionFunctional}[args.model]
+    adhesion = functional(h)
     adhesion.parameters = {"rho": args.rho, "surface_energy": args.w}
     solver.addFunctionalTerm(adhesion)
     return model, solver, adhesion  # the solver does not own the functional: keep it alive
@@ -83,7 +89,8 @@ def tamaas_point(model, solver, top, d):
     g = u - h_of(solver)
     g += (top - d) - g.mean()
     area = float(np.mean(g <= ZERO_GAP * np.std(h_of(solver))))
-    return float(np.mean(model.traction)), area
+    tensile = float(np.mean(np.asarray(model.traction) < 0.0))
+    return float(np.mean(model.traction)), area, tensile
 
 
 def compare(args, n, tmp):
@@ -99,10 +106,11 @@ def compare(args, n, tmp):
     t0, table = time.process_time(), []
     for r in rows:
         d = float(r["indentation"])
-        f_t, a_t = tamaas_point(model, solver, top, d)
+        f_t, a_t, t_t = tamaas_point(model, solver, top, d)
         table.append({"branch": r["branch"], "indentation": d, "mean_gap": top - d,
                       "force_asperity": float(r["force"]), "force_tamaas": f_t,
                       "area_asperity": float(r["area_fraction"]), "area_tamaas": a_t,
+                      "tensile_asperity": float(r["tensile_fraction"]), "tensile_tamaas": t_t,
                       "rounds": int(r["rounds"]), "cg_iterations": int(r["cg_iterations"])})
     cpu_t = time.process_time() - t0
     scale = max(abs(r["force_asperity"]) for r in table)
@@ -110,15 +118,26 @@ def compare(args, n, tmp):
         r["force_difference"] = abs(r["force_asperity"] - r["force_tamaas"]) / scale
     pull = record["adhesion"]["pull_off"]["displacement_controlled"]
     d_po = pull["indentation"]
-    sweep = [tamaas_point(model, solver, top, d)[0]
-             for d in np.linspace(0.0, 2.0 * d_po, 41)]
+    sweep_d = np.linspace(0.0, 2.0 * d_po, 41)
+    sweep = [tamaas_point(model, solver, top, d)[0] for d in sweep_d]
     at_po = tamaas_point(model, solver, top, d_po)[0]
+    # asperity along the same history (its rows, then the sweep) for the least force on the sweep
+    path = ",".join(repr(float(r["indentation"])) for r in rows)
+    path += "," + ",".join(repr(float(d)) for d in sweep_d[1:])
+    swept, _, _ = run_asperity(args, surface, os.path.join(tmp, f"b{n}.csv"), path)
+    sweep_a = [float(r["force"]) for r in swept[len(rows):len(rows) + len(sweep_d) - 1]]
     return {"n": n, "load_average_before": load, "load_average_after": os.getloadavg()[0],
             "rms_height": float(h.std()), "zone_resolution": record["adhesion"]["zone_resolution"],
             "max_force_difference": max(r["force_difference"] for r in table),
             "max_area_difference": max(abs(r["area_asperity"] - r["area_tamaas"]) for r in table),
+            "max_tensile_difference": max(abs(r["tensile_asperity"] - r["tensile_tamaas"])
+                                          for r in table),
+            "pixel_area": 1.0 / n**2,
             "pull_off": {"asperity_force": pull["force"], "indentation": d_po,
-                         "tamaas_force_at_same_d": at_po, "tamaas_least_force_sweep": min(sweep)},
+                         "tamaas_force_at_same_d": at_po, "tamaas_least_force_sweep": min(sweep),
+                         "asperity_least_force_sweep": min(sweep_a),
+                         "max_force_difference_sweep": max(
+                             abs(a - t) for a, t in zip(sweep_a, sweep[1:])) / scale},
             "cpu_seconds": {"asperity": cpu_a, "tamaas": cpu_t, "ratio_tamaas_over_asperity":
                             cpu_t / cpu_a if cpu_a > 0 else None},
             "solves": len(table), "rows": table}
@@ -128,6 +147,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--asperity", required=True)
     p.add_argument("--sizes", default="64,128,256")
+    p.add_argument("--model", choices=["exponential", "maugis-dugdale"], default="exponential")
     p.add_argument("--w", type=float, default=1e-6, help="work of adhesion (E* x length, L = 1)")
     p.add_argument("--rho", type=float, default=5e-4, help="range of the exponential law")
     p.add_argument("--rms-slope", type=float, default=0.1)
@@ -136,27 +156,35 @@ def main():
     p.add_argument("--tol", type=float, default=1e-10)
     p.add_argument("--out")
     args = p.parse_args()
-    with tempfile.TemporaryDirectory() as tmp:
-        runs = [compare(args, int(n), tmp) for n in args.sizes.split(",")]
     version = subprocess.run([args.asperity, "--version"], capture_output=True, text=True).stdout
     result = {"machine": platform.node(), "cpus": os.cpu_count(), "asperity": version.strip(),
-              "tamaas": tm.__version__, "threads": 1, "w": args.w, "rho": args.rho,
-              "rms_slope": args.rms_slope, "tolerance_both": args.tol, "runs": runs}
-    for r in runs:
-        print(f"n={r['n']}: max |dF|/max|F| = {r['max_force_difference']:.2e}, "
-              f"max |dA/A0| = {r['max_area_difference']:.2e}, pull-off asperity "
-              f"{r['pull_off']['asperity_force']:.5e} tamaas {r['pull_off']['tamaas_force_at_same_d']:.5e}"
-              f" (sweep min {r['pull_off']['tamaas_least_force_sweep']:.5e}); CPU s asperity "
-              f"{r['cpu_seconds']['asperity']:.2f} tamaas {r['cpu_seconds']['tamaas']:.2f}; "
-              f"load {r['load_average_before']:.1f}")
-    text = json.dumps(result, indent=1)
-    if args.out:
-        tmp_out = args.out + ".tmp"
-        with open(tmp_out, "w") as f:
-            f.write(text + "\n")
-        os.replace(tmp_out, args.out)
-    else:
-        print(text)
+              "tamaas": tm.__version__, "threads": 1, "model": args.model, "w": args.w,
+              "rho": args.rho, "rms_slope": args.rms_slope, "tolerance_both": args.tol,
+              "indentations": args.indentations, "retract_step": args.retract_step, "runs": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in args.sizes.split(","):
+            r = compare(args, int(n), tmp)
+            result["runs"].append(r)
+            print(f"n={r['n']}: max |dF|/max|F| = {r['max_force_difference']:.2e}, "
+                  f"max |dA/A0| = {r['max_area_difference']:.2e}, pull-off asperity "
+                  f"{r['pull_off']['asperity_force']:.5e} tamaas "
+                  f"{r['pull_off']['tamaas_force_at_same_d']:.5e} (sweep min "
+                  f"{r['pull_off']['tamaas_least_force_sweep']:.5e}); CPU s asperity "
+                  f"{r['cpu_seconds']['asperity']:.2f} tamaas {r['cpu_seconds']['tamaas']:.2f}; "
+                  f"load {r['load_average_before']:.1f}", flush=True)
+            write(args.out, result)
+    if not args.out:
+        print(json.dumps(result, indent=1))
+
+
+def write(path, result):
+    """Rewrite the record with the sizes done so far (atomically: a stopped run keeps them)."""
+    if not path:
+        return
+    tmp_out = path + ".tmp"
+    with open(tmp_out, "w") as f:
+        f.write(json.dumps(result, indent=1) + "\n")
+    os.replace(tmp_out, path)
 
 
 if __name__ == "__main__":
