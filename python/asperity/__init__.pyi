@@ -233,16 +233,13 @@ def reproduce(figure: str, out: PathLike, *, setting: str = "paper",
               force: bool = False) -> str: ...
 
 def contact(
-    surface: Any, size: Optional[float] = ..., *, pressures: Optional[Sequence[float]] = ...,
+    surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
     modulus: Optional[float] = ..., young: Union[None, float, Sequence[float]] = ...,
     poisson: Union[None, float, Sequence[float]] = ...,
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
     hardness: Optional[float] = ..., tangential: bool = ...,
-    work_of_adhesion: Optional[float] = ..., adhesion_range: Optional[float] = ...,
-    adhesion_model: Optional[str] = ..., indentations: Optional[Sequence[float]] = ...,
-    retract_step: Optional[float] = ...,
 ) -> Sweep: ...
 
 @dataclass

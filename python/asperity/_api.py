@@ -1220,7 +1220,7 @@ def contact(
     surface: Any,
     size: Optional[float] = None,
     *,
-    pressures: Optional[Sequence[float]] = None,
+    pressures: Sequence[float],
     modulus: Optional[float] = None,
     young: Union[None, float, Sequence[float]] = None,
     poisson: Union[None, float, Sequence[float]] = None,
@@ -1231,11 +1231,6 @@ def contact(
     thermal_conductivity: Optional[Sequence[float]] = None,
     hardness: Optional[float] = None,
     tangential: bool = False,
-    work_of_adhesion: Optional[float] = None,
-    adhesion_range: Optional[float] = None,
-    adhesion_model: Optional[str] = None,
-    indentations: Optional[Sequence[float]] = None,
-    retract_step: Optional[float] = None,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -1277,45 +1272,17 @@ def contact(
         ...                           hardness=2e9)
         >>> bool(capped.plastic_fraction[0] > 0)
         True
-
-    With ``work_of_adhesion`` (Δγ, J/m²) the run is adhesive instead of a load sweep, as
-    ``asperity contact --work-of-adhesion`` (the solver and rules of :func:`bem_adhesion`,
-    in SI units): the path of ``indentations`` (m), then the retraction to pull-off in
-    steps of ``retract_step`` (m); ``adhesion_range`` (m) and ``adhesion_model``
-    (``"maugis-dugdale"`` or ``"exponential"``) choose a cohesive law, none the pixel
-    criterion. Columns ``indentation_m``, ``force_n``, ``mean_pressure_pa``,
-    ``contact_area_m2``, ``area_fraction``, ``tensile_fraction``, ``rounds``,
-    ``cg_iterations``, ``branch``; ``critical_stress`` (Pa) and ``effective_modulus``;
-    ``metadata["pull_off"]`` (both controls, force in N, indentation in m) and
-    ``metadata["warning"]``. See docs/adhesion.md.
     """
     heights, size_x, size_y = _surface_input(surface, size)
-    loads = [] if pressures is None else [
-        float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
-    path = [] if indentations is None else [
-        float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
-    adhesion = (_opt(work_of_adhesion), _opt(adhesion_range),
-                None if adhesion_model is None else str(adhesion_model), path,
-                _opt(retract_step))
+    loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
     columns = _core.contact(
         heights, size_x, size_y, loads, _opt(modulus), _floats(young), _floats(poisson),
         str(boundary), float(tolerance), bool(map),
         None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
         None if thermal_conductivity is None
         else [float(v) for v in np.atleast_1d(thermal_conductivity)],
-        _opt(hardness), bool(tangential), adhesion,
+        _opt(hardness), bool(tangential),
     )
-    if work_of_adhesion is not None:
-        extra = {k: columns.pop(k) for k in ("pull_off", "warning")}
-        request = {"work_of_adhesion": adhesion[0], "adhesion_range": adhesion[1],
-                   "adhesion_model": adhesion[2], "indentations": path,
-                   "retract_step": adhesion[4], "modulus": _opt(modulus),
-                   "young": _one_or_both(young), "poisson": _one_or_both(poisson),
-                   "boundary": str(boundary)}
-        return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
-                               **extra, "shape": list(heights.shape),
-                               "sizes": [size_x, size_y],
-                               "surface": _surface_identity(surface, heights)})
     if "map" in columns:
         dx = size_x / heights.shape[1]
         dy = dx if size_y is None else size_y / heights.shape[0]

@@ -15,8 +15,6 @@ returns the ``Axes``:
   (``asperity contact --map``);
 * :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``);
 * :func:`load_path` -- a load path's loading–unloading loop (``bem --load-path --plot``);
-* :func:`adhesion_loop` -- an adhesive run's force–approach loop with arrows and pull-offs
-  (``bem|contact|mdr --work-of-adhesion --plot``);
   :func:`field` -- a field (the plastic or permanent displacement) as an image;
 * :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
 
@@ -148,13 +146,6 @@ def _draw_series(ax, chart: dict, s: dict, color) -> None:
     x, y = xy[:, 0], xy[:, 1]
     shown = lambda v, log: _np.isfinite(v) & ((v > 0) if log else True)  # noqa: E731
     keep = shown(x, chart["log_x"]) & shown(y, chart["log_y"])
-    if s["style"] == "arrows":
-        for k in range(0, len(xy) - 1, 2):
-            if keep[k] and keep[k + 1]:
-                ax.annotate("", xy=tuple(xy[k + 1]), xytext=tuple(xy[k]),
-                            arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.5})
-        ax.plot([], [], "-", color=color, label=s["label"] or None)  # the legend's entry
-        return
     fmt = {"line": "-", "dashed": "--", "points": "o", "line_points": "-o"}[s["style"]]
     ax.plot(x[keep], y[keep], fmt, color=color, label=s["label"] or None, markersize=4)
     if s.get("interval"):
@@ -275,40 +266,6 @@ def load_path(path: Any, axes=None):
         c["force"].tolist(), c["area_fraction"].tolist(), c["stiffness"].tolist(), "surface",
         solver.get("boundary", "free"), solver.get("hardness"))
     return figure(__import__("json").loads(text), axes)
-
-
-def adhesion_loop(run: Any, ax=None, *, theory: Optional[tuple] = None):
-    """The force–approach loop of an adhesive run as ``asperity bem|contact|mdr
-    --work-of-adhesion --plot`` draws it (one figure definition,
-    ``asperity_app::figure::adhesion``): the path and the retraction to pull-off, an arrow
-    on every monotone run the way it was travelled (loading red, unloading blue), both
-    pull-offs marked. ``run``: a :func:`asperity.bem_adhesion` result, an adhesive
-    :func:`asperity.mdr` curve, or an adhesive :func:`asperity.contact` result (SI units);
-    ``theory``: an optional ``(label, [(d, F), ...])`` curve, dashed. Returns the axes."""
-    import json
-
-    from . import _asperity
-
-    if hasattr(run, "columns"):  # asperity.contact(work_of_adhesion=...): SI units
-        c, pull = run.columns, run.metadata.get("pull_off")
-        d, f, branch = c["indentation_m"], c["force_n"], c["branch"]
-        labels = ("indentation d  [m]", "normal force F  [N]", " N")
-        title = "adhesive contact"
-    else:
-        d, f, branch, pull = run.indentation, run.force, run.branch, run.pull_off
-        labels = ("indentation d  [length]", "normal force F  [E*·length²]", "")
-        title = "adhesive loop"
-    if branch is None:
-        raise ValueError("adhesion_loop: the run has no branches (not an adhesive run)")
-    mark = None
-    if pull is not None:
-        point = lambda p: (float(p["indentation"]), float(p["force"]))  # noqa: E731
-        mark = (point(pull["force_controlled"]), point(pull["displacement_controlled"]))
-    text = _asperity.adhesion_loop_figure(
-        [float(v) for v in d], [float(v) for v in f], [b == "retract" for b in branch],
-        mark, title, *labels,
-        None if theory is None else (str(theory[0]), [(float(x), float(y)) for x, y in theory[1]]))
-    return _draw(json.loads(text)["charts"][0], ax)
 
 
 def field(values: Any, ax=None, *, size: Optional[tuple] = None, label: str = "",

@@ -64,13 +64,10 @@ fn label_patches<'py>(
     Ok((labels.into_pyarray(py), sizes, areas))
 }
 
-/// An adhesive run's options: Δγ (J/m²), the range (m), the law, the path (m), the step (m).
-type Adhesion = (Option<f64>, Option<f64>, Option<String>, Vec<f64>, Option<f64>);
-
-/// The request's rules, then the sweep (or with `adhesion` the adhesive run); returns the CLI's columns (and the contact set of
+/// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, adhesion=None))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -88,7 +85,6 @@ fn contact<'py>(
     thermal_conductivity: Option<Vec<f64>>,
     hardness: Option<f64>,
     tangential: bool,
-    adhesion: Option<Adhesion>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (young, young_2) =
         app::one_or_two(app::params::YOUNG, young.as_deref().unwrap_or(&[])).map_err(refused)?;
@@ -108,27 +104,7 @@ fn contact<'py>(
         thermal_conductivity,
         hardness,
         tangential,
-        ..ContactRequest::default()
     };
-    let request = match adhesion {
-        Some((w, range, model, path, step)) => ContactRequest {
-            work_of_adhesion: w,
-            adhesion_range: range,
-            adhesion_model: model,
-            indentations: path,
-            retract_step: step,
-            ..request
-        },
-        None => request,
-    };
-    if request.is_adhesive() {
-        if map {
-            return Err(invalid(
-                "work_of_adhesion takes a path of indentations (m) and does not go with map",
-            ));
-        }
-        return crate::adhesion::contact_adhesion(py, &request, &heights, (size_x, size_y));
-    }
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();
     ensure_solver_fits(

@@ -30,7 +30,6 @@ pub mod adhesion;
 pub mod argument;
 pub mod bem;
 pub mod contact;
-pub mod contact_adhesion;
 pub mod derived;
 pub mod fields;
 pub mod figure;
