@@ -146,6 +146,13 @@ def _draw_series(ax, chart: dict, s: dict, color) -> None:
     x, y = xy[:, 0], xy[:, 1]
     shown = lambda v, log: _np.isfinite(v) & ((v > 0) if log else True)  # noqa: E731
     keep = shown(x, chart["log_x"]) & shown(y, chart["log_y"])
+    if s["style"] == "arrows":  # points in pairs, tail then head (an adhesive loop's way)
+        for k in range(0, len(xy) - 1, 2):
+            if keep[k] and keep[k + 1]:
+                ax.annotate("", xy=tuple(xy[k + 1]), xytext=tuple(xy[k]),
+                            arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.5})
+        ax.plot([], [], "-", color=color, label=s["label"] or None)  # the legend's entry
+        return
     fmt = {"line": "-", "dashed": "--", "points": "o", "line_points": "-o"}[s["style"]]
     ax.plot(x[keep], y[keep], fmt, color=color, label=s["label"] or None, markersize=4)
     if s.get("interval"):

@@ -104,6 +104,7 @@ fn contact<'py>(
         thermal_conductivity,
         hardness,
         tangential,
+        ..ContactRequest::default()
     };
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();

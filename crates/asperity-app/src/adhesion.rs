@@ -104,8 +104,8 @@ pub struct AdhesionRow {
     pub branch: Branch,
     /// Its scalars.
     pub summary: AdhesiveSummary,
-    /// How it was reached (zero for the retraction's steps: the library's retraction
-    /// reports its states, not their iteration counts).
+    /// How it was reached (for a retraction's step, that step's rounds and CG iterations;
+    /// the bisection to pull-off is not a row).
     pub info: AdhesionInfo,
 }
 
@@ -125,6 +125,28 @@ pub struct AdhesionRun {
 }
 
 impl AdhesionRun {
+    /// The loop figure of the run ([`crate::figure::adhesion::loop_chart`]): each row's
+    /// `(d, F)` and whether it is the retraction's, and both pull-offs; `title`, the axes'
+    /// labels and the forces' unit as the front end words them (model or SI units).
+    pub fn loop_chart(&self, figure: crate::figure::adhesion::LoopFigure) -> crate::figure::Chart {
+        use crate::figure::adhesion::{loop_chart, LoopPoint, LoopPullOffs};
+        let points: Vec<LoopPoint> = self
+            .rows
+            .iter()
+            .map(|r| LoopPoint {
+                indentation: r.summary.indentation,
+                force: r.summary.force,
+                retract: r.branch == Branch::Retract,
+            })
+            .collect();
+        let at = |s: &AdhesiveSummary| (s.indentation, s.force);
+        let pull = self.pull_off.map(|p| LoopPullOffs {
+            force_controlled: at(&p.force_controlled),
+            displacement_controlled: at(&p.displacement_controlled),
+        });
+        loop_chart(&points, pull, figure)
+    }
+
     /// The contact radius `√(A/π)` in pixels at the force-controlled pull-off.
     pub fn pull_off_radius_pixels(&self) -> Option<f64> {
         let p = self.pull_off?;
@@ -295,11 +317,11 @@ impl AdhesionPlan {
             on_row(&row);
             rows.push(row);
         }
-        let pull_off = contact.retract(self.retract_step, |summary| {
+        let pull_off = contact.retract(self.retract_step, |summary, info| {
             let row = AdhesionRow {
                 branch: Branch::Retract,
                 summary: *summary,
-                info: AdhesionInfo::default(),
+                info: *info,
             };
             on_row(&row);
             rows.push(row);
@@ -392,6 +414,13 @@ mod tests {
         assert_eq!(seen, run.rows.len());
         assert_eq!(run.rows[0].branch, Branch::Path);
         assert_eq!(run.rows.last().unwrap().branch, Branch::Retract);
+        // Every row, the retraction's included, reports the solves that settled it.
+        for row in &run.rows {
+            assert!(
+                row.info.rounds >= 1 && row.info.cg_iterations > 0,
+                "{row:?}"
+            );
+        }
         let pull = run.pull_off.unwrap();
         let least = run.rows.iter().map(|r| r.summary.force).fold(0.0, f64::min);
         // The bisection's states (not rows) may only lower it.

@@ -146,6 +146,22 @@ pub struct ContactRequest {
     /// (given with `young`, or beside `modulus` for this alone).
     #[serde(default)]
     pub tangential: bool,
+    /// The work of adhesion Δγ, J/m²: an adhesive run along `indentations`
+    /// ([`crate::contact_adhesion`]) instead of the load sweep.
+    #[serde(default)]
+    pub work_of_adhesion: Option<f64>,
+    /// The range of a cohesive law, m (`asperity bem --adhesion-range`).
+    #[serde(default)]
+    pub adhesion_range: Option<f64>,
+    /// The cohesive law of the range: `maugis-dugdale` or `exponential`.
+    #[serde(default)]
+    pub adhesion_model: Option<String>,
+    /// The adhesive run's path of indentations, m (negative: pulled back beyond first touch).
+    #[serde(default)]
+    pub indentations: Vec<f64>,
+    /// The adhesive retraction's step, m.
+    #[serde(default)]
+    pub retract_step: Option<f64>,
 }
 
 impl Default for ContactRequest {
@@ -164,6 +180,11 @@ impl Default for ContactRequest {
             thermal_conductivity: None,
             hardness: None,
             tangential: false,
+            work_of_adhesion: None,
+            adhesion_range: None,
+            adhesion_model: None,
+            indentations: Vec::new(),
+            retract_step: None,
         }
     }
 }
@@ -187,6 +208,14 @@ impl ContactRequest {
     /// The plan, or why not: E*, the boundary, the pressures, the tolerance, the derived
     /// columns.
     pub fn validate(&self) -> Result<ContactPlan, Refusal> {
+        self.refuse_adhesion_options()?;
+        if self.is_adhesive() {
+            // The adhesive run's plan is `adhesion_plan`'s; a sweep has none.
+            return Err(Refusal::of(crate::adhesion::WORK_OF_ADHESION)
+                .text(" makes an adhesive run along ")
+                .param(bem::INDENTATIONS)
+                .text(" (m), not a load sweep"));
+        }
         let modulus = self.modulus()?;
         let boundary = parse_boundary(&self.boundary)?;
         check_values(bem::PRESSURES, &self.pressures, false)?;
@@ -221,6 +250,11 @@ impl ContactRequest {
 }
 
 impl ContactRequest {
+    /// E* in Pa by this request's rule ([`Self::modulus`]), for the adhesive run.
+    pub(crate) fn modulus_pa(&self) -> Result<f64, Refusal> {
+        self.modulus()
+    }
+
     /// E*: `modulus`, or one body's E and ν, or two bodies' ([`two_body_modulus`]).
     fn modulus(&self) -> Result<f64, Refusal> {
         if self.young_2.is_some() || self.poisson_2.is_some() {

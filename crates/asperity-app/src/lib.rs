@@ -30,6 +30,7 @@ pub mod adhesion;
 pub mod argument;
 pub mod bem;
 pub mod contact;
+pub mod contact_adhesion;
 pub mod derived;
 pub mod fields;
 pub mod figure;

@@ -449,6 +449,25 @@ impl Drawn<'_> {
                 chart.draw_series(LineSeries::new(pts.clone(), line))?;
                 chart.draw_series(dots(pts.clone()))?
             }
+            Style::Arrows => {
+                let pairs: Vec<[(f64, f64); 2]> = s
+                    .points
+                    .chunks_exact(2)
+                    .filter(|p| self.shows(p[0]) && self.shows(p[1]))
+                    .map(|p| [p[0], p[1]])
+                    .collect();
+                for [tail, head] in &pairs {
+                    let (t, h) = (chart.backend_coord(tail), chart.backend_coord(head));
+                    chart
+                        .draw_series([EmptyElement::at(*head)
+                            + PathElement::new(arrow_head(t, h, scale), line)])?;
+                }
+                chart.draw_series(
+                    pairs
+                        .into_iter()
+                        .map(|p| PathElement::new(p.to_vec(), line)),
+                )?
+            }
             // Drawn by `image::render`, never here.
             Style::Image => return Ok(()),
         };
@@ -475,6 +494,26 @@ impl Drawn<'_> {
         }
         Ok(())
     }
+}
+
+/// An arrow's head drawn at its tip, pointing from the pixel `t` to the pixel `h`: the
+/// pixel offsets from the tip of two strokes of 10 pixels (at scale 1) 25° either side of
+/// the shaft, barb, tip, barb (none for an arrow of no length on screen).
+fn arrow_head(t: (i32, i32), h: (i32, i32), scale: u32) -> Vec<(i32, i32)> {
+    let (dx, dy) = ((h.0 - t.0) as f64, (h.1 - t.1) as f64);
+    let length = dx.hypot(dy);
+    if length == 0.0 {
+        return Vec::new();
+    }
+    let (ux, uy) = (dx / length, dy / length);
+    let barb = 10.0 * scale as f64;
+    let (cos, sin) = (25f64.to_radians().cos(), 25f64.to_radians().sin());
+    let side = |s: f64| {
+        // The shaft's backward direction turned by ±25°.
+        let (bx, by) = (-ux * cos - s * uy * sin, -uy * cos + s * ux * sin);
+        ((barb * bx).round() as i32, (barb * by).round() as i32)
+    };
+    vec![side(1.0), (0, 0), side(-1.0)]
 }
 
 /// `color` blended halfway to white: intervals drawn beside the line they belong to.

@@ -259,3 +259,234 @@ fn meaningless_adhesive_requests_are_refused_in_one_line() {
     refused(&out, "square pixels");
     assert!(!csv.exists());
 }
+
+/// The cells of a CSV: the header, then each row's cells.
+fn cells(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect());
+    let header = lines.next().unwrap();
+    (header, lines.collect())
+}
+
+/// `contact --work-of-adhesion` in SI units is `bem --work-of-adhesion` in model units,
+/// scaled: the sphere of the tests above with every length times ℓ = 2⁻¹⁰ m, E* = 2³⁰ Pa,
+/// Δγ times E*ℓ (J/m²), a range times ℓ. Powers of two scale every product exactly, so
+/// the critical stress and the indentations are the same and the pixel sets of every row;
+/// the forces agree to 1e-8 of the largest only: the Love kernel's near field takes
+/// logarithms of the pixel's dimensional coordinates (`elastic::love`: `x ln(y + r)` terms
+/// whose ln ℓ parts cancel only to rounding), and that rounding moves the CG's iterates,
+/// which stop at the solver's tolerance (1e-10 relative residual): measured 8.7e-11
+/// relative on the pixel criterion. Both laws tried: the
+/// pixel criterion and the exponential potential. The record is in SI units.
+#[test]
+fn contact_adhesion_in_si_units_is_bems_run_scaled() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (ell, e_star) = (2f64.powi(-10), 2f64.powi(30));
+    let model = sphere(d);
+    let heights: Array2<f64> = ndarray_npy::read_npy(&model).unwrap();
+    write_npy(d.join("si.npy"), &heights.mapv(|h| h * ell)).unwrap();
+    let w = work_of_adhesion();
+    let path: Vec<f64> = (1..=10).map(|k| 0.015625 * k as f64 / 10.0).collect();
+    let list = |scale: f64| -> String {
+        let v: Vec<String> = path.iter().map(|x| format!("{:?}", x * scale)).collect();
+        v.join(",")
+    };
+    let range = w.powf(2.0 / 3.0);
+    for law in [None, Some(range)] {
+        let mut bem_extra: Vec<String> = vec![];
+        let mut si_extra: Vec<String> = vec![];
+        if let Some(rho) = law {
+            bem_extra.extend(["--adhesion-range".into(), format!("{rho:?}")]);
+            si_extra.extend(["--adhesion-range".into(), format!("{:?}", rho * ell)]);
+            for extra in [&mut bem_extra, &mut si_extra] {
+                extra.extend(["--adhesion-model".into(), "exponential".into()]);
+            }
+        }
+        let mut bem = vec![
+            "bem",
+            "--surface",
+            model.to_str().unwrap(),
+            "--size",
+            "0.32",
+        ];
+        let (w_model, path_model) = (format!("{w:?}"), list(1.0));
+        bem.extend([
+            "--work-of-adhesion",
+            &w_model,
+            "--indentations",
+            &path_model,
+        ]);
+        bem.extend(bem_extra.iter().map(String::as_str));
+        bem.extend(["--out", "m.csv", "--force"]);
+        ok(&common::asperity(&bem, d));
+        let (size, modulus) = (format!("{:?}", 0.32 * ell), format!("{e_star:?}"));
+        let (w_si, path_si) = (format!("{:?}", w * e_star * ell), list(ell));
+        let mut si = vec!["contact", "si.npy", "--size", &size, "--detrend", "none"];
+        si.extend(["--modulus", &modulus, "--work-of-adhesion", &w_si]);
+        si.extend(["--indentations", &path_si]);
+        si.extend(si_extra.iter().map(String::as_str));
+        si.extend(["--out", "s.csv", "--plot", "s.json", "--force"]);
+        let out = common::asperity(&si, d);
+        ok(&out);
+        assert!(stderr(&out).contains(" N at d = "), "{}", stderr(&out));
+        // The loop's figure: arrows both ways, the pull-offs named in newtons.
+        let figure: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("s.json")).unwrap()).unwrap();
+        let series = figure["charts"][0]["series"].as_array().unwrap();
+        let styles: Vec<&str> = series
+            .iter()
+            .map(|s| s["style"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            styles.iter().filter(|s| **s == "arrows").count(),
+            2,
+            "{styles:?}"
+        );
+        assert!(series.iter().any(|s| {
+            let label = s["label"].as_str().unwrap();
+            label.starts_with("pull-off, force control: F = ") && label.ends_with(" N")
+        }));
+        let (m_head, m_rows) = cells(&d.join("m.csv"));
+        let (s_head, s_rows) = cells(&d.join("s.csv"));
+        assert_eq!(
+            s_head,
+            [
+                "indentation_m",
+                "force_n",
+                "mean_pressure_pa",
+                "contact_area_m2",
+                "area_fraction",
+                "tensile_fraction",
+                "rounds",
+                "cg_iterations",
+                "branch"
+            ]
+        );
+        assert_eq!(m_head[0], "indentation");
+        assert_eq!(m_rows.len(), s_rows.len(), "{law:?}");
+        let num = |s: &str| s.parse::<f64>().unwrap();
+        let largest = m_rows.iter().map(|r| num(&r[1]).abs()).fold(0.0, f64::max);
+        let pixel_area = (5e-3 * ell) * (5e-3 * ell);
+        for (m, s) in m_rows.iter().zip(&s_rows) {
+            assert_eq!(num(&s[0]), num(&m[0]) * ell, "indentation");
+            let force = num(&m[1]) * e_star * ell * ell;
+            assert!(
+                (num(&s[1]) - force).abs() <= 1e-8 * largest * e_star * ell * ell,
+                "{law:?}: {} vs {force}",
+                s[1]
+            );
+            let (fraction, points) = (num(&s[4]), 64.0 * 64.0);
+            assert_eq!((fraction, &s[5], &s[8]), (num(&m[3]), &m[4], &m[7]));
+            assert_eq!(num(&s[3]), (fraction * points).round() * pixel_area);
+            assert!(s[6].parse::<usize>().unwrap() >= 1 && s[7].parse::<usize>().unwrap() > 0);
+        }
+        let record: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("s.csv.json")).unwrap()).unwrap();
+        let model: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("m.csv.json")).unwrap()).unwrap();
+        let (a, m) = (&record["adhesion"], &model["adhesion"]);
+        assert_eq!(record["effective_modulus_pa"].as_f64(), Some(e_star));
+        let sigma = m["critical_stress"].as_f64().unwrap() * e_star;
+        assert!((a["critical_stress_pa"].as_f64().unwrap() / sigma - 1.0).abs() < 1e-14);
+        let f_si = a["pull_off"]["force_controlled"]["force_n"]
+            .as_f64()
+            .unwrap();
+        let f_model = m["pull_off"]["force_controlled"]["force"].as_f64().unwrap();
+        assert!(
+            (f_si / (f_model * e_star * ell * ell) - 1.0).abs() < 1e-8,
+            "{f_si} {f_model}"
+        );
+    }
+}
+
+#[test]
+fn contact_adhesion_refuses_mixed_requests_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    sphere(d);
+    let base = ["contact", "sphere.npy", "--size", "0.32", "--modulus", "1"];
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &["--work-of-adhesion", "1e-3", "--pressures", "0.01", "--indentations", "0.01"],
+            "--work-of-adhesion takes a path of --indentations (m; solved under displacement control, both pull-offs reported) and does not go with --pressures",
+        ),
+        (&["--work-of-adhesion", "1e-3"], "--work-of-adhesion needs --indentations"),
+        (
+            &["--pressures", "0.01", "--adhesion-range", "1e-3"],
+            "--adhesion-range needs --work-of-adhesion (J/m²): it belongs to an adhesive run",
+        ),
+        (
+            &["--work-of-adhesion", "0", "--indentations", "0.01"],
+            "invalid --work-of-adhesion",
+        ),
+    ];
+    for (extra, needle) in cases {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        refused(&common::asperity(&args, d), needle);
+    }
+}
+
+/// `mdr --work-of-adhesion --plot FILE.json` draws the loop of the one figure definition:
+/// the JKR sphere approached in 30 steps then retracted event by event (a row before and
+/// after each release, at one approach): one loading run and one unloading run, so one
+/// arrow each, pointing up and down the approach; the pull-off markers are the record's.
+#[test]
+fn contact_adhesion_loops_have_one_arrow_per_run_in_the_mdr_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = [
+        "mdr",
+        "--profile",
+        "hertz",
+        "--radius",
+        "1",
+        "--n",
+        "1001",
+        "--dx",
+        "1e-3",
+        "--work-of-adhesion",
+        "1e-3",
+        "--nloads",
+        "30",
+        "--dmax",
+        "0.09",
+        "--out",
+        "j.csv",
+        "--plot",
+        "j.json",
+    ];
+    ok(&common::asperity(&args, d));
+    let read = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join(name)).unwrap()).unwrap()
+    };
+    let figure = read("j.json");
+    let series = figure["charts"][0]["series"].as_array().unwrap();
+    let named = |label: &str| {
+        series
+            .iter()
+            .find(|s| s["label"].as_str().unwrap().starts_with(label))
+            .unwrap_or_else(|| panic!("no series {label}"))
+    };
+    let points = |s: &serde_json::Value| -> Vec<(f64, f64)> {
+        let p = s["points"].as_array().unwrap();
+        p.iter()
+            .map(|q| (q[0].as_f64().unwrap(), q[1].as_f64().unwrap()))
+            .collect()
+    };
+    let loading = points(named("loading"));
+    let unloading = points(named("unloading"));
+    assert_eq!(
+        (loading.len(), unloading.len()),
+        (2, 2),
+        "{loading:?} {unloading:?}"
+    );
+    assert!(loading[1].0 > loading[0].0 && unloading[1].0 < unloading[0].0);
+    let pull = &read("j.csv.json")["adhesion"]["pull_off"];
+    let marked = points(named("pull-off, force control"));
+    let force = pull["force_controlled"]["force"].as_f64().unwrap();
+    assert_eq!(marked[0].1, force);
+}

@@ -6,10 +6,11 @@
 //!
 //! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`contact`] (an SI contact
 //! sweep's k(F), A(F) and mean gap), [`path`] (a load path's
-//! loading–unloading loop), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
+//! loading–unloading loop), [`adhesion`] (an adhesive loop with its arrows and pull-offs), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
 //! [`psd`] (a PSD with its fitted power law), [`map`] (a height map with scale and colour
 //! bars, a contact set with its patches: a series that is an [`Image`]).
 
+pub mod adhesion;
 pub mod contact;
 pub mod map;
 pub mod path;
@@ -35,6 +36,9 @@ pub enum Style {
     LinePoints,
     /// The series' [`Image`] (it has no points).
     Image,
+    /// Arrows: the points in pairs, each an arrow from the first (tail) to the second
+    /// (head), in the series' colour (the way a loop was travelled).
+    Arrows,
 }
 
 /// A series' colour.

@@ -12,6 +12,8 @@ use serde_json::json;
 
 use super::bem::{read_surface_for, stage_outputs, BemArgs};
 use crate::output::{format_number, pull_off_line, Table};
+use crate::plot::stage_charts;
+use asperity_app::figure::adhesion::LoopFigure;
 
 /// The columns of the table.
 pub const COLUMNS: [&str; 8] = [
@@ -37,7 +39,6 @@ fn refuse_other_options(args: &BemArgs) -> Result<()> {
         (args.solver != "bccg", "--solver"),
         (args.fd_stiffness, "--fd-stiffness"),
         (args.fields.is_some(), "--fields"),
-        (args.plot.is_some(), "--plot"),
         (args.timing || args.no_stiffness, "--timing"),
         (args.poisson.is_some(), "--poisson"),
         (args.resistivity.is_some(), "--resistivity"),
@@ -76,6 +77,9 @@ pub fn run(args: &BemArgs, w: f64) -> Result<()> {
     refuse_other_options(args)?;
     let request = request(args, w);
     let plan = request.validate()?;
+    if let Some(plot) = &args.plot {
+        crate::plot::ImageFormat::from_path(plot, "--plot")?;
+    }
     let mut outputs = stage_outputs(args, 0)?;
     let (surface, size_source) = read_surface_for(args, plan.half_space.boundary)?;
     let mut table = Table::new(&COLUMNS);
@@ -95,6 +99,25 @@ pub fn run(args: &BemArgs, w: f64) -> Result<()> {
             ]);
         })
         .context("adhesive BEM")?;
+    if let Some(plot) = &args.plot {
+        let name = args
+            .surface
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into());
+        let chart = run.loop_chart(LoopFigure {
+            title: format!(
+                "{name}: {}, Δγ = {w}, E* = {}",
+                plan.law.name(),
+                request.modulus
+            ),
+            x_label: "indentation d  [length]".into(),
+            y_label: "normal force F  [E*·length²]".into(),
+            force_unit: String::new(),
+            theory: None,
+        });
+        stage_charts(&mut outputs.staged, plot, &[chart])
+            .with_context(|| format!("writing {}", plot.display()))?;
+    }
     if let Some(out) = &args.out {
         table
             .stage(&mut outputs.staged, out)

@@ -137,6 +137,34 @@ pub struct ContactArgs {
     /// loop: F and A/A0 against d, k against F, the steps marked by branch.
     #[arg(long)]
     pub load_path: bool,
+    /// Work of adhesion Δγ in J/m²: an adhesive run instead of the load sweep — the path of
+    /// --indentations (m), then the retraction to pull-off (asperity bem --work-of-adhesion's
+    /// solver and rules, docs/adhesion.md): Pohrt & Popov's pixel criterion, or with
+    /// --adhesion-range a cohesive law. Columns indentation_m, force_n, mean_pressure_pa,
+    /// contact_area_m2, area_fraction, tensile_fraction, rounds, cg_iterations, branch; both
+    /// pull-offs (N, m) on stderr and in OUT.csv.json.
+    #[arg(long, value_name = "J_PER_M2", allow_negative_numbers = true)]
+    pub work_of_adhesion: Option<f64>,
+    /// Range of the cohesive law in m (with --work-of-adhesion): h₀ of a Maugis–Dugdale zone
+    /// (stress Δγ/h₀) or ρ of an exponential potential (--adhesion-model exponential).
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub adhesion_range: Option<f64>,
+    /// The cohesive law of --adhesion-range: maugis-dugdale (the default) or exponential.
+    #[arg(long, value_name = "MODEL")]
+    pub adhesion_model: Option<String>,
+    /// The adhesive run's path of indentations in m, comma separated (negative: pulled back
+    /// beyond first touch); the retraction to pull-off follows the last.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "D1,D2,…"
+    )]
+    pub indentations: Vec<f64>,
+    /// The adhesive retraction's step in m (default: the deepest indentation, plus any
+    /// --adhesion-range, / 200).
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub retract_step: Option<f64>,
     /// Overwrite existing outputs.
     #[arg(long)]
     pub force: bool,
@@ -153,7 +181,7 @@ pub struct ContactArgs {
 }
 
 /// The request of the arguments.
-fn request(args: &ContactArgs) -> Result<ContactRequest> {
+pub(super) fn request(args: &ContactArgs) -> Result<ContactRequest> {
     let (young, young_2) = contact::one_or_two(contact::params::YOUNG, &args.young)?;
     let (poisson, poisson_2) = contact::one_or_two(contact::params::POISSON, &args.poisson)?;
     Ok(ContactRequest {
@@ -169,6 +197,11 @@ fn request(args: &ContactArgs) -> Result<ContactRequest> {
         thermal_conductivity: args.thermal_conductivity.clone(),
         hardness: args.hardness,
         tangential: args.tangential,
+        work_of_adhesion: args.work_of_adhesion,
+        adhesion_range: args.adhesion_range,
+        adhesion_model: args.adhesion_model.clone(),
+        indentations: args.indentations.clone(),
+        retract_step: args.retract_step,
     })
 }
 
@@ -278,6 +311,9 @@ pub(super) fn inputs_record(
 /// Runs `asperity contact`: check, read, solve (the library's load sweep), then write
 /// every output together.
 pub fn run(args: &ContactArgs) -> Result<()> {
+    if args.work_of_adhesion.is_some() {
+        return super::contact_adhesion::run(args);
+    }
     if args.load_path {
         return super::contact_path::run(args);
     }

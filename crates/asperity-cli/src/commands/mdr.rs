@@ -19,6 +19,7 @@ use crate::request::refused;
 
 use crate::output::{format_number, pull_off_line, Table};
 use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
+use asperity_app::figure::adhesion::{LoopFigure, LoopPoint, LoopPullOffs};
 
 /// Arguments of `asperity mdr`.
 #[derive(Debug, clap::Args)]
@@ -441,33 +442,24 @@ pub fn run(args: &MdrArgs) -> Result<()> {
     Ok(())
 }
 
-/// The F–d panel of an adhesive loop: approach and retraction (from the last point of the
-/// approach on), JKR's curve for a sphere (dashed), the pull-offs marked.
+/// The F–d panel of an adhesive loop ([`asperity_app::figure::adhesion::loop_chart`]):
+/// the path and the retraction with arrows the way they were travelled, JKR's curve for a
+/// sphere (dashed), the pull-offs marked.
 fn loop_chart(
     points: &[(CurvePoint, Branch)],
     pull: Option<&PullOffs>,
     jkr: Option<Jkr>,
     title: &str,
 ) -> Chart {
-    let xy = |p: &CurvePoint| (p.indentation, p.force);
-    let approach = points
+    let loop_points: Vec<LoopPoint> = points
         .iter()
-        .filter(|(_, b)| *b == Branch::Approach)
-        .map(|(p, _)| xy(p))
+        .map(|(p, b)| LoopPoint {
+            indentation: p.indentation,
+            force: p.force,
+            retract: *b == Branch::Retract,
+        })
         .collect();
-    let first_retract = points
-        .iter()
-        .position(|(_, b)| *b == Branch::Retract)
-        .unwrap_or(points.len());
-    let retract = points[first_retract.saturating_sub(1)..]
-        .iter()
-        .map(|(p, _)| xy(p))
-        .collect();
-    let mut series = vec![
-        Series::new("approach (springs attach)", approach, Style::LinePoints),
-        Series::new("retraction (Heß's rule)", retract, Style::Line),
-    ];
-    if let Some(jkr) = jkr {
+    let theory = jkr.map(|jkr| {
         // Contact radii up to beyond the deepest approach (a²/R − Δl ≤ a²/R), the curve
         // cut there.
         let largest = points
@@ -480,35 +472,21 @@ fn loop_chart(
             .map(|a| (jkr.approach(a), jkr.force(a)))
             .filter(|&(d, _)| d <= largest)
             .collect();
-        series.push(Series::new("JKR (equilibrium)", curve, Style::Dashed));
-    }
-    if let Some(p) = pull {
-        let mark = |q: &CurvePoint| vec![(q.indentation, q.force)];
-        series.push(Series::new(
-            format!(
-                "pull-off, force control: F = {:.4e}",
-                p.force_controlled.force
-            ),
-            mark(&p.force_controlled),
-            Style::Points,
-        ));
-        series.push(Series::new(
-            format!(
-                "pull-off, displacement control: F = {:.4e}",
-                p.displacement_controlled.force
-            ),
-            mark(&p.displacement_controlled),
-            Style::Points,
-        ));
-    }
-    Chart {
+        ("JKR (equilibrium)".to_string(), curve)
+    });
+    let at = |q: &CurvePoint| (q.indentation, q.force);
+    let pull = pull.map(|p| LoopPullOffs {
+        force_controlled: at(&p.force_controlled),
+        displacement_controlled: at(&p.displacement_controlled),
+    });
+    let figure = LoopFigure {
         title: title.into(),
         x_label: "indentation d  [length]".into(),
         y_label: "normal force F  [E*·length²]".into(),
-        log_x: false,
-        log_y: false,
-        series,
-    }
+        force_unit: String::new(),
+        theory,
+    };
+    asperity_app::figure::adhesion::loop_chart(&loop_points, pull, figure)
 }
 
 /// `asperity mdr --work-of-adhesion`: the load path, then the retraction to pull-off.

@@ -5,6 +5,7 @@ pub mod bem_adhesion;
 pub mod bem_path;
 pub mod bench;
 pub mod contact;
+pub mod contact_adhesion;
 pub mod contact_path;
 pub mod fields_nc;
 pub mod figures;

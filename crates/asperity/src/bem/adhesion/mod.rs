@@ -98,7 +98,7 @@
 //! for k in 1..=5 {
 //!     contact.move_to(2e-3 * k as f64)?; // approach
 //! }
-//! let pull = contact.retract(5e-5, |_| {})?.expect("in contact");
+//! let pull = contact.retract(5e-5, |_, _| {})?.expect("in contact");
 //! let jkr = -1.5 * std::f64::consts::PI * 2e-4;
 //! assert!(pull.force_controlled.force < 0.0);
 //! assert!((pull.force_controlled.force / jkr - 1.0).abs() < 0.25); // a_c/Δx ≈ 18

@@ -448,13 +448,14 @@ impl PixelAdhesion {
     }
 
     /// Retracts from the current state in steps of `step` (> 0) until no pixel is attached,
-    /// calling `on_point` with each settled state; the two pull-offs (module docs of
+    /// calling `on_point` with each settled state and how it was reached (the step's rounds
+    /// and CG iterations; the bisection's states are not reported); the two pull-offs (module docs of
     /// [`super`]), or `None` if nothing is attached to begin with. The contact is left
     /// separated at [`AdhesivePullOff::separated_at`].
     pub fn retract(
         &mut self,
         step: f64,
-        mut on_point: impl FnMut(&AdhesiveSummary),
+        mut on_point: impl FnMut(&AdhesiveSummary, &AdhesionInfo),
     ) -> Result<Option<AdhesivePullOff>, SolveError> {
         crate::positive_finite("retraction step", step, "")?;
         let mut last = self.summary();
@@ -465,13 +466,13 @@ impl PixelAdhesion {
         let mut saved = Snapshot::of(self);
         loop {
             saved.take(self);
-            let (state, _) = self.move_to(self.indentation - step)?;
+            let (state, info) = self.move_to(self.indentation - step)?;
             if state.attached_points == 0 {
                 // A cohesive zone may still pull just after contact is lost.
                 least = lesser(least, state);
                 break;
             }
-            on_point(&state);
+            on_point(&state, &info);
             least = lesser(least, state);
             last = state;
         }

@@ -37,7 +37,7 @@ fn jkr_retraction(pixels_per_radius: f64) -> (f64, f64, f64) {
     let start = contact.summary().attached_points;
     let mut worst = 0.0f64;
     let pull = contact
-        .retract(3.0 * d0 / 1000.0, |s| {
+        .retract(3.0 * d0 / 1000.0, |s, _| {
             if s.attached_points < start {
                 let a = (s.attached_points as f64 * dx * dx / PI).sqrt();
                 worst = worst.max((s.force - jkr.force(a)).abs() / f_c.abs());
@@ -111,7 +111,10 @@ fn kendall_pull_off(a_px: f64) -> (f64, f64) {
     let area = pressed.attached_points as f64 * dx * dx;
     let kendall = -(8.0 * PI * w * (area / PI).powf(1.5)).sqrt();
     let step = (2.0 * PI * a * w).sqrt() / 200.0;
-    let pull = contact.retract(step, |_| {}).unwrap().expect("in contact");
+    let pull = contact
+        .retract(step, |_, _| {})
+        .unwrap()
+        .expect("in contact");
     (
         pull.force_controlled.force / kendall - 1.0,
         pull.displacement_controlled.force / kendall - 1.0,
@@ -152,7 +155,10 @@ fn vanishing_adhesion_is_the_hard_wall() {
         let error = (adhesive.force / plain.force - 1.0).abs();
         assert!(error < 1e-6, "d = {d}: {error:e} ({info:?})");
     }
-    let pull = contact.retract(1e-4, |_| {}).unwrap().expect("in contact");
+    let pull = contact
+        .retract(1e-4, |_, _| {})
+        .unwrap()
+        .expect("in contact");
     assert!(pull.force_controlled.force.abs() < 1e-6, "{pull:?}");
 }
 
@@ -179,6 +185,32 @@ fn retraction_lies_below_the_approach() {
     }
 }
 
+/// The retraction reports each step's counts: every step solves at least once (rounds ≥ 1,
+/// CG iterations > 0), and the counts are those of the same steps taken one by one with
+/// `move_to` from the same state (the callback passes the step's own `AdhesionInfo`).
+#[test]
+fn retraction_reports_each_steps_counts() {
+    let (n, dx, radius, w, step) = (32, 0.01, 1.0, 2e-3, 1e-3);
+    let surface = sphere(n, dx, radius);
+    let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), w).unwrap();
+    let mut replay = PixelAdhesion::new(&surface, HalfSpace::default(), w).unwrap();
+    contact.move_to(0.01).unwrap();
+    replay.move_to(0.01).unwrap();
+    let mut reported = Vec::new();
+    contact
+        .retract(step, |s, info| reported.push((*s, *info)))
+        .unwrap()
+        .expect("in contact");
+    assert!(reported.len() >= 5, "{} steps", reported.len());
+    let mut d = 0.01;
+    for (state, info) in &reported {
+        assert!(info.rounds >= 1 && info.cg_iterations > 0, "{info:?}");
+        d -= step;
+        let (again, expected) = replay.move_to(d).unwrap();
+        assert_eq!((state, info), (&again, &expected), "d = {d}");
+    }
+}
+
 #[test]
 fn refuses_meaningless_inputs() {
     let surface = sphere(16, 0.01, 1.0);
@@ -197,8 +229,8 @@ fn refuses_meaningless_inputs() {
     assert!(error.contains("square pixels"), "{error}");
     let mut contact = PixelAdhesion::new(&surface, HalfSpace::default(), 1e-3).unwrap();
     assert!(contact.move_to(f64::NAN).is_err());
-    assert!(contact.retract(0.0, |_| {}).is_err());
-    assert_eq!(contact.retract(1e-3, |_| {}).unwrap(), None);
+    assert!(contact.retract(0.0, |_, _| {}).is_err());
+    assert_eq!(contact.retract(1e-3, |_, _| {}).unwrap(), None);
 }
 
 /// Maugis–Dugdale's sphere on the BEM at Maugis parameter `λ`, `a_c/Δx` pixels in JKR's
@@ -227,7 +259,7 @@ fn maugis_retraction(lambda: f64, pixels_per_radius: f64) -> (f64, f64, f64, f64
     let start = contact.summary().attached_points;
     let mut worst = 0.0f64;
     let pull = contact
-        .retract(3.0 * d0 / 1000.0, |s| {
+        .retract(3.0 * d0 / 1000.0, |s, _| {
             if s.attached_points < start {
                 let a = (s.attached_points as f64 * dx * dx / PI).sqrt();
                 let f = md.at_radius(a / unit.radius).force * unit.force;
@@ -364,7 +396,7 @@ fn johnson_retraction(n: usize, diagonal: bool, law: AdhesionLaw) -> (f64, f64, 
     let half_width = |s: &AdhesiveSummary| s.area_fraction * wavelength / 2.0;
     let mut worst = 0.0f64;
     let pull = contact
-        .retract((d0 + law.range().unwrap_or(0.0)) / 2000.0, |s| {
+        .retract((d0 + law.range().unwrap_or(0.0)) / 2000.0, |s, _| {
             if s.attached_points < start {
                 let p = wavy.mean_pressure(half_width(s));
                 worst = worst.max((s.mean_pressure - p).abs() / p_c.abs());
@@ -444,7 +476,7 @@ fn exponential_sphere(mu: f64, pixels: f64) -> (f64, f64, usize) {
     }
     let resolution = contact.cohesive_resolution().unwrap();
     let pull = contact
-        .retract((d0 + range) / 500.0, |_| {})
+        .retract((d0 + range) / 500.0, |_, _| {})
         .unwrap()
         .expect("in contact");
     (
