@@ -1,13 +1,18 @@
-"""Reading a 4096² HDF5 (.h5) and Zygo .datx file: asperity against SurfaceTopography (issue 34,
-item 4: "reads a 4096² file in under a second").
+"""Importing a 4096² measured topography: asperity against SurfaceTopography's read (issue 34,
+item 4: "reads a 4096² file in under a second, benchmark beside SurfaceTopography").
 
-The files are made here with h5py from one seeded random map (float64, 4096 × 4096, metres):
+The files are made here (in --folder: keep it out of the repository and of ../shared, e.g.
+/tmp) from one seeded random map (float64, 4096 × 4096, metres):
   * `.h5`: one dataset `heights` (the generic HDF5 layout both tools read; no size in the file,
     both are given 1 mm);
   * `.datx`: the Zygo layout of crates/asperity/tests/data/make_datx.py (MetaData links,
-    surface with Unit, No Data and X/Y/Z converters; variable-length strings).
-Both tools are first checked to read the same heights (bit for bit: both return the stored
-float64 numbers, ours indexed (y, x), the peer's [x, y]).
+    surface with Unit, No Data and X/Y/Z converters; variable-length strings);
+  * `.x3p`: written by `asperity import MAP.npy --out MAP.x3p` (float64 payload, stored), and
+    the same archive with every member deflated (bench/topography_peers.py's `deflate_zip`);
+  * `.sur`: bench/topography_peers.py's one-object Digital Surf writer (int32 samples).
+Both tools are first checked to read the same heights: bit for bit for `.h5`, `.datx` and
+`.x3p` (both return the stored float64 numbers, ours indexed (y, x), the peer's [x, y]); for
+`.sur`, both to the writer's quantised heights within 1e-12 relative.
 
 Timed (`--repeat` interleaved rounds, minimum reported), both as wall time and as CPU time
 (user + system: the process's own for asperity, from its rusage; the Python process's
@@ -15,8 +20,8 @@ Timed (`--repeat` interleaved rounds, minimum reported), both as wall time and a
 cores are shared with other work:
   * asperity: `asperity import FILE --out OUT.npy --detrend none --force` in a fresh process
     (read, check, write the 128 MiB .npy and its sidecar to the output folder);
-  * SurfaceTopography 1.27.1: `open_topography(FILE).topography(...)` then `.heights()`, in
-    one Python process (import time excluded).
+  * SurfaceTopography 1.27.1: `open_topography(FILE).topography(...)` (`.to_unit("m")` where
+    the file has a unit) then `.heights()`, in one Python process (import time excluded).
 """
 
 import argparse
@@ -66,13 +71,37 @@ def write_datx(path, z):
         ds.attrs["Z Converter"] = converter("HeightCat", "Meters", "Meters", [0, 1, 0, 0])
 
 
+def write_x3p(exe, folder, z):
+    """The stored and the deflated X3P of `z`, written from a `.npy` by asperity."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from topography_peers import deflate_zip
+    npy = os.path.join(folder, f"r{z.shape[0]}.npy")
+    np.save(npy, z)
+    x3p = npy[:-4] + ".x3p"
+    subprocess.run([exe, "import", npy, "--out", x3p, "--size", repr(SIDE_M), "--detrend", "none",
+                    "--force"], check=True, capture_output=True)
+    deflated = npy[:-4] + "-deflated.x3p"
+    deflate_zip(x3p, deflated)
+    os.remove(npy)
+    return x3p, deflated
+
+
+def write_sur(path, z):
+    """The SUR of `z` and the heights it holds (quantised)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from topography_peers import write_sur as sur
+    heights, _ = sur(z, SIDE_M, path)
+    return heights
+
+
 def peer_read(path):
     from SurfaceTopography import open_topography
     reader = open_topography(path)
     if path.endswith(".h5"):
         t = reader.topography(physical_sizes=(SIDE_M, SIDE_M))
     else:
-        t = reader.topography()
+        # In metres, as asperity writes them (the SUR file's heights are in µm).
+        t = reader.topography().to_unit("m")
     return t.heights()
 
 
@@ -96,19 +125,40 @@ def main():
     p.add_argument("--folder", default="bench/out")
     p.add_argument("--out", help="where asperity writes its .npy (default: the folder; a "
                    "tmpfs such as /dev/shm keeps the disk out of the timing)")
+    p.add_argument("--formats", default="h5,datx,x3p,x3p-deflated,sur",
+                   help="comma-separated, of h5, datx, x3p, x3p-deflated, sur")
     a = p.parse_args()
     os.makedirs(a.folder, exist_ok=True)
     z = np.random.default_rng(1).standard_normal((a.n, a.n)) * 1e-6
-    files = {"h5": os.path.join(a.folder, f"r{a.n}.h5"), "datx": os.path.join(a.folder, f"r{a.n}.datx")}
-    write_h5(files["h5"], z)
-    write_datx(files["datx"], z)
+    wanted = a.formats.split(",")
+    files, expected = {}, {}
+    if "h5" in wanted:
+        files["h5"] = os.path.join(a.folder, f"r{a.n}.h5")
+        write_h5(files["h5"], z)
+    if "datx" in wanted:
+        files["datx"] = os.path.join(a.folder, f"r{a.n}.datx")
+        write_datx(files["datx"], z)
+    if "x3p" in wanted or "x3p-deflated" in wanted:
+        stored, deflated = write_x3p(a.asperity, a.folder, z)
+        for kind, path in (("x3p", stored), ("x3p-deflated", deflated)):
+            if kind in wanted:
+                files[kind] = path
+    if "sur" in wanted:
+        files["sur"] = os.path.join(a.folder, f"r{a.n}.sur")
+        expected["sur"] = write_sur(files["sur"], z)
     out = os.path.join(a.out or a.folder, "read.npy")
     results = {}
     for kind, path in files.items():
         ours(a.asperity, path, out)
         mine = np.load(out)
         peer = np.asarray(peer_read(path))
-        same = np.array_equal(mine, peer.T) and np.array_equal(mine, z)
+        want = expected.get(kind, z)
+        if kind in expected:
+            scale = np.abs(want).max()
+            same = bool(np.abs(mine - want).max() <= 1e-12 * scale
+                        and np.abs(peer.T - want).max() <= 1e-12 * scale)
+        else:
+            same = np.array_equal(mine, peer.T) and np.array_equal(mine, want)
         if not same:
             sys.exit(f"{kind}: the two readings differ")
         wall = {"asperity": [], "SurfaceTopography": []}
@@ -130,6 +180,8 @@ def main():
               f"{best_wall['asperity']:.3f} s, SurfaceTopography {best_wall['SurfaceTopography']:.3f} s; "
               f"CPU: asperity {best_cpu['asperity']:.3f} s, SurfaceTopography "
               f"{best_cpu['SurfaceTopography']:.3f} s", flush=True)
+    results["environment"] = {"date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                              "nproc": os.cpu_count(), "loadavg": os.getloadavg()}
     with open(os.path.join(a.folder, "hdf5_read.json"), "w") as f:
         json.dump(results, f, indent=1)
 

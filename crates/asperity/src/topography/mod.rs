@@ -679,8 +679,21 @@ pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
         return Err(bad_file(path, "grew beyond its size limit while read"));
     }
     let (reading, notes) =
-        detect_and_read(path, &bytes).map_err(|e| bad_file(path, e.to_string()))?;
+        detect_and_read_owned(path, bytes).map_err(|e| bad_file(path, e.to_string()))?;
     topography_from(path, reading, notes, options)
+}
+
+/// [`detect_and_read`] of bytes the reader may keep: an HDF5 file (`.h5`, `.datx`) is
+/// given to its decoder without a copy, and its bytes dropped before its maps are
+/// transposed (a 4096² map: two 128 MiB buffers at a time instead of four).
+fn detect_and_read_owned(path: &Path, bytes: Vec<u8>) -> Result<(Reading, Vec<String>)> {
+    let first = FORMATS.iter().find(|f| (f.sniff)(&bytes));
+    if first.is_some_and(|f| f.name == hdf5::FORMAT) {
+        let mut reading = hdf5::read_owned(bytes)?;
+        infinities_undefined(&mut reading);
+        return Ok((reading, Vec::new()));
+    }
+    detect_and_read(path, &bytes)
 }
 
 /// Reads `bytes` in the format found by content, else by the extension of `path`;
