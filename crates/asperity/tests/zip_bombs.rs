@@ -78,8 +78,31 @@ fn declare_size(zip: &mut [u8], size: u32) {
     }
 }
 
+/// A VK4 file whose one height image (offset table entry 6) declares `w × h` 32-bit
+/// samples, followed by `filler` bytes: the format's own layout (header, offset table, 304
+/// bytes of measurement conditions, image header and palette).
+fn forged_vk4(w: u32, h: u32, filler: usize) -> Vec<u8> {
+    let mut f = b"VK4_\x01\x00\x00\x00\0\0\0\0".to_vec();
+    let image_at = 12 + 72 + 304;
+    let mut table = [0u32; 18];
+    table[6] = image_at;
+    f.extend(table.iter().flat_map(|v| v.to_le_bytes()));
+    let mut conditions = vec![0u32; 76];
+    conditions[0] = 304;
+    (conditions[42], conditions[43], conditions[44]) = (1_000, 1_000, 1_000);
+    f.extend(conditions.iter().flat_map(|v| v.to_le_bytes()));
+    let bytes = u64::from(w) * u64::from(h) * 4;
+    for v in [w, h, 32, 0, bytes as u32, 0, 0] {
+        f.extend_from_slice(&v.to_le_bytes());
+    }
+    f.extend_from_slice(&[0u8; 768]);
+    f.resize(f.len() + filler, 0);
+    f
+}
+
 #[test]
 fn zip_bombs_are_refused_in_one_line_without_allocating_them() {
+    forged_vk4_headers_are_refused_before_the_member_is_inflated();
     // (file name, bytes before the archive, the member the reader opens first)
     let mut zon_prefix = b"KPK0".to_vec();
     zon_prefix.extend_from_slice(&2u32.to_le_bytes());
@@ -124,5 +147,39 @@ fn zip_bombs_are_refused_in_one_line_without_allocating_them() {
                 bytes.len()
             );
         }
+    }
+}
+
+/// A VK6/VK7 whose `Vk4File` is honest about its size (32 MiB of zeros, deflated to about
+/// 32 KiB: within the ratio a deflated member may have) but whose VK4 header declares a
+/// 20000 × 20000 × 32-bit height image (1.6 GB): refused from the header, in one line,
+/// before the member is inflated (no allocation near its 32 MiB).
+fn forged_vk4_headers_are_refused_before_the_member_is_inflated() {
+    let dir = tempfile::tempdir().unwrap();
+    let member = forged_vk4(20_000, 20_000, 32 << 20);
+    for magic in [&b"VK6"[..], b"VK7"] {
+        let mut prefix = magic.to_vec();
+        prefix.resize(24, 0);
+        let bytes = container(&prefix, "Vk4File", &member);
+        // Not refused for its ratio: the header is what refuses it.
+        assert!((bytes.len() as u64) * 1100 > member.len() as u64);
+        let path = dir.path().join("forged.vk6");
+        std::fs::write(&path, &bytes).unwrap();
+        LARGEST.with(|m| m.set(0));
+        let err = read_file(&path, &ReadOptions::default())
+            .expect_err("forged")
+            .to_string();
+        let largest = LARGEST.with(Cell::get);
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains("20000 × 20000 × 32 bits"), "{err}");
+        assert!(
+            largest <= bytes.len() + (1 << 20),
+            "an allocation of {largest} bytes for a file of {}",
+            bytes.len()
+        );
+        eprintln!(
+            "forged VK4 header ({} bytes): {err}; largest allocation {largest} bytes",
+            bytes.len()
+        );
     }
 }

@@ -143,11 +143,94 @@ fn read_container(bytes: &[u8]) -> Result<Reading> {
         .ok_or_else(|| bad(FORMAT, "a VK6/VK7 file without its zip archive"))?;
     let mut archive = ZipArchive::new(IoCursor::new(&bytes[start..]))
         .map_err(|e| bad(FORMAT, format!("the VK6/VK7 archive: {e}")))?;
-    let inner = super::zipped::member(&mut archive, FORMAT, "Vk4File", MAX_MEMBER)?;
-    if !inner.starts_with(b"VK4_") {
+    let inner = inner_vk4(&mut archive)?;
+    read(&inner)
+}
+
+/// The bytes before the first image: signature, version, file type and the offset table.
+const VK4_HEAD: u64 = 12 + 4 * 18;
+/// An image's header: width, height, depth, compression, byte size, palette range, and
+/// the 768-byte palette before the samples.
+const IMAGE_HEAD: u64 = 7 * 4 + 768;
+
+/// The container's `Vk4File`, its VK4 header checked as it is inflated, before anything
+/// the size of the member is allocated: the signature, and every image's dimensions,
+/// which must fit (`offset + header + width · height · depth/8`) in the bytes the member
+/// declares, themselves within what the container's compressed bytes can inflate to.
+fn inner_vk4(archive: &mut ZipArchive<IoCursor<&[u8]>>) -> Result<Vec<u8>> {
+    use std::io::Read;
+    const NAME: &str = "Vk4File";
+    let file = archive
+        .by_name(NAME)
+        .map_err(|e| bad(FORMAT, format!("{NAME}: {e}")))?;
+    let declared = super::zipped::declared_size(&file, FORMAT, NAME, MAX_MEMBER)?;
+    let mut reader = file.take(declared + 1);
+    let mut data = Vec::new();
+    let mut upto = |data: &mut Vec<u8>, end: u64| -> Result<()> {
+        let want = end.min(declared).saturating_sub(data.len() as u64);
+        (&mut reader)
+            .take(want)
+            .read_to_end(data)
+            .map_err(|e| bad(FORMAT, format!("{NAME}: {e}")))?;
+        match data.len() as u64 >= end {
+            true => Ok(()),
+            false => Err(bad(
+                FORMAT,
+                format!(
+                    "{NAME} ends at byte {} of the {declared} it declares",
+                    data.len()
+                ),
+            )),
+        }
+    };
+    upto(&mut data, 4)?;
+    if !data.starts_with(b"VK4_") {
         return Err(bad(FORMAT, "the archive's Vk4File is not a VK4 file"));
     }
-    read(&inner)
+    upto(&mut data, VK4_HEAD)?;
+    let at = |data: &[u8], k: usize| u32::from_le_bytes(data[k..k + 4].try_into().expect("4"));
+    // The light and height images (table entries 3–8), in the order of their offsets.
+    let mut images: Vec<u64> = (3..9)
+        .map(|k| u64::from(at(&data, 12 + 4 * k)))
+        .filter(|&o| o != 0)
+        .collect();
+    images.sort_unstable();
+    for offset in images {
+        if offset + IMAGE_HEAD > declared {
+            return Err(bad(
+                FORMAT,
+                format!("an image at byte {offset}, past the {declared} bytes of {NAME}"),
+            ));
+        }
+        upto(&mut data, offset + IMAGE_HEAD)?;
+        let o = offset as usize;
+        let (w, h, depth) = (at(&data, o), at(&data, o + 4), at(&data, o + 8));
+        let need = u64::from(w) * u64::from(h) * u64::from(depth / 8);
+        if offset + IMAGE_HEAD + need > declared {
+            return Err(bad(
+                FORMAT,
+                format!(
+                    "an image of {w} × {h} × {depth} bits at byte {offset} does not fit in \
+                     the {declared} bytes of {NAME}"
+                ),
+            ));
+        }
+    }
+    crate::memory::ensure_fits(&format!("reading {NAME} of a vk file"), Some(declared))?;
+    data.reserve_exact((declared as usize).saturating_sub(data.len()));
+    upto(&mut data, declared)?;
+    // One byte past the declared size means the member inflates to more than it says.
+    if reader
+        .read(&mut [0u8; 1])
+        .map_err(|e| bad(FORMAT, format!("{NAME}: {e}")))?
+        != 0
+    {
+        return Err(bad(
+            FORMAT,
+            format!("{NAME} inflates to more than its {declared} bytes"),
+        ));
+    }
+    Ok(data)
 }
 
 #[cfg(test)]

@@ -35,13 +35,7 @@ pub(crate) fn member(
     let file = archive
         .by_name(name)
         .map_err(|e| bad(format, format!("{name}: {e}")))?;
-    let (declared, packed) = (file.size(), file.compressed_size());
-    if declared > cap || declared > packed.saturating_mul(MAX_RATIO).max(1 << 16) {
-        return Err(bad(
-            format,
-            format!("{name} declares {declared} bytes from {packed} compressed: refused"),
-        ));
-    }
+    let declared = declared_size(&file, format, name, cap)?;
     crate::memory::ensure_fits(
         &format!("reading {name} of a {format} file"),
         Some(declared),
@@ -57,6 +51,24 @@ pub(crate) fn member(
         ));
     }
     Ok(data)
+}
+
+/// The size `file` (the member `name`) declares, refused unless within `cap` and within
+/// what its compressed bytes can inflate to ([`MAX_RATIO`]); nothing is allocated.
+pub(crate) fn declared_size(
+    file: &zip::read::ZipFile<'_, Cursor<&[u8]>>,
+    format: &'static str,
+    name: &str,
+    cap: u64,
+) -> Result<u64> {
+    let (declared, packed) = (file.size(), file.compressed_size());
+    if declared > cap || declared > packed.saturating_mul(MAX_RATIO).max(1 << 16) {
+        return Err(bad(
+            format,
+            format!("{name} declares {declared} bytes from {packed} compressed: refused"),
+        ));
+    }
+    Ok(declared)
 }
 
 /// Whether the archive has a member `name`.
