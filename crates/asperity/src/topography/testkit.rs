@@ -165,16 +165,7 @@ pub(crate) fn assert_robust(
         assert!(!sniff(&wrong), "a wrong signature is not recognised");
         assert!(read(&wrong).is_err(), "a wrong signature is refused");
     }
-    // `ASPERITY_FUZZ_MS` lengthens the loop for a longer run by hand (milliseconds).
-    let budget = std::env::var("ASPERITY_FUZZ_MS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .map_or(budget, Duration::from_millis);
-    let max_tries = if budget > Duration::from_secs(1) {
-        usize::MAX
-    } else {
-        20_000
-    };
+    let (budget, max_tries) = fuzz_budget(budget);
     let mut work = bytes.to_vec();
     let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
     let start = Instant::now();
@@ -194,6 +185,41 @@ pub(crate) fn assert_robust(
     }
     assert!(tries > 0);
     eprintln!("{tries} corrupted headers read without a panic");
+}
+
+/// The time and the most tries of a fuzz loop given `budget`: `ASPERITY_FUZZ_MS`
+/// (milliseconds) replaces the budget, for a longer run by hand; see [`budget_from`].
+pub(crate) fn fuzz_budget(budget: Duration) -> (Duration, usize) {
+    budget_from(std::env::var("ASPERITY_FUZZ_MS").ok().as_deref(), budget)
+}
+
+/// The budget (`ms`, when it is a number of milliseconds, else `budget`) and the most
+/// tries: 20 000 within a second, no cap beyond (a run by hand lasts its time).
+fn budget_from(ms: Option<&str>, budget: Duration) -> (Duration, usize) {
+    let budget = ms
+        .and_then(|v| v.trim().parse().ok())
+        .map_or(budget, Duration::from_millis);
+    let tries = if budget > Duration::from_secs(1) {
+        usize::MAX
+    } else {
+        20_000
+    };
+    (budget, tries)
+}
+
+#[test]
+fn every_fuzz_loop_takes_its_time_from_asperity_fuzz_ms() {
+    let short = Duration::from_millis(300);
+    assert_eq!(budget_from(None, short), (short, 20_000));
+    assert_eq!(budget_from(Some("nonsense"), short), (short, 20_000));
+    assert_eq!(
+        budget_from(Some("60000"), short),
+        (Duration::from_secs(60), usize::MAX)
+    );
+    assert_eq!(
+        budget_from(Some("10"), short),
+        (Duration::from_millis(10), 20_000)
+    );
 }
 
 /// The offsets of the size fields of every zip header in `bytes`: the compressed and
@@ -244,9 +270,10 @@ pub(crate) fn assert_zip_sizes_robust(bytes: &[u8], read: ReadFn, budget: Durati
         }
     }
     let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+    let (budget, max_tries) = fuzz_budget(budget);
     let (start, mut tries, mut refused) = (Instant::now(), 0usize, 0usize);
     let mut work = bytes.to_vec();
-    while start.elapsed() < budget && tries < 20_000 {
+    while start.elapsed() < budget && tries < max_tries {
         tries += 1;
         let picked: Vec<usize> = (0..1 + rng.below(3))
             .map(|_| rng.below(fields.len()))
