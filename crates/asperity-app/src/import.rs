@@ -127,6 +127,57 @@ pub fn sidecar_record(topography: &Topography) -> serde_json::Value {
     value
 }
 
+/// What an import found and wrote, in one line for the terminal: the output, the format
+/// (the instrument's file format) and file, the channel chosen among all the file's
+/// channels, the grid and sizes, the heights' unit in the file, the undefined points, and
+/// the cleaning steps.
+pub fn summary(out: &Path, file: &Path, topography: &Topography) -> String {
+    let p = &topography.provenance;
+    let shape: Vec<String> = topography
+        .heights
+        .shape()
+        .iter()
+        .map(|d| d.to_string())
+        .collect();
+    let sizes: Vec<String> = topography.sizes.iter().map(|s| format!("{s:e}")).collect();
+    let channel = if p.channels.len() > 1 {
+        let all: Vec<String> = p.channels.iter().map(|c| format!("{c:?}")).collect();
+        format!(
+            "channel {:?} ({} of {}: {})",
+            p.channel,
+            p.channel_index,
+            p.channels.len(),
+            all.join(", ")
+        )
+    } else {
+        format!("channel {:?}", p.channel)
+    };
+    let unit = match (&p.file_unit, &p.unit) {
+        (Some(f), Some(_)) => format!("heights in {f} in the file"),
+        (Some(f), None) => format!("heights in {f} (no length: kept as they are)"),
+        (None, Some(u)) => format!("heights in {u}"),
+        (None, None) => "no height unit in the file".to_string(),
+    };
+    let undefined = match topography.heights.undefined_count() {
+        0 if p.cleaning.iter().any(|c| c.starts_with("filled ")) => String::new(),
+        0 => ", no undefined points".to_string(),
+        n => format!(", {n} undefined points kept"),
+    };
+    let cleaning = if p.cleaning.is_empty() {
+        String::new()
+    } else {
+        format!("; {}", p.cleaning.join("; "))
+    };
+    format!(
+        "wrote {} ({} {}, {channel}, {} grid, sizes {} m, {unit}{undefined}{cleaning})",
+        out.display(),
+        p.format,
+        file.display(),
+        shape.join("x"),
+        sizes.join(" x "),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,6 +205,45 @@ mod tests {
         assert!(
             err.words(Names::Flags).contains("is the input file"),
             "{err}"
+        );
+    }
+
+    #[test]
+    fn the_summary_says_what_was_found() {
+        use asperity::topography::Provenance;
+        let mut t = Topography {
+            heights: Heights::Areal(ndarray::array![[1e-9, f64::NAN, 0.0]]),
+            sizes: vec![3e-6, 1e-6],
+            provenance: Provenance {
+                source: "scan.nid".into(),
+                format: "nid".into(),
+                channel: "Z-Axis".into(),
+                channel_index: 1,
+                channels: vec!["Amplitude".into(), "Z-Axis".into()],
+                file_unit: Some("nm".into()),
+                unit: Some("m".into()),
+                size_source: "file".into(),
+                cleaning: vec!["no levelling".into()],
+            },
+        };
+        let line = summary(Path::new("s.npy"), Path::new("scan.nid"), &t);
+        assert_eq!(
+            line,
+            "wrote s.npy (nid scan.nid, channel \"Z-Axis\" (1 of 2: \"Amplitude\", \"Z-Axis\"), \
+             1x3 grid, sizes 3e-6 x 1e-6 m, heights in nm in the file, 1 undefined points kept; \
+             no levelling)"
+        );
+        // Filled: the cleaning step counts them; one channel, no unit.
+        t.heights = Heights::Areal(ndarray::array![[1.0, 2.0, 0.0]]);
+        t.provenance.channels.truncate(1);
+        (t.provenance.file_unit, t.provenance.unit) = (None, None);
+        t.provenance.cleaning =
+            vec!["filled 1 undefined points by harmonic (Laplace) inpainting".into()];
+        let line = summary(Path::new("s.npy"), Path::new("scan.nid"), &t);
+        assert!(
+            line.contains("channel \"Z-Axis\", 1x3 grid")
+                && line.contains("no height unit in the file; filled 1 undefined"),
+            "{line}"
         );
     }
 }

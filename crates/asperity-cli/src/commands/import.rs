@@ -44,26 +44,9 @@ pub fn run(args: &ImportArgs) -> Result<()> {
     let import = Import::stage(&args.file, &args.out, args.force).map_err(refused)?;
     let topography = load(&args.file, &args.measured, args.size.as_deref())?;
     import.write(&args.file, &topography).map_err(refused)?;
-    let shape: Vec<String> = topography
-        .heights
-        .shape()
-        .iter()
-        .map(|d| d.to_string())
-        .collect();
-    let sizes: Vec<String> = topography.sizes.iter().map(|s| format!("{s:e}")).collect();
     eprintln!(
-        "wrote {} ({} {}, channel {:?}, {} grid, sizes {} m{})",
-        args.out.display(),
-        topography.provenance.format,
-        args.file.display(),
-        topography.provenance.channel,
-        shape.join("x"),
-        sizes.join(" x "),
-        if topography.provenance.cleaning.is_empty() {
-            String::new()
-        } else {
-            format!("; {}", topography.provenance.cleaning.join("; "))
-        }
+        "{}",
+        asperity_app::import::summary(&args.out, &args.file, &topography)
     );
     Ok(())
 }
