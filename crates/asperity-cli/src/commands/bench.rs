@@ -29,7 +29,8 @@ pub enum Kernel {
     /// BEM solves: one cold solve of an N×N surface (H, roll-off 6, rms slope 1, seed of
     /// --seed) per mean pressure of --pressures, by each solver (pk, bccg), free and periodic,
     /// with the iterations, operator applications and the cost of an iteration in padded FFT
-    /// pairs.
+    /// pairs; after each solve its frozen-set stiffness, by the default CG and all in double
+    /// precision, in CPU seconds against the solve's.
     BemSolve,
     /// The tangential frozen-set stiffness against the normal one: on the solved states of
     /// an N×N surface (H, roll-off --rolloff or 4, rms slope 1, seed of --seed, free
@@ -50,7 +51,8 @@ pub enum Kernel {
                   bem-estimate: prints, per N and in total, the estimated run time of a BEM study\n\
                   (free boundaries, 24 loads per sample, frozen-set stiffness at each).\n\
                   bem-solve: per boundary, pressure and solver, iterations, operator applications and\n\
-                  the solve time, also in padded FFT pairs per iteration.\n\
+                  the solve time, also in padded FFT pairs per iteration; then (kernel=bem-stiffness)\n\
+                  the frozen-set stiffness after it, mixed and f64, in CPU seconds over the solve's.\n\
                   tangential: per mean pressure and solve (normal; x, y, both in f64 and mixed), the\n\
                   operator applications and the CPU seconds (median, min, max over --repeat rounds).\n\n\
                   Examples:\n  asperity bench surface --n 4096 --repeat 5\n  \
@@ -386,12 +388,15 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
                 let mut contact = ContactSolver::new(&surface, half_space, params)?;
                 let mut times = Vec::new();
                 let mut last = None;
-                for _ in 0..args.repeat {
+                let mut stiffness = StiffnessTimes::default();
+                for round in 0..args.repeat {
                     contact.reset();
-                    let start = Instant::now();
+                    let (start, cpu) = (Instant::now(), cpu_seconds());
                     let solved = contact.solve(Control::MeanPressure(pressure))?;
                     times.push(start.elapsed().as_secs_f64());
+                    stiffness.solve_cpu.push(cpu_seconds() - cpu);
                     last = Some(solved);
+                    stiffness.time(&mut contact, round)?;
                 }
                 let (summary, info) = last.expect("repeat is at least 1");
                 let (min, median) = min_median(times);
@@ -414,10 +419,60 @@ fn bem_solve(args: &BenchArgs) -> Result<()> {
                     min / info.iterations.max(1) as f64 / fft_pair,
                     min / info.iterations.max(1) as f64 / padded_pair,
                 );
+                stiffness.print(args, boundary, pressure);
             }
         }
     }
     Ok(())
+}
+
+/// `bench bem-solve`'s frozen-set stiffness after each cold solve, by the default CG (a
+/// single-precision pass refined in double on large grids, `mixed`) and all in double
+/// precision (`f64`), in alternating order: CPU seconds of the process (and of the solves),
+/// the last applications and stiffnesses.
+#[derive(Default)]
+struct StiffnessTimes {
+    solve_cpu: Vec<f64>,
+    cpu: [Vec<f64>; 2],
+    applications: [usize; 2],
+    k: [f64; 2],
+}
+
+impl StiffnessTimes {
+    /// Times both stiffnesses of `contact`'s solved state, `mixed` first in even rounds.
+    fn time(&mut self, contact: &mut ContactSolver, round: usize) -> Result<()> {
+        for which in [round % 2, 1 - round % 2] {
+            contact.set_single_precision_stiffness(which == 0);
+            let cpu = cpu_seconds();
+            let (k, info) = contact.frozen_set_stiffness()?;
+            self.cpu[which].push(cpu_seconds() - cpu);
+            (self.k[which], self.applications[which]) = (k, info.operator_applications);
+        }
+        contact.set_single_precision_stiffness(true);
+        Ok(())
+    }
+
+    /// One line: the solve's CPU time, each stiffness's applications and CPU time (minimum
+    /// over the rounds) and its ratio to the solve's, and the two stiffnesses' difference.
+    fn print(&mut self, args: &BenchArgs, boundary: Boundary, pressure: f64) {
+        let solve = median_spread(&mut self.solve_cpu).1;
+        let [mixed, double] = [0, 1].map(|i| median_spread(&mut self.cpu[i]).1);
+        println!(
+            "kernel=bem-stiffness n={} seed={} threads={} boundary={} mean_pressure={pressure} \
+             solve_cpu_min_s={solve:.4} mixed_applications={} mixed_cpu_min_s={mixed:.4} \
+             mixed_over_solve={:.3} f64_applications={} f64_cpu_min_s={double:.4} \
+             f64_over_solve={:.3} mixed_vs_f64_relative={:.2e}",
+            args.n,
+            args.seed,
+            rayon::current_num_threads(),
+            boundary.name(),
+            self.applications[0],
+            mixed / solve,
+            self.applications[1],
+            double / solve,
+            (self.k[0] / self.k[1] - 1.0).abs(),
+        );
+    }
 }
 
 /// CPU seconds of this process, all threads (`CLOCK_PROCESS_CPUTIME_ID`): on a shared

@@ -100,6 +100,9 @@ pub struct ContactSolver<K: ContactOperator = ElasticOperator> {
     /// [`ContactSolver::keep_plastic_displacement`], added to the profile; allocated on
     /// first use.
     pub(super) permanent: Option<Vec<f64>>,
+    /// Whether the frozen-set CG of large grids makes its first pass in single precision
+    /// (`stiffness/mod.rs`; on by default).
+    pub(super) single_precision_stiffness: bool,
 }
 
 impl ContactSolver {
@@ -225,6 +228,7 @@ impl<K: ContactOperator> ContactSolver<K> {
             stiffness_work: None,
             full_contact_scratch: None,
             permanent: None,
+            single_precision_stiffness: true,
         })
     }
 

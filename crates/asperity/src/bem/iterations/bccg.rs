@@ -195,7 +195,7 @@ pub(in crate::bem) struct BccgScratch<K: ContactOperator = ElasticOperator> {
     /// transform alone (always, but in the test that compares it with forming `K s`).
     energy_steps: bool,
     /// The operator in single precision (module docs, step 7).
-    single: K::Single,
+    pub(in crate::bem) single: K::Single,
     /// Whether the iteration uses `single` (always, but in the test that compares the
     /// solves with and without it).
     single_steps: bool,

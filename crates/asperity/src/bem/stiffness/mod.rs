@@ -51,8 +51,16 @@ use super::threshold::FullContactThreshold;
 use super::{Control, SolveError, SolveInfo};
 use crate::elastic::ContactOperator;
 use crate::Error;
-use cg::{conjugate_gradient_on_set, CgInfo, CgParams, RightHandSide};
+use cg::{
+    conjugate_gradient_on_set, conjugate_gradient_on_set_from, CgError, CgInfo, CgParams,
+    RightHandSide, Start,
+};
 use work::StiffnessWork;
+
+/// Grids of at least this many points make the frozen-set CG's first pass in single
+/// precision (`ContactSolver::frozen_set_cg`): those where it was measured (512² to 2048²,
+/// docs/performance.md). Smaller grids keep the all-`f64` CG and its bits.
+pub(in crate::bem) const SINGLE_STIFFNESS_MIN_POINTS: usize = RING_MIN_POINTS;
 
 /// The power of two by which the threshold's CG divides the profile `f`: 1 where its
 /// largest value lies within 2^±64 (so the usual bits), else the power of two nearest it
@@ -146,23 +154,80 @@ impl<K: ContactOperator> ContactSolver<K> {
                     energy_error: Some(self.cx.params.stiffness_error).filter(|&e| e > 0.0),
                     max_iterations,
                 };
-                let (pressure, interface) = (&self.cx.state.pressure, self.cx.interface);
-                conjugate_gradient_on_set(
-                    &mut self.cx.problem.operator,
-                    &mut self.cx.preconditioner,
-                    |i| interface.elastic(pressure[i]),
-                    RightHandSide::Ones,
-                    &mut work.cg,
-                    (&params, &self.cx.stop),
-                )
-                .map(|info| (solve_info(&info), info.energy))
-                .map_err(SolveError::from)
+                self.frozen_set_cg(&mut work, &params)
             }
         };
         let (dx, dy) = self.cx.problem.operator.spacings();
         work.tangent = result.is_ok();
         self.stiffness_work = Some(work);
         result.map(|(info, ones_x)| (ones_x * dx * dy, info))
+    }
+
+    /// The frozen-set CG on the current pressure's set: `(info, 1ᵀx)`, `x` in `work`. On
+    /// grids of at least [`SINGLE_STIFFNESS_MIN_POINTS`] points (and operators whose scale
+    /// `f32` holds) it runs first on the single-precision copy of the operator that the BCCG
+    /// keeps, then is refined in double precision ([`Start::Refine`], as the tangential CGs:
+    /// one `f64` application for the true residual and the energy `bᵀx₀ + x₀ᵀr₀`, then `f64`
+    /// steps until the last one moved the energy by at most its error); where that pass
+    /// fails the `f64` CG starts over from zero and decides alone. Elsewhere all in `f64`.
+    fn frozen_set_cg(
+        &mut self,
+        work: &mut StiffnessWork,
+        params: &CgParams,
+    ) -> Result<(SolveInfo, f64), SolveError> {
+        let (pressure, interface, stop) =
+            (&self.cx.state.pressure, self.cx.interface, &self.cx.stop);
+        let in_set = |i: usize| interface.elastic(pressure[i]);
+        let operator = &mut self.cx.problem.operator;
+        let scale = operator.self_influence();
+        let single_pass = self.single_precision_stiffness
+            && operator.rows() * operator.cols() >= SINGLE_STIFFNESS_MIN_POINTS
+            && scale > 2f64.powi(-40)
+            && scale < 2f64.powi(40);
+        let (mut single, mut start, mut refine) = (0, Start::Zero, 0);
+        if single_pass {
+            let singles = &mut self.bccg_scratch.single;
+            match conjugate_gradient_on_set(
+                singles,
+                &mut self.cx.preconditioner,
+                in_set,
+                RightHandSide::Ones,
+                &mut work.cg,
+                (params, stop),
+            ) {
+                Ok(info) => (single, start, refine) = (info.iterations, Start::Refine, 1),
+                Err(CgError::Interrupted { iterations }) => {
+                    return Err(SolveError::Interrupted { iterations })
+                }
+                Err(
+                    CgError::NoConvergence { iterations, .. }
+                    | CgError::Breakdown { iterations, .. },
+                ) => single = iterations,
+            }
+        }
+        conjugate_gradient_on_set_from(
+            operator,
+            &mut self.cx.preconditioner,
+            in_set,
+            (RightHandSide::Ones, start),
+            &mut work.cg,
+            (params, stop),
+        )
+        .map(|info| {
+            let mut solve = solve_info(&info);
+            solve.iterations += single;
+            solve.operator_applications += single + refine;
+            (solve, info.energy)
+        })
+        .map_err(SolveError::from)
+    }
+
+    /// Whether the frozen-set CG of grids of at least [`SINGLE_STIFFNESS_MIN_POINTS`] points
+    /// makes its first pass in single precision (the default: yes); off, it runs all in
+    /// double precision, bit for bit the CG of before (for comparisons: `asperity bench
+    /// bem-solve` times both).
+    pub fn set_single_precision_stiffness(&mut self, on: bool) {
+        self.single_precision_stiffness = on;
     }
 
     /// The frozen-set solution `x = K_SS⁻¹ 1_S` of the solved state (zero off the set), if
@@ -405,6 +470,46 @@ mod tests {
             assert!(
                 error.abs() < 0.005,
                 "{rows}x{cols} {boundary:?}: frozen {frozen} vs fd {fd}"
+            );
+        }
+    }
+
+    #[test]
+    fn single_precision_pass_gives_the_double_precision_stiffness() {
+        // On grids of at least SINGLE_STIFFNESS_MIN_POINTS points the frozen-set CG runs on
+        // the f32 operator first and is refined in f64. Its stiffness must be the all-f64
+        // CG's to their energy stops (each ends once a step moved the energy by at most
+        // stiffness_error = 1e-12 of it, and what is left falls geometrically from there:
+        // a few 1e-12 apart at most; the tangential CGs' same refinement measured 3.2e-13),
+        // and Barber's dF/dd to the 0.5 % of the test above.
+        let (rows, cols) = (512, 512);
+        assert!(rows * cols >= SINGLE_STIFFNESS_MIN_POINTS);
+        for (boundary, pressure) in [(Boundary::Free, 0.02), (Boundary::Periodic, 0.05)] {
+            let mut solver = solved_rough((rows, cols, 11), boundary, pressure);
+            let (mixed, info) = solver.frozen_set_stiffness().unwrap();
+            // The f32 pass ran and was refined: one application (the refinement's start)
+            // more than its iterations, both passes'.
+            assert_eq!(
+                info.operator_applications,
+                info.iterations + 1,
+                "{boundary:?}"
+            );
+            solver.set_single_precision_stiffness(false);
+            let (double, info_f64) = solver.frozen_set_stiffness().unwrap();
+            assert_eq!(info_f64.operator_applications, info_f64.iterations);
+            solver.set_single_precision_stiffness(true);
+            let gap = (mixed / double - 1.0).abs();
+            eprintln!(
+                "{boundary:?}: k mixed / f64 - 1 = {gap:.2e}, iterations {} / {}",
+                info.iterations, info_f64.iterations
+            );
+            assert!(gap < 1e-11, "{boundary:?}: {mixed} vs {double}");
+            let fd = solver
+                .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
+                .unwrap();
+            assert!(
+                (mixed / fd - 1.0).abs() < 5e-3,
+                "{boundary:?}: {mixed} vs dF/dd {fd}"
             );
         }
     }

@@ -112,7 +112,8 @@ fn hash_solve(hash: &mut Fingerprint, solver: &mut ContactSolver, iterations: us
     hash.word(info.iterations as u64);
 }
 
-/// `(rows, cols, boundary, solver, recorded hash)`, recorded at commit 3380c57. The 512²
+/// `(rows, cols, boundary, solver, recorded hash)`, recorded at commit 3380c57 (the 512²
+/// case again for issue 39, item 2, below). The 512²
 /// case is the smallest grid on which the BCCG extends its gradient over rings
 /// (`RING_MIN_POINTS`).
 #[rustfmt::skip]
@@ -131,7 +132,11 @@ const RECORDED: &[(usize, usize, Boundary, SolverKind, u64)] = &[
     (50, 72, Boundary::Periodic, SolverKind::PolonskyKeer, 0x46c30991e6baf83b),
     (256, 256, Boundary::Free, SolverKind::Bccg, 0x22b6c48f1b9b0966),
     (256, 256, Boundary::Periodic, SolverKind::Bccg, 0x6236f59cb36420db),
-    (512, 512, Boundary::Free, SolverKind::Bccg, 0x24769b344cf23648),
+    // Re-recorded for issue 39, item 2: on grids of 2¹⁸ points and more the frozen-set CG
+    // makes a single-precision pass refined in double (`stiffness/mod.rs`), so this case's
+    // stiffness (and the tangent the second load starts from) moves within the CG's energy
+    // stop; the smaller grids keep their bits. Was 0x24769b344cf23648.
+    (512, 512, Boundary::Free, SolverKind::Bccg, 0x3ec56e8b6454a676),
 ];
 
 #[test]
