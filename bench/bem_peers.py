@@ -19,8 +19,10 @@ solver) in its own process so that peak memory (VmHWM) is per solve:
   cm-ccg        ContactMechanics' CCG without restart (Bugnicourt et al. 2018):
                 NonSmoothContactSystem.dual_minimize_proxy(offset,
                 solver="ccg-without-restart", gtol=tol·h_rms) at the offset of
-                ContactMechanics' own Polonsky-Keer solution of the same case (solved
-                untimed in the worker when the contactmechanics run did not provide it),
+                ContactMechanics' own Polonsky-Keer solution of the same case where the
+                contactmechanics run provided it, else at asperity's indentation converted
+                to ContactMechanics' offset (free: d - max h; periodic: minus the mean of
+                its displacement under the uniform load; both recorded where both exist),
                 starting from the uniform pixel force p̄·A/n (unpadded shape)
 
 Indentation of the peers is computed the same way as asperity's: apply the code's own
@@ -58,6 +60,7 @@ import json
 import os
 import platform
 import re
+import resource
 import subprocess
 import sys
 import time
@@ -159,6 +162,22 @@ def solve_contactmechanics(args, heights):
     return seconds, force / pixel_area, u, int(result.nit), {"offset": float(result.offset)}
 
 
+def offset_from_indentation(args, heights, substrate):
+    """ContactMechanics' offset of asperity's indentation d (--indentation): free boundaries
+    d - max(h); periodic, where asperity's displacement has zero mean and ContactMechanics'
+    carries the mean of its response to the uniform load (negative, its sign convention), d -
+    max(h) minus that mean. Checked against ContactMechanics' own Polonsky-Keer offsets on
+    the 256² surface (free and periodic, p = 0.01 and 0.05: equal within 3e-12)."""
+    import numpy as np
+
+    offset = args.indentation - float(heights.max())
+    if args.boundary == "periodic":
+        n_rows, n_cols = heights.shape
+        uniform = np.full((n_rows, n_cols), args.pressure * (n_rows / n_cols) / (n_rows * n_cols))
+        offset -= float(np.mean(np.asarray(substrate.evaluate_disp(uniform))[:n_rows, :n_cols]))
+    return offset
+
+
 def solve_cm_ccg(args, heights):
     """CCG without restart at ContactMechanics' Polonsky-Keer offset (--offset, or solved
     here untimed)."""
@@ -168,7 +187,11 @@ def solve_cm_ccg(args, heights):
 
     n_rows, n_cols = heights.shape
     substrate = cm_substrate(args, heights.shape)
-    offset = args.offset
+    offset, extra = args.offset, {}
+    if args.indentation is not None:
+        extra["offset_from_asperity"] = offset_from_indentation(args, heights, substrate)
+        if offset is None:
+            offset = extra["offset_from_asperity"]
     if offset is None:
         offset = float(cm_polonsky_keer(args, heights, substrate)[1].offset)
         substrate = cm_substrate(args, heights.shape)
@@ -178,16 +201,17 @@ def solve_cm_ccg(args, heights):
     area = n_rows / n_cols
     init_force = np.full((n_rows, n_cols), args.pressure * area / (n_rows * n_cols))
     rms = float(np.std(heights))
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     result = system.dual_minimize_proxy(offset, init_force=init_force, solver="ccg-without-restart",
                                         gtol=args.tol * rms, maxiter=100000)
     seconds = time.perf_counter() - start
+    extra["cpu_seconds"] = time.process_time() - cpu_start
     if not result.success:
         raise RuntimeError(f"CCG without restart: {result.message}")
     force = np.asarray(result.x).reshape(n_rows, n_cols)
     pixel_area = area / (n_rows * n_cols)
     u = np.asarray(substrate.evaluate_disp(force))[:n_rows, :n_cols]
-    return seconds, force / pixel_area, u, int(result.nit), {"offset": offset}
+    return seconds, force / pixel_area, u, int(result.nit), {"offset": offset, **extra}
 
 
 def worker(args):
@@ -240,7 +264,9 @@ def run_asperity(exe, surface, boundary, pressure, tol, out_dir, threads=None, s
            "--tol", repr(tol), "--timing", "--no-stiffness", "--quiet", "--force", "--out", out]
     if solver:
         cmd += ["--solver", solver]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode != 0:
         return {"error": proc.stderr.strip()}
     with open(out) as fh:
@@ -252,6 +278,9 @@ def run_asperity(exe, surface, boundary, pressure, tol, out_dir, threads=None, s
         "mean_pressure": float(row["mean_pressure"]),
         "indentation": float(row["indentation"]),
         "peak_rss_mib": float(row["peak_rss_mib"]),
+        # The whole process's CPU time (reading the surface and planning included): on a
+        # shared machine the comparable figure where wall times wait for a core.
+        "process_cpu_seconds": (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime),
     }
 
 
@@ -292,11 +321,13 @@ def fft_pair_seconds(exe, n, boundary, threads, repeat, processes):
             "apply_seconds": min(applications), "pair_seconds_per_process": pairs}
 
 
-def run_peer(code, surface, boundary, pressure, tol, timeout, offset=None):
+def run_peer(code, surface, boundary, pressure, tol, timeout, offset=None, indentation=None):
     cmd = [sys.executable, os.path.abspath(__file__), "worker", "--code", code, "--surface", surface,
            "--boundary", boundary, "--pressure", repr(pressure), "--tol", repr(tol)]
     if offset is not None:
         cmd += ["--offset", repr(offset)]
+    if indentation is not None:
+        cmd += ["--indentation", repr(indentation)]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -389,8 +420,12 @@ def run_case(args, surface, n, boundary, pressure, configs, pairs):
         results.append(r)
     for code in [p for p in args.peers.split(",") if p]:
         tol = args.tamaas_tol if (code == "tamaas" and args.tamaas_tol) else args.tol
+        # The CCG's offset: ContactMechanics' Polonsky-Keer's where it ran, else asperity's
+        # indentation converted (`offset_from_indentation`; recorded beside it either way).
+        indentation = next((a["indentation"] for a in results if "indentation" in a), None)
         r = run_peer(code, surface, boundary, pressure, tol, args.timeout,
-                     offset=offset if code == "cm-ccg" else None)
+                     offset=offset if code == "cm-ccg" else None,
+                     indentation=indentation if code == "cm-ccg" else None)
         if code == "contactmechanics" and "offset" in r:
             offset = r["offset"]
         r.update({"code": code, "threads": 1})
@@ -422,6 +457,7 @@ def main():
     w.add_argument("--pressure", type=float, required=True)
     w.add_argument("--tol", type=float, required=True)
     w.add_argument("--offset", type=float, default=None)
+    w.add_argument("--indentation", type=float, default=None)
     parser.add_argument("--asperity", default="target/release/asperity")
     parser.add_argument("--out", default="bench/out")
     parser.add_argument("--sizes", default="256,512,1024")
@@ -437,7 +473,8 @@ def main():
                         help="tamaas' tolerance (its error measure differs; default: same value)")
     parser.add_argument("--pair-repeat", type=int, default=10, help="repetitions of the FFT pair timing")
     parser.add_argument("--pair-processes", type=int, default=3,
-                        help="processes timing the FFT pair (the fastest is the unit)")
+                        help="processes timing the FFT pair (the fastest is the unit; 0: no pair "
+                             "timed, no per-pair columns)")
     parser.add_argument("--asperity-processes", type=int, default=3,
                         help="processes per asperity solve (the median is reported)")
     parser.add_argument("--timeout", type=float, default=1800)
@@ -462,7 +499,7 @@ def main():
                         "--rms-slope", "1", "--seed", "1", "--out", surface, "--force"], check=True,
                        capture_output=True)
         for boundary in args.boundaries.split(","):
-            for threads in thread_counts:
+            for threads in thread_counts if args.pair_processes > 0 else []:
                 pair = fft_pair_seconds(args.asperity, n, boundary, threads, args.pair_repeat,
                                         args.pair_processes)
                 if pair:
