@@ -330,6 +330,81 @@ fn stats_writes_height_slope_and_curvature_distributions() {
 }
 
 #[test]
+fn stats_draws_each_analysis_beside_its_csv() {
+    // Every analysis option given twice, a CSV and a figure: the figure's one series is
+    // the CSV's rows (every finite row on linear axes; those a log axis can show on log–log
+    // ones: fewer than 5000, so none thinned), bit for bit (both write shortest round-trip
+    // decimals); PNG and SVG files are written and non-empty.
+    let dir = tempfile::tempdir().unwrap();
+    let h = ndarray::Array2::from_shape_fn((24, 32), |(r, c)| {
+        ((r * 7 + c * 13) % 17) as f64 + 0.01 * (c * c) as f64 + 0.3 * (r as f64).sin()
+    });
+    ndarray_npy::write_npy(dir.path().join("h.npy"), &h).unwrap();
+    let flags = [
+        ("bearing-area", "material_ratio,height", false),
+        ("acf", "distance,acf", true),
+        ("acf-2d", "distance,acf", true),
+        ("variable-bandwidth", "bandwidth,rms_height", true),
+        ("scale-dependent-slope", "distance,slope", true),
+        ("scale-dependent-curvature", "distance,curvature", true),
+        ("height-distribution", "height,density", false),
+        ("slope-distribution", "slope,density", false),
+        ("curvature-distribution", "curvature,density", false),
+    ];
+    let mut args: Vec<String> = ["stats", "h.npy", "--size", "2"].map(String::from).into();
+    for (flag, _, _) in flags {
+        for ext in ["csv", "json"] {
+            args.extend([format!("--{flag}"), format!("{flag}.{ext}")]);
+        }
+    }
+    args.extend([
+        "--acf".into(),
+        "acf.png".into(),
+        "--acf".into(),
+        "acf.svg".into(),
+    ]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&asperity(&args, dir.path()));
+    for (flag, header, log) in flags {
+        let rows = numeric_csv(&dir.path().join(format!("{flag}.csv")), header);
+        let figure = json(&dir.path().join(format!("{flag}.json")));
+        let chart = &figure["charts"][0];
+        assert_eq!(chart["log_x"], log, "{flag}");
+        assert_eq!(chart["log_y"], log, "{flag}");
+        assert_eq!(
+            chart["title"].as_str().unwrap().split(':').next(),
+            Some("h.npy")
+        );
+        let points: Vec<Vec<f64>> =
+            serde_json::from_value(chart["series"][0]["points"].clone()).unwrap();
+        let shown: Vec<Vec<f64>> = (rows.into_iter())
+            .filter(|r| !log || (r[0] > 0.0 && r[1] > 0.0))
+            .collect();
+        assert!(shown.len() > 2, "{flag}: {shown:?}");
+        assert_eq!(points, shown, "{flag}");
+        let unit = if flag.ends_with("distribution") && flag != "height-distribution" {
+            "]"
+        } else {
+            "[length"
+        };
+        let labels = format!("{} {}", chart["x_label"], chart["y_label"]);
+        assert!(labels.contains(unit), "{flag}: {labels}");
+    }
+    let png = std::fs::read(dir.path().join("acf.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG") && png.len() > 10_000,
+        "{}",
+        png.len()
+    );
+    let svg = std::fs::read_to_string(dir.path().join("acf.svg")).unwrap();
+    assert!(
+        svg.contains("<svg") && svg.contains("distance r"),
+        "{}",
+        svg.len()
+    );
+}
+
+#[test]
 fn bad_files_give_one_line_and_exit_2() {
     let Some(shared) = shared() else { return };
     let dir = tempfile::tempdir().unwrap();

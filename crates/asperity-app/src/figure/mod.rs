@@ -7,10 +7,13 @@
 //! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`contact`] (an SI contact
 //! sweep's k(F), A(F) and mean gap), [`path`] (a load path's
 //! loading–unloading loop), [`adhesion`] (an adhesive loop with its arrows and pull-offs), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
-//! [`psd`] (a PSD with its fitted power law), [`map`] (a height map with scale and colour
+//! [`psd`] (a PSD with its fitted power law), [`analysis`] (the surface analyses of
+//! `asperity stats`: ACFs, scale-dependent slope and curvature, variable-bandwidth rms
+//! height, bearing-area curve, distributions), [`map`] (a height map with scale and colour
 //! bars, a contact set with its patches: a series that is an [`Image`]).
 
 pub mod adhesion;
+pub mod analysis;
 pub mod contact;
 pub mod map;
 pub mod path;

@@ -15,6 +15,7 @@ use asperity_app::Names;
 use super::measured::{open_argument, parse_size, record as measured_record, MeasuredArgs};
 use crate::output::{format_number, Table};
 use asperity_app::argument::{Arrays, Dims};
+use asperity_app::figure::analysis::{analysis_chart, AnalysisFigure};
 use asperity_app::figure::psd::{self, PsdFigure};
 
 use crate::plot::{stage_charts, Chart, ImageFormat};
@@ -25,7 +26,13 @@ use crate::plot::{stage_charts, Chart, ImageFormat};
     allow_negative_numbers = true,
     after_help = "Examples:\n  asperity stats s.npy\n  asperity stats s.npy --psd psd.csv --fit-from 6\n  \
     asperity stats s.npy --plot psd.png\n  asperity stats scan.x3p --detrend plane --bearing-area bearing.csv\n  \
-    asperity stats profile.csv --detrend mean --json"
+    asperity stats scan.x3p --acf acf.csv --acf acf.png --scale-dependent-slope slope.svg\n  \
+    asperity stats profile.csv --detrend mean --json\n\n\
+    Each analysis option (--bearing-area to --curvature-distribution) writes its table as CSV,\n\
+    or its figure where the path ends in .png, .svg or .json (the figure as data): log–log\n\
+    against the length scale for --acf, --acf-2d, --variable-bandwidth and the\n\
+    scale-dependent slope and curvature, linear for the bearing-area curve and the\n\
+    distributions, lengths in metres for a measured file. Give an option twice for both."
 )]
 pub struct StatsArgs {
     /// A surface (2D) or line (1D): `.npy` (float64), or a measured file (X3P, SDF, text,
@@ -66,52 +73,52 @@ pub struct StatsArgs {
     /// (0 to 1 in 101 steps) and height: the height c above which that fraction of the
     /// defined heights lies (ISO 25178-2's material ratio Smr(c), inverted; linear between
     /// order statistics), in the heights' unit (metres for a measured file).
-    #[arg(long, value_name = "OUT.csv")]
-    pub bearing_area: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub bearing_area: Vec<PathBuf>,
     /// Write the height-difference autocorrelation function along x as CSV with columns
     /// distance (r = kΔx) and acf (A(r) = ½⟨(h(x + r) − h(x))²⟩ over every pair of defined
     /// points at that distance in a row, pooled over the rows; SurfaceTopography's ACF of a
     /// non-periodic scan on its grid), in the heights' unit (squared for acf).
-    #[arg(long, value_name = "OUT.csv")]
-    pub acf: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub acf: Vec<PathBuf>,
     /// Write the radially averaged 2-D height-difference ACF of a map as CSV with columns
     /// distance (the mean |r| of the bin's pairs, bins of width min(Δx, Δy)) and acf
     /// (½⟨(h(x + r) − h(x))²⟩ over every pair of defined points, any direction, whose
     /// distance falls in the bin); refused for a profile.
-    #[arg(long, value_name = "OUT.csv")]
-    pub acf_2d: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub acf_2d: Vec<PathBuf>,
     /// Write the variable-bandwidth analysis as CSV with columns bandwidth (the section
     /// size ℓ) and rms_height: the rms height after a least-squares plane is removed in each
     /// rectangle of a checkerboard of 1, 2, 4, … rectangles a side (a profile: a line in
     /// each of 1, 2, 4, … sections), down to 4 grid points a section
     /// (SurfaceTopography's variable_bandwidth_from_area / _from_profile).
-    #[arg(long, value_name = "OUT.csv")]
-    pub variable_bandwidth: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub variable_bandwidth: Vec<PathBuf>,
     /// Write the scale-dependent rms slope along x as CSV with columns distance (r = kΔx,
     /// k ≥ 1) and slope (√(2A(r))/r from the --acf function: the rms of (h(x + r) − h(x))/r;
     /// SurfaceTopography's scale_dependent_slope_from_profile on the scan's grid).
-    #[arg(long, value_name = "OUT.csv")]
-    pub scale_dependent_slope: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub scale_dependent_slope: Vec<PathBuf>,
     /// Write the scale-dependent rms curvature along x as CSV with columns distance (the
     /// stencil's length r = 2sΔx, scale factors s log-spaced, 10 a decade) and curvature
     /// (the rms of (h[i+s] − 2h[i] + h[i−s])/(sΔx)² over the rows; SurfaceTopography's
     /// scale_dependent_statistical_property(n=2) of a profile at that distance).
-    #[arg(long, value_name = "OUT.csv")]
-    pub scale_dependent_curvature: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub scale_dependent_curvature: Vec<PathBuf>,
     /// Write the height distribution as CSV with columns height (bin centre) and density
     /// (count / (n · bin width): it integrates to 1), over ⌊√n⌋ equal bins (10 to 100) from
     /// the lowest to the highest defined height.
-    #[arg(long, value_name = "OUT.csv")]
-    pub height_distribution: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub height_distribution: Vec<PathBuf>,
     /// Write the distribution of the slopes along x, (h[i+1] − h[i])/Δx within each row, as
     /// CSV with columns slope and density (bins as --height-distribution).
-    #[arg(long, value_name = "OUT.csv")]
-    pub slope_distribution: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub slope_distribution: Vec<PathBuf>,
     /// Write the distribution of the curvatures along x, (h[i+1] − 2h[i] + h[i−1])/Δx²
     /// within each row, as CSV with columns curvature and density (bins as
     /// --height-distribution).
-    #[arg(long, value_name = "OUT.csv")]
-    pub curvature_distribution: Option<PathBuf>,
+    #[arg(long, value_name = "OUT.csv|FIG")]
+    pub curvature_distribution: Vec<PathBuf>,
     /// Also plot the PSD, .png or .svg by the extension: log–log C(q) vs q·L/2π, with the
     /// fitted power law over the fit range (its slope in the legend).
     #[arg(long, value_name = "FILE.png|FILE.svg")]
@@ -129,10 +136,7 @@ pub struct StatsArgs {
 /// The `--plot` chart ([`asperity_app::figure::psd::psd_chart`]): the PSD against q·L/2π,
 /// log–log, with the fitted power law drawn over the fit range.
 fn psd_chart(file: &Path, stats: &Statistics) -> Chart {
-    let name = file.file_name().map_or_else(
-        || file.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    );
+    let name = file_name(file);
     let q: Vec<f64> = stats.bins.iter().map(|b| b.q).collect();
     let psd: Vec<f64> = stats.bins.iter().map(|b| b.psd).collect();
     psd::psd_chart(PsdFigure {
@@ -243,16 +247,36 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
     let requested = analyses(args);
     let outputs = (args.psd.iter().chain(&args.plot)).chain(requested.iter().map(|(p, _)| *p));
+    let figures: Vec<bool> = requested.iter().map(|(p, _)| is_figure(p)).collect();
     let mut staged = StagedOutputs::new(outputs, args.force)?;
     staged.ensure_not_input(&args.file)?;
     let (source, record) = open_source(args, size)?;
-    let wanted: Vec<Analysis> = requested.iter().map(|(_, a)| *a).collect();
+    // Each analysis once, however many outputs it has.
+    let mut wanted: Vec<Analysis> = Vec::new();
+    for &(_, analysis) in &requested {
+        if !wanted.contains(&analysis) {
+            wanted.push(analysis);
+        }
+    }
     let tables = analyse(&source, &wanted).map_err(crate::request::refused)?;
     let stats = compute(&request, source, &args.file.display().to_string())
         .map_err(crate::request::refused)?;
     stage_outputs(args, &mut staged, &stats)?;
-    for ((path, analysis), rows) in requested.iter().zip(&tables) {
-        stage_pairs(&mut staged, path, analysis.columns(), rows)?;
+    let name = file_name(&args.file);
+    for ((path, analysis), figure) in requested.iter().zip(figures) {
+        let at = wanted.iter().position(|a| a == analysis);
+        let rows = &tables[at.expect("every analysis asked for is computed")];
+        if figure {
+            let figure = AnalysisFigure {
+                name: &name,
+                analysis: *analysis,
+                metres: record.is_some(),
+            };
+            stage_charts(&mut staged, path, &[analysis_chart(rows, figure)])
+                .with_context(|| format!("writing {}", path.display()))?;
+        } else {
+            stage_pairs(&mut staged, path, analysis.columns(), rows)?;
+        }
     }
     staged.commit()?;
     if args.json {
@@ -263,7 +287,22 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     }
 }
 
-/// The analyses asked for, each with its output, in the order of the options.
+/// Whether an analysis' output is its figure (`.png`, `.svg`, `.json`) rather than CSV.
+fn is_figure(path: &Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str());
+    ext.is_some_and(|e| ["png", "svg", "json"].contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// The file's name for the figures' titles (its path when it has none).
+fn file_name(file: &Path) -> String {
+    file.file_name().map_or_else(
+        || file.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    )
+}
+
+/// The analyses asked for, each with its outputs (an option given twice: both), in the
+/// order of the options.
 fn analyses(args: &StatsArgs) -> Vec<(&PathBuf, Analysis)> {
     let paths = [
         (&args.bearing_area, Analysis::BearingArea),
@@ -283,7 +322,7 @@ fn analyses(args: &StatsArgs) -> Vec<(&PathBuf, Analysis)> {
         ),
     ];
     (paths.into_iter())
-        .filter_map(|(path, analysis)| path.as_ref().map(|p| (p, analysis)))
+        .flat_map(|(paths, analysis)| paths.iter().map(move |p| (p, analysis)))
         .collect()
 }
 
