@@ -18,7 +18,8 @@ command line, so the same seed gives the same numbers bit for bit):
 * :func:`study_alpha`, :func:`study_curve` -- checkpointed ensemble studies of the exponent
   α of ``k ∝ F^α`` and of mean ``k(F)`` curves, in the CLI's folders (a study started here
   resumes from ``asperity study`` and the other way round); :func:`study_windows` refits a
-  BEM study's α with other windows.
+  BEM study's α with other windows; :func:`study_compare` writes ``asperity study
+  compare``'s comparison with the paper (``comparison.csv``, ``report.md``).
 
 Conventions (as the library's): lengths in the unit of the heights, E* = 1 by default,
 side L = 1 by default; arrays row-major ``(row, col) = (y, x)`` with square pixels
@@ -73,6 +74,7 @@ from ._api import (  # noqa: F401 (re-exported)
     Solver,
     stats,
     study_alpha,
+    study_compare,
     study_curve,
     study_file,
     study_windows,
@@ -127,6 +129,7 @@ __all__ = [
     "reproduce",
     "stats",
     "study_alpha",
+    "study_compare",
     "study_curve",
     "study_file",
     "study_windows",

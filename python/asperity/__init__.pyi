@@ -72,6 +72,7 @@ class Analysis:
     columns: List[str]
     x: F64
     y: F64
+    metres: bool = ...
     @property
     def table(self) -> Dict[str, F64]: ...
     def __getitem__(self, column: str) -> F64: ...
@@ -239,7 +240,8 @@ def contact(
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
-    hardness: Optional[float] = ..., tangential: bool = ...,
+    hardness: Optional[float] = ..., tangential: bool = ..., load_path: bool = ...,
+    progress: ProgressArg = ...,
 ) -> Sweep: ...
 
 @dataclass
@@ -367,4 +369,8 @@ def study_file(
     path: PathLike, out: PathLike, *, force: bool = ..., checkpoint_every: Optional[float] = ...,
     progress: ProgressArg = ...,
 ) -> StudyResult: ...
+def study_compare(
+    folder: PathLike, *, force: bool = ...,
+) -> Dict[str, npt.NDArray[Any]]: ...
+
 def study_windows(out: PathLike) -> Dict[str, npt.NDArray[Any]]: ...

@@ -460,12 +460,15 @@ class Analysis(_Saved):
     without its dashes and with underscores: ``acf_2d`` for ``--acf-2d``), ``columns`` (the
     names of the two columns of the CSV the CLI writes) and their values ``x`` and ``y``
     (float64, bit for bit the CLI's). ``a["distance"]`` is a column by name, ``a.table`` both
-    as a dict (``pandas.DataFrame(a.table)`` copies nothing)."""
+    as a dict (``pandas.DataFrame(a.table)`` copies nothing). ``metres``: lengths and
+    heights in metres (of a :class:`Topography`), else in the heights' own unit (the
+    axes of :func:`asperity.plot.analysis`)."""
 
     name: str
     columns: List[str]
     x: np.ndarray
     y: np.ndarray
+    metres: bool = False
 
     @property
     def table(self) -> Dict[str, np.ndarray]:
@@ -524,7 +527,7 @@ def analysis(values: Any, name: str, *,
     heights, size_x, size_y, measured, metadata = _stats_source(values, size)
     ((first, x), (second, y)), = _core.analyses(heights, size_x, size_y, measured, metadata,
                                                 [str(name)])
-    return Analysis(str(name), [first, second], x, y)
+    return Analysis(str(name), [first, second], x, y, isinstance(values, Topography))
 
 
 @dataclass
@@ -1231,6 +1234,8 @@ def contact(
     thermal_conductivity: Optional[Sequence[float]] = None,
     hardness: Optional[float] = None,
     tangential: bool = False,
+    load_path: bool = False,
+    progress: ProgressArg = None,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -1257,6 +1262,17 @@ def contact(
     ``poisson``: with ``young``, or beside ``modulus`` for Cerruti's kernel alone) also
     ``stiffness_x_n_per_m``, ``stiffness_y_n_per_m`` (the no-slip tangential stiffness of
     the frozen contact set) and ``tangential_ratio`` = (k_x + k_y)/(2k).
+    ``progress``: as for :meth:`Solver.sweep` (``asperity contact --progress``; none by
+    default, as ``--quiet``), counted in loads.
+
+    With ``load_path=True`` (``asperity contact --load-path``) the pressures are walked in
+    the given order as one load path -- loading, unloading, reloading -- each step warm
+    from the last and its plastic displacement kept (:meth:`Solver.load_path`, the
+    library's load path, in SI units); the columns are the CLI's: ``branch``, ``force_n``,
+    ``mean_pressure_pa``, ``indentation_m``, ``area_fraction``, ``plastic_fraction``,
+    ``stiffness_n_per_m`` (the frozen elastic set), ``iterations``, ``permanent_max_m``,
+    and ``permanent_displacement_m`` (rows × cols, after the last step). It does not go
+    with ``map``, ``tangential``, ``resistivity`` or ``thermal_conductivity``.
 
     Example::
 
@@ -1273,16 +1289,25 @@ def contact(
         >>> bool(capped.plastic_fraction[0] > 0)
         True
     """
+    if load_path:
+        return _contact_path(surface, size, pressures, modulus, young, poisson, boundary,
+                             tolerance, hardness, map=map, tangential=tangential,
+                             resistivity=resistivity,
+                             thermal_conductivity=thermal_conductivity)
     heights, size_x, size_y = _surface_input(surface, size)
     loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
-    columns = _core.contact(
-        heights, size_x, size_y, loads, _opt(modulus), _floats(young), _floats(poisson),
-        str(boundary), float(tolerance), bool(map),
-        None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
-        None if thermal_conductivity is None
-        else [float(v) for v in np.atleast_1d(thermal_conductivity)],
-        _opt(hardness), bool(tangential),
-    )
+    bar = _Progress(progress, "contact")
+    try:
+        columns = _core.contact(
+            heights, size_x, size_y, loads, _opt(modulus), _floats(young), _floats(poisson),
+            str(boundary), float(tolerance), bool(map),
+            None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
+            None if thermal_conductivity is None
+            else [float(v) for v in np.atleast_1d(thermal_conductivity)],
+            _opt(hardness), bool(tangential), bar.callback,
+        )
+    finally:
+        bar.close()
     if "map" in columns:
         dx = size_x / heights.shape[1]
         dy = dx if size_y is None else size_y / heights.shape[0]
@@ -1296,6 +1321,36 @@ def contact(
     return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
                            "shape": list(heights.shape), "sizes": [size_x, size_y],
                            "surface": _surface_identity(surface, heights)})
+
+
+#: ``Solver.load_path``'s columns under ``asperity contact --load-path``'s SI names.
+_PATH_SI = {"branch": "branch", "force": "force_n", "mean_pressure": "mean_pressure_pa",
+            "indentation": "indentation_m", "area_fraction": "area_fraction",
+            "plastic_fraction": "plastic_fraction", "stiffness": "stiffness_n_per_m",
+            "iterations": "iterations", "permanent_max": "permanent_max_m",
+            "permanent_displacement": "permanent_displacement_m"}
+
+
+def _contact_path(surface, size, pressures, modulus, young, poisson, boundary, tolerance,
+                  hardness, **others: Any) -> Sweep:
+    """``contact(load_path=True)``: the solver of ``asperity contact`` (E* from the same
+    rule, its boundary, tolerance and hardness) walked along the pressures."""
+    given = [name for name, value in others.items() if value not in (None, False)]
+    if given:
+        raise ValueError(f"load_path does not go with {given[0]} (a path reports the "
+                         "frozen-set stiffness of each step)")
+    e_star = effective_modulus(modulus=modulus, young=young, poisson=poisson)
+    solver = Solver(surface, size, modulus=e_star, boundary=boundary, tolerance=tolerance,
+                    hardness=hardness)
+    loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
+    path = solver.load_path(pressures=loads)
+    columns = {si: path.columns[name] for name, si in _PATH_SI.items()}
+    request = {"pressures": loads, "modulus": _opt(modulus), "young": _one_or_both(young),
+               "poisson": _one_or_both(poisson), "boundary": str(boundary),
+               "tolerance": float(tolerance), "hardness": _opt(hardness), "load_path": True}
+    return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
+                           "shape": list(solver.shape), "sizes": [solver.size, solver._size_y],
+                           "surface": solver._surface})
 
 
 @dataclass
@@ -1946,6 +2001,48 @@ def _study_metadata(kind: str, out: Union[str, os.PathLike]) -> Dict[str, Any]:
         spec = None
     return {"generator": f"asperity {__version__}", "study": kind, "folder": folder,
             "spec": spec}
+
+
+def study_compare(folder: Union[str, "os.PathLike[str]"], *, force: bool = False
+                  ) -> Dict[str, np.ndarray]:
+    """``asperity study compare FOLDER``: the finished study in ``folder`` (of
+    :func:`study_alpha`, :func:`study_curve`, :func:`study_file` or the CLI) beside the
+    paper, by the command's own code: writes ``comparison.csv`` and ``report.md`` (the
+    verdicts, the trend with N, the window sensitivity of a BEM study) into the folder
+    (an existing one is refused unless ``force``) and returns the comparison as
+    :meth:`StudyResult.comparison` does: the columns of ``comparison.csv`` (``method``,
+    ``n``, ``hurst``, ``quantity``, ``ours``, ``low``, ``high``, ``reference``, ``source``,
+    ``tolerance``) and each row's ``verdict`` (``agrees``, ``close`` or ``differs``, as
+    ``report.md`` prints it).
+
+    A missing folder, or one without ``study.json``: ``FileNotFoundError``; an unfinished
+    study, a roll-off study whose sweeps ended, an existing output without ``force``:
+    ``ValueError`` in the command's words.
+
+    Example::
+
+        >>> _ = asperity.study_alpha(method="mdr", n=256, hurst=[0.5], samples=8, out="s")
+        >>> c = asperity.study_compare("s")                   # writes s/comparison.csv, s/report.md
+        >>> c["quantity"][0], c["verdict"][0] in ("agrees", "close", "differs")
+        ('alpha', True)
+    """
+    import csv
+    import errno
+
+    folder = os.fspath(folder)
+    for path, what in ((folder, "no such study folder"),
+                       (os.path.join(folder, "study.json"), "not a study folder (no study.json)")):
+        if not os.path.exists(path):
+            raise FileNotFoundError(errno.ENOENT, f"{folder}: {what}", path)
+    verdicts = _core.compare_study(folder, bool(force))
+    with open(os.path.join(folder, "comparison.csv"), newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    columns = {}
+    for name, kind in _core.comparison_columns():
+        values = [r[name] if kind == "text" else float(r[name]) for r in rows]
+        columns[name] = np.array(values, dtype=object if kind == "text" else np.float64)
+    columns["verdict"] = np.array(verdicts, dtype=object)
+    return columns
 
 
 # --------------------------------------------------------------------------------------

@@ -216,6 +216,10 @@ def psd_figure(
     range: Optional[Tuple[float, float]], fit: Optional[Tuple[float, float]],
     hurst: Optional[float], name: str,
 ) -> str: ...
+def compare_study(dir: str, force: bool) -> List[str]: ...
+def analysis_figure(
+    analysis: str, x: List[float], y: List[float], metres: bool, name: str,
+) -> str: ...
 def contact_figure(
     force: List[float], stiffness: List[float], area: List[float], mean_gap: List[float],
     modulus: float, name: str,

@@ -11,6 +11,10 @@ returns the ``Axes``:
 * :func:`stiffness`, :func:`area` -- k(F) and the contact area against force, k with the
   95 % interval of an ensemble mean as a band (``asperity study curve``, ``bem --plot``,
   ``contact --plot``);
+* :func:`analysis` -- a surface analysis of :func:`asperity.analysis` (the ACFs, the
+  scale-dependent slope and curvature and the variable-bandwidth rms height log–log
+  against the length scale; the bearing-area curve and the distributions) as ``asperity
+  stats --acf acf.png`` (and the other analysis options) draws it;
 * :func:`contact_map` -- a contact set with its 4-connected patches coloured
   (``asperity contact --map``);
 * :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``);
@@ -41,8 +45,8 @@ from typing import Any, Optional
 
 import numpy as _np
 
-__all__ = ["surface", "psd", "stiffness", "area", "contact_map", "alpha", "figure", "load_path",
-           "field"]
+__all__ = ["surface", "psd", "analysis", "stiffness", "area", "contact_map", "alpha", "figure",
+           "load_path", "field"]
 
 
 def __dir__() -> list:
@@ -125,6 +129,39 @@ def psd(spectrum: Any, ax=None, *, name: Optional[str] = None):
     if name is None:
         name = "line" if spectrum.ndim == 1 else "surface"
     return _draw(_psd_charts(spectrum, name)[0], ax)
+
+
+def _analysis_charts(result: Any, name: str) -> list:
+    """``asperity stats --acf FILE.png``'s chart (and the other analysis options') of an
+    :class:`~asperity.Analysis`."""
+    from . import Analysis, _asperity
+
+    if not isinstance(result, Analysis):
+        raise ValueError(f"analysis: expected an asperity.Analysis (asperity.analysis(...)), "
+                         f"got {type(result).__name__}")
+    return _record(_asperity.analysis_figure(result.name, result.x.tolist(), result.y.tolist(),
+                                             bool(result.metres), name))
+
+
+def analysis(result: Any, ax=None, *, name: str = "surface"):
+    """An :class:`~asperity.Analysis` (of :func:`asperity.analysis`) as ``asperity stats
+    --acf acf.png`` (and each other analysis option with a ``.png``/``.svg`` name) draws it
+    (one definition, ``asperity_app::figure::analysis``): the ACF (1D and radially averaged
+    2D), the scale-dependent rms slope and curvature and the variable-bandwidth rms height
+    on log–log axes against the length scale (the points a log axis can show), the
+    bearing-area (Abbott–Firestone) curve and the height, slope and curvature distributions
+    on linear axes; lengths in metres for a :class:`~asperity.Topography`, else in the
+    heights' unit (``length``). ``name``: the title's name.
+
+    Example::
+
+        >>> import asperity, asperity.plot
+        >>> s = asperity.surface(64, hurst=0.8, seed=1)
+        >>> ax = asperity.plot.analysis(asperity.analysis(s, "scale_dependent_slope"))
+        >>> ax.get_xscale(), ax.get_xlabel()
+        ('log', 'distance r  [length]')
+    """
+    return _draw(_analysis_charts(result, name)[0], ax)
 
 
 def _color(color: Any, index: int):

@@ -67,7 +67,7 @@ fn label_patches<'py>(
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -85,6 +85,7 @@ fn contact<'py>(
     thermal_conductivity: Option<Vec<f64>>,
     hardness: Option<f64>,
     tangential: bool,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (young, young_2) =
         app::one_or_two(app::params::YOUNG, young.as_deref().unwrap_or(&[])).map_err(refused)?;
@@ -130,8 +131,17 @@ fn contact<'py>(
     .map_err(from_solve)?;
     drop(surface);
     let stop = solver.stop().clone();
-    let run = run_detached_with(py, &stop, |_| {
-        app::run(&mut solver, &plan, pixel_area, map, &mut || {})
+    let total = plan.loads.len();
+    // `progress(done, total)` before the first load and after each (`asperity contact
+    // --progress`); an exception it raises stops the sweep.
+    let run = run_detached_with(py, &stop, |cancel| {
+        cancel.call(progress.as_ref(), 0, total);
+        let mut done = 0;
+        let mut on_load = || {
+            done += 1;
+            cancel.call(progress.as_ref(), done, total);
+        };
+        app::run(&mut solver, &plan, pixel_area, map, &mut on_load)
     })?
     .map_err(|e: SweepError<_>| match e.explain("fd_stiffness") {
         SweepFailure::Input(source) => from_solve(source),

@@ -2,11 +2,13 @@
 //! draws with `--plot`, as JSON, which the package draws with matplotlib.
 
 use asperity_app::bem::branches;
+use asperity_app::figure::analysis::{analysis_chart, AnalysisFigure};
 use asperity_app::figure::contact::{contact_charts, ContactColumns};
 use asperity_app::figure::map::{contact_map_chart, surface_chart, MapFigure};
 use asperity_app::figure::path::{PathColumns, PathFigure};
 use asperity_app::figure::psd::{psd_chart, PsdFigure};
 use asperity_app::figure::{self, sweep::SweepColumns, sweep::SweepFigure};
+use asperity_app::stats::analysis::Analysis;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
@@ -17,6 +19,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact_map_figure, m)?)?;
     m.add_function(wrap_pyfunction!(psd_figure, m)?)?;
     m.add_function(wrap_pyfunction!(contact_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis_figure, m)?)?;
     Ok(())
 }
 
@@ -85,6 +88,32 @@ fn psd_figure(
         hurst,
     };
     Ok(figure::to_json(&[psd_chart(figure)]).to_string())
+}
+
+/// An analysis' figure as `asperity stats --acf FILE.json` (and the other analysis
+/// options) writes it: the analysis' name (`acf`, ...), its two columns, lengths in metres
+/// or the heights' own unit.
+#[pyfunction]
+fn analysis_figure(
+    analysis: &str,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    metres: bool,
+    name: &str,
+) -> PyResult<String> {
+    let analysis = Analysis::parse(analysis).map_err(crate::errors::refused)?;
+    if x.len() != y.len() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "analysis_figure: the columns differ in length",
+        ));
+    }
+    let rows: Vec<(f64, f64)> = x.into_iter().zip(y).collect();
+    let figure = AnalysisFigure {
+        name,
+        analysis,
+        metres,
+    };
+    Ok(figure::to_json(&[analysis_chart(&rows, figure)]).to_string())
 }
 
 /// The two panels of a load sweep (k(F), A/A₀(F)) as `asperity bem --plot FILE.json`

@@ -33,6 +33,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(hurst_range, m)?)?;
     m.add_function(wrap_pyfunction!(comparison_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(compare_study, m)?)?;
     m.add_function(wrap_pyfunction!(thread_count, m)?)?;
     m.add_class::<StudyCoordinator>()?;
     m.add_class::<SampleComputer>()?;
@@ -75,6 +76,20 @@ impl StudyEta {
 #[pyfunction]
 fn hurst_range(text: &str) -> PyResult<Vec<f64>> {
     parse_range(text).map_err(from_error)
+}
+
+/// `asperity study compare DIR` by the command's own code: writes `comparison.csv` and
+/// `report.md` into the finished study's folder and returns each row's verdict; its error
+/// (an unfinished study, a roll-off study whose sweeps ended, an existing output without
+/// `force`) is a `ValueError` in the command's words.
+#[pyfunction]
+fn compare_study(
+    py: Python<'_>,
+    dir: std::path::PathBuf,
+    force: bool,
+) -> PyResult<Vec<&'static str>> {
+    py.detach(|| asperity_cli::compare_study(&dir, force))
+        .map_err(pyo3::exceptions::PyValueError::new_err)
 }
 
 /// The columns of `comparison.csv`, `(name, type)` with type `text`, `count` or `number`

@@ -88,6 +88,63 @@ def test_a_capped_solver_in_pa_equals_contact_hardness(cli, tmp_path):
     assert ours.plastic_fraction[-1] > 0
 
 
+def test_contact_load_path_equals_the_clis_contact_load_path(cli, tmp_path):
+    """`asperity.contact(..., load_path=True)` is `asperity contact --load-path`: every
+    column of its table bit for bit (branch names included), SI units; what a path cannot
+    carry is refused alike."""
+    s = asperity.surface(48, hurst=0.8, rolloff=2, rms_slope=1, seed=4, size=1e-4)
+    np.save(tmp_path / "h.npy", s.heights * 1e-6)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none", "--out",
+        tmp_path / "t.npy")
+    t = asperity.read_topography(tmp_path / "t.npy", detrend="none")
+    loads = [1e4, 1e5, 3e4, 2e5]
+    cli("contact", tmp_path / "t.npy", "--young", 210e9, "--poisson", 0.3, "--pressures",
+        ",".join(map(str, loads)), "--hardness", 4e5, "--load-path", "--detrend", "none",
+        "--out", tmp_path / "p.csv")
+    import csv
+
+    with open(tmp_path / "p.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ours = asperity.contact(t, young=210e9, poisson=0.3, pressures=loads, hardness=4e5,
+                            load_path=True)
+    assert list(rows[0]) == [n for n in ours.columns if n != "permanent_displacement_m"]
+    assert list(ours.branch) == [r["branch"] for r in rows]
+    assert list(ours.branch) == ["loading", "loading", "unloading", "loading"]
+    for name in list(rows[0])[1:]:
+        assert ours[name].tolist() == [float(r[name]) for r in rows], name
+    assert ours.permanent_displacement_m.shape == t.heights.shape
+    assert ours.permanent_max_m[-1] > 0
+    refused = cli("contact", tmp_path / "t.npy", "--young", 210e9, "--poisson", 0.3,
+                  "--pressures", "1e4", "--load-path", "--tangential", "--detrend", "none",
+                  ok=False).stderr
+    with pytest.raises(ValueError, match="load_path does not go with tangential") as err:
+        asperity.contact(t, young=210e9, poisson=0.3, pressures=[1e4], load_path=True,
+                         tangential=True)
+    assert str(err.value).split(" (")[1] in refused
+
+
+def test_contact_reports_its_progress_per_load_and_stops_on_an_exception():
+    """`contact(progress=)` (`asperity contact --progress`): called before the first load
+    and after each, with the same numbers as without it; an exception it raises stops the
+    sweep and comes back."""
+    s = asperity.surface(32, hurst=0.8, rolloff=2, rms_slope=1, seed=4, size=1e-4)
+    heights, loads = s.heights * 1e-6, [1e4, 3e4, 1e5]
+    calls = []
+    ours = asperity.contact(heights, 1e-4, young=210e9, poisson=0.3, pressures=loads,
+                            progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(0, 3), (1, 3), (2, 3), (3, 3)]
+    quiet = asperity.contact(heights, 1e-4, young=210e9, poisson=0.3, pressures=loads)
+    assert ours.force_n.tolist() == quiet.force_n.tolist()
+
+    def stop(done, total):
+        if done == 1:
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        asperity.contact(heights, 1e-4, young=210e9, poisson=0.3, pressures=loads,
+                         progress=stop)
+
+
 @pytest.mark.parametrize("solver_name", ["bccg", "pk"])
 @pytest.mark.parametrize("boundary", ["free", "periodic"])
 def test_a_cap_above_the_elastic_peak_is_the_elastic_result_bit_for_bit(rough, boundary,

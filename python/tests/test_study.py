@@ -125,6 +125,43 @@ def test_the_comparison_with_the_paper_equals_study_compare(cli, tmp_path):
     assert report.count("| differs |") == list(ours["verdict"]).count("differs")
 
 
+def test_study_compare_writes_the_clis_comparison_and_report(cli, tmp_path):
+    """`asperity.study_compare(folder)` is `asperity study compare folder`: the same
+    comparison.csv byte for byte and the same report.md (but for the folder's name), its
+    verdicts those of report.md; an existing output needs `force` (the CLI's words); a
+    missing folder, or one that holds no study, is a FileNotFoundError."""
+    import shutil
+
+    cli("study", "alpha", *MDR_FLAGS, "--out", tmp_path / "a", "--quiet")
+    shutil.copytree(tmp_path / "a", tmp_path / "b")
+    cli("study", "compare", tmp_path / "a")
+    ours = asperity.study_compare(tmp_path / "b")
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert (a / "comparison.csv").read_bytes() == (b / "comparison.csv").read_bytes()
+    report = (b / "report.md").read_text()
+    assert (a / "report.md").read_text().replace(str(a), str(b)) == report
+    with open(b / "comparison.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(ours["verdict"]) == len(rows) == 6
+    for name in ("ours", "low", "high", "reference"):
+        assert ours[name].tolist() == [float(r[name]) for r in rows], name
+    assert list(ours["method"]) == [r["method"] for r in rows]
+    assert report.count("| agrees |") == list(ours["verdict"]).count("agrees")
+    assert report.count("| differs |") == list(ours["verdict"]).count("differs")
+    assert list(ours["verdict"]) == list(
+        asperity.study_alpha(**MDR, out=tmp_path / "c").comparison()["verdict"])
+    again = cli("study", "compare", a, ok=False).stderr
+    with pytest.raises(ValueError) as err:
+        asperity.study_compare(b)
+    assert str(err.value).replace(str(b), str(a)) in again
+    asperity.study_compare(b, force=True)
+    for missing in (tmp_path / "none", tmp_path / "empty"):
+        (tmp_path / "empty").mkdir(exist_ok=True)
+        with pytest.raises(FileNotFoundError) as err:
+            asperity.study_compare(missing)
+        assert isinstance(err.value, OSError) and str(missing) in str(err.value)
+
+
 def test_a_rolloff_study_is_compared_by_its_steepest_slope_as_study_compare(cli, tmp_path):
     """A roll-off study's comparison (Fig. 2: the steepest slope of the mean curve against
     the paper's "≈ 1", bootstrap interval over the stored BEM sample curves) is
