@@ -222,8 +222,8 @@ impl<K: ContactOperator> ContactSolver<K> {
         .map_err(SolveError::from)
     }
 
-    /// Whether the frozen-set CG of grids of at least [`SINGLE_STIFFNESS_MIN_POINTS`] points
-    /// makes its first pass in single precision (the default: yes); off, it runs all in
+    /// Whether the frozen-set CG of grids of at least 2¹⁸ points (512² and up) makes its
+    /// first pass in single precision (the default: yes); off, it runs all in
     /// double precision, bit for bit the CG of before (for comparisons: `asperity bench
     /// bem-solve` times both).
     pub fn set_single_precision_stiffness(&mut self, on: bool) {
