@@ -204,6 +204,7 @@ class Solver:
         resistivity: Optional[Sequence[float]] = ...,
         thermal_conductivity: Optional[Sequence[float]] = ...,
         persson: bool = ..., gamma: Optional[float] = ..., kappa: Optional[float] = ...,
+        tangential: Optional[str] = ...,
     ) -> Sweep: ...
     def load_path(
         self, *, pressures: Optional[Sequence[float]] = ..., forces: Optional[Sequence[float]] = ...,
@@ -240,7 +241,7 @@ def contact(
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
     resistivity: Optional[Sequence[float]] = ...,
     thermal_conductivity: Optional[Sequence[float]] = ...,
-    hardness: Optional[float] = ..., tangential: bool = ..., load_path: bool = ...,
+    hardness: Optional[float] = ..., tangential: Union[bool, str] = ..., load_path: bool = ...,
     progress: ProgressArg = ...,
 ) -> Sweep: ...
 
@@ -363,7 +364,7 @@ def study_curve(
     min_contacts: Optional[int] = ..., max_fraction: Optional[float] = ..., levels: Optional[int] = ...,
     force: bool = ..., checkpoint_every: Optional[float] = ..., progress: ProgressArg = ...,
     poisson: Optional[float] = ..., resistivity: Optional[Sequence[float]] = ...,
-    thermal_conductivity: Optional[Sequence[float]] = ...,
+    thermal_conductivity: Optional[Sequence[float]] = ..., tangential: Optional[str] = ...,
 ) -> StudyResult: ...
 def study_file(
     path: PathLike, out: PathLike, *, force: bool = ..., checkpoint_every: Optional[float] = ...,

@@ -369,6 +369,19 @@ def _opt(value: Optional[float]) -> Optional[float]:
     return None if value is None else float(value)
 
 
+def _text(value: Any) -> Optional[str]:
+    return None if value is None else str(value)
+
+
+def _tangential(tangential: Union[bool, str]) -> Tuple[bool, Optional[str]]:
+    """:func:`contact`'s ``tangential``: False (none), True (both directions) or the
+    directions ``"x"``, ``"y"``, ``"both"`` (checked by the front-end layer), as the CLI's
+    ``--tangential[=DIR]``."""
+    if isinstance(tangential, str):
+        return True, tangential
+    return bool(tangential), None
+
+
 def _stats_source(values: Any, size: Union[None, float, Tuple[float, float]]
                   ) -> Tuple[np.ndarray, float, Optional[float], bool, Optional[str]]:
     """What :func:`stats` and :func:`psd` hand to the front-end layer: heights, size along x,
@@ -1029,6 +1042,7 @@ class Solver:
         persson: bool = False,
         gamma: Optional[float] = None,
         kappa: Optional[float] = None,
+        tangential: Optional[str] = None,
     ) -> Sweep:
         """A load sweep exactly as ``asperity bem`` runs it (same numbers bit for bit):
         ``pressures``, ``forces`` or ``indentations`` in the given order, or ``nloads``
@@ -1044,6 +1058,10 @@ class Solver:
         (no-slip) stiffnesses ``stiffness_x``, ``stiffness_y`` of the frozen contact set
         (Cerruti's kernel; E* stays the solver's modulus) and ``tangential_ratio`` =
         (k_x + k_y)/(2k), Mindlin's 2(1−ν)/(2−ν) for one circular contact.
+        ``tangential`` (``"x"``, ``"y"`` or ``"both"``, the default; ``asperity bem
+        --tangential``): one direction alone, at about half the cost: only its column,
+        and ``tangential_ratio`` = k_x/k (or k_y/k); ``"x"`` gives the ``"both"`` run's
+        ``stiffness_x`` bit for bit.
         ``resistivity`` (ρ₁, ρ₂) and ``thermal_conductivity`` (κ₁, κ₂), one value per
         body: also ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and ``thermal_conductance``
         = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy). docs/tangential.md.
@@ -1080,10 +1098,12 @@ class Solver:
         try:
             columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields),
                                        bar.callback, _opt(poisson), _floats(resistivity),
-                                       _floats(thermal_conductivity), theory)
+                                       _floats(thermal_conductivity), theory,
+                                       _text(tangential))
         finally:
             bar.close()
-        derived = {"poisson": _opt(poisson), "resistivity": _floats(resistivity),
+        derived = {"poisson": _opt(poisson), "tangential": _text(tangential),
+                   "resistivity": _floats(resistivity),
                    "thermal_conductivity": _floats(thermal_conductivity)}
         if theory is not None:
             derived["persson"] = {"gamma": theory[0], "kappa": theory[1]}
@@ -1233,7 +1253,7 @@ def contact(
     resistivity: Optional[Sequence[float]] = None,
     thermal_conductivity: Optional[Sequence[float]] = None,
     hardness: Optional[float] = None,
-    tangential: bool = False,
+    tangential: Union[bool, str] = False,
     load_path: bool = False,
     progress: ProgressArg = None,
 ) -> Sweep:
@@ -1261,7 +1281,9 @@ def contact(
     or a pressure at or above it, raises ValueError. With ``tangential=True`` (needs
     ``poisson``: with ``young``, or beside ``modulus`` for Cerruti's kernel alone) also
     ``stiffness_x_n_per_m``, ``stiffness_y_n_per_m`` (the no-slip tangential stiffness of
-    the frozen contact set) and ``tangential_ratio`` = (k_x + k_y)/(2k).
+    the frozen contact set) and ``tangential_ratio`` = (k_x + k_y)/(2k);
+    ``tangential="x"`` (or ``"y"``; ``asperity contact --tangential=x``) one direction
+    alone, at about half the cost: its column, and ``tangential_ratio`` = k_x/k (k_y/k).
     ``progress``: as for :meth:`Solver.sweep` (``asperity contact --progress``; none by
     default, as ``--quiet``), counted in loads.
 
@@ -1304,7 +1326,7 @@ def contact(
             None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
             None if thermal_conductivity is None
             else [float(v) for v in np.atleast_1d(thermal_conductivity)],
-            _opt(hardness), bool(tangential), bar.callback,
+            _opt(hardness), *_tangential(tangential), bar.callback,
         )
     finally:
         bar.close()
@@ -1317,7 +1339,9 @@ def contact(
                "poisson": _one_or_both(poisson), "boundary": str(boundary),
                "tolerance": float(tolerance), "resistivity": _floats(resistivity),
                "thermal_conductivity": _floats(thermal_conductivity),
-               "hardness": _opt(hardness), "tangential": bool(tangential)}
+               "hardness": _opt(hardness), "tangential": _tangential(tangential)[0]}
+    if isinstance(tangential, str):
+        request["directions"] = tangential
     return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
                            "shape": list(heights.shape), "sizes": [size_x, size_y],
                            "surface": _surface_identity(surface, heights)})
@@ -1832,7 +1856,7 @@ def _hursts(hurst: Union[str, float, Sequence[float]]) -> List[float]:
 
 def _run_study(kind, method, sizes, hurst, samples, out, rolloff, seed, min_contacts,
                max_fraction, levels, full_sweep, force, checkpoint_every, progress,
-               description, derived=(None, None, None)):
+               description, derived=(None, None, None, None)):
     # The study's keywords, read by the front-end layer (asperity_app::study::request):
     # integers as given (a negative count is refused there, in the CLI's words).
     count = lambda v: None if v is None else int(v)
@@ -1841,10 +1865,10 @@ def _run_study(kind, method, sizes, hurst, samples, out, rolloff, seed, min_cont
         samples=int(samples), rolloff=_opt(rolloff),
         seed=None if seed is None else _seed(seed), min_contacts=count(min_contacts),
         max_fraction=_opt(max_fraction), levels=count(levels), full_sweep=bool(full_sweep),
-        poisson=_opt(derived[0]),
+        poisson=_opt(derived[0]), tangential=_text(derived[3]),
     )
     args = (request, os.fspath(out), bool(force), _opt(checkpoint_every))
-    _, resistivity, thermal = derived
+    _, resistivity, thermal, _ = derived
     pair = lambda v: None if v is None else [float(x) for x in np.atleast_1d(v)]
     derived = dict(resistivity=pair(resistivity), thermal_conductivity=pair(thermal))
     # Under `mpirun -n K python ...` with mpi4py: one study over the K ranks (docs/mpi.md).
@@ -1957,6 +1981,7 @@ def study_curve(
     poisson: Optional[float] = None,
     resistivity: Optional[Sequence[float]] = None,
     thermal_conductivity: Optional[Sequence[float]] = None,
+    tangential: Optional[str] = None,
 ) -> StudyResult:
     """Ensemble-mean ``k(F)`` curves at one grid size ``n`` over ``hurst``, as
     ``asperity study curve`` (same folder, checkpoints and numbers; see
@@ -1966,7 +1991,9 @@ def study_curve(
     (95 % interval of the mean), per (method, n, hurst).
 
     BEM only: ``poisson`` (ν) adds the tangential (no-slip) stiffness at every load,
-    ``tangential_ratio`` = (k_x + k_y)/(2k) with ``tangential_ratio_low``/``_high``;
+    ``tangential_ratio`` = (k_x + k_y)/(2k) with ``tangential_ratio_low``/``_high``
+    (``tangential="x"`` or ``"y"``, the CLI's ``--tangential``: k_x/k or k_y/k alone, at
+    about half the cost);
     ``resistivity=[ρ₁, ρ₂]`` adds ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and
     ``thermal_conductivity=[κ₁, κ₂]`` ``thermal_conductance``, each with its interval
     (Barber's analogy, E* = 1), as the CLI's ``--poisson``, ``--resistivity`` and
@@ -1984,7 +2011,7 @@ def study_curve(
     records = _run_study("curve", method, [n], hurst, samples, out, rolloff, seed,
                          min_contacts, max_fraction, levels, False, force, checkpoint_every,
                          progress, f"{method} study", (poisson, resistivity,
-                                                       thermal_conductivity))
+                                                       thermal_conductivity, tangential))
     columns, rows = _table(records["curve"])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
                        records["comparison_error"], _study_metadata("curve", out),
@@ -2064,7 +2091,7 @@ def study_file(path: Union[str, "os.PathLike[str]"], out: Union[str, "os.PathLik
                          k["rolloff"], k["seed"], k["min_contacts"], k["max_fraction"],
                          k["levels"], k["full_sweep"], force, checkpoint_every, progress,
                          f"{k['method']} study", (k["poisson"], k["resistivity"],
-                                                  k["thermal_conductivity"]))
+                                                  k["thermal_conductivity"], k["tangential"]))
     columns, rows = _table(records[kind])
     return StudyResult(columns, rows, records["tasks"], records["comparisons"],
                        records["comparison_error"], _study_metadata(kind, out),

@@ -58,6 +58,7 @@ def contact(
     poisson: Optional[List[float]], boundary: str, tolerance: float, map: bool,
     resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
     hardness: Optional[float] = ..., tangential: bool = ...,
+    directions: Optional[str] = ...,
 ) -> Dict[str, Any]: ...
 
 class Solver:
@@ -88,6 +89,7 @@ class Solver:
         resistivity: Optional[List[float]] = ...,
         thermal_conductivity: Optional[List[float]] = ...,
         persson: Optional[Tuple[float, float]] = ...,
+        tangential: Optional[str] = ...,
     ) -> Dict[str, Any]: ...
 
 def mdr_curve(
@@ -112,7 +114,7 @@ def persson_table(
 def read_study_file(path: str) -> Dict[str, Any]: ...
 def study_windows(dir: str) -> Dict[str, npt.NDArray[Any]]: ...
 # A study's keywords: kind ("alpha"|"curve"), method, sizes, hursts, samples, rolloff,
-# seed (its digits), min_contacts, max_fraction, levels, full_sweep, poisson.
+# seed (its digits), min_contacts, max_fraction, levels, full_sweep, poisson, tangential.
 StudyKeywords = Dict[str, Any]
 def run_study(
     request: StudyKeywords, out: str, force: bool, checkpoint_every: Optional[float],

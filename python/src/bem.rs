@@ -388,7 +388,7 @@ impl Solver {
     /// `thermal_conductivity`, two bodies each) by the front-end layer's one definition;
     /// `persson` = `(gamma, kappa)`: the BEM's mean gap and Persson's columns
     /// (`asperity bem --persson`).
-    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None, persson=None))]
+    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None, persson=None, tangential=None))]
     #[allow(clippy::too_many_arguments)]
     fn sweep<'py>(
         &mut self,
@@ -403,6 +403,7 @@ impl Solver {
         resistivity: Option<Vec<f64>>,
         thermal_conductivity: Option<Vec<f64>>,
         persson: Option<(f64, f64)>,
+        tangential: Option<String>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let loads = values
             .iter()
@@ -411,8 +412,13 @@ impl Solver {
         if let Some(step) = fd_step {
             check_fd_step(step).map_err(refused)?;
         }
-        let derived =
-            Derived::validate(poisson, &resistivity, &thermal_conductivity).map_err(refused)?;
+        let derived = Derived::validate(
+            poisson,
+            tangential.as_deref(),
+            &resistivity,
+            &thermal_conductivity,
+        )
+        .map_err(refused)?;
         self.check_capped(&loads)?;
         let theory = persson
             .map(|(gamma, kappa)| SweepTheory::new(&self.solver, SweepPersson { gamma, kappa }))
@@ -423,6 +429,7 @@ impl Solver {
             stiffness,
             fd_step,
             tangential: derived.tangential,
+            directions: derived.directions,
         };
         let rows = run_detached_with(py, &stop, |cancel| {
             let mut observer = PyObserver {

@@ -67,7 +67,7 @@ fn label_patches<'py>(
 /// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
 /// the last load with `map`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, progress=None))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, directions=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -85,6 +85,7 @@ fn contact<'py>(
     thermal_conductivity: Option<Vec<f64>>,
     hardness: Option<f64>,
     tangential: bool,
+    directions: Option<String>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (young, young_2) =
@@ -105,6 +106,7 @@ fn contact<'py>(
         thermal_conductivity,
         hardness,
         tangential,
+        directions,
         ..ContactRequest::default()
     };
     let plan = request.validate().map_err(refused)?;

@@ -123,6 +123,8 @@ struct StudyKeywords {
     levels: Option<i128>,
     full_sweep: bool,
     poisson: Option<f64>,
+    /// `x`, `y` or `both` (none: both), with `poisson`.
+    tangential: Option<String>,
 }
 
 impl From<StudyKeywords> for StudyRequest {
@@ -143,6 +145,7 @@ impl From<StudyKeywords> for StudyRequest {
             levels: k.levels,
             full_sweep: k.full_sweep,
             poisson: k.poisson,
+            tangential: k.tangential,
         }
     }
 }
@@ -165,7 +168,7 @@ fn run_study(
     eta: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let request = StudyRequest::from(request);
-    let derived = derived(request.poisson, &resistivity, &thermal_conductivity)?;
+    let derived = derived(&request, &resistivity, &thermal_conductivity)?;
     let spec = request.spec().map_err(refused)?;
     let interval = checkpoint_interval(checkpoint_every)?;
     let spec = resumable(py, spec, &out, force)?;
@@ -192,19 +195,21 @@ fn run_study(
 
 /// The tangential and conductance columns and figures of a curve study
 /// ([`asperity_app::derived::Derived`]: the CLI's `--poisson`, `--resistivity`,
-/// `--thermal-conductivity`, refused in the same words).
+/// `--thermal-conductivity`, refused in the same words; the request's `poisson` and
+/// `tangential`).
 fn derived(
-    poisson: Option<f64>,
+    request: &StudyRequest,
     resistivity: &Option<Vec<f64>>,
     thermal_conductivity: &Option<Vec<f64>>,
 ) -> PyResult<StudyDerived> {
-    let derived =
-        asperity_app::derived::Derived::validate(poisson, resistivity, thermal_conductivity)
-            .map_err(crate::errors::refused)?;
-    Ok(StudyDerived {
-        poisson: derived.tangential,
-        transport: derived.transport,
-    })
+    let derived = asperity_app::derived::Derived::validate(
+        request.poisson,
+        request.tangential.as_deref(),
+        resistivity,
+        thermal_conductivity,
+    )
+    .map_err(crate::errors::refused)?;
+    Ok(derived.into())
 }
 
 /// The checkpoint interval: `checkpoint_every` seconds by the front-end layer's rule, or
@@ -355,7 +360,7 @@ impl StudyCoordinator {
         thermal_conductivity: Option<Vec<f64>>,
     ) -> PyResult<Vec<PyAction>> {
         let request = StudyRequest::from(request);
-        let derived = derived(request.poisson, &resistivity, &thermal_conductivity)?;
+        let derived = derived(&request, &resistivity, &thermal_conductivity)?;
         let spec = request.spec().map_err(refused)?;
         let interval = checkpoint_interval(checkpoint_every)?;
         let spec = resumable(py, spec, &out, force)?;

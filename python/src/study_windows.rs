@@ -84,6 +84,7 @@ pub fn read_study_file(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDi
     dict.set_item("levels", r.levels)?;
     dict.set_item("full_sweep", r.full_sweep)?;
     dict.set_item("poisson", r.poisson)?;
+    dict.set_item("tangential", r.tangential)?;
     dict.set_item("resistivity", read.resistivity)?;
     dict.set_item("thermal_conductivity", read.thermal_conductivity)?;
     Ok(dict)

@@ -127,6 +127,10 @@ BEM = [
     (["--pressures", "0.01", "--poisson", "0.7"], {}, dict(pressures=[0.01], poisson=0.7),
      "poisson must be in [0, 0.5] (Poisson's ratio), got 0.7"),
     (["--pressures", "0.01", "--poisson=-0.1"], {}, dict(pressures=[0.01], poisson=-0.1), "got -0.1"),
+    (["--pressures", "0.01", "--poisson", "0.3", "--tangential", "z"], {},
+     dict(pressures=[0.01], poisson=0.3, tangential="z"), 'tangential must be x, y or both, got "z"'),
+    (["--pressures", "0.01", "--tangential", "x"], {}, dict(pressures=[0.01], tangential="x"),
+     "tangential needs poisson ν (of Cerruti's kernel)"),
     (["--pressures", "0.01", "--resistivity", "1"], {}, dict(pressures=[0.01], resistivity=[1]),
      "invalid resistivity: give two values, body 1 and body 2, got 1"),
     (["--pressures", "0.01", "--thermal-conductivity", "1,nan"], {},
@@ -180,6 +184,9 @@ CONTACT = [
      dict(young=1e9, poisson=-0.1, pressures=[1e5]), "got -0.1"),
     (["--young", "1e9", "--poisson", "nan", "--pressures", "1e5"],
      dict(young=1e9, poisson=NAN, pressures=[1e5]), "poisson must be in"),
+    (["--young", "1e9", "--poisson", "0.3", "--pressures", "1e5", "--tangential=X"],
+     dict(young=1e9, poisson=0.3, pressures=[1e5], tangential="X"),
+     'tangential must be x, y or both, got "X"'),
     (["--young", "-1", "--poisson", "0.3", "--pressures", "1e5"],
      dict(young=-1, poisson=0.3, pressures=[1e5]), "young must be positive and finite, got -1"),
     # Two bodies: one E and one ν each, no E* beside them; three values are none of those.
@@ -395,6 +402,9 @@ STUDY = [
     ("curve", dict(seed=-1), "seed must be a whole number from 0 to 18446744073709551615, got -1"),
     ("alpha", dict(method="fem"), 'method must be mdr or bem, got "fem"'),
     ("curve", dict(method="MDR"), 'method must be mdr or bem, got "MDR"'),
+    ("curve", dict(method="bem", poisson=0.3, tangential="xy"),
+     'tangential must be x, y or both, got "xy"'),
+    ("curve", dict(method="bem", tangential="x"), "tangential needs poisson ν (of Cerruti's kernel)"),
 ]
 
 ALL = BEM + CONTACT + SURFACE + MDR + STATS + MEASURED + PERSSON + STUDY

@@ -40,6 +40,43 @@ def test_bem_sweep_columns_are_the_clis(cli, tmp_path):
         assert np.array_equal(plain[name], ours[name]), name
 
 
+def test_one_direction_is_the_clis_and_the_both_runs(cli, tmp_path):
+    # tangential="x": only stiffness_x, the ratio k_x/k; the CLI's numbers bit for bit, and
+    # the both run's k_x bit for bit (the same start and CG). "y" starts elsewhere (Mindlin
+    # times the normal solution, not 2w - k_x's): the both run's k_y to the CG's stopping
+    # energy error (1e-12 relative).
+    s = asperity.surface(64, hurst=0.8, rolloff=4, rms_slope=0.5, seed=3)
+    np.save(tmp_path / "s.npy", s.heights)
+    loads = [0.005, 0.02, 0.08]
+    cli("bem", "--surface", tmp_path / "s.npy", "--pressures", "0.005,0.02,0.08", "--poisson", 0.3,
+        "--tangential", "x", "--out", tmp_path / "x.csv", "--quiet")
+    theirs = np.genfromtxt(tmp_path / "x.csv", delimiter=",", names=True)
+    sweep = lambda **kw: asperity.Solver(s.heights, size=1.0).sweep(pressures=loads, poisson=0.3,
+                                                                    **kw)
+    ours, both, y = sweep(tangential="x"), sweep(), sweep(tangential="y")
+    assert "stiffness_y" not in ours.columns and "stiffness_y" not in theirs.dtype.names
+    for name in ["stiffness", "stiffness_x", "tangential_ratio"]:
+        assert np.array_equal(ours[name], theirs[name]), name
+    assert np.array_equal(ours.stiffness_x, both.stiffness_x)
+    assert np.array_equal(ours.tangential_ratio, ours.stiffness_x / ours.stiffness)
+    assert "stiffness_x" not in y.columns
+    np.testing.assert_allclose(y.stiffness_y, both.stiffness_y, rtol=1e-11, atol=0)
+    assert ours.metadata["tangential"] == "x"
+    # contact: tangential="x" is --tangential=x, cell for cell.
+    t = asperity.surface(48, hurst=0.8, rolloff=2, rms_slope=1, seed=3, size=1e-4)
+    np.save(tmp_path / "h.npy", t.heights * 1e-6)
+    cli("import", tmp_path / "h.npy", "--size", "1e-4", "--detrend", "none",
+        "--out", tmp_path / "t.npy")
+    cli("contact", tmp_path / "t.npy", "--young", 2e11, "--poisson", 0.3, "--tangential=x",
+        "--pressures", "1e4,1e5", "--detrend", "none", "--out", tmp_path / "c.csv")
+    theirs = np.genfromtxt(tmp_path / "c.csv", delimiter=",", names=True)
+    t = asperity.read_topography(tmp_path / "t.npy")
+    ours = asperity.contact(t, young=2e11, poisson=0.3, tangential="x", pressures=[1e4, 1e5])
+    assert "stiffness_y_n_per_m" not in ours.columns
+    for name in ["stiffness_n_per_m", "stiffness_x_n_per_m", "tangential_ratio"]:
+        assert np.array_equal(ours[name], theirs[name]), name
+
+
 def test_contact_tangential_is_the_clis(cli, tmp_path):
     s = asperity.surface(48, hurst=0.8, rolloff=2, rms_slope=1, seed=3, size=1e-4)
     np.save(tmp_path / "h.npy", s.heights * 1e-6)

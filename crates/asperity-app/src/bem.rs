@@ -592,6 +592,9 @@ pub struct BemRequest {
     /// Poisson's ratio of the tangential (no-slip) stiffness of every load, or none.
     #[serde(default)]
     pub poisson: Option<f64>,
+    /// Which tangential stiffnesses with `poisson`: `x`, `y` or `both` (none: both).
+    #[serde(default)]
+    pub tangential: Option<String>,
     /// The two bodies' electrical resistivities (conductance by Barber's analogy).
     #[serde(default)]
     pub resistivity: Option<Vec<f64>>,
@@ -610,6 +613,7 @@ impl Default for BemRequest {
             fd_step: None,
             fields: false,
             poisson: None,
+            tangential: None,
             resistivity: None,
             thermal_conductivity: None,
         }
@@ -672,8 +676,12 @@ impl BemRequest {
         if let Some(step) = self.fd_step {
             check_fd_step(step)?;
         }
-        let derived =
-            Derived::validate(self.poisson, &self.resistivity, &self.thermal_conductivity)?;
+        let derived = Derived::validate(
+            self.poisson,
+            self.tangential.as_deref(),
+            &self.resistivity,
+            &self.thermal_conductivity,
+        )?;
         check_capped_loads(interface, &loads, None, "")?;
         Ok(BemPlan {
             half_space,
@@ -684,6 +692,7 @@ impl BemRequest {
                 stiffness: self.stiffness,
                 fd_step: self.fd_step,
                 tangential: derived.tangential,
+                directions: derived.directions,
             },
             derived,
         })

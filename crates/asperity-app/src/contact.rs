@@ -23,12 +23,10 @@ use crate::refusal::{Param, Refusal};
 pub mod params {
     use crate::refusal::Param;
 
-    pub use crate::derived::params::{POISSON, RESISTIVITY, THERMAL_CONDUCTIVITY};
+    pub use crate::derived::params::{POISSON, RESISTIVITY, TANGENTIAL, THERMAL_CONDUCTIVITY};
 
     /// Young's modulus E.
     pub const YOUNG: Param = Param::new("--young", "young");
-    /// The tangential (no-slip) stiffness.
-    pub const TANGENTIAL: Param = Param::new("--tangential", "tangential");
     /// The hardness that caps the contact pressure, Pa (`asperity bem`'s parameter).
     pub use crate::bem::params::HARDNESS;
 }
@@ -162,6 +160,9 @@ pub struct ContactRequest {
     /// The adhesive retraction's step, m.
     #[serde(default)]
     pub retract_step: Option<f64>,
+    /// With `tangential`: `x`, `y` or `both` (none: both), the stiffnesses computed.
+    #[serde(default)]
+    pub directions: Option<String>,
 }
 
 impl Default for ContactRequest {
@@ -185,6 +186,7 @@ impl Default for ContactRequest {
             adhesion_model: None,
             indentations: Vec::new(),
             retract_step: None,
+            directions: None,
         }
     }
 }
@@ -227,7 +229,12 @@ impl ContactRequest {
                 .text(" ν (of Cerruti's kernel)"));
         }
         let poisson = self.poisson.filter(|_| self.tangential);
-        let derived = Derived::validate(poisson, &self.resistivity, &self.thermal_conductivity)?;
+        let derived = Derived::validate(
+            poisson,
+            self.directions.as_deref(),
+            &self.resistivity,
+            &self.thermal_conductivity,
+        )?;
         // The hardness by `asperity bem`'s rules, in Pa.
         let interface = hardness_interface(self.hardness)?;
         let loads: Vec<Control> = self
@@ -487,6 +494,7 @@ pub fn run(
         stiffness: true,
         fd_step: None,
         tangential: plan.derived.tangential,
+        directions: plan.derived.directions,
     };
     sweep(solver, &plan.loads, params, &mut observer)?;
     Ok(ContactRun {

@@ -6,22 +6,29 @@
 //! same refusals and the same numbers.
 //!
 //! * `tangential_ratio` is `(k_x + k_y)/(2k)`: the mean of the two directions over the
-//!   normal frozen-set stiffness (Mindlin: `2(1−ν)/(2−ν)` for one circular contact);
+//!   normal frozen-set stiffness (Mindlin: `2(1−ν)/(2−ν)` for one circular contact); with
+//!   one direction (`--tangential x|y`, `tangential="x"`: about half the cost) only that
+//!   direction's column, and the ratio is `k_x/k` (or `k_y/k`);
 //! * the conductances are `2k/(E*(ρ₁+ρ₂))` and `(2k/E*)·κ₁κ₂/(κ₁+κ₂)` from the same `k`.
 //!
 //! ```
 //! use asperity_app::derived::{Derived, Units};
-//! let derived = Derived::validate(Some(0.3), &Some(vec![1.7e-8, 1.7e-8]), &None).unwrap();
+//! let derived =
+//!     Derived::validate(Some(0.3), None, &Some(vec![1.7e-8, 1.7e-8]), &None).unwrap();
 //! assert_eq!(
 //!     derived.columns(Units::Si),
 //!     ["stiffness_x_n_per_m", "stiffness_y_n_per_m", "tangential_ratio",
 //!      "electrical_conductance_s"]
 //! );
 //! assert_eq!(derived.columns(Units::Model)[0], "stiffness_x");
+//! // One direction: its column and k_y/k as the ratio.
+//! let y = Derived::validate(Some(0.3), Some("y"), &None, &None).unwrap();
+//! assert_eq!(y.columns(Units::Model), ["stiffness_y", "tangential_ratio"]);
 //! ```
 
 use asperity::bem::conductance::Transport;
 use asperity::bem::sweep::SweepRow;
+use asperity::bem::tangential::Directions;
 
 use crate::refusal::{Param, Refusal};
 
@@ -31,6 +38,9 @@ pub mod params {
 
     /// Poisson's ratio ν (of Cerruti's kernel; in `asperity contact` also of E/(1 − ν²)).
     pub const POISSON: Param = Param::new("--poisson", "poisson");
+    /// Which tangential stiffnesses: `x`, `y` or `both` (in `asperity contact` also the
+    /// switch that asks for them).
+    pub const TANGENTIAL: Param = Param::new("--tangential", "tangential");
     /// The two bodies' electrical resistivities.
     pub const RESISTIVITY: Param = Param::new("--resistivity", "resistivity");
     /// The two bodies' thermal conductivities.
@@ -60,6 +70,16 @@ pub fn check_poisson(poisson: f64) -> Result<(), Refusal> {
         " must be in [0, 0.5] (Poisson's ratio), got {}",
         crate::refusal::number(poisson)
     )))
+}
+
+/// Which tangential stiffnesses: `x`, `y` or `both`.
+pub fn parse_directions(name: &str) -> Result<Directions, Refusal> {
+    match name {
+        "x" => Ok(Directions::X),
+        "y" => Ok(Directions::Y),
+        "both" => Ok(Directions::Both),
+        _ => Err(Refusal::of(TANGENTIAL).text(format!(" must be x, y or both, got {name:?}"))),
+    }
 }
 
 /// Two values, one per body, each positive and finite.
@@ -92,6 +112,8 @@ pub fn body_pair(
 pub struct Derived {
     /// Poisson's ratio of the tangential stiffness, if asked for.
     pub tangential: Option<f64>,
+    /// Which of `k_x`, `k_y` (both unless asked otherwise).
+    pub directions: Directions,
     /// The bodies' resistivities and conductivities, if given.
     pub transport: Transport,
 }
@@ -104,7 +126,7 @@ pub struct DerivedRow {
     pub stiffness_x: Option<f64>,
     /// `k_y`.
     pub stiffness_y: Option<f64>,
-    /// `(k_x + k_y)/(2k)`.
+    /// `(k_x + k_y)/(2k)`, or with one direction `k_x/k` (`k_y/k`).
     pub tangential_ratio: Option<f64>,
     /// Electrical conductance.
     pub electrical_conductance: Option<f64>,
@@ -114,14 +136,23 @@ pub struct DerivedRow {
 
 impl Derived {
     /// The derived columns of a request, or why not: `poisson` (tangential stiffness),
-    /// the two bodies' resistivities and thermal conductivities.
+    /// `directions` (`x`, `y` or `both`, the default; only with `poisson`), the two bodies'
+    /// resistivities and thermal conductivities.
     pub fn validate(
         poisson: Option<f64>,
+        directions: Option<&str>,
         resistivity: &Option<Vec<f64>>,
         thermal_conductivity: &Option<Vec<f64>>,
     ) -> Result<Derived, Refusal> {
         if let Some(poisson) = poisson {
             check_poisson(poisson)?;
+        }
+        let directions = directions.map(parse_directions).transpose()?;
+        if directions.is_some() && poisson.is_none() {
+            return Err(Refusal::of(TANGENTIAL)
+                .text(" needs ")
+                .param(POISSON)
+                .text(" ν (of Cerruti's kernel)"));
         }
         let resistivity = body_pair(RESISTIVITY, "resistivity", resistivity)?;
         let thermal_conductivity = body_pair(
@@ -131,6 +162,7 @@ impl Derived {
         )?;
         Ok(Derived {
             tangential: poisson,
+            directions: directions.unwrap_or_default(),
             transport: Transport {
                 resistivity,
                 thermal_conductivity,
@@ -143,9 +175,14 @@ impl Derived {
         let si = units == Units::Si;
         let mut columns = Vec::new();
         if self.tangential.is_some() {
-            columns.extend(match si {
-                true => ["stiffness_x_n_per_m", "stiffness_y_n_per_m"],
-                false => ["stiffness_x", "stiffness_y"],
+            let (x, y) = match si {
+                true => ("stiffness_x_n_per_m", "stiffness_y_n_per_m"),
+                false => ("stiffness_x", "stiffness_y"),
+            };
+            columns.extend(match self.directions {
+                Directions::X => vec![x],
+                Directions::Y => vec![y],
+                Directions::Both => vec![x, y],
             });
             columns.push("tangential_ratio");
         }
@@ -171,9 +208,9 @@ impl Derived {
         let k = row.stiffness;
         let t = row.tangential;
         DerivedRow {
-            stiffness_x: t.map(|t| t.x),
-            stiffness_y: t.map(|t| t.y),
-            tangential_ratio: t.zip(k).map(|(t, k)| (t.x + t.y) / (2.0 * k)),
+            stiffness_x: t.and_then(|t| t.stiffness_x()),
+            stiffness_y: t.and_then(|t| t.stiffness_y()),
+            tangential_ratio: t.zip(k).map(|(t, k)| t.ratio(k)),
             electrical_conductance: k.and_then(|k| self.transport.electrical(k, modulus)),
             thermal_conductance: k.and_then(|k| self.transport.thermal(k, modulus)),
         }
@@ -183,7 +220,12 @@ impl Derived {
     pub fn values(&self, row: &DerivedRow) -> Vec<Option<f64>> {
         let mut values = Vec::new();
         if self.tangential.is_some() {
-            values.extend([row.stiffness_x, row.stiffness_y, row.tangential_ratio]);
+            match self.directions {
+                Directions::X => values.push(row.stiffness_x),
+                Directions::Y => values.push(row.stiffness_y),
+                Directions::Both => values.extend([row.stiffness_x, row.stiffness_y]),
+            }
+            values.push(row.tangential_ratio);
         }
         if self.transport.resistivity.is_some() {
             values.push(row.electrical_conductance);
@@ -203,7 +245,7 @@ mod tests {
     #[test]
     fn refusals_in_both_front_ends_words() {
         let refused = |nu: Option<f64>, r: Option<Vec<f64>>, t: Option<Vec<f64>>| {
-            let refusal = Derived::validate(nu, &r, &t).unwrap_err();
+            let refusal = Derived::validate(nu, None, &r, &t).unwrap_err();
             (refusal.words(Names::Flags), refusal.words(Names::Keywords))
         };
         for bad in [-0.1, 0.51, f64::NAN, f64::INFINITY] {
@@ -227,27 +269,52 @@ mod tests {
              and finite, got 0"
         );
         for nu in [0.0, 0.5] {
-            assert!(Derived::validate(Some(nu), &None, &None).is_ok());
+            assert!(Derived::validate(Some(nu), None, &None, &None).is_ok());
+        }
+        let along = |nu: Option<f64>, d: &str| {
+            let refusal = Derived::validate(nu, Some(d), &None, &None).unwrap_err();
+            (refusal.words(Names::Flags), refusal.words(Names::Keywords))
+        };
+        assert_eq!(
+            along(Some(0.3), "z"),
+            (
+                "--tangential must be x, y or both, got \"z\"".to_string(),
+                "tangential must be x, y or both, got \"z\"".to_string()
+            )
+        );
+        assert_eq!(
+            along(None, "x").0,
+            "--tangential needs --poisson ν (of Cerruti's kernel)"
+        );
+        for (name, d) in [
+            ("x", Directions::X),
+            ("y", Directions::Y),
+            ("both", Directions::Both),
+        ] {
+            let derived = Derived::validate(Some(0.3), Some(name), &None, &None).unwrap();
+            assert_eq!((derived.directions, d.name()), (d, name));
         }
     }
 
     #[test]
     fn columns_and_values_line_up() {
         use asperity::bem::{ContactSummary, Control, SolveInfo};
-        let derived =
-            Derived::validate(Some(0.3), &Some(vec![1e-8, 3e-8]), &Some(vec![50.0, 200.0]))
-                .unwrap();
+        let derived = Derived::validate(
+            Some(0.3),
+            None,
+            &Some(vec![1e-8, 3e-8]),
+            &Some(vec![50.0, 200.0]),
+        )
+        .unwrap();
         let info = SolveInfo {
             iterations: 1,
             residual: 0.0,
             operator_applications: 1,
             energy_transforms: 0,
         };
-        let tangential = asperity::bem::tangential::Tangential {
-            x: 0.8,
-            y: 0.9,
-            info_x: info,
-            info_y: info,
+        let tangential = asperity::bem::tangential::Along {
+            x: Some((0.8, info)),
+            y: Some((0.9, info)),
         };
         let row = SweepRow {
             control: Control::MeanPressure(0.01),
@@ -289,5 +356,24 @@ mod tests {
             (None, None)
         );
         assert!(Derived::default().columns(Units::Si).is_empty());
+        // One direction: its column, and its own ratio to k.
+        let x = Derived {
+            directions: Directions::X,
+            ..derived
+        };
+        let one = SweepRow {
+            tangential: Some(asperity::bem::tangential::Along {
+                x: Some((0.8, info)),
+                y: None,
+            }),
+            ..row
+        };
+        let values = x.values(&x.row(&one, 2.0));
+        assert_eq!(
+            x.columns(Units::Model)[..2],
+            ["stiffness_x", "tangential_ratio"]
+        );
+        assert_eq!(values[..2], [Some(0.8), Some(0.8)]);
+        assert_eq!(values.len(), x.columns(Units::Model).len());
     }
 }

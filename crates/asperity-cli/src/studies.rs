@@ -291,6 +291,7 @@ mod tests {
             levels: 48,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         let segments = StudyProgress::new(&spec, vec![0, 3]).segments();
         let mut eta = asperity_app::study::progress::Eta::weighted(&segments);

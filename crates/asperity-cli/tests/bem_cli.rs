@@ -1424,6 +1424,61 @@ fn tangential_and_conductance_columns_follow_the_frozen_set() {
     refused(&asperity(&adhesive), "does not go with --poisson");
 }
 
+/// `--tangential x|y|both`: one direction adds only its column, and `tangential_ratio` is
+/// its `k_d/k`; `x` is the `both` run's `k_x` cell for cell (the same start and CG), `y`
+/// its `k_y` to the CG's tolerance (another start); the contract's columns are unchanged;
+/// a bad direction, or one without `--poisson`, is refused with one line and exit 2.
+#[test]
+fn one_tangential_direction_is_the_both_runs_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = surface(dir.path());
+    let s = s.to_str().unwrap();
+    let run = |extra: &[&str], name: &str| {
+        let csv = dir.path().join(name);
+        let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
+        let base = [&base[..], &["--quiet", "--pressures", "0.005,0.02,0.08"]].concat();
+        ok(&asperity(
+            &[&base[..], &["--poisson", "0.3"], extra].concat(),
+        ));
+        read_csv(&csv)
+    };
+    let (both_header, both) = run(&[], "both.csv");
+    let (explicit_header, explicit) = run(&["--tangential", "both"], "explicit.csv");
+    assert_eq!((&explicit_header, &explicit), (&both_header, &both));
+    for (direction, name) in [("x", "stiffness_x"), ("y", "stiffness_y")] {
+        let (header, rows) = run(&["--tangential", direction], &format!("{direction}.csv"));
+        assert_eq!(header[7..9], [name, "tangential_ratio"]);
+        assert_eq!(header.len(), 9, "{header:?}");
+        for (row, whole) in rows.iter().zip(&both) {
+            assert_eq!(row[..7], whole[..7], "the contract's cells");
+            let (k, kd) = (row[4], row[7]);
+            let whole_kd = whole[column(&both_header, name)];
+            if direction == "x" {
+                assert_eq!(kd, whole_kd);
+            } else {
+                // Stopping energy error 1e-12 relative.
+                assert!((kd / whole_kd - 1.0).abs() < 1e-11, "{kd} {whole_kd}");
+            }
+            assert_eq!(row[8], kd / k);
+        }
+    }
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("x.csv.json")).unwrap()).unwrap();
+    assert_eq!(record["tangential"]["directions"], "x");
+    let bad = |extra: &[&str], needle: &str| {
+        let base = ["bem", "--surface", s, "--pressures", "0.01"];
+        refused(&asperity(&[&base[..], extra].concat()), needle);
+    };
+    bad(
+        &["--poisson", "0.3", "--tangential", "z"],
+        "--tangential must be x, y or both, got \"z\"",
+    );
+    bad(
+        &["--tangential", "x"],
+        "--tangential needs --poisson ν (of Cerruti's kernel)",
+    );
+}
+
 /// Issue 33 items 13 and 15: a solve that cannot converge ends early, in one line that says
 /// why, instead of running to its iteration limit (here a million: hours at 64²). A
 /// tolerance below the rounding floor stands for every stagnating solve; both solvers.

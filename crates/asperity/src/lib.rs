@@ -73,6 +73,7 @@
 //!     levels: 48,
 //!     sweep_end: None,
 //!     poisson: None,
+//!     tangential: Default::default(),
 //! };
 //! let task = Task { n, hurst: 1.0 };
 //! let samples = TaskSamples::new(&spec, task)?.compute(&(0..100).collect::<Vec<_>>())?;

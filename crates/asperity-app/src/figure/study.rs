@@ -305,8 +305,20 @@ fn task_color(results: &[TaskResult], r: &TaskResult) -> Color {
 pub struct Derived {
     /// Poisson's ratio ν of the study's tangential stiffness.
     pub poisson: Option<f64>,
+    /// Which of `k_x`, `k_y` the ratio is made of.
+    pub directions: asperity::bem::tangential::Directions,
     /// The bodies' resistivities and conductivities.
     pub transport: asperity::bem::conductance::Transport,
+}
+
+impl From<crate::derived::Derived> for Derived {
+    fn from(derived: crate::derived::Derived) -> Self {
+        Derived {
+            poisson: derived.tangential,
+            directions: derived.directions,
+            transport: derived.transport,
+        }
+    }
 }
 
 /// The figures of what the normal stiffness stands for, for a study that computed them:
@@ -317,7 +329,11 @@ pub struct Derived {
 pub fn derived_charts(results: &[TaskResult], derived: Derived) -> Vec<Chart> {
     let mut charts = Vec::new();
     if crate::study::rows::has_tangential(results) {
-        charts.push(tangential_chart(results, derived.poisson));
+        charts.push(tangential_chart(
+            results,
+            derived.poisson,
+            derived.directions,
+        ));
     }
     let modulus = |r: &TaskResult| asperity::study::Scales::of(r.method).modulus;
     let transport = derived.transport;
@@ -380,8 +396,19 @@ fn force_label(results: &[TaskResult]) -> String {
 
 /// `k_t/k_n` against force (see [`derived_charts`]): with ν known, as its excess over
 /// Mindlin's ratio in per cent (Mindlin's line at 0; the ratio differs from it by parts in
-/// 1e-3, which a plain ratio axis cannot resolve); without, the ratio itself.
-fn tangential_chart(results: &[TaskResult], poisson: Option<f64>) -> Chart {
+/// 1e-3, which a plain ratio axis cannot resolve); without, the ratio itself. Mindlin's
+/// ratio bounds the mean of the two directions from below, not one direction alone.
+fn tangential_chart(
+    results: &[TaskResult],
+    poisson: Option<f64>,
+    directions: asperity::bem::tangential::Directions,
+) -> Chart {
+    use asperity::bem::tangential::Directions;
+    let (ratio_name, bound) = match directions {
+        Directions::Both => ("(k_x + k_y)/(2k)", ": a lower bound"),
+        Directions::X => ("k_x/k", ""),
+        Directions::Y => ("k_y/k", ""),
+    };
     let mindlin = poisson.map(|nu| 2.0 * (1.0 - nu) / (2.0 - nu));
     let shown = |ratio: f64| match mindlin {
         Some(m) => 100.0 * (ratio / m - 1.0),
@@ -411,13 +438,16 @@ fn tangential_chart(results: &[TaskResult], poisson: Option<f64>) -> Chart {
     let y_label = match (poisson, mindlin) {
         (Some(nu), Some(m)) => {
             if hi > lo {
-                let label = format!("Mindlin 2(1−ν)/(2−ν) = {m:.5} (ν = {nu}): a lower bound");
+                let label = format!("Mindlin 2(1−ν)/(2−ν) = {m:.5} (ν = {nu}){bound}");
                 let line = vec![(lo, 0.0), (hi, 0.0)];
                 series.push(Series::new(label, line, Style::Dashed).color(Color::BLACK));
             }
-            format!("k_t/k_n over Mindlin's ratio − 1 [%], ν = {nu}  (band: 95 % of the mean)")
+            format!(
+                "k_t/k_n = {ratio_name} over Mindlin's ratio − 1 [%], ν = {nu}  \
+                 (band: 95 % of the mean)"
+            )
         }
-        _ => "k_t/k_n = (k_x + k_y)/(2k)  (band: 95 % of the mean)".into(),
+        _ => format!("k_t/k_n = {ratio_name}  (band: 95 % of the mean)"),
     };
     Chart {
         title: "Tangential over normal contact stiffness vs force (ensemble mean, full stick)"

@@ -147,6 +147,7 @@ struct StudyFile {
     levels: Option<usize>,
     full_sweep: Option<bool>,
     poisson: Option<f64>,
+    tangential: Option<String>,
     resistivity: Option<Vec<f64>>,
     thermal_conductivity: Option<Vec<f64>>,
 }
@@ -191,6 +192,7 @@ pub fn read(path: &Path, text: &str) -> Result<StudyFileRequest, Refusal> {
         levels: file.levels.map(|l| l as i128),
         full_sweep: file.full_sweep.unwrap_or(false),
         poisson: file.poisson,
+        tangential: file.tangential.clone(),
     };
     if file.kind == Kind::Curve && file.full_sweep.is_some() {
         return Err(Refusal::saying(format!(
@@ -219,20 +221,24 @@ fn file_derived(path: &Path, file: &StudyFile) -> Result<figure::Derived, Refusa
         file.resistivity.is_some(),
         file.thermal_conductivity.is_some(),
     ];
-    if file.kind == Kind::Alpha && (file.poisson.is_some() || given.contains(&true)) {
+    let tangential = file.poisson.is_some() || file.tangential.is_some();
+    if file.kind == Kind::Alpha && (tangential || given.contains(&true)) {
         return Err(Refusal::saying(format!(
-            "{}: poisson, resistivity and thermal_conductivity apply to curve studies only",
+            "{}: poisson, tangential, resistivity and thermal_conductivity apply to curve \
+             studies only",
             path.display()
         )));
     }
     let refused =
         |r: Refusal| Refusal::saying(format!("{}: {}", path.display(), r.words(Names::Keywords)));
-    let derived = Derived::validate(file.poisson, &file.resistivity, &file.thermal_conductivity)
-        .map_err(refused)?;
-    Ok(figure::Derived {
-        poisson: derived.tangential,
-        transport: derived.transport,
-    })
+    let derived = Derived::validate(
+        file.poisson,
+        file.tangential.as_deref(),
+        &file.resistivity,
+        &file.thermal_conductivity,
+    )
+    .map_err(refused)?;
+    Ok(derived.into())
 }
 
 /// `FILE, line L, column C (key K): MESSAGE`, in one line. The key is the one assigned on

@@ -322,6 +322,7 @@ mod tests {
             levels: 12,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         }
     }
 
@@ -411,6 +412,7 @@ mod tests {
             levels: 48,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         assert!(check_min_contacts(&spec(Method::Mdr, 32)).is_ok());
         assert!(check_min_contacts(&spec(Method::Bem, 1024)).is_ok());

@@ -70,6 +70,8 @@ pub struct StudyRequest {
     pub full_sweep: bool,
     /// Poisson's ratio of the tangential stiffness (BEM curve studies).
     pub poisson: Option<f64>,
+    /// Which tangential stiffnesses: `x`, `y` or `both` (none: both).
+    pub tangential: Option<String>,
 }
 
 impl Default for StudyRequest {
@@ -90,6 +92,7 @@ impl Default for StudyRequest {
             levels: None,
             full_sweep: false,
             poisson: None,
+            tangential: None,
         }
     }
 }
@@ -122,6 +125,9 @@ impl StudyRequest {
             max_fraction: self.max_fraction.unwrap_or(defaults.window.max_fraction),
         };
         let seed = self.seed.as_deref().map(parse_seed).transpose()?;
+        let tangential = (self.tangential.as_deref())
+            .map(crate::derived::parse_directions)
+            .transpose()?;
         let spec = StudySpec {
             method: method(&self.method)?,
             sizes,
@@ -132,6 +138,7 @@ impl StudyRequest {
             window,
             levels: optional_count(LEVELS, self.levels)?.unwrap_or(defaults.levels),
             poisson: self.poisson,
+            tangential: tangential.unwrap_or_default(),
             ..defaults
         };
         Ok(self.kind.spec(spec, self.full_sweep))
@@ -162,6 +169,7 @@ mod tests {
             levels: Some(12),
             full_sweep: false,
             poisson: None,
+            tangential: None,
         };
         let whole = StudySpec {
             method: Method::Bem,
@@ -177,6 +185,7 @@ mod tests {
             levels: 12,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         assert_eq!(request.spec().unwrap(), whole.clone().with_alpha_sweep());
         let full = StudyRequest {

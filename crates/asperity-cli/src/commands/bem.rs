@@ -195,6 +195,11 @@ pub struct BemArgs {
     /// E* stays --modulus.
     #[arg(long, value_name = "NU", allow_hyphen_values = true)]
     pub poisson: Option<f64>,
+    /// With --poisson: which tangential stiffnesses, x, y or both [default: both]. One
+    /// direction adds only its column (stiffness_x or stiffness_y), tangential_ratio is
+    /// then k_x/k (k_y/k), and costs about one stiffness solve per load instead of two.
+    #[arg(long, value_name = "DIR")]
+    pub tangential: Option<String>,
     /// Electrical resistivities ρ₁,ρ₂ of the two bodies (units of E*·length/conductance):
     /// adds the column electrical_conductance = 2k/(E*(ρ₁+ρ₂)) (Barber's analogy).
     #[arg(
@@ -524,6 +529,7 @@ pub(super) fn request(args: &BemArgs) -> Result<BemRequest> {
         fd_step: args.fd_stiffness.then_some(FD_STEP),
         fields: args.fields.is_some(),
         poisson: args.poisson,
+        tangential: args.tangential.clone(),
         resistivity: args.resistivity.clone(),
         thermal_conductivity: args.thermal_conductivity.clone(),
     })
@@ -797,6 +803,7 @@ fn inputs(args: &BemArgs, plan: &Plan, surface: &SurfaceInfo) -> serde_json::Val
         "fd_relative_step": args.fd_stiffness.then_some(FD_STEP),
         "tangential": plan.bem.derived.tangential.map(|nu| json!({
             "poisson": nu,
+            "directions": plan.bem.derived.directions.name(),
             "method": "frozen contact set, Cerruti kernel (normal-tangential coupling neglected)",
         })),
         "resistivity": args.resistivity,

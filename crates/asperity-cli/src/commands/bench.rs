@@ -292,6 +292,7 @@ fn estimate_bem_study(args: &BenchArgs) -> Result<()> {
         levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
         poisson: None,
+        tangential: Default::default(),
     }
     .with_alpha_sweep();
     let sweep_end = alpha.sweep_end.filter(|_| !args.full_sweep);

@@ -125,9 +125,17 @@ pub struct ContactArgs {
     /// --poisson's ν, docs/tangential.md) and tangential_ratio = (k_x + k_y)/(2k). Needs
     /// --poisson (with --young, or beside --modulus for the kernel alone). About two more
     /// stiffness solves per load. With --hardness, on the elastic set as k: points at the
-    /// hardness take no added traction, normal or tangential.
-    #[arg(long)]
-    pub tangential: bool,
+    /// hardness take no added traction, normal or tangential. --tangential=x (or y) computes
+    /// one direction only: its column, tangential_ratio = k_x/k (k_y/k), about one
+    /// stiffness solve per load; --tangential alone is --tangential=both.
+    #[arg(
+        long,
+        value_name = "DIR",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "both"
+    )]
+    pub tangential: Option<String>,
     /// Walk the pressures in the given order as one load path (loading, unloading,
     /// reloading: e.g. --pressures 1e7,4e7,1e7,4e7 --hardness 2e8), each step warm from the
     /// last and its plastic displacement kept (the library's load_path, as `asperity bem
@@ -196,7 +204,8 @@ pub(super) fn request(args: &ContactArgs) -> Result<ContactRequest> {
         resistivity: args.resistivity.clone(),
         thermal_conductivity: args.thermal_conductivity.clone(),
         hardness: args.hardness,
-        tangential: args.tangential,
+        tangential: args.tangential.is_some(),
+        directions: args.tangential.clone(),
         work_of_adhesion: args.work_of_adhesion,
         adhesion_range: args.adhesion_range,
         adhesion_model: args.adhesion_model.clone(),
@@ -298,8 +307,10 @@ pub(super) fn inputs_record(
         "hardness_pa": args.hardness,
         "tangential": plan.derived.tangential.map(|nu| json!({
             "poisson": nu,
+            "directions": plan.derived.directions.name(),
             "method": "frozen contact set, Cerruti kernel (normal-tangential coupling \
-                neglected); tangential_ratio = (k_x + k_y)/(2k); with a hardness, on the \
+                neglected); tangential_ratio = (k_x + k_y)/(2k), or k_x/k (k_y/k) with one \
+                direction; with a hardness, on the \
                 elastic set (points at the hardness take no added traction)",
         })),
         "conductance": "Barber's analogy from the frozen-set stiffness: electrical \

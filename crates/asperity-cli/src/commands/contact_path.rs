@@ -23,7 +23,7 @@ use crate::plot::{stage_charts, Chart};
 fn refuse_other_options(args: &ContactArgs) -> Result<()> {
     let given = [
         (args.map.is_some(), "--map"),
-        (args.tangential, "--tangential"),
+        (args.tangential.is_some(), "--tangential"),
         (args.resistivity.is_some(), "--resistivity"),
         (
             args.thermal_conductivity.is_some(),

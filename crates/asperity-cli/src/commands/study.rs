@@ -158,6 +158,11 @@ pub struct CurveArgs {
     /// (k_x + k_y)/(2k) with its interval, and the figure DIR/tangential.png.
     #[arg(long, value_name = "NU")]
     pub poisson: Option<f64>,
+    /// With --poisson: which tangential stiffnesses, x, y or both [default: both]; with one
+    /// direction tangential_ratio is k_x/k (k_y/k), at about half the cost (Mindlin's
+    /// ratio then bounds neither direction alone).
+    #[arg(long, value_name = "DIR")]
+    pub tangential: Option<String>,
     /// The two bodies' electrical resistivities ρ₁,ρ₂: adds electrical_conductance
     /// 2k/(E*(ρ₁+ρ₂)) with its interval (Barber's analogy; E* = 1) and its figure.
     #[arg(
@@ -390,6 +395,7 @@ fn request(kind: Kind, common: &CommonArgs, sizes: &[i128], hurst: &str) -> Resu
         levels: Some(common.levels),
         full_sweep: false,
         poisson: None,
+        tangential: None,
     })
 }
 
@@ -425,16 +431,19 @@ pub fn run(args: &StudyArgs) -> Result<()> {
         StudyCommand::Curve(c) => {
             let request = StudyRequest {
                 poisson: c.poisson,
+                tangential: c.tangential.clone(),
                 ..request(Kind::Curve, &c.common, &c.n, &c.hurst)?
             };
             let spec = request.spec().map_err(|r| refused(r.into()))?;
-            let derived = Derived::validate(c.poisson, &c.resistivity, &c.thermal_conductivity)
-                .map_err(|r| refused(r.into()))?;
+            let derived = Derived::validate(
+                c.poisson,
+                c.tangential.as_deref(),
+                &c.resistivity,
+                &c.thermal_conductivity,
+            )
+            .map_err(|r| refused(r.into()))?;
             let options = RunOptions {
-                derived: figure::Derived {
-                    poisson: derived.tangential,
-                    transport: derived.transport,
-                },
+                derived: derived.into(),
                 ..RunOptions::from_args(&c.common.run)?
             };
             (Kind::Curve, spec, &c.common.run.out, options)

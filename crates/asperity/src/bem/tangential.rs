@@ -84,6 +84,87 @@ pub struct Tangential {
     pub info_y: SolveInfo,
 }
 
+/// Which tangential stiffnesses to compute: `k_x`, `k_y` or both (the default). One
+/// direction costs about half of both ([`TangentialStiffness::solve_along`]) and is enough
+/// for a statistically isotropic surface, whose `k_x` and `k_y` differ by the sample's own
+/// anisotropy only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Directions {
+    /// `k_x` alone.
+    X,
+    /// `k_y` alone.
+    Y,
+    /// `k_x` and `k_y`.
+    #[default]
+    Both,
+}
+
+impl Directions {
+    /// `x`, `y` or `both`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Directions::X => "x",
+            Directions::Y => "y",
+            Directions::Both => "both",
+        }
+    }
+
+    /// Whether both directions are asked for (the default).
+    pub fn is_both(&self) -> bool {
+        *self == Directions::Both
+    }
+}
+
+/// The tangential stiffnesses asked for by [`Directions`], each with its CG.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Along {
+    /// `k_x` and its CG, if asked for.
+    pub x: Option<(f64, SolveInfo)>,
+    /// `k_y` and its CG, if asked for.
+    pub y: Option<(f64, SolveInfo)>,
+}
+
+impl Along {
+    /// `k_x`, if asked for.
+    pub fn stiffness_x(&self) -> Option<f64> {
+        self.x.map(|(k, _)| k)
+    }
+
+    /// `k_y`, if asked for.
+    pub fn stiffness_y(&self) -> Option<f64> {
+        self.y.map(|(k, _)| k)
+    }
+
+    /// The ratio to the normal stiffness `k`: `(k_x + k_y)/(2k)` with both directions,
+    /// else the one direction's `k_d/k` (Mindlin: `2(1−ν)/(2−ν)` for a circle either way).
+    pub fn ratio(&self, k: f64) -> f64 {
+        match (self.x, self.y) {
+            (Some((x, _)), Some((y, _))) => (x + y) / (2.0 * k),
+            (Some((d, _)), None) | (None, Some((d, _))) => d / k,
+            (None, None) => f64::NAN,
+        }
+    }
+
+    /// The operator applications of the CGs asked for.
+    pub fn operator_applications(&self) -> usize {
+        [self.x, self.y]
+            .iter()
+            .flatten()
+            .map(|(_, info)| info.operator_applications)
+            .sum()
+    }
+}
+
+impl From<Tangential> for Along {
+    fn from(t: Tangential) -> Self {
+        Along {
+            x: Some((t.x, t.info_x)),
+            y: Some((t.y, t.info_y)),
+        }
+    }
+}
+
 /// Cerruti's operators along x and y for a solver's grid, their preconditioners and the
 /// CG's fields: planned once, then [`TangentialStiffness::solve`] for every state.
 pub struct TangentialStiffness {
@@ -251,6 +332,29 @@ impl TangentialStiffness {
         let result = self.direction(k, solver, &cg, start);
         self.guess = guess;
         result
+    }
+
+    /// The stiffnesses asked for by `directions`: [`TangentialStiffness::solve`] for both,
+    /// [`TangentialStiffness::solve_along`] for one. `X` gives `solve`'s `k_x` bit for bit
+    /// (the same start and CG); `Y` starts from Mindlin's ratio × the normal solution
+    /// rather than from `2w − k_x`'s solution, so its `k_y` equals `solve`'s to the CG's
+    /// tolerance.
+    pub fn solve_directions(
+        &mut self,
+        solver: &ContactSolver,
+        directions: Directions,
+    ) -> std::result::Result<Along, SolveError> {
+        Ok(match directions {
+            Directions::Both => self.solve(solver)?.into(),
+            Directions::X => Along {
+                x: Some(self.solve_along(solver, Direction::X)?),
+                y: None,
+            },
+            Directions::Y => Along {
+                x: None,
+                y: Some(self.solve_along(solver, Direction::Y)?),
+            },
+        })
     }
 
     /// Mindlin's ratio `2(1−ν)/(2−ν)`.

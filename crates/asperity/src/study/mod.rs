@@ -83,6 +83,7 @@ pub use store::{
     Received, Restored, StudyDir, CHECKPOINT_INTERVAL, MAX_CHECKPOINT_INTERVAL_SECONDS,
 };
 
+use crate::bem::tangential::Directions;
 use crate::fit::PowerLawFit;
 use crate::lock::FolderLock;
 use crate::memory::array_bytes;
@@ -110,6 +111,7 @@ pub(crate) mod tests {
             levels: 16,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         let dir = tempfile::tempdir().unwrap();
         let store = StudyDir::open(dir.path(), &spec, false).unwrap();
@@ -171,6 +173,7 @@ pub(crate) mod tests {
             levels: 16,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         let (small, grown) = (spec(3), spec(5));
         let task = small.tasks()[0];
@@ -238,6 +241,7 @@ pub(crate) mod tests {
             levels: 10,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         }
     }
 

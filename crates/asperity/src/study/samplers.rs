@@ -26,7 +26,7 @@ use super::{
     run_task, CurvePoint, Method, ProgressFn, SampleCurve, Sampler, StudyDir, StudySpec, Task,
     TaskResult,
 };
-use crate::bem::tangential::TangentialStiffness;
+use crate::bem::tangential::{Directions, TangentialStiffness};
 use crate::bem::{ContactSolver, Control, HalfSpace, Parallelism, SolverParams};
 use crate::elastic::Boundary;
 use crate::mdr::LinearCurve;
@@ -265,6 +265,8 @@ pub struct BemSampler {
     sweep_end: Option<f64>,
     /// Poisson's ratio of the tangential stiffness at every load, if asked for.
     poisson: Option<f64>,
+    /// Which of `k_x`, `k_y`.
+    directions: Directions,
     params: SolverParams,
     stop: crate::stop::Stop,
     on_load: Option<OnLoad>,
@@ -290,6 +292,7 @@ impl BemSampler {
             mean_pressures,
             sweep_end: spec.sweep_end,
             poisson: spec.poisson,
+            directions: spec.tangential,
             params: bem_solver_params(),
             stop: crate::stop::Stop::new(),
             on_load: None,
@@ -375,11 +378,14 @@ impl Sampler for BemSampler {
         for (i, &p) in self.mean_pressures.iter().enumerate() {
             let (summary, _) = solver.solve(Control::MeanPressure(p)).map_err(bem_error)?;
             let (stiffness, _) = solver.frozen_set_stiffness().map_err(bem_error)?;
-            // (k_x + k_y)/(2k), from the normal solution the stiffness left (warm start).
+            // (k_x + k_y)/(2k) (one direction: k_d/k), from the normal solution the
+            // stiffness left (warm start).
             let tangential_ratio = match worker.tangential.as_mut() {
                 Some(t) => {
-                    let t = t.solve(solver).map_err(bem_error)?;
-                    Some((t.x + t.y) / (2.0 * stiffness))
+                    let t = t
+                        .solve_directions(solver, self.directions)
+                        .map_err(bem_error)?;
+                    Some(t.ratio(stiffness))
                 }
                 None => None,
             };
@@ -603,6 +609,7 @@ mod tests {
             levels: 48,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         }
     }
 

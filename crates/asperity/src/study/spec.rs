@@ -55,6 +55,10 @@ pub struct StudySpec {
     /// `None`: none. MDR studies refuse it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub poisson: Option<f64>,
+    /// BEM with [`StudySpec::poisson`]: which of `k_x`, `k_y` (both by default; one for
+    /// about half the cost, the ratio then `k_d/k`); absent (both) from the JSON when both.
+    #[serde(default, skip_serializing_if = "Directions::is_both")]
+    pub tangential: Directions,
 }
 
 /// A study of one MDR task, 64 samples of a line of N = 512 points at H = 0.5 without
@@ -83,6 +87,7 @@ impl Default for StudySpec {
             levels: DEFAULT_LEVELS,
             sweep_end: None,
             poisson: None,
+            tangential: Directions::Both,
         }
     }
 }
@@ -188,6 +193,12 @@ impl StudySpec {
                 let reason = "the tangential stiffness of a study is computed by BEM only";
                 return Err(Error::invalid("poisson", reason));
             }
+        } else if !self.tangential.is_both() {
+            let reason = format!(
+                "the direction {} needs a Poisson's ratio (poisson)",
+                self.tangential.name()
+            );
+            return Err(Error::invalid("tangential", reason));
         }
         self.ensure_size()?;
         self.ensure_samplers()

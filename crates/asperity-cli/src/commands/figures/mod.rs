@@ -88,6 +88,7 @@ fn study_spec(
         levels: asperity::study::DEFAULT_LEVELS,
         sweep_end: None,
         poisson: None,
+        tangential: Default::default(),
     }
 }
 

@@ -17,6 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::bem::tangential::Directions;
 use crate::study::samplers::Scales;
 use crate::study::{FitWindow, Method, StudySpec, Task};
 
@@ -91,6 +92,10 @@ pub struct TaskIdentity {
     /// absent (none) in older checkpoints, which keep their checksums.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub poisson: Option<f64>,
+    /// Which tangential stiffnesses ([`StudySpec::tangential`]); absent when both (the
+    /// only choice of older checkpoints, which keep their checksums).
+    #[serde(default, skip_serializing_if = "Directions::is_both")]
+    pub tangential: Directions,
 }
 
 impl TaskIdentity {
@@ -114,6 +119,7 @@ impl TaskIdentity {
             },
             sweep_end: spec.sweep_end,
             poisson: spec.poisson,
+            tangential: spec.tangential,
         }
     }
 
@@ -273,6 +279,7 @@ mod tests {
             levels: 10,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         };
         TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 })
     }
@@ -295,6 +302,7 @@ mod tests {
             levels: 10,
             sweep_end: None,
             poisson: Some(0.3),
+            tangential: Default::default(),
         };
         let with = TaskIdentity::of(&spec, Task { n: 16, hurst: 0.5 });
         let differences = with.differences(&plain);

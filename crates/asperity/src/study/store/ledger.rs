@@ -216,6 +216,7 @@ mod tests {
             levels: 12,
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
         }
     }
 

@@ -192,6 +192,7 @@ impl StudyDir {
         let whole = StudySpec {
             sweep_end: None,
             poisson: None,
+            tangential: Default::default(),
             ..spec.clone()
         };
         let resumes = matches!(
