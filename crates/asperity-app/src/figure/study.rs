@@ -509,6 +509,7 @@ mod tests {
         let derived = Derived {
             poisson: Some(0.3),
             transport,
+            ..Derived::default()
         };
         let mut charts = derived_charts(&results, derived);
         charts.push(curve_chart(&results, "k(F)"));
@@ -558,6 +559,7 @@ mod tests {
         let derived = Derived {
             poisson: Some(0.3),
             transport,
+            ..Derived::default()
         };
         let charts = derived_charts(&[result(Some(mindlin * 1.001))], derived);
         assert_eq!(charts.len(), 2);

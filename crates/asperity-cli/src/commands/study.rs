@@ -186,7 +186,7 @@ pub struct CurveArgs {
 }
 
 /// The keys of a study file: `(key, type, default, meaning)`, for `--help` and the README.
-pub const FILE_KEYS: [(&str, &str, &str, &str); 14] = [
+pub const FILE_KEYS: [(&str, &str, &str, &str); 15] = [
     (
         "kind",
         "\"alpha\" or \"curve\"",
@@ -248,6 +248,12 @@ pub const FILE_KEYS: [(&str, &str, &str, &str); 14] = [
         "number in [0, 0.5]",
         "none",
         "curve, BEM: Poisson's ratio of the tangential stiffness at every load (tangential_ratio)",
+    ),
+    (
+        "tangential",
+        "\"x\", \"y\" or \"both\"",
+        "\"both\"",
+        "curve, BEM, with poisson: which tangential stiffnesses (one: k_d/k, about half the cost)",
     ),
     (
         "resistivity",
