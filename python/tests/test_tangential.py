@@ -143,7 +143,7 @@ def test_the_distributed_coordinator_carries_poisson_and_the_resistivities(tmp_p
     def args(out):
         request = dict(kind="curve", method="bem", sizes=[32], hursts=[0.5], samples=2,
                        rolloff=4.0, seed=None, min_contacts=None, max_fraction=None, levels=4,
-                       full_sweep=False, poisson=0.3)
+                       full_sweep=False, poisson=0.3, tangential=None)
         return (request, str(tmp_path / out), False, None)
 
     derived = dict(resistivity=[1.0, 3.0])
