@@ -81,16 +81,25 @@ impl Table {
     }
 }
 
-/// The stderr line of an adhesive run's pull-offs (`bem` and `mdr` with
+/// The stderr line of an adhesive run's pull-offs (`bem`, `contact` and `mdr` with
 /// `--work-of-adhesion`): force and indentation `(F, d)` under force control, then under
-/// displacement control.
-pub fn pull_off_line(force_controlled: (f64, f64), displacement_controlled: (f64, f64)) -> String {
+/// displacement control, each number followed by its unit (`""` in model units).
+pub fn pull_off_line(
+    force_controlled: (f64, f64),
+    displacement_controlled: (f64, f64),
+    (force_unit, length_unit): (&str, &str),
+) -> String {
+    let point = |(f, d): (f64, f64)| {
+        format!(
+            "F = {}{force_unit} at d = {}{length_unit}",
+            format_number(f),
+            format_number(d)
+        )
+    };
     format!(
-        "pull-off: force control F = {} at d = {}; displacement control F = {} at d = {}",
-        format_number(force_controlled.0),
-        format_number(force_controlled.1),
-        format_number(displacement_controlled.0),
-        format_number(displacement_controlled.1),
+        "pull-off: force control {}; displacement control {}",
+        point(force_controlled),
+        point(displacement_controlled)
     )
 }
 

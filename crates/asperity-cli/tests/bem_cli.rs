@@ -44,6 +44,23 @@ fn column(header: &[String], name: &str) -> usize {
     header.iter().position(|h| h == name).unwrap()
 }
 
+/// `bem` on the surface `s` at p̄ = 0.005, 0.02, 0.08 with the `extra` flags, quietly, into
+/// `dir/name`; returns that CSV's path.
+fn three_loads(dir: &Path, s: &str, extra: &[&str], name: &str) -> PathBuf {
+    let csv = dir.join(name);
+    let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
+    let base = [&base[..], &["--quiet", "--pressures", "0.005,0.02,0.08"]].concat();
+    ok(&asperity(&[&base[..], extra].concat()));
+    csv
+}
+
+/// `bem` on the surface `s` at p̄ = 0.01 with the `extra` flags is refused (exit 2, one
+/// line) with `needle`.
+fn refused_at_one_load(s: &str, extra: &[&str], needle: &str) {
+    let base = ["bem", "--surface", s, "--pressures", "0.01"];
+    refused(&asperity(&[&base[..], extra].concat()), needle);
+}
+
 #[test]
 fn pressures_with_fields_write_the_documented_outputs() {
     let dir = tempfile::tempdir().unwrap();
@@ -1340,10 +1357,7 @@ fn tangential_and_conductance_columns_follow_the_frozen_set() {
     let s = surface(dir.path());
     let s = s.to_str().unwrap();
     let run = |extra: &[&str], name: &str| {
-        let csv = dir.path().join(name);
-        let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
-        let base = [&base[..], &["--quiet", "--pressures", "0.005,0.02,0.08"]].concat();
-        ok(&asperity(&[&base[..], extra].concat()));
+        let csv = three_loads(dir.path(), s, extra, name);
         (std::fs::read_to_string(&csv).unwrap(), read_csv(&csv))
     };
     let derived = [
@@ -1393,10 +1407,7 @@ fn tangential_and_conductance_columns_follow_the_frozen_set() {
             .unwrap();
     assert_eq!(record["tangential"]["poisson"], 0.3);
     assert_eq!(record["resistivity"], serde_json::json!([2.0, 3.0]));
-    let bad = |extra: &[&str], needle: &str| {
-        let base = ["bem", "--surface", s, "--pressures", "0.01"];
-        refused(&asperity(&[&base[..], extra].concat()), needle);
-    };
+    let bad = |extra: &[&str], needle: &str| refused_at_one_load(s, extra, needle);
     bad(
         &["--poisson", "0.7"],
         "--poisson must be in [0, 0.5] (Poisson's ratio), got 0.7",
@@ -1434,13 +1445,12 @@ fn one_tangential_direction_is_the_both_runs_column() {
     let s = surface(dir.path());
     let s = s.to_str().unwrap();
     let run = |extra: &[&str], name: &str| {
-        let csv = dir.path().join(name);
-        let base = ["bem", "--surface", s, "--out", csv.to_str().unwrap()];
-        let base = [&base[..], &["--quiet", "--pressures", "0.005,0.02,0.08"]].concat();
-        ok(&asperity(
-            &[&base[..], &["--poisson", "0.3"], extra].concat(),
-        ));
-        read_csv(&csv)
+        read_csv(&three_loads(
+            dir.path(),
+            s,
+            &[&["--poisson", "0.3"], extra].concat(),
+            name,
+        ))
     };
     let (both_header, both) = run(&[], "both.csv");
     let (explicit_header, explicit) = run(&["--tangential", "both"], "explicit.csv");
@@ -1465,10 +1475,7 @@ fn one_tangential_direction_is_the_both_runs_column() {
     let record: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("x.csv.json")).unwrap()).unwrap();
     assert_eq!(record["tangential"]["directions"], "x");
-    let bad = |extra: &[&str], needle: &str| {
-        let base = ["bem", "--surface", s, "--pressures", "0.01"];
-        refused(&asperity(&[&base[..], extra].concat()), needle);
-    };
+    let bad = |extra: &[&str], needle: &str| refused_at_one_load(s, extra, needle);
     bad(
         &["--poisson", "0.3", "--tangential", "z"],
         "--tangential must be x, y or both, got \"z\"",
@@ -1592,10 +1599,7 @@ fn persson_columns_beside_the_sweep() {
     assert_eq!(record["persson"]["gamma"], 0.4);
     assert_eq!(record["persson"]["kappa"], 2.0);
     assert!(record["persson"]["u0"].as_f64().unwrap() > 0.0);
-    let bad = |extra: &[&str], needle: &str| {
-        let base = ["bem", "--surface", s, "--pressures", "0.01"];
-        refused(&asperity(&[&base[..], extra].concat()), needle);
-    };
+    let bad = |extra: &[&str], needle: &str| refused_at_one_load(s, extra, needle);
     bad(
         &["--persson", "--gamma", "1.5"],
         "γ must lie in (0, 1], got 1.5",

@@ -3,55 +3,16 @@
 //! or many rounds and iterations. (Its own binary, with a counting allocator, as
 //! `bem_allocation.rs`; one test, so that nothing else allocates while it counts.)
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use asperity::bem::adhesion::PixelAdhesion;
 use asperity::bem::HalfSpace;
 use asperity::surface::Surface;
 use ndarray::Array2;
 
-struct Counting;
-
-thread_local! {
-    // This thread's allocations, as in bem_allocation.rs: counted per thread so that the
-    // test harness's own threads (its "running for over 60 seconds" warning on a busy
-    // machine once added 4) do not count; const, no destructor: allocation-free to touch.
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-fn note() {
-    ALLOCATIONS.with(|count| count.set(count.get() + 1));
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note();
-        // SAFETY: the caller's contract for `alloc` is passed on.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note();
-        // SAFETY: as for `alloc`.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note();
-        // SAFETY: as for `dealloc`; `new_size` is the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
+use common::count;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn moves_allocate_nothing_per_round_or_iteration() {
@@ -62,9 +23,8 @@ fn moves_allocate_nothing_per_round_or_iteration() {
         .expect("a one-thread pool");
     pool.install(|| {
         // A positive control: the counter sees this thread's allocations.
-        let before = ALLOCATIONS.with(Cell::get);
-        std::hint::black_box(Vec::<u8>::with_capacity(24));
-        assert_eq!(ALLOCATIONS.with(Cell::get) - before, 1);
+        let (_, allocations, _) = count(|| std::hint::black_box(Vec::<u8>::with_capacity(24)));
+        assert_eq!(allocations, 1);
         let (n, dx) = (48, 5e-3);
         let heights = Array2::from_shape_fn((n, n), |(i, j)| {
             let (y, x) = ((i as f64 - 24.0) * dx, (j as f64 - 24.0) * dx);
@@ -76,9 +36,7 @@ fn moves_allocate_nothing_per_round_or_iteration() {
         let mut counted = Vec::new();
         // A small step (few rounds), a long one (many), a retraction that releases pixels.
         for d in [0.0021, 0.009, 0.002] {
-            let before = ALLOCATIONS.with(Cell::get);
-            let (_, info) = contact.move_to(d).unwrap();
-            let allocations = ALLOCATIONS.with(Cell::get) - before;
+            let ((_, info), allocations, _) = count(|| contact.move_to(d).unwrap());
             counted.push((allocations, info.rounds, info.cg_iterations));
         }
         let (first, _, _) = counted[0];

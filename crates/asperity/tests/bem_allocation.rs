@@ -2,12 +2,9 @@
 //! on a warm solver cost the same number of heap allocations whether they take few or many
 //! iterations (and that number is small and fixed).
 //!
-//! A counting global allocator applies to this test binary only (an integration test), so
-//! it stays out of the library and of the other tests. This binary holds one test so that
-//! no other test allocates while it counts.
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+//! The counting global allocator of `tests/common` applies to this test binary only (an
+//! integration test); this binary holds one test so that no other test allocates while it
+//! counts.
 
 use asperity::bem::tangential::TangentialStiffness;
 use asperity::bem::{
@@ -17,59 +14,11 @@ use asperity::elastic::Boundary;
 use asperity::spectrum::{LongWavelength, Psd};
 use asperity::surface::{Normalisation, SurfaceGenerator, SurfaceSpec};
 
-struct Counting;
-
-thread_local! {
-    // This thread's allocations and bytes. Counted per thread, so that only the solver's own
-    // work counts (it runs on the one rayon worker that calls it): the test harness's other
-    // threads allocate whenever they like (its "running for over 60 seconds" warning on a
-    // busy machine once added 4). Const-initialised cells without a destructor: touching
-    // them inside the allocator allocates nothing and works while a thread exits.
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-    static BYTES: Cell<u64> = const { Cell::new(0) };
-}
-
-fn note(bytes: usize) {
-    ALLOCATIONS.with(|count| count.set(count.get() + 1));
-    BYTES.with(|total| total.set(total.get() + bytes as u64));
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note(layout.size());
-        // SAFETY: the caller's contract for `alloc` is passed on.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note(layout.size());
-        // SAFETY: as for `alloc`.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note(new_size);
-        // SAFETY: as for `dealloc`; `new_size` is the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
+use common::count;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-/// `(allocations, bytes)` made by this thread while `f` runs.
-fn count<T>(f: impl FnOnce() -> T) -> (T, u64, u64) {
-    let (a, b) = (ALLOCATIONS.with(Cell::get), BYTES.with(Cell::get));
-    let value = f();
-    let (a2, b2) = (ALLOCATIONS.with(Cell::get), BYTES.with(Cell::get));
-    (value, a2 - a, b2 - b)
-}
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn solves_and_stiffness_allocate_nothing_per_iteration() {

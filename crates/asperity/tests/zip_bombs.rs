@@ -4,56 +4,19 @@
 //! inflates to 64 MiB, are refused in one line, and no single allocation made while reading
 //! them comes near either size.
 //!
-//! A global allocator that records the largest allocation made on the reading thread
-//! applies to this test binary only (an integration test); this binary holds one test so
+//! The counting global allocator of `tests/common` (it records the largest allocation made
+//! on the reading thread) applies to this test binary only; this binary holds one test so
 //! that no other test allocates while it measures.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::io::Write;
 
 use asperity::topography::{read_file, ReadOptions};
 
-struct Largest;
-
-thread_local! {
-    // The largest single allocation on this thread since the last reset. Const-initialised
-    // without a destructor: touching it inside the allocator allocates nothing.
-    static LARGEST: Cell<usize> = const { Cell::new(0) };
-}
-
-fn note(bytes: usize) {
-    LARGEST.with(|m| m.set(m.get().max(bytes)));
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only records sizes.
-unsafe impl GlobalAlloc for Largest {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note(layout.size());
-        // SAFETY: the caller's contract for `alloc` is passed on.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note(layout.size());
-        // SAFETY: as for `alloc`.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note(new_size);
-        // SAFETY: as for `dealloc`; `new_size` is the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
+use common::largest_allocation;
 
 #[global_allocator]
-static GLOBAL: Largest = Largest;
+static GLOBAL: common::Counting = common::Counting;
 
 /// `prefix` then a zip archive whose one member `name` holds `data`, deflated.
 fn container(prefix: &[u8], name: &str, data: &[u8]) -> Vec<u8> {
@@ -130,11 +93,8 @@ fn zip_bombs_are_refused_in_one_line_without_allocating_them() {
         declare_size(&mut lying, 1000);
         for (what, bytes) in [("declared", declared), ("lying", lying)] {
             std::fs::write(&path, &bytes).unwrap();
-            LARGEST.with(|m| m.set(0));
-            let err = read_file(&path, &ReadOptions::default())
-                .expect_err(file)
-                .to_string();
-            let largest = LARGEST.with(Cell::get);
+            let (err, largest) = largest_allocation(|| read_file(&path, &ReadOptions::default()));
+            let err = err.expect_err(file).to_string();
             assert_eq!(err.lines().count(), 1, "{file} ({what}): {err}");
             // The file itself is read whole: allow it, and 1 MiB of working buffers.
             assert!(
@@ -165,11 +125,8 @@ fn forged_vk4_headers_are_refused_before_the_member_is_inflated() {
         assert!((bytes.len() as u64) * 1100 > member.len() as u64);
         let path = dir.path().join("forged.vk6");
         std::fs::write(&path, &bytes).unwrap();
-        LARGEST.with(|m| m.set(0));
-        let err = read_file(&path, &ReadOptions::default())
-            .expect_err("forged")
-            .to_string();
-        let largest = LARGEST.with(Cell::get);
+        let (err, largest) = largest_allocation(|| read_file(&path, &ReadOptions::default()));
+        let err = err.expect_err("forged").to_string();
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains("20000 × 20000 × 32 bits"), "{err}");
         assert!(

@@ -177,22 +177,7 @@ fn record(
 
 /// The pull-offs and any resolution warning on stderr; the table on stdout without --out.
 fn report(args: &BemArgs, run: &AdhesionRun, table: &Table) -> Result<()> {
-    match &run.pull_off {
-        Some(p) => eprintln!(
-            "{}",
-            pull_off_line(
-                (p.force_controlled.force, p.force_controlled.indentation),
-                (
-                    p.displacement_controlled.force,
-                    p.displacement_controlled.indentation
-                ),
-            )
-        ),
-        None => eprintln!("pull-off: nothing attached at the end of the path"),
-    }
-    if let Some(warning) = run.resolution_warning() {
-        eprintln!("warning: {warning}");
-    }
+    report_pull_off(run, ("", ""));
     match &args.out {
         Some(out) if !args.quiet => eprintln!(
             "wrote {} and {} ({} rows)",
@@ -204,4 +189,26 @@ fn report(args: &BemArgs, run: &AdhesionRun, table: &Table) -> Result<()> {
         None => crate::output::print_stdout(&table.to_csv()?)?,
     }
     Ok(())
+}
+
+/// The pull-offs (numbers followed by `units`: force, length) and any resolution warning,
+/// on stderr: `bem` in model units, `contact` in SI.
+pub(super) fn report_pull_off(run: &AdhesionRun, units: (&str, &str)) {
+    match &run.pull_off {
+        Some(p) => eprintln!(
+            "{}",
+            pull_off_line(
+                (p.force_controlled.force, p.force_controlled.indentation),
+                (
+                    p.displacement_controlled.force,
+                    p.displacement_controlled.indentation
+                ),
+                units,
+            )
+        ),
+        None => eprintln!("pull-off: nothing attached at the end of the path"),
+    }
+    if let Some(warning) = run.resolution_warning() {
+        eprintln!("warning: {warning}");
+    }
 }

@@ -17,6 +17,7 @@ use anyhow::{bail, Context, Result};
 use asperity::bem::sweep::{SweepError, SweepFailure};
 use asperity::bem::ContactSolver;
 use asperity::io::{sidecar_path, StagedOutputs};
+use asperity::surface::Surface;
 use asperity_app::bem::{ensure_solver_fits, SolverRequest};
 use asperity_app::contact::{self, ContactPlan, ContactRequest, ContactRow, Value};
 use serde_json::json;
@@ -338,12 +339,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         .chain(&record_path)
         .chain(&args.plot)
         .chain(&args.map);
-    let mut staged = StagedOutputs::new(outputs, args.force)?;
-    staged.ensure_not_input(&args.file)?;
-    let topography = load(&args.file, &args.measured, args.size.as_deref())?;
-    let surface = topography
-        .to_surface()
-        .with_context(|| format!("{}", args.file.display()))?;
+    let (mut staged, surface, provenance) = staged_surface(args, outputs)?;
     let (rows, cols) = surface.dim();
     ensure_solver_fits(rows, cols, boundary, Some(0))?;
     let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params)
@@ -371,7 +367,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     match &record_path {
         Some(record_path) => {
             table.stage(&mut staged, args.out.as_deref().expect("with its record"))?;
-            let inputs = inputs_record(args, &plan, record(&topography));
+            let inputs = inputs_record(args, &plan, provenance);
             staged.write_json(record_path, &inputs)?;
         }
         None => print!("{}", String::from_utf8(table.to_csv()?)?),
@@ -394,4 +390,20 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     staged.commit()?;
     Ok(())
+}
+
+/// Stages a contact run's outputs (all-or-nothing, none of them the input), then reads the
+/// measured surface, naming the file in any error: the first steps of every `contact` mode.
+/// Returns the staged outputs, the surface and the file's provenance record.
+pub(super) fn staged_surface<'a>(
+    args: &ContactArgs,
+    outputs: impl IntoIterator<Item = &'a PathBuf>,
+) -> Result<(StagedOutputs, Surface, serde_json::Value)> {
+    let staged = StagedOutputs::new(outputs, args.force)?;
+    staged.ensure_not_input(&args.file)?;
+    let topography = load(&args.file, &args.measured, args.size.as_deref())?;
+    let surface = topography
+        .to_surface()
+        .with_context(|| format!("{}", args.file.display()))?;
+    Ok((staged, surface, record(&topography)))
 }

@@ -6,14 +6,13 @@
 
 use anyhow::{bail, Context, Result};
 use asperity::bem::adhesion::AdhesiveSummary;
-use asperity::io::{sidecar_path, StagedOutputs};
+use asperity::io::sidecar_path;
 use asperity_app::adhesion::{AdhesionPlan, AdhesionRun};
 use asperity_app::contact::Value;
 use asperity_app::contact_adhesion::{values, COLUMNS};
 use serde_json::json;
 
 use super::contact::{file_name, request, ContactArgs};
-use super::measured::{load, record};
 use crate::output::{format_number, Table};
 use crate::plot::stage_charts;
 use asperity_app::figure::adhesion::LoopFigure;
@@ -41,12 +40,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     let record_path = args.out.as_deref().map(sidecar_path);
     let outputs = args.out.iter().chain(&record_path).chain(&args.plot);
-    let mut staged = StagedOutputs::new(outputs, args.force)?;
-    staged.ensure_not_input(&args.file)?;
-    let topography = load(&args.file, &args.measured, args.size.as_deref())?;
-    let surface = topography
-        .to_surface()
-        .with_context(|| format!("{}", args.file.display()))?;
+    let (mut staged, surface, provenance) = super::contact::staged_surface(args, outputs)?;
     let points = surface.dim().0 * surface.dim().1;
     let pixel_area = surface.spacing() * surface.spacing_y();
     let mut table = Table::new(&COLUMNS);
@@ -86,13 +80,13 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             table
                 .stage(&mut staged, out)
                 .with_context(|| format!("writing {}", out.display()))?;
-            let inputs = inputs_record(args, &plan, record(&topography));
+            let inputs = inputs_record(args, &plan, provenance);
             staged.write_json(record_path, &adhesion_record(inputs, &plan, &run))?;
         }
         _ => crate::output::print_stdout(&table.to_csv()?)?,
     }
     staged.commit()?;
-    report(&run);
+    super::bem_adhesion::report_pull_off(&run, (" N", " m"));
     Ok(())
 }
 
@@ -141,21 +135,4 @@ fn adhesion_record(
     });
     inputs["columns"] = json!(COLUMNS);
     inputs
-}
-
-/// The pull-offs (N, m) and any resolution warning, on stderr.
-fn report(run: &AdhesionRun) {
-    match &run.pull_off {
-        Some(p) => eprintln!(
-            "pull-off: force control F = {} N at d = {} m; displacement control F = {} N at d = {} m",
-            format_number(p.force_controlled.force),
-            format_number(p.force_controlled.indentation),
-            format_number(p.displacement_controlled.force),
-            format_number(p.displacement_controlled.indentation),
-        ),
-        None => eprintln!("pull-off: nothing attached at the end of the path"),
-    }
-    if let Some(warning) = run.resolution_warning() {
-        eprintln!("warning: {warning}");
-    }
 }

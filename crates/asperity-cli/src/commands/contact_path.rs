@@ -7,7 +7,7 @@
 
 use anyhow::{bail, Context, Result};
 use asperity::bem::{ContactSolver, PathPoint};
-use asperity::io::{sidecar_path, StagedOutputs};
+use asperity::io::sidecar_path;
 use asperity_app::bem::{branches, ensure_solver_fits, Branch};
 use asperity_app::contact::{self, ContactPlan, PATH_COLUMNS};
 use asperity_app::figure::path::{path_charts, PathColumns, PathFigure};
@@ -15,7 +15,6 @@ use serde_json::json;
 
 use super::bem_path::cells;
 use super::contact::{check_args, file_name, inputs_record, ContactArgs};
-use super::measured::{load, record};
 use crate::output::Table;
 use crate::plot::{stage_charts, Chart};
 
@@ -74,12 +73,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     let plan = check_args(args)?;
     let record_path = args.out.as_deref().map(sidecar_path);
     let outputs = args.out.iter().chain(&record_path).chain(&args.plot);
-    let mut staged = StagedOutputs::new(outputs, args.force)?;
-    staged.ensure_not_input(&args.file)?;
-    let topography = load(&args.file, &args.measured, args.size.as_deref())?;
-    let surface = topography
-        .to_surface()
-        .with_context(|| format!("{}", args.file.display()))?;
+    let (mut staged, surface, provenance) = super::contact::staged_surface(args, outputs)?;
     let (rows, cols) = surface.dim();
     ensure_solver_fits(rows, cols, plan.half_space.boundary, Some(0))?;
     let mut solver = ContactSolver::new(&surface, plan.half_space, plan.params)
@@ -100,7 +94,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             table
                 .stage(&mut staged, out)
                 .with_context(|| format!("writing {}", out.display()))?;
-            let mut inputs = inputs_record(args, &plan, record(&topography));
+            let mut inputs = inputs_record(args, &plan, provenance);
             inputs["command"] = json!("asperity contact --load-path");
             inputs["stiffness"] =
                 json!("frozen contact set (the elastic set 0 < p < H under a hardness)");

@@ -546,6 +546,7 @@ fn run_adhesive(
                     p.displacement_controlled.force,
                     p.displacement_controlled.indentation
                 ),
+                ("", ""),
             )
         ),
         None => eprintln!("pull-off: nothing in contact at the end of the path"),
