@@ -438,27 +438,9 @@ fn contact_adhesion_refuses_mixed_requests_in_one_line() {
 fn contact_adhesion_loops_have_one_arrow_per_run_in_the_mdr_too() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let args = [
-        "mdr",
-        "--profile",
-        "hertz",
-        "--radius",
-        "1",
-        "--n",
-        "1001",
-        "--dx",
-        "1e-3",
-        "--work-of-adhesion",
-        "1e-3",
-        "--nloads",
-        "30",
-        "--dmax",
-        "0.09",
-        "--out",
-        "j.csv",
-        "--plot",
-        "j.json",
-    ];
+    let path = ["--nloads", "30", "--dmax", "0.09"];
+    let outputs = ["--out", "j.csv", "--plot", "j.json"];
+    let args = [&common::JKR_SPHERE_MDR[..], &path, &outputs].concat();
     ok(&common::asperity(&args, d));
     let read = |name: &str| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(d.join(name)).unwrap()).unwrap()

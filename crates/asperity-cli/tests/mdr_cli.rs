@@ -958,30 +958,13 @@ fn bad_plots_are_refused_before_any_work_and_nothing_is_written() {
 
 #[test]
 fn adhesive_sphere_loop_lets_go_at_the_jkr_pull_offs() {
-    // R = 1, E* = 1, Δγ = 1e-3 on 1001 springs Δx = 1e-3 apart: the force-controlled
-    // pull-off radius is 152 Δx, the displacement-controlled one 73 Δx (library tests:
+    // common::JKR_SPHERE_MDR: the pull-off radii are 152 Δx and 73 Δx (library tests:
     // 4e-5 and 4.5e-3 at this Δx).
     let dir = tempfile::tempdir().unwrap();
+    let path = ["--indentations", "0.02,0.09,0.05"];
+    let outputs = ["--out", "jkr.csv", "--plot", "jkr.svg"];
     let out = asperity(
-        &[
-            "mdr",
-            "--profile",
-            "hertz",
-            "--radius",
-            "1",
-            "--n",
-            "1001",
-            "--dx",
-            "1e-3",
-            "--work-of-adhesion",
-            "1e-3",
-            "--indentations",
-            "0.02,0.09,0.05",
-            "--out",
-            "jkr.csv",
-            "--plot",
-            "jkr.svg",
-        ],
+        &[&common::JKR_SPHERE_MDR[..], &path, &outputs].concat(),
         dir.path(),
     );
     ok(&out);

@@ -105,3 +105,20 @@ pub fn files_under(dir: &Path, skip: impl Fn(&str) -> bool) -> BTreeMap<String, 
     }
     out
 }
+
+/// `mdr` on the adhesive JKR sphere of the CLI tests: R = 1, E* = 1, Δγ = 1e-3 on 1001
+/// springs Δx = 1e-3 apart (the force-controlled pull-off radius is 152 Δx, the
+/// displacement-controlled one 73 Δx); the path and outputs follow.
+pub const JKR_SPHERE_MDR: [&str; 11] = [
+    "mdr",
+    "--profile",
+    "hertz",
+    "--radius",
+    "1",
+    "--n",
+    "1001",
+    "--dx",
+    "1e-3",
+    "--work-of-adhesion",
+    "1e-3",
+];
