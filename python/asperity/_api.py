@@ -646,7 +646,8 @@ def read_topography(path: Union[str, "os.PathLike[str]"], *, channel: Union[None
     ``asperity import`` and every command's measured surface use (format by content, then
     extension: X3P, SDF, text and Gwyddion matrices, x y z lists, x z profiles, SUR, PLU,
     OPD, DI, AL3D, MetroPro DAT, FRT, WSxM, TMD, ``.npy``). ``channel``: a name or 0-based
-    index (default: the first height channel); ``size``: ``x`` or ``(x, y)`` in metres
+    index (default: the first height channel; a name that several channels share raises
+    ``ValueError`` listing their indices: give the index); ``size``: ``x`` or ``(x, y)`` in metres
     where the file carries none, or to override it; ``detrend``: ``none``, ``mean``,
     ``plane``, ``poly2``, ``poly3``, ``lines`` or ``line-means`` (default: none chosen, and
     an :class:`UnlevelledWarning` when the surface looks tilted, as the CLI warns);

@@ -1423,3 +1423,45 @@ fn zip_bombs_give_one_line_and_exit_2() {
         }
     }
 }
+
+/// `shared/topographies-2/di-2.di` holds three channels, "Height", "Height" and
+/// "Deflection": `--channel Height` is refused in one line (exit 2, nothing written) that
+/// lists both with their indices and says to choose by index, in every command that reads a
+/// file; `--channel 0` and `--channel 1` then give the two distinct maps, the first being
+/// the default's, and a unique name ignoring case still chooses.
+#[test]
+fn an_ambiguous_channel_name_is_refused_and_an_index_chooses() {
+    let Some(shared) = shared() else { return };
+    let file = shared.parent().unwrap().join("topographies-2/di-2.di");
+    let file = file.to_str().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let words = "2 channels are named \"Height\" (0: Height, 1: Height): choose one by its \
+                 0-based index, channel 0 or 1";
+    for command in [
+        &["import", file, "--out", "h.npy"][..],
+        &["stats", file],
+        &["bem", "--surface", file, "--pressures", "1e-3"],
+    ] {
+        let args = [command, &["--channel", "Height", "--detrend", "none"]].concat();
+        assert_refused(&asperity(&args, d), d, &[], words);
+    }
+    let import = |channel: Option<&str>, out: &str| {
+        let mut args = vec!["import", file, "--out", out, "--detrend", "none"];
+        args.extend(channel.map(|c| ["--channel", c]).into_iter().flatten());
+        ok(&asperity(&args, d));
+        let sidecar = json(&d.join(format!("{out}.json")));
+        (
+            npy(&d.join(out)),
+            sidecar["channel_index"].as_u64().unwrap(),
+        )
+    };
+    let (first, i0) = import(Some("0"), "0.npy");
+    let (second, i1) = import(Some("1"), "1.npy");
+    let (default, id) = import(None, "d.npy");
+    let (deflection, i2) = import(Some("deflection"), "2.npy");
+    assert_eq!((i0, i1, id, i2), (0, 1, 0, 2));
+    assert_eq!(first, default);
+    assert_ne!(first, second, "the two Height channels hold different maps");
+    assert_ne!(second, deflection);
+}

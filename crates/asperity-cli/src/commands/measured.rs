@@ -16,8 +16,8 @@ pub use asperity_app::measured::record;
 /// `--size`).
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct MeasuredArgs {
-    /// Channel of a measured file, by name or 0-based index [default: the first height
-    /// channel].
+    /// Channel of a measured file, by name or 0-based index (a name that several channels
+    /// share is refused, listing their indices) [default: the first height channel].
     #[arg(long, value_name = "NAME|INDEX")]
     pub channel: Option<String>,
     /// Levelling of a measured file: none, mean, plane (least-squares mean plane), poly2,

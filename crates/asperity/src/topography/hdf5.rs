@@ -95,8 +95,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
 }
 
 /// [`read`] of a file's bytes given to the decoder without a copy. The maps are read in
-/// the dataset's order, the file (its bytes) dropped, and only then transposed (in place
-/// when square): a 4096² `.h5` holds two 128 MiB buffers at a time, not four.
+/// the dataset's order, the file (its bytes) dropped, and only then transposed in place
+/// ([`into_transposed`]): a 4096² `.h5` holds two 128 MiB buffers at a time, not four.
 pub(crate) fn read_owned(bytes: Vec<u8>) -> Result<Reading> {
     check_length(&bytes)?;
     let file_len = bytes.len();
@@ -232,17 +232,45 @@ fn map_of(ds: &h5::Dataset, file_len: usize) -> Result<Option<Array2<f64>>> {
     Ok(Some(read_values(ds, file_len)?))
 }
 
-/// The transpose of `a`, in place (tile by tile) when `a` is square and in standard
-/// layout, else [`transposed`]'s copy.
+/// The transpose of `a`, in place when `a` is in standard layout (else [`transposed`]'s
+/// copy): a square map tile by tile; a map whose long side is a multiple of its short one
+/// as square blocks (each transposed tile by tile) whose rows are moved as runs of the
+/// short side; any other map element by element along the permutation's cycles (see
+/// [`transpose_runs`]). A 4096 × 2048 map is never held twice.
 pub(crate) fn into_transposed(mut a: Array2<f64>) -> Array2<f64> {
-    const TILE: usize = 32;
-    let n = a.nrows();
-    if n != a.ncols() || !a.is_standard_layout() {
+    let (rows, cols) = a.dim();
+    // The cycles' index arithmetic multiplies an index by a side: it must not overflow.
+    let fits = (rows * cols).checked_mul(rows.max(cols)).is_some();
+    if !a.is_standard_layout() || !fits {
         return transposed(&a);
     }
     let v = a.as_slice_mut().expect("standard layout");
+    if rows == cols {
+        square_in_place(v, rows);
+    } else if cols % rows == 0 {
+        // Rows of k runs of `rows` values: runs moved block by block, then each square.
+        transpose_runs(v, rows, cols / rows, rows);
+        for block in v.chunks_exact_mut(rows * rows) {
+            square_in_place(block, rows);
+        }
+    } else if rows % cols == 0 {
+        // The inverse: each square of `cols` rows transposed, then its runs moved.
+        for block in v.chunks_exact_mut(cols * cols) {
+            square_in_place(block, cols);
+        }
+        transpose_runs(v, rows / cols, cols, cols);
+    } else {
+        transpose_runs(v, rows, cols, 1);
+    }
+    a.into_shape_with_order((cols, rows))
+        .expect("the same values, rows and columns exchanged")
+}
+
+/// Transposes the square `n × n` row-major matrix `v` in place, 32 × 32 tiles at a time
+/// (the diagonal tile, then each tile right of it swapped with its mirror below).
+fn square_in_place(v: &mut [f64], n: usize) {
+    const TILE: usize = 32;
     for r0 in (0..n).step_by(TILE) {
-        // The diagonal tile, then each tile right of it swapped with its mirror below.
         for c0 in (r0..n).step_by(TILE) {
             for r in r0..(r0 + TILE).min(n) {
                 let from = if c0 == r0 { r + 1 } else { c0 };
@@ -252,7 +280,37 @@ pub(crate) fn into_transposed(mut a: Array2<f64>) -> Array2<f64> {
             }
         }
     }
-    a
+}
+
+/// Transposes in place the `rows × cols` row-major matrix whose entries are runs of `run`
+/// consecutive values of `v`, by following the cycles of the permutation: the entry at
+/// `p` goes to `p · rows mod (rows · cols − 1)` (the first and last stay), a bit per
+/// entry marking those already moved; one run is held aside. `rows · cols · max(rows,
+/// cols)` must fit a `usize` (see [`into_transposed`]).
+fn transpose_runs(v: &mut [f64], rows: usize, cols: usize, run: usize) {
+    let n = rows * cols;
+    debug_assert_eq!(v.len(), n * run);
+    if rows < 2 || cols < 2 {
+        return; // a row or a column: the same values in the same order
+    }
+    let mut moved = vec![0u64; n.div_ceil(64)];
+    let mut held = vec![0.0; run];
+    for start in 1..n - 1 {
+        if moved[start / 64] >> (start % 64) & 1 == 1 {
+            continue;
+        }
+        held.copy_from_slice(&v[start * run..(start + 1) * run]);
+        let mut p = start;
+        loop {
+            let q = p * rows % (n - 1);
+            v[q * run..(q + 1) * run].swap_with_slice(&mut held);
+            moved[q / 64] |= 1 << (q % 64);
+            if q == start {
+                break;
+            }
+            p = q;
+        }
+    }
 }
 
 /// The transpose of `a` in standard layout, copied tile by tile: a 4096² map in about a
@@ -373,8 +431,8 @@ mod tests {
     #[test]
     fn read_file_reads_the_owned_bytes_like_the_slice() {
         // `read_file` gives its bytes to the decoder (`read_owned`) and transposes after
-        // dropping them: in place for the square f64 `dataset1` (256²), by copy for the
-        // f32 `dataset2` (640 × 480 stored, 480 × 640 ours). The same numbers as the
+        // dropping them: in place for the square f64 `dataset1` (256²) and, along the
+        // permutation's cycles, for the f32 `dataset2` (640 × 480 stored, 480 × 640 ours). The same numbers as the
         // slice reader, whose maps `multiple_data_sets_reads_like_the_reference` checks.
         use super::super::{read_file, ChannelChoice, ReadOptions};
         let Some(dir) = super::super::testkit::set_dir("topographies-3") else {
@@ -420,11 +478,39 @@ mod tests {
             assert_eq!(into_transposed(a.clone()), a.t());
             assert_eq!(into_transposed(a.clone().reversed_axes()), a);
         }
-        // Square sides around the tile's, in place.
-        for n in [1, 2, 31, 32, 33, 64, 100] {
-            let a = Array2::from_shape_fn((n, n), |(r, c)| (r * 1000 + c) as f64);
+        // In place: square sides around the tile's; non-square odd and even grids whose
+        // long side is a multiple of the short one (square blocks) or not (cycles);
+        // against the naive transpose (element by element from the index rule).
+        for (rows, cols) in [
+            (1, 1),
+            (2, 2),
+            (31, 31),
+            (32, 32),
+            (33, 33),
+            (64, 64),
+            (100, 100),
+            (1, 7),
+            (7, 1),
+            (2, 4),
+            (4, 2),
+            (3, 9),
+            (9, 3),
+            (33, 99),
+            (99, 33),
+            (64, 128),
+            (96, 32),
+            (2, 3),
+            (3, 2),
+            (5, 8),
+            (8, 5),
+            (45, 33),
+            (70, 3),
+            (17, 64),
+        ] {
+            let a = Array2::from_shape_fn((rows, cols), |(r, c)| (r * 1000 + c) as f64);
+            let naive = Array2::from_shape_fn((cols, rows), |(c, r)| a[(r, c)]);
             let t = into_transposed(a.clone());
-            assert_eq!(t, a.t());
+            assert_eq!(t, naive, "{rows} x {cols}");
             assert!(t.is_standard_layout());
         }
     }

@@ -647,7 +647,7 @@ fn infinities_undefined(reading: &mut Reading) {
 /// neither gives one. `.npy` files are read by [`crate::io::read_npy`]; their sizes come
 /// from `options.size`, else from an asperity sidecar. No cleaning is done (see [`clean`]).
 pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
-    use std::io::Read;
+    use std::io::{Read, Seek};
     // Every input is opened by one rule, in one wording (a FIFO is refused, not waited on).
     let (file, length) = crate::input::open_regular(path)?;
     if length > options.max_bytes {
@@ -671,9 +671,20 @@ pub fn read_file(path: &Path, options: &ReadOptions) -> Result<Topography> {
     if head[..head_len].starts_with(NPY_MAGIC) {
         return read_npy_topography(path, options);
     }
+    if head[..head_len].starts_with(b"PK\x03\x04") {
+        // An X3P archive is read from the file, never held whole (its payload streamed).
+        if let Some(reading) = x3p::read_from_file(file.get_ref()) {
+            let mut reading = reading.map_err(|e| bad_file(path, e.to_string()))?;
+            infinities_undefined(&mut reading);
+            return topography_from(path, reading, Vec::new(), options);
+        }
+    }
+    let mut file = file.into_inner();
+    file.seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| Error::io(path, e))?;
     let mut bytes = Vec::with_capacity(length as usize);
-    bytes.extend_from_slice(&head[..head_len]);
-    file.read_to_end(&mut bytes)
+    file.take(options.max_bytes + 1)
+        .read_to_end(&mut bytes)
         .map_err(|e| Error::io(path, e))?;
     if bytes.len() as u64 > options.max_bytes {
         return Err(bad_file(path, "grew beyond its size limit while read"));
@@ -812,21 +823,41 @@ fn choose_channel(
             list()
         )),
         Some(ChannelChoice::Name(name)) => {
-            if let Some(i) = channels.iter().position(|c| &c.name == name) {
-                return Ok(i);
+            // Exact matches first; else matches ignoring case. One is the channel; several
+            // are refused (never the first taken silently), listed with their indices.
+            let matching = |same: &dyn Fn(&str) -> bool| -> Vec<usize> {
+                (0..channels.len())
+                    .filter(|&i| same(&channels[i].name))
+                    .collect()
+            };
+            let mut found = matching(&|c| c == name);
+            if found.is_empty() {
+                found = matching(&|c| c.eq_ignore_ascii_case(name));
             }
-            let folded: Vec<usize> = (0..channels.len())
-                .filter(|&i| channels[i].name.eq_ignore_ascii_case(name))
-                .collect();
-            match folded[..] {
+            match found[..] {
                 [i] => Ok(i),
-                _ => Err(format!(
+                [] => Err(format!(
                     "no channel named {name:?}; the file holds {}",
                     list()
                 )),
+                _ => Err(ambiguous(channels, name, &found)),
             }
         }
     }
+}
+
+/// Why the name `name`, matching the channels `found`, chooses none: the candidates with
+/// their indices, and how to pick one (both front ends take an index where a name goes).
+fn ambiguous(channels: &[Channel], name: &str, found: &[usize]) -> String {
+    let listed = |sep: &str, f: &dyn Fn(usize) -> String| {
+        found.iter().map(|&i| f(i)).collect::<Vec<_>>().join(sep)
+    };
+    format!(
+        "{} channels are named {name:?} ({}): choose one by its 0-based index, channel {}",
+        found.len(),
+        listed(", ", &|i| format!("{i}: {}", channels[i].name)),
+        listed(" or ", &|i| i.to_string()),
+    )
 }
 
 /// Sizes per axis from the options, else the file; with only x given for a map, y follows
@@ -1069,6 +1100,30 @@ mod tests {
         let err = choose_channel(&channels, Some(&ChannelChoice::Index(3))).unwrap_err();
         assert!(err.contains("0: Amplitude"), "{err}");
         assert!(choose_channel(&channels[..1], None).is_err());
+        // A name two channels share is refused with both indices, exactly or ignoring
+        // case; an exact match among case variants is the one meant.
+        let twice = vec![
+            ch("Height", true),
+            ch("Deflection", false),
+            ch("Height", true),
+            ch("HEIGHT", false),
+        ];
+        let name = ChannelChoice::Name("Height".into());
+        let err = choose_channel(&twice, Some(&name)).unwrap_err();
+        assert_eq!(
+            err,
+            "2 channels are named \"Height\" (0: Height, 2: Height): choose one by its \
+             0-based index, channel 0 or 2"
+        );
+        let name = ChannelChoice::Name("height".into());
+        let err = choose_channel(&twice, Some(&name)).unwrap_err();
+        assert!(err.starts_with("3 channels are named"), "{err}");
+        let name = ChannelChoice::Name("HEIGHT".into());
+        assert_eq!(choose_channel(&twice, Some(&name)), Ok(3));
+        assert_eq!(
+            choose_channel(&twice, Some(&ChannelChoice::Index(2))),
+            Ok(2)
+        );
     }
 
     #[test]

@@ -22,9 +22,11 @@
 //!
 //! Untrusted archives: `main.xml` is read up to 16 MiB; a payload is read only when its
 //! size follows from the grid, at most 1100 × its compressed size (deflate cannot do
-//! better) and within the memory available.
+//! better) and within the memory available. The payload is streamed (256 KiB at a time)
+//! through its MD5 straight into the heights, sized once from the header; `read_file`
+//! reads an X3P archive from the file itself (`read_from_file`), never holding it whole.
 
-use std::io::{Cursor, Read, Write};
+use std::io::{Cursor, Read, Seek, Write};
 use std::path::Path;
 
 use md5::{Digest, Md5};
@@ -292,29 +294,72 @@ impl Layout {
         out.z.push(self.scale(self.z_coding().raw(record)));
     }
 
+    /// Decodes the whole records of `piece` into `out` (see [`Self::push_record`]); heights
+    /// alone (no absolute axis) go straight into `out.z`, one loop per data type.
+    fn decode(&self, piece: &[u8], out: &mut Records) {
+        if self.absolute.iter().any(Option::is_some) {
+            for record in piece.chunks_exact(self.record_width()) {
+                self.push_record(record, out);
+            }
+            return;
+        }
+        let scale = self.scaler();
+        let z = &mut out.z;
+        match self.data_type {
+            'I' => z.extend(
+                piece
+                    .chunks_exact(2)
+                    .map(|b| scale(i16::from_le_bytes([b[0], b[1]]) as f64)),
+            ),
+            'L' => z.extend(
+                piece
+                    .chunks_exact(4)
+                    .map(|b| scale(i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)),
+            ),
+            'F' => z.extend(
+                piece
+                    .chunks_exact(4)
+                    .map(|b| scale(f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)),
+            ),
+            _ => z.extend(
+                piece
+                    .chunks_exact(8)
+                    .map(|b| scale(f64::from_le_bytes(b.try_into().expect("8 bytes")))),
+            ),
+        }
+    }
+
     fn scale(&self, v: f64) -> f64 {
-        let z = if self.data_type == 'I'
+        self.scaler()(v)
+    }
+
+    /// A height from its stored value: `Offset + Increment · raw` for integers or where an
+    /// increment or offset is given, the value itself otherwise; non-finite: undefined.
+    fn scaler(&self) -> impl Fn(f64) -> f64 {
+        let affine = self.data_type == 'I'
             || self.data_type == 'L'
             || self.z_increment != 1.0
-            || self.z_offset != 0.0
-        {
-            self.z_offset + self.z_increment * v
-        } else {
-            v
-        };
-        if z.is_finite() {
-            z
-        } else {
-            f64::NAN
+            || self.z_offset != 0.0;
+        let (increment, offset) = (self.z_increment, self.z_offset);
+        move |v| {
+            let z = if affine { offset + increment * v } else { v };
+            if z.is_finite() {
+                z
+            } else {
+                f64::NAN
+            }
         }
     }
 }
 
-/// Reads an archive entry of exactly `len` bytes: its declared size must be `len` (a
-/// payload that does not match the grid and data type of `main.xml` is refused), checked
-/// against the compressed size and the memory before allocating, and read to its end so
-/// that the zip CRC-32 is verified.
-fn entry(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str, len: usize) -> Result<Vec<u8>> {
+/// Opens the archive entry `name`, which must declare exactly `len` bytes (a payload that
+/// does not match the grid and data type of `main.xml` is refused) and be able to come
+/// from its compressed size ([`MAX_RATIO`]); nothing is allocated.
+fn open_entry<'a, R: Read + Seek>(
+    archive: &'a mut ZipArchive<R>,
+    name: &str,
+    len: usize,
+) -> Result<zip::read::ZipFile<'a, R>> {
     let file = archive
         .by_name(name)
         .map_err(|_| bad(FORMAT, format!("the archive has no {name}")))?;
@@ -341,11 +386,16 @@ fn entry(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str, len: usize) -> Res
             ),
         ));
     }
-    crate::memory::ensure_fits(
-        &format!("reading {name} of an X3P file"),
-        Some(len as u64 * 2),
-    )?;
+    Ok(file)
+}
+
+/// Reads an archive entry of exactly `len` bytes whole (see [`open_entry`]), checked
+/// against the memory before allocating, and read to its end so that the zip CRC-32 is
+/// verified. For small entries (the valid-points bits); the payload is streamed.
+fn entry<R: Read + Seek>(archive: &mut ZipArchive<R>, name: &str, len: usize) -> Result<Vec<u8>> {
+    crate::memory::ensure_fits(&format!("reading {name} of an X3P file"), Some(len as u64))?;
     let mut data = Vec::with_capacity(len);
+    let file = open_entry(archive, name, len)?;
     file.take(len as u64 + 1)
         .read_to_end(&mut data)
         .map_err(|e| entry_error(name, e))?;
@@ -356,6 +406,65 @@ fn entry(archive: &mut ZipArchive<Cursor<&[u8]>>, name: &str, len: usize) -> Res
         ));
     }
     Ok(data)
+}
+
+/// The most bytes of an entry held at a time while it is streamed.
+const PIECE: usize = 1 << 18;
+
+/// Streams the archive entry `name` of exactly `len` bytes (see [`open_entry`]) to `sink`
+/// in pieces of whole `unit`s (at most [`PIECE`] bytes, one buffer reused), each also
+/// given to `md5` where there is one; read to its end so that the zip CRC-32 is verified.
+/// `len` must be a multiple of `unit`.
+fn stream_entry<R: Read + Seek>(
+    archive: &mut ZipArchive<R>,
+    name: &str,
+    len: usize,
+    unit: usize,
+    mut md5: Option<&mut Md5>,
+    mut sink: impl FnMut(&[u8]),
+) -> Result<()> {
+    let piece = unit * (PIECE / unit).max(1);
+    let mut reader = open_entry(archive, name, len)?.take(len as u64 + 1);
+    let mut buf = vec![0u8; piece];
+    let mut done = 0usize;
+    loop {
+        let mut filled = 0;
+        while filled < piece {
+            match reader.read(&mut buf[filled..]) {
+                Ok(0) => break,
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(entry_error(name, e)),
+            }
+        }
+        done += filled;
+        if done > len || filled % unit != 0 || (filled < piece && done != len) {
+            let more = if done > len { "more" } else { "fewer" };
+            return Err(bad(
+                FORMAT,
+                format!("{name} holds {more} bytes than the {len} declared"),
+            ));
+        }
+        if let Some(md5) = md5.as_deref_mut() {
+            md5.update(&buf[..filled]);
+        }
+        sink(&buf[..filled]);
+        if filled < piece {
+            return Ok(());
+        }
+    }
+}
+
+/// The MD5 of the archive entry `name`, streamed (see [`stream_entry`]).
+fn entry_md5<R: Read + Seek>(archive: &mut ZipArchive<R>, name: &str) -> Result<String> {
+    let size = archive
+        .by_name(name)
+        .map(|f| f.size())
+        .map_err(|_| bad(FORMAT, format!("the archive has no {name}")))?;
+    let len = usize::try_from(size).map_err(|_| bad(FORMAT, format!("{name} is too large")))?;
+    let mut md5 = Md5::new();
+    stream_entry(archive, name, len, 1, Some(&mut md5), |_| {})?;
+    Ok(hex(&md5.finalize()))
 }
 
 /// A failed read of an archive entry; a zip CRC-32 mismatch said in those words.
@@ -373,10 +482,18 @@ fn entry_error(name: &str, e: std::io::Error) -> Error {
 /// Checks `data` against an MD5 checksum recorded in `main.xml` or `md5checksum.hex`
 /// (hex, either case); an empty record is no checksum.
 fn check_md5(what: &str, data: &[u8], recorded: Option<&str>) -> Result<()> {
+    if recorded.is_some_and(|r| !r.trim().is_empty()) {
+        compare_md5(what, &md5_hex(data), recorded)
+    } else {
+        Ok(())
+    }
+}
+
+/// Compares the MD5 `got` (hex) of `what` with a recorded one (see [`check_md5`]).
+fn compare_md5(what: &str, got: &str, recorded: Option<&str>) -> Result<()> {
     let Some(want) = recorded.map(str::trim).filter(|s| !s.is_empty()) else {
         return Ok(());
     };
-    let got = md5_hex(data);
     if got.eq_ignore_ascii_case(want) {
         Ok(())
     } else {
@@ -390,24 +507,26 @@ fn check_md5(what: &str, data: &[u8], recorded: Option<&str>) -> Result<()> {
 /// `main.xml`, read whole (so its CRC-32 is checked) up to [`MAX_XML`] bytes, through
 /// [`zipped::member`](super::zipped::member) (its declared size checked before anything is
 /// allocated, and against what it inflates to).
-fn main_xml_text(archive: &mut ZipArchive<Cursor<&[u8]>>) -> Result<String> {
+fn main_xml_text<R: Read + Seek>(archive: &mut ZipArchive<R>) -> Result<String> {
     let xml = super::zipped::member(archive, FORMAT, "main.xml", MAX_XML)?;
     String::from_utf8(xml).map_err(|_| bad(FORMAT, "main.xml is not UTF-8"))
 }
 
-/// The checksum file that `Record4/ChecksumFile` names: `HEX *NAME` lines, each checked
-/// against the archive entry it names (`main.xml` where no name is given; the standard's
-/// choice, while some writers record the payload's). Absent: nothing to check.
-fn check_checksum_file(
-    archive: &mut ZipArchive<Cursor<&[u8]>>,
+/// The checksum file that `Record4/ChecksumFile` names: `HEX *NAME` lines, `main.xml`'s
+/// checked here (where no name is given, the line is `main.xml`'s: the standard's choice,
+/// while some writers record the payload's); the other lines returned as (entry, MD5) for
+/// [`read`] to check as it streams those entries. Absent: nothing to check.
+fn check_checksum_file<R: Read + Seek>(
+    archive: &mut ZipArchive<R>,
     root: roxmltree::Node<'_, '_>,
     xml: &str,
-) -> Result<()> {
+) -> Result<Vec<(String, String)>> {
+    let mut others = Vec::new();
     let Some(name) = text_at(root, &["Record4", "ChecksumFile"]).filter(|n| !n.is_empty()) else {
-        return Ok(());
+        return Ok(others);
     };
     let Ok(file) = archive.by_name(name) else {
-        return Ok(());
+        return Ok(others);
     };
     if file.size() > 4096 {
         return Err(bad(
@@ -427,48 +546,61 @@ fn check_checksum_file(
             .map_or("main.xml", |t| t.trim_start_matches('*'));
         if target == "main.xml" {
             check_md5("main.xml", xml.as_bytes(), Some(hex))?;
+        } else if !has_entry(archive, target) {
+            return Err(bad(
+                FORMAT,
+                format!("{name} names {target}, which the archive lacks"),
+            ));
         } else {
-            let size = archive.by_name(target).map(|f| f.size()).map_err(|_| {
-                bad(
-                    FORMAT,
-                    format!("{name} names {target}, which the archive lacks"),
-                )
-            })?;
-            let len =
-                usize::try_from(size).map_err(|_| bad(FORMAT, format!("{target} is too large")))?;
-            let data = entry(archive, target, len)?;
-            check_md5(target, &data, Some(hex))?;
+            others.push((target.to_string(), hex.to_string()));
         }
     }
-    Ok(())
+    Ok(others)
+}
+
+fn has_entry<R: Read + Seek>(archive: &ZipArchive<R>, name: &str) -> bool {
+    archive.index_for_name(name).is_some()
 }
 
 /// Reads an X3P file (see the module docs).
 pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
-    let mut archive = ZipArchive::new(Cursor::new(bytes)).map_err(zip_error)?;
+    read_archive(ZipArchive::new(Cursor::new(bytes)).map_err(zip_error)?)
+}
+
+/// Reads the X3P file `file` where it is one (a zip archive that holds a `main.xml`),
+/// without holding the file whole: its members are read from the file, the payload
+/// streamed into the heights; `None` where it is not an X3P archive (the file is then read
+/// whole and its format found as for any other).
+pub(crate) fn read_from_file(file: &std::fs::File) -> Option<Result<Reading>> {
+    let reader = std::io::BufReader::with_capacity(1 << 16, file);
+    let archive = ZipArchive::new(reader).ok()?;
+    if !has_entry(&archive, "main.xml") {
+        return None;
+    }
+    Some(read_archive(archive))
+}
+
+/// Reads the X3P archive `archive` (see the module docs).
+fn read_archive<R: Read + Seek>(mut archive: ZipArchive<R>) -> Result<Reading> {
     let xml = main_xml_text(&mut archive)?;
     let doc =
         roxmltree::Document::parse(&xml).map_err(|e| bad(FORMAT, format!("main.xml: {e}")))?;
     let root = doc.root_element();
-    check_checksum_file(&mut archive, root, &xml)?;
+    let mut checksums = check_checksum_file(&mut archive, root, &xml)?;
     let layout = layout(root)?;
     let count = layout.validate()?;
     let records = match &layout.payload {
         Some(name) => {
-            let width = layout.record_width();
-            let len = count
-                .checked_mul(width)
-                .ok_or_else(|| bad(FORMAT, "the grid is larger than any memory"))?;
-            let data = entry(&mut archive, name, len)?;
-            check_md5(name, &data, layout.payload_md5.as_deref())?;
-            let mut records = Records::default();
-            for record in data.chunks_exact(width) {
-                layout.push_record(record, &mut records);
-            }
-            records
+            // The payload's MD5s: main.xml's record and the checksum file's lines for it.
+            let mut md5s: Vec<String> = layout.payload_md5.iter().cloned().collect();
+            md5s.extend(take_lines_for(&mut checksums, name));
+            payload(&mut archive, &layout, name, count, &md5s)?
         }
         None => inline_values(root, &layout, count)?,
     };
+    for (target, hex) in &checksums {
+        compare_md5(target, &entry_md5(&mut archive, target)?, Some(hex))?;
+    }
     let spacing = absolute_spacing(&layout, &records)?;
     let mut values = records.z;
     if let Some(name) = &layout.valid_points {
@@ -499,6 +631,48 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
             is_height: true,
         }],
     })
+}
+
+/// Removes from `lines` (entry, MD5) those for `name`; returns their MD5s.
+fn take_lines_for(lines: &mut Vec<(String, String)>, name: &str) -> Vec<String> {
+    let (mine, others) = std::mem::take(lines)
+        .into_iter()
+        .partition(|(target, _)| target == name);
+    *lines = others;
+    mine.into_iter().map(|(_, hex)| hex).collect()
+}
+
+/// The binary payload `name` of `count` records, streamed into the records' arrays (sized
+/// once from the header, checked against the memory; no copy of the payload is held) and
+/// checked against each MD5 of `md5s` (none: no MD5 is computed).
+fn payload<R: Read + Seek>(
+    archive: &mut ZipArchive<R>,
+    layout: &Layout,
+    name: &str,
+    count: usize,
+    md5s: &[String],
+) -> Result<Records> {
+    let width = layout.record_width();
+    let len = count
+        .checked_mul(width)
+        .ok_or_else(|| bad(FORMAT, "the grid is larger than any memory"))?;
+    let arrays = 1 + layout.absolute.iter().flatten().count();
+    crate::memory::ensure_fits(
+        &format!("reading {name} of an X3P file"),
+        (count as u64).checked_mul(8 * arrays as u64),
+    )?;
+    let mut records = Records::with_capacity(count, layout.absolute.map(|a| a.is_some()));
+    let mut md5 = md5s.iter().any(|m| !m.trim().is_empty()).then(Md5::new);
+    stream_entry(archive, name, len, width, md5.as_mut(), |piece| {
+        layout.decode(piece, &mut records)
+    })?;
+    if let Some(md5) = md5 {
+        let got = hex(&md5.finalize());
+        for want in md5s {
+            compare_md5(name, &got, Some(want))?;
+        }
+    }
+    Ok(records)
 }
 
 /// The values of an inline `DataList` (`Datum` elements; empty = undefined).
@@ -564,6 +738,18 @@ struct Records {
     z: Vec<f64>,
 }
 
+impl Records {
+    /// Room for `count` heights, and as many coordinates along each axis marked absolute.
+    fn with_capacity(count: usize, absolute: [bool; 2]) -> Self {
+        let room = |yes: bool| Vec::with_capacity(if yes { count } else { 0 });
+        Records {
+            x: room(absolute[0]),
+            y: room(absolute[1]),
+            z: Vec::with_capacity(count),
+        }
+    }
+}
+
 /// The largest distance of a stored coordinate from the uniform grid, in steps: coordinates
 /// are written as f32 or rounded decimals, and a thousandth of a step is far below what
 /// matters for the grid and well above f32 rounding on grids below a million points a side.
@@ -619,10 +805,12 @@ fn absolute_spacing(layout: &Layout, r: &Records) -> Result<[f64; 2]> {
 
 /// Hex MD5 in capitals, as X3P records it.
 fn md5_hex(bytes: &[u8]) -> String {
-    Md5::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02X}"))
-        .collect()
+    hex(&Md5::digest(bytes))
+}
+
+/// A digest in hex capitals.
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02X}")).collect()
 }
 
 /// `main.xml` of a float64 map (`SUR`) of `nx × ny` points with spacings `dx, dy`.

@@ -13,7 +13,7 @@
 //! Zstandard stream is read through [`zstd`], a reader that the caller bounds by what the
 //! data say they hold (e.g. a grid's header), never by the stream's own claims.
 
-use std::io::{Cursor, Read};
+use std::io::{Read, Seek};
 
 use zip::ZipArchive;
 
@@ -26,8 +26,8 @@ pub(crate) const MAX_RATIO: u64 = 1100;
 const MAX_WINDOW: u64 = 64 << 20;
 
 /// Reads the member `name` of at most `cap` bytes (see the module docs).
-pub(crate) fn member(
-    archive: &mut ZipArchive<Cursor<&[u8]>>,
+pub(crate) fn member<R: Read + Seek>(
+    archive: &mut ZipArchive<R>,
     format: &'static str,
     name: &str,
     cap: u64,
@@ -55,8 +55,8 @@ pub(crate) fn member(
 
 /// The size `file` (the member `name`) declares, refused unless within `cap` and within
 /// what its compressed bytes can inflate to ([`MAX_RATIO`]); nothing is allocated.
-pub(crate) fn declared_size(
-    file: &zip::read::ZipFile<'_, Cursor<&[u8]>>,
+pub(crate) fn declared_size<R: Read>(
+    file: &zip::read::ZipFile<'_, R>,
     format: &'static str,
     name: &str,
     cap: u64,
@@ -72,7 +72,7 @@ pub(crate) fn declared_size(
 }
 
 /// Whether the archive has a member `name`.
-pub(crate) fn has(archive: &ZipArchive<Cursor<&[u8]>>, name: &str) -> bool {
+pub(crate) fn has<R: Read + Seek>(archive: &ZipArchive<R>, name: &str) -> bool {
     archive.index_for_name(name).is_some()
 }
 
