@@ -235,7 +235,7 @@ def reproduce(figure: str, out: PathLike, *, setting: str = "paper",
               force: bool = False) -> str: ...
 
 def contact(
-    surface: Any, size: Optional[float] = ..., *, pressures: Sequence[float],
+    surface: Any, size: Optional[float] = ..., *, pressures: Optional[Sequence[float]] = ...,
     modulus: Optional[float] = ..., young: Union[None, float, Sequence[float]] = ...,
     poisson: Union[None, float, Sequence[float]] = ...,
     boundary: str = ..., tolerance: float = ..., map: bool = ...,
@@ -243,6 +243,9 @@ def contact(
     thermal_conductivity: Optional[Sequence[float]] = ...,
     hardness: Optional[float] = ..., tangential: Union[bool, str] = ..., load_path: bool = ...,
     progress: ProgressArg = ...,
+    work_of_adhesion: Optional[float] = ..., adhesion_range: Optional[float] = ...,
+    adhesion_model: Optional[str] = ..., indentations: Optional[Sequence[float]] = ...,
+    retract_step: Optional[float] = ...,
 ) -> Sweep: ...
 
 @dataclass
@@ -256,6 +259,7 @@ class MdrCurve:
     critical_depth: float
     branch: Optional[List[str]] = ...
     pull_off: Optional[Dict[str, Dict[str, float]]] = ...
+    modulus: Optional[float] = ...
     def save(self, path: PathLike, *, force: bool = ...) -> None: ...
 
 def mdr(

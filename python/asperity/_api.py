@@ -1244,7 +1244,7 @@ def contact(
     surface: Any,
     size: Optional[float] = None,
     *,
-    pressures: Sequence[float],
+    pressures: Optional[Sequence[float]] = None,
     modulus: Optional[float] = None,
     young: Union[None, float, Sequence[float]] = None,
     poisson: Union[None, float, Sequence[float]] = None,
@@ -1257,6 +1257,11 @@ def contact(
     tangential: Union[bool, str] = False,
     load_path: bool = False,
     progress: ProgressArg = None,
+    work_of_adhesion: Optional[float] = None,
+    adhesion_range: Optional[float] = None,
+    adhesion_model: Optional[str] = None,
+    indentations: Optional[Sequence[float]] = None,
+    retract_step: Optional[float] = None,
 ) -> Sweep:
     """``asperity contact``: the surface (rigid; SI units, heights and sizes in metres)
     pressed into an elastic half-space at each mean ``pressure`` (Pa), with E* =
@@ -1311,14 +1316,27 @@ def contact(
         ...                           hardness=2e9)
         >>> bool(capped.plastic_fraction[0] > 0)
         True
+
+    With ``work_of_adhesion`` (Δγ, J/m²) the run is adhesive instead of a load sweep, as
+    ``asperity contact --work-of-adhesion`` (the solver and rules of :func:`bem_adhesion`,
+    in SI units): the path of ``indentations`` (m), then the retraction to pull-off in
+    steps of ``retract_step`` (m); ``adhesion_range`` (m) and ``adhesion_model``
+    (``"maugis-dugdale"`` or ``"exponential"``) choose a cohesive law, none the pixel
+    criterion. Columns ``indentation_m``, ``force_n``, ``mean_pressure_pa``,
+    ``contact_area_m2``, ``area_fraction``, ``tensile_fraction``, ``rounds``,
+    ``cg_iterations``, ``branch``; ``critical_stress`` (Pa) and ``effective_modulus``;
+    ``metadata["pull_off"]`` (both controls, force in N, indentation in m) and
+    ``metadata["warning"]``. It goes with neither ``load_path`` nor ``map`` (nor the load
+    sweep's options), and reports no ``progress``. See docs/adhesion.md.
     """
-    if load_path:
-        return _contact_path(surface, size, pressures, modulus, young, poisson, boundary,
-                             tolerance, hardness, map=map, tangential=tangential,
-                             resistivity=resistivity,
-                             thermal_conductivity=thermal_conductivity)
     heights, size_x, size_y = _surface_input(surface, size)
-    loads = [float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
+    loads = [] if pressures is None else [
+        float(p) for p in np.atleast_1d(np.asarray(pressures, dtype=np.float64))]
+    path = [] if indentations is None else [
+        float(d) for d in np.atleast_1d(np.asarray(indentations, dtype=np.float64))]
+    adhesion = (_opt(work_of_adhesion), _opt(adhesion_range),
+                None if adhesion_model is None else str(adhesion_model), path,
+                _opt(retract_step))
     bar = _Progress(progress, "contact")
     try:
         columns = _core.contact(
@@ -1327,10 +1345,25 @@ def contact(
             None if resistivity is None else [float(v) for v in np.atleast_1d(resistivity)],
             None if thermal_conductivity is None
             else [float(v) for v in np.atleast_1d(thermal_conductivity)],
-            _opt(hardness), *_tangential(tangential), bar.callback,
+            _opt(hardness), *_tangential(tangential), bar.callback, adhesion,
+            bool(load_path),
         )
     finally:
         bar.close()
+    if columns is None:  # load_path: the request's rules passed, the path on Solver
+        return _contact_path(surface, size, loads, modulus, young, poisson, boundary,
+                             tolerance, hardness)
+    if work_of_adhesion is not None:
+        extra = {k: columns.pop(k) for k in ("pull_off", "warning")}
+        request = {"work_of_adhesion": adhesion[0], "adhesion_range": adhesion[1],
+                   "adhesion_model": adhesion[2], "indentations": path,
+                   "retract_step": adhesion[4], "modulus": _opt(modulus),
+                   "young": _one_or_both(young), "poisson": _one_or_both(poisson),
+                   "boundary": str(boundary)}
+        return Sweep(columns, {"generator": f"asperity {__version__}", "contact": request,
+                               **extra, "shape": list(heights.shape),
+                               "sizes": [size_x, size_y],
+                               "surface": _surface_identity(surface, heights)})
     if "map" in columns:
         dx = size_x / heights.shape[1]
         dy = dx if size_y is None else size_y / heights.shape[0]
@@ -1357,13 +1390,10 @@ _PATH_SI = {"branch": "branch", "force": "force_n", "mean_pressure": "mean_press
 
 
 def _contact_path(surface, size, pressures, modulus, young, poisson, boundary, tolerance,
-                  hardness, **others: Any) -> Sweep:
-    """``contact(load_path=True)``: the solver of ``asperity contact`` (E* from the same
-    rule, its boundary, tolerance and hardness) walked along the pressures."""
-    given = [name for name, value in others.items() if value not in (None, False)]
-    if given:
-        raise ValueError(f"load_path does not go with {given[0]} (a path reports the "
-                         "frozen-set stiffness of each step)")
+                  hardness) -> Sweep:
+    """``contact(load_path=True)``, its request checked by the front-end layer (what a
+    path cannot carry refused as the CLI does): the solver of ``asperity contact`` (E* from
+    the same rule, its boundary, tolerance and hardness) walked along the pressures."""
     e_star = effective_modulus(modulus=modulus, young=young, poisson=poisson)
     solver = Solver(surface, size, modulus=e_star, boundary=boundary, tolerance=tolerance,
                     hardness=hardness)
@@ -1452,7 +1482,8 @@ def _surface_identity(surface: Any, heights: np.ndarray) -> Dict[str, Any]:
 class MdrCurve(_Saved):
     """An MDR curve (``asperity mdr``): ``indentation`` (from first contact), ``force``,
     ``stiffness`` (dF/dd), ``contacts`` (springs compressed), with a ``description`` of the
-    indenter, the ``spring`` law and its ``critical_depth`` u0. With a work of adhesion,
+    indenter, the ``spring`` law and its ``critical_depth`` u0, and E* (``modulus``; None in
+    a curve saved before it was kept). With a work of adhesion,
     also ``branch`` (``"approach"`` or ``"retract"`` per row) and ``pull_off``
     (``{"force_controlled": {...}, "displacement_controlled": {...}}``, each with
     ``force``, ``indentation`` and ``contacts``; None if nothing was in contact)."""
@@ -1466,6 +1497,7 @@ class MdrCurve(_Saved):
     critical_depth: float
     branch: Optional[List[str]] = None
     pull_off: Optional[Dict[str, Dict[str, float]]] = None
+    modulus: Optional[float] = None
 
 
 #: The keywords of the front-end layer's ``MdrRequest`` that :func:`mdr` and

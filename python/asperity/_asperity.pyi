@@ -58,8 +58,11 @@ def contact(
     poisson: Optional[List[float]], boundary: str, tolerance: float, map: bool,
     resistivity: Optional[List[float]] = ..., thermal_conductivity: Optional[List[float]] = ...,
     hardness: Optional[float] = ..., tangential: bool = ...,
-    directions: Optional[str] = ...,
-) -> Dict[str, Any]: ...
+    directions: Optional[str] = ..., progress: Progress = ...,
+    adhesion: Optional[Tuple[Optional[float], Optional[float], Optional[str], List[float],
+                             Optional[float]]] = ...,
+    load_path: bool = ...,
+) -> Optional[Dict[str, Any]]: ...
 
 class Solver:
     def __init__(
@@ -206,6 +209,16 @@ def path_figure(
     values: List[float], indentation: List[float], force: List[float],
     area_fraction: List[float], stiffness: List[float], name: str, boundary: str,
     hardness: Optional[float],
+) -> str: ...
+def adhesion_loop_figure(
+    indentation: List[float], force: List[float], retract: List[bool],
+    pull_off: Optional[Tuple[Tuple[float, float], Tuple[float, float]]], title: str,
+    x_label: str, y_label: str, force_unit: str,
+    theory: Optional[Tuple[str, List[Tuple[float, float]]]] = ...,
+) -> str: ...
+def mdr_figure(
+    indentation: List[float], force: List[float], stiffness: List[float], description: str,
+    law: str, modulus: float,
 ) -> str: ...
 def surface_figure(
     heights: npt.NDArray[np.float64], size_x: float, size_y: float, metres: bool, name: str,

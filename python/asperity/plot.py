@@ -19,6 +19,9 @@ returns the ``Axes``:
   (``asperity contact --map``);
 * :func:`alpha` -- α(H) with its 95 % intervals and the theory (``asperity study alpha``);
 * :func:`load_path` -- a load path's loading–unloading loop (``bem --load-path --plot``);
+* :func:`mdr` -- an MDR curve's F(d) and k(F), log–log (``asperity mdr --plot``);
+* :func:`adhesion_loop` -- an adhesive run's force–approach loop with arrows and pull-offs
+  (``bem|contact|mdr --work-of-adhesion --plot``);
   :func:`field` -- a field (the plastic or permanent displacement) as an image;
 * :func:`figure` -- any figure the CLI wrote as data (``--plot FILE.json``).
 
@@ -46,7 +49,7 @@ from typing import Any, Optional
 import numpy as _np
 
 __all__ = ["surface", "psd", "analysis", "stiffness", "area", "contact_map", "alpha", "figure",
-           "load_path", "field"]
+           "load_path", "adhesion_loop", "mdr", "field"]
 
 
 def __dir__() -> list:
@@ -310,6 +313,69 @@ def load_path(path: Any, axes=None):
         c["force"].tolist(), c["area_fraction"].tolist(), c["stiffness"].tolist(), "surface",
         solver.get("boundary", "free"), solver.get("hardness"))
     return figure(__import__("json").loads(text), axes)
+
+
+def mdr(curve: Any, axes=None):
+    """An :func:`asperity.mdr` curve as ``asperity mdr --plot`` draws it (one figure
+    definition, ``asperity_app::figure::mdr``): F/E* against the indentation d and k/E*
+    against F/E*, log–log (the row at zero force left out). ``axes``: two matplotlib axes,
+    or None for a new figure. Returns the axes. An adhesive curve's loop is
+    :func:`adhesion_loop`'s.
+
+    Example::
+
+        >>> import asperity, asperity.plot
+        >>> c = asperity.mdr(profile="hertz", radius=1.0, n=2001, dx=0.01,
+        ...                  indentations=[1e-4, 1e-3, 1e-2])
+        >>> force_ax, stiffness_ax = asperity.plot.mdr(c)
+        >>> force_ax.get_xscale(), stiffness_ax.get_ylabel()
+        ('log', 'contact stiffness k / E*  [length]')
+    """
+    from . import _asperity
+
+    if getattr(curve, "branch", None) is not None:
+        raise ValueError("plot.mdr: an adhesive curve; draw its loop with "
+                         "asperity.plot.adhesion_loop")
+    modulus = 1.0 if getattr(curve, "modulus", None) is None else float(curve.modulus)
+    text = _asperity.mdr_figure(
+        [float(v) for v in curve.indentation], [float(v) for v in curve.force],
+        [float(v) for v in curve.stiffness], str(curve.description), str(curve.spring),
+        modulus)
+    return figure(__import__("json").loads(text), axes)
+
+
+def adhesion_loop(run: Any, ax=None, *, theory: Optional[tuple] = None):
+    """The force–approach loop of an adhesive run as ``asperity bem|contact|mdr
+    --work-of-adhesion --plot`` draws it (one figure definition,
+    ``asperity_app::figure::adhesion``): the path and the retraction to pull-off, an arrow
+    on every monotone run the way it was travelled (loading red, unloading blue), both
+    pull-offs marked. ``run``: a :func:`asperity.bem_adhesion` result, an adhesive
+    :func:`asperity.mdr` curve, or an adhesive :func:`asperity.contact` result (SI units);
+    ``theory``: an optional ``(label, [(d, F), ...])`` curve, dashed. Returns the axes."""
+    import json
+
+    from . import _asperity
+
+    if hasattr(run, "columns"):  # asperity.contact(work_of_adhesion=...): SI units
+        c, pull = run.columns, run.metadata.get("pull_off")
+        d, f, branch = c["indentation_m"], c["force_n"], c["branch"]
+        labels = ("indentation d  [m]", "normal force F  [N]", " N")
+        title = "adhesive contact"
+    else:
+        d, f, branch, pull = run.indentation, run.force, run.branch, run.pull_off
+        labels = ("indentation d  [length]", "normal force F  [E*·length²]", "")
+        title = "adhesive loop"
+    if branch is None:
+        raise ValueError("adhesion_loop: the run has no branches (not an adhesive run)")
+    mark = None
+    if pull is not None:
+        point = lambda p: (float(p["indentation"]), float(p["force"]))  # noqa: E731
+        mark = (point(pull["force_controlled"]), point(pull["displacement_controlled"]))
+    text = _asperity.adhesion_loop_figure(
+        [float(v) for v in d], [float(v) for v in f], [b == "retract" for b in branch],
+        mark, title, *labels,
+        None if theory is None else (str(theory[0]), [(float(x), float(y)) for x, y in theory[1]]))
+    return _draw(json.loads(text)["charts"][0], ax)
 
 
 def field(values: Any, ax=None, *, size: Optional[tuple] = None, label: str = "",

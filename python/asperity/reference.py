@@ -13,7 +13,8 @@ approaches are positive into the half-space; compressive forces are positive.
 * :class:`CattaneoMindlin` -- a Hertz contact under a tangential force (partial slip);
 * :class:`Jkr`, :class:`Dmt`, :class:`Kendall` -- adhesive sphere and punch;
 * :class:`MaugisDugdale` -- the adhesive sphere between DMT and JKR (a Dugdale cohesive
-  zone), dimensionless, with the units of a given sphere (:meth:`MaugisDugdale.scales`).
+  zone), dimensionless, with the units of a given sphere (:meth:`MaugisDugdale.scales`);
+* :class:`JohnsonSinusoid` -- Johnson's adhesive periodic sinusoid (JKR-type edges).
 
 Example::
 
@@ -32,7 +33,7 @@ import numpy as _np
 from . import _asperity as _core
 
 __all__ = ["Hertz", "FlatPunch", "Cone", "PowerLaw", "Westergaard", "CattaneoMindlin",
-           "Jkr", "Dmt", "Kendall", "MaugisDugdale"]
+           "Jkr", "Dmt", "Kendall", "MaugisDugdale", "JohnsonSinusoid"]
 
 
 def __dir__() -> list:
@@ -347,3 +348,71 @@ class MaugisDugdale(_Model):
                  for name in ("radius", "force", "approach", "lambda")}
         value["maugis_parameter"] = value.pop("lambda")
         return value
+
+
+class JohnsonSinusoid(_Model):
+    """Johnson's adhesive sinusoid (Johnson, Int. J. Solids Struct. 32, 423, 1995): a rigid
+    periodic sinusoid ``amplitude · (1 − cos 2πx/λ)`` of ``wavelength`` λ on a half-space
+    of ``modulus`` E* with ``work_of_adhesion`` w of vanishing range, as the library's
+    ``asperity::reference::JohnsonSinusoid`` (the closed form the adhesive BEM is checked
+    against, docs/adhesion.md). At contact half-width a (ψ = πa/λ) the mean pressure is
+    ``p̄ = p*[sin²ψ − α√(tan ψ)]``, ``p* = πE*Δ/λ``, ``α = √(2wλ/(π²E*Δ²))``.
+
+    Examples
+    --------
+    >>> from asperity.reference import JohnsonSinusoid
+    >>> j = JohnsonSinusoid(wavelength=1.0, amplitude=0.01, modulus=1.0,
+    ...                     work_of_adhesion=1.2337e-4)
+    >>> round(j.alpha(), 3)
+    0.5
+    >>> round(j.pull_off_pressure() / j.full_contact_pressure(), 3)   # force control
+    -0.192
+    """
+
+    _name, _probe = "johnson_sinusoid", "alpha"
+    _params = ("wavelength", "amplitude", "modulus", "work_of_adhesion")
+
+    def full_contact_pressure(self) -> float:
+        """Westergaard's ``p* = πE*Δ/λ``."""
+        return self._eval("full_contact_pressure", 0.0)
+
+    def alpha(self) -> float:
+        """Johnson's parameter ``α = √(2wλ/(π²E*Δ²))``."""
+        return self._eval("alpha", 0.0)
+
+    def mean_pressure(self, half_width: Any) -> Any:
+        """``p̄`` at contact half-width ``a`` (0 ≤ a < λ/2)."""
+        return self._eval("mean_pressure", half_width)
+
+    def approach(self, half_width: Any) -> Any:
+        """The approach at ``a``: Westergaard's ``Δr(1 − ln r)``, ``r = sin²ψ``, plus the
+        edge punches' ``(2λp̄ₚ/πE*) ln(1/sin ψ)`` (displacements of zero mean)."""
+        return self._eval("approach", half_width)
+
+    def stable_branch(self) -> Any:
+        """The half-widths ``(least, greatest)`` of the stable branch's least and greatest
+        mean pressure, or None when no partial contact is stable (α ≥ 1.065)."""
+        least = self._eval("stable_branch_least", 0.0)
+        return None if _np.isnan(least) else (least, self._eval("stable_branch_greatest", 0.0))
+
+    def pull_off_half_width(self, control: str = "force") -> float:
+        """The half-width at pull-off (NaN when no partial contact is stable)."""
+        return self._eval(f"pull_off_half_width_{_control(control)}", 0.0)
+
+    def pull_off_pressure(self, control: str = "force") -> float:
+        """The mean pressure at pull-off: the stable branch's least (``"force"``) or the
+        one at the least approach (``"displacement"``); NaN when none is stable."""
+        return self._eval(f"pull_off_pressure_{_control(control)}", 0.0)
+
+    @staticmethod
+    def alpha_stable() -> float:
+        """α above which no partial contact is stable, ``4(3/8)^{3/4}(5/8)^{5/4} ≈ 1.065``."""
+        return float(_core.reference("johnson_sinusoid", [1.0, 1.0, 1.0, 1.0], "alpha_stable",
+                                     [], _np.asarray(0.0)))
+
+    @staticmethod
+    def alpha_snap() -> float:
+        """α above which the surfaces pull themselves into full contact under no load,
+        ``(3/4)^{3/4}/√2 ≈ 0.570``."""
+        return float(_core.reference("johnson_sinusoid", [1.0, 1.0, 1.0, 1.0], "alpha_snap",
+                                     [], _np.asarray(0.0)))

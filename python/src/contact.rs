@@ -64,10 +64,20 @@ fn label_patches<'py>(
     Ok((labels.into_pyarray(py), sizes, areas))
 }
 
-/// The request's rules, then the sweep; returns the CLI's columns (and the contact set of
-/// the last load with `map`).
+/// An adhesive run's options: Δγ (J/m²), the range (m), the law, the path (m), the step (m).
+type Adhesion = (
+    Option<f64>,
+    Option<f64>,
+    Option<String>,
+    Vec<f64>,
+    Option<f64>,
+);
+
+/// The request's rules, then the sweep (or with `adhesion` the adhesive run); returns the
+/// CLI's columns (and the contact set of the last load with `map`); with `load_path`, the
+/// rules alone (None: `_api._contact_path` walks the path on `Solver.load_path`).
 #[pyfunction]
-#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, directions=None, progress=None))]
+#[pyo3(signature = (heights, size_x, size_y, pressures, modulus, young, poisson, boundary, tolerance, map, resistivity=None, thermal_conductivity=None, hardness=None, tangential=false, directions=None, progress=None, adhesion=None, load_path=false))]
 #[allow(clippy::too_many_arguments)]
 fn contact<'py>(
     py: Python<'py>,
@@ -87,7 +97,9 @@ fn contact<'py>(
     tangential: bool,
     directions: Option<String>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+    adhesion: Option<Adhesion>,
+    load_path: bool,
+) -> PyResult<Option<Bound<'py, PyDict>>> {
     let (young, young_2) =
         app::one_or_two(app::params::YOUNG, young.as_deref().unwrap_or(&[])).map_err(refused)?;
     let (poisson, poisson_2) =
@@ -109,6 +121,28 @@ fn contact<'py>(
         directions,
         ..ContactRequest::default()
     };
+    let request = match adhesion {
+        Some((w, range, model, path, step)) => ContactRequest {
+            work_of_adhesion: w,
+            adhesion_range: range,
+            adhesion_model: model,
+            indentations: path,
+            retract_step: step,
+            ..request
+        },
+        None => request,
+    };
+    request
+        .refuse_run_options(load_path, map)
+        .map_err(refused)?;
+    if request.is_adhesive() {
+        return crate::adhesion::contact_adhesion(py, &request, &heights, (size_x, size_y))
+            .map(Some);
+    }
+    if load_path {
+        // The rules alone: the path itself runs on `Solver.load_path` (`_api._contact_path`).
+        return request.validate().map(|_| None).map_err(refused);
+    }
     let plan = request.validate().map_err(refused)?;
     let (rows, cols) = heights.as_array().dim();
     ensure_solver_fits(
@@ -176,5 +210,5 @@ fn contact<'py>(
         dict.set_item("map", map.into_pyarray(py))?;
     }
     dict.set_item("effective_modulus", plan.half_space.modulus)?;
-    Ok(dict)
+    Ok(Some(dict))
 }

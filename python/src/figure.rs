@@ -15,12 +15,91 @@ use pyo3::prelude::*;
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_figure, m)?)?;
     m.add_function(wrap_pyfunction!(path_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(adhesion_loop_figure, m)?)?;
+    m.add_function(wrap_pyfunction!(mdr_figure, m)?)?;
     m.add_function(wrap_pyfunction!(surface_figure, m)?)?;
     m.add_function(wrap_pyfunction!(contact_map_figure, m)?)?;
     m.add_function(wrap_pyfunction!(psd_figure, m)?)?;
     m.add_function(wrap_pyfunction!(contact_figure, m)?)?;
     m.add_function(wrap_pyfunction!(analysis_figure, m)?)?;
     Ok(())
+}
+
+/// An MDR curve's figure as `asperity mdr --plot FILE.json` writes it
+/// ([`asperity_app::figure::mdr::mdr_charts`]): the columns d, F, k, the indenter's
+/// description, the spring law and E*.
+#[pyfunction]
+#[pyo3(signature = (indentation, force, stiffness, description, law, modulus))]
+fn mdr_figure(
+    indentation: Vec<f64>,
+    force: Vec<f64>,
+    stiffness: Vec<f64>,
+    description: &str,
+    law: &str,
+    modulus: f64,
+) -> PyResult<String> {
+    use asperity_app::figure::mdr::{mdr_charts, MdrColumns, MdrFigure};
+    if force.len() != indentation.len() || stiffness.len() != indentation.len() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "mdr_figure: the columns differ in length",
+        ));
+    }
+    let columns = MdrColumns {
+        indentation: &indentation,
+        force: &force,
+        stiffness: &stiffness,
+    };
+    let figure = MdrFigure {
+        description,
+        law,
+        modulus,
+    };
+    Ok(figure::to_json(&mdr_charts(columns, figure)).to_string())
+}
+
+/// An adhesive loop's figure as `asperity bem|contact|mdr --work-of-adhesion --plot
+/// FILE.json` writes it ([`asperity_app::figure::adhesion::loop_chart`]): per state `(d,
+/// F)` and whether it is the retraction's; both pull-offs `((d, F), (d, F))` (force,
+/// displacement control); the labels and the forces' unit; a dashed theory curve.
+#[pyfunction]
+#[pyo3(signature = (indentation, force, retract, pull_off, title, x_label, y_label, force_unit, theory=None))]
+#[allow(clippy::too_many_arguments)]
+fn adhesion_loop_figure(
+    indentation: Vec<f64>,
+    force: Vec<f64>,
+    retract: Vec<bool>,
+    pull_off: Option<((f64, f64), (f64, f64))>,
+    title: String,
+    x_label: String,
+    y_label: String,
+    force_unit: String,
+    theory: Option<(String, Vec<(f64, f64)>)>,
+) -> PyResult<String> {
+    use asperity_app::figure::adhesion::{loop_chart, LoopFigure, LoopPoint, LoopPullOffs};
+    if force.len() != indentation.len() || retract.len() != indentation.len() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "adhesion_loop_figure: the columns differ in length",
+        ));
+    }
+    let points: Vec<LoopPoint> = (0..indentation.len())
+        .map(|k| LoopPoint {
+            indentation: indentation[k],
+            force: force[k],
+            retract: retract[k],
+        })
+        .collect();
+    let pull = pull_off.map(|(f, d)| LoopPullOffs {
+        force_controlled: f,
+        displacement_controlled: d,
+    });
+    let figure = LoopFigure {
+        title,
+        x_label,
+        y_label,
+        force_unit,
+        theory,
+    };
+    Ok(figure::to_json(&[loop_chart(&points, pull, figure)]).to_string())
 }
 
 /// The height map's figure as `asperity surface --plot FILE.json` writes it (heights rows

@@ -56,6 +56,7 @@ fn mdr_curve<'py>(
     dict.set_item("description", indenter.description)?;
     dict.set_item("spring", law.name())?;
     dict.set_item("critical_depth", spring.critical_depth())?;
+    dict.set_item("modulus", modulus)?;
     Ok(dict)
 }
 
@@ -176,5 +177,6 @@ fn adhesive_curve<'py>(
         Spring::new(SpringLaw::Linear, indenter.spacing, request.modulus).map_err(from_error)?;
     dict.set_item("spring", SpringLaw::Linear.name())?;
     dict.set_item("critical_depth", spring.critical_depth())?;
+    dict.set_item("modulus", request.modulus)?;
     Ok(dict)
 }

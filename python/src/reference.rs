@@ -3,9 +3,10 @@
 //! library's tests and the CLI's reports use.
 
 use asperity::reference::{
-    CattaneoMindlin, Cone, Dmt, FlatPunch, Hertz, Jkr, Kendall, MaugisDugdale, PowerLaw, PullOff,
-    Westergaard,
+    CattaneoMindlin, Cone, Dmt, FlatPunch, Hertz, Jkr, JohnsonSinusoid, Kendall, MaugisDugdale,
+    PowerLaw, PullOff, Westergaard,
 };
+use asperity_app::refusal::{self, Names, Param};
 use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 
@@ -19,8 +20,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// A method of a model: its value at `x` (the array argument) given the scalars before it.
 type Method = Box<dyn Fn(f64) -> f64>;
 
-/// `N` parameters, each positive and finite (the model is named in the error).
-fn positive<const N: usize>(model: &str, names: [&str; N], params: &[f64]) -> PyResult<[f64; N]> {
+/// `N` parameters, each positive and finite by the front-end layer's rule
+/// (`asperity_app::refusal::positive`, the CLI's), the model named in the error.
+fn positive<const N: usize>(
+    model: &str,
+    names: [&'static str; N],
+    params: &[f64],
+) -> PyResult<[f64; N]> {
     if params.len() != N {
         return Err(invalid(format!(
             "{model}: expected {N} parameters ({}), got {}",
@@ -28,13 +34,9 @@ fn positive<const N: usize>(model: &str, names: [&str; N], params: &[f64]) -> Py
             params.len()
         )));
     }
-    for (name, value) in names.iter().zip(params) {
-        if !(value.is_finite() && *value > 0.0) {
-            return Err(invalid(format!(
-                "{model}: {name} must be positive and finite, got {}",
-                asperity_app::refusal::number(*value)
-            )));
-        }
+    for (&name, &value) in names.iter().zip(params) {
+        refusal::positive(Param::new(name, name), value)
+            .map_err(|r| invalid(format!("{model}: {}", r.words(Names::Keywords))))?;
     }
     Ok(std::array::from_fn(|i| params[i]))
 }
@@ -207,7 +209,38 @@ fn maugis(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
             };
             Box::new(move |_| value)
         }
+        "johnson_sinusoid" => return johnson(model, params, method),
         _ => return Err(invalid(format!("unknown reference solution {model:?}"))),
+    })
+}
+
+/// Johnson's adhesive sinusoid (`asperity::reference::JohnsonSinusoid`): its curve against
+/// the contact half-width, the ends of its stable branch and its pull-offs (NaN where no
+/// partial contact is stable), and the two thresholds of α.
+fn johnson(model: &str, params: &[f64], method: &str) -> PyResult<Method> {
+    let names = ["wavelength", "amplitude", "modulus", "work_of_adhesion"];
+    let [l, amp, e, w] = positive(model, names, params)?;
+    let j = JohnsonSinusoid::new(l, amp, e, w).map_err(from_error)?;
+    let constant = |v: f64| -> Method { Box::new(move |_| v) };
+    let branch = j.stable_branch();
+    Ok(match method {
+        "mean_pressure" => Box::new(move |a| j.mean_pressure(a)),
+        "approach" => Box::new(move |a| j.approach(a)),
+        "full_contact_pressure" => constant(j.full_contact_pressure()),
+        "alpha" => constant(j.alpha()),
+        "alpha_stable" => constant(JohnsonSinusoid::ALPHA_STABLE),
+        "alpha_snap" => constant(JohnsonSinusoid::ALPHA_SNAP),
+        "stable_branch_least" => constant(branch.map_or(f64::NAN, |b| b.0)),
+        "stable_branch_greatest" => constant(branch.map_or(f64::NAN, |b| b.1)),
+        _ if method.starts_with("pull_off_half_width_") => {
+            let point = j.pull_off(control(&method[20..])?);
+            constant(point.map_or(f64::NAN, |p| p.0))
+        }
+        _ if method.starts_with("pull_off_pressure_") => {
+            let point = j.pull_off(control(&method[18..])?);
+            constant(point.map_or(f64::NAN, |p| p.1))
+        }
+        _ => return Err(unknown(model, method)),
     })
 }
 

@@ -345,3 +345,72 @@ def test_bem_exponential_potential_equals_the_cli(cli, tmp_path):
     with pytest.raises(ValueError, match="invalid adhesion_model"):
         asperity.bem_adhesion(h, size=0.2, work_of_adhesion=2e-4, indentations=path,
                               adhesion_range=rho, adhesion_model="lennard-jones")
+
+
+def test_contact_adhesion_equals_the_cli(cli, tmp_path):
+    # asperity contact --work-of-adhesion (SI units) and contact(work_of_adhesion=...): the
+    # same request, run and numbers, bit for bit; the loop's figure is one definition
+    # (the CLI's --plot FILE.json series are Python's adhesion_loop's).
+    from asperity import _asperity
+
+    x = (np.arange(40) - 20) * 5e-7                      # 0.5 µm pixels
+    h = -(x[:, None]**2 + x[None, :]**2) / (2 * 1e-4)   # a sphere R = 0.1 mm, in m
+    np.save(tmp_path / "sphere.npy", h)
+    path = [2e-8, 4e-8, 8e-8, 4e-8]
+    w, rho, e_star = 0.05, 1e-8, 1e9                     # zone resolution 4.2
+    cli("contact", tmp_path / "sphere.npy", "--size", 2e-5, "--detrend", "none",
+        "--modulus", e_star, "--work-of-adhesion", w, "--adhesion-range", rho,
+        "--adhesion-model", "exponential", "--indentations", ",".join(map(str, path)),
+        "--retract-step", 2e-9, "--out", tmp_path / "c.csv", "--plot", tmp_path / "c.json")
+    with open(tmp_path / "c.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    ours = asperity.contact(h, size=2e-5, modulus=e_star, work_of_adhesion=w,
+                            adhesion_range=rho, adhesion_model="exponential",
+                            indentations=path, retract_step=2e-9)
+    assert ours.branch == [r["branch"] for r in rows]
+    for name in ["indentation_m", "force_n", "mean_pressure_pa", "contact_area_m2",
+                 "area_fraction", "tensile_fraction"]:
+        assert ours[name].tolist() == [float(r[name]) for r in rows], name
+    for name in ["rounds", "cg_iterations"]:
+        assert ours[name].tolist() == [int(r[name]) for r in rows], name
+    assert min(ours["rounds"]) >= 1  # the retraction's rows count their solves too
+    record = json.load(open(tmp_path / "c.csv.json"))
+    pull = record["adhesion"]["pull_off"]["force_controlled"]
+    assert pull["force_n"] == ours.metadata["pull_off"]["force_controlled"]["force"] < 0
+    assert record["adhesion"]["work_of_adhesion_j_per_m2"] == w
+    drawn = json.load(open(tmp_path / "c.json"))["charts"][0]
+    pulls = ours.metadata["pull_off"]
+    mark = tuple((p["indentation"], p["force"]) for p in
+                 (pulls["force_controlled"], pulls["displacement_controlled"]))
+    python = json.loads(_asperity.adhesion_loop_figure(
+        ours["indentation_m"].tolist(), ours["force_n"].tolist(),
+        [b == "retract" for b in ours.branch], mark, "t", "x", "y", " N"))["charts"][0]
+    assert python["series"] == drawn["series"]
+    assert [s["style"] for s in drawn["series"]].count("arrows") == 2
+    # asperity.plot.adhesion_loop draws that chart: its labels, and each line series' points.
+    pytest.importorskip("matplotlib").use("Agg")
+    from asperity import plot
+
+    ax = plot.adhesion_loop(ours)
+    assert (ax.get_xlabel(), ax.get_ylabel()) == (drawn["x_label"], drawn["y_label"])
+    lines = [np.asarray(line.get_xydata()) for line in ax.lines]
+    for series in drawn["series"]:
+        if series["style"] == "line" and len(series["points"]) > 1:
+            assert any(np.array_equal(xy, np.array(series["points"])) for xy in lines)
+    # Refusals in Python's words, the CLI's rules.
+    with pytest.raises(ValueError, match="does not go with pressures"):
+        asperity.contact(h, size=2e-5, modulus=e_star, work_of_adhesion=w,
+                         indentations=path, pressures=[1e6])
+    with pytest.raises(ValueError, match="adhesion_range needs work_of_adhesion"):
+        asperity.contact(h, size=2e-5, modulus=e_star, pressures=[1e6], adhesion_range=rho)
+    # What an adhesive run cannot carry, in the front-end layer's words for both.
+    refused = cli("contact", tmp_path / "sphere.npy", "--size", 2e-5, "--detrend", "none",
+                  "--modulus", e_star, "--work-of-adhesion", w, "--indentations", "2e-8",
+                  "--load-path", ok=False).stderr
+    assert "--work-of-adhesion takes a path of --indentations (m) and does not go with " \
+           "--load-path" in refused
+    for extra, name in [({"load_path": True}, "load_path"), ({"map": True}, "map")]:
+        with pytest.raises(ValueError, match=f"work_of_adhesion takes a path of indentations "
+                                             rf"\(m\) and does not go with {name}$"):
+            asperity.contact(h, size=2e-5, modulus=e_star, work_of_adhesion=w,
+                             indentations=path, **extra)

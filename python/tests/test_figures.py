@@ -267,3 +267,37 @@ def test_a_study_curves_k_and_area_are_curve_csv_with_its_intervals(cli, tmp_pat
     assert ax.get_yscale() == "log" and ax.get_ylabel() == area_chart["y_label"]
     np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(),
                                   [p[1] for p in area_chart["series"][0]["points"]])
+
+
+def test_an_mdr_curves_figure_is_the_clis_bit_for_bit(cli, tmp_path):
+    """`asperity mdr --plot FILE.json` and `asperity.plot.mdr` of the same curve: the same
+    two charts (F/E* against d, k/E* against F/E*, log–log; titles included, both name the
+    indenter and its springs), the forces over E* as the table holds them, and matplotlib
+    draws the charts' points."""
+    d = [1e-4, 3e-4, 1e-3, 3e-3, 1e-2]
+    cli("mdr", "--profile", "hertz", "--radius", "1", "--n", "2001", "--dx", "0.01",
+        "--modulus", "2.5", "--indentations", ",".join(map(str, d)),
+        "--out", tmp_path / "c.csv", "--plot", tmp_path / "c.json")
+    theirs = json.loads((tmp_path / "c.json").read_text())["charts"]
+    curve = asperity.mdr(profile="hertz", radius=1.0, n=2001, dx=0.01, modulus=2.5,
+                         indentations=d)
+    assert curve.modulus == 2.5
+    from asperity import _asperity
+
+    mine = json.loads(_asperity.mdr_figure(
+        curve.indentation.tolist(), curve.force.tolist(), curve.stiffness.tolist(),
+        curve.description, curve.spring, curve.modulus))["charts"]
+    assert _nan_to_none(mine) == _nan_to_none(theirs)
+    shown = curve.force > 0
+    assert theirs[0]["series"][0]["points"] == [
+        [x, f / 2.5] for x, f in zip(curve.indentation[shown], curve.force[shown])]
+    axes = asperity.plot.mdr(curve)
+    assert len(axes) == 2
+    for ax, chart in zip(axes, theirs):
+        assert ax.get_xscale() == ax.get_yscale() == "log"
+        assert ax.get_xlabel() == chart["x_label"] and ax.get_ylabel() == chart["y_label"]
+        assert np.array_equal(ax.lines[0].get_xydata(), np.array(chart["series"][0]["points"]))
+    adhesive = asperity.mdr(profile="hertz", radius=1.0, n=1001, dx=1e-3,
+                            work_of_adhesion=1e-3, indentations=[0.09])
+    with pytest.raises(ValueError, match="adhesion_loop"):
+        asperity.plot.mdr(adhesive)

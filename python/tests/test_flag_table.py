@@ -79,4 +79,4 @@ def test_the_keywords_named_exist(command):
 
 def test_the_gaps_are_few_and_named():
     gaps = [(c, f) for c in COMMANDS for f, cell in table(c).items() if cell.startswith("—")]
-    assert gaps == [("mdr", "--plot"), ("bem", "--timing")]
+    assert gaps == [("bem", "--timing")]

@@ -208,3 +208,43 @@ def test_the_jkr_curve_the_cli_draws_is_asperity_reference_jkr(cli, tmp_path):
     record = json.loads((tmp_path / "c.csv.json").read_text())
     pull = record["adhesion"]["pull_off"]["force_controlled"]["force"]
     assert abs(pull / jkr.pull_off_force("force") - 1) < 1e-4
+
+
+def test_johnson_sinusoid_is_the_closed_form_with_its_pull_offs_and_thresholds():
+    # The library's JohnsonSinusoid through Python against the closed form written here in
+    # numpy: p̄ = p*[sin²ψ − α√tan ψ] and the approach Δr(1 − ln r) + (2λp̄ₚ/πE*) ln(1/sin ψ),
+    # p̄ₚ = −√(2E*w tan ψ/λ); the pull-offs against a fine numpy scan of the same curve
+    # (force control: the least p̄ on the stable branch; displacement control: p̄ at the
+    # least approach); the thresholds against Johnson's closed forms of α.
+    from asperity.reference import JohnsonSinusoid
+
+    lam, amp, e, w = 1.0, 0.01, 1.0, 1.2337e-4
+    j = JohnsonSinusoid(wavelength=lam, amplitude=amp, modulus=e, work_of_adhesion=w)
+    alpha = np.sqrt(2 * w * lam / (np.pi**2 * e * amp**2))
+    p_star = np.pi * e * amp / lam
+    assert j.alpha() == pytest.approx(alpha, rel=1e-14)
+    assert j.full_contact_pressure() == pytest.approx(p_star, rel=1e-14)
+    a = np.linspace(1e-4, 0.4, 4000) * lam
+    psi = np.pi * a / lam
+    punch = -np.sqrt(2 * e * w * np.tan(psi) / lam)
+    p = p_star * np.sin(psi)**2 + punch
+    r = np.sin(psi)**2
+    d = amp * r * (1 - np.log(r)) - 2 * lam * punch / (np.pi * e) * np.log(np.sin(psi))
+    np.testing.assert_allclose(j.mean_pressure(a), p, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(j.approach(a), d, rtol=1e-12, atol=1e-15)
+    least, greatest = j.stable_branch()
+    stable = (a >= least) & (a <= greatest)
+    assert j.pull_off_pressure("force") == pytest.approx(p[stable].min(), rel=1e-6)
+    assert j.pull_off_half_width("force") == pytest.approx(a[np.argmin(p)], abs=2e-4)
+    upto = a <= greatest
+    k = np.argmin(d[upto])
+    assert j.pull_off_half_width("displacement") == pytest.approx(a[upto][k], abs=2e-4)
+    assert j.pull_off_pressure("displacement") == pytest.approx(p[upto][k], rel=1e-3)
+    # Johnson's α thresholds, and beyond the first no partial contact is stable.
+    assert JohnsonSinusoid.alpha_stable() == pytest.approx(
+        4 * (3 / 8)**0.75 * (5 / 8)**1.25, rel=1e-14)
+    assert JohnsonSinusoid.alpha_snap() == pytest.approx(0.75**0.75 / np.sqrt(2), rel=1e-14)
+    sticky = JohnsonSinusoid(lam, amp, e, w * (1.1 / alpha)**2)
+    assert sticky.stable_branch() is None and np.isnan(sticky.pull_off_pressure())
+    with pytest.raises(ValueError, match="work_of_adhesion"):
+        JohnsonSinusoid(lam, amp, e, -1.0)

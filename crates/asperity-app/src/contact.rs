@@ -29,6 +29,10 @@ pub mod params {
     pub const YOUNG: Param = Param::new("--young", "young");
     /// The hardness that caps the contact pressure, Pa (`asperity bem`'s parameter).
     pub use crate::bem::params::HARDNESS;
+    /// The contact set of the last load: a picture (CLI) or an array (Python).
+    pub const MAP: Param = Param::new("--map", "map");
+    /// The pressures walked as one load path (`asperity contact --load-path`).
+    pub const LOAD_PATH: Param = Param::new("--load-path", "load_path");
 }
 
 use params::*;
@@ -257,6 +261,40 @@ impl ContactRequest {
 }
 
 impl ContactRequest {
+    /// The two options of a run that the request does not carry (`load_path`: the
+    /// pressures walked as one path; `map`: the last contact set) against the request's
+    /// others, the one rule of both front ends: an adhesive run takes neither, a load path
+    /// no map, tangential stiffness or conductance (it reports the frozen-set stiffness of
+    /// each step). Checked before [`Self::validate`] or [`Self::adhesion_plan`].
+    pub fn refuse_run_options(&self, load_path: bool, map: bool) -> Result<(), Refusal> {
+        if self.is_adhesive() {
+            return match [(map, MAP), (load_path, LOAD_PATH)]
+                .iter()
+                .find(|(on, _)| *on)
+            {
+                Some((_, param)) => Err(Refusal::of(crate::adhesion::WORK_OF_ADHESION)
+                    .text(" takes a path of ")
+                    .param(bem::INDENTATIONS)
+                    .text(" (m) and does not go with ")
+                    .param(*param)),
+                None => Ok(()),
+            };
+        }
+        let given = [
+            (map, MAP),
+            (self.tangential, TANGENTIAL),
+            (self.resistivity.is_some(), RESISTIVITY),
+            (self.thermal_conductivity.is_some(), THERMAL_CONDUCTIVITY),
+        ];
+        match given.iter().find(|(on, _)| *on) {
+            Some((_, param)) if load_path => Err(Refusal::of(LOAD_PATH)
+                .text(" does not go with ")
+                .param(*param)
+                .text(" (a path reports the frozen-set stiffness of each step)")),
+            _ => Ok(()),
+        }
+    }
+
     /// E* in Pa by this request's rule ([`Self::modulus`]), for the adhesive run.
     pub(crate) fn modulus_pa(&self) -> Result<f64, Refusal> {
         self.modulus()
@@ -539,6 +577,49 @@ mod tests {
     /// A refusal in Python's words.
     fn first(refusal: &Refusal) -> String {
         refusal.words(crate::refusal::Names::Keywords)
+    }
+
+    #[test]
+    fn a_load_path_or_an_adhesive_run_refuses_what_it_cannot_carry() {
+        let request = ContactRequest {
+            modulus: Some(1e9),
+            pressures: vec![1e6],
+            resistivity: Some(vec![1e-7, 1e-7]),
+            ..ContactRequest::default()
+        };
+        assert_eq!(request.refuse_run_options(false, true), Ok(()));
+        let words = |r: &ContactRequest, path, map| {
+            let refusal = r.refuse_run_options(path, map).unwrap_err();
+            (refusal.words(crate::refusal::Names::Flags), first(&refusal))
+        };
+        assert_eq!(
+            words(&request, true, true),
+            (
+                "--load-path does not go with --map (a path reports the frozen-set stiffness \
+                 of each step)"
+                    .to_string(),
+                "load_path does not go with map (a path reports the frozen-set stiffness of \
+                 each step)"
+                    .to_string()
+            )
+        );
+        assert!(words(&request, true, false)
+            .1
+            .contains("with resistivity ("));
+        let adhesive = ContactRequest {
+            work_of_adhesion: Some(0.05),
+            indentations: vec![1e-7],
+            ..ContactRequest::default()
+        };
+        assert_eq!(adhesive.refuse_run_options(false, false), Ok(()));
+        assert_eq!(
+            words(&adhesive, true, false).0,
+            "--work-of-adhesion takes a path of --indentations (m) and does not go with \
+             --load-path"
+        );
+        assert!(words(&adhesive, false, true)
+            .1
+            .ends_with("does not go with map"));
     }
 
     #[test]

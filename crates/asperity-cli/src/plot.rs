@@ -17,7 +17,7 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-pub use asperity_app::figure::psd::thin_log;
+use asperity_app::figure::tick_label;
 use asperity_app::figure::Color as SeriesColor;
 pub use asperity_app::figure::{Chart, Series, Style};
 
@@ -107,24 +107,6 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
             (v / scale).round() * scale
         })
         .collect()
-}
-
-fn tick_label(v: f64) -> String {
-    let a = v.abs();
-    if v == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e4).contains(&a) {
-        let e = a.log10().floor() as i32;
-        let m = v / 10f64.powi(e);
-        if (m - m.round()).abs() < 1e-9 {
-            format!("{}e{e}", m.round())
-        } else {
-            format!("{m:.1}e{e}")
-        }
-    } else {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
 }
 
 impl ChartFiles for Chart {
@@ -288,15 +270,25 @@ impl Drawn<'_> {
                 .with_key_points(ticks.clone())
                 .with_light_points(ticks)
         };
+        // The spans that round a tick near 0 to `0` (none on a log axis).
+        let span = |log: bool, lo: f64, hi: f64| if log { 0.0 } else { hi - lo };
+        let spans = (span(self.log_x, x0, x1), span(self.log_y, y0, y1));
         match (self.log_x, self.log_y) {
-            (true, true) => self.draw(root, scale, log_axis(x0, x1), log_axis(y0, y1)),
-            (true, false) => self.draw(root, scale, log_axis(x0, x1), y0..y1),
-            (false, true) => self.draw(root, scale, x0..x1, log_axis(y0, y1)),
-            (false, false) => self.draw(root, scale, x0..x1, y0..y1),
+            (true, true) => self.draw(root, scale, spans, log_axis(x0, x1), log_axis(y0, y1)),
+            (true, false) => self.draw(root, scale, spans, log_axis(x0, x1), y0..y1),
+            (false, true) => self.draw(root, scale, spans, x0..x1, log_axis(y0, y1)),
+            (false, false) => self.draw(root, scale, spans, x0..x1, y0..y1),
         }
     }
 
-    fn draw<DB, X, Y>(&self, root: &DrawingArea<DB, Shift>, scale: u32, x: X, y: Y) -> Result<()>
+    fn draw<DB, X, Y>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: u32,
+        (x_span, y_span): (f64, f64),
+        x: X,
+        y: Y,
+    ) -> Result<()>
     where
         DB: DrawingBackend,
         DB::ErrorType: 'static,
@@ -319,8 +311,8 @@ impl Drawn<'_> {
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
+            .x_label_formatter(&|v| tick_label(*v, x_span))
+            .y_label_formatter(&|v| tick_label(*v, y_span))
             .label_style(("sans-serif", px(15)))
             .axis_desc_style(("sans-serif", px(18)))
             .bold_line_style(BLACK.mix(0.1).stroke_width(scale))
@@ -799,17 +791,6 @@ mod words_tests {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tick_labels_are_short() {
-        assert_eq!(tick_label(0.001), "0.001");
-        assert_eq!(tick_label(1e-5), "1e-5");
-        assert_eq!(tick_label(250.0), "250");
-        assert_eq!(tick_label(2.5e6), "2.5e6");
-        assert_eq!(tick_label(2.0000000000000004e-5), "2e-5");
-        assert_eq!(tick_label(-1e-7), "-1e-7");
-        assert_eq!(tick_label(0.30000000000000004), "0.3");
-    }
 
     #[test]
     fn log_ticks_label_every_axis() {

@@ -6,7 +6,7 @@
 //!
 //! The builders: [`sweep`] (a load sweep's k(F) and A/A₀(F)), [`contact`] (an SI contact
 //! sweep's k(F), A(F) and mean gap), [`path`] (a load path's
-//! loading–unloading loop), [`adhesion`] (an adhesive loop with its arrows and pull-offs), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
+//! loading–unloading loop), [`mdr`] (an MDR curve's F(d) and k(F)), [`adhesion`] (an adhesive loop with its arrows and pull-offs), [`study`] (α(H), α(N) and the ensemble k(F) of a study),
 //! [`psd`] (a PSD with its fitted power law), [`analysis`] (the surface analyses of
 //! `asperity stats`: ACFs, scale-dependent slope and curvature, variable-bandwidth rms
 //! height, bearing-area curve, distributions), [`map`] (a height map with scale and colour
@@ -16,6 +16,7 @@ pub mod adhesion;
 pub mod analysis;
 pub mod contact;
 pub mod map;
+pub mod mdr;
 pub mod path;
 pub mod psd;
 pub mod study;
@@ -140,6 +141,31 @@ pub struct Chart {
     pub series: Vec<Series>,
 }
 
+/// A tick's label, short: `0`, `0.25`, `250`, `2.5e6`, `-1e-7`. `span` is the axis'
+/// range (its largest less its least value; 0 on a log axis): a value within
+/// [`ZERO_TICK`]·`span` of 0 is the rounding of a tick at zero (`-2.7e-20` on an axis from
+/// −1 to 1) and reads `0`.
+pub fn tick_label(v: f64, span: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || a <= ZERO_TICK * span.abs() {
+        "0".into()
+    } else if !(1e-3..1e4).contains(&a) {
+        let e = a.log10().floor() as i32;
+        let m = v / 10f64.powi(e);
+        if (m - m.round()).abs() < 1e-9 {
+            format!("{}e{e}", m.round())
+        } else {
+            format!("{m:.1}e{e}")
+        }
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// A tick within this share of its axis' range from 0 is labelled `0` ([`tick_label`]).
+pub const ZERO_TICK: f64 = 1e-12;
+
 /// `charts` as JSON (`{"format": "asperity-figure/1", "charts": [...]}`), what
 /// `--plot FILE.json` writes and what the Python package renders; a missing value (NaN) is
 /// `null`.
@@ -153,6 +179,24 @@ pub const FORMAT: &str = "asperity-figure/1";
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_short_and_zero_is_zero() {
+        assert_eq!(tick_label(0.001, 1.0), "0.001");
+        assert_eq!(tick_label(1e-5, 1e-4), "1e-5");
+        assert_eq!(tick_label(250.0, 1e3), "250");
+        assert_eq!(tick_label(2.5e6, 1e7), "2.5e6");
+        assert_eq!(tick_label(2.0000000000000004e-5, 1e-4), "2e-5");
+        assert_eq!(tick_label(-1e-7, 1e-6), "-1e-7");
+        assert_eq!(tick_label(0.30000000000000004, 1.0), "0.3");
+        // A tick at zero on an axis crossing it, off by rounding: 0.
+        assert_eq!(tick_label(-2.7e-20, 2.0), "0");
+        assert_eq!(tick_label(1.5e-13, 1.0), "0");
+        // Small values that are the axis' own scale keep their digits; a log axis (span 0)
+        // never rounds to 0.
+        assert_eq!(tick_label(-2.7e-20, 1e-19), "-2.7e-20");
+        assert_eq!(tick_label(1e-20, 0.0), "1e-20");
+    }
 
     #[test]
     fn a_chart_round_trips_through_json_with_missing_values_as_null() {

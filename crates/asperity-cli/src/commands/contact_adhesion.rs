@@ -4,7 +4,7 @@
 //! of `asperity bem --work-of-adhesion`, the one Python's `contact(work_of_adhesion=…)`
 //! runs). Outputs checked before any work and written together at the end.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use asperity::bem::adhesion::AdhesiveSummary;
 use asperity::io::sidecar_path;
 use asperity_app::adhesion::{AdhesionPlan, AdhesionRun};
@@ -17,24 +17,13 @@ use crate::output::{format_number, Table};
 use crate::plot::stage_charts;
 use asperity_app::figure::adhesion::LoopFigure;
 
-/// The options of `asperity contact` an adhesive run refuses that the request does not
-/// carry (the others are the front-end layer's refusals).
-fn refuse_other_options(args: &ContactArgs) -> Result<()> {
-    let given = [
-        (args.map.is_some(), "--map"),
-        (args.load_path, "--load-path"),
-    ];
-    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
-        bail!("--work-of-adhesion takes a path of --indentations (m) and does not go with {flag}");
-    }
-    Ok(())
-}
-
 /// Runs `asperity contact --work-of-adhesion`: check (every refusal before the surface is
 /// read), read, the path and the retraction, then the table, its record and the loop's plot.
 pub fn run(args: &ContactArgs) -> Result<()> {
-    refuse_other_options(args)?;
-    let plan = request(args)?.adhesion_plan()?;
+    let request = request(args)?;
+    // The front-end layer's rule: no --map, no --load-path.
+    request.refuse_run_options(args.load_path, args.map.is_some())?;
+    let plan = request.adhesion_plan()?;
     if let Some(plot) = &args.plot {
         crate::plot::ImageFormat::from_path(plot, "--plot")?;
     }

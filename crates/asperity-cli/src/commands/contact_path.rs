@@ -5,7 +5,7 @@
 //! --load-path` runs). The request is `asperity contact`'s; outputs checked before any
 //! work and written together at the end.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use asperity::bem::{ContactSolver, PathPoint};
 use asperity::io::sidecar_path;
 use asperity_app::bem::{branches, ensure_solver_fits, Branch};
@@ -14,26 +14,9 @@ use asperity_app::figure::path::{path_charts, PathColumns, PathFigure};
 use serde_json::json;
 
 use super::bem_path::cells;
-use super::contact::{check_args, file_name, inputs_record, ContactArgs};
+use super::contact::{check_args, file_name, inputs_record, request, ContactArgs};
 use crate::output::Table;
 use crate::plot::{stage_charts, Chart};
-
-/// The options of `asperity contact` that a load path refuses, with the flag named.
-fn refuse_other_options(args: &ContactArgs) -> Result<()> {
-    let given = [
-        (args.map.is_some(), "--map"),
-        (args.tangential.is_some(), "--tangential"),
-        (args.resistivity.is_some(), "--resistivity"),
-        (
-            args.thermal_conductivity.is_some(),
-            "--thermal-conductivity",
-        ),
-    ];
-    if let Some((_, flag)) = given.iter().find(|(on, _)| *on) {
-        bail!("--load-path does not go with {flag} (a path reports the frozen-set stiffness of each step)");
-    }
-    Ok(())
-}
 
 /// The `--plot` panels ([`asperity_app::figure::path`]): F(d), A/A₀(d) and k(F), each
 /// step marked by its branch, in SI units.
@@ -69,7 +52,8 @@ fn charts(
 /// Runs `asperity contact --load-path`: check (every refusal before the surface is read),
 /// read, the path, then the table, its record and the plot, written together.
 pub fn run(args: &ContactArgs) -> Result<()> {
-    refuse_other_options(args)?;
+    // The front-end layer's rule: no --map, --tangential or conductance on a path.
+    request(args)?.refuse_run_options(true, args.map.is_some())?;
     let plan = check_args(args)?;
     let record_path = args.out.as_deref().map(sidecar_path);
     let outputs = args.out.iter().chain(&record_path).chain(&args.plot);

@@ -18,8 +18,9 @@ use asperity_app::refusal::count;
 use crate::request::refused;
 
 use crate::output::{format_number, pull_off_line, Table};
-use crate::plot::{stage_charts, thin_log, Chart, ImageFormat, Series, Style};
+use crate::plot::{stage_charts, Chart, ImageFormat};
 use asperity_app::figure::adhesion::{LoopFigure, LoopPoint, LoopPullOffs};
+use asperity_app::figure::mdr::{mdr_charts, MdrColumns, MdrFigure};
 
 /// Arguments of `asperity mdr`.
 #[derive(Debug, clap::Args)]
@@ -251,55 +252,40 @@ pub(super) fn load_indenter(args: &MdrArgs, request: &MdrRequest) -> Result<Inde
     request.closed_form().map_err(refused)
 }
 
-/// Extra bytes per output row with --plot: the kept curve point and its two plotted
-/// `(x, y)` pairs.
+/// Extra bytes per output row with --plot: the kept curve point, its three columns and
+/// its two plotted `(x, y)` pairs.
 fn plot_row_bytes(args: &MdrArgs) -> usize {
     if args.plot.is_some() {
-        std::mem::size_of::<CurvePoint>() + 2 * std::mem::size_of::<(f64, f64)>()
+        std::mem::size_of::<CurvePoint>()
+            + 3 * std::mem::size_of::<f64>()
+            + 2 * std::mem::size_of::<(f64, f64)>()
     } else {
         0
     }
 }
 
-/// The `--plot` panels: F/E* vs d and k/E* vs F/E*, log–log (points at zero left out).
+/// The `--plot` panels ([`asperity_app::figure::mdr`]): F/E* vs d and k/E* vs F/E*,
+/// log–log (points at zero left out).
 fn curve_charts(points: &[CurvePoint], modulus: f64, description: &str, law: &str) -> [Chart; 2] {
-    // Markers for a readable number of points; a line alone for dense curves (breakpoints),
-    // thinned to what a figure shows.
-    let style = if points.len() <= 200 {
-        Style::LinePoints
-    } else {
-        Style::Line
+    let column = |f: fn(&CurvePoint) -> f64| -> Vec<f64> { points.iter().map(f).collect() };
+    let (indentation, force, stiffness) = (
+        column(|p| p.indentation),
+        column(|p| p.force),
+        column(|p| p.stiffness),
+    );
+    let columns = MdrColumns {
+        indentation: &indentation,
+        force: &force,
+        stiffness: &stiffness,
     };
-    let force = |p: &CurvePoint| p.force / modulus;
-    let title = format!("{description}, {law} springs");
-    let force_chart = Chart {
-        title: title.clone(),
-        x_label: "indentation d  [length]".into(),
-        y_label: "normal force F / E*  [length²]".into(),
-        log_x: true,
-        log_y: true,
-        series: vec![Series::new(
-            "",
-            thin_log(points.iter().map(|p| (p.indentation, force(p))), 4000),
-            style,
-        )],
-    };
-    let stiffness_chart = Chart {
-        title: format!("E* = {modulus}"),
-        x_label: "normal force F / E*  [length²]".into(),
-        y_label: "contact stiffness k / E*  [length]".into(),
-        log_x: true,
-        log_y: true,
-        series: vec![Series::new(
-            "",
-            thin_log(
-                points.iter().map(|p| (force(p), p.stiffness / modulus)),
-                4000,
-            ),
-            style,
-        )],
-    };
-    [force_chart, stiffness_chart]
+    mdr_charts(
+        columns,
+        MdrFigure {
+            description,
+            law,
+            modulus,
+        },
+    )
 }
 
 /// Step 1: `--plot` needs a curve (at least 2 indentations); checked before any work.

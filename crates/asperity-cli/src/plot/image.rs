@@ -10,7 +10,8 @@ use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{rgb, tick_label};
+use super::rgb;
+use asperity_app::figure::tick_label;
 
 /// The most cells drawn along a side in an SVG (larger images are drawn in blocks of the
 /// nearest cell, keeping the file a few MB at most); a PNG draws every cell.
@@ -84,8 +85,8 @@ where
         .disable_mesh()
         .x_desc(&chart.x_label)
         .y_desc(&chart.y_label)
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
+        .x_label_formatter(&|v| tick_label(*v, ex))
+        .y_label_formatter(&|v| tick_label(*v, ey))
         .x_labels(5)
         .y_labels(5)
         .label_style(("sans-serif", px(15)))
@@ -201,7 +202,7 @@ fn colour_bar<DB: DrawingBackend>(
         .disable_x_axis()
         .y_desc(label)
         .y_labels(6)
-        .y_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v, high - low))
         .label_style(("sans-serif", px(14)))
         .axis_desc_style(("sans-serif", px(16)))
         .axis_style(BLACK.stroke_width(scale))
