@@ -266,3 +266,18 @@ def test_import_topography_refuses_as_the_cli(cli, tmp_path):
     with pytest.raises(ValueError, match="a line profile cannot be written as X3P"):
         asperity.import_topography(shared("dektak-1.csv"), tmp_path / "p.x3p", detrend="mean")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_channel_name_two_channels_share_raises_and_an_index_chooses():
+    # di-2.di (topographies-2) holds "Height", "Height" and "Deflection": the name is
+    # ambiguous, so read_topography raises the CLI's words; the indices give two distinct
+    # maps, the first being the default's (as crates/asperity-cli/tests/topography_cli.rs).
+    path = shared("../topographies-2/di-2.di")
+    with pytest.raises(ValueError, match=r'2 channels are named "Height" \(0: Height, 1: Height\)'):
+        asperity.read_topography(path, channel="Height")
+    first = asperity.read_topography(path, channel=0, detrend="none")
+    second = asperity.read_topography(path, channel=1, detrend="none")
+    default = asperity.read_topography(path, detrend="none")
+    np.testing.assert_array_equal(first.heights, default.heights)
+    assert first.heights.shape == second.heights.shape
+    assert not np.array_equal(first.heights, second.heights)
