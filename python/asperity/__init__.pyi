@@ -204,7 +204,7 @@ class Solver:
         resistivity: Optional[Sequence[float]] = ...,
         thermal_conductivity: Optional[Sequence[float]] = ...,
         persson: bool = ..., gamma: Optional[float] = ..., kappa: Optional[float] = ...,
-        tangential: Optional[str] = ...,
+        tangential: Optional[str] = ..., timing: bool = ...,
     ) -> Sweep: ...
     def load_path(
         self, *, pressures: Optional[Sequence[float]] = ..., forces: Optional[Sequence[float]] = ...,

@@ -1044,6 +1044,7 @@ class Solver:
         gamma: Optional[float] = None,
         kappa: Optional[float] = None,
         tangential: Optional[str] = None,
+        timing: bool = False,
     ) -> Sweep:
         """A load sweep exactly as ``asperity bem`` runs it (same numbers bit for bit):
         ``pressures``, ``forces`` or ``indentations`` in the given order, or ``nloads``
@@ -1066,6 +1067,10 @@ class Solver:
         ``resistivity`` (ρ₁, ρ₂) and ``thermal_conductivity`` (κ₁, κ₂), one value per
         body: also ``electrical_conductance`` = 2k/(E*(ρ₁+ρ₂)) and ``thermal_conductance``
         = (2k/E*)·κ₁κ₂/(κ₁+κ₂) (Barber's analogy). docs/tangential.md.
+
+        ``timing`` (``asperity bem --timing``): also each load's ``solve_seconds`` and
+        ``stiffness_seconds`` (wall time), the process's ``peak_rss_mib`` after it, and
+        ``tangential_seconds`` with ``poisson``.
 
         ``persson`` (``asperity bem --persson``): also the BEM's ``mean_gap`` (with
         periodic boundaries Persson's mean separation) and Persson's theory from the
@@ -1100,7 +1105,7 @@ class Solver:
             columns = self._core.sweep(quantity, values, bool(stiffness), fd, bool(fields),
                                        bar.callback, _opt(poisson), _floats(resistivity),
                                        _floats(thermal_conductivity), theory,
-                                       _text(tangential))
+                                       _text(tangential), bool(timing))
         finally:
             bar.close()
         derived = {"poisson": _opt(poisson), "tangential": _text(tangential),

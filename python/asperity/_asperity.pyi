@@ -93,6 +93,7 @@ class Solver:
         thermal_conductivity: Optional[List[float]] = ...,
         persson: Optional[Tuple[float, float]] = ...,
         tangential: Optional[str] = ...,
+        timing: bool = ...,
     ) -> Dict[str, Any]: ...
 
 def mdr_curve(

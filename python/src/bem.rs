@@ -14,7 +14,8 @@ use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::params;
 use asperity_app::bem::{
-    branches, check_capped_loads, check_fd_step, ensure_solver_fits, Loads, SolverRequest,
+    branches, check_capped_loads, check_fd_step, ensure_solver_fits, peak_rss_mib, Loads,
+    SolverRequest, TIMING_COLUMNS,
 };
 use asperity_app::derived::{Derived, Units};
 use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
@@ -130,6 +131,8 @@ struct PyObserver<'a> {
     progress: Option<&'a Py<PyAny>>,
     cancel: &'a Cancel,
     total: usize,
+    /// The peak resident memory after each load (`timing`).
+    peak_rss: Option<Vec<f64>>,
 }
 
 impl SweepObserver for PyObserver<'_> {
@@ -147,6 +150,9 @@ impl SweepObserver for PyObserver<'_> {
     }
 
     fn finished(&mut self, load: usize, _row: &SweepRow) -> Result<(), Cancelled> {
+        if let Some(peaks) = &mut self.peak_rss {
+            peaks.push(peak_rss_mib().unwrap_or(f64::NAN));
+        }
         self.cancel.call(self.progress, load + 1, self.total);
         if self.cancel.is_set() {
             return Err(Cancelled);
@@ -388,7 +394,9 @@ impl Solver {
     /// `thermal_conductivity`, two bodies each) by the front-end layer's one definition;
     /// `persson` = `(gamma, kappa)`: the BEM's mean gap and Persson's columns
     /// (`asperity bem --persson`).
-    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None, persson=None, tangential=None))]
+    /// `timing`: also the columns of `asperity bem --timing` ([`TIMING_COLUMNS`], then
+    /// `tangential_seconds` with the tangential stiffness).
+    #[pyo3(signature = (quantity, values, stiffness, fd_step, fields, progress, poisson=None, resistivity=None, thermal_conductivity=None, persson=None, tangential=None, timing=false))]
     #[allow(clippy::too_many_arguments)]
     fn sweep<'py>(
         &mut self,
@@ -404,6 +412,7 @@ impl Solver {
         thermal_conductivity: Option<Vec<f64>>,
         persson: Option<(f64, f64)>,
         tangential: Option<String>,
+        timing: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let loads = values
             .iter()
@@ -440,14 +449,16 @@ impl Solver {
                 progress: progress.as_ref(),
                 cancel,
                 total: loads.len(),
+                peak_rss: timing.then(Vec::new),
             };
             cancel.call(observer.progress, 0, loads.len());
             let rows = sweep(solver, &loads, params, &mut observer);
             let mean_gaps = observer.mean_gaps.unwrap_or_default();
-            rows.map(|rows| (rows, (observer.pressures, observer.gaps), mean_gaps))
+            let peaks = observer.peak_rss.unwrap_or_default();
+            rows.map(|rows| (rows, (observer.pressures, observer.gaps), (mean_gaps, peaks)))
         })?
         .map_err(sweep_error)?;
-        let (rows, observer, mean_gaps) = rows;
+        let (rows, observer, (mean_gaps, peaks)) = rows;
         let plastic = self.hardness().is_some();
         let dict = columns_dict(py, &rows, (params, plastic), observer)?;
         for (k, name) in derived.columns(Units::Model).into_iter().enumerate() {
@@ -459,6 +470,9 @@ impl Solver {
         }
         if let Some(theory) = &theory {
             persson_columns(py, &dict, theory, &rows, &mean_gaps)?;
+        }
+        if timing {
+            timing_columns(py, &dict, &rows, &peaks, derived.tangential.is_some())?;
         }
         Ok(dict)
     }
@@ -523,6 +537,27 @@ fn persson_columns(
     }
     for (name, column) in SWEEP_COLUMNS.into_iter().zip(columns) {
         dict.set_item(name, PyArray1::from_vec(py, column))?;
+    }
+    Ok(())
+}
+
+/// `asperity bem --timing`'s columns, in its order: each load's solve and stiffness
+/// seconds, the peak resident memory after it (MiB, NaN where the system does not say),
+/// then `tangential_seconds` with the tangential stiffness.
+fn timing_columns(
+    py: Python<'_>,
+    dict: &Bound<'_, PyDict>,
+    rows: &[SweepRow],
+    peaks: &[f64],
+    tangential: bool,
+) -> PyResult<()> {
+    let column = |f: &dyn Fn(&SweepRow) -> f64| PyArray1::from_iter(py, rows.iter().map(f));
+    let [solve, stiffness, peak] = TIMING_COLUMNS;
+    dict.set_item(solve, column(&|r| r.solve_seconds))?;
+    dict.set_item(stiffness, column(&|r| r.stiffness_seconds))?;
+    dict.set_item(peak, PyArray1::from_slice(py, peaks))?;
+    if tangential {
+        dict.set_item("tangential_seconds", column(&|r| r.tangential_seconds))?;
     }
     Ok(())
 }

@@ -255,6 +255,33 @@ def test_bem_persson_columns_equal_the_cli(cli, tmp_path, boundary):
         solver.sweep(pressures=[0.01], persson=True, gamma=1.5)
 
 
+@pytest.mark.parametrize("tangential", [False, True])
+def test_bem_timing_columns_are_the_cli_s(cli, tmp_path, tangential):
+    # `Solver.sweep(timing=True)` adds `asperity bem --timing`'s columns, in its order; the
+    # times and memory are the process's own (so only their names, finiteness and sign are
+    # compared), every other column equals the CLI's bit for bit.
+    s = asperity.surface(48, hurst=0.8, rolloff=4, rms_slope=0.5, seed=2)
+    s.save(tmp_path / "s.npy")
+    extra = ["--poisson", 0.3] if tangential else []
+    cli("bem", "--surface", tmp_path / "s.npy", "--pressures", "0.005,0.02", "--timing",
+        *extra, "--quiet", "--out", tmp_path / "t.csv")
+    theirs = read_csv(tmp_path / "t.csv")
+    timed = ["solve_seconds", "stiffness_seconds", "peak_rss_mib"]
+    timed += ["tangential_seconds"] if tangential else []
+    kwargs = dict(poisson=0.3) if tangential else {}
+    ours = asperity.Solver(s).sweep(pressures=[0.005, 0.02], timing=True, **kwargs)
+    assert [c for c in ours.columns if c in theirs] == list(theirs)
+    assert list(theirs)[-len(timed):] == timed
+    for name, values in theirs.items():
+        if name in timed:
+            assert np.isfinite(ours[name]).all() and (ours[name] >= 0).all(), name
+            assert (ours[name] > 0).any(), name
+        else:
+            assert ours[name].tolist() == values, name
+    plain = asperity.Solver(s).sweep(pressures=[0.005, 0.02], **kwargs)
+    assert not set(timed) & set(plain.columns)
+
+
 def test_bem_adhesion_equals_the_cli(cli, tmp_path):
     x = (np.arange(40) - 20) * 5e-3
     h = -(x[:, None]**2 + x[None, :]**2) / 2

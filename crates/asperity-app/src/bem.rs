@@ -67,6 +67,20 @@ pub fn bookkeeping_bytes(loads: usize, fields: bool) -> Option<u64> {
     array_bytes(&[loads], per_load)
 }
 
+/// The timing columns of a sweep (`asperity bem --timing`, Python's `Solver.sweep(timing=True)`):
+/// each load's solve and frozen-set stiffness in seconds and the process's peak resident
+/// memory after it, then the tangential stiffness's seconds when it was asked for.
+pub const TIMING_COLUMNS: [&str; 3] = ["solve_seconds", "stiffness_seconds", "peak_rss_mib"];
+
+/// Peak resident memory of this process (MiB), from `/proc/self/status` (Linux; `None`
+/// elsewhere): the `peak_rss_mib` column of a timed sweep.
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
 /// A load's control of its value.
 type LoadOf = fn(f64) -> Control;
 

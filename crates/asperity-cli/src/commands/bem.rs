@@ -16,8 +16,8 @@ use asperity::io::{sidecar_path, StagedOutputs};
 use asperity::memory::array_bytes;
 use asperity::surface::Surface;
 use asperity_app::bem::{
-    bookkeeping_bytes, ensure_solver_fits, params, BemPlan, BemRequest, Loads, SolverRequest,
-    FD_STEP,
+    bookkeeping_bytes, ensure_solver_fits, params, peak_rss_mib, BemPlan, BemRequest, Loads,
+    SolverRequest, FD_STEP, TIMING_COLUMNS,
 };
 use asperity_app::derived::{Derived, Units};
 use asperity_app::persson::{bem_mean_gap, SweepPersson, SweepTheory, SWEEP_COLUMNS};
@@ -255,14 +255,6 @@ pub struct BemArgs {
     pub force: bool,
 }
 
-/// Peak resident memory of this process (MiB), from /proc/self/status (Linux).
-fn peak_rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
-}
-
 fn field_paths(dir: &Path, count: usize) -> Vec<(PathBuf, PathBuf)> {
     (0..count)
         .map(|k| {
@@ -407,7 +399,7 @@ impl Columns {
             header.extend(SWEEP_COLUMNS);
         }
         if self.timing {
-            header.extend(["solve_seconds", "stiffness_seconds", "peak_rss_mib"]);
+            header.extend(TIMING_COLUMNS);
             if self.derived.tangential.is_some() {
                 header.push("tangential_seconds");
             }
