@@ -478,6 +478,34 @@ mod tests {
         }
     }
 
+    /// The frozen-set stiffness of both precision tests below, and how each CG ran: on
+    /// `rough_grid(512, 512, 11)` solved at `pressure`, first with the default switch
+    /// (`default`), then with the single-precision pass switched off (`double`), and then
+    /// Barber's dF/dd (central differences, ±1e-3 of the load) from that solved state.
+    struct BothPrecisions {
+        default: (f64, SolveInfo),
+        double: (f64, SolveInfo),
+        finite_difference: f64,
+    }
+
+    fn both_precisions(boundary: Boundary, pressure: f64) -> BothPrecisions {
+        let (rows, cols) = (512, 512);
+        assert!(rows * cols >= SINGLE_STIFFNESS_MIN_POINTS);
+        let mut solver = solved_rough((rows, cols, 11), boundary, pressure);
+        let default = solver.frozen_set_stiffness().unwrap();
+        solver.set_single_precision_stiffness(false);
+        let double = solver.frozen_set_stiffness().unwrap();
+        solver.set_single_precision_stiffness(true);
+        let finite_difference = solver
+            .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
+            .unwrap();
+        BothPrecisions {
+            default,
+            double,
+            finite_difference,
+        }
+    }
+
     #[test]
     fn single_precision_pass_gives_the_double_precision_stiffness() {
         // On free grids of at least SINGLE_STIFFNESS_MIN_POINTS points the frozen-set CG runs
@@ -486,26 +514,19 @@ mod tests {
         // stiffness_error = 1e-12 of it, and what is left falls geometrically from there:
         // a few 1e-12 apart at most; the tangential CGs' same refinement measured 3.2e-13),
         // and Barber's dF/dd to the 0.5 % of the test above.
-        let (rows, cols, pressure) = (512, 512, 0.02);
-        assert!(rows * cols >= SINGLE_STIFFNESS_MIN_POINTS);
-        let mut solver = solved_rough((rows, cols, 11), Boundary::Free, pressure);
-        let (mixed, info) = solver.frozen_set_stiffness().unwrap();
+        let run = both_precisions(Boundary::Free, 0.02);
+        let ((mixed, info), (double, info_f64)) = (run.default, run.double);
         // The f32 pass ran and was refined: one application (the refinement's start) more
         // than its iterations, both passes'.
         assert_eq!(info.operator_applications, info.iterations + 1);
-        solver.set_single_precision_stiffness(false);
-        let (double, info_f64) = solver.frozen_set_stiffness().unwrap();
         assert_eq!(info_f64.operator_applications, info_f64.iterations);
-        solver.set_single_precision_stiffness(true);
         let gap = (mixed / double - 1.0).abs();
         eprintln!(
             "k mixed / f64 - 1 = {gap:.2e}, iterations {} / {}",
             info.iterations, info_f64.iterations
         );
         assert!(gap < 1e-11, "{mixed} vs {double}");
-        let fd = solver
-            .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
-            .unwrap();
+        let fd = run.finite_difference;
         assert!((mixed / fd - 1.0).abs() < 5e-3, "{mixed} vs dF/dd {fd}");
     }
 
@@ -515,18 +536,12 @@ mod tests {
         // they run the all-f64 CG whatever the switch says: as many applications as
         // iterations (no refinement's start), and bit for bit the stiffness with the
         // single-precision pass switched off.
-        let (rows, cols, pressure) = (512, 512, 0.05);
-        assert!(rows * cols >= SINGLE_STIFFNESS_MIN_POINTS);
-        let mut solver = solved_rough((rows, cols, 11), Boundary::Periodic, pressure);
-        let (default, info) = solver.frozen_set_stiffness().unwrap();
+        let run = both_precisions(Boundary::Periodic, 0.05);
+        let ((default, info), (double, info_f64)) = (run.default, run.double);
         assert_eq!(info.operator_applications, info.iterations);
-        solver.set_single_precision_stiffness(false);
-        let (double, info_f64) = solver.frozen_set_stiffness().unwrap();
         assert_eq!(info_f64.iterations, info.iterations);
         assert_eq!(default.to_bits(), double.to_bits(), "{default} vs {double}");
-        let fd = solver
-            .finite_difference_stiffness(Control::MeanPressure(pressure), 1e-3)
-            .unwrap();
+        let fd = run.finite_difference;
         assert!((default / fd - 1.0).abs() < 5e-3, "{default} vs dF/dd {fd}");
     }
 
