@@ -22,9 +22,10 @@
 //!
 //! Untrusted archives: `main.xml` is read up to 16 MiB; a payload is read only when its
 //! size follows from the grid, at most 1100 × its compressed size (deflate cannot do
-//! better) and within the memory available. The payload is streamed (256 KiB at a time)
-//! through its MD5 straight into the heights, sized once from the header; `read_file`
-//! reads an X3P archive from the file itself (`read_from_file`), never holding it whole.
+//! better) and within the memory available. The payload is streamed (256 KiB at a time, a
+//! second thread running its MD5 and decoding beside the inflate) straight into the
+//! heights, sized once from the header; `read_file` reads an X3P archive from the file
+//! itself (`read_from_file`), never holding it whole.
 
 use std::io::{Cursor, Read, Seek, Write};
 use std::path::Path;
@@ -408,26 +409,102 @@ fn entry<R: Read + Seek>(archive: &mut ZipArchive<R>, name: &str, len: usize) ->
     Ok(data)
 }
 
-/// The most bytes of an entry held at a time while it is streamed.
+/// The most bytes of an entry held at a time in one buffer while it is streamed.
 const PIECE: usize = 1 << 18;
+/// The buffers in flight between the thread that inflates an entry and the one that
+/// checks and decodes it: a fixed pool, so at most `IN_FLIGHT × PIECE` bytes are held.
+const IN_FLIGHT: usize = 4;
 
 /// Streams the archive entry `name` of exactly `len` bytes (see [`open_entry`]) to `sink`
-/// in pieces of whole `unit`s (at most [`PIECE`] bytes, one buffer reused), each also
-/// given to `md5` where there is one; read to its end so that the zip CRC-32 is verified.
-/// `len` must be a multiple of `unit`.
+/// in pieces of whole `unit`s (at most [`PIECE`] bytes), each also given to `md5` where
+/// there is one; read to its end so that the zip CRC-32 is verified. `len` must be a
+/// multiple of `unit`. An entry of more than one piece is inflated on this thread while a
+/// second one runs the MD5 and `sink` on the pieces already read (in order, through a
+/// pool of [`IN_FLIGHT`] buffers: nothing else is buffered); a smaller one reads on this
+/// thread alone.
 fn stream_entry<R: Read + Seek>(
     archive: &mut ZipArchive<R>,
     name: &str,
     len: usize,
     unit: usize,
     mut md5: Option<&mut Md5>,
-    mut sink: impl FnMut(&[u8]),
+    mut sink: impl FnMut(&[u8]) + Send,
 ) -> Result<()> {
     let piece = unit * (PIECE / unit).max(1);
-    let mut reader = open_entry(archive, name, len)?.take(len as u64 + 1);
-    let mut buf = vec![0u8; piece];
+    let reader = open_entry(archive, name, len)?.take(len as u64 + 1);
+    let mut use_piece = move |buf: &[u8]| {
+        if let Some(md5) = md5.as_deref_mut() {
+            md5.update(buf);
+        }
+        sink(buf);
+    };
+    if len < piece {
+        let spare = std::cell::Cell::new(Some(vec![0u8; piece]));
+        return pump(
+            reader,
+            name,
+            len,
+            unit,
+            piece,
+            || spare.take(),
+            |buf, filled| {
+                use_piece(&buf[..filled]);
+                spare.set(Some(buf));
+                true
+            },
+        );
+    }
+    std::thread::scope(|scope| {
+        let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<(Vec<u8>, usize)>(IN_FLIGHT);
+        let (empty_tx, empty_rx) = std::sync::mpsc::sync_channel::<Vec<u8>>(IN_FLIGHT);
+        for _ in 0..IN_FLIGHT {
+            empty_tx
+                .send(vec![0u8; piece])
+                .expect("the pool's channel is open");
+        }
+        let worker = scope.spawn(move || {
+            for (buf, filled) in full_rx {
+                use_piece(&buf[..filled]);
+                // The reading thread may have stopped on an error: nothing to give back to.
+                let _ = empty_tx.send(buf);
+            }
+        });
+        let read = pump(
+            reader,
+            name,
+            len,
+            unit,
+            piece,
+            || empty_rx.recv().ok(),
+            |buf, filled| full_tx.send((buf, filled)).is_ok(),
+        );
+        drop(full_tx);
+        if let Err(panic) = worker.join() {
+            std::panic::resume_unwind(panic);
+        }
+        read
+    })
+}
+
+/// Reads `reader` (the entry `name`, declared `len` bytes) in pieces of `piece` bytes,
+/// each into a buffer of that length that `take` gives and then handed to `give` with the
+/// bytes filled (whole `unit`s; the last piece is shorter, maybe empty); stops early
+/// where `take` has no buffer or `give` takes none (the other thread has stopped). Refuses
+/// an entry of more or fewer bytes than declared.
+fn pump(
+    mut reader: impl Read,
+    name: &str,
+    len: usize,
+    unit: usize,
+    piece: usize,
+    mut take: impl FnMut() -> Option<Vec<u8>>,
+    mut give: impl FnMut(Vec<u8>, usize) -> bool,
+) -> Result<()> {
     let mut done = 0usize;
     loop {
+        let Some(mut buf) = take() else {
+            return Ok(());
+        };
         let mut filled = 0;
         while filled < piece {
             match reader.read(&mut buf[filled..]) {
@@ -445,11 +522,7 @@ fn stream_entry<R: Read + Seek>(
                 format!("{name} holds {more} bytes than the {len} declared"),
             ));
         }
-        if let Some(md5) = md5.as_deref_mut() {
-            md5.update(&buf[..filled]);
-        }
-        sink(&buf[..filled]);
-        if filled < piece {
+        if !give(buf, filled) || filled < piece {
             return Ok(());
         }
     }
@@ -1128,6 +1201,39 @@ mod tests {
         });
         let err = read(&edited).unwrap_err().to_string();
         assert!(err.contains("main.xml fails its MD5"), "{err}");
+    }
+
+    #[test]
+    fn payloads_of_many_pieces_are_read_through_the_second_thread() {
+        // 300 × 400 float64 (3.7 pieces of 256 KiB) and 256 × 256 (exactly 2 pieces, so a
+        // last empty read): stored and deflated, bit for bit the map written, MD5 checked.
+        for (ny, nx) in [(300, 400), (256, 256)] {
+            let h = Array2::from_shape_fn((ny, nx), |(r, c)| {
+                ((r * nx + c) as f64 * 0.731).sin() * 3.2e-7
+            });
+            let stored = to_bytes(h.view(), [1e-3, 1e-3]).unwrap();
+            let deflated = rezip(&stored, false, |_, data| data);
+            assert!(deflated.len() < stored.len() + 4096);
+            for bytes in [&stored, &deflated] {
+                let r = read(bytes).unwrap();
+                let Heights::Areal(back) = &r.channels[0].heights else {
+                    panic!()
+                };
+                assert!(back.iter().zip(&h).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+            // One byte changed in the last piece (CRC-32 made consistent by the re-zip):
+            // the MD5, run on the second thread, refuses it.
+            let edited = rezip(&stored, false, |name, mut data| {
+                if name.ends_with("data.bin") {
+                    assert!(data.len() >= 2 * PIECE);
+                    let i = data.len() - 12_345;
+                    data[i] ^= 0x40;
+                }
+                data
+            });
+            let err = read(&edited).unwrap_err().to_string();
+            assert!(err.contains("MD5"), "{err}");
+        }
     }
 
     #[test]
