@@ -1666,6 +1666,10 @@ mod tests {
                         relative(*ka, *kb),
                     ];
                     let points = a.contact_points.abs_diff(b.contact_points);
+                    // Bounds: each run stops anywhere within its tolerance of 1e-8 (the rms
+                    // gap violation over the rms height), so the two may differ by a few
+                    // tolerances, not to the last bit: 1e-7 on d, two marginal points, 1e-6
+                    // on k (measured: 3e-10, 0 points, 0).
                     eprintln!("{rows}x{cols} {boundary:?} load {load}: indentation {:.1e}, area {:.1e} ({points} points), stiffness {:.1e}", change[0], change[1], change[2]);
                     assert!(
                         change[0] < 1e-7,
