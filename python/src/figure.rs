@@ -39,11 +39,14 @@ fn mdr_figure(
     modulus: f64,
 ) -> PyResult<String> {
     use asperity_app::figure::mdr::{mdr_charts, MdrColumns, MdrFigure};
-    if force.len() != indentation.len() || stiffness.len() != indentation.len() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "mdr_figure: the columns differ in length",
-        ));
-    }
+    same_length(
+        "mdr_figure",
+        &[
+            ("indentation", indentation.len()),
+            ("force", force.len()),
+            ("stiffness", stiffness.len()),
+        ],
+    )?;
     let columns = MdrColumns {
         indentation: &indentation,
         force: &force,
@@ -76,11 +79,14 @@ fn adhesion_loop_figure(
     theory: Option<(String, Vec<(f64, f64)>)>,
 ) -> PyResult<String> {
     use asperity_app::figure::adhesion::{loop_chart, LoopFigure, LoopPoint, LoopPullOffs};
-    if force.len() != indentation.len() || retract.len() != indentation.len() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "adhesion_loop_figure: the columns differ in length",
-        ));
-    }
+    same_length(
+        "adhesion_loop_figure",
+        &[
+            ("indentation", indentation.len()),
+            ("force", force.len()),
+            ("retract", retract.len()),
+        ],
+    )?;
     let points: Vec<LoopPoint> = (0..indentation.len())
         .map(|k| LoopPoint {
             indentation: indentation[k],
@@ -151,11 +157,7 @@ fn psd_figure(
     hurst: Option<f64>,
     name: &str,
 ) -> PyResult<String> {
-    if q.len() != psd.len() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "psd_figure: q and psd differ in length",
-        ));
-    }
+    same_length("psd_figure", &[("q", q.len()), ("psd", psd.len())])?;
     let figure = PsdFigure {
         name,
         q: &q,
@@ -181,11 +183,7 @@ fn analysis_figure(
     name: &str,
 ) -> PyResult<String> {
     let analysis = Analysis::parse(analysis).map_err(crate::errors::refused)?;
-    if x.len() != y.len() {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "analysis_figure: the columns differ in length",
-        ));
-    }
+    same_length("analysis_figure", &[("x", x.len()), ("y", y.len())])?;
     let rows: Vec<(f64, f64)> = x.into_iter().zip(y).collect();
     let figure = AnalysisFigure {
         name,
@@ -210,17 +208,13 @@ fn sweep_figure(
     physical: bool,
     boundary: &str,
 ) -> PyResult<String> {
-    let n = force.len();
-    let lengths = [stiffness.len(), area_fraction.len()];
-    if lengths
-        .iter()
-        .chain(stiffness_fd.as_ref().map(Vec::len).iter())
-        .any(|&l| l != n)
-    {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "sweep_figure: the columns differ in length",
-        ));
-    }
+    let mut lengths = vec![
+        ("force", force.len()),
+        ("stiffness", stiffness.len()),
+        ("area_fraction", area_fraction.len()),
+    ];
+    lengths.extend(stiffness_fd.as_ref().map(|fd| ("stiffness_fd", fd.len())));
+    same_length("sweep_figure", &lengths)?;
     let columns = SweepColumns {
         force: &force,
         stiffness: &stiffness,
@@ -253,18 +247,16 @@ fn path_figure(
     boundary: &str,
     hardness: Option<f64>,
 ) -> PyResult<String> {
-    let n = values.len();
-    let lengths = [
-        indentation.len(),
-        force.len(),
-        area_fraction.len(),
-        stiffness.len(),
-    ];
-    if lengths.iter().any(|&l| l != n) {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "path_figure: the columns differ in length",
-        ));
-    }
+    same_length(
+        "path_figure",
+        &[
+            ("values", values.len()),
+            ("indentation", indentation.len()),
+            ("force", force.len()),
+            ("area_fraction", area_fraction.len()),
+            ("stiffness", stiffness.len()),
+        ],
+    )?;
     let branch = branches(&values);
     let columns = PathColumns {
         branch: &branch,
@@ -293,15 +285,15 @@ fn contact_figure(
     modulus: f64,
     name: &str,
 ) -> PyResult<String> {
-    let n = force.len();
-    if [stiffness.len(), area.len(), mean_gap.len()]
-        .iter()
-        .any(|&l| l != n)
-    {
-        return Err(pyo3::exceptions::PyValueError::new_err(
-            "contact_figure: the columns differ in length",
-        ));
-    }
+    same_length(
+        "contact_figure",
+        &[
+            ("force", force.len()),
+            ("stiffness", stiffness.len()),
+            ("area", area.len()),
+            ("mean_gap", mean_gap.len()),
+        ],
+    )?;
     let columns = ContactColumns {
         force: &force,
         stiffness: &stiffness,
@@ -309,4 +301,19 @@ fn contact_figure(
         mean_gap: &mean_gap,
     };
     Ok(figure::to_json(&contact_charts(columns, name, modulus)).to_string())
+}
+
+/// The one check of every figure above whose columns go side by side: `columns` as `(name,
+/// length)`, each as long as the first, else a `ValueError` naming `what` (the function),
+/// the first column that differs and both lengths.
+fn same_length(what: &str, columns: &[(&str, usize)]) -> PyResult<()> {
+    let Some(((first, expected), rest)) = columns.split_first() else {
+        return Ok(());
+    };
+    match rest.iter().find(|(_, length)| length != expected) {
+        Some((name, length)) => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{what}: the column {name} has {length} values, {first} has {expected}"
+        ))),
+        None => Ok(()),
+    }
 }

@@ -301,3 +301,27 @@ def test_an_mdr_curves_figure_is_the_clis_bit_for_bit(cli, tmp_path):
                             work_of_adhesion=1e-3, indentations=[0.09])
     with pytest.raises(ValueError, match="adhesion_loop"):
         asperity.plot.mdr(adhesive)
+
+
+@pytest.mark.parametrize("function, columns, rest", [
+    ("mdr_figure", ["indentation", "force", "stiffness"], ("hertz", "harmonic", 1.0)),
+    ("contact_figure", ["force", "stiffness", "area", "mean_gap"], (2e11, "m.npy")),
+])
+def test_a_figures_column_of_another_length_is_refused_by_name(function, columns, rest):
+    """The figures' one length check (python/src/figure.rs `same_length`): each column in
+    turn one value short is a ValueError naming that column, its length and the first's."""
+    from asperity import _asperity
+
+    draw = getattr(_asperity, function)
+    draw(*[[1.0, 2.0, 3.0]] * len(columns), *rest)  # equal lengths draw
+    for short in columns[1:]:
+        values = [[1.0, 2.0] if name == short else [1.0, 2.0, 3.0] for name in columns]
+        with pytest.raises(ValueError) as refused:
+            draw(*values, *rest)
+        assert str(refused.value) == (
+            f"{function}: the column {short} has 2 values, {columns[0]} has 3")
+    # The first column short: the others are named against it.
+    values = [[1.0]] + [[1.0, 2.0, 3.0]] * (len(columns) - 1)
+    with pytest.raises(ValueError, match=f"{function}: the column {columns[1]} has 3 values, "
+                                         f"{columns[0]} has 1"):
+        draw(*values, *rest)
