@@ -2082,7 +2082,7 @@ def study_compare(folder: Union[str, "os.PathLike[str]"], *, force: bool = False
 
     A missing folder, or one without ``study.json``: ``FileNotFoundError``; an unfinished
     study, a roll-off study whose sweeps ended, an existing output without ``force``:
-    ``ValueError`` in the command's words.
+    ``ValueError``.
 
     Example::
 

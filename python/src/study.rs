@@ -78,18 +78,25 @@ fn hurst_range(text: &str) -> PyResult<Vec<f64>> {
     parse_range(text).map_err(from_error)
 }
 
-/// `asperity study compare DIR` by the command's own code: writes `comparison.csv` and
+/// `asperity study compare DIR` by the command's own code
+/// ([`asperity_app::study::report::compare_study`]): writes `comparison.csv` and
 /// `report.md` into the finished study's folder and returns each row's verdict; its error
 /// (an unfinished study, a roll-off study whose sweeps ended, an existing output without
-/// `force`) is a `ValueError` in the command's words.
+/// `force`) is a `ValueError`, the library's as every function of the package raises it.
 #[pyfunction]
 fn compare_study(
     py: Python<'_>,
     dir: std::path::PathBuf,
     force: bool,
 ) -> PyResult<Vec<&'static str>> {
-    py.detach(|| asperity_cli::compare_study(&dir, force))
-        .map_err(pyo3::exceptions::PyValueError::new_err)
+    use asperity_app::study::report::{self, ReportError};
+    let rows = py
+        .detach(|| report::compare_study(&dir, force))
+        .map_err(|error| match error {
+            ReportError::Library(error) => from_error(error),
+            other => pyo3::exceptions::PyValueError::new_err(other.to_string()),
+        })?;
+    Ok(rows.iter().map(report::verdict).collect())
 }
 
 /// The columns of `comparison.csv`, `(name, type)` with type `text`, `count` or `number`

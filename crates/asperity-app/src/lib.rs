@@ -44,5 +44,6 @@ pub mod slip;
 pub mod stats;
 pub mod study;
 pub mod surface;
+pub mod table;
 
 pub use refusal::{Names, Param, Refusal, RequestError};

@@ -13,7 +13,6 @@ mod interrupt;
 mod output;
 mod plot;
 mod progress;
-mod report;
 mod request;
 mod rerun;
 mod studies;
@@ -103,23 +102,6 @@ fn in_one_line(err: &anyhow::Error) -> String {
         }
     }
     shorten_numbers(&asperity::input::one_line(&line))
-}
-
-/// `asperity study compare DIR [--force]` for the Python package
-/// (`asperity.study_compare`): writes `comparison.csv` and `report.md` (and the window
-/// sensitivity) into the finished study's folder `dir` by the command's own code, and
-/// returns the verdict of each row of `comparison.csv` as `report.md` words it; an error
-/// is the one line the command prints after `error: `.
-pub fn compare_study(dir: &std::path::Path, force: bool) -> Result<Vec<&'static str>, String> {
-    compare_and_judge(dir, force).map_err(|e| in_one_line(&e))
-}
-
-/// [`compare_study`]'s work: the command, then the verdicts read back from its table.
-fn compare_and_judge(dir: &std::path::Path, force: bool) -> anyhow::Result<Vec<&'static str>> {
-    report::compare_study(dir, force)?;
-    let path = dir.join("comparison.csv");
-    let text = asperity::input::read_text(&path, asperity::input::TEXT_MAX_BYTES)?;
-    Ok(report::parse(&text)?.iter().map(report::verdict).collect())
 }
 
 /// The pool the command runs on: one worker per core (or `RAYON_NUM_THREADS`). Where its

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use asperity::io::StagedOutputs;
+pub use asperity_app::table::format_number;
 
 /// A CSV table under construction: header plus rows of already formatted fields.
 #[derive(Debug, Clone, Default)]
@@ -33,34 +34,11 @@ impl Table {
             .push(fields.iter().map(|f| f.to_string()).collect());
     }
 
-    /// The table as CSV text; refused if a field is a non-finite number (no command writes
-    /// one: it means an input beyond what float64 can compute with).
+    /// The table as CSV text ([`asperity_app::table::csv_bytes`]); refused if a field is a
+    /// non-finite number (no command writes one: it means an input beyond what float64 can
+    /// compute with).
     pub fn to_csv(&self) -> Result<Vec<u8>> {
-        self.ensure_finite()?;
-        let mut writer = csv::Writer::from_writer(Vec::new());
-        writer.write_record(&self.header)?;
-        for row in &self.rows {
-            writer.write_record(row)?;
-        }
-        writer.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
-    }
-
-    /// Fails, naming the column and row, if a field is `NaN` or an infinity.
-    fn ensure_finite(&self) -> Result<()> {
-        for (r, row) in self.rows.iter().enumerate() {
-            for (c, field) in row.iter().enumerate() {
-                let lower = field.trim().to_ascii_lowercase();
-                if lower == "nan" || lower.trim_start_matches(['-', '+']).starts_with("inf") {
-                    anyhow::bail!(
-                        "the result is not a finite number ({field} in column `{}`, row {}): \
-                         an input is beyond what float64 can compute with; nothing was written",
-                        self.header.get(c).map_or("?", String::as_str),
-                        r + 1
-                    );
-                }
-            }
-        }
-        Ok(())
+        Ok(asperity_app::table::csv_bytes(&self.header, &self.rows)?)
     }
 
     /// Number of data rows.
@@ -101,11 +79,6 @@ pub fn pull_off_line(
         point(force_controlled),
         point(displacement_controlled)
     )
-}
-
-/// Shortest text that parses back to the same f64.
-pub fn format_number(v: f64) -> String {
-    format!("{v:?}")
 }
 
 /// Writes `bytes` to standard output; a closed pipe (`| head`) is not an error of ours.

@@ -18,6 +18,7 @@
 pub mod distributed;
 pub mod file;
 pub mod progress;
+pub mod report;
 pub mod request;
 pub mod rows;
 pub mod windows;

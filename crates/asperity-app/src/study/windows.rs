@@ -8,6 +8,7 @@ use std::path::Path;
 use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity, TaskSensitivity};
 
 use crate::refusal::{Refusal, RequestError};
+use crate::table::{csv_bytes, format_number, CsvError};
 
 /// The columns of the table, in order.
 pub const COLUMNS: [&str; 8] = [
@@ -59,6 +60,20 @@ pub fn rows(found: &[TaskSensitivity]) -> Vec<WindowRow> {
             })
         })
         .collect()
+}
+
+/// The CSV text of `rows` under [`COLUMNS`] (`asperity study windows`, and
+/// `window_sensitivity.csv` beside a comparison with the paper): counts as integers
+/// ("256", not "256.0"), measurements as round-trip floats.
+pub fn csv(rows: &[WindowRow]) -> Result<Vec<u8>, CsvError> {
+    let fields = |r: &WindowRow| {
+        let mut row = vec![r.n.to_string(), format_number(r.hurst)];
+        row.push(r.min_contacts.to_string());
+        row.extend([r.max_fraction, r.alpha, r.low, r.high].map(format_number));
+        row.push(r.samples.to_string());
+        row
+    };
+    csv_bytes(&COLUMNS, &rows.iter().map(fields).collect::<Vec<_>>())
 }
 
 /// The window sensitivity of the study in `dir` (read only); refused where no task has

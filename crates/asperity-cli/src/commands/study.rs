@@ -14,6 +14,7 @@ use crate::studies::{execute, Kind, RunOptions};
 use asperity_app::derived::Derived;
 use asperity_app::figure::study as figure;
 use asperity_app::range::parse_range;
+use asperity_app::study::report::compare_study;
 use asperity_app::study::request::StudyRequest;
 
 use crate::request::refused;
@@ -362,9 +363,9 @@ pub struct WindowsArgs {
 fn windows(args: &WindowsArgs) -> Result<()> {
     let rows = asperity_app::study::windows::window_sensitivity(&args.dir)
         .map_err(crate::request::refused)?;
-    let table = crate::report::window_table(&rows);
+    let table = asperity_app::study::windows::csv(&rows)?;
     use std::io::Write as _;
-    std::io::stdout().write_all(&table.to_csv()?)?;
+    std::io::stdout().write_all(&table)?;
     Ok(())
 }
 
@@ -455,7 +456,11 @@ pub fn run(args: &StudyArgs) -> Result<()> {
             (Kind::Curve, spec, &c.common.run.out, options)
         }
         StudyCommand::Windows(w) => return windows(w),
-        StudyCommand::Compare(c) => return crate::report::compare_study(&c.dir, c.force),
+        StudyCommand::Compare(c) => {
+            return compare_study(&c.dir, c.force)
+                .map(drop)
+                .map_err(crate::request::report_error)
+        }
         StudyCommand::File(f) => {
             let text = asperity::input::read_text(&f.file, asperity::input::TEXT_MAX_BYTES)?;
             let (kind, spec, derived) = parse_study_file(&f.file, &text)?;

@@ -8,9 +8,11 @@ use anyhow::Result;
 use asperity::study::theory::alpha_theory;
 use asperity::study::{Method, TaskResult};
 use asperity_app::range::parse_range;
+use asperity_app::study::report::{write as write_comparison, Results};
 
 use super::super::setting::Setting;
 use super::{announce, describe_hursts, figure_study, study_spec};
+use crate::request::report_error;
 use crate::studies::{write_alpha, Kind};
 
 fn alpha_rows_md(results: &[TaskResult]) -> String {
@@ -70,5 +72,5 @@ pub fn fig1(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         mdr.window.describe(),
         alpha_rows_md(&all)
     );
-    crate::report::write(dir, crate::report::Results::Fig1(&all), &report, force)
+    write_comparison(dir, Results::Fig1(&all), &report, force).map_err(report_error)
 }

@@ -6,10 +6,13 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
+use asperity::study::compare::steepest_slope;
 use asperity::study::Method;
+use asperity_app::study::report::{write as write_comparison, Results};
 
 use super::super::setting::Setting;
 use super::{announce, figure_study, study_spec};
+use crate::request::report_error;
 use crate::studies::{write_curves, Kind};
 
 /// Paper Fig. 2: k(F) for nominally flat surfaces with roll-off q0 L/2π = 6 (BEM).
@@ -25,7 +28,7 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
          |---|---|---|---|\n",
     );
     for r in &results {
-        let (steepest, fractions) = match crate::report::steepest_slope(r, &spec.window) {
+        let (steepest, fractions) = match steepest_slope(r, &spec.window) {
             Some((slope, first, last)) => {
                 (format!("{slope:.3}"), format!("{first:.2e} – {last:.2e}"))
             }
@@ -60,10 +63,6 @@ pub fn fig2(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         setting.describe(),
         min_contacts = spec.window.min_contacts,
     );
-    crate::report::write(
-        dir,
-        crate::report::Results::Fig2(&results, spec.window),
-        &report,
-        force,
-    )
+    let results = Results::Fig2(&results, spec.window);
+    write_comparison(dir, results, &report, force).map_err(report_error)
 }

@@ -7,11 +7,13 @@ use std::path::Path;
 use anyhow::Result;
 use asperity::study::theory::alpha_white_noise;
 use asperity::study::{Method, TaskResult};
+use asperity_app::study::report::{write as write_comparison, Results};
 
 use super::super::setting::Setting;
 use super::{announce, figure_study, study_spec};
 use crate::output::{format_number, Table};
 use crate::plot::{Chart, ChartFiles, Series, Style};
+use crate::request::report_error;
 use crate::studies::Kind;
 
 /// How a row's N counts modes: the paper plots each BEM grid twice.
@@ -126,8 +128,8 @@ pub fn fig5(dir: &Path, setting: Setting, force: bool, discard: bool) -> Result<
         bem.samples,
         mdr.window.describe()
     );
-    let results = crate::report::Results::Fig5(&mdr_results, &bem_results);
-    crate::report::write(dir, results, &report, force)
+    let results = Results::Fig5(&mdr_results, &bem_results);
+    write_comparison(dir, results, &report, force).map_err(report_error)
 }
 
 fn write_table(dir: &Path, rows: &[Row], force: bool) -> Result<()> {

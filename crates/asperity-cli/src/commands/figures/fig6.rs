@@ -103,7 +103,7 @@ pub fn fig6(dir: &Path, setting: Setting, force: bool) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     write_images(dir, &plan, &rows, force)?;
     write_table(dir, &plan, &rows, force)?;
-    write_report(dir, &report(&plan, &rows), force)
+    Ok(write_report(dir, &report(&plan, &rows), force)?)
 }
 
 fn write_images(dir: &Path, plan: &Plan, rows: &[Row], force: bool) -> Result<()> {

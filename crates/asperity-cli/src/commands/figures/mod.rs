@@ -27,7 +27,7 @@ pub use fig2::fig2;
 pub use fig5::fig5;
 pub use fig6::fig6;
 
-pub use crate::report::write_report;
+pub use asperity_app::study::report::write_report;
 
 /// Output files of one book figure, checked before any work.
 struct Outputs {

@@ -1,34 +1,74 @@
-//! The comparison with the paper in each `report.md` of `asperity reproduce` (Figs. 1, 2,
-//! 5): every result beside the paper's statement or equation, with its 95 % interval,
-//! whether the two agree within it, by how much, and the likely reason when they do not;
-//! how α moves with N; and how it moves with the fit window.
+//! The comparison with the paper (`asperity study compare`, Python's `study_compare`, and
+//! each `report.md` of `asperity reproduce`, Figs. 1, 2, 5): every result beside the
+//! paper's statement or equation, with its 95 % interval, whether the two agree within
+//! it, by how much, and the likely reason when they do not; how α moves with N; and how it
+//! moves with the fit window.
 //!
-//! The figure code hands its task results to [`write`]; the rows go to
-//! `comparison.csv`, and the tables of the report are rendered **from that CSV**
-//! ([`render`]), so that the text a reader sees is the file a script can check.
+//! The rows go to `comparison.csv` ([`comparison_csv`]), and the tables of the report are
+//! rendered **from that CSV** ([`parse`], [`render`]), so that the text a reader sees is
+//! the file a script can check.
 //!
-//! The rows, their intervals and verdicts are the library's
-//! ([`asperity::study::compare`], which Python's `StudyResult.comparison()` also uses);
-//! this module writes and renders them.
+//! The rows, their intervals and verdicts are the library's ([`asperity::study::compare`],
+//! which Python's `StudyResult.comparison()` also uses); this module writes and renders
+//! them, once for both front ends.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
 use asperity::study::compare;
-pub use asperity::study::compare::{rows, steepest_slope, Results, Row, CLOSE};
+pub use asperity::study::compare::{Results, Row, CLOSE};
 use asperity::study::sensitivity::{sensitivity_windows, study_sensitivity, study_slopes};
-use asperity_app::study::rows::COMPARISON_COLUMNS;
-use asperity_app::study::windows::WindowRow;
 
-use crate::output::{format_number, Table};
+use crate::study::rows::COMPARISON_COLUMNS;
+use crate::table::{csv_bytes, format_number, CsvError};
 
-/// `comparison.csv` of `rows`, under the front-end layer's header ([`COMPARISON_COLUMNS`]).
-pub fn table(rows: &[Row]) -> Table {
+/// Why a comparison could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// The library's error: the study folder cannot be read, a roll-off study's sweeps
+    /// ended, an output exists and overwriting was not allowed.
+    #[error(transparent)]
+    Library(#[from] asperity::Error),
+    /// A table's CSV text could not be made.
+    #[error(transparent)]
+    Csv(#[from] CsvError),
+    /// A task of the study is not finished.
+    #[error(
+        "{}: task N = {n}, H = {hurst} is not finished ({done} of {samples} samples): \
+         rerun the study's command to finish it first",
+        dir.display()
+    )]
+    Unfinished {
+        /// The study folder.
+        dir: PathBuf,
+        /// The task's grid size.
+        n: usize,
+        /// The task's Hurst exponent.
+        hurst: f64,
+        /// Samples it has finished.
+        done: usize,
+        /// Samples it needs.
+        samples: usize,
+    },
+    /// A row of `comparison.csv` has fewer fields than its header.
+    #[error("short row in comparison.csv")]
+    ShortRow,
+    /// A field of `comparison.csv` that holds a number does not.
+    #[error("comparison.csv: `{field}` is not a number")]
+    NotANumber {
+        /// The field.
+        field: String,
+        /// Why it does not parse.
+        source: std::num::ParseFloatError,
+    },
+}
+
+/// The text of `comparison.csv` of `rows`, under the front-end layer's header
+/// ([`COMPARISON_COLUMNS`]).
+pub fn comparison_csv(rows: &[Row]) -> Result<Vec<u8>, CsvError> {
     let header: Vec<&str> = COMPARISON_COLUMNS.iter().map(|(name, _)| *name).collect();
-    let mut table = Table::new(&header);
-    for r in rows {
-        table.push(&[
+    let fields = |r: &Row| {
+        vec![
             r.method.clone(),
             // A grid size: lines per side or grid points, always a whole number.
             format!("{}", r.n as u64),
@@ -40,22 +80,25 @@ pub fn table(rows: &[Row]) -> Table {
             format_number(r.reference),
             r.source.clone(),
             format_number(r.tolerance),
-        ]);
-    }
-    table
+        ]
+    };
+    csv_bytes(&header, &rows.iter().map(fields).collect::<Vec<_>>())
 }
 
 /// Reads the rows back from the text of a `comparison.csv`.
-pub fn parse(csv_text: &str) -> Result<Vec<Row>> {
+pub fn parse(csv_text: &str) -> Result<Vec<Row>, ReportError> {
     let mut reader = csv::Reader::from_reader(csv_text.as_bytes());
     let mut rows = Vec::new();
     for record in reader.records() {
-        let rec = record?;
-        let num = |i: usize| -> Result<f64> {
-            let field = rec.get(i).context("short row in comparison.csv")?;
+        let rec = record.map_err(CsvError::from)?;
+        let num = |i: usize| -> Result<f64, ReportError> {
+            let field = rec.get(i).ok_or(ReportError::ShortRow)?;
             field
                 .parse::<f64>()
-                .with_context(|| format!("comparison.csv: `{field}` is not a number"))
+                .map_err(|source| ReportError::NotANumber {
+                    field: field.to_string(),
+                    source,
+                })
         };
         rows.push(Row {
             method: rec.get(0).unwrap_or_default().to_string(),
@@ -217,7 +260,7 @@ pub fn trend(rows: &[Row]) -> String {
 /// The window sensitivity of the study in `study_dir` (from the sample curves its
 /// checkpoints keep): `window_sensitivity.csv` in `dir` and a markdown table, or a
 /// sentence saying why there is none.
-fn sensitivity(dir: &Path, study_dir: &Path, force: bool) -> Result<String> {
+fn sensitivity(dir: &Path, study_dir: &Path, force: bool) -> Result<String, ReportError> {
     let windows = sensitivity_windows();
     let found = study_sensitivity(study_dir, &windows)?;
     if found.is_empty() {
@@ -243,48 +286,34 @@ fn sensitivity(dir: &Path, study_dir: &Path, force: bool) -> Result<String> {
             );
         }
     }
-    let table = window_table(&asperity_app::study::windows::rows(&found));
-    table.write(&dir.join("window_sensitivity.csv"), force)?;
+    let table = crate::study::windows::csv(&crate::study::windows::rows(&found))?;
+    asperity::io::write_bytes(&dir.join("window_sensitivity.csv"), force, &table)?;
     Ok(md)
-}
-
-/// The window sensitivity as a table: one row per (task, window), the columns of
-/// [`asperity_app::study::windows`].
-pub fn window_table(rows: &[WindowRow]) -> Table {
-    let mut table = Table::new(&asperity_app::study::windows::COLUMNS);
-    for r in rows {
-        // Counts as integers ("256", not "256.0"), measurements as round-trip floats.
-        let mut row = vec![r.n.to_string(), format_number(r.hurst)];
-        row.push(r.min_contacts.to_string());
-        row.extend([r.max_fraction, r.alpha, r.low, r.high].map(format_number));
-        row.push(r.samples.to_string());
-        table.push(&row);
-    }
-    table
 }
 
 /// Writes `comparison.csv` and `report.md`: the figure's own `report` text, then the
 /// comparison rendered from the CSV, the N trend and the window sensitivity of its BEM
 /// study (folder `dir/bem`).
-pub fn write(dir: &Path, results: Results, report: &str, force: bool) -> Result<()> {
-    write_for_study(dir, &dir.join("bem"), results, report, force)
+pub fn write(dir: &Path, results: Results, report: &str, force: bool) -> Result<(), ReportError> {
+    write_for_study(dir, &dir.join("bem"), results, report, force).map(drop)
 }
 
 /// [`write`] with the BEM study in `study_dir` (its stored sample curves give the window
-/// sensitivity and the slopes' intervals).
+/// sensitivity and the slopes' intervals); the rows as read back from `comparison.csv`.
 fn write_for_study(
     dir: &Path,
     study_dir: &Path,
     results: Results,
     report: &str,
     force: bool,
-) -> Result<()> {
+) -> Result<Vec<Row>, ReportError> {
     let slopes = match results {
         Results::Fig2(..) if study_dir.join("study.json").is_file() => study_slopes(study_dir)?,
         _ => Vec::new(),
     };
     let path = dir.join("comparison.csv");
-    table(&rows(&results, &slopes)).write(&path, force)?;
+    let table = comparison_csv(&compare::rows(&results, &slopes))?;
+    asperity::io::write_bytes(&path, force, &table)?;
     let text = asperity::input::read_text(&path, asperity::input::TEXT_MAX_BYTES)?;
     let rows = parse(&text)?;
     let mut md = format!(
@@ -307,19 +336,22 @@ fn write_for_study(
          windows DIR/bem`); interval: bootstrap over samples.\n\n{}",
         sensitivity(dir, study_dir, force)?
     );
-    write_report(dir, &md, force)
+    write_report(dir, &md, force)?;
+    Ok(rows)
 }
 
 /// Writes `report.md` into `dir` atomically.
-pub fn write_report(dir: &Path, text: &str, force: bool) -> Result<()> {
-    asperity::io::write_bytes(&dir.join("report.md"), force, text.as_bytes())?;
-    Ok(())
+pub fn write_report(dir: &Path, text: &str, force: bool) -> asperity::Result<()> {
+    asperity::io::write_bytes(&dir.join("report.md"), force, text.as_bytes())
 }
 
-/// `asperity study compare DIR`: the finished study in `dir` beside the paper —
-/// `comparison.csv` and `report.md` in `dir`. A study with roll-off is compared like Fig. 2
-/// (steepest slope against "≈ 1"), one without like Fig. 1 (α against eqs. (6), (24)).
-pub fn compare_study(dir: &Path, force: bool) -> Result<()> {
+/// `asperity study compare DIR` (Python's `study_compare`): the finished study in `dir`
+/// beside the paper — `comparison.csv` and `report.md` (and `window_sensitivity.csv` of a
+/// BEM study with stored sample curves) in `dir`, overwritten only if `force`. A study
+/// with roll-off is compared like Fig. 2 (steepest slope against "≈ 1"), one without like
+/// Fig. 1 (α against eqs. (6), (24)). Returns the rows of `comparison.csv` as read back
+/// from it ([`verdict`] gives each one's verdict).
+pub fn compare_study(dir: &Path, force: bool) -> Result<Vec<Row>, ReportError> {
     use asperity::study::{Restored, StudyDir};
     let store = StudyDir::read(dir)?;
     let spec = store.spec().clone();
@@ -327,15 +359,15 @@ pub fn compare_study(dir: &Path, force: bool) -> Result<()> {
     for task in spec.tasks() {
         match store.restore(task)? {
             Restored::Done(r) => results.push(r),
-            Restored::Partial(done) => anyhow::bail!(
-                "{}: task N = {}, H = {} is not finished ({} of {} samples): rerun the \
-                 study's command to finish it first",
-                dir.display(),
-                task.n,
-                task.hurst,
-                done.len(),
-                spec.samples
-            ),
+            Restored::Partial(done) => {
+                return Err(ReportError::Unfinished {
+                    dir: dir.to_path_buf(),
+                    n: task.n,
+                    hurst: task.hurst,
+                    done: done.len(),
+                    samples: spec.samples,
+                })
+            }
         }
     }
     if spec.rolloff.is_some() {
@@ -392,7 +424,7 @@ mod tests {
             row(0.85, 0.85, 0.85, 1.0, 0.1),
             row(0.85, 0.84, 0.86, 0.833, 0.0),
         ];
-        let csv = String::from_utf8(table(&rows).to_csv().unwrap()).unwrap();
+        let csv = String::from_utf8(comparison_csv(&rows).unwrap()).unwrap();
         let back = parse(&csv).unwrap();
         assert_eq!(back, rows);
         let verdicts: Vec<&str> = back.iter().map(verdict).collect();
