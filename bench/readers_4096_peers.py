@@ -11,12 +11,18 @@ map (metres, 1 mm a side), in --folder (keep it out of the repository: /tmp):
   * `.sdf`: ISO 25178-71 binary (`bISO-1.0`, 81-byte header, float64, Zscale 1);
   * `.tmd`: TrueMap v2 (32-byte signature, 24-byte comment, float32 heights in mm);
   * `.bcrf`: SPIP BCRF (2048-character ASCII header, float32 heights in nm);
-  * `.mi`: PicoView MI (text header, one `Topography` buffer of int32 samples in µm).
+  * `.mi`: PicoView MI (text header, one `Topography` buffer of int32 samples in µm);
+  * the instrument formats neither tool writes (DI, PLU, MetroPro, OPDx, NID, IBW, AL3D,
+    VK4, VK6, ZON, LEXT, OPD, FRT, NMS, WSxM, JPK, Park TIFF, MNT), by
+    bench/readers_4096_layouts.py: each from the real file of the shared folders where
+    there is one (its header kept, the grid's dimensions and offsets changed), else in the
+    layout the readers document; their heights computed there from the header's scale.
 Before timing, each file is read by both tools and both readings are checked against the
 heights the file holds (float32 files: the map rounded to float32, times the unit's
-factor), to 1e-12 of the largest height.
+factor), to 1e-12 of the largest height; where the peer fails or reads other heights, it
+says so (and the peer is timed only where it reads the file).
 
-Timed (`--repeat` interleaved rounds; minimum reported): asperity as
+Timed (`--repeat` interleaved rounds; the median reported, every run in the JSON): asperity as
 `asperity import FILE --out OUT.npy --detrend none --force` in a fresh process (CPU =
 user + system and the peak RSS by /usr/bin/time; wall around it); the
 peer as `open_topography(FILE).topography()` (`.to_unit("m")`), `.heights()` in this
@@ -34,6 +40,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hdf5_read_peers as h5b  # noqa: E402
+import readers_4096_layouts as layouts  # noqa: E402
 
 SIDE_M = h5b.SIDE_M
 
@@ -132,6 +139,11 @@ def make_files(a, z):
         if kind in wanted:
             path = os.path.join(a.folder, f"r{a.n}.{kind}")
             files[kind] = (path, write(path, z))
+    rng = np.random.default_rng(2)
+    for kind, write in layouts.WRITERS.items():
+        if kind in wanted:
+            path = os.path.join(a.folder, f"r{a.n}.{layouts.SUFFIX.get(kind, kind)}")
+            files[kind] = (path, write(path, a.n, rng))
     return files
 
 
@@ -140,8 +152,8 @@ def ours(exe, path, out):
     /usr/bin/time (a child forked from this Python process would start its peak RSS from
     this process's size)."""
     args = [exe, "import", path, "--out", out, "--detrend", "none", "--force"]
-    if path.endswith(".h5"):
-        args += ["--size", repr(SIDE_M)]
+    if path.endswith(".h5") or path.endswith(".nms"):
+        args += ["--size", repr(SIDE_M)]  # the file gives none
     stats = out + ".time"
     t0 = time.perf_counter()
     p = subprocess.run(["/usr/bin/time", "-f", "%U %S %M", "-o", stats] + args,
@@ -161,13 +173,29 @@ def peer(path):
 
 
 def check(kind, exe, path, want, out):
+    """Both readings against the heights the file holds; returns None where the peer reads
+    them too, else (why, whether the peer still reads the file: it is then timed)."""
     ours(exe, path, out)
-    mine = np.load(out)
-    theirs, _, _ = peer(path)
     scale = np.abs(want).max()
-    for who, got in (("asperity", mine), ("SurfaceTopography", theirs.T)):
-        if got.shape != want.shape or not np.abs(got - want).max() <= 1e-12 * scale:
-            sys.exit(f"{kind}: {who}'s reading differs from the heights written")
+
+    def same(got):
+        return got.shape == want.shape and np.abs(got - want).max() <= 1e-12 * scale
+
+    if not same(np.load(out)):
+        sys.exit(f"{kind}: asperity's reading differs from the heights written")
+    try:
+        theirs, _, _ = peer(path)
+    except Exception as e:  # noqa: BLE001 (any failure of the peer's reader is reported)
+        return f"SurfaceTopography fails: {type(e).__name__}: {str(e)[:200]}", False
+    theirs = np.asarray(theirs).T
+    if not same(theirs):
+        if theirs.shape != want.shape:
+            return f"SurfaceTopography reads a {theirs.shape} map", True
+        ratio = np.median(theirs[want != 0] / want[want != 0])
+        return (f"SurfaceTopography's reading differs from the heights written: largest "
+                f"difference {np.abs(theirs - want).max() / scale:.3g} of the largest height, "
+                f"median ratio {ratio:.6g}"), True
+    return None
 
 
 def main():
@@ -177,39 +205,62 @@ def main():
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--folder", default="/tmp/asperity-readers")
     p.add_argument("--out", help="where asperity writes its .npy (default: the folder)")
-    p.add_argument("--formats", default="h5,datx,x3p,x3p-deflated,sur,nc,gwy,sdf,tmd,bcrf,mi")
+    p.add_argument("--formats", default="h5,datx,x3p,x3p-deflated,sur,nc,gwy,sdf,tmd,bcrf,mi,"
+                   + ",".join(layouts.WRITERS))
     p.add_argument("--json", help="where to write the results (default: FOLDER/readers.json)")
+    p.add_argument("--baseline", help="a second asperity binary (e.g. main's) timed in the "
+                   "same rounds, interleaved, for a before/after comparison")
     a = p.parse_args()
     os.makedirs(a.folder, exist_ok=True)
     z = np.random.default_rng(1).standard_normal((a.n, a.n)) * 1e-6
     files = make_files(a, z)
     out = os.path.join(a.out or a.folder, "read.npy")
+    peer_fails, peer_differs = {}, {}
     for kind, (path, want) in files.items():
-        check(kind, a.asperity, path, want, out)
+        result = check(kind, a.asperity, path, want, out)
+        if result:
+            why, reads = result
+            (peer_differs if reads else peer_fails)[kind] = why
+            print(f"{kind}: {why}", flush=True)
     runs = {kind: {"ours_cpu": [], "ours_wall": [], "ours_rss_mb": [], "st_cpu": [],
-                   "st_wall": []} for kind in files}
+                   "st_wall": [], "base_cpu": [], "base_wall": [], "base_rss_mb": []}
+            for kind in files}
     loads = [os.getloadavg()[0]]
     for _ in range(a.repeat):
         for kind, (path, _) in files.items():
             cpu, wall, rss = ours(a.asperity, path, out)
-            _, st_cpu, st_wall = peer(path)
+            _, st_cpu, st_wall = (None, None, None) if kind in peer_fails else peer(path)
             r = runs[kind]
+            if a.baseline:
+                b_cpu, b_wall, b_rss = ours(a.baseline, path, out)
+                r["base_cpu"].append(b_cpu)
+                r["base_wall"].append(b_wall)
+                r["base_rss_mb"].append(b_rss)
             r["ours_cpu"].append(cpu)
             r["ours_wall"].append(wall)
             r["ours_rss_mb"].append(rss)
             r["st_cpu"].append(st_cpu)
             r["st_wall"].append(st_wall)
         loads.append(os.getloadavg()[0])
-    print("| 4096² file | MiB | asperity CPU / wall | SurfaceTopography CPU / wall | "
-          "asperity peak RSS |")
+    print("| 4096² file | MiB | asperity CPU / wall (median) | SurfaceTopography CPU / wall "
+          "(median) | asperity peak RSS |")
     print("|---|---|---|---|---|")
+
+    def med(xs):
+        return f"{np.median(xs):.2f}"
+
     for kind, (path, _) in files.items():
         r = runs[kind]
-        print(f"| `{kind}` | {os.path.getsize(path) / 2**20:.0f} | {min(r['ours_cpu']):.2f} / "
-              f"{min(r['ours_wall']):.2f} s | {min(r['st_cpu']):.2f} / {min(r['st_wall']):.2f} s | "
-              f"{max(r['ours_rss_mb']):.0f} MB |", flush=True)
+        st = (f"{med(r['st_cpu'])} / {med(r['st_wall'])} s" if kind not in peer_fails
+              else "does not read it") + (" (reads other heights)" if kind in peer_differs
+                                          else "")
+        base = (f" (baseline: {med(r['base_cpu'])} / {med(r['base_wall'])} s, "
+                f"{max(r['base_rss_mb']):.0f} MB)" if a.baseline else "")
+        print(f"| `{kind}` | {os.path.getsize(path) / 2**20:.0f} | {med(r['ours_cpu'])} / "
+              f"{med(r['ours_wall'])} s | {st} | {max(r['ours_rss_mb']):.0f} MB |{base}",
+              flush=True)
     print(f"load average (1 min) over the rounds: {min(loads):.1f}–{max(loads):.1f}")
-    results = {"runs": runs, "sizes_mib": {k: os.path.getsize(p) / 2**20 for k, (p, _) in
+    results = {"runs": runs, "peer_fails": peer_fails, "peer_differs": peer_differs, "sizes_mib": {k: os.path.getsize(p) / 2**20 for k, (p, _) in
                                           files.items()},
                "environment": {"date": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
                                "nproc": os.cpu_count(), "loadavg_1min": loads}}
