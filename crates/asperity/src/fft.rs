@@ -34,7 +34,7 @@ use rayon::prelude::*;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftNum, FftPlanner};
 
-use crate::memory::try_vec;
+use crate::memory::{array_bytes, try_vec};
 use crate::{Error, Result};
 
 /// The floating-point type a [`RealFft2`] computes in: `f64` (the default, and the only
@@ -171,6 +171,19 @@ pub struct RealFft2<T: Precision = f64> {
     /// and the column passes.
     work: Vec<Complex<T>>,
     lanes: Vec<Lane<T>>,
+}
+
+/// Bytes of the plans and per-thread buffers of a `rows × cols` transform, an upper bound
+/// (`None` on overflow); its half-spectrum work buffer is not included. Each lane (one per
+/// thread of the pool) holds a strip of columns ([`Precision::STRIP`] × `rows` complex
+/// values: 64 bytes per row in either precision), a row (at most 8 bytes per column) and
+/// the transforms' scratch (at most 4 × max(rows, cols) complex values, Bluestein's for
+/// sizes with large prime factors): at most 128 bytes per row and column. The four plans'
+/// twiddles (at most about 9 complex values per point of their length, Bluestein's) are
+/// bounded by as much as three lanes.
+pub(crate) fn plan_memory_bytes(rows: usize, cols: usize) -> Option<u64> {
+    let lanes = rayon::current_num_threads().max(1);
+    array_bytes(&[lanes.checked_add(3)?, rows.checked_add(cols)?], 128)
 }
 
 impl RealFft2 {

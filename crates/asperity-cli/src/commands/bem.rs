@@ -59,7 +59,11 @@ thermal_conductance with --thermal-conductivity, mean_gap, area_fraction_persson
 mean_gap_persson, stiffness_persson with --persson, and solve_seconds, stiffness_seconds,\n\
 peak_rss_mib (tangential_seconds with --poisson) with --timing. With --out, OUT.csv.json records the inputs (surface, L and where it came from,\n\
 E*, boundary, tolerance, loads, columns). Loads beyond full contact are refused before\n\
-any solve.")]
+any solve.\n\n\
+Memory: a solve holds at most about 240 bytes per grid point with free boundaries, 210\n\
+periodic (3.7 GiB at 4096² free); a surface that would not fit in 90 % of the memory\n\
+available is refused before its heights are read (ASPERITY_MEMORY_LIMIT_MIB=N caps that\n\
+figure at N MiB; docs/performance.md).")]
 pub struct BemArgs {
     /// Surface heights, positive up: a .npy (float64, 2D), or a measured file (X3P, SDF,
     /// text matrix, x y z, ...; sizes and units from the file, see --channel, --detrend,
@@ -610,8 +614,8 @@ pub(super) fn stage_outputs(args: &BemArgs, loads: usize) -> Result<Outputs> {
 }
 
 /// Step 1c: the surface, with where its side length came from. A `.npy`'s memory is checked
-/// from its header before its data is read (the solver plus the heights, alive while the
-/// solver is built, plus the per-load bookkeeping); a measured file is read, bounded, by
+/// from its header before its data is read (the solver plus the per-load bookkeeping: the
+/// heights are freed before the first solve, `run`); a measured file is read, bounded, by
 /// the topography reader and checked after.
 fn read_surface(args: &BemArgs, plan: &Plan, outputs: &Outputs) -> Result<(Surface, SizeSource)> {
     let loads = plan.bem.loads.len();
@@ -620,6 +624,7 @@ fn read_surface(args: &BemArgs, plan: &Plan, outputs: &Outputs) -> Result<(Surfa
         args,
         (plan.size, plan.bem.half_space.boundary),
         (loads, fields),
+        true,
     )
 }
 
@@ -633,23 +638,29 @@ pub(super) fn read_surface_for(
         Some(text) => parse_size(text)?,
         None => [None, None],
     };
-    let (surface, source) = read_surface_with(args, (size, boundary), (0, (false, false)))?;
+    let (surface, source) = read_surface_with(args, (size, boundary), (0, (false, false)), false)?;
     Ok((surface, source.name()))
 }
 
 /// [`read_surface`] for `size` (`--size`) and `boundary`, with the bookkeeping of `loads`
 /// loads (and their fields: written as solved, or kept for one `.nc` file) in the memory
-/// check.
+/// check, and the heights unless `heights_freed` (the caller frees them before solving).
 fn read_surface_with(
     args: &BemArgs,
     (size, boundary): ([Option<f64>; 2], asperity::elastic::Boundary),
     (loads, (fields, kept)): (usize, (bool, bool)),
+    heights_freed: bool,
 ) -> Result<(Surface, SizeSource)> {
     let fits = |shape: &[usize]| match *shape {
         [rows, cols] => {
             // A .nc file: pressure and gap of every load, a filled copy and the bytes.
             let kept = if kept { [loads, rows, cols, 6] } else { [0; 4] };
-            let extra = array_bytes(&[rows, cols], 8)
+            // The heights, unless freed before the first solve (`run`): while they live
+            // (read, solver built) the solver holds less than its estimate by more than
+            // they take (8 bytes per point, and a reader's copy while it converts them):
+            // the stiffness CG's 56 bytes per point come with the first stiffness.
+            let heights = array_bytes(&[rows, cols], if heights_freed { 0 } else { 8 });
+            let extra = heights
                 .zip(bookkeeping_bytes(loads, fields || kept[0] > 0))
                 .and_then(|(heights, loads)| heights.checked_add(loads))
                 .zip(array_bytes(&kept, 8))

@@ -53,7 +53,7 @@ impl<K: ContactOperator> ContactSolver<K> {
             return full;
         }
         let len = self.cx.problem.profile.len();
-        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, len);
+        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, len, false);
         if self
             .cx
             .problem
@@ -109,7 +109,7 @@ impl<K: ContactOperator> ContactSolver<K> {
             .profile
             .iter()
             .fold(0.0f64, |m, &f| m.max(f));
-        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, n as usize);
+        let scratch = FullContactScratch::lend(&mut self.full_contact_scratch, n as usize, true);
         let problem = &mut self.cx.problem;
         let mut bound = 0.0f64;
         for weights in [Weights::Depth, Weights::Laplacian] {

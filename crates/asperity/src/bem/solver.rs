@@ -51,7 +51,7 @@ use super::context::{ContactProblem, Context, SolverState, Target};
 use super::interface::{restore_capped_load, Interface};
 use super::iterations::BccgScratch;
 use super::iterations::PkScratch;
-use super::iterations::{Iteration, Limits};
+use super::iterations::{Iteration, Limits, RING_MIN_POINTS};
 use super::precondition::{FourierPreconditioner, Real};
 use super::stagnation::Progress;
 use super::stiffness::work::StiffnessWork;
@@ -107,37 +107,51 @@ pub struct ContactSolver<K: ContactOperator = ElasticOperator> {
 
 impl ContactSolver {
     /// Estimated peak memory of a solver for a `rows × cols` grid (bytes; `None` on
-    /// overflow), an upper bound on what its parts hold once all have been used: the
-    /// operator, its single-precision copy and the preconditioner; the profile, pressure
-    /// and gap; the BCCG's five fields and its mask, with the rings of large grids one more
-    /// field and eleven bytes per point (counts and lists); the Polonsky–Keer iteration's
-    /// two; the six of the stiffness CG and its set's index list (on large grids its rings'
-    /// field and twelve bytes per point); the two of the full-contact code (periodic: three
-    /// more for the coarse correction of displacement control); the direct solve of small
-    /// sets, a field of indices, a mask and its dense factor. The caller's [`Surface`] (one
-    /// more `rows × cols` field while the solver is built) is not included.
+    /// overflow) once a BCCG solve, its frozen-set stiffness and the full-contact checks
+    /// have run, all that `asperity bem` does with it: the sum of every buffer they
+    /// allocate (an upper bound; `solver_bytes_per_point` lists them) and the plans and
+    /// per-thread buffers of the three transforms. Not included: the caller's
+    /// [`Surface`] (one more `rows × cols` field while the solver is built; `asperity bem`
+    /// frees it before the first solve), a Polonsky–Keer solve's two fields
+    /// ([`ContactSolver::new`] adds them when its parameters choose it), and the fields of
+    /// a hardness cap (`K 1_C`) and of kept plastic displacement (one field each).
+    ///
+    /// Measured (`asperity bem --tol 1e-3 --timing`, peak resident set less the 5 MiB of
+    /// `asperity --version`; docs/performance.md): 205 bytes per point free and 176
+    /// periodic at 4096², p̄ = 0.05, and 220 and 184 at higher loads (p̄ = 0.2 free, a
+    /// periodic indentation), where the CG's set fills; the estimate is 238 and 209 bytes
+    /// per point there.
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        // The masks and the rings' bytes (27 per point) count as four fields (rounding up);
-        // periodic grids add the coarse correction's two fields and its mask (`mean_gap.rs`).
-        let count = if boundary == Boundary::Periodic {
-            29
-        } else {
-            26
-        };
-        let fields = memory::array_bytes(&[count, rows, cols], 8)?;
-        let limit = super::iterations::small_set::limit(rows.checked_mul(cols)?);
+        Self::memory_bytes_for(rows, cols, boundary, SolverKind::Bccg)
+    }
+
+    /// [`ContactSolver::memory_bytes`] with the fields of `solver`'s iteration: a
+    /// Polonsky–Keer solver also holds its direction and response (two fields).
+    pub fn memory_bytes_for(
+        rows: usize,
+        cols: usize,
+        boundary: Boundary,
+        solver: SolverKind,
+    ) -> Option<u64> {
+        let len = rows.checked_mul(cols)?;
+        let per_point = solver_bytes_per_point(boundary, len >= RING_MIN_POINTS, solver);
+        let fields = memory::array_bytes(&[len], per_point)?;
+        let limit = super::iterations::small_set::limit(len);
         let factor = memory::array_bytes(&[limit + 3, limit], 8)?;
-        ElasticOperator::memory_bytes(rows, cols, boundary)?
+        let resident = ElasticOperator::resident_memory_bytes(rows, cols, boundary)?
             .checked_add(ElasticOperator::single_precision_memory_bytes(
                 rows, cols, boundary,
             )?)?
             .checked_add(FourierPreconditioner::<Real>::memory_bytes(rows, cols)?)?
             .checked_add(fields)?
-            .checked_add(factor)
+            .checked_add(factor)?;
+        // The operator's set-up holds its kernel's whole spectrum before anything else of
+        // the solver is allocated: the larger of the two is the peak.
+        Some(resident.max(ElasticOperator::memory_bytes(rows, cols, boundary)?))
     }
 
     /// Plans a solver for `surface` on `half_space`; validates `params`, refuses grids that
-    /// would not fit in memory.
+    /// would not fit in memory ([`ContactSolver::memory_bytes_for`] of `params.solver`).
     pub fn new(
         surface: &Surface,
         half_space: HalfSpace,
@@ -150,11 +164,50 @@ impl ContactSolver {
                 "a BEM solver for a {rows}x{cols} grid ({} boundaries)",
                 half_space.boundary.name()
             ),
-            Self::memory_bytes(rows, cols, half_space.boundary),
+            Self::memory_bytes_for(rows, cols, half_space.boundary, params.solver),
         )?;
         let problem = ContactProblem::new(surface, half_space)?;
         Self::assemble(problem, params)
     }
+}
+
+/// Bytes per grid point of the fields a solver allocates for its solves (BCCG, or `solver`),
+/// its frozen-set stiffness and its full-contact checks, each counted whole: a buffer is
+/// written only in part by some loads (the CG's set list, the rings' lists, the small set's
+/// entering list) but filled by others (measured: the peak rises from 212 to 227 bytes per
+/// point at 1024² free from p̄ = 0.05 to 0.2). `rings`: the grid has the rings around the
+/// free set ([`RING_MIN_POINTS`]). The operators' and the preconditioner's buffers are
+/// counted apart ([`ContactSolver::memory_bytes`]).
+fn solver_bytes_per_point(boundary: Boundary, rings: bool, solver: SolverKind) -> usize {
+    const F64: usize = 8;
+    const INDEX: usize = std::mem::size_of::<usize>();
+    let free = boundary == Boundary::Free;
+    // The problem's profile; the state's pressure and gap (`context.rs`).
+    let problem = 3 * F64;
+    // BCCG: direction, response, preconditioned gradient, gradient, previous gradient and
+    // the impulse response; the free set and the previous one; the chunks' cut lists (96
+    // pairs per 8192 points, 0.19 bytes per point: one) (`bccg.rs`).
+    let bccg = 6 * F64 + 2 + 1;
+    // The periodic coarse correction: 1_O and its free set (`mean_gap.rs`).
+    let mean_gap = if free { 0 } else { F64 + 1 };
+    // The small-set solve: membership and the entering list (`small_set.rs`; its dense
+    // factor is counted apart).
+    let small_set = 1 + INDEX;
+    // Full contact: the weights, and K v of the free lower bound (`threshold.rs`).
+    let full_contact = if free { 2 * F64 } else { F64 };
+    // The stiffness CG: x, residual, preconditioned residual, direction, response and its
+    // set's index list; K⁻¹f of the free threshold (`stiffness/`).
+    let stiffness = 5 * F64 + INDEX + if free { F64 } else { 0 };
+    // The rings of the BCCG and of the stiffness CG (two counts, a mask, two u32 column
+    // lists and a value list each, `ring_extension.rs`), and the CG's set mask.
+    let ring = 3 + 2 * 4 + F64;
+    let rings = if rings { 2 * ring + 1 } else { 0 };
+    // Polonsky–Keer: its direction and response (`polonsky_keer.rs`).
+    let pk = match solver {
+        SolverKind::PolonskyKeer => 2 * F64,
+        SolverKind::Bccg => 0,
+    };
+    problem + bccg + mean_gap + small_set + full_contact + stiffness + rings + pk
 }
 
 impl<K: ContactOperator> ContactSolver<K> {
@@ -197,7 +250,7 @@ impl<K: ContactOperator> ContactSolver<K> {
                 "a BEM solver for a {rows}x{cols} grid ({} boundaries)",
                 boundary.name()
             ),
-            ContactSolver::memory_bytes(rows, cols, boundary),
+            ContactSolver::memory_bytes_for(rows, cols, boundary, params.solver),
         )?;
         let problem = ContactProblem::with_operator(surface, operator)?;
         Self::assemble(problem, params)

@@ -38,11 +38,18 @@ pub(super) struct FullContactScratch {
 }
 
 impl FullContactScratch {
-    /// The fields in `slot`, allocated there for `len` points on first use.
-    pub(super) fn lend(slot: &mut Option<Self>, len: usize) -> &mut Self {
-        slot.get_or_insert_with(|| FullContactScratch {
+    /// The fields in `slot`, allocated there for `len` points on first use: the weights,
+    /// and `K v` only if `response` (the lower bound of free boundaries: the periodic
+    /// threshold never reads it, and memory not allocated needs no estimate,
+    /// `ContactSolver::memory_bytes`).
+    pub(super) fn lend(slot: &mut Option<Self>, len: usize, response: bool) -> &mut Self {
+        let scratch = slot.get_or_insert_with(|| FullContactScratch {
             weights: vec![0.0; len],
-            response: vec![0.0; len],
-        })
+            response: Vec::new(),
+        });
+        if response && scratch.response.len() != len {
+            scratch.response = vec![0.0; len];
+        }
+        scratch
     }
 }

@@ -150,11 +150,21 @@ fn check_positive(name: &'static str, value: f64) -> Result<()> {
 
 impl ElasticOperator {
     /// Estimated peak memory of an operator for a `rows × cols` grid, in bytes (`None` on
-    /// overflow): row-pass buffer and kernel, and the whole spectrum the kernel's set-up
-    /// holds for a while (free boundaries; an upper bound for periodic ones).
+    /// overflow): row-pass buffer, kernel and the transforms' plans and lanes, and the
+    /// whole spectrum the kernel's set-up holds for a while (free boundaries; an upper
+    /// bound for periodic ones).
     pub fn memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
-        let [work, kernel, spectrum] = buffer_bytes(rows, cols, boundary, 8)?;
-        spectrum.checked_add(work)?.checked_add(kernel)
+        let [_, _, spectrum] = buffer_bytes(rows, cols, boundary, 8)?;
+        spectrum.checked_add(Self::resident_memory_bytes(rows, cols, boundary)?)
+    }
+
+    /// Memory an operator for a `rows × cols` grid keeps once planned, in bytes (`None` on
+    /// overflow): [`ElasticOperator::memory_bytes`] less the spectrum of the kernel's
+    /// set-up, which is freed before the operator is returned.
+    pub fn resident_memory_bytes(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
+        let [work, kernel, _] = buffer_bytes(rows, cols, boundary, 8)?;
+        work.checked_add(kernel)?
+            .checked_add(plans(rows, cols, boundary)?)
     }
 
     /// Plans the operator of a `rows × cols` grid of square pixels of side `spacing` on a
@@ -289,15 +299,24 @@ impl ElasticOperator {
     }
 
     /// Estimated memory of [`ElasticOperator::single_precision`]'s copy for a `rows × cols`
-    /// grid, in bytes (`None` on overflow): its row-pass buffer and kernel in `f32`.
+    /// grid, in bytes (`None` on overflow): its row-pass buffer and kernel in `f32`, and
+    /// its transforms' plans and lanes.
     pub fn single_precision_memory_bytes(
         rows: usize,
         cols: usize,
         boundary: Boundary,
     ) -> Option<u64> {
         let [work, kernel, _] = buffer_bytes(rows, cols, boundary, 4)?;
-        work.checked_add(kernel)
+        work.checked_add(kernel)?
+            .checked_add(plans(rows, cols, boundary)?)
     }
+}
+
+/// The plans and lanes of the transforms of an operator for a `rows × cols` grid (the
+/// padded grid of free boundaries), in bytes (`None` on overflow).
+fn plans(rows: usize, cols: usize, boundary: Boundary) -> Option<u64> {
+    let pad = boundary.padding();
+    crate::fft::plan_memory_bytes(rows.checked_mul(pad)?, cols.checked_mul(pad)?)
 }
 
 /// The buffers of an operator for a `rows × cols` grid computing with `real` bytes per real

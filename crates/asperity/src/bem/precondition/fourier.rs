@@ -54,11 +54,13 @@ pub(in crate::bem) struct FourierPreconditioner<T: Precision = Real> {
 
 impl<T: Precision> FourierPreconditioner<T> {
     /// Bytes of a preconditioner for a `rows × cols` grid (`None` on overflow): the FFT's
-    /// work buffer (complex, half grid) and the symbol (real, half grid), and the lanes'
-    /// column buffers. Rounded up to whole `rows × cols` double fields: two (one in single
-    /// precision, but the estimate does not count on it).
+    /// work buffer (complex, half grid) and the symbol (real, half grid), three values of
+    /// `T` per point of the half grid, and the transform's plans and lanes (6 bytes per
+    /// grid point in single precision, the solvers').
     pub(in crate::bem) fn memory_bytes(rows: usize, cols: usize) -> Option<u64> {
-        memory::array_bytes(&[2, rows, cols], 8)
+        let value = std::mem::size_of::<T>();
+        memory::array_bytes(&[rows, cols / 2 + 1], 3 * value)?
+            .checked_add(crate::fft::plan_memory_bytes(rows, cols)?)
     }
 
     /// Plans the transforms and tabulates the symbol for a `rows × cols` grid of pixels

@@ -9,7 +9,8 @@ use crate::elastic::HalfSpaceOperator;
 pub(in crate::bem) struct StiffnessWork {
     /// The CG's fields; its unknown `cg.x` holds the pressures on the set.
     pub(in crate::bem) cg: CgWork,
-    /// `K⁻¹f` of the full-contact threshold.
+    /// `K⁻¹f` of the full-contact threshold of free boundaries (empty on periodic grids,
+    /// whose threshold is spectral, `full_contact.rs`).
     pub(in crate::bem) profile_pressure: Vec<f64>,
     /// Whether `cg.x` is the frozen-set solution `K_SS⁻¹ 1_S` of the solved state (the
     /// tangent `dp/dd` of its pressure), not yet used by a solve.
@@ -21,9 +22,10 @@ impl StiffnessWork {
     /// BCCG, `ring_extension.rs`) if `rings`.
     pub(in crate::bem) fn new(operator: &impl HalfSpaceOperator, rings: bool) -> Self {
         let len = operator.rows() * operator.cols();
+        let free = operator.boundary() == crate::elastic::Boundary::Free;
         StiffnessWork {
             cg: CgWork::for_operator(operator, rings),
-            profile_pressure: vec![0.0; len],
+            profile_pressure: vec![0.0; if free { len } else { 0 }],
             tangent: false,
         }
     }
