@@ -39,6 +39,7 @@
 use rayon::prelude::*;
 
 use super::fourier::{centre_on_set, Preconditioner};
+use super::pyramid::Pyramid;
 use crate::elastic::{Boundary, HalfSpaceOperator};
 
 /// Weights of the first and the second ring (measured, see the module docs).
@@ -116,6 +117,29 @@ pub(in crate::bem) struct RingExtension {
     /// A row of zeros of each type: the rows outside a free grid.
     zeros: (Vec<u8>, Vec<bool>),
     grid: Grid,
+    /// Experiment (issue 39): the multilevel extension beyond the rings (`far`) or in
+    /// their place (`all`), from `ASPERITY_PYRAMID=far|all:λ:γ`.
+    pyramid: Option<(Pyramid, bool)>,
+}
+
+/// The experiment's switch (issue 39, item 1; off when unset): `ASPERITY_PYRAMID=all:λ:γ`
+/// extends the preconditioned field by the multilevel pyramid (`pyramid.rs`) in place of
+/// the rings, `far:λ:γ` beyond them. Read once, when the rings' fields are made.
+const PYRAMID_ENV: &str = "ASPERITY_PYRAMID";
+
+/// `(all, λ, γ)` of a setting of [`PYRAMID_ENV`]; `None` (the rings alone) unless it is
+/// `all` or `far` with `0 < λ ≤ 1` and `0 < γ ≤ 2`.
+fn pyramid_setting(value: &str) -> Option<(bool, f64, f64)> {
+    let mut parts = value.split(':');
+    let all = match parts.next()? {
+        "all" => true,
+        "far" => false,
+        _ => return None,
+    };
+    let lambda: f64 = parts.next()?.parse().ok()?;
+    let gamma: f64 = parts.next()?.parse().ok()?;
+    let valid = lambda > 0.0 && lambda <= 1.0 && gamma > 0.0 && gamma <= 2.0;
+    (valid && parts.next().is_none()).then_some((all, lambda, gamma))
 }
 
 /// The row above row `i` (periodic: wrapped; free: none above the first).
@@ -255,6 +279,10 @@ impl RingExtension {
             },
             zeros: (vec![0; cols], vec![false; cols]),
             grid: (rows, cols, periodic),
+            pyramid: std::env::var(PYRAMID_ENV)
+                .ok()
+                .and_then(|v| pyramid_setting(&v))
+                .map(|(all, lambda, gamma)| (Pyramid::new(rows, cols, lambda, gamma), all)),
         }
     }
 
@@ -315,6 +343,9 @@ impl RingExtension {
                     .for_each(|(c, (&f, &r))| *c *= u8::from(!f && r == 0));
             });
         self.counted_for.copy_from_slice(free);
+        if let Some((pyramid, _)) = self.pyramid.as_mut() {
+            pyramid.count(free);
+        }
     }
 
     /// `z ← (I + E) z` for the free set `free`, of the field that is `z − centre` on the
@@ -325,6 +356,10 @@ impl RingExtension {
         self.count(free);
         let (grid, cols) = (self.grid, self.grid.1);
         let (first, second) = (&self.first, &self.second);
+        if let Some((pyramid, true)) = self.pyramid.as_mut() {
+            pyramid.extend(free, |k: usize| !free[k], z, centre);
+            return;
+        }
         // The first ring: γ₁/c times the sum of its c neighbours on the set (z is zero off
         // it, and on the rings until they are written; `z − centre·1` there is `z − 0`).
         self.listed.update(z, List::FirstRing, |(i, j), z| {
@@ -336,6 +371,11 @@ impl RingExtension {
         self.listed.update(z, List::SecondRing, |(i, j), z| {
             weight(1, second[i * cols + j]) * around(grid, (i, j), |m| z[m])
         });
+        // Beyond the second ring (after it: the rings read zeros there).
+        if let Some((pyramid, false)) = self.pyramid.as_mut() {
+            let target = |k: usize| !free[k] && first[k] == 0 && second[k] == 0;
+            pyramid.extend(free, target, z, centre);
+        }
     }
 
     /// `z ← (I + E)ᵀ z` on the free set `free` of the last [`RingExtension::extend`]: there
@@ -345,6 +385,14 @@ impl RingExtension {
         debug_assert!(self.counted_for[..] == *free, "gather follows extend");
         let (grid, cols) = (self.grid, self.grid.1);
         let (first, second) = (&self.first, &self.second);
+        if let Some((pyramid, all)) = self.pyramid.as_mut() {
+            let all = *all;
+            let target = |k: usize| !free[k] && (all || (first[k] == 0 && second[k] == 0));
+            pyramid.gather(free, target, z);
+            if all {
+                return;
+            }
+        }
         // A first-ring point holds γ₁/c times its value and what its second-ring
         // neighbours took (γ₂/c′ each; the weight is zero off the second ring) …
         self.listed.update(z, List::FirstRing, |(i, j), z| {
