@@ -303,7 +303,7 @@ mod tests {
         for (rows, cols) in [(13, 9), (16, 16), (1, 7), (33, 20)] {
             let n = rows * cols;
             let free: Vec<bool> = (0..n).map(|_| random(&mut state) > 0.2).collect();
-            let target = |k: usize| !free[k] && k % 3 != 0;
+            let target = |k: usize| !free[k] && !k.is_multiple_of(3);
             let mut pyramid = Pyramid::new(rows, cols, 0.9, 0.5);
             pyramid.count(&free);
             let x: Vec<f64> = (0..n)
