@@ -3,6 +3,7 @@
 # toolchain, Python >= 3.9 and pip (network to PyPI and crates.io).
 #
 #   python/ci.sh            # from anywhere; PYTHON=python3.12 python/ci.sh to pick one
+#   python/ci.sh --deps-only   # steps 1-2 only (.ci/run downloads them while Rust compiles)
 #
 # 1. a virtual environment python/.venv (git-ignored; reused when present);
 # 2. the build and test dependencies from PyPI: maturin, numpy, pytest, matplotlib, scipy
@@ -21,6 +22,13 @@ repo="$(dirname "$here")"
 python="${PYTHON:-python3}"
 venv="$here/.venv"
 start=$(date +%s)
+deps_only=0
+for arg in "$@"; do
+    case "$arg" in
+    --deps-only) deps_only=1 ;;
+    *) echo "usage: python/ci.sh [--deps-only]" >&2 && exit 2 ;;
+    esac
+done
 
 if [ ! -x "$venv/bin/python" ]; then
     "$python" -m venv "$venv"
@@ -28,6 +36,10 @@ fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 "$venv/bin/python" -m pip install --quiet "maturin>=1.16,<2" numpy pytest matplotlib \
     scipy xarray ContactMechanics SurfaceTopography
+if [ "$deps_only" = 1 ]; then
+    echo "python/ci.sh: test dependencies in $venv after $(( $(date +%s) - start )) s" >&2
+    exit 0
+fi
 
 # The CLI the tests compare with: ASPERITY_BIN where given (.ci/run passes the binary its
 # Rust tests built), else a release build here.
