@@ -372,21 +372,60 @@ pub(crate) fn metres_per(format: &'static str, what: &str, unit: &str) -> Result
     })
 }
 
-/// Reverses the order of the rows of a map (a flip upside down).
+/// Reverses the order of the rows of a map (a flip upside down), in place (rows swapped
+/// pairwise) when the map is in standard layout, so a reader never holds it twice.
 pub(crate) fn flip_rows(a: &mut Array2<f64>) {
-    a.invert_axis(ndarray::Axis(0));
-    *a = a.as_standard_layout().into_owned();
+    let cols = a.ncols();
+    match a.as_slice_mut() {
+        Some(v) if cols > 0 => {
+            let rows = v.len() / cols;
+            for i in 0..rows / 2 {
+                let (top, bottom) = v.split_at_mut((rows - 1 - i) * cols);
+                top[i * cols..(i + 1) * cols].swap_with_slice(&mut bottom[..cols]);
+            }
+        }
+        Some(_) => {}
+        None => {
+            a.invert_axis(ndarray::Axis(0));
+            *a = a.as_standard_layout().into_owned();
+        }
+    }
 }
 
-/// Reverses the order of the columns of a map (a left-right mirror).
+/// Reverses the order of the columns of a map (a left-right mirror), in place when the
+/// map is in standard layout.
 pub(crate) fn flip_cols(a: &mut Array2<f64>) {
-    a.invert_axis(ndarray::Axis(1));
-    *a = a.as_standard_layout().into_owned();
+    let cols = a.ncols();
+    match a.as_slice_mut() {
+        Some(v) if cols > 0 => v.chunks_exact_mut(cols).for_each(|row| row.reverse()),
+        Some(_) => {}
+        None => {
+            a.invert_axis(ndarray::Axis(1));
+            *a = a.as_standard_layout().into_owned();
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn flips_in_place_match_the_reversed_views() {
+        // Odd and even row counts, a single row and column, and a map not in standard
+        // layout (a transposed view), against ndarray's reversed views copied.
+        for (rows, cols) in [(5, 3), (4, 6), (1, 4), (3, 1)] {
+            let a = Array2::from_shape_fn((rows, cols), |(i, j)| (i * 10 + j) as f64);
+            for m in [a.clone(), a.t().to_owned(), a.t().into_owned()] {
+                let mut r = m.clone();
+                flip_rows(&mut r);
+                assert_eq!(r, m.slice(ndarray::s![..;-1, ..]));
+                let mut c = m.clone();
+                flip_cols(&mut c);
+                assert_eq!(c, m.slice(ndarray::s![.., ..;-1]));
+            }
+        }
+    }
 
     #[test]
     fn cursor_reads_both_byte_orders_and_stops_at_the_end() {

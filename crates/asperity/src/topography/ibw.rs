@@ -191,9 +191,15 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     };
     let names = layer_names(bytes, &s, layers);
     let mut channels = Vec::with_capacity(layers);
-    for (layer, name) in values.chunks_exact(n).zip(names) {
-        let scaled = layer.iter().map(|v| v * metres.unwrap_or(1.0)).collect();
-        let mut heights = areal(FORMAT, ny, nx, scaled)?;
+    // One layer (the usual image) is scaled in place, several are split into copies.
+    let layers_values: Vec<Vec<f64>> = if layers == 1 {
+        vec![values]
+    } else {
+        values.chunks_exact(n).map(<[f64]>::to_vec).collect()
+    };
+    for (mut layer, name) in layers_values.into_iter().zip(names) {
+        layer.iter_mut().for_each(|v| *v *= metres.unwrap_or(1.0));
+        let mut heights = areal(FORMAT, ny, nx, layer)?;
         flip_rows(&mut heights);
         channels.push(Channel {
             name,

@@ -112,7 +112,12 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
         tiff::check_strips(FORMAT, bytes, p)?;
     }
     let (rows, cols, values) = tiff::raster(FORMAT, bytes, e, page)?;
-    let map = super::bytes::areal(FORMAT, rows, cols, values.iter().map(|v| v * dz).collect())?;
+    let map = super::bytes::areal(
+        FORMAT,
+        rows,
+        cols,
+        values.into_iter().map(|v| v * dz).collect(),
+    )?;
     Ok(height_reading(
         FORMAT,
         "Height",

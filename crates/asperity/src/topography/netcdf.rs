@@ -297,7 +297,8 @@ fn channel(
             * scale;
         // `heights(x, y)` is x-major: our rows are y, the transpose.
         if dim_names[0] == "x" {
-            let t = a.t().as_standard_layout().into_owned();
+            // In place (tile by tile): the map is never held twice.
+            let t = super::hdf5::into_transposed(a);
             (Heights::Areal(t), [length(coords[0]), length(coords[1])])
         } else {
             (Heights::Areal(a), [length(coords[1]), length(coords[0])])

@@ -189,17 +189,22 @@ fn raster(bytes: &[u8], b: &Block, factor: f64) -> Result<Array2<f64>> {
             format!("array `{}` is longer than its block", b.name),
         ));
     }
-    let values = samples(FORMAT, bytes, c.pos(), n, sample, LE)?;
-    let (nx, ny) = (usize::from(nx), usize::from(ny));
-    // Stored [x][y]; ours is (row, col) = (y, x) with y reversed.
-    Ok(Array2::from_shape_fn((ny, nx), |(y, x)| {
-        let v = values[x * ny + (ny - 1 - y)];
-        if v.is_finite() && v < limit {
-            v * factor
+    let mut values = samples(FORMAT, bytes, c.pos(), n, sample, LE)?;
+    for v in &mut values {
+        *v = if v.is_finite() && *v < limit {
+            *v * factor
         } else {
             f64::NAN
-        }
-    }))
+        };
+    }
+    let (nx, ny) = (usize::from(nx), usize::from(ny));
+    // Stored [x][y]; ours is (row, col) = (y, x) with y reversed: the transpose, its rows
+    // reversed, both in place (the map is never held twice).
+    let stored =
+        Array2::from_shape_vec((nx, ny), values).map_err(|e| bad(FORMAT, e.to_string()))?;
+    let mut map = super::hdf5::into_transposed(stored);
+    super::bytes::flip_rows(&mut map);
+    Ok(map)
 }
 
 #[cfg(test)]

@@ -71,14 +71,14 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     let (dx, dy, dz) = (c.u32(le)?, c.u32(le)?, c.u32(le)?);
     let mut channels = Vec::new();
     for (k, &offset) in table[3..6].iter().enumerate() {
-        if let Some((map, depth)) = image(bytes, offset)? {
-            let map = map.mapv(|v| v / f64::powi(2.0, depth as i32));
+        if let Some((mut map, depth)) = image(bytes, offset)? {
+            map.mapv_inplace(|v| v / f64::powi(2.0, depth as i32));
             channels.push(channel(format!("Intensity {k}"), map, [dx, dy], None));
         }
     }
     for (k, &offset) in table[6..9].iter().enumerate() {
-        if let Some((map, _)) = image(bytes, offset)? {
-            let map = map.mapv(|v| v * f64::from(dz) * PM);
+        if let Some((mut map, _)) = image(bytes, offset)? {
+            map.mapv_inplace(|v| v * f64::from(dz) * PM);
             channels.push(channel(format!("Height {k}"), map, [dx, dy], Some("pm")));
         }
     }

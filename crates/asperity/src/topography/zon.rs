@@ -75,7 +75,8 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     let per_pixel = calibration(&doc, "XYCalibration", "MeterPerPixel")?;
     let per_unit = calibration(&doc, "ZCalibration", "MeterPerUnit")?;
     let heights = unpacked(&mut archive, HEIGHTS, zstd, |r| grid(r, HEIGHTS, 4))?;
-    let mut map = counts(&heights)?.mapv(|v| v * per_unit);
+    let mut map = counts(&heights)?;
+    map.mapv_inplace(|v| v * per_unit);
     if zipped::has(&archive, VALID) {
         let mask = unpacked(&mut archive, VALID, zstd, |r| grid(r, VALID, 1))?;
         apply_mask(&mut map, &mask)?;
