@@ -18,6 +18,9 @@ use common::{asperity, ok, stderr};
 
 /// Runs the binary with `args` in `dir` (output discarded) and returns its peak resident
 /// set in bytes; panics, with the run's stderr, if it fails.
+// The child is reaped by `wait4` below (which also gives its peak), not by `Child::wait`,
+// which clippy's zombie_processes lint looks for.
+#[allow(clippy::zombie_processes)]
 fn peak_bytes(args: &[&str], dir: &Path) -> u64 {
     let child = Command::new(env!("CARGO_BIN_EXE_asperity"))
         .args(args)
