@@ -132,6 +132,35 @@ fn dimensions(c: &mut Cursor, e: Endian) -> Result<[usize; 4]> {
 }
 
 /// Reads a version-5 binary wave (see the module docs).
+/// Refuses a file whose header's blocks run past its end, or whose wave record is shorter
+/// than the `total` samples of `sample` it declares.
+fn check_blocks(bytes: &[u8], s: &Sizes, total: usize, sample: Sample) -> Result<()> {
+    let declared = [
+        s.wave,
+        s.before_labels,
+        s.labels.iter().sum(),
+        s.after_labels,
+    ]
+    .iter()
+    .try_fold(BIN_HEADER, |acc, &b| acc.checked_add(b));
+    if declared.is_none_or(|end| end > bytes.len()) {
+        return Err(bad(
+            FORMAT,
+            "truncated: the header's blocks run past the end of the file",
+        ));
+    }
+    if total
+        .checked_mul(sample.size())
+        .is_none_or(|d| d + 320 > s.wave)
+    {
+        return Err(bad(
+            FORMAT,
+            "the wave record is shorter than the data its header declares",
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     if !sniff(bytes) {
         return Err(bad(FORMAT, "not an Igor binary wave of version 5"));
@@ -159,29 +188,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Reading> {
     let total = n
         .checked_mul(layers)
         .ok_or_else(|| bad(FORMAT, "the wave is too large"))?;
-    let declared = [
-        s.wave,
-        s.before_labels,
-        s.labels.iter().sum(),
-        s.after_labels,
-    ]
-    .iter()
-    .try_fold(BIN_HEADER, |acc, &b| acc.checked_add(b));
-    if declared.is_none_or(|end| end > bytes.len()) {
-        return Err(bad(
-            FORMAT,
-            "truncated: the header's blocks run past the end of the file",
-        ));
-    }
-    if total
-        .checked_mul(sample.size())
-        .is_none_or(|d| d + 320 > s.wave)
-    {
-        return Err(bad(
-            FORMAT,
-            "the wave record is shorter than the data its header declares",
-        ));
-    }
+    check_blocks(bytes, &s, total, sample)?;
     let values = samples(FORMAT, bytes, DATA, total, sample, e)?;
     let metres = length_unit(&data_unit).map(|(_, f)| f);
     let size = |k: usize| {
